@@ -1,0 +1,91 @@
+// zhc — baked-lighting codecs for asset pipelines. See README.md.
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <vector>
+
+#include "cli.h"
+
+namespace zhc::cli {
+
+namespace {
+struct Verb {
+    int order;
+    VerbSetup setup;
+};
+std::vector<Verb>& verbs() {
+    static std::vector<Verb> v;
+    return v;
+}
+}  // namespace
+
+VerbRegistration::VerbRegistration(int order, VerbSetup setup) { verbs().push_back({order, std::move(setup)}); }
+
+int exit_code_for(const Error& error) {
+    switch (error.code) {
+        case ErrorCode::kInvalidArgument: return kExitUsage;
+        case ErrorCode::kIoError: return kExitInputUnreadable;
+        case ErrorCode::kBadFormat:
+        case ErrorCode::kTruncated:
+        case ErrorCode::kTrailingBytes:
+        case ErrorCode::kChecksum:
+        case ErrorCode::kInvalidValue: return kExitInvalidInput;
+        case ErrorCode::kUnsupported: return kExitUnsupported;
+        case ErrorCode::kTooLarge: return kExitTooLarge;
+        case ErrorCode::kInternal: return kExitInternal;
+    }
+    return kExitInternal;
+}
+
+int report(const Error& error) {
+    std::fprintf(stderr, "zhc: error: %s\n", error.message.c_str());
+    return exit_code_for(error);
+}
+
+int report_output(const Error& error) {
+    std::fprintf(stderr, "zhc: error: %s\n", error.message.c_str());
+    return kExitOutputFailed;
+}
+
+}  // namespace zhc::cli
+
+int main(int argc, char** argv) {
+    using namespace zhc::cli;
+    CLI::App app{"zhc — compress and transcode baked lighting (SH3, ZH3, quantised probes, lightmaps)", "zhc"};
+    app.set_version_flag("--version", std::string("zhc ") + ZHC_VERSION);
+    app.require_subcommand(1);
+    app.footer("Run 'zhc VERB --help' for a verb's options. Exit codes: see README.md.");
+
+    auto& registered = verbs();
+    std::stable_sort(registered.begin(), registered.end(), [](const Verb& a, const Verb& b) { return a.order < b.order; });
+    std::vector<std::function<int()>> runners;
+    for (const Verb& v : registered) runners.push_back(v.setup(app));
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::fprintf(stderr, "zhc: error: %s\n", e.what());
+        std::fprintf(stderr, "Run 'zhc --help' for usage.\n");
+        return kExitUsage;
+    }
+    // Each setup adds exactly one top-level subcommand, in `registered` order; run the parsed one.
+    const auto all = app.get_subcommands({});
+    for (size_t i = 0; i < all.size() && i < runners.size(); ++i) {
+        if (all[i]->parsed()) {
+            try {
+                return runners[i]();
+            } catch (const std::exception& e) {
+                std::fprintf(stderr, "zhc: internal error: %s\n", e.what());
+                return kExitInternal;
+            }
+        }
+    }
+    std::fprintf(stderr, "zhc: error: no verb given; run 'zhc --help'\n");
+    return kExitUsage;
+}

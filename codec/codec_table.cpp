@@ -1,0 +1,41 @@
+// The codec table: concatenation of each module's entries, built once.
+#include <cstring>
+#include <vector>
+
+#include "codec.h"
+
+namespace zhc {
+
+std::span<const Codec> codecs() {
+    static const std::vector<Codec> table = [] {
+        std::vector<Codec> all;
+        for (auto part : {core_codecs(), zh3_codecs(), dering_codecs(), quantized_codecs()})
+            all.insert(all.end(), part.begin(), part.end());
+        return all;
+    }();
+    return table;
+}
+
+const Codec* find_codec(std::string_view name) {
+    for (const Codec& c : codecs())
+        if (c.name == name) return &c;
+    return nullptr;
+}
+
+void store_floats(std::span<const float> values, std::uint8_t* out) {
+    for (size_t i = 0; i < values.size(); ++i) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &values[i], 4);
+        for (int b = 0; b < 4; ++b) out[i * 4 + static_cast<size_t>(b)] = static_cast<std::uint8_t>(bits >> (8 * b));
+    }
+}
+
+void load_floats(const std::uint8_t* in, std::span<float> values) {
+    for (size_t i = 0; i < values.size(); ++i) {
+        std::uint32_t bits = 0;
+        for (int b = 0; b < 4; ++b) bits |= std::uint32_t(in[i * 4 + static_cast<size_t>(b)]) << (8 * b);
+        std::memcpy(&values[i], &bits, 4);
+    }
+}
+
+}  // namespace zhc

@@ -1,0 +1,61 @@
+// zhc/codec/status.h — error values returned across zhc's library APIs (never exceptions).
+//
+// Every failure carries a stable code and a one-line message naming the file (when there is
+// one), what is wrong and where (field, byte offset). The CLI maps codes to exit codes
+// (README "Exit codes").
+#pragma once
+
+#include <string>
+#include <utility>
+#include <variant>
+
+namespace zhc {
+
+enum class ErrorCode {
+    kInvalidArgument,  // the caller's mistake: bad option, unknown representation name
+    kIoError,          // file missing, unreadable, not writable
+    kBadFormat,        // not the format it claims to be: bad magic, malformed header or field
+    kTruncated,        // ends before the data it declares
+    kTrailingBytes,    // data after the declared end
+    kChecksum,         // stored checksum does not match
+    kUnsupported,      // well-formed but uses a feature/version zhc does not support
+    kTooLarge,         // declared sizes exceed zhc's limits (checked before allocating)
+    kInvalidValue,     // NaN/Inf or otherwise unusable numbers in the data
+    kInternal,         // a bug in zhc
+};
+
+const char* error_code_name(ErrorCode code);
+
+struct Error {
+    ErrorCode code = ErrorCode::kInternal;
+    std::string message;  // one line: "<file>: <what is wrong> (<where>)"
+};
+
+// A value or an Error. Small on purpose: std::expected is C++23 and clang 14 (the fuzzers'
+// compiler) cannot use libstdc++'s.
+template <class T>
+class Result {
+public:
+    Result(T value) : v_(std::move(value)) {}
+    Result(Error error) : v_(std::move(error)) {}
+    bool ok() const { return v_.index() == 0; }
+    explicit operator bool() const { return ok(); }
+    T& value() & { return std::get<0>(v_); }
+    const T& value() const& { return std::get<0>(v_); }
+    T&& value() && { return std::get<0>(std::move(v_)); }
+    T* operator->() { return &std::get<0>(v_); }
+    const T* operator->() const { return &std::get<0>(v_); }
+    T& operator*() & { return std::get<0>(v_); }
+    const T& operator*() const& { return std::get<0>(v_); }
+    const Error& error() const { return std::get<1>(v_); }
+
+private:
+    std::variant<T, Error> v_;
+};
+
+struct Ok {};
+using Status = Result<Ok>;
+
+inline Error make_error(ErrorCode code, std::string message) { return Error{code, std::move(message)}; }
+
+}  // namespace zhc

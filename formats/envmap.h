@@ -1,0 +1,61 @@
+// zhc/formats/envmap.h — environment maps: OpenEXR and Radiance .hdr in, OpenEXR out.
+//
+// Orientation (also in codec/sh.h and the README): a latitude-longitude map, row 0 at the top
+// (+Z, zhc is Z-up), the centre column looking along +X, longitude decreasing left to right:
+//   phi = pi (1 - 2 (col + 0.5) / W),  theta = pi (row + 0.5) / H,
+//   direction = (sin theta cos phi, sin theta sin phi, cos theta).
+// That is OpenEXR's Imf::LatLongMap orientation with (x, y, z)_zhc = (z, x, y)_OpenEXR.
+// Any width and height are accepted (not only 2:1).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "codec/status.h"
+
+namespace zhc {
+
+// An owning RGB float image, interleaved, rows top to bottom.
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<float> rgb;  // width * height * 3
+    float* row(int y) { return rgb.data() + static_cast<size_t>(y) * static_cast<size_t>(width) * 3; }
+    const float* row(int y) const { return rgb.data() + static_cast<size_t>(y) * static_cast<size_t>(width) * 3; }
+};
+
+enum class NonFinitePolicy {
+    kReject,       // default: NaN/Inf pixels are an error naming the first one
+    kReplaceZero,  // replace each non-finite channel value by 0 and count them
+};
+
+struct EnvmapReadOptions {
+    std::uint64_t max_pixels = std::uint64_t(1) << 26;  // 8192 x 8192; checked before allocating
+    std::uint64_t max_file_bytes = std::uint64_t(2) << 30;
+    NonFinitePolicy non_finite = NonFinitePolicy::kReject;
+};
+
+struct EnvmapInfo {
+    std::string format;       // "openexr" or "radiance-hdr"
+    std::string compression;  // EXR compression name, "rle" or "flat" for .hdr
+    std::string channels;     // e.g. "RGBA half"
+    std::uint64_t replaced_non_finite = 0;
+};
+
+// Reads an EXR (RGB or RGBA or Y, half/float/uint, any compression OpenEXR supports, scanline or
+// tiled) or a Radiance .hdr, detected by its magic bytes (not by the extension).
+Result<Image> read_envmap(const std::string& path, const EnvmapReadOptions& options = {},
+                          EnvmapInfo* info = nullptr);
+// The same from bytes in memory; `name` is used in messages. Safe for untrusted input.
+Result<Image> read_envmap_memory(std::span<const std::uint8_t> bytes, const std::string& name,
+                                 const EnvmapReadOptions& options = {}, EnvmapInfo* info = nullptr);
+
+// True when the bytes start like an EXR or a Radiance file.
+bool looks_like_envmap(std::span<const std::uint8_t> bytes);
+
+// Writes a float RGB OpenEXR (ZIP compression), atomically.
+Status write_exr(const std::string& path, const Image& image);
+
+}  // namespace zhc

@@ -1,0 +1,89 @@
+#include "file_io.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+namespace zhc {
+
+namespace fs = std::filesystem;
+
+Result<std::vector<std::uint8_t>> read_file_bytes(const std::string& path, std::uint64_t max_bytes) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (ec || !fs::exists(st)) return make_error(ErrorCode::kIoError, path + ": no such file");
+    if (fs::is_directory(st)) return make_error(ErrorCode::kIoError, path + ": is a directory, not a file");
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return make_error(ErrorCode::kIoError, path + ": cannot open (" + std::strerror(errno) + ")");
+    std::vector<std::uint8_t> bytes;
+    // Read in chunks: works for pipes and special files whose size is unknown, and never
+    // allocates more than max_bytes + one chunk.
+    std::uint8_t chunk[1 << 16];
+    for (;;) {
+        const size_t n = std::fread(chunk, 1, sizeof chunk, f);
+        if (n > 0) {
+            if (bytes.size() + n > max_bytes) {
+                std::fclose(f);
+                return make_error(ErrorCode::kTooLarge, path + ": file larger than the limit of " +
+                                                            std::to_string(max_bytes) + " bytes");
+            }
+            bytes.insert(bytes.end(), chunk, chunk + n);
+        }
+        if (n < sizeof chunk) break;
+    }
+    const bool failed = std::ferror(f) != 0;
+    std::fclose(f);
+    if (failed) return make_error(ErrorCode::kIoError, path + ": read error");
+    return bytes;
+}
+
+namespace {
+std::string temporary_name_for(const std::string& path) {
+    std::random_device rd;
+    char suffix[32];
+    std::snprintf(suffix, sizeof suffix, ".tmp-%d-%08x", static_cast<int>(::getpid()), rd());
+    return path + suffix;
+}
+}  // namespace
+
+Status write_via_temporary(const std::string& path, const std::function<Status(const std::string&)>& writer) {
+    const std::string tmp = temporary_name_for(path);
+    Status st = writer(tmp);
+    std::error_code ec;
+    if (!st) {
+        fs::remove(tmp, ec);
+        return st;
+    }
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        return make_error(ErrorCode::kIoError, path + ": cannot write (" + ec.message() + ")");
+    }
+    return Ok{};
+}
+
+Status write_file_atomic(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    return write_via_temporary(path, [&](const std::string& tmp) -> Status {
+        std::FILE* f = std::fopen(tmp.c_str(), "wb");
+        if (!f) return make_error(ErrorCode::kIoError, path + ": cannot create (" + std::strerror(errno) + ")");
+        const bool ok = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+        const bool flushed = std::fflush(f) == 0;
+        const bool closed = std::fclose(f) == 0;
+        if (!ok || !flushed || !closed) return make_error(ErrorCode::kIoError, path + ": write failed");
+        return Ok{};
+    });
+}
+
+std::string file_extension(const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    return ext;
+}
+
+}  // namespace zhc

@@ -1,0 +1,152 @@
+#include "support.h"
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace zhc::test {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> envmap_paths() {
+    std::vector<std::string> out;
+    for (const char* name : {"city", "courtyard", "forest", "interior", "night", "studio", "sunrise", "sunset"})
+        out.push_back(std::string(ZHC_ENVMAP_DIR) + "/" + name + ".exr");
+    return out;
+}
+
+Image load_envmap(const std::string& path) {
+    auto img = read_envmap(path);
+    if (!img) {
+        ADD_FAILURE() << "cannot load sample map (run the README's test command, which fetches them): "
+                      << img.error().message;
+        return {};
+    }
+    return std::move(img).value();
+}
+
+std::string envmap_name(const std::string& path) { return fs::path(path).stem().string(); }
+
+std::vector<Vec3> fibonacci_directions(int n) {
+    std::vector<Vec3> out;
+    out.reserve(static_cast<size_t>(n));
+    const double golden = kPi * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < n; ++i) {
+        const double z = 1.0 - (2.0 * i + 1.0) / n;
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        out.push_back({r * std::cos(golden * i), r * std::sin(golden * i), z});
+    }
+    return out;
+}
+
+Vec3 uniform_direction(double u1, double u2) {
+    const double z = 1.0 - 2.0 * u1, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u2;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+Sh3Radiance project_latlong_reference(const Image& img, int sub) {
+    // Each pixel split into sub x sub sub-pixels, each contributing value * Y(centre) * its exact
+    // solid angle (a lat-long map of sub-times the resolution, nearest-sampled).
+    double acc[9][3] = {};
+    const int sw = img.width * sub, sh = img.height * sub;
+    for (int y = 0; y < sh; ++y) {
+        const double w = latlong_pixel_solid_angle(y, sw, sh);
+        for (int x = 0; x < sw; ++x) {
+            const auto basis = sh3_basis(latlong_direction(x, y, sw, sh));
+            const float* p = img.row(y / sub) + (x / sub) * 3;
+            for (int i = 0; i < 9; ++i)
+                for (int k = 0; k < 3; ++k) acc[i][k] += w * p[k] * basis[static_cast<size_t>(i)];
+        }
+    }
+    Sh3Radiance out;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) out[i][k] = static_cast<float>(acc[i][k]);
+    return out;
+}
+
+Rgb integrate_irradiance(const Image& img, Vec3 n) {
+    double acc[3] = {};
+    for (int y = 0; y < img.height; ++y) {
+        const double w = latlong_pixel_solid_angle(y, img.width, img.height);
+        for (int x = 0; x < img.width; ++x) {
+            const double c = dot(n, latlong_direction(x, y, img.width, img.height));
+            if (c <= 0) continue;
+            const float* p = img.row(y) + x * 3;
+            for (int k = 0; k < 3; ++k) acc[k] += w * c * p[k];
+        }
+    }
+    return {static_cast<float>(acc[0] / kPi), static_cast<float>(acc[1] / kPi), static_cast<float>(acc[2] / kPi)};
+}
+
+Image downsample_latlong(const Image& img, int f) {
+    Image out;
+    out.width = img.width / f;
+    out.height = img.height / f;
+    out.rgb.assign(static_cast<size_t>(out.width) * out.height * 3, 0.0f);
+    for (int y = 0; y < out.height; ++y) {
+        const double big = latlong_pixel_solid_angle(y, out.width, out.height);
+        for (int x = 0; x < out.width; ++x) {
+            double acc[3] = {};
+            for (int sy = 0; sy < f; ++sy) {
+                const double w = latlong_pixel_solid_angle(y * f + sy, img.width, img.height);
+                for (int sx = 0; sx < f; ++sx) {
+                    const float* p = img.row(y * f + sy) + (x * f + sx) * 3;
+                    for (int k = 0; k < 3; ++k) acc[k] += w * p[k];
+                }
+            }
+            for (int k = 0; k < 3; ++k) out.row(y)[x * 3 + k] = static_cast<float>(acc[k] / big);
+        }
+    }
+    return out;
+}
+
+namespace {
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+std::string slurp(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+}  // namespace
+
+CommandResult run_zhc(const std::vector<std::string>& args) {
+    static int counter = 0;
+    const std::string dir = temp_dir("cli_runs");
+    const std::string base = dir + "/run" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
+    std::string cmd = quote(ZHC_CLI_PATH);
+    for (const auto& a : args) cmd += " " + quote(a);
+    cmd += " > " + quote(base + ".out") + " 2> " + quote(base + ".err") + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    CommandResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = slurp(base + ".out");
+    r.err = slurp(base + ".err");
+    return r;
+}
+
+std::string temp_dir(const std::string& name) {
+    const fs::path p = fs::temp_directory_path() / ("zhc_tests_" + std::to_string(::getuid())) / name;
+    std::error_code ec;
+    fs::create_directories(p, ec);
+    return p.string();
+}
+
+void write_bytes(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::vector<std::uint8_t> read_bytes(const std::string& path) {
+    const std::string s = slurp(path);
+    return {s.begin(), s.end()};
+}
+
+}  // namespace zhc::test

@@ -1,0 +1,64 @@
+// Shared test helpers: sample maps, direction sets, slow reference implementations, CLI runner.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "codec/sh.h"
+#include "formats/envmap.h"
+
+namespace zhc::test {
+
+// The eight CC0 sample maps (../shared/data/envmaps, or the copy the setup script fetched).
+std::vector<std::string> envmap_paths();
+// Loads one; fails the test (ASSERT) if it cannot.
+Image load_envmap(const std::string& path);
+std::string envmap_name(const std::string& path);
+
+// n directions spread uniformly over the sphere (spherical Fibonacci lattice).
+std::vector<Vec3> fibonacci_directions(int n);
+// Uniform random unit vector from two uniforms in [0, 1).
+Vec3 uniform_direction(double u1, double u2);
+
+// Slow, obviously-correct twin of project_latlong: evaluates all nine basis functions at the
+// centres of sub x sub sub-pixels of every pixel, times their exact solid angles.
+Sh3Radiance project_latlong_reference(const Image& img, int sub = 1);
+// Irradiance at n by direct integration of the map: (1/pi) sum L max(0, n.w) dw.
+Rgb integrate_irradiance(const Image& img, Vec3 n);
+// A box downsample that keeps total flux (solid-angle weighted), by integer factors.
+Image downsample_latlong(const Image& img, int factor);
+
+// A lat-long image whose pixels are a function of direction.
+template <class F>
+Image render_latlong(int w, int h, F&& radiance_of_direction) {
+    Image img;
+    img.width = w;
+    img.height = h;
+    img.rgb.resize(static_cast<size_t>(w) * h * 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const Rgb c = radiance_of_direction(latlong_direction(x, y, w, h));
+            float* p = img.row(y) + x * 3;
+            p[0] = c.r;
+            p[1] = c.g;
+            p[2] = c.b;
+        }
+    return img;
+}
+
+struct CommandResult {
+    int exit_code = -1;
+    std::string out;
+    std::string err;
+};
+// Runs the zhc binary with the given arguments (shell-quoted here), capturing output.
+CommandResult run_zhc(const std::vector<std::string>& args);
+
+// A fresh empty directory under the build tree for one test.
+std::string temp_dir(const std::string& name);
+void write_bytes(const std::string& path, const std::vector<std::uint8_t>& bytes);
+std::vector<std::uint8_t> read_bytes(const std::string& path);
+
+}  // namespace zhc::test
