@@ -1,5 +1,727 @@
-// ZH3 representations — to be filled by the ZH3 work (issue 3).
-#include "codec.h"
+// ZH3 representations: fit (Eq. 9/10), luminance axis (Sec. 3.2), BFGS axis solve (Sec. 3.3,
+// Eq. 11, App. C), hallucination (Sec. 3.4, Listing 1) and ZH3 deringing (App. B).
+//
+// Source: Roughton, Sloan, Silvennoinen, Iwanicki, Shirley, "ZH3: Quadratic Zonal Harmonics",
+// I3D 2024. Derivations redone in docs/zh3.md (Eq. 11 gradient, Eq. 20, the App. B interval).
+//
+// Vector form of the bands used throughout (sh.h conventions): the L1 band of a channel,
+// (f1-1, f10, f11), is the vector v = (-f11, -f1-1, f10) with f1(d) = kY1 v . d; |v| = |f1| and
+// the optimal linear direction is v / |v|. The L2 band evaluated at a unit direction a is
+// Y2(a) . f2 = a^T Q a for a traceless symmetric Q.
+#include "zh3.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 namespace zhc {
-std::span<const Codec> zh3_codecs() { return {}; }
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// |Y2(a)|^2 = 5 / (4 pi) on the unit sphere (Eq. 8/9).
+const double kFourPiOverFive = 4.0 * kPi / 5.0;
+const double kSqrtFourPiOverFive = std::sqrt(4.0 * kPi / 5.0);
+const double kSqrt3 = std::sqrt(3.0);
+
+Vec3 l1_vector(const Rgb* c, int k) { return {-double(c[3][k]), -double(c[1][k]), double(c[2][k])}; }
+// Inverse of l1_vector: writes (f1-1, f10, f11) of channel k.
+void set_l1(Rgb* c, int k, Vec3 v) {
+    c[1][k] = static_cast<float>(-v.y);
+    c[2][k] = static_cast<float>(v.z);
+    c[3][k] = static_cast<float>(-v.x);
+}
+
+std::array<double, 5> y2(Vec3 a) {
+    return {kY2 * a.x * a.y, -kY2 * a.y * a.z, kY20 * (3.0 * a.z * a.z - 1.0), -kY2 * a.x * a.z,
+            kY22 * (a.x * a.x - a.y * a.y)};
+}
+double dot5(const std::array<double, 5>& a, const double* b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4];
+}
+// J_Y2^T r: gradient with respect to a of Y2(a) . r (App. C Eq. 28, the Cartesian polynomials).
+Vec3 y2_jacobian_t(Vec3 a, const double* r) {
+    return {kY2 * a.y * r[0] - kY2 * a.z * r[3] + 2.0 * kY22 * a.x * r[4],
+            kY2 * a.x * r[0] - kY2 * a.z * r[1] - 2.0 * kY22 * a.y * r[4],
+            -kY2 * a.y * r[1] + 6.0 * kY20 * a.z * r[2] - kY2 * a.x * r[3]};
+}
+
+Vec3 luminance_l1(const Rgb* c, const LuminanceWeights& w) {
+    return w.r * l1_vector(c, 0) + w.g * l1_vector(c, 1) + w.b * l1_vector(c, 2);
+}
+
+// Axis source vector of channel k (not normalised).
+Vec3 axis_source(const Rgb* c, ZonalAxisMode mode, int k, const LuminanceWeights& w) {
+    return mode == ZonalAxisMode::kLuminance ? luminance_l1(c, w) : l1_vector(c, k);
+}
+
+bool usable_length(double len) { return len > 0.0 && std::isfinite(len); }
+
+// ---- the solve's target in irradiance vector form ------------------------------------------
+
+struct Target {
+    Vec3 t1[3];       // irradiance L1 per channel (vector form)
+    double t2[3][5];  // irradiance L2 per channel
+    double t2sq[3];   // |t2_k|^2
+    double t1sq[3];
+    double t0[3];     // irradiance DC
+};
+
+Target make_target(const Sh3Radiance& sh) {
+    Target t;
+    for (int k = 0; k < 3; ++k) {
+        t.t0[k] = sh[0][k];
+        t.t1[k] = kIrradianceBandScale[1] * l1_vector(sh.c.data(), k);
+        t.t1sq[k] = dot(t.t1[k], t.t1[k]);
+        t.t2sq[k] = 0;
+        for (int m = 0; m < 5; ++m) {
+            t.t2[k][m] = kIrradianceBandScale[2] * sh[4 + m][k];
+            t.t2sq[k] += t.t2[k][m] * t.t2[k][m];
+        }
+    }
+    return t;
+}
+
+// L2 part of Eq. 11 for channel k along unit axis a: |t2|^2 - (4 pi/5) (Y2(a) . t2)^2 (the residual
+// of the orthogonal projection of t2 onto Y2(a), since |Y2(a)|^2 = 5 / (4 pi)).
+double l2_residual(const Target& t, int k, Vec3 a) {
+    const double h = dot5(y2(a), t.t2[k]);
+    return t.t2sq[k] - kFourPiOverFive * h * h;
+}
+
+// Eq. 11 for the shared axis, x = nine irradiance L1 coefficients in vector form (x[3k + j] is
+// component j of channel k's vector). The gradient is App. C Eq. 27 simplified: the L2 residual
+// r_k = (4 pi/5) h_k q - t2_k is orthogonal to q (|q|^2 = 5/(4 pi)), so of Eq. 27's second factor
+// only -(8 pi/5) h_k t2_k^T J_Y2 J_A survives; J_A = w_k (I - a a^T) / |v| (Eq. 33-36; the sign
+// permutation of Eq. 35 is absorbed by working in vector form).
+double lum_objective_vec(const Target& t, const double w[3], const double* x, double* grad) {
+    Vec3 v{};
+    for (int k = 0; k < 3; ++k) v = v + w[k] * Vec3{x[3 * k], x[3 * k + 1], x[3 * k + 2]};
+    const double len = length(v);
+    if (!usable_length(len)) return kInf;
+    const Vec3 a = (1.0 / len) * v;
+    const auto q = y2(a);
+    double e = 0, r[5] = {0, 0, 0, 0, 0};
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 d{x[3 * k] - t.t1[k].x, x[3 * k + 1] - t.t1[k].y, x[3 * k + 2] - t.t1[k].z};
+        const double h = dot5(q, t.t2[k]);
+        e += dot(d, d) + t.t2sq[k] - kFourPiOverFive * h * h;
+        for (int m = 0; m < 5; ++m) r[m] += h * t.t2[k][m];
+        if (grad) {
+            grad[3 * k] = 2.0 * d.x;
+            grad[3 * k + 1] = 2.0 * d.y;
+            grad[3 * k + 2] = 2.0 * d.z;
+        }
+    }
+    if (grad) {
+        const Vec3 de_da = (-2.0 * kFourPiOverFive) * y2_jacobian_t(a, r);
+        const Vec3 de_dv = (1.0 / len) * (de_da - dot(a, de_da) * a);
+        for (int k = 0; k < 3; ++k) {
+            grad[3 * k] += w[k] * de_dv.x;
+            grad[3 * k + 1] += w[k] * de_dv.y;
+            grad[3 * k + 2] += w[k] * de_dv.z;
+        }
+    }
+    return e;
+}
+
+// Per-channel Eq. 11 over an unnormalised axis x: L1 = projection of t1 on a, L2 = Eq. 9 fit.
+//   E(a) = |t1|^2 - (a.t1)^2 + |t2|^2 - (4 pi/5) h(a)^2.
+double channel_objective_vec(const Target& t, int k, Vec3 x, Vec3* grad) {
+    const double len = length(x);
+    if (!usable_length(len)) return kInf;
+    const Vec3 a = (1.0 / len) * x;
+    const double p = dot(a, t.t1[k]);
+    const double h = dot5(y2(a), t.t2[k]);
+    const double e = t.t1sq[k] - p * p + t.t2sq[k] - kFourPiOverFive * h * h;
+    if (grad) {
+        double r[5];
+        for (int m = 0; m < 5; ++m) r[m] = h * t.t2[k][m];
+        const Vec3 de_da = (-2.0 * p) * t.t1[k] + (-2.0 * kFourPiOverFive) * y2_jacobian_t(a, r);
+        *grad = (1.0 / len) * (de_da - dot(a, de_da) * a);
+    }
+    return e;
+}
+
+// ---- BFGS (Nocedal & Wright, Alg. 6.1) with a backtracking Armijo line search ---------------
+//
+// Few function evaluations per iteration: the full step is tried first and then shrunk by a
+// safeguarded quadratic interpolation. The initial inverse Hessian is h0 * I, rescaled after the
+// first step by s.y / y.y (N&W Eq. 6.20).
+template <int N, class F>
+int bfgs(F&& f, double* x, double* fx, int max_iterations, double gradient_tolerance, double h0) {
+    double g[N], gn[N], xn[N], p[N], s[N], y[N], hy[N];
+    double h[N][N];
+    for (int i = 0; i < N; ++i)
+        for (int j = 0; j < N; ++j) h[i][j] = i == j ? h0 : 0.0;
+    double e = f(x, g);
+    int it = 0;
+    for (; it < max_iterations; ++it) {
+        double gg = 0;
+        for (int i = 0; i < N; ++i) gg += g[i] * g[i];
+        if (!(std::sqrt(gg) > gradient_tolerance)) break;
+        double slope = 0;
+        for (int i = 0; i < N; ++i) {
+            double acc = 0;
+            for (int j = 0; j < N; ++j) acc -= h[i][j] * g[j];
+            p[i] = acc;
+            slope += acc * g[i];
+        }
+        if (!(slope < 0)) {  // lost positive definiteness: restart from steepest descent
+            for (int i = 0; i < N; ++i) {
+                for (int j = 0; j < N; ++j) h[i][j] = i == j ? h0 : 0.0;
+                p[i] = -h0 * g[i];
+            }
+            slope = -h0 * gg;
+        }
+        double step = 1.0, en = kInf;
+        bool accepted = false;
+        for (int ls = 0; ls < 12; ++ls) {
+            for (int i = 0; i < N; ++i) xn[i] = x[i] + step * p[i];
+            en = f(xn, gn);
+            if (en <= e + 1e-4 * step * slope) {
+                accepted = true;
+                break;
+            }
+            // Minimiser of the quadratic through e, slope and en, kept within [0.1, 0.5] step.
+            double next = 0.5 * step;
+            if (std::isfinite(en)) {
+                const double denom = 2.0 * (en - e - slope * step);
+                if (denom > 0) next = std::clamp(-slope * step * step / denom, 0.1 * step, 0.5 * step);
+            }
+            step = next;
+        }
+        if (!accepted) break;
+        double sy = 0, yy = 0;
+        for (int i = 0; i < N; ++i) {
+            s[i] = xn[i] - x[i];
+            y[i] = gn[i] - g[i];
+            sy += s[i] * y[i];
+            yy += y[i] * y[i];
+            x[i] = xn[i];
+            g[i] = gn[i];
+        }
+        e = en;
+        if (sy > 1e-300 && yy > 0) {
+            if (it == 0) {
+                const double scale = sy / yy;
+                for (int i = 0; i < N; ++i)
+                    for (int j = 0; j < N; ++j) h[i][j] = i == j ? scale : 0.0;
+            }
+            // H <- H - rho (Hy s^T + s (Hy)^T) + (rho^2 y^T H y + rho) s s^T
+            const double rho = 1.0 / sy;
+            double yhy = 0;
+            for (int i = 0; i < N; ++i) {
+                double acc = 0;
+                for (int j = 0; j < N; ++j) acc += h[i][j] * y[j];
+                hy[i] = acc;
+                yhy += y[i] * acc;
+            }
+            const double c = rho * rho * yhy + rho;
+            for (int i = 0; i < N; ++i)
+                for (int j = 0; j < N; ++j) h[i][j] += -rho * (hy[i] * s[j] + s[i] * hy[j]) + c * s[i] * s[j];
+        }
+    }
+    *fx = e;
+    return it;
+}
+
+// ---- start axes -------------------------------------------------------------------------------
+
+// Traceless symmetric Q with Y2(d) . f2 = d^T Q d on the unit sphere (3z^2 - 1 = 2z^2 - x^2 - y^2).
+void l2_quadratic_form(const double* f2, double q[3][3]) {
+    const double xy = 0.5 * kY2 * f2[0], yz = -0.5 * kY2 * f2[1], xz = -0.5 * kY2 * f2[3];
+    q[0][0] = -kY20 * f2[2] + kY22 * f2[4];
+    q[1][1] = -kY20 * f2[2] - kY22 * f2[4];
+    q[2][2] = 2.0 * kY20 * f2[2];
+    q[0][1] = q[1][0] = xy;
+    q[1][2] = q[2][1] = yz;
+    q[0][2] = q[2][0] = xz;
+}
+
+// Eigenvectors (columns of v) of a symmetric 3x3 matrix by cyclic Jacobi rotations.
+void symmetric_eigenvectors(double a[3][3], double v[3][3]) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) v[i][j] = i == j ? 1.0 : 0.0;
+    double norm = 0;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) norm += a[i][j] * a[i][j];
+    if (!(norm > 0) || !std::isfinite(norm)) return;
+    for (int sweep = 0; sweep < 10; ++sweep) {
+        const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        if (off <= 1e-24 * norm) break;
+        for (int p = 0; p < 2; ++p)
+            for (int r = p + 1; r < 3; ++r) {
+                if (a[p][r] == 0.0) continue;
+                const double theta = (a[r][r] - a[p][p]) / (2.0 * a[p][r]);
+                const double t = (theta >= 0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1.0));
+                const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 3; ++k) {  // A <- A J
+                    const double akp = a[k][p], akr = a[k][r];
+                    a[k][p] = c * akp - s * akr;
+                    a[k][r] = s * akp + c * akr;
+                }
+                for (int k = 0; k < 3; ++k) {  // A <- J^T A
+                    const double apk = a[p][k], ark = a[r][k];
+                    a[p][k] = c * apk - s * ark;
+                    a[r][k] = s * apk + c * ark;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    const double vkp = v[k][p], vkr = v[k][r];
+                    v[k][p] = c * vkp - s * vkr;
+                    v[k][r] = s * vkp + c * vkr;
+                }
+            }
+    }
+}
+
+struct Candidate {
+    Vec3 axis;
+    double error;
+};
+
+// Adds `axis` unless it is (anti)parallel to one already there (Y2 is even, so +-a are the same).
+void add_candidate(Candidate* list, int* count, Vec3 axis, double error) {
+    if (!std::isfinite(error)) return;
+    for (int i = 0; i < *count; ++i)
+        if (std::fabs(dot(list[i].axis, axis)) > 0.9999) {
+            if (error < list[i].error) list[i] = {axis, error};
+            return;
+        }
+    list[(*count)++] = {axis, error};
+}
+
+// Best (lowest profile error) first.
+void sort_candidates(Candidate* list, int count) {
+    for (int i = 1; i < count; ++i)  // insertion sort: at most 7 entries
+        for (int j = i; j > 0 && list[j].error < list[j - 1].error; --j) std::swap(list[j], list[j - 1]);
+}
+
+// Eq. 11 of a stored ZH3 (radiance L1 as floats) against the target, exactly as decoded.
+double stored_error(const Target& t, const Sh2Radiance& linear, ZonalAxisMode mode, const LuminanceWeights& w,
+                    int channel_only = -1) {
+    double e = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (channel_only >= 0 && k != channel_only) continue;
+        const Vec3 d = kIrradianceBandScale[1] * l1_vector(linear.c.data(), k) - t.t1[k];
+        e += dot(d, d) + l2_residual(t, k, zh3_axis(linear, mode, k, w));
+    }
+    return e;
+}
+
+// The zonal coefficient (radiance, Eq. 10) of channel k of `sh` along unit axis a.
+double fit_zonal(const Sh3Radiance& sh, int k, Vec3 a) {
+    const auto q = y2(a);
+    double f2[5];
+    for (int m = 0; m < 5; ++m) f2[m] = sh[4 + m][k];
+    return kSqrtFourPiOverFive * dot5(q, f2);
+}
+
+Zh3 solve_luminance(const Sh3Radiance& sh, const CodecOptions& o, EncodeStats* stats) {
+    const LuminanceWeights& lw = o.luminance;
+    const Zh3 fit = zh3_fit(sh, ZonalAxisMode::kLuminance, lw);
+    const Target t = make_target(sh);
+    const double w[3] = {lw.r, lw.g, lw.b};
+    const double ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    const double fit_error = stored_error(t, fit.linear, ZonalAxisMode::kLuminance, lw);
+    const Vec3 u = w[0] * t.t1[0] + w[1] * t.t1[1] + w[2] * t.t1[2];  // luminance L1 of the target
+    double scale = 0;
+    for (int k = 0; k < 3; ++k) scale += t.t1sq[k] + t.t2sq[k];
+    scale = std::sqrt(scale);
+    if (!(ww > 0) || !usable_length(scale) || !std::isfinite(fit_error)) return fit;
+
+    // Profile error of an axis: the best L1 whose luminance points along +-a costs |P_perp u|^2 / |w|^2
+    // (g_k = t1_k - w_k P_perp u / |w|^2), plus the L2 residuals.
+    auto profile = [&](Vec3 a) {
+        const double ua = dot(u, a);
+        double e = (dot(u, u) - ua * ua) / ww;
+        for (int k = 0; k < 3; ++k) e += l2_residual(t, k, a);
+        return e;
+    };
+    Candidate cand[8];
+    int count = 0;
+    Vec3 a;
+    if (optimal_linear_direction(-u.y, u.z, -u.x, &a)) add_candidate(cand, &count, a, profile(a));
+    for (int k = 0; k < 3; ++k) {
+        const double len = length(t.t1[k]);
+        if (usable_length(len)) add_candidate(cand, &count, (1.0 / len) * t.t1[k], profile((1.0 / len) * t.t1[k]));
+    }
+    {
+        double q[3][3] = {}, qk[3][3], v[3][3];
+        for (int k = 0; k < 3; ++k) {
+            l2_quadratic_form(t.t2[k], qk);
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) q[i][j] += w[k] * qk[i][j];
+        }
+        symmetric_eigenvectors(q, v);
+        for (int j = 0; j < 3; ++j) {
+            const Vec3 e{v[0][j], v[1][j], v[2][j]};
+            add_candidate(cand, &count, e, profile(e));
+        }
+    }
+    sort_candidates(cand, count);
+
+    // Keep the luminance L1 long enough that float rounding of the stored coefficients cannot
+    // swing the decoded axis: the degenerate (zero luminance L1) optimum is approached, not met.
+    const double min_length = 1e-3 * scale;
+    Zh3 best = fit;
+    double best_error = fit_error;
+    int iterations = 0;
+    const int starts = std::min(count, 2);
+    for (int c = 0; c < starts; ++c) {
+        const Vec3 axis = cand[c].axis;
+        double ua = dot(u, axis);
+        const double along = std::fabs(ua) < min_length ? (ua < 0 ? -min_length : min_length) : ua;
+        // g_k = t1_k - w_k (u - along a) / |w|^2: luminance of g is along * a.
+        const Vec3 shift = (1.0 / ww) * (u - along * axis);
+        double x[9];
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 g = t.t1[k] - w[k] * shift;
+            x[3 * k] = g.x;
+            x[3 * k + 1] = g.y;
+            x[3 * k + 2] = g.z;
+        }
+        double e = 0;
+        iterations += bfgs<9>([&](const double* xx, double* gg) { return lum_objective_vec(t, w, xx, gg); }, x, &e,
+                              o.solver_iterations, o.solver_tolerance * scale, 0.5);
+        {
+            // Re-inflate a luminance L1 the solve shrank towards zero (see min_length).
+            Vec3 v{};
+            for (int k = 0; k < 3; ++k) v = v + w[k] * Vec3{x[3 * k], x[3 * k + 1], x[3 * k + 2]};
+            const double len = length(v);
+            if (!(len >= min_length)) {
+                const Vec3 dir = usable_length(len) ? (1.0 / len) * v : axis;
+                const Vec3 add = ((min_length - (usable_length(len) ? len : 0.0)) / ww) * dir;
+                for (int k = 0; k < 3; ++k) {
+                    x[3 * k] += w[k] * add.x;
+                    x[3 * k + 1] += w[k] * add.y;
+                    x[3 * k + 2] += w[k] * add.z;
+                }
+            }
+        }
+        Zh3 z;
+        for (int k = 0; k < 3; ++k) {
+            z.linear[0][k] = sh[0][k];
+            set_l1(z.linear.c.data(), k, (1.0 / kIrradianceBandScale[1]) * Vec3{x[3 * k], x[3 * k + 1], x[3 * k + 2]});
+        }
+        const double err = stored_error(t, z.linear, ZonalAxisMode::kLuminance, lw);
+        if (err < best_error) {
+            const Vec3 axis_out = zh3_axis(z.linear, ZonalAxisMode::kLuminance, 0, lw);
+            for (int k = 0; k < 3; ++k) z.zonal[k] = static_cast<float>(fit_zonal(sh, k, axis_out));
+            best = z;
+            best_error = err;
+        }
+    }
+    if (stats) stats->solver_iterations = iterations;
+    return best;
+}
+
+Zh3 solve_channel(const Sh3Radiance& sh, const CodecOptions& o, EncodeStats* stats) {
+    const LuminanceWeights& lw = o.luminance;
+    Zh3 out = zh3_fit(sh, ZonalAxisMode::kPerChannel, lw);
+    const Target t = make_target(sh);
+    int iterations = 0;
+    for (int k = 0; k < 3; ++k) {
+        const double fit_error = stored_error(t, out.linear, ZonalAxisMode::kPerChannel, lw, k);
+        const double scale = std::sqrt(t.t1sq[k] + t.t2sq[k]);
+        if (!usable_length(scale) || !std::isfinite(fit_error)) continue;
+        Candidate cand[4];
+        int count = 0;
+        const double len = length(t.t1[k]);
+        auto profile = [&](Vec3 a) { return channel_objective_vec(t, k, a, nullptr); };
+        if (usable_length(len)) add_candidate(cand, &count, (1.0 / len) * t.t1[k], profile((1.0 / len) * t.t1[k]));
+        double q[3][3], v[3][3];
+        l2_quadratic_form(t.t2[k], q);
+        symmetric_eigenvectors(q, v);
+        for (int j = 0; j < 3; ++j) {
+            const Vec3 e{v[0][j], v[1][j], v[2][j]};
+            add_candidate(cand, &count, e, profile(e));
+        }
+        sort_candidates(cand, count);
+        // Curvature of E along the sphere is about 2 |t1|^2 + 12 (4 pi / 5) |h| |t2|: scale the
+        // initial inverse Hessian by it (the axis has unit length).
+        const double h0 = 1.0 / std::max(2.0 * (t.t1sq[k] + 6.0 * t.t2sq[k]), 1e-300);
+        const int starts = std::min(count, 2);
+        for (int c = 0; c < starts; ++c) {
+            double x[3] = {cand[c].axis.x, cand[c].axis.y, cand[c].axis.z};
+            double e = 0;
+            iterations += bfgs<3>(
+                [&](const double* xx, double* gg) {
+                    Vec3 grad;
+                    const double v2 = channel_objective_vec(t, k, {xx[0], xx[1], xx[2]}, &grad);
+                    gg[0] = grad.x;
+                    gg[1] = grad.y;
+                    gg[2] = grad.z;
+                    return v2;
+                },
+                x, &e, o.solver_iterations, o.solver_tolerance * scale, h0);
+            const Vec3 a = normalize_or({x[0], x[1], x[2]}, {0, 0, 1});
+            // L1 = projection of t1 on a, kept non-zero so the decoder recovers the axis.
+            double p = dot(a, t.t1[k]);
+            const double min_length = 1e-3 * scale;
+            if (std::fabs(p) < min_length) p = p < 0 ? -min_length : min_length;
+            Zh3 z = out;
+            set_l1(z.linear.c.data(), k, (p / kIrradianceBandScale[1]) * a);
+            const double err = stored_error(t, z.linear, ZonalAxisMode::kPerChannel, lw, k);
+            if (err < stored_error(t, out.linear, ZonalAxisMode::kPerChannel, lw, k)) {
+                z.zonal[k] = static_cast<float>(fit_zonal(sh, k, zh3_axis(z.linear, ZonalAxisMode::kPerChannel, k, lw)));
+                out = z;
+            }
+        }
+    }
+    if (stats) stats->solver_iterations = iterations;
+    return out;
+}
+
+// ---- codec entries ----------------------------------------------------------------------------
+
+constexpr std::size_t kZh3Floats = 15;
+constexpr std::size_t kLinearFloats = 12;
+
+void store_zh3(const Zh3& z, std::uint8_t* out) {
+    float v[kZh3Floats];
+    for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 3; ++k) v[i * 3 + k] = z.linear[i][k];
+    for (int k = 0; k < 3; ++k) v[12 + k] = z.zonal[k];
+    store_floats(v, out);
+}
+Zh3 load_zh3(const std::uint8_t* in) {
+    float v[kZh3Floats];
+    load_floats(in, v);
+    Zh3 z;
+    for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 3; ++k) z.linear[i][k] = v[i * 3 + k];
+    for (int k = 0; k < 3; ++k) z.zonal[k] = v[12 + k];
+    return z;
+}
+Sh2Radiance load_linear(const std::uint8_t* in) {
+    float v[kLinearFloats];
+    load_floats(in, v);
+    Sh2Radiance s;
+    for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 3; ++k) s[i][k] = v[i * 3 + k];
+    return s;
+}
+
+template <ZonalAxisMode Mode>
+void encode_fit(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats*) {
+    store_zh3(zh3_fit(in, Mode, o.luminance), out);
+}
+template <ZonalAxisMode Mode>
+void encode_solved(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
+    store_zh3(zh3_solve(in, Mode, o, stats), out);
+}
+void encode_lum_dering(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
+    Zh3 z = zh3_fit(in, ZonalAxisMode::kLuminance, o.luminance);
+    const bool clamped = zh3_dering(&z, ZonalAxisMode::kLuminance, o.luminance);
+    if (stats) stats->dering_clamped = clamped;
+    store_zh3(z, out);
+}
+template <ZonalAxisMode Mode>
+Sh3Radiance decode_zh3(const std::uint8_t* in, const CodecOptions& o) {
+    return zh3_expand(load_zh3(in), Mode, o.luminance);
+}
+template <ZonalAxisMode Mode>
+Rgb irradiance_zh3(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
+    return zh3_irradiance(load_zh3(in), Mode, o.luminance, n);
+}
+
+// Hallucinated: the stored bytes are exactly sh2's (DC + L1, 12 floats).
+void encode_linear(const Sh3Radiance& in, const CodecOptions&, std::uint8_t* out, EncodeStats*) {
+    float v[kLinearFloats];
+    for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 3; ++k) v[i * 3 + k] = in[i][k];
+    store_floats(v, out);
+}
+template <Hallucination Model, ZonalAxisMode Mode>
+Sh3Radiance decode_hall(const std::uint8_t* in, const CodecOptions& o) {
+    return zh3_expand(zh3_hallucinate(load_linear(in), Model, Mode, o), Mode, o.luminance);
+}
+template <Hallucination Model, ZonalAxisMode Mode>
+Rgb irradiance_hall(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
+    return zh3_irradiance(zh3_hallucinate(load_linear(in), Model, Mode, o), Mode, o.luminance, n);
+}
+
+constexpr auto kLum = ZonalAxisMode::kLuminance;
+constexpr auto kChan = ZonalAxisMode::kPerChannel;
+constexpr auto kAmbDir = Hallucination::kAmbientDirectional;
+constexpr auto kSphere = Hallucination::kSphere;
+constexpr auto kCurve = Hallucination::kCurve;
+
+const Codec kZh3Codecs[] = {
+    {"zh3_lum", "ZH3 fit (Eq. 9/10) on the luminance L1 axis, 15 floats", kZh3Floats * 4, encode_fit<kLum>,
+     decode_zh3<kLum>, irradiance_zh3<kLum>},
+    {"zh3_channel", "ZH3 fit (Eq. 9/10) on each channel's L1 axis, 15 floats", kZh3Floats * 4, encode_fit<kChan>,
+     decode_zh3<kChan>, irradiance_zh3<kChan>},
+    {"zh3_solved_lum", "ZH3, luminance axis solved by BFGS (Eq. 11), 15 floats", kZh3Floats * 4,
+     encode_solved<kLum>, decode_zh3<kLum>, irradiance_zh3<kLum>},
+    {"zh3_solved_channel", "ZH3, per-channel axes solved by BFGS (Eq. 11), 15 floats", kZh3Floats * 4,
+     encode_solved<kChan>, decode_zh3<kChan>, irradiance_zh3<kChan>},
+    {"hall_ambdir", "linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), luminance axis",
+     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kLum>, irradiance_hall<kAmbDir, kLum>},
+    {"hall_sphere", "linear SH + zonal L2 hallucinated, sphere light (Eq. 20), luminance axis", kLinearFloats * 4,
+     encode_linear, decode_hall<kSphere, kLum>, irradiance_hall<kSphere, kLum>},
+    {"hall_curve", "linear SH + zonal L2 hallucinated, curve fit (Eq. 21), luminance axis", kLinearFloats * 4,
+     encode_linear, decode_hall<kCurve, kLum>, irradiance_hall<kCurve, kLum>},
+    {"hall_ambdir_channel", "linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), channel axes",
+     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kChan>, irradiance_hall<kAmbDir, kChan>},
+    {"hall_sphere_channel", "linear SH + zonal L2 hallucinated, sphere light (Eq. 20), channel axes",
+     kLinearFloats * 4, encode_linear, decode_hall<kSphere, kChan>, irradiance_hall<kSphere, kChan>},
+    {"hall_curve_channel", "linear SH + zonal L2 hallucinated, curve fit (Eq. 21), channel axes",
+     kLinearFloats * 4, encode_linear, decode_hall<kCurve, kChan>, irradiance_hall<kCurve, kChan>},
+    {"zh3_lum_dering", "zh3_lum with the zonal L2 clamped for non-negative irradiance (App. B)",
+     kZh3Floats * 4, encode_lum_dering, decode_zh3<kLum>, irradiance_zh3<kLum>},
+};
+
+}  // namespace
+
+// ---- public API -------------------------------------------------------------------------------
+
+Vec3 zh3_axis(const Sh2Radiance& linear, ZonalAxisMode mode, int channel, const LuminanceWeights& w) {
+    return normalize_or(axis_source(linear.c.data(), mode, std::clamp(channel, 0, 2), w), {0, 0, 1});
+}
+
+bool has_zonal_axis(const Sh2Radiance& linear, ZonalAxisMode mode, int channel, const LuminanceWeights& w) {
+    return usable_length(length(axis_source(linear.c.data(), mode, std::clamp(channel, 0, 2), w)));
+}
+
+// Eq. 9/10: l20 = sqrt(4 pi / 5) Y2(axis) . f2, the least-squares zonal coefficient along the axis.
+Zh3 zh3_fit(const Sh3Radiance& sh, ZonalAxisMode mode, const LuminanceWeights& w) {
+    Zh3 z;
+    z.linear = truncate_to_sh2(sh);
+    for (int k = 0; k < 3; ++k) z.zonal[k] = static_cast<float>(fit_zonal(sh, k, zh3_axis(z.linear, mode, k, w)));
+    return z;
+}
+
+Sh3Radiance zh3_expand(const Zh3& zh3, ZonalAxisMode mode, const LuminanceWeights& w) {
+    Sh3Radiance out = extend_to_sh3(zh3.linear);
+    for (int k = 0; k < 3; ++k) {
+        // Eq. 2 on a zonal function: f_2^m = f_2^0 sqrt(4 pi / 5) Y_2^m(axis).
+        const auto q = y2(zh3_axis(zh3.linear, mode, k, w));
+        for (int m = 0; m < 5; ++m) out[4 + m][k] = static_cast<float>(zh3.zonal[k] * kSqrtFourPiOverFive * q[static_cast<size_t>(m)]);
+    }
+    return out;
+}
+
+Rgb zh3_irradiance(const Zh3& zh3, ZonalAxisMode mode, const LuminanceWeights& w, Vec3 n) {
+    Rgb out;
+    const Rgb* c = zh3.linear.c.data();
+    Vec3 shared{};
+    if (mode == ZonalAxisMode::kLuminance) shared = zh3_axis(zh3.linear, mode, 0, w);
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 a = mode == ZonalAxisMode::kLuminance ? shared : zh3_axis(zh3.linear, mode, k, w);
+        const double z = dot(a, n);
+        // Listing 1: linear SH with the L1 band scaled by 2/3, plus 1/4 of the zonal L2 term.
+        const double e = kY00 * c[0][k] + kIrradianceBandScale[1] * kY1 * dot(l1_vector(c, k), n) +
+                         kIrradianceBandScale[2] * zh3.zonal[k] * kY20 * (3.0 * z * z - 1.0);
+        out[k] = static_cast<float>(e);
+    }
+    return out;
+}
+
+double zh3_eq11_error(const Sh3Radiance& target, const Sh2Radiance& linear, ZonalAxisMode mode,
+                      const LuminanceWeights& w) {
+    return stored_error(make_target(target), linear, mode, w);
+}
+
+double zh3_lum_objective(const Sh3Radiance& target, const LuminanceWeights& w, const double g[9], double grad[9]) {
+    const Target t = make_target(target);
+    const double wv[3] = {w.r, w.g, w.b};
+    // SH order g[3 m + k] (m = 0, 1, 2 for f1-1, f10, f11) -> vector form x[3 k + j], v = (-f11, -f1-1, f10).
+    double x[9], gx[9];
+    for (int k = 0; k < 3; ++k) {
+        x[3 * k] = -g[6 + k];
+        x[3 * k + 1] = -g[k];
+        x[3 * k + 2] = g[3 + k];
+    }
+    const double e = lum_objective_vec(t, wv, x, grad ? gx : nullptr);
+    if (grad)
+        for (int k = 0; k < 3; ++k) {
+            grad[k] = -gx[3 * k + 1];
+            grad[3 + k] = gx[3 * k + 2];
+            grad[6 + k] = -gx[3 * k];
+        }
+    return e;
+}
+
+double zh3_channel_objective(const Sh3Radiance& target, int channel, Vec3 x, Vec3* grad) {
+    return channel_objective_vec(make_target(target), std::clamp(channel, 0, 2), x, grad);
+}
+
+Zh3 zh3_solve(const Sh3Radiance& sh, ZonalAxisMode mode, const CodecOptions& options, EncodeStats* stats) {
+    return mode == ZonalAxisMode::kLuminance ? solve_luminance(sh, options, stats) : solve_channel(sh, options, stats);
+}
+
+double hallucinate_zonal(Hallucination model, double f0, double f1_zonal, double curve_a, double curve_b) {
+    const double f1 = std::fabs(f1_zonal);
+    if (model == Hallucination::kAmbientDirectional) {
+        // Eq. 14: the directional light's zonal L2 over its zonal L1 is Y20(z=1) / Y10(z=1) = sqrt(5/3).
+        return std::sqrt(15.0) / 3.0 * f1;
+    }
+    if (!(f0 > 0) || !std::isfinite(f0)) return 0.0;
+    // p = |f1^0| / f0 in [0, sqrt(3)]: sqrt(3) is a delta light (cos sigma = 1), 0 the full sphere.
+    const double p = std::clamp(f1 / f0, 0.0, kSqrt3);
+    if (model == Hallucination::kSphere) {
+        // Eq. 20 (from Eq. 15 with cos sigma = 2 p / sqrt(3) - 1, Eq. 19).
+        return (2.0 * std::sqrt(5.0) / 3.0 * p * p - std::sqrt(5.0 / 3.0) * p) * f0;
+    }
+    return (curve_a * p * p + curve_b * p) * f0;  // Eq. 21
+}
+
+Zh3 zh3_hallucinate(const Sh2Radiance& linear, Hallucination model, ZonalAxisMode mode, const CodecOptions& o) {
+    Zh3 z;
+    z.linear = linear;
+    for (int k = 0; k < 3; ++k) {
+        // Listing 1: f1^0 = L1 projected on the zonal axis (the channel's |L1| for per-channel axes).
+        const double f1 = dot(l1_vector(linear.c.data(), k), zh3_axis(linear, mode, k, o.luminance));
+        z.zonal[k] = static_cast<float>(hallucinate_zonal(model, linear[0][k], f1, o.hallucinate_a, o.hallucinate_b));
+    }
+    return z;
+}
+
+// App. B, re-derived (docs/zh3.md). Along the zonal axis, irradiance / (Y00 f0) is
+//   g(z) = 1 + a z + b (3 z^2 - 1),  a = 2 f1 / (sqrt(3) f0),  b = sqrt(5) f20 / (8 f0)   (Eq. 23).
+// With a >= 0 (g(-z) swaps the sign of a): the end z = -1 needs b >= (a - 1) / 2; for b >= a / 6
+// the vertex z* = -a / (6 b) lies in [-1, 0] and needs 12 b^2 - 12 b + a^2 <= 0, i.e.
+// b in [b-, b+] = [(1 -+ sqrt(1 - a^2 / 3)) / 2]. Together:
+//   a <= 3/2:           b in [(a - 1) / 2, b+]
+//   3/2 < a <= sqrt(3): b in [b-, b+]          (the paper's Eq. 25 lower bound is too low here)
+//   a > sqrt(3):        infeasible; b = a / (2 sqrt(3)) maximises min g (= 1 - a / sqrt(3)).
+// The paper's upper bound sqrt(5)/4 (Eq. 24-26) is neither b+ (which runs from 1 to 1/2) nor safe
+// near a = sqrt(3); see docs/zh3.md.
+ZonalInterval zh3_dering_interval(double f0, double f1_zonal) {
+    ZonalInterval out;
+    if (!(f0 > 0) || !std::isfinite(f0) || !std::isfinite(f1_zonal)) return out;  // nothing is safe
+    const double a = std::fabs(2.0 * f1_zonal / (kSqrt3 * f0));
+    const double to_f20 = 8.0 * f0 / std::sqrt(5.0);  // f20 = b * 8 f0 / sqrt(5)
+    if (a > kSqrt3) {
+        out.lo = out.hi = a / (2.0 * kSqrt3) * to_f20;
+        return out;
+    }
+    const double root = std::sqrt(std::max(0.0, 1.0 - a * a / 3.0));
+    const double lo = a <= 1.5 ? (a - 1.0) / 2.0 : (1.0 - root) / 2.0;
+    out.lo = lo * to_f20;
+    out.hi = (1.0 + root) / 2.0 * to_f20;
+    out.feasible = true;
+    return out;
+}
+
+bool zh3_dering(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w) {
+    bool clamped = false;
+    for (int k = 0; k < 3; ++k) {
+        // Only the L1 component along the zonal axis enters g(z); see docs/zh3.md for what that
+        // guarantees when the channel's L1 is not parallel to the axis.
+        const double f1 = dot(l1_vector(zh3->linear.c.data(), k), zh3_axis(zh3->linear, mode, k, w));
+        const ZonalInterval iv = zh3_dering_interval(zh3->linear[0][k], f1);
+        const double f20 = zh3->zonal[k];
+        const double c = std::isfinite(f20) ? std::clamp(f20, iv.lo, iv.hi) : iv.lo;
+        if (c != f20) {
+            zh3->zonal[k] = static_cast<float>(c);
+            clamped = true;
+        }
+    }
+    return clamped;
+}
+
+std::span<const Codec> zh3_codecs() { return kZh3Codecs; }
+
 }  // namespace zhc

@@ -34,4 +34,66 @@ Sh3Radiance zh3_expand(const Zh3& zh3, ZonalAxisMode mode, const LuminanceWeight
 // Irradiance at n straight from ZH3 (runtime path, Listing 1 style).
 Rgb zh3_irradiance(const Zh3& zh3, ZonalAxisMode mode, const LuminanceWeights& w, Vec3 n);
 
+// ---- axis solve (Sec. 3.3, Eq. 11, App. C) ---------------------------------------------------
+//
+// Eq. 11 with t the IRRADIANCE SH of `target` (band scales 1, 2/3, 1/4) and f the IRRADIANCE linear
+// SH of the candidate (its stored radiance L1 times 2/3):
+//   E = sum_k |f1_k - t1_k|^2 + |(4 pi / 5)(Y2(a_k) . t2_k) Y2(a_k) - t2_k|^2,
+// a_k the zonal axis of channel k derived from f (shared luminance axis or the channel's own).
+// Because the zonal coefficient is the least-squares fit (Eq. 9), E is exactly the squared L2 norm
+// over the sphere of (irradiance of the ZH3 expansion) minus (irradiance of the SH3 target); L0 is
+// exact and does not enter. Units: irradiance^2 * sr.
+double zh3_eq11_error(const Sh3Radiance& target, const Sh2Radiance& linear, ZonalAxisMode mode,
+                      const LuminanceWeights& w);
+
+// Eq. 11 in the paper's shared-axis parameterisation (App. C): g holds the nine IRRADIANCE L1
+// coefficients, g[3 m + k] = coefficient (1, m - 1) of channel k (the order of Eq. 34). Returns E and
+// writes dE/dg (analytic, App. C Eq. 27-36) when `grad` is not null. E is +inf when the luminance L1
+// of g is zero (no axis).
+double zh3_lum_objective(const Sh3Radiance& target, const LuminanceWeights& w, const double g[9],
+                         double grad[9]);
+// Per-channel form (Sec. 3.3: "it suffices to solve for the axis"): x is an unnormalised axis
+// direction, the channel's L1 is the projection of t1 onto it, and the zonal L2 its Eq. 9 fit;
+// returns that E for channel `channel` (same units) and dE/dx when `grad` is not null.
+double zh3_channel_objective(const Sh3Radiance& target, int channel, Vec3 x, Vec3* grad);
+
+// The BFGS axis solve. Iterations per start and the relative gradient tolerance come from
+// `options`; stats->solver_iterations gets the BFGS iterations summed over the starts.
+// The result's Eq. 11 error (evaluated on the float-rounded stored L1) is never above that of
+// zh3_fit(sh, mode): the fit is returned instead when the solve does not beat it.
+Zh3 zh3_solve(const Sh3Radiance& sh, ZonalAxisMode mode, const CodecOptions& options,
+              EncodeStats* stats);
+
+// ---- hallucination (Sec. 3.4, Listing 1) -----------------------------------------------------
+
+enum class Hallucination : std::uint8_t {
+    kAmbientDirectional = 0,  // Eq. 14: f20 = sqrt(15)/3 |f1^0|
+    kSphere = 1,              // Eq. 19/20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0, p in [0, sqrt(3)]
+    kCurve = 2,               // Eq. 21: f20 = (a p^2 + b p) f0, p in [0, sqrt(3)]
+};
+// Radiance zonal coefficient hallucinated from DC f0 and the L1 projected on the zonal axis
+// (f1_zonal; its absolute value is used as in Listing 1). p = |f1_zonal| / f0 is clamped to
+// [0, sqrt(3)] (the ratio range of non-negative functions); f0 <= 0 gives 0 (except Eq. 14,
+// which does not involve f0).
+double hallucinate_zonal(Hallucination model, double f0, double f1_zonal, double curve_a,
+                         double curve_b);
+Zh3 zh3_hallucinate(const Sh2Radiance& linear, Hallucination model, ZonalAxisMode mode,
+                    const CodecOptions& options);
+
+// ---- ZH3 deringing (App. B) --------------------------------------------------------------------
+
+// The interval of RADIANCE zonal coefficients f20 for which
+//   Y00 f0 + (2/3) kY1 f1_zonal z + (1/4) kY20 f20 (3 z^2 - 1) >= 0  for all z in [-1, 1]
+// (App. B Eq. 22, re-derived exactly: see docs/zh3.md). When no f20 works (|a| > sqrt(3) or
+// f0 <= 0) `feasible` is false and lo == hi is the value that maximises the minimum over z
+// (0 when f0 <= 0).
+struct ZonalInterval {
+    double lo = 0, hi = 0;
+    bool feasible = false;
+};
+ZonalInterval zh3_dering_interval(double f0, double f1_zonal);
+// Clamps each channel's zonal coefficient into its interval (f1_zonal = the channel's L1 projected
+// on its zonal axis). Returns true when a coefficient changed.
+bool zh3_dering(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
+
 }  // namespace zhc
