@@ -97,7 +97,10 @@ void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radi
 
 Sh3Radiance decode_probe(const Codec& codec, const StorageParams& params, const std::uint8_t* in) {
     PackedLayout packed;
-    if (packed_layout_from_name(codec.name, &packed)) return decode_packed(packed, in, params);
+    if (packed_layout_from_name(codec.name, &packed)) {
+        const Sh3Radiance linear = decode_packed(packed, in, params);
+        return hallucinates_at_decode(codec.name) ? hallucinate_curve(linear, params, codec_options(params)) : linear;
+    }
     const Sh3Radiance stored = codec.decode(in, codec_options(params));
     if (params.kind != StoredKind::kIrradiance) return stored;
     Sh3Irradiance e;

@@ -302,7 +302,7 @@ std::size_t packed_size_bytes(PackedLayout layout) {
 bool packed_layout_from_name(std::string_view name, PackedLayout* out) {
     if (name == "zh3_q16") *out = PackedLayout::kZh3Q16;
     else if (name == "sh3_q28") *out = PackedLayout::kSh3Q28;
-    else if (name == "sh2_q") *out = PackedLayout::kSh2Q;
+    else if (name == "sh2_q" || name == "hall_curve_q") *out = PackedLayout::kSh2Q;
     else return false;
     return true;
 }
@@ -364,16 +364,6 @@ std::array<double, 5> zonal_l2_direction(Vec3 axis) {
     return {s * y[4], s * y[5], s * y[6], s * y[7], s * y[8]};
 }
 
-// TEMPORARY until the zh3 branch lands zh3_axis: the same definition (ZH3 paper Sec. 3.1/3.2).
-Vec3 decoder_axis(const Sh2Radiance& lin, ZonalAxisMode mode, int k, const LuminanceWeights& w) {
-    double l1[3];
-    for (int i = 0; i < 3; ++i)
-        l1[i] = mode == ZonalAxisMode::kLuminance ? luminance(lin[i + 1], w) : static_cast<double>(lin[i + 1][k]);
-    Vec3 axis;
-    optimal_linear_direction(l1[0], l1[1], l1[2], &axis);
-    return axis;
-}
-
 // Zonal axes from (dequantised) L1, per channel: shares zh3.h's definition (luminance-weighted L1
 // or each channel's own optimal linear direction; +Z when the L1 is zero).
 std::array<Vec3, 3> axes_from_l1(const Coeffs& c, const QuantParams& p) {
@@ -381,7 +371,7 @@ std::array<Vec3, 3> axes_from_l1(const Coeffs& c, const QuantParams& p) {
     for (int i = 0; i < 4; ++i)
         for (int k = 0; k < 3; ++k) linear[i][k] = static_cast<float>(c[static_cast<size_t>(i)][static_cast<size_t>(k)]);
     std::array<Vec3, 3> axes;
-    for (int k = 0; k < 3; ++k) axes[static_cast<size_t>(k)] = decoder_axis(linear, p.axis_mode, k, p.luminance);
+    for (int k = 0; k < 3; ++k) axes[static_cast<size_t>(k)] = zh3_axis(linear, p.axis_mode, k, p.luminance);
     return axes;
 }
 
@@ -473,6 +463,14 @@ Sh3Radiance quantize_roundtrip(PackedLayout layout, const Sh3Radiance& hub, cons
     return hub_from_stored(q, params.kind);
 }
 
+bool hallucinates_at_decode(std::string_view name) { return name == "hall_curve_q"; }
+
+Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const QuantParams& params, const CodecOptions& options) {
+    // ZH3 paper Sec. 3.4.3, Eq. 21 on the decoder's axis (luminance by default).
+    const Zh3 z = zh3_hallucinate(truncate_to_sh2(linear_hub), Hallucination::kCurve, params.axis_mode, options);
+    return zh3_expand(z, params.axis_mode, params.luminance);
+}
+
 // ---- codec table entries -------------------------------------------------------------------
 
 namespace {
@@ -489,6 +487,14 @@ Rgb irradiance_entry(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
     return irradiance(decode_packed(L, in, quant_params(o)), n);
 }
 
+Sh3Radiance decode_hall_curve(const std::uint8_t* in, const CodecOptions& o) {
+    const QuantParams p = quant_params(o);
+    return hallucinate_curve(decode_packed(PackedLayout::kSh2Q, in, p), p, o);
+}
+Rgb irradiance_hall_curve(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
+    return irradiance(decode_hall_curve(in, o), n);
+}
+
 const Codec kQuantized[] = {
     {"zh3_q16", "ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)", 16,
      encode_entry<PackedLayout::kZh3Q16>, decode_entry<PackedLayout::kZh3Q16>, irradiance_entry<PackedLayout::kZh3Q16>},
@@ -496,6 +502,8 @@ const Codec kQuantized[] = {
      encode_entry<PackedLayout::kSh3Q28>, decode_entry<PackedLayout::kSh3Q28>, irradiance_entry<PackedLayout::kSh3Q28>},
     {"sh2_q", "linear SH, 16 bytes: DC slot + 9 8-bit L1 ratios (padded; hallucination decodes from it)", 16,
      encode_entry<PackedLayout::kSh2Q>, decode_entry<PackedLayout::kSh2Q>, irradiance_entry<PackedLayout::kSh2Q>},
+    {"hall_curve_q", "sh2_q bytes, zonal L2 hallucinated at decode by the Eq. 21 curve (luminance axis)", 16,
+     encode_entry<PackedLayout::kSh2Q>, decode_hall_curve, irradiance_hall_curve},
 };
 }  // namespace
 

@@ -134,8 +134,12 @@ enum class PackedLayout : std::uint8_t {
     kSh2Q = 2,    // 16 bytes: DC slot (6) + per channel [L1-1, L10, L11] + 1 zero byte
 };
 std::size_t packed_size_bytes(PackedLayout layout);
-// "zh3_q16", "sh3_q28", "sh2_q" -> layout; false for any other name.
+// "zh3_q16", "sh3_q28", "sh2_q", "hall_curve_q" (sh2_q bytes) -> layout; false for other names.
 bool packed_layout_from_name(std::string_view name, PackedLayout* out);
+// True for the entries whose decoder adds a hallucinated zonal L2 to the decoded linear SH
+// ("hall_curve_q": ZH3 paper Eq. 21 with options.hallucinate_a/b on params.axis_mode's axis).
+bool hallucinates_at_decode(std::string_view name);
+Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const QuantParams& params, const CodecOptions& options);
 
 // Quantisation controls that are not part of the stored format (they never change how bytes
 // decode, only which bytes the encoder picks). Defaults are what the codec table uses.
