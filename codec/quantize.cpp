@@ -166,6 +166,7 @@ namespace {
 std::uint32_t pack_ufloat(double v, int mbits) {
     const std::uint32_t max_code = (30u << mbits) | ((1u << mbits) - 1u);  // largest finite
     if (!(v > 0.0)) return 0;                                              // <= 0 or NaN
+    if (std::isinf(v)) return max_code;
     int e;
     std::frexp(v, &e);  // v in [2^(e-1), 2^e)
     const int exp = e - 1;
