@@ -624,6 +624,21 @@ TEST(QuantRealMaps, QuantisationErrorTableOverRotatedMaps) {
             std::printf("%-6d %-5s %11.4f%% %11.4f%% %12.4f\n", bits, sq ? "yes" : "no", 100 * naive, 100 * refit, refit / naive);
             EXPECT_LE(refit, naive * (1 + 1e-9)) << bits << sq;
         }
+    // The same errors relative to the directional (non-DC) part of the irradiance instead of all of it.
+    {
+        double dir = 0, all = 0;
+        for (const Sh3Radiance& sh : probes) {
+            Sh3Radiance no_dc = sh;
+            no_dc[0] = {};
+            dir += irradiance_energy(no_dc);
+            all += irradiance_energy(sh);
+        }
+        const double f = std::sqrt(all / dir);
+        std::printf("\nrelative to the directional (non-DC) irradiance instead (x%.3f): tight/lin/r11 %.3f%%, "
+                    "tight/sqrt/r11 %.3f%%, loose/lin/r11 %.3f%%, loose/sqrt/r11 %.3f%%\n",
+                    f, 100 * f * table["tight/lin/affine/r11"], 100 * f * table["tight/sqrt/affine/r11"],
+                    100 * f * table["loose/lin/affine/r11"], 100 * f * table["loose/sqrt/affine/r11"]);
+    }
     std::printf("\nerror budget (tight, affine zonal): ratios alone (exact DC) vs with R11G11B10F DC\n");
     for (const char* sq : {"/lin/", "/sqrt/"}) {
         const double ratios = table[std::string("tight") + sq + "affine/exact"];
