@@ -87,7 +87,10 @@ void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radi
                   EncodeStats* stats, const CodecOptions& base) {
     PackedLayout packed;
     if (packed_layout_from_name(codec.name, &packed)) {
-        encode_packed(packed, hub, params, out, stats);  // handles kind itself (scaled bounds)
+        QuantEncodeControls controls;  // the table entry's encoder choices
+        controls.solve_axis = codec.name == "zh3_solved_q16";
+        controls.solver = codec_options(params, base);
+        encode_packed(packed, hub, params, out, stats, controls);  // handles kind itself (scaled bounds)
         return;
     }
     const CodecOptions o = codec_options(params, base);

@@ -301,7 +301,7 @@ std::size_t packed_size_bytes(PackedLayout layout) {
 }
 
 bool packed_layout_from_name(std::string_view name, PackedLayout* out) {
-    if (name == "zh3_q16") *out = PackedLayout::kZh3Q16;
+    if (name == "zh3_q16" || name == "zh3_solved_q16") *out = PackedLayout::kZh3Q16;
     else if (name == "sh3_q28") *out = PackedLayout::kSh3Q28;
     else if (name == "sh2_q" || name == "hall_curve_q") *out = PackedLayout::kSh2Q;
     else return false;
@@ -387,7 +387,18 @@ void encode_impl(PackedLayout layout, const Sh3Radiance& hub, const QuantParams&
                  EncodeStats* stats, const QuantEncodeControls& controls, Coeffs* decoded) {
     const size_t size = packed_size_bytes(layout);
     std::memset(out, 0, size);
-    const Coeffs c = stored_coefficients(hub, p.kind);
+    Coeffs c = stored_coefficients(hub, p.kind);
+    if (layout == PackedLayout::kZh3Q16 && controls.solve_axis) {
+        // Replace the L1 by the solved one (same DC); L2 stays the target for the zonal refit.
+        CodecOptions so = controls.solver;
+        so.luminance = p.luminance;
+        EncodeStats solve_stats;
+        const Zh3 z = zh3_solve(hub, p.axis_mode, so, &solve_stats);
+        if (stats) stats->solver_iterations += solve_stats.solver_iterations;
+        for (int i = 1; i < 4; ++i)
+            for (int k = 0; k < 3; ++k)
+                c[static_cast<size_t>(i)][static_cast<size_t>(k)] = z.linear[i][k] * band_scale(p.kind, 1);
+    }
     Rgb dc_in{static_cast<float>(c[0][0]), static_cast<float>(c[0][1]), static_cast<float>(c[0][2])};
     Rgb dc = store_dc(dc_in, effective_dc_format(layout, p.dc_format), out);
     if (controls.exact_dc) dc = dc_in;
@@ -488,6 +499,13 @@ Rgb irradiance_entry(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
     return irradiance(decode_packed(L, in, quant_params(o)), n);
 }
 
+void encode_solved_q16(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
+    QuantEncodeControls c;
+    c.solve_axis = true;
+    c.solver = o;
+    encode_packed(PackedLayout::kZh3Q16, in, quant_params(o), out, stats, c);
+}
+
 Sh3Radiance decode_hall_curve(const std::uint8_t* in, const CodecOptions& o) {
     const QuantParams p = quant_params(o);
     return hallucinate_curve(decode_packed(PackedLayout::kSh2Q, in, p), p, o);
@@ -499,6 +517,8 @@ Rgb irradiance_hall_curve(const std::uint8_t* in, const CodecOptions& o, Vec3 n)
 const Codec kQuantized[] = {
     {"zh3_q16", "ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)", 16,
      encode_entry<PackedLayout::kZh3Q16>, decode_entry<PackedLayout::kZh3Q16>, irradiance_entry<PackedLayout::kZh3Q16>},
+    {"zh3_solved_q16", "zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted", 16,
+     encode_solved_q16, decode_entry<PackedLayout::kZh3Q16>, irradiance_entry<PackedLayout::kZh3Q16>},
     {"sh3_q28", "quadratic SH, 28 bytes: R11G11B10F DC + 24 8-bit ratios (tight L2 bound)", 28,
      encode_entry<PackedLayout::kSh3Q28>, decode_entry<PackedLayout::kSh3Q28>, irradiance_entry<PackedLayout::kSh3Q28>},
     {"sh2_q", "linear SH, 16 bytes: DC slot + 9 8-bit L1 ratios (padded; hallucination decodes from it)", 16,

@@ -134,7 +134,8 @@ enum class PackedLayout : std::uint8_t {
     kSh2Q = 2,    // 16 bytes: DC slot (6) + per channel [L1-1, L10, L11] + 1 zero byte
 };
 std::size_t packed_size_bytes(PackedLayout layout);
-// "zh3_q16", "sh3_q28", "sh2_q", "hall_curve_q" (sh2_q bytes) -> layout; false for other names.
+// "zh3_q16", "zh3_solved_q16" (zh3_q16 bytes), "sh3_q28", "sh2_q", "hall_curve_q" (sh2_q bytes)
+// -> layout; false for other names.
 bool packed_layout_from_name(std::string_view name, PackedLayout* out);
 // True for the entries whose decoder adds a hallucinated zonal L2 to the decoded linear SH
 // ("hall_curve_q": ZH3 paper Eq. 21 with options.hallucinate_a/b on params.axis_mode's axis).
@@ -147,6 +148,11 @@ struct QuantEncodeControls {
     // zh3_q16: fit the zonal coefficient along the axis the DECODER will derive (from the
     // dequantised L1). false = fit along the float L1's axis first and quantise afterwards.
     bool refit_zonal_after_l1 = true;
+    // zh3_q16: take the L1 to quantise from the BFGS axis solve (zh3_solve, ZH3 paper Sec. 3.3,
+    // Eq. 11) instead of the projection; the zonal is still refitted on the decoder's axis. The
+    // bytes decode with the ordinary zh3_q16 decoder (entry "zh3_solved_q16"). Slower encode.
+    bool solve_axis = false;
+    CodecOptions solver;  // iterations, tolerance (luminance weights come from QuantParams)
     // Analysis only (the output is then not a valid layout): keep the DC exact instead of
     // quantising it, to split the error budget between DC and ratios. Used via quantize_roundtrip.
     bool exact_dc = false;
