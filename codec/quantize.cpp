@@ -376,8 +376,16 @@ std::array<Vec3, 3> axes_from_l1(const Coeffs& c, const QuantParams& p) {
     return axes;
 }
 
-double zonal_fit(const Coeffs& c, int k, Vec3 axis) {
-    const auto v = zonal_l2_direction(axis);
+// The unit L2 directions of the three channels' axes (computed once when they share one axis).
+using ZonalDirections = std::array<std::array<double, 5>, 3>;
+ZonalDirections zonal_directions(const std::array<Vec3, 3>& axes, ZonalAxisMode mode) {
+    ZonalDirections v;
+    v[0] = zonal_l2_direction(axes[0]);
+    for (size_t k = 1; k < 3; ++k) v[k] = mode == ZonalAxisMode::kLuminance ? v[0] : zonal_l2_direction(axes[k]);
+    return v;
+}
+
+double zonal_fit(const Coeffs& c, int k, const std::array<double, 5>& v) {
     double z = 0;
     for (int m = 0; m < 5; ++m) z += c[static_cast<size_t>(4 + m)][static_cast<size_t>(k)] * v[static_cast<size_t>(m)];
     return z;
@@ -420,17 +428,18 @@ void encode_impl(PackedLayout layout, const Sh3Radiance& hub, const QuantParams&
         // The decoder derives each axis from the dequantised L1; fitting the zonal coefficient
         // along that axis (rather than the float L1's) makes it the least-squares best for what
         // is actually reconstructed (Eq. 9 with the decoder's axis).
-        const std::array<Vec3, 3> decoder_axes = axes_from_l1(q, p);
-        const std::array<Vec3, 3> fit_axes = controls.refit_zonal_after_l1 ? decoder_axes : axes_from_l1(c, p);
+        const ZonalDirections decoder_dirs = zonal_directions(axes_from_l1(q, p), p.axis_mode);
+        const ZonalDirections fit_dirs =
+            controls.refit_zonal_after_l1 ? decoder_dirs : zonal_directions(axes_from_l1(c, p), p.axis_mode);
         const RatioCoder coder = zonal_coder(p);
         for (int k = 0; k < 3; ++k) {
-            const double z = zonal_fit(c, k, fit_axes[static_cast<size_t>(k)]);
+            const double z = zonal_fit(c, k, fit_dirs[static_cast<size_t>(k)]);
             bool clamped = false;
             const std::uint8_t code = coder.encode(ratio_of(z, dc[k]), &clamped);
             clamped_count += clamped;
             out[zonal_offset(k)] = code;
             const double zq = coder.decode(code) * dc[k];
-            const auto v = zonal_l2_direction(decoder_axes[static_cast<size_t>(k)]);
+            const auto& v = decoder_dirs[static_cast<size_t>(k)];
             for (int m = 0; m < 5; ++m) q[static_cast<size_t>(4 + m)][static_cast<size_t>(k)] = zq * v[static_cast<size_t>(m)];
         }
     }
@@ -456,11 +465,11 @@ Sh3Radiance decode_packed(PackedLayout layout, const std::uint8_t* in, const Qua
             q[static_cast<size_t>(i)][static_cast<size_t>(k)] = ratio_coder(i, p).decode(in[ratio_offset(layout, k, i)]) * dc[k];
     }
     if (layout == PackedLayout::kZh3Q16) {
-        const std::array<Vec3, 3> axes = axes_from_l1(q, p);
+        const ZonalDirections dirs = zonal_directions(axes_from_l1(q, p), p.axis_mode);
         const RatioCoder coder = zonal_coder(p);
         for (int k = 0; k < 3; ++k) {
             const double zq = coder.decode(in[zonal_offset(k)]) * dc[k];
-            const auto v = zonal_l2_direction(axes[static_cast<size_t>(k)]);
+            const auto& v = dirs[static_cast<size_t>(k)];
             for (int m = 0; m < 5; ++m) q[static_cast<size_t>(4 + m)][static_cast<size_t>(k)] = zq * v[static_cast<size_t>(m)];
         }
     }
