@@ -519,6 +519,47 @@ TEST(QuantRealMaps, ParsevalErrorMatchesDenseDirectionSampling) {
     }
 }
 
+TEST(QuantRealMaps, EveryCoefficientIsWithinHalfAStepOfItsIntervalTimesDc) {
+    // For rotated real maps, every stored coefficient decodes within (half a quantisation step of
+    // its interval, sqrt-adjusted) x (decoded DC) of the input, unless its ratio was clamped; the
+    // DC within half an R11G11B10F ulp (relative 2^-7 R/G, 2^-6 B).
+    const auto maps = real_map_probes();
+    std::mt19937 rng(77);
+    int checked = 0, clamped_skipped = 0;
+    for (const Sh3Radiance& base : maps)
+        for (int r = 0; r < 6; ++r) {
+            const Sh3Radiance sh = rotate(base, random_rotation(rng));
+            for (int bits : {8, 5})
+                for (bool sq : {false, true})
+                    for (PackedLayout L : {PackedLayout::kSh3Q28, PackedLayout::kSh2Q, PackedLayout::kZh3Q16}) {
+                        QuantParams p;
+                        p.bits = bits;
+                        p.sqrt_encoding = sq;
+                        std::uint8_t b[28];
+                        encode_packed(L, sh, p, b, nullptr);
+                        const Sh3Radiance d = decode_packed(L, b, p);
+                        const int last = L == PackedLayout::kSh3Q28 ? 8 : 3;
+                        for (int k = 0; k < 3; ++k) {
+                            const double dc = d[0][k];
+                            EXPECT_LE(std::fabs(dc - sh[0][k]), std::fabs(sh[0][k]) * std::exp2(k == 2 ? -6 : -7) * (1 + 1e-6));
+                            for (int i = 1; i <= last; ++i) {
+                                const RatioCoder c = ratio_coder(i, p);
+                                const double ratio = sh[i][k] / dc;
+                                if (ratio < c.interval.lo || ratio > c.interval.hi) {
+                                    ++clamped_skipped;
+                                    continue;
+                                }
+                                EXPECT_LE(std::fabs(d[i][k] - sh[i][k]), max_ratio_error(c, ratio) * dc + 1e-6 * dc)
+                                    << "layout " << int(L) << " bits " << bits << " sqrt " << sq << " i " << i;
+                                ++checked;
+                            }
+                        }
+                    }
+        }
+    std::printf("checked %d coefficients (%d out-of-range ratios skipped)\n", checked, clamped_skipped);
+    EXPECT_GT(checked, 5000);
+}
+
 struct Config {
     std::string name;
     QuantParams params;
