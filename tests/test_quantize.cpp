@@ -681,6 +681,36 @@ TEST(QuantRealMaps, QuantisationErrorTableOverRotatedMaps) {
                     f, 100 * f * table["tight/lin/affine/r11"], 100 * f * table["tight/sqrt/affine/r11"],
                     100 * f * table["loose/lin/affine/r11"], 100 * f * table["loose/sqrt/affine/r11"]);
     }
+    // Other normalisations, for comparing with numbers measured elsewhere: mean over probes of the
+    // per-probe relative RMSE, and the RMS over directions of the pointwise relative error
+    // |E_q - E| / |E| (directions with luminance E below 1% of the probe's mean excluded).
+    {
+        const auto dirs = fibonacci_directions(2000);
+        std::printf("\nother normalisations (sh3_q28, R11G11B10F DC, affine zonal): per-probe mean | pointwise relative\n");
+        for (L2Bound bound : {L2Bound::kTight, L2Bound::kLoose})
+            for (bool sq : {false, true}) {
+                QuantParams p;
+                p.l2_bound = bound;
+                p.sqrt_encoding = sq;
+                double per_probe = 0, pw_num = 0;
+                size_t pw_n = 0;
+                for (const Sh3Radiance& sh : probes) {
+                    const Sh3Radiance q = quantize_roundtrip(PackedLayout::kSh3Q28, sh, p, nullptr);
+                    per_probe += std::sqrt(irradiance_energy(difference(q, sh)) / irradiance_energy(sh));
+                    const double mean = luminance(sh[0], {}) / (2 * std::sqrt(kPi));
+                    for (const Vec3 n : dirs) {
+                        const Rgb e = irradiance(sh, n), eq = irradiance(q, n);
+                        const double l = luminance(e, {});
+                        if (l < 0.01 * mean) continue;
+                        const double rel = (luminance(eq, {}) - l) / l;
+                        pw_num += rel * rel;
+                        ++pw_n;
+                    }
+                }
+                std::printf("  %-6s sqrt %-4s %8.4f%% | %8.4f%%\n", bound == L2Bound::kTight ? "tight" : "loose",
+                            sq ? "yes" : "no", 100 * per_probe / probes.size(), 100 * std::sqrt(pw_num / pw_n));
+            }
+    }
     std::printf("\nerror budget (tight, affine zonal): ratios alone (exact DC) vs with R11G11B10F DC\n");
     for (const char* sq : {"/lin/", "/sqrt/"}) {
         const double ratios = table[std::string("tight") + sq + "affine/exact"];
