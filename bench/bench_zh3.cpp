@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <random>
 #include <string>
 #include <vector>
@@ -20,6 +21,21 @@
 using namespace zhc;
 
 namespace {
+
+// Thread CPU time of fn() (seconds), minimum over `repeats`: robust to other processes sharing the
+// machine (preemption does not count), unlike wall time.
+template <class F>
+double cpu_time_min(int repeats, F&& fn) {
+    double best = 1e300;
+    for (int i = 0; i < repeats; ++i) {
+        timespec a{}, b{};
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
+        fn();
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
+        best = std::min(best, double(b.tv_sec - a.tv_sec) + 1e-9 * double(b.tv_nsec - a.tv_nsec));
+    }
+    return best;
+}
 
 struct Rng {
     std::mt19937 gen{1234};
@@ -91,7 +107,7 @@ double encode_ns(const Codec& c, const std::vector<Sh3Radiance>& probes, const C
                  double* iterations = nullptr) {
     std::vector<std::uint8_t> bytes(c.size_bytes * probes.size());
     long long its = 0;
-    const double t = bench::cpu_time_min(repeats, [&] {
+    const double t = cpu_time_min(repeats, [&] {
         its = 0;
         for (size_t i = 0; i < probes.size(); ++i) {
             EncodeStats st;

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <vector>
 
 namespace zhc::bench {
@@ -23,21 +22,6 @@ Timing time_repeats(int repeats, F&& fn) {
     }
     std::sort(t.begin(), t.end());
     return {t[t.size() / 2], t.front(), t.back()};
-}
-
-// Thread CPU time of fn() (seconds), minimum over `repeats`: robust to other processes sharing the
-// machine (preemption does not count), unlike wall time.
-template <class F>
-double cpu_time_min(int repeats, F&& fn) {
-    double best = 1e300;
-    for (int i = 0; i < repeats; ++i) {
-        timespec a{}, b{};
-        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
-        fn();
-        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
-        best = std::min(best, double(b.tv_sec - a.tv_sec) + 1e-9 * double(b.tv_nsec - a.tv_nsec));
-    }
-    return best;
 }
 
 // Keeps the optimiser from discarding a computed value.
