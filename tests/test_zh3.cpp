@@ -601,6 +601,14 @@ TEST(Zh3Dering, PapersEq25LowerBoundIsNotSufficientAboveThreeHalves) {
     const double paper_lo = (a - 1) / 2 * 8 * f0 / std::sqrt(5.0);
     EXPECT_LT(min_along(f0, f1, paper_lo), -1e-3 * kY00);
     EXPECT_GT(zh3_dering_interval(f0, f1).lo, paper_lo);
+    // Its upper bound b <= sqrt(5)/4 (Eq. 24-26, f20 <= 2 f0) is too high near a = sqrt(3), where
+    // the exact upper bound b+ = (1 + sqrt(1 - a^2/3)) / 2 tends to 1/2 ...
+    const double a2 = std::sqrt(3.0) - 1e-3, f1b = a2 * std::sqrt(3.0) / 2.0;
+    EXPECT_LT(min_along(f0, f1b, 2.0 * f0), -1e-3 * kY00);
+    EXPECT_LT(zh3_dering_interval(f0, f1b).hi, 2.0 * f0);
+    // ... and needlessly low for small a (b+ tends to 1, i.e. f20 <= 8 f0 / sqrt(5)).
+    EXPECT_GE(min_along(f0, 0.0, 8.0 / std::sqrt(5.0) * f0), -1e-12);
+    EXPECT_NEAR(zh3_dering_interval(f0, 0.0).hi, 8.0 / std::sqrt(5.0) * f0, 1e-12);
 }
 
 TEST(Zh3Dering, ClampedResultIsNonNegativeAlongTheAxisAndValidInputsAreUnchanged) {
