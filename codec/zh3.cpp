@@ -534,6 +534,12 @@ void encode_lum_dering(const Sh3Radiance& in, const CodecOptions& o, std::uint8_
     if (stats) stats->dering_clamped = clamped;
     store_zh3(z, out);
 }
+void encode_lum_dering_sphere(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
+    Zh3 z = zh3_fit(in, ZonalAxisMode::kLuminance, o.luminance);
+    const bool clamped = zh3_dering_sphere(&z, ZonalAxisMode::kLuminance, o.luminance);
+    if (stats) stats->dering_clamped = clamped;
+    store_zh3(z, out);
+}
 template <ZonalAxisMode Mode>
 Sh3Radiance decode_zh3(const std::uint8_t* in, const CodecOptions& o) {
     return zh3_expand(load_zh3(in), Mode, o.luminance);
@@ -588,6 +594,8 @@ const Codec kZh3Codecs[] = {
      kLinearFloats * 4, encode_linear, decode_hall<kCurve, kChan>, irradiance_hall<kCurve, kChan>},
     {"zh3_lum_dering", "zh3_lum with the zonal L2 clamped for non-negative irradiance (App. B)",
      kZh3Floats * 4, encode_lum_dering, decode_zh3<kLum>, irradiance_zh3<kLum>},
+    {"zh3_lum_dering_sphere", "zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere",
+     kZh3Floats * 4, encode_lum_dering_sphere, decode_zh3<kLum>, irradiance_zh3<kLum>},
 };
 
 }  // namespace
@@ -741,6 +749,112 @@ bool zh3_dering(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w) {
         }
     }
     return clamped;
+}
+
+namespace {
+// h(theta) = 1 + a cos t - c sin t + b (3 cos^2 t - 1) over [0, pi]: a trigonometric polynomial of
+// degree 2 (1 + b/2 + a cos t - c sin t + (3b/2) cos 2t), so it has at most four critical points
+// per period. Sampling 33 points and polishing every sampled local minimum by safeguarded Newton
+// finds the minimum to rounding.
+double sphere_min_ratio(double a, double c, double b) {
+    auto h = [&](double t) {
+        const double ct = std::cos(t);
+        return 1.0 + a * ct - c * std::sin(t) + b * (3.0 * ct * ct - 1.0);
+    };
+    constexpr int kSamples = 32;
+    double v[kSamples + 1];
+    for (int i = 0; i <= kSamples; ++i) v[i] = h(kPi * i / kSamples);
+    double best = std::min(v[0], v[kSamples]);
+    for (int i = 1; i < kSamples; ++i) {
+        best = std::min(best, v[i]);
+        if (!(v[i] <= v[i - 1] && v[i] <= v[i + 1])) continue;
+        const double lo = kPi * (i - 1) / kSamples, hi = kPi * (i + 1) / kSamples;
+        double t = kPi * i / kSamples;
+        for (int it = 0; it < 8; ++it) {
+            const double st = std::sin(t), ct = std::cos(t);
+            const double d1 = -a * st - c * ct - 6.0 * b * st * ct;            // h'
+            const double d2 = -a * ct + c * st - 6.0 * b * (ct * ct - st * st);  // h''
+            if (!(d2 > 0)) break;
+            t = std::clamp(t - d1 / d2, lo, hi);
+        }
+        best = std::min(best, h(t));
+    }
+    return best;
+}
+}  // namespace
+
+double zh3_dering_sphere_zonal(double f0, double f1_zonal, double f1_perp, double f20, bool* clamped) {
+    *clamped = false;
+    if (!(f0 > 0) || !std::isfinite(f0) || !std::isfinite(f1_zonal) || !std::isfinite(f1_perp)) {
+        *clamped = f20 != 0.0;
+        return 0.0;
+    }
+    const double a = 2.0 * f1_zonal / (kSqrt3 * f0), c = std::fabs(2.0 * f1_perp / (kSqrt3 * f0));
+    const double to_f20 = 8.0 * f0 / std::sqrt(5.0);
+    const double b0 = std::isfinite(f20) ? f20 / to_f20 : 0.0;
+    // F(b) = min over the sphere is concave in b (a minimum of affine functions), so {F >= 0} is an
+    // interval and the nearest feasible b lies between b0 and the maximiser of F.
+    auto f = [&](double b) { return sphere_min_ratio(a, c, b); };
+    if (std::isfinite(f20) && f(b0) >= 0) return f20;
+    *clamped = true;
+    // F(b) <= 1 - b - c at z = 0 and <= 1 + 2b - |a| at z = -+1: the maximiser lies in this bracket.
+    const double r = std::sqrt(a * a + c * c);
+    double lo = -1.0 - r, hi = 1.0 + r;
+    const double phi = (std::sqrt(5.0) - 1.0) / 2.0;
+    double x1 = hi - phi * (hi - lo), x2 = lo + phi * (hi - lo), f1 = f(x1), f2 = f(x2);
+    for (int it = 0; it < 60 && hi - lo > 1e-13 * (1.0 + r); ++it) {  // golden section on concave F
+        if (f1 < f2) {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + phi * (hi - lo);
+            f2 = f(x2);
+        } else {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - phi * (hi - lo);
+            f1 = f(x1);
+        }
+    }
+    const double bstar = f1 >= f2 ? x1 : x2;
+    if (!(f(bstar) >= 0) || !std::isfinite(b0)) return bstar * to_f20;  // nothing is safe: least negative
+    // Bisection between the infeasible b0 and the feasible bstar; keep the feasible end.
+    double bad = b0, good = bstar;
+    for (int it = 0; it < 60 && std::fabs(good - bad) > 1e-14 * (1.0 + r); ++it) {
+        const double mid = 0.5 * (bad + good);
+        (f(mid) >= 0 ? good : bad) = mid;
+    }
+    return good * to_f20;
+}
+
+bool zh3_dering_sphere(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w) {
+    bool any = false;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 axis = zh3_axis(zh3->linear, mode, k, w);
+        const Vec3 v = l1_vector(zh3->linear.c.data(), k);
+        const double along = dot(v, axis);
+        const double across = length(v - along * axis);
+        bool clamped = false;
+        const double c = zh3_dering_sphere_zonal(zh3->linear[0][k], along, across, zh3->zonal[k], &clamped);
+        if (clamped) {
+            // The stored value is a float: step it by ulps further into the feasible side (away from
+            // the infeasible original) until the stored value itself passes.
+            const double f0 = zh3->linear[0][k];
+            const float from = zh3->zonal[k];
+            float cf = static_cast<float>(c);
+            if (f0 > 0 && std::isfinite(from) &&
+                sphere_min_ratio(2.0 * along / (kSqrt3 * f0), 2.0 * across / (kSqrt3 * f0), c * std::sqrt(5.0) / (8.0 * f0)) >= 0) {
+                const float toward = c > from ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+                const double a = 2.0 * along / (kSqrt3 * f0), cc = 2.0 * across / (kSqrt3 * f0);
+                for (int step = 0; step < 8 && sphere_min_ratio(a, cc, cf * std::sqrt(5.0) / (8.0 * f0)) < 0; ++step)
+                    cf = std::nextafter(cf, toward);
+            }
+            zh3->zonal[k] = cf;
+            any = true;
+        }
+    }
+    return any;
 }
 
 std::span<const Codec> zh3_codecs() { return kZh3Codecs; }
