@@ -5,6 +5,10 @@
 // coefficient f_2^0 in the frame of the zonal axis. The axis is never stored: it is derived from
 // the stored L1 (the luminance L1's optimal linear direction, shared by all channels, or each
 // channel's own), so the decoder needs nothing else.
+//
+// Codec-table entries (codec/zh3.cpp, zh3_codecs()): zh3_lum, zh3_channel, zh3_solved_lum,
+// zh3_solved_channel, hall_{ambdir,sphere,curve}[_channel], zh3_lum_dering (App. B; issue 4's
+// name, defined here), zh3_lum_dering_sphere. Derivations and choices: docs/zh3.md.
 #pragma once
 
 #include "codec.h"
