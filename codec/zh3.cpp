@@ -614,7 +614,7 @@ bool has_zonal_axis(const Sh2Radiance& linear, ZonalAxisMode mode, int channel, 
 Zh3 zh3_fit(const Sh3Radiance& sh, ZonalAxisMode mode, const LuminanceWeights& w) {
     Zh3 z;
     z.linear = truncate_to_sh2(sh);
-    const Vec3 shared = zh3_axis(z.linear, ZonalAxisMode::kLuminance, 0, w);
+    const Vec3 shared = mode == ZonalAxisMode::kLuminance ? zh3_axis(z.linear, mode, 0, w) : Vec3{};
     for (int k = 0; k < 3; ++k)
         z.zonal[k] = static_cast<float>(
             fit_zonal(sh, k, mode == ZonalAxisMode::kLuminance ? shared : zh3_axis(z.linear, mode, k, w)));
@@ -754,30 +754,51 @@ bool zh3_dering(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w) {
 namespace {
 // h(theta) = 1 + a cos t - c sin t + b (3 cos^2 t - 1) over [0, pi]: a trigonometric polynomial of
 // degree 2 (1 + b/2 + a cos t - c sin t + (3b/2) cos 2t), so it has at most four critical points
-// per period. Sampling 33 points and polishing every sampled local minimum by safeguarded Newton
+// per period. Sampling 33 points (tabulated) and polishing every sampled local minimum by Newton
 // finds the minimum to rounding.
+struct SampleTable {
+    static constexpr int kSamples = 32;
+    double cos_t[kSamples + 1], sin_t[kSamples + 1];
+    SampleTable() {
+        for (int i = 0; i <= kSamples; ++i) {
+            cos_t[i] = std::cos(kPi * i / kSamples);
+            sin_t[i] = std::sin(kPi * i / kSamples);
+        }
+    }
+};
+
 double sphere_min_ratio(double a, double c, double b) {
-    auto h = [&](double t) {
-        const double ct = std::cos(t);
-        return 1.0 + a * ct - c * std::sin(t) + b * (3.0 * ct * ct - 1.0);
-    };
-    constexpr int kSamples = 32;
-    double v[kSamples + 1];
-    for (int i = 0; i <= kSamples; ++i) v[i] = h(kPi * i / kSamples);
-    double best = std::min(v[0], v[kSamples]);
-    for (int i = 1; i < kSamples; ++i) {
+    static const SampleTable table;
+    constexpr int n = SampleTable::kSamples;
+    auto h = [&](double ct, double st) { return 1.0 + a * ct - c * st + b * (3.0 * ct * ct - 1.0); };
+    double v[n + 1];
+    for (int i = 0; i <= n; ++i) v[i] = h(table.cos_t[i], table.sin_t[i]);
+    double best = std::min(v[0], v[n]);
+    for (int i = 1; i < n; ++i) {
         best = std::min(best, v[i]);
         if (!(v[i] <= v[i - 1] && v[i] <= v[i + 1])) continue;
-        const double lo = kPi * (i - 1) / kSamples, hi = kPi * (i + 1) / kSamples;
-        double t = kPi * i / kSamples;
-        for (int it = 0; it < 8; ++it) {
-            const double st = std::sin(t), ct = std::cos(t);
+        // Newton on theta, carried as (cos, sin) and rotated by the step: every iterate is a real
+        // direction, so h there is an upper bound of the minimum that converges to it. Steps stay
+        // within one sample spacing (pi/32), where the Taylor rotation is accurate to ~1e-10.
+        double ct = table.cos_t[i], st = table.sin_t[i];
+        const double max_step = kPi / n;
+        for (int it = 0; it < 5; ++it) {
             const double d1 = -a * st - c * ct - 6.0 * b * st * ct;            // h'
             const double d2 = -a * ct + c * st - 6.0 * b * (ct * ct - st * st);  // h''
             if (!(d2 > 0)) break;
-            t = std::clamp(t - d1 / d2, lo, hi);
+            const double delta = std::clamp(-d1 / d2, -max_step, max_step);
+            const double d2s = delta * delta;
+            const double cd = 1.0 - d2s / 2.0 * (1.0 - d2s / 12.0), sd = delta * (1.0 - d2s / 6.0 * (1.0 - d2s / 20.0));
+            double nc = ct * cd - st * sd, ns = st * cd + ct * sd;
+            if (ns < 0) break;  // left [0, pi]: the end samples cover it
+            const double len = std::sqrt(nc * nc + ns * ns);
+            nc /= len;
+            ns /= len;
+            ct = nc;
+            st = ns;
+            if (std::fabs(delta) < 1e-12) break;
         }
-        best = std::min(best, h(t));
+        best = std::min(best, h(ct, st));
     }
     return best;
 }
@@ -802,7 +823,7 @@ double zh3_dering_sphere_zonal(double f0, double f1_zonal, double f1_perp, doubl
     double lo = -1.0 - r, hi = 1.0 + r;
     const double phi = (std::sqrt(5.0) - 1.0) / 2.0;
     double x1 = hi - phi * (hi - lo), x2 = lo + phi * (hi - lo), f1 = f(x1), f2 = f(x2);
-    for (int it = 0; it < 60 && hi - lo > 1e-13 * (1.0 + r); ++it) {  // golden section on concave F
+    for (int it = 0; it < 60 && hi - lo > 1e-9 * (1.0 + r); ++it) {  // golden section on concave F
         if (f1 < f2) {
             lo = x1;
             x1 = x2;
@@ -821,7 +842,7 @@ double zh3_dering_sphere_zonal(double f0, double f1_zonal, double f1_perp, doubl
     if (!(f(bstar) >= 0) || !std::isfinite(b0)) return bstar * to_f20;  // nothing is safe: least negative
     // Bisection between the infeasible b0 and the feasible bstar; keep the feasible end.
     double bad = b0, good = bstar;
-    for (int it = 0; it < 60 && std::fabs(good - bad) > 1e-14 * (1.0 + r); ++it) {
+    for (int it = 0; it < 60 && std::fabs(good - bad) > 1e-9 * (1.0 + r); ++it) {
         const double mid = 0.5 * (bad + good);
         (f(mid) >= 0 ? good : bad) = mid;
     }
