@@ -85,44 +85,53 @@ const std::vector<Vec3>& reference_directions() {
     static const std::vector<Vec3> dirs = fibonacci_directions(2048);
     return dirs;
 }
-// The eight maps, projected exactly at full resolution, with the directly integrated irradiance
-// (flux-preserving 4x box downsample to 256x128, 2048 Fibonacci directions). Loaded once.
-const std::vector<RealMap>& real_maps() {
-    static const std::vector<RealMap> maps = [] {
-        std::vector<RealMap> out;
+// Reference irradiance of a map at reference_directions() by direct integration.
+void add_true_irradiance(const Image& img, RealMap* out) {
+    // Same sum as test::integrate_irradiance (flux-preserving 4x box downsample to 256x128), with the
+    // pixel directions and solid angles computed once instead of per direction.
+    RealMap& m = *out;
+    const Image small = test::downsample_latlong(img, 4);
+    std::vector<Vec3> pixel_dir;
+    std::vector<double> pixel_weight;
+    for (int y = 0; y < small.height; ++y)
+        for (int x = 0; x < small.width; ++x) {
+            pixel_dir.push_back(latlong_direction(x, y, small.width, small.height));
+            pixel_weight.push_back(latlong_pixel_solid_angle(y, small.width, small.height));
+        }
+    for (const Vec3 n : reference_directions()) {
+        double acc[3] = {};
+        for (size_t i = 0; i < pixel_dir.size(); ++i) {
+            const double c = dot(n, pixel_dir[i]);
+            if (c <= 0) continue;
+            for (int k = 0; k < 3; ++k) acc[k] += pixel_weight[i] * c * small.rgb[i * 3 + static_cast<size_t>(k)];
+        }
+        m.true_irradiance.push_back({float(acc[0] / kPi), float(acc[1] / kPi), float(acc[2] / kPi)});
+    }
+    // spot check against the support twin
+    const Rgb twin = test::integrate_irradiance(small, reference_directions()[100]);
+    for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(twin[k], m.true_irradiance[100][k], 1e-5 * (1 + std::fabs(twin[k])));
+}
+
+// The eight maps; with_true_irradiance also integrates the reference irradiance (slower).
+std::vector<RealMap> load_real_maps(bool with_true_irradiance) {
+    std::vector<RealMap> out;
+    {
         for (const std::string& path : test::envmap_paths()) {
             const Image img = test::load_envmap(path);
             if (img.width == 0) continue;
             RealMap m;
             m.name = test::envmap_name(path);
             m.sh = project_latlong(img.rgb.data(), img.width, img.height, static_cast<size_t>(img.width) * 3, 2);
-            // Same sum as test::integrate_irradiance, with the pixel directions and solid angles
-            // computed once instead of per direction.
-            const Image small = test::downsample_latlong(img, 4);
-            std::vector<Vec3> pixel_dir;
-            std::vector<double> pixel_weight;
-            for (int y = 0; y < small.height; ++y)
-                for (int x = 0; x < small.width; ++x) {
-                    pixel_dir.push_back(latlong_direction(x, y, small.width, small.height));
-                    pixel_weight.push_back(latlong_pixel_solid_angle(y, small.width, small.height));
-                }
-            for (const Vec3 n : reference_directions()) {
-                double acc[3] = {};
-                for (size_t i = 0; i < pixel_dir.size(); ++i) {
-                    const double c = dot(n, pixel_dir[i]);
-                    if (c <= 0) continue;
-                    for (int k = 0; k < 3; ++k) acc[k] += pixel_weight[i] * c * small.rgb[i * 3 + static_cast<size_t>(k)];
-                }
-                m.true_irradiance.push_back({float(acc[0] / kPi), float(acc[1] / kPi), float(acc[2] / kPi)});
-            }
-            // spot check against the support twin
-            const Rgb twin = test::integrate_irradiance(small, reference_directions()[100]);
-            for (int k = 0; k < 3; ++k)
-                EXPECT_NEAR(twin[k], m.true_irradiance[100][k], 1e-5 * (1 + std::fabs(twin[k])));
+            if (with_true_irradiance) add_true_irradiance(img, &m);
             out.push_back(std::move(m));
         }
-        return out;
-    }();
+    }
+    return out;
+}
+// The eight maps projected exactly at full resolution, loaded once per test process.
+const std::vector<RealMap>& real_maps() {
+    static const std::vector<RealMap> maps = load_real_maps(false);
     return maps;
 }
 
@@ -780,7 +789,7 @@ TEST(Zh3Dering, SphereVariantIsNonNegativeEverywhereWhenAnyZonalValueIs) {
 // ---- real maps: irradiance RMSE table ----------------------------------------------------------
 
 TEST(Zh3RealMaps, IrradianceRmseTable) {
-    const auto& maps = real_maps();
+    const std::vector<RealMap> maps = load_real_maps(true);
     ASSERT_EQ(maps.size(), 8u);
     const auto& dirs = reference_directions();
     std::vector<std::string> names = {"sh2", "sh3"};
