@@ -5,6 +5,10 @@
 // coefficient f_2^0 in the frame of the zonal axis. The axis is never stored: it is derived from
 // the stored L1 (the luminance L1's optimal linear direction, shared by all channels, or each
 // channel's own), so the decoder needs nothing else.
+//
+// Codec-table entries (codec/zh3.cpp, zh3_codecs()): zh3_lum, zh3_channel, zh3_solved_lum,
+// zh3_solved_channel, hall_{ambdir,sphere,curve}[_channel], zh3_lum_dering (App. B; issue 4's
+// name, defined here), zh3_lum_dering_sphere. Derivations and choices: docs/zh3.md.
 #pragma once
 
 #include "codec.h"
@@ -95,5 +99,15 @@ ZonalInterval zh3_dering_interval(double f0, double f1_zonal);
 // Clamps each channel's zonal coefficient into its interval (f1_zonal = the channel's L1 projected
 // on its zonal axis). Returns true when a coefficient changed.
 bool zh3_dering(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
+
+// Whole-sphere variant (zhc's extension, docs/zh3.md): with the channel's L1 split into f1_zonal
+// along the zonal axis and f1_perp (length) across it, the channel's minimum irradiance over the
+// sphere, divided by Y00 f0, is min over theta in [0, pi] of
+//   1 + a cos(theta) - c sin(theta) + b (3 cos^2(theta) - 1),  c = 2 f1_perp / (sqrt(3) f0)
+// (the worst azimuth is analytic). Returns the radiance f20 nearest to `f20` that makes it >= 0, or,
+// when none does, the one that maximises it; *clamped tells whether it changed. f0 <= 0 gives 0.
+double zh3_dering_sphere_zonal(double f0, double f1_zonal, double f1_perp, double f20, bool* clamped);
+// Applies it to every channel of a ZH3 (axis from `mode`). Returns true when a coefficient changed.
+bool zh3_dering_sphere(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
 
 }  // namespace zhc
