@@ -204,7 +204,7 @@ double hemisphere_min(double a, double b, double c, double amp) {
 
 }  // namespace
 
-double sh3_min_bound(const Sh3AxisForm& form, double s1, double s2, bool early_out) {
+double sh3_min_bound(const Sh3AxisForm& form, double s1, double s2, bool early_out, double threshold) {
     // In the frame of the optimal linear direction (Eq. 3 and Sec. 2.3.1, re-derived: the
     // extraction's a and b carry a stray z^2 / z and a drops the 3 of 3z^2 - 1):
     //   zonal: kY00 f0 + kY1 f10 z + kY20 f20 (3 z^2 - 1)
@@ -224,7 +224,7 @@ double sh3_min_bound(const Sh3AxisForm& form, double s1, double s2, bool early_o
         if (early_out) {
             // |z sqrt(1 - z^2)| <= 1/2: a valid, cheaper bound; enough when it is non-negative.
             const double quick = quadratic_min_lower(a, bb, c) - 0.5 * amp;
-            if (quick >= 0.0) {
+            if (quick >= threshold) {
                 result = std::min(result, quick);
                 continue;
             }
@@ -371,12 +371,13 @@ double negative_fraction(const Sh3Irradiance& irradiance, int count) {
 
 namespace {
 
-// Irradiance bound of a radiance axis form under window t (kernel band scales 2/3, 1/4 times the
+// Whether the irradiance bound of a radiance axis form under window t reaches the margin (kernel band scales 2/3, 1/4 times the
 // window's band scales).
 bool window_passes(const Sh3AxisForm& form, WindowScales base, double t) {
     const WindowScales w = dering_window(t);
+    const double target = kDeringMargin * kY00 * std::fabs(form.dc);
     return sh3_min_bound(form, kIrradianceBandScale[1] * base.l1 * w.l1, kIrradianceBandScale[2] * base.l2 * w.l2,
-                         /*early_out=*/true) >= 0.0;
+                         /*early_out=*/true, target) >= target;
 }
 
 // Least t in [lo_start, kDeringWindowMax] passing `passes`, by bisection (Sec. 2.4). Returns the
@@ -423,7 +424,7 @@ DeringResult dering_sh3(const Sh3Radiance& radiance, const DeringOptions& option
     if (!all_pass(t) && t < kDeringWindowMax) {
         double s = 0.0;
         t = all_pass(kDeringWindowMax) ? bisect_window(all_pass, t, steps, &s) : kDeringWindowMax;
-        step = std::max(step, s);
+        step = s;
     }
     r.window = t;
     r.bisection_step = step;

@@ -46,10 +46,11 @@ Sh3AxisForm sh3_axis_form(const Sh3Channel& f);
 // Lower bound of min over the sphere of the function whose axis form is `form`, with band 1
 // scaled by s1 and band 2 by s2 (windowing and/or the irradiance kernel commute with the
 // rotation, so the form is computed once). Exact for the zonal and |m| = 2 parts; the |m| = 1 pair
-// is taken at its worst phase on each hemisphere. `early_out`: when min(quadratic) - |A|/2 >= 0 on
-// a hemisphere (|z sqrt(1-z^2)| <= 1/2), that cheaper (still valid, looser) bound is returned for
-// it; use it when only the sign matters.
-double sh3_min_bound(const Sh3AxisForm& form, double s1 = 1.0, double s2 = 1.0, bool early_out = false);
+// is taken at its worst phase on each hemisphere. `early_out`: when min(quadratic) - |A|/2 >=
+// `threshold` on a hemisphere (|z sqrt(1-z^2)| <= 1/2), that cheaper (still valid, looser) bound is
+// returned for it (Sec. 2.3.3's early out); use it when only "bound >= threshold" matters.
+double sh3_min_bound(const Sh3AxisForm& form, double s1 = 1.0, double s2 = 1.0, bool early_out = false,
+                     double threshold = 0.0);
 // Lower bound of min over the sphere of the SH3 function f (any kind: apply the irradiance band
 // scales first for irradiance, or use the functions below).
 double sh3_min_bound(const Sh3Channel& f);
@@ -108,6 +109,11 @@ inline constexpr WindowScales kPunctualWindow{0.92, 0.73};
 
 Sh3Radiance apply_window(const Sh3Radiance& radiance, WindowScales scales);
 
+// The search asks the irradiance bound to reach kDeringMargin x the mean irradiance rather than 0,
+// so the irradiance stays >= 0 after the windowed coefficients are rounded to float (relative
+// error 2^-24 per coefficient); 2^-18 is a window change far below one Table 1 step.
+inline constexpr double kDeringMargin = 1.0 / (1 << 18);
+
 struct DeringOptions {
     bool punctual = false;     // apply kPunctualWindow first (source marked as direct lights)
     int bisection_steps = 24;  // halvings of [0, kDeringWindowMax]
@@ -118,7 +124,8 @@ struct DeringResult {
     double window = 0;                   // t applied to all channels (0: untouched by the search)
     std::array<double, 3> channel_window{};  // least t per channel (Sec. 3 takes the largest)
     WindowScales scales;                 // total band scales applied (punctual x table)
-    double bisection_step = 0;           // width of the final bisection interval
+    double bisection_step = 0;           // width of the final interval of the search that set
+                                         // `window` (per-channel searches: kDeringWindowMax / 2^steps)
     bool windowed = false;               // any coefficient changed
     bool nonnegative = true;             // the irradiance bound is >= 0 in every channel
 };
