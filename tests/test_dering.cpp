@@ -600,5 +600,107 @@ TEST(DeringRealMaps, ReportAndNonNegativity) {
                 "rmse_dr: deringed vs plain SH3; rmse_sh3 / rmse_der: plain / deringed SH3 vs the map's true irradiance\n");
 }
 
+// ---- zhc dering -----------------------------------------------------------------------------------
+
+nlohmann::json read_json(const std::string& path) {
+    std::ifstream f(path);
+    return nlohmann::json::parse(f, nullptr, false);
+}
+
+TEST(DeringCli, EnvironmentMapIn_DeringedJsonOut) {
+    const std::string dir = test::temp_dir("dering_cli");
+    // A small map: dim sky plus one very bright pixel (a near-delta sun) that rings negative.
+    Image img = test::render_latlong(64, 32, [](Vec3) { return Rgb{0.01f, 0.01f, 0.01f}; });
+    img.row(20)[10 * 3 + 0] = img.row(20)[10 * 3 + 1] = img.row(20)[10 * 3 + 2] = 5000.0f;
+    ASSERT_TRUE(write_exr(dir + "/sun.exr", img).ok());
+    const std::string out = dir + "/sun_dering.json";
+    std::remove(out.c_str());
+    const auto r = test::run_zhc({"dering", dir + "/sun.exr", "-o", out});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = read_json(out);
+    ASSERT_FALSE(j.is_discarded());
+    ASSERT_EQ(j["probes"].size(), 1u);
+    const auto& p = j["probes"][0];
+    EXPECT_TRUE(p["windowed"].get<bool>());
+    EXPECT_TRUE(p["nonnegative"].get<bool>());
+    EXPECT_GT(p["window"].get<double>(), 0.0);
+    const Sh3Radiance sh = project_latlong(img.rgb.data(), 64, 32, 64 * 3);
+    const DeringResult expected = dering_sh3(sh);
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) EXPECT_EQ(p["sh3"][i][k].get<float>(), expected.radiance[i][k]);
+    EXPECT_DOUBLE_EQ(p["window"].get<double>(), expected.window);
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_LT(p["min_irradiance_bound_before"][k].get<double>(), 0.0);
+        EXPECT_GE(p["min_irradiance_bound_after"][k].get<double>(), 0.0);
+    }
+}
+
+TEST(DeringCli, ProbeListIn_NamesKept_PunctualOption) {
+    const std::string dir = test::temp_dir("dering_cli");
+    const Sh3Radiance a = project_directional({0, 0, 1}, {1, 2, 3});
+    const Sh3Radiance b = project_constant({1, 1, 1});
+    nlohmann::json in;
+    in["probes"] = nlohmann::json::array();
+    for (const auto& [name, sh] : {std::pair{"sun", a}, std::pair{"sky", b}}) {
+        nlohmann::json p;
+        p["name"] = name;
+        nlohmann::json rows = nlohmann::json::array();
+        for (int i = 0; i < 9; ++i) rows.push_back({sh[i].r, sh[i].g, sh[i].b});
+        p["sh3"] = rows;
+        in["probes"].push_back(p);
+    }
+    const std::string text = in.dump();
+    test::write_bytes(dir + "/probes.json", std::vector<std::uint8_t>(text.begin(), text.end()));
+    const auto r = test::run_zhc({"dering", dir + "/probes.json", "-o", dir + "/probes_out.json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = read_json(dir + "/probes_out.json");
+    ASSERT_EQ(j["probes"].size(), 2u);
+    EXPECT_EQ(j["probes"][0]["name"], "sun");
+    EXPECT_TRUE(j["probes"][0]["windowed"].get<bool>());
+    EXPECT_EQ(j["probes"][1]["name"], "sky");
+    EXPECT_FALSE(j["probes"][1]["windowed"].get<bool>());
+    const auto rp = test::run_zhc({"dering", dir + "/probes.json", "-o", dir + "/probes_p.json", "--punctual"});
+    ASSERT_EQ(rp.exit_code, 0) << rp.err;
+    const nlohmann::json jp = read_json(dir + "/probes_p.json");
+    EXPECT_TRUE(jp["probes"][1]["windowed"].get<bool>());
+    EXPECT_DOUBLE_EQ(jp["probes"][1]["scales"][1].get<double>(), 0.92);
+    EXPECT_DOUBLE_EQ(jp["probes"][1]["scales"][2].get<double>(), 0.73);
+    // `zhc project --json` output is accepted as a one-probe list
+    const nlohmann::json single = {{"sh3", in["probes"][0]["sh3"]}};
+    const std::string t2 = single.dump();
+    test::write_bytes(dir + "/single.json", std::vector<std::uint8_t>(t2.begin(), t2.end()));
+    EXPECT_EQ(test::run_zhc({"dering", dir + "/single.json", "-o", dir + "/single_out.json"}).exit_code, 0);
+}
+
+TEST(DeringCli, BadInputsGiveDocumentedExitCodesAndNoOutput) {
+    const std::string dir = test::temp_dir("dering_cli");
+    const std::string out = dir + "/never.json";
+    std::remove(out.c_str());
+    const auto put = [&](const std::string& name, const std::string& text) {
+        test::write_bytes(dir + "/" + name, std::vector<std::uint8_t>(text.begin(), text.end()));
+        return dir + "/" + name;
+    };
+    struct Case { std::string file; int code; };
+    const Case cases[] = {
+        {put("garbage.json", "this is not json"), 4},
+        {put("short.json", "{\"sh3\": [[1,2,3]]}"), 4},
+        {put("strings.json", "[[[\"a\",1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1]]]"), 4},
+        {put("huge.json", "{\"sh3\": [[1e39,1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1],[1,1,1]]}"), 4},
+        {put("noprobe.json", "{\"probes\": [{\"name\": \"x\"}]}"), 4},
+        {put("empty.json", ""), 4},
+        {dir + "/missing.json", 3},
+    };
+    for (const Case& c : cases) {
+        const auto r = test::run_zhc({"dering", c.file, "-o", out});
+        EXPECT_EQ(r.exit_code, c.code) << c.file << ": " << r.err;
+        EXPECT_NE(r.err.find("zhc: error: "), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one-line error: " << r.err;
+        EXPECT_FALSE(std::ifstream(out).good()) << "no output on failure";
+    }
+    const std::string ok = put("ok.json", "{\"sh3\": [[1,1,1],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0]]}");
+    EXPECT_EQ(test::run_zhc({"dering", ok, "-o", dir + "/no_such_dir/x.json"}).exit_code, 7);
+    EXPECT_EQ(test::run_zhc({"dering", ok}).exit_code, 2) << "-o is required";
+}
+
 }  // namespace
 }  // namespace zhc
