@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "audit.h"  // fibonacci_sphere
 #include "codec.h"
 
 namespace zhc {
@@ -237,20 +238,6 @@ double sh3_min_bound(const Sh3AxisForm& form, double s1, double s2, bool early_o
 double sh3_min_bound(const Sh3Channel& f) { return sh3_min_bound(sh3_axis_form(f)); }
 
 // ---- numerical minimum ----------------------------------------------------------------------
-
-std::vector<Vec3> fibonacci_sphere(int n) {
-    std::vector<Vec3> out;
-    if (n <= 0) return out;
-    out.reserve(static_cast<size_t>(n));
-    const double golden = kPi * (3.0 - std::sqrt(5.0));
-    for (int i = 0; i < n; ++i) {
-        const double z = 1.0 - (2.0 * i + 1.0) / n;
-        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-        const double phi = golden * i;
-        out.push_back({r * std::cos(phi), r * std::sin(phi), z});
-    }
-    return out;
-}
 
 namespace {
 

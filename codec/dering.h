@@ -74,10 +74,8 @@ std::array<double, 3> sh3_min_numeric(const Sh3Irradiance& irradiance, int sampl
 
 // Fraction of `directions` at which any channel of the irradiance is negative (0 when empty).
 double negative_fraction(const Sh3Irradiance& irradiance, std::span<const Vec3> directions);
-// Same on `count` spherical-Fibonacci directions (uniform over the sphere).
+// Same on `count` spherical-Fibonacci directions (fibonacci_sphere of codec/audit.h).
 double negative_fraction(const Sh3Irradiance& irradiance, int count = 16384);
-// The spherical-Fibonacci lattice used above: n unit directions, equal-area spread.
-std::vector<Vec3> fibonacci_sphere(int n);
 
 // ---- windowing (Sec. 2.4, Table 1, Eq. 6) ---------------------------------------------------
 
