@@ -216,7 +216,8 @@ TEST(Bound, NeverAboveTheTrueMinimumOnHundredThousandRandomInputs) {
     Generator g(2017);
     const auto dense_dirs = fibonacci_directions(100000);
     int violations = 0, refine_misses = 0;
-    double worst_excess = -1e300, worst_gap = 0;
+    double worst_excess = -1e300, worst_gap = 0, lighting_gap_sum = 0, lighting_gap_max = 0;
+    int lighting = 0;
     for (int i = 0; i < 100000; ++i) {
         const Sh3Channel f = g.any(i);
         const double scale = magnitude(f);
@@ -227,6 +228,12 @@ TEST(Bound, NeverAboveTheTrueMinimumOnHundredThousandRandomInputs) {
         worst_excess = std::max(worst_excess, excess);
         worst_gap = std::max(worst_gap, -excess);
         if (bound > truth.value + 1e-12 * scale) ++violations;
+        if (i % 5 != 4 && f[0] > 0) {  // lighting families: gap as a fraction of the mean (DC) value
+            const double rel = (truth.value - bound) / (kY00 * f[0]);
+            lighting_gap_sum += rel;
+            lighting_gap_max = std::max(lighting_gap_max, rel);
+            ++lighting;
+        }
         if (i < 300) {
             const double dense = dense_min(f, dense_dirs);
             if (truth.value > dense + 1e-12 * scale) {
@@ -238,6 +245,8 @@ TEST(Bound, NeverAboveTheTrueMinimumOnHundredThousandRandomInputs) {
     }
     std::printf("[bound] 1e5 inputs: worst (bound - true)/scale = %.3g, largest gap/scale = %.3g\n",
                 worst_excess, worst_gap);
+    std::printf("[bound] %d lighting inputs: (true - bound) / mean value: mean %.4f, max %.4f\n", lighting,
+                lighting_gap_sum / lighting, lighting_gap_max);
     EXPECT_EQ(refine_misses, 0) << "refined minimum above the 100k-sample minimum";
     EXPECT_EQ(violations, 0);
 }
