@@ -213,6 +213,9 @@ double sh3_min_bound(const Sh3AxisForm& form, double s1, double s2, bool early_o
     //     z is -kY22 q2 (1 - z^2) (Sec. 2.3.2), so a += kY22 q2, c -= kY22 q2;
     //   |m| = 1 pair (Eq. 5): amplitude q1 times kY2 x z rotated; its worst value at height z is
     //     -kY2 q1 |z| sqrt(1 - z^2) (Sec. 2.3.3), a lower bound independent of the |m| = 2 phase.
+    if (!std::isfinite(form.dc) || !std::isfinite(form.linear) || !std::isfinite(form.zonal2) ||
+        !std::isfinite(form.amp1) || !std::isfinite(form.amp2) || !std::isfinite(s1) || !std::isfinite(s2))
+        return std::numeric_limits<double>::quiet_NaN();
     const double f20 = s2 * form.zonal2, q2 = s2 * form.amp2, q1 = s2 * form.amp1;
     const double a = 3.0 * kY20 * f20 + kY22 * q2;
     const double b = kY1 * s1 * form.linear;
@@ -384,6 +387,14 @@ double bisect_window(Pred passes, double lo, int steps, double* step_out) {
 
 DeringResult dering_sh3(const Sh3Radiance& radiance, const DeringOptions& options) {
     DeringResult r;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!std::isfinite(radiance[i][k])) {
+                // Nothing to search on: returned unchanged, flagged as not fixed.
+                r.radiance = radiance;
+                r.nonnegative = false;
+                return r;
+            }
     const WindowScales base = options.punctual ? kPunctualWindow : WindowScales{};
     Sh3AxisForm forms[3];
     for (int k = 0; k < 3; ++k) forms[k] = sh3_axis_form(channel_of(radiance, k));

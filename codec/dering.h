@@ -129,6 +129,7 @@ struct DeringResult {
 };
 
 // Least windowing (on the bound, in double) that makes the irradiance of `radiance` non-negative.
+// Non-finite coefficients: returned unchanged with nonnegative = false (the bound is NaN).
 DeringResult dering_sh3(const Sh3Radiance& radiance, const DeringOptions& options = {});
 
 }  // namespace zhc

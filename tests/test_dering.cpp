@@ -3,6 +3,7 @@
 // lighting, the sh3_dering codec entry and the `zhc dering` verb.
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <random>
 
@@ -502,6 +503,39 @@ TEST(DeringCodec, IsInTheTableAndStoresTheDeringedSh3) {
         (void)c->decode(bytes.data(), o);
         (void)c->irradiance(bytes.data(), o, {0, 0, 1});
     }
+}
+
+TEST(DeringCodec, StoredFloatsKeepTheIrradianceNonNegative) {
+    // The float margin: after encode (windowing + rounding to float) and decode, no direction of
+    // a deringed delta sum is negative at all (not just >= -1e-6 of the mean).
+    const Codec* c = find_codec("sh3_dering");
+    ASSERT_NE(c, nullptr);
+    Generator g(123);
+    const auto dirs = fibonacci_directions(16384);
+    std::vector<std::uint8_t> bytes(c->size_bytes);
+    for (int i = 0; i < 300; ++i) {
+        const Sh3Radiance sh = g.deltas(1 + i % 4);
+        c->encode(sh, CodecOptions{}, bytes.data(), nullptr);
+        const Sh3Radiance back = c->decode(bytes.data(), CodecOptions{});
+        EXPECT_EQ(negative_fraction(to_irradiance(back), dirs), 0.0) << i;
+        const auto m = sh3_min_irradiance_numeric(back);
+        for (int k = 0; k < 3; ++k) EXPECT_GE(m[static_cast<size_t>(k)], 0.0) << i;
+    }
+}
+
+TEST(Dering, NonFiniteInputTerminatesWithoutAFix) {
+    Sh3Radiance sh = project_directional({0, 0, 1}, {1, 1, 1});
+    sh[4].r = std::numeric_limits<float>::quiet_NaN();
+    sh[2].b = std::numeric_limits<float>::infinity();
+    const DeringResult r = dering_sh3(sh);
+    EXPECT_FALSE(r.nonnegative);
+    EXPECT_TRUE(std::isnan(sh3_min_bound(sh3_axis_form(channel_of(sh, 0)))));
+    std::vector<std::uint8_t> bytes(108);
+    EXPECT_FALSE(r.windowed);
+    EXPECT_EQ(std::memcmp(&r.radiance, &sh, sizeof sh), 0) << "returned unchanged";
+    EncodeStats st;
+    find_codec("sh3_dering")->encode(sh, CodecOptions{}, bytes.data(), &st);  // must not hang or trap
+    EXPECT_FALSE(st.dering_clamped);
 }
 
 // ---- the eight real maps: the closing-note report ---------------------------------------------
