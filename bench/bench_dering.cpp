@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "codec/dering.h"
+#include "timing.h"
 
 using namespace zhc;
 
@@ -39,11 +40,10 @@ std::vector<Sh3Radiance> make_probes(int n) {
     return out;
 }
 
+// Median over 5 repeats (bench/timing.h), per item.
 template <class F>
 double time_ns_per(int n, F&& f) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() / n;
+    return zhc::bench::time_repeats(5, f).median_s * 1e9 / n;
 }
 
 volatile double g_sink = 0;
@@ -74,20 +74,21 @@ int main() {
         for (const auto& f : forms) sum += sh3_min_bound(f, 1, 1, true);
     });
     const int mn = 2000;  // the baseline is slow: a subset
-    double gap = 0, mean = 0;
     const double t_numeric = time_ns_per(mn, [&] {
-        for (int i = 0; i < mn; ++i) {
-            const double v = sh3_min_numeric(irr[size_t(i)], 2048, 6).value;
-            gap += v - sh3_min_bound(forms[size_t(i)]);
-            mean += kY00 * irr[size_t(i)][0];
-        }
+        for (int i = 0; i < mn; ++i) sum += sh3_min_numeric(irr[size_t(i)], 2048, 6).value;
+    });
+    double gap = 0, mean = 0;
+    for (int i = 0; i < mn; ++i) {
+        gap += sh3_min_numeric(irr[size_t(i)], 2048, 6).value - sh3_min_bound(forms[size_t(i)]);
+        mean += kY00 * irr[size_t(i)][0];
+    }
+    const double t_dering = time_ns_per(n, [&] {
+        for (const auto& sh : probes) sum += dering_sh3(sh).window;
     });
     int windowed = 0;
-    const double t_dering = time_ns_per(n, [&] {
-        for (const auto& sh : probes) windowed += dering_sh3(sh).windowed ? 1 : 0;
-    });
+    for (const auto& sh : probes) windowed += dering_sh3(sh).windowed ? 1 : 0;
     g_sink = sum;
-    std::printf("bench_dering: %d probes (%d channels) of random HDR lighting, irradiance\n", n, m);
+    std::printf("bench_dering: %d probes (%d channels) of random HDR lighting, irradiance; median of 5 runs\n", n, m);
     std::printf("%-44s %12s %10s\n", "step", "ns/channel", "vs numeric");
     std::printf("%-44s %12.1f %10.5f\n", "axis form (rotate into optimal linear frame)", t_form, t_form / t_numeric);
     std::printf("%-44s %12.1f %10.5f\n", "conservative bound (full)", t_bound, t_bound / t_numeric);
