@@ -167,14 +167,20 @@ double hemisphere_min(double a, double b, double c, double amp) {
     // End of the convex part.
     double zs = 0.0;
     if (a < 0.0) {
-        // Solve 2a + A h''(z) = 0 on (-1, 0); the left side decreases with z (bisection).
-        double lo = -1.0, hi = 0.0;
-        for (int it = 0; it < 200 && hi - lo > 1e-16; ++it) {
-            const double mid = 0.5 * (lo + hi);
-            if (mid <= lo || mid >= hi) break;
-            if (g2(mid) > 0.0) lo = mid; else hi = mid;
+        // Solve F(z) = 2a + A h''(z) = 0 on (-1, 0). F' = A h''' with h'''(z) = -3 / (1 - z^2)^(5/2):
+        // F is decreasing and convex there, so Newton from any point with F > 0 climbs
+        // monotonically towards the root without passing it (the tangent lies below F). Every
+        // iterate keeps g'' >= 0, so [-1, zs] stays inside the convex part.
+        double z = -1.0 / std::sqrt(2.0);
+        while (g2(z) <= 0.0 && z > -1.0) z = 0.5 * (-1.0 + z);  // a start with F > 0
+        for (int it = 0; it < 100; ++it) {
+            const double w = (1.0 - z) * (1.0 + z);
+            const double step = g2(z) * w * w * std::sqrt(w) / (3.0 * amp);  // -F / F'
+            const double next = z + step;
+            if (!(step > 4.0 * std::numeric_limits<double>::epsilon()) || !(next < 0.0) || !(g2(next) >= 0.0)) break;
+            z = next;
         }
-        zs = lo;  // g'' > 0 on [-1, lo]
+        zs = z;
         best = std::min(best, g(zs));
     }
     if (zs <= -1.0) return best;
