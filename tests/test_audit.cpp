@@ -154,8 +154,10 @@ TEST(BenchCli, PrintsJsonRowsAndWritesBothPlots) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     ASSERT_EQ(j["representations"].size(), 2u);
-    EXPECT_EQ(j["representations"][0]["bytes_per_probe"].get<int>(), 108);
-    EXPECT_GT(j["representations"][1]["mean_rmse"].get<double>(), j["representations"][0]["mean_rmse"].get<double>());
+    // Rows follow --representations: sh2 (48 bytes) then sh3 (108 bytes); SH2 has the larger error.
+    EXPECT_EQ(j["representations"][0]["bytes_per_probe"].get<int>(), 48);
+    EXPECT_EQ(j["representations"][1]["bytes_per_probe"].get<int>(), 108);
+    EXPECT_GT(j["representations"][0]["mean_rmse"].get<double>(), j["representations"][1]["mean_rmse"].get<double>());
     EXPECT_GT(j["representations"][0]["encode_ns_per_probe"]["median"].get<double>(), 0.0);
     EXPECT_GT(test::read_bytes(dir + "/error_vs_encode_time.png").size(), 1000u);
     EXPECT_GT(test::read_bytes(dir + "/error_vs_bytes.png").size(), 1000u);
