@@ -428,6 +428,11 @@ TEST(CliConvert, EnvmapInputAndOptions) {
     r = test::run_zhc({"info", map});
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("1024"), std::string::npos);
+    // Same bytes whatever the projection thread count.
+    const std::string t1 = dir + "/t1.zhp", t3 = dir + "/t3.zhp";
+    ASSERT_EQ(test::run_zhc({"convert", map, "-o", t1, "--to", "zh3_q16", "--threads", "1"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"convert", map, "-o", t3, "--to", "zh3_q16", "--threads", "3"}).exit_code, 0);
+    EXPECT_EQ(test::read_bytes(t1), test::read_bytes(t3));
     // JSON output through a representation (a lossy preview) and info on it.
     const std::string js = dir + "/one.json";
     ASSERT_EQ(test::run_zhc({"convert", map, "-o", js, "--to", "zh3_q16"}).exit_code, 0);
