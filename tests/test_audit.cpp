@@ -165,3 +165,33 @@ TEST(BenchCli, PrintsJsonRowsAndWritesBothPlots) {
 
 }  // namespace
 }  // namespace zhc
+
+#include "codec/probe_set.h"
+#include "formats/probe_file.h"
+
+namespace zhc {
+namespace {
+
+TEST(AuditCli, AuditsProbeContainersAndNamesFailingProbes) {
+    std::vector<Sh3Radiance> hubs;
+    for (int i = 0; i < 3; ++i)
+        hubs.push_back(project_cone(normalize_or({double(i), 1, 2}, {0, 0, 1}), 0.4, {2, 1, 1}) + project_constant({0.2f, 0.2f, 0.2f}));
+    auto set = encode_probe_set(hubs, "sh3", StorageParams{}, ProbeLayout{});
+    ASSERT_TRUE(set) << set.error().message;
+    const std::string path = test::temp_dir("audit_probes") + "/three.zhp";
+    ASSERT_TRUE(write_probe_file(path, *set));
+    auto ok = test::run_zhc({"audit", path, "--json", "--no-timing", "--representations", "sh3,sh2"});
+    ASSERT_EQ(ok.exit_code, 0) << ok.err;
+    const auto j = nlohmann::json::parse(ok.out);
+    EXPECT_EQ(j["files"][0]["kind"], "probes");
+    EXPECT_EQ(j["files"][0]["probes"].get<int>(), 3);
+    // Against its own SH3 the hub is exact; SH2 is not.
+    EXPECT_LT(j["files"][0]["representations"]["sh3"]["rmse"].get<double>(), 1e-6);
+    EXPECT_GT(j["files"][0]["representations"]["sh2"]["rmse"].get<double>(), 1e-3);
+    auto gate = test::run_zhc({"audit", path, "--no-timing", "--representations", "sh2", "--max-rmse", "1e-6"});
+    EXPECT_EQ(gate.exit_code, cli::kExitGateFailed);
+    EXPECT_NE(gate.err.find("at probe 0,1,2"), std::string::npos) << gate.err;
+}
+
+}  // namespace
+}  // namespace zhc
