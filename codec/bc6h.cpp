@@ -293,19 +293,36 @@ std::int64_t evaluate(const Target& t, int mode_i, int partition, SubsetFit fit[
         for (int j = 0; j < n; ++j)
             for (int c = 0; c < 3; ++c) pal[s][j][c] = finish(ua[c], ub[c], wts[j]);
     }
+    // Index per texel: project onto the palette's axis, then test the nearest index and its two
+    // neighbours exactly (the palette is linear in the weight up to integer rounding, and the
+    // weights are within 1/64 of uniform, so the best index is among those three).
+    float axis[2][3], inv_len2[2];
+    for (int s = 0; s < ns; ++s) {
+        float l2 = 0;
+        for (int c = 0; c < 3; ++c) {
+            axis[s][c] = static_cast<float>(pal[s][n - 1][c] - pal[s][0][c]);
+            l2 += axis[s][c] * axis[s][c];
+        }
+        inv_len2[s] = l2 > 0 ? static_cast<float>(n - 1) / l2 : 0.0f;
+    }
     std::int64_t err = 0;
     std::uint8_t idx[16];
     for (int i = 0; i < 16; ++i) {
         const int s = pmask >> i & 1;
         const int lim = (i == anchor[s]) ? n / 2 : n;
+        const float proj = (static_cast<float>(t.h[i][0] - pal[s][0][0]) * axis[s][0] +
+                            static_cast<float>(t.h[i][1] - pal[s][0][1]) * axis[s][1] +
+                            static_cast<float>(t.h[i][2] - pal[s][0][2]) * axis[s][2]) * inv_len2[s];
+        const int j0 = std::clamp(static_cast<int>(proj + 0.5f), 0, lim - 1);  // proj < 0 truncates to 0
         int best = 0, be = std::numeric_limits<int>::max();
-        for (int j = 0; j < lim; ++j) {
+        for (int j = std::max(0, j0 - 1); j <= std::min(lim - 1, j0 + 1); ++j) {
             const int d0 = pal[s][j][0] - t.h[i][0], d1 = pal[s][j][1] - t.h[i][1], d2 = pal[s][j][2] - t.h[i][2];
             const int e = d0 * d0 + d1 * d1 + d2 * d2;
             if (e < be) be = e, best = j;
         }
         idx[i] = static_cast<std::uint8_t>(best);
         err += be;
+        if (err >= out.err) return err;  // cannot win any more
     }
     if (err < out.err) {
         out.err = err;
@@ -340,6 +357,45 @@ void refine(const Target& t, const Encoded& e, SubsetFit fit[2]) {
     }
 }
 
+// Whether the quantized initial endpoints of both subsets fit the mode's delta precision.
+bool deltas_fit(const Mode& md, const SubsetFit fit[2]) {
+    if (!md.transformed) return true;
+    int q[4][3];
+    for (int s = 0; s < 2; ++s)
+        for (int c = 0; c < 3; ++c) {
+            q[2 * s][c] = quantize(fit[s].a[c], md.ep_bits);
+            q[2 * s + 1][c] = quantize(fit[s].b[c], md.ep_bits);
+        }
+    // Either orientation of subset 0 may become the base after the anchor fix: test both.
+    for (int flip = 0; flip < 2; ++flip) {
+        const int base = flip;
+        bool ok = true;
+        for (int e = 0; e < 4 && ok; ++e) {
+            if (e == base) continue;
+            for (int c = 0; c < 3; ++c) {
+                const int d = sign_extend(q[e][c] - q[base][c], md.ep_bits);
+                const int lim = 1 << (md.delta_bits[c] - 1);
+                if (d < -lim || d >= lim) ok = false;
+            }
+        }
+        if (ok) return true;
+    }
+    return false;
+}
+
+// The most precise one-subset delta mode (16/4, 12/8, 11/9 bits) whose delta range holds the
+// endpoint span: 2^(db-1) - 1 steps of 2^(16 - ep) in the unquantized domain; -1 if none.
+int best_delta_mode(const SubsetFit& f) {
+    float span = 0;
+    for (int c = 0; c < 3; ++c) span = std::max(span, std::abs(f.b[c] - f.a[c]));
+    for (int m : {13, 12, 11}) {
+        const Mode& md = modes()[static_cast<size_t>(m)];
+        if (span < static_cast<float>((1 << (md.delta_bits[0] - 1)) - 1) * static_cast<float>(1 << (16 - md.ep_bits)))
+            return m;
+    }
+    return -1;
+}
+
 // Fit one (mode, partition) with `iters` refinement rounds; updates `best`.
 void try_mode(const Target& t, int mode_i, int partition, const SubsetFit init[2], int iters, Encoded& best) {
     SubsetFit fit[2] = {init[0], init[1]};
@@ -354,38 +410,47 @@ void try_mode(const Target& t, int mode_i, int partition, const SubsetFit init[2
     if (local.err < best.err) best = local;
 }
 
-// Cheap score of a partition: for each subset the squared residual orthogonal to its principal
-// axis (what a line fit cannot represent), from per-subset moments.
-float partition_score(const Target& t, int p) {
-    float score = 0;
-    for (int s = 0; s < 2; ++s) {
-        float mean[3] = {0, 0, 0}, cov[6] = {0, 0, 0, 0, 0, 0};
-        int n = 0;
-        for (int i = 0; i < 16; ++i)
-            if ((kPartition[p] >> i & 1) == s) {
-                for (int c = 0; c < 3; ++c) mean[c] += t.u[i][c];
-                ++n;
-            }
-        for (float& m : mean) m /= static_cast<float>(n);
-        for (int i = 0; i < 16; ++i)
-            if ((kPartition[p] >> i & 1) == s) {
-                const float d0 = t.u[i][0] - mean[0], d1 = t.u[i][1] - mean[1], d2 = t.u[i][2] - mean[2];
-                cov[0] += d0 * d0, cov[1] += d0 * d1, cov[2] += d0 * d2;
-                cov[3] += d1 * d1, cov[4] += d1 * d2, cov[5] += d2 * d2;
-            }
-        float ax[3] = {1, 1, 1}, lambda = 0;
-        for (int it = 0; it < 4; ++it) {
-            const float x = cov[0] * ax[0] + cov[1] * ax[1] + cov[2] * ax[2];
-            const float y = cov[1] * ax[0] + cov[3] * ax[1] + cov[4] * ax[2];
-            const float z = cov[2] * ax[0] + cov[4] * ax[1] + cov[5] * ax[2];
-            const float m = std::sqrt(x * x + y * y + z * z);
-            if (m <= 0) break;
-            lambda = m;
-            ax[0] = x / m, ax[1] = y / m, ax[2] = z / m;
-        }
-        score += std::max(0.0f, cov[0] + cov[3] + cov[5] - lambda);
+// Cheap score of every partition: for each subset the squared residual orthogonal to its
+// principal axis (what a line fit cannot represent), from per-subset moments. Subset 0's moments
+// are the block's minus subset 1's, so each partition costs one masked sum.
+void partition_scores(const Target& t, float score[32]) {
+    float m[16][9];
+    float total[9] = {};
+    for (int i = 0; i < 16; ++i) {
+        const float x = t.u[i][0] * (1.0f / 256), y = t.u[i][1] * (1.0f / 256), z = t.u[i][2] * (1.0f / 256);
+        const float v[9] = {x, y, z, x * x, x * y, x * z, y * y, y * z, z * z};
+        for (int k = 0; k < 9; ++k) m[i][k] = v[k], total[k] += v[k];
     }
-    return score;
+    for (int p = 0; p < 32; ++p) {
+        float s1[9] = {};
+        int n1 = 0;
+        for (int i = 0; i < 16; ++i)
+            if (kPartition[p] >> i & 1) {
+                for (int k = 0; k < 9; ++k) s1[k] += m[i][k];
+                ++n1;
+            }
+        float sc = 0;
+        for (int s = 0; s < 2; ++s) {
+            float a[9];
+            const int n = s ? n1 : 16 - n1;
+            for (int k = 0; k < 9; ++k) a[k] = s ? s1[k] : total[k] - s1[k];
+            const float inv = 1.0f / static_cast<float>(n);
+            const float cov[6] = {a[3] - a[0] * a[0] * inv, a[4] - a[0] * a[1] * inv, a[5] - a[0] * a[2] * inv,
+                                  a[6] - a[1] * a[1] * inv, a[7] - a[1] * a[2] * inv, a[8] - a[2] * a[2] * inv};
+            float ax[3] = {1, 1, 1}, lambda = 0;
+            for (int it = 0; it < 4; ++it) {
+                const float x = cov[0] * ax[0] + cov[1] * ax[1] + cov[2] * ax[2];
+                const float y = cov[1] * ax[0] + cov[3] * ax[1] + cov[4] * ax[2];
+                const float z = cov[2] * ax[0] + cov[4] * ax[1] + cov[5] * ax[2];
+                const float len = std::sqrt(x * x + y * y + z * z);
+                if (!(len > 0)) break;
+                lambda = len;
+                ax[0] = x / len, ax[1] = y / len, ax[2] = z / len;
+            }
+            sc += std::max(0.0f, cov[0] + cov[3] + cov[5] - lambda);
+        }
+        score[p] = sc;
+    }
 }
 
 void make_target(const float rgb[16][3], Target& t) {
@@ -558,15 +623,24 @@ void encode_block(const float rgb[16][3], Quality quality, std::uint8_t out[16])
         case Quality::kFast: {
             // Mode 11 (10-bit absolute) plus the most precise delta mode whose deltas fit.
             try_mode(t, 10, 0, one, 1, best);
-            float span = 0;
-            for (int c = 0; c < 3; ++c) span = std::max(span, std::abs(one[0].b[c] - one[0].a[c]));
-            // Delta range of mode m in the unquantized domain: 2^(db-1) steps of 2^(16-ep).
-            for (int m : {13, 12, 11}) {
-                const Mode& md = modes()[static_cast<size_t>(m)];
-                if (span < static_cast<float>((1 << (md.delta_bits[0] - 1)) - 1) * static_cast<float>(1 << (16 - md.ep_bits))) {
-                    try_mode(t, m, 0, one, 1, best);
-                    break;
-                }
+            const int dm = best_delta_mode(one[0]);
+            if (dm >= 0) try_mode(t, dm, 0, one, 1, best);
+            // Blocks with a large error (> ~6 half ULPs rms per value): the single best-scoring
+            // partition with its most precise fitting mode.
+            if (best.err > 48 * 36) {
+                float score[32];
+                partition_scores(t, score);
+                const int bp = static_cast<int>(std::min_element(score, score + 32) - score);
+                SubsetFit two[2];
+                initial_endpoints(t, static_cast<std::uint16_t>(~kPartition[bp]), two[0].a, two[0].b);
+                initial_endpoints(t, kPartition[bp], two[1].a, two[1].b);
+                int mode2 = 9;
+                for (const int m : {2, 3, 4, 0, 5, 6, 7, 8, 1})
+                    if (deltas_fit(modes()[static_cast<size_t>(m)], two)) {
+                        mode2 = m;
+                        break;
+                    }
+                try_mode(t, mode2, bp, two, 1, best);
             }
             break;
         }
@@ -574,27 +648,46 @@ void encode_block(const float rgb[16][3], Quality quality, std::uint8_t out[16])
         case Quality::kExhaustive: {
             const bool ex = quality == Quality::kExhaustive;
             const int iters = ex ? 4 : 2;
-            for (int m = 10; m < 14; ++m) try_mode(t, m, 0, one, iters, best);
-            // Two subsets: exhaustive tries every partition with every mode; default only for
-            // blocks whose one-subset error is above ~1 half ULP rms per channel, and only the 4
-            // partitions whose subsets are closest to lines.
-            if (!ex && best.err <= 48) break;
+            if (ex) {
+                for (int m = 10; m < 14; ++m) try_mode(t, m, 0, one, iters, best);
+            } else {
+                try_mode(t, 10, 0, one, iters, best);
+                const int dm = best_delta_mode(one[0]);
+                if (dm >= 0) try_mode(t, dm, 0, one, iters, best);
+            }
+            // Two subsets: exhaustive tries every partition with every mode.
+            // Default: two subsets only for blocks above ~3 half ULPs rms per value, and only the
+            // 3 partitions whose subsets are closest to lines (tuned with bench_bc6h).
+            const int npart = 3;
+            if (!ex && best.err <= 48 * 9) break;
             int order[32];
             for (int p = 0; p < 32; ++p) order[p] = p;
             int count = 32;
             if (!ex) {
                 float score[32];
-                for (int p = 0; p < 32; ++p) score[p] = partition_score(t, p);
-                std::partial_sort(order, order + 4, order + 32,
+                partition_scores(t, score);
+                std::partial_sort(order, order + npart, order + 32,
                                   [&](int a, int b) { return score[a] < score[b] || (score[a] == score[b] && a < b); });
-                count = 4;
+                count = npart;
             }
             for (int k = 0; k < count; ++k) {
                 const int p = order[k];
                 SubsetFit two[2];
                 initial_endpoints(t, static_cast<std::uint16_t>(~kPartition[p]), two[0].a, two[0].b);
                 initial_endpoints(t, kPartition[p], two[1].a, two[1].b);
-                for (int m = 0; m < 10; ++m) try_mode(t, m, p, two, iters, best);
+                if (ex) {
+                    for (int m = 0; m < 10; ++m) try_mode(t, m, p, two, iters, best);
+                    continue;
+                }
+                // Default: the two most precise modes whose deltas hold the initial endpoints
+                // without clamping; the absolute 6-bit mode when none does.
+                int tried = 0;
+                for (const int m : {2, 3, 4, 0, 5, 6, 7, 8, 1}) {
+                    if (!deltas_fit(modes()[static_cast<size_t>(m)], two)) continue;
+                    try_mode(t, m, p, two, iters, best);
+                    if (++tried == 2) break;
+                }
+                if (tried == 0) try_mode(t, 9, p, two, iters, best);
             }
             break;
         }
