@@ -78,6 +78,7 @@ void for_cap_nodes(double c, F&& f) {
 // constant 1, and the HLSH projection vectors over the upper hemisphere.
 struct Tables {
     Vec9 hemi{}, ambient{};
+    Vec9 g_hemi_hemi{}, g_hemi_ambient{};  // G_hemi times the two constant terms
     Vec9 p_one_minus_z{}, p_x{}, p_y{};  // integral over z >= 0 of Y_i * (1 - z), Y_i x, Y_i y
     Vec9 y_up{};                         // Y_i(+Z)
     Mat9 g_hemi{}, g_sphere{};
@@ -99,6 +100,8 @@ const Tables& tables() {
         });
         t.y_up = sh3_basis({0, 0, 1});
         t.g_hemi = cap_gram(0.0);
+        t.g_hemi_hemi = mul(t.g_hemi, t.hemi);
+        t.g_hemi_ambient = mul(t.g_hemi, t.ambient);
         for (int i = 0; i < 9; ++i) t.g_sphere[static_cast<size_t>(i * 10)] = 1.0;
         return t;
     }();
@@ -160,7 +163,8 @@ Fit fit_direction(const Target& tg, Vec3 d, Model model, const Mat9& g) {
     Vec9 a = clamped_cosine_sh(d);
     for (double& v : a) v /= d.z;
     const Vec9 ga = mul(g, a);
-    const Vec9 gh = mul(g, h);
+    // G h is constant; reuse the precomputed product for the hemispherical Gram matrix.
+    const Vec9 gh = &g == &tb.g_hemi ? (model == Model::kHhd ? tb.g_hemi_hemi : tb.g_hemi_ambient) : mul(g, h);
     const double aga = dot9(a, ga), agh = dot9(a, gh), hgh = dot9(h, gh);
     const double bgb = hgh - 2 * agh + aga;
     double r0[3], bgr[3], num = 0, den = 0;
@@ -318,14 +322,12 @@ IrradZ encode(const Sh3Radiance& tangent_radiance, const EncodeOptions& options,
     };
     const int steps = std::max(2, options.scan_steps);
     Fit best = eval(0.0, phi);
-    int best_j = 0;
     for (int j = 1; j < steps; ++j) {
         const double th = kMaxTheta * j / (steps - 1);
         const Fit f = eval(th, phi);
         if (f.err < best.err) {
             best = f;
             theta = th;
-            best_j = j;
         }
     }
     // Golden-section search for the minimum of err over [lo, hi]; keeps the best point seen.
@@ -450,7 +452,7 @@ Rgb evaluate(const Hlsh& h, Vec3 m) {
 }
 
 Sh3Radiance cap_multiply(const Sh3Radiance& l, double cos_alpha) {
-    const Mat9 g = cap_gram(cos_alpha);
+    const Mat9 g = cos_alpha == 0.0 ? hemisphere_gram() : cap_gram(cos_alpha);
     Sh3Radiance o;
     for (int k = 0; k < 3; ++k) {
         Vec9 v{};

@@ -68,7 +68,7 @@ struct EncodeOptions {
     Model model = Model::kHhd;
     Solve solve = Solve::kSearch;
     int scan_steps = 8;           // coarse theta samples before golden-section (bracketing)
-    int golden_iterations = 24;   // golden-section steps (bracket shrinks by 0.618^n)
+    int golden_iterations = 16;   // golden-section steps (bracket shrinks by 0.618^16 ~ 5e-4)
     int azimuth_rounds = 1;       // phi-then-theta refinement rounds after the talk's theta search
     LuminanceWeights luminance;   // azimuth of the search plane from the luminance L1 band
 };

@@ -60,8 +60,10 @@ ShLightmap synthesize_sphere(const Sh3Radiance& world, int width, int height, in
                     n.x = ox, n.y = oy;
                 }
                 n = normalize_or(n, {0, 0, 1});
+                // The surface hides the lower hemisphere: a baker sees radiance over the visible
+                // hemisphere only, so window the rotated radiance by it (SH3 hemisphere multiply).
                 lm.texels[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)] =
-                    rotate(world, transpose(frame_from_z(n)));
+                    irradz::cap_multiply(rotate(world, transpose(frame_from_z(n))), 0.0);
             }
     });
     return lm;

@@ -22,7 +22,8 @@ struct ShLightmap {
 
 // A synthetic lightmap: the surface of a unit sphere (texel (x, y) -> normal by the octahedral
 // map of the whole sphere) lit by the world-space SH3 radiance `world`; each texel holds `world`
-// rotated into its tangent frame (frame_from_z(normal)).
+// rotated into its tangent frame (frame_from_z(normal)) and multiplied by the visible (upper)
+// hemisphere, projected back to SH3 (irradz::cap_multiply with cos_alpha = 0), as a baker would see it.
 ShLightmap synthesize_sphere(const Sh3Radiance& world, int width, int height, int threads = 1);
 
 // The stored parameters as float planes (before or after block compression).
