@@ -151,6 +151,8 @@ int main(int argc, char** argv) {
         for (int k = 0; k < 4; ++k) std::printf(" %6.2f %6.2f |", sum[pass][k][0] / count[pass], sum[pass][k][1] / count[pass]);
         std::printf("\n%-22s |", "  dB vs exhaustive");
         for (int k = 0; k < 4; ++k) std::printf(" %+6.2f        |", (sum[pass][k][0] - sum[pass][3][0]) / count[pass]);
+        std::printf("\n%-22s |", "  speed / mode11");
+        for (int k = 0; k < 4; ++k) std::printf(" %6.3f        |", sum[pass][k][1] / sum[pass][0][1]);
         std::printf("\n");
     }
     std::printf("\nBC4 (w_a plane) and BC5 (d plane) of the lightmaps: PSNR (dB, unorm) and Mpixel/s on 1 thread\n");
