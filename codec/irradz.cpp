@@ -79,6 +79,10 @@ void for_cap_nodes(double c, F&& f) {
 struct Tables {
     Vec9 hemi{}, ambient{};
     Vec9 g_hemi_hemi{}, g_hemi_ambient{};  // G_hemi times the two constant terms
+    // Non-zero entries of G_hemi: over z >= 0 the phi integral only pairs basis functions of the
+    // same m (and sin/cos type), so 19 of the 81 entries are non-zero.
+    std::array<std::uint8_t, 81> nz_i{}, nz_j{};
+    int nnz = 0;
     Vec9 p_one_minus_z{}, p_x{}, p_y{};  // integral over z >= 0 of Y_i * (1 - z), Y_i x, Y_i y
     Vec9 y_up{};                         // Y_i(+Z)
     Mat9 g_hemi{}, g_sphere{};
@@ -100,6 +104,12 @@ const Tables& tables() {
         });
         t.y_up = sh3_basis({0, 0, 1});
         t.g_hemi = cap_gram(0.0);
+        for (int i = 0; i < 9; ++i)
+            for (int j = 0; j < 9; ++j)
+                if (std::abs(t.g_hemi[static_cast<size_t>(i * 9 + j)]) > 1e-12) {
+                    t.nz_i[static_cast<size_t>(t.nnz)] = static_cast<std::uint8_t>(i);
+                    t.nz_j[static_cast<size_t>(t.nnz++)] = static_cast<std::uint8_t>(j);
+                }
         t.g_hemi_hemi = mul(t.g_hemi, t.hemi);
         t.g_hemi_ambient = mul(t.g_hemi, t.ambient);
         for (int i = 0; i < 9; ++i) t.g_sphere[static_cast<size_t>(i * 10)] = 1.0;
@@ -162,7 +172,15 @@ Fit fit_direction(const Target& tg, Vec3 d, Model model, const Mat9& g) {
     const Vec9& h = model == Model::kHhd ? tb.hemi : tb.ambient;
     Vec9 a = clamped_cosine_sh(d);
     for (double& v : a) v /= d.z;
-    const Vec9 ga = mul(g, a);
+    Vec9 ga{};
+    if (&g == &tb.g_hemi) {
+        for (int k = 0; k < tb.nnz; ++k) {
+            const size_t i = tb.nz_i[static_cast<size_t>(k)], j = tb.nz_j[static_cast<size_t>(k)];
+            ga[i] += g[i * 9 + j] * a[j];
+        }
+    } else {
+        ga = mul(g, a);
+    }
     // G h is constant; reuse the precomputed product for the hemispherical Gram matrix.
     const Vec9 gh = &g == &tb.g_hemi ? (model == Model::kHhd ? tb.g_hemi_hemi : tb.g_hemi_ambient) : mul(g, h);
     const double aga = dot9(a, ga), agh = dot9(a, gh), hgh = dot9(h, gh);
