@@ -161,15 +161,57 @@ struct RowSums {
     double s[5][3];
 };
 
+// Columns c and W-1-c are mirror images (phi -> -phi): their integrals of 1, cos(phi), cos(2 phi)
+// are equal and those of sin(phi), sin(2 phi) are opposite, so each mirrored pair needs the sum of
+// its two pixels for the even factors and their difference for the odd ones: half the multiplies.
 void project_rows(const float* rgb, int width, size_t row_stride, int row_begin, int row_end,
                   const std::vector<double>& column_integrals, RowSums* out) {
+    const int half = width / 2;
+    // With width % 4 == 0 the half-period shift (phi -> phi - pi: cos, sin change sign, cos 2phi,
+    // sin 2phi do not) adds a second symmetry: columns c, W-1-c, c+W/2, W/2-1-c share one set of
+    // integrals up to signs, and the five sums need four adds and five multiplies per quad.
+    const bool quads = width % 4 == 0;
     for (int row = row_begin; row < row_end; ++row) {
         const float* p = rgb + static_cast<size_t>(row) * row_stride;
         double acc[5][3] = {};
-        for (int col = 0; col < width; ++col) {
+        if (quads) {
+            const int quarter = width / 4;
+            for (int col = 0; col < quarter; ++col) {
+                const double* t = &column_integrals[static_cast<size_t>(col) * 5];
+                const float* a = p + col * 3;                     // phi
+                const float* b = p + (width - 1 - col) * 3;       // -phi
+                const float* c = p + (col + half) * 3;            // phi - pi
+                const float* d = p + (half - 1 - col) * 3;        // pi - phi
+                for (int k = 0; k < 3; ++k) {
+                    const double ab = double(a[k]) + b[k], cd = double(c[k]) + d[k];
+                    const double amb = double(a[k]) - b[k], cmd = double(c[k]) - d[k];
+                    acc[0][k] += (ab + cd) * t[0];
+                    acc[1][k] += (ab - cd) * t[1];
+                    acc[2][k] += (amb - cmd) * t[2];
+                    acc[3][k] += (ab + cd) * t[3];
+                    acc[4][k] += (amb + cmd) * t[4];
+                }
+            }
+            std::copy(&acc[0][0], &acc[0][0] + 15, &out[row].s[0][0]);
+            continue;
+        }
+        for (int col = 0; col < half; ++col) {
             const double* t = &column_integrals[static_cast<size_t>(col) * 5];
+            const float* a = p + col * 3;
+            const float* b = p + (width - 1 - col) * 3;
             for (int k = 0; k < 3; ++k) {
-                const double v = p[col * 3 + k];
+                const double even = double(a[k]) + b[k], odd = double(a[k]) - b[k];
+                acc[0][k] += even * t[0];
+                acc[1][k] += even * t[1];
+                acc[2][k] += odd * t[2];
+                acc[3][k] += even * t[3];
+                acc[4][k] += odd * t[4];
+            }
+        }
+        if (width % 2) {  // the middle column of an odd width pairs with itself
+            const double* t = &column_integrals[static_cast<size_t>(half) * 5];
+            for (int k = 0; k < 3; ++k) {
+                const double v = p[half * 3 + k];
                 for (int j = 0; j < 5; ++j) acc[j][k] += v * t[j];
             }
         }

@@ -10,6 +10,7 @@
 #include <ImfStandardAttributes.h>
 #include <ImfTestFile.h>
 #include <stb_image.h>
+#include <stb_image_write.h>
 
 #include <cmath>
 #include <cstring>
@@ -99,13 +100,75 @@ Status check_finite(const std::string& name, Image& img, const EnvmapReadOptions
     return Ok{};
 }
 
+// Walks the OpenEXR header(s) without allocating before OpenEXR sees them: every attribute must
+// fit inside the file (OpenEXR would otherwise allocate an attribute's declared size, up to 2 GiB,
+// before noticing the file is short), and the data window's declared size is checked against
+// zhc's limits first. Header layout: magic, version, then attributes "name\0type\0" int32 size,
+// value; a 0 byte ends a header; multi-part files (version bit 12) end the list with another 0.
+Status validate_exr_header(std::span<const std::uint8_t> b, const std::string& name, const EnvmapReadOptions& o) {
+    if (b.size() < 8) return make_error(ErrorCode::kTruncated, name + ": OpenEXR file ends inside its magic/version");
+    std::uint32_t version;
+    std::memcpy(&version, b.data() + 4, 4);
+    const bool multipart = (version & 0x1000u) != 0;
+    const size_t max_name = (version & 0x400u) ? 255 : 31;
+    size_t pos = 8;
+    auto truncated = [&]() {
+        return make_error(ErrorCode::kTruncated, name + ": OpenEXR header ends early (byte " + std::to_string(pos) + ")");
+    };
+    auto read_cstr = [&](std::string* out) -> bool {
+        out->clear();
+        while (pos < b.size() && b[pos] != 0 && out->size() <= max_name) out->push_back(static_cast<char>(b[pos++]));
+        if (pos >= b.size() || b[pos] != 0) return false;
+        ++pos;
+        return true;
+    };
+    for (int part = 0; part < 64; ++part) {
+        for (int attrs = 0;; ++attrs) {
+            if (pos >= b.size()) return truncated();
+            if (b[pos] == 0) {
+                ++pos;
+                break;
+            }
+            if (attrs >= 1024) return make_error(ErrorCode::kBadFormat, name + ": OpenEXR header has too many attributes");
+            const size_t at = pos;
+            std::string attr, type;
+            if (!read_cstr(&attr) || !read_cstr(&type)) {
+                if (pos >= b.size()) return truncated();
+                return make_error(ErrorCode::kBadFormat,
+                                  name + ": malformed OpenEXR attribute name or type at byte " + std::to_string(at));
+            }
+            if (pos + 4 > b.size()) return truncated();
+            std::int32_t size;
+            std::memcpy(&size, b.data() + pos, 4);
+            pos += 4;
+            if (size < 0) return make_error(ErrorCode::kBadFormat, name + ": OpenEXR attribute '" + attr + "' has a negative size");
+            if (pos + static_cast<size_t>(size) > b.size()) return truncated();
+            if (attr == "dataWindow" && type == "box2i" && size == 16) {
+                std::int32_t v[4];
+                std::memcpy(v, b.data() + pos, 16);
+                const std::int64_t w = std::int64_t(v[2]) - v[0] + 1, h = std::int64_t(v[3]) - v[1] + 1;
+                if (w <= 0 || h <= 0) return make_error(ErrorCode::kBadFormat, name + ": OpenEXR data window is empty");
+                if (Status st = check_size(name, static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), o); !st)
+                    return st;
+            }
+            pos += static_cast<size_t>(size);
+        }
+        if (!multipart) return Ok{};
+        if (pos >= b.size()) return truncated();
+        if (b[pos] == 0) return Ok{};  // end of the header list
+    }
+    return make_error(ErrorCode::kUnsupported, name + ": OpenEXR file has more than 64 parts");
+}
+
 Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& name, const EnvmapReadOptions& o,
                        EnvmapInfo* info) {
+    if (Status s = validate_exr_header(bytes, name, o); !s) return s.error();
     try {
-        // Limit what OpenEXR itself allocates while reading the header (line offset tables).
-        const int side = static_cast<int>(std::min<std::uint64_t>(o.max_pixels, 1u << 30));
-        Imf::Header::setMaxImageSize(side, side);
-        Imf::Header::setMaxTileSize(side, side);
+        // Bound what OpenEXR itself allocates while reading the header (its line-offset table
+        // grows with the height): 2^20 per side, far above any real map; zhc's own pixel limit is
+        // checked below, before the pixel buffer is allocated.
+        Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
+        Imf::Header::setMaxTileSize(1 << 20, 1 << 20);
         MemoryIStream stream(bytes, name);
         Imf::InputFile file(stream);
         const Imath::Box2i dw = file.header().dataWindow();
@@ -156,8 +219,67 @@ Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& n
         std::string what = e.what();
         for (char& ch : what)
             if (ch == '\n' || ch == '\r') ch = ' ';
+        if (what.find("exceeds the maximum") != std::string::npos)
+            return make_error(ErrorCode::kTooLarge, name + ": OpenEXR image too large (" + what + ")");
+        if (what.find("unexpected end of file") != std::string::npos)
+            return make_error(ErrorCode::kTruncated, name + ": OpenEXR file is truncated (" + what + ")");
         return make_error(ErrorCode::kBadFormat, name + ": cannot read OpenEXR data (" + what + ")");
     }
+}
+
+// stb_image silently fills rows that a truncated .hdr is missing; walk the scanline structure
+// first (new-style RLE or flat RGBE pixels) so truncation is an error. Header: lines up to an
+// empty line, then the resolution line.
+Status validate_hdr_scanlines(std::span<const std::uint8_t> b, const std::string& name, int width, int height) {
+    size_t pos = 0;
+    // Skip header lines until the blank line, then the resolution line.
+    bool blank = false;
+    while (pos < b.size() && !blank) {
+        const size_t start = pos;
+        while (pos < b.size() && b[pos] != '\n') ++pos;
+        blank = pos == start;
+        ++pos;
+    }
+    while (pos < b.size() && b[pos] != '\n') ++pos;
+    ++pos;
+    auto truncated = [&](int row) {
+        return make_error(ErrorCode::kTruncated, name + ": Radiance .hdr data ends in scanline " + std::to_string(row) +
+                                                     " of " + std::to_string(height));
+    };
+    for (int row = 0; row < height; ++row) {
+        if (pos + 4 > b.size()) return truncated(row);
+        const bool rle = width >= 8 && width < 32768 && b[pos] == 2 && b[pos + 1] == 2 && (b[pos + 2] & 0x80) == 0;
+        if (!rle) {
+            // Flat (or old-style RLE, which only shortens data): at most 4 bytes per pixel remain.
+            const std::uint64_t need = static_cast<std::uint64_t>(width) * 4;
+            if (pos + need > b.size()) {
+                // Old-style RLE can be shorter than flat data; let stb decide when this is the last row.
+                return row == height - 1 ? Status(Ok{}) : Status(truncated(row));
+            }
+            pos += need;
+            continue;
+        }
+        pos += 4;
+        for (int channel = 0; channel < 4; ++channel) {
+            int filled = 0;
+            while (filled < width) {
+                if (pos >= b.size()) return truncated(row);
+                int count = b[pos++];
+                if (count > 128) {
+                    count -= 128;
+                    if (pos >= b.size()) return truncated(row);
+                    ++pos;
+                } else {
+                    if (count == 0 || pos + static_cast<size_t>(count) > b.size()) return truncated(row);
+                    pos += static_cast<size_t>(count);
+                }
+                filled += count;
+            }
+            if (filled != width)
+                return make_error(ErrorCode::kBadFormat, name + ": Radiance .hdr run overruns scanline " + std::to_string(row));
+        }
+    }
+    return Ok{};
 }
 
 Result<Image> read_hdr(std::span<const std::uint8_t> bytes, const std::string& name, const EnvmapReadOptions& o,
@@ -171,17 +293,7 @@ Result<Image> read_hdr(std::span<const std::uint8_t> bytes, const std::string& n
                           name + ": malformed Radiance .hdr header (" + stbi_failure_reason() + ")");
     if (Status s = check_size(name, static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), o); !s)
         return s.error();
-    // A scanline needs at least a few bytes; a file much too short for its declared size is
-    // truncated (stb_image would silently fill the missing rows).
-    if (Status s = [&]() -> Status {
-            // Minimum bytes per scanline: 4 (an RLE scanline header or one flat pixel).
-            if (bytes.size() < static_cast<std::uint64_t>(h) * 4)
-                return make_error(ErrorCode::kTruncated, name + ": Radiance .hdr data ends before its " +
-                                                              std::to_string(h) + " scanlines");
-            return Ok{};
-        }();
-        !s)
-        return s.error();
+    if (Status s = validate_hdr_scanlines(bytes, name, w, h); !s) return s.error();
     int x = 0, y = 0, n = 0;
     std::unique_ptr<float, void (*)(void*)> data(stbi_loadf_from_memory(bytes.data(), len, &x, &y, &n, 3),
                                                  stbi_image_free);
@@ -241,6 +353,17 @@ Status write_exr(const std::string& path, const Image& image) {
         } catch (const std::exception& e) {
             return make_error(ErrorCode::kIoError, path + ": cannot write OpenEXR (" + e.what() + ")");
         }
+    });
+}
+
+Status write_hdr(const std::string& path, const Image& image) {
+    if (image.width <= 0 || image.height <= 0 ||
+        image.rgb.size() != static_cast<size_t>(image.width) * static_cast<size_t>(image.height) * 3)
+        return make_error(ErrorCode::kInvalidArgument, path + ": image buffer does not match its size");
+    return write_via_temporary(path, [&](const std::string& tmp) -> Status {
+        if (!stbi_write_hdr(tmp.c_str(), image.width, image.height, 3, image.rgb.data()))
+            return make_error(ErrorCode::kIoError, path + ": cannot write Radiance .hdr");
+        return Ok{};
     });
 }
 

@@ -57,5 +57,7 @@ bool looks_like_envmap(std::span<const std::uint8_t> bytes);
 
 // Writes a float RGB OpenEXR (ZIP compression), atomically.
 Status write_exr(const std::string& path, const Image& image);
+// Writes a Radiance .hdr (RGBE, run-length encoded), atomically.
+Status write_hdr(const std::string& path, const Image& image);
 
 }  // namespace zhc

@@ -1,0 +1,33 @@
+// Tiny timing helpers for the plain-main benchmarks: medians over repeats with the spread.
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+namespace zhc::bench {
+
+struct Timing {
+    double median_s = 0, min_s = 0, max_s = 0;
+};
+
+// Runs fn() `repeats` times and returns median/min/max wall time in seconds.
+template <class F>
+Timing time_repeats(int repeats, F&& fn) {
+    std::vector<double> t;
+    for (int i = 0; i < repeats; ++i) {
+        const auto a = std::chrono::steady_clock::now();
+        fn();
+        t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count());
+    }
+    std::sort(t.begin(), t.end());
+    return {t[t.size() / 2], t.front(), t.back()};
+}
+
+// Keeps the optimiser from discarding a computed value.
+template <class T>
+inline void keep(const T& value) {
+    asm volatile("" : : "g"(&value) : "memory");
+}
+
+}  // namespace zhc::bench

@@ -1,0 +1,293 @@
+// zhc audit FILE|FOLDER... : every representation's irradiance error, size and speed per input.
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include "formats/audit_inputs.h"
+#include "cli.h"
+#include "codec/audit.h"
+#include "formats/file_io.h"
+
+namespace zhc::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Options {
+    std::vector<std::string> inputs;
+    std::string representations;
+    bool json = false;
+    std::string markdown;
+    std::string images;
+    int directions = 2048;
+    int threads = 0;
+    bool progress = false;
+    bool no_timing = false;
+    double max_rmse = -1, max_relative_rmse = -1;
+    bool fail_on_negative = false;
+    bool replace_non_finite = false;
+};
+
+struct FileReport {
+    AuditInput input;
+    std::vector<RepresentationResult> results;  // pooled over the file's probes
+    std::vector<std::vector<std::size_t>> worst_probes;  // per representation: probe indices failing a gate
+};
+
+std::string fmt(double v, const char* f = "%.4g") {
+    char b[64];
+    std::snprintf(b, sizeof b, f, v);
+    return b;
+}
+
+std::vector<std::string> columns() {
+    return {"representation", "bytes", "rmse", "rel_rmse", "max_abs", "min_irr", "neg_frac", "chroma", "enc_ns", "dec_ns"};
+}
+std::vector<std::string> row_of(const RepresentationResult& r) {
+    const ErrorMetrics& m = r.metrics;
+    return {std::string(r.codec->name), std::to_string(r.codec->size_bytes), fmt(m.rmse), fmt(m.relative_rmse, "%.4f"),
+            fmt(m.max_abs), fmt(m.min_irradiance), fmt(m.negative_fraction, "%.4f"), fmt(m.chromaticity_error, "%.4f"),
+            fmt(r.encode_ns, "%.0f"), fmt(r.decode_ns, "%.0f")};
+}
+
+void print_table(std::ostream& os, const std::vector<std::vector<std::string>>& rows, bool markdown) {
+    std::vector<size_t> width(rows[0].size(), 0);
+    for (const auto& r : rows)
+        for (size_t i = 0; i < r.size(); ++i) width[i] = std::max(width[i], r[i].size());
+    for (size_t ri = 0; ri < rows.size(); ++ri) {
+        std::string line = markdown ? "|" : "";
+        for (size_t i = 0; i < rows[ri].size(); ++i) {
+            const std::string& c = rows[ri][i];
+            const std::string pad(width[i] - c.size(), ' ');
+            const std::string cell = i == 0 ? c + pad : pad + c;
+            line += markdown ? " " + cell + " |" : (i ? "  " : "") + cell;
+        }
+        os << line << "\n";
+        if (markdown && ri == 0) {
+            std::string sep = "|";
+            for (size_t i = 0; i < width.size(); ++i) sep += (i == 0 ? " :" : " ") + std::string(width[i] - 1, '-') + (i == 0 ? " |" : ": |");
+            os << sep << "\n";
+        }
+    }
+}
+
+nlohmann::json metrics_json(const RepresentationResult& r) {
+    const ErrorMetrics& m = r.metrics;
+    return {{"rmse", m.rmse},
+            {"relative_rmse", m.relative_rmse},
+            {"max_abs", m.max_abs},
+            {"min_irradiance", m.min_irradiance},
+            {"negative_fraction", m.negative_fraction},
+            {"chromaticity_error", m.chromaticity_error},
+            {"size_bytes", r.codec->size_bytes},
+            {"encode_ns", r.encode_ns},
+            {"decode_ns", r.decode_ns},
+            {"clamped_ratios", r.stats.clamped_ratios},
+            {"dering_clamped", r.stats.dering_clamped}};
+}
+
+int run(const Options& o) {
+    // Which representations.
+    std::vector<const Codec*> selected;
+    if (o.representations.empty()) {
+        for (const Codec& c : codecs()) selected.push_back(&c);
+    } else {
+        std::stringstream ss(o.representations);
+        for (std::string name; std::getline(ss, name, ',');) {
+            const Codec* c = find_codec(name);
+            if (!c) {
+                std::string known;
+                for (const Codec& k : codecs()) known += (known.empty() ? "" : ", ") + std::string(k.name);
+                return report(make_error(ErrorCode::kInvalidArgument,
+                                         "--representations: unknown representation '" + name + "' (known: " + known + ")"));
+            }
+            selected.push_back(c);
+        }
+    }
+    auto files = expand_audit_inputs(o.inputs);
+    if (!files) return report(files.error());
+    if (files->empty()) return report(make_error(ErrorCode::kInvalidArgument, "no audit inputs found"));
+
+    const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const std::vector<Vec3> dirs = fibonacci_sphere(o.directions);
+    const bool show_progress = o.progress || ::isatty(STDERR_FILENO);
+    CodecOptions copt;
+    AuditLoadOptions lopt;
+    lopt.threads = threads;
+    lopt.replace_non_finite = o.replace_non_finite;
+
+    std::vector<FileReport> reports;
+    for (size_t fi = 0; fi < files->size(); ++fi) {
+        const std::string& path = (*files)[fi];
+        if (show_progress) std::fprintf(stderr, "[%zu/%zu] %s\n", fi + 1, files->size(), path.c_str());
+        auto input = load_audit_input(path, dirs, lopt);
+        if (!input) return report(input.error());
+        FileReport fr;
+        fr.input = std::move(input).value();
+        std::vector<MetricsAccumulator> acc(selected.size());
+        std::vector<double> enc(selected.size()), dec(selected.size());
+        std::vector<EncodeStats> stats(selected.size());
+        fr.worst_probes.resize(selected.size());
+        const size_t probes = fr.input.probes.size();
+        const size_t timed = std::min<size_t>(probes, 8);  // time a few probes, not all of a big grid
+        for (size_t p = 0; p < probes; ++p) {
+            const std::vector<Rgb> ref = fr.input.reference_for(p, dirs);
+            std::vector<std::vector<Rgb>> rec;
+            auto res = audit_probe(fr.input.probes[p], ref, dirs, selected, copt, !o.no_timing && p < timed, &rec);
+            for (size_t c = 0; c < selected.size(); ++c) {
+                acc[c].add(rec[c], ref);
+                if (p < timed) {
+                    enc[c] += res[c].encode_ns / static_cast<double>(timed);
+                    dec[c] += res[c].decode_ns / static_cast<double>(timed);
+                }
+                stats[c].clamped_ratios += res[c].stats.clamped_ratios;
+                stats[c].dering_clamped = stats[c].dering_clamped || res[c].stats.dering_clamped;
+                const ErrorMetrics& m = res[c].metrics;
+                const bool fails = (o.max_rmse >= 0 && m.rmse > o.max_rmse) ||
+                                   (o.max_relative_rmse >= 0 && m.relative_rmse > o.max_relative_rmse) ||
+                                   (o.fail_on_negative && m.min_irradiance < 0);
+                if (fails) fr.worst_probes[c].push_back(p);
+            }
+        }
+        for (size_t c = 0; c < selected.size(); ++c) {
+            RepresentationResult r;
+            r.codec = selected[c];
+            r.metrics = acc[c].result();
+            r.encode_ns = enc[c];
+            r.decode_ns = dec[c];
+            r.stats = stats[c];
+            fr.results.push_back(r);
+        }
+        if (!o.images.empty()) {
+            if (Status s = write_audit_images(o.images, fr.input, dirs, selected, copt); !s) return report_output(s.error());
+        }
+        reports.push_back(std::move(fr));
+    }
+
+    // Aggregate over files: mean RMSE and relative RMSE, worst max_abs and minimum, mean fractions.
+    std::vector<RepresentationResult> aggregate(selected.size());
+    for (size_t c = 0; c < selected.size(); ++c) {
+        RepresentationResult& a = aggregate[c];
+        a.codec = selected[c];
+        a.metrics.min_irradiance = reports[0].results[c].metrics.min_irradiance;
+        for (const FileReport& fr : reports) {
+            const RepresentationResult& r = fr.results[c];
+            const double n = static_cast<double>(reports.size());
+            a.metrics.rmse += r.metrics.rmse / n;
+            a.metrics.relative_rmse += r.metrics.relative_rmse / n;
+            a.metrics.max_abs = std::max(a.metrics.max_abs, r.metrics.max_abs);
+            a.metrics.min_irradiance = std::min(a.metrics.min_irradiance, r.metrics.min_irradiance);
+            a.metrics.negative_fraction += r.metrics.negative_fraction / n;
+            a.metrics.chromaticity_error += r.metrics.chromaticity_error / n;
+            a.encode_ns += r.encode_ns / n;
+            a.decode_ns += r.decode_ns / n;
+            a.stats.clamped_ratios += r.stats.clamped_ratios;
+            a.stats.dering_clamped = a.stats.dering_clamped || r.stats.dering_clamped;
+        }
+    }
+
+    // Gates.
+    std::vector<std::string> failures;
+    for (const FileReport& fr : reports)
+        for (size_t c = 0; c < selected.size(); ++c) {
+            const auto& bad = fr.worst_probes[c];
+            if (bad.empty()) continue;
+            std::string probes;
+            for (size_t i = 0; i < bad.size() && i < 10; ++i) probes += (i ? "," : "") + std::to_string(bad[i]);
+            if (bad.size() > 10) probes += ",... (" + std::to_string(bad.size()) + " probes)";
+            const ErrorMetrics& m = fr.results[c].metrics;
+            failures.push_back(fr.input.path + ": " + std::string(selected[c]->name) + " fails a gate (rmse " +
+                               fmt(m.rmse) + ", relative_rmse " + fmt(m.relative_rmse) + ", min_irradiance " +
+                               fmt(m.min_irradiance) + ") at probe " + probes);
+        }
+
+    if (o.json) {
+        nlohmann::json j;
+        j["directions"] = o.directions;
+        j["reference"] = "environment maps: direct integration of the map (box-downsampled to >= 512x256); "
+                         "probe files: the probes' SH3 irradiance";
+        j["files"] = nlohmann::json::array();
+        for (const FileReport& fr : reports) {
+            nlohmann::json f;
+            f["path"] = fr.input.path;
+            f["kind"] = fr.input.kind;
+            f["probes"] = fr.input.probes.size();
+            nlohmann::json reps = nlohmann::json::object();
+            for (const RepresentationResult& r : fr.results) reps[std::string(r.codec->name)] = metrics_json(r);
+            f["representations"] = reps;
+            j["files"].push_back(f);
+        }
+        nlohmann::json agg = nlohmann::json::object();
+        for (const RepresentationResult& r : aggregate) agg[std::string(r.codec->name)] = metrics_json(r);
+        j["aggregate"] = {{"files", reports.size()}, {"representations", agg}};
+        j["gates"] = {{"passed", failures.empty()}, {"failures", failures}};
+        std::cout << j.dump(2) << "\n";
+    } else {
+        for (const FileReport& fr : reports) {
+            std::cout << fr.input.path << " (" << fr.input.description << ", " << o.directions << " directions)\n";
+            std::vector<std::vector<std::string>> rows{columns()};
+            for (const RepresentationResult& r : fr.results) rows.push_back(row_of(r));
+            print_table(std::cout, rows, false);
+            std::cout << "\n";
+        }
+        if (reports.size() > 1) {
+            std::cout << "aggregate over " << reports.size() << " files (mean rmse, rel_rmse, fractions, times; worst max_abs, min_irr)\n";
+            std::vector<std::vector<std::string>> rows{columns()};
+            for (const RepresentationResult& r : aggregate) rows.push_back(row_of(r));
+            print_table(std::cout, rows, false);
+        }
+    }
+    if (!o.markdown.empty()) {
+        std::ostringstream md;
+        md << "# zhc audit\n\nIrradiance error against the reference at " << o.directions
+           << " directions (environment maps: direct integration of the map; probe files: their SH3).\n\n";
+        for (const FileReport& fr : reports) {
+            md << "## " << fr.input.path << "\n\n" << fr.input.description << "\n\n";
+            std::vector<std::vector<std::string>> rows{columns()};
+            for (const RepresentationResult& r : fr.results) rows.push_back(row_of(r));
+            print_table(md, rows, true);
+            md << "\n";
+        }
+        md << "## Aggregate over " << reports.size() << " files\n\n";
+        std::vector<std::vector<std::string>> rows{columns()};
+        for (const RepresentationResult& r : aggregate) rows.push_back(row_of(r));
+        print_table(md, rows, true);
+        const std::string text = md.str();
+        if (Status s = write_file_atomic(o.markdown, std::vector<std::uint8_t>(text.begin(), text.end())); !s)
+            return report_output(s.error());
+    }
+    if (!failures.empty()) {
+        for (const std::string& f : failures) std::fprintf(stderr, "zhc: gate failed: %s\n", f.c_str());
+        return kExitGateFailed;
+    }
+    return kExitOk;
+}
+
+const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()> {
+    auto o = std::make_shared<Options>();
+    CLI::App* sub = app.add_subcommand("audit", "Irradiance error, size and speed of every representation on your lighting");
+    sub->add_option("INPUTS", o->inputs, "environment maps (.exr, .hdr), probe files, or folders of them")->required();
+    sub->add_option("--representations", o->representations, "comma-separated subset of the codec table (default: all)");
+    sub->add_flag("--json", o->json, "print one JSON object (files, aggregate, gates) on stdout");
+    sub->add_option("--markdown", o->markdown, "also write the tables as Markdown to this file");
+    sub->add_option("--images", o->images, "write irradiance/error PNGs per input into this folder");
+    sub->add_option("--directions", o->directions, "number of Fibonacci-lattice directions")->check(CLI::Range(16, 1 << 20));
+    sub->add_option("--threads", o->threads, "worker threads (results do not depend on it)")->check(CLI::Range(0, 256));
+    sub->add_flag("--progress", o->progress, "report progress on stderr even when it is not a terminal");
+    sub->add_flag("--no-timing", o->no_timing, "skip encode/decode timing (outputs become byte-identical across runs)");
+    sub->add_option("--max-rmse", o->max_rmse, "gate: fail (exit 8) if any representation's RMSE exceeds this");
+    sub->add_option("--max-relative-rmse", o->max_relative_rmse, "gate: fail (exit 8) if any relative RMSE exceeds this");
+    sub->add_flag("--fail-on-negative", o->fail_on_negative, "gate: fail (exit 8) if any reconstruction goes negative");
+    sub->add_flag("--replace-non-finite", o->replace_non_finite, "replace NaN/Inf pixels by 0 instead of failing");
+    return [o] { return run(*o); };
+});
+
+}  // namespace
+}  // namespace zhc::cli

@@ -1,0 +1,134 @@
+#include "audit_inputs.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+
+#include "envmap.h"
+#include "file_io.h"
+#include "raster.h"
+
+namespace zhc {
+
+namespace fs = std::filesystem;
+
+std::vector<Rgb> AuditInput::reference_for(std::size_t probe, const std::vector<Vec3>& dirs) const {
+    if (kind == "envmap" && probe == 0 && map_reference.size() == dirs.size()) return map_reference;
+    return sh3_irradiance(probes[probe], dirs);
+}
+
+namespace {
+bool audit_extension(const std::string& ext) { return ext == ".exr" || ext == ".hdr" || ext == ".zhp" || ext == ".json"; }
+}  // namespace
+
+Result<std::vector<std::string>> expand_audit_inputs(const std::vector<std::string>& paths) {
+    std::vector<std::string> out;
+    for (const std::string& p : paths) {
+        std::error_code ec;
+        if (fs::is_directory(p, ec)) {
+            std::vector<std::string> found;
+            for (const auto& e : fs::directory_iterator(p, ec))
+                if (e.is_regular_file() && audit_extension(file_extension(e.path().string())))
+                    found.push_back(e.path().string());
+            if (ec) return make_error(ErrorCode::kIoError, p + ": cannot list folder (" + ec.message() + ")");
+            std::sort(found.begin(), found.end());
+            out.insert(out.end(), found.begin(), found.end());
+        } else if (fs::exists(p, ec)) {
+            out.push_back(p);
+        } else {
+            return make_error(ErrorCode::kIoError, p + ": no such file or folder");
+        }
+    }
+    return out;
+}
+
+Result<AuditInput> load_audit_input(const std::string& path, const std::vector<Vec3>& dirs,
+                                    const AuditLoadOptions& options) {
+    AuditInput in;
+    in.path = path;
+    auto bytes = read_file_bytes(path, std::uint64_t(2) << 30);
+    if (!bytes) return bytes.error();
+    if (looks_like_envmap(*bytes)) {
+        EnvmapReadOptions ro;
+        if (options.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
+        auto img = read_envmap_memory(*bytes, path, ro);
+        if (!img) return img.error();
+        in.kind = "envmap";
+        in.probes.push_back(project_latlong(img->rgb.data(), img->width, img->height,
+                                            static_cast<size_t>(img->width) * 3, options.threads));
+        in.map = downsample_for_audit({img->rgb.data(), img->width, img->height});
+        in.map_reference = integrate_irradiance(in.map.view(), dirs, options.threads);
+        in.description = "environment map " + std::to_string(img->width) + "x" + std::to_string(img->height) +
+                         ", reference: the map integrated at " + std::to_string(in.map.width) + "x" +
+                         std::to_string(in.map.height);
+        return in;
+    }
+    return make_error(ErrorCode::kUnsupported, path + ": not an environment map zhc audit can read");
+}
+
+Status write_audit_images(const std::string& dir, const AuditInput& input, const std::vector<Vec3>&,
+                          const std::vector<const Codec*>& codecs, const CodecOptions& options) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) return make_error(ErrorCode::kIoError, dir + ": cannot create folder (" + ec.message() + ")");
+    if (input.probes.empty()) return Ok{};
+    // Strips: a lat-long picture of irradiance, one pixel per normal direction.
+    const int sw = 256, sh = 128;
+    std::vector<Vec3> pixel_dirs;
+    for (int y = 0; y < sh; ++y)
+        for (int x = 0; x < sw; ++x) pixel_dirs.push_back(latlong_direction(x, y, sw, sh));
+    // Reference picture: the map integrated at 64x32 (irradiance is smooth; the audit numbers
+    // use the finer reference), or the probe's SH3 for probe files.
+    std::vector<Rgb> ref;
+    if (input.kind == "envmap") {
+        const LatLongImage coarse = downsample_for_audit(input.map.view(), 64, 32);
+        ref = integrate_irradiance(coarse.view(), pixel_dirs, 2);
+    } else {
+        ref = sh3_irradiance(input.probes[0], pixel_dirs);
+    }
+    double mean = 0;
+    for (const Rgb& c : ref) mean += (double(c.r) + c.g + c.b) / 3.0;
+    mean = std::max(mean / ref.size(), 1e-12);
+
+    const int scale = 2, label_w = 150, pad = 6, title_h = 30, legend_h = 34;
+    const int rows = 1 + static_cast<int>(codecs.size());
+    Canvas canvas(label_w + 2 * sw + 3 * pad, title_h + rows * (sh + pad) + legend_h, {32, 32, 36});
+    const Rgb8 white{235, 235, 235}, magenta{255, 0, 255};
+    canvas.text(pad, 8, fs::path(input.path).filename().string() + "  irradiance (tone-mapped)  |  abs error / mean",
+                scale, white);
+    const double error_full_scale = 0.25;  // error of 25 % of the mean irradiance saturates the ramp
+    auto draw_row = [&](int row, const std::string& label, const std::vector<Rgb>& rec) {
+        const int y0 = title_h + row * (sh + pad);
+        canvas.text(pad, y0 + sh / 2 - 5, label, scale, white);
+        for (int y = 0; y < sh; ++y)
+            for (int x = 0; x < sw; ++x) {
+                const size_t i = static_cast<size_t>(y) * sw + x;
+                const Rgb& c = rec[i];
+                const bool negative = c.r < 0 || c.g < 0 || c.b < 0;
+                Rgb8 p = negative ? magenta
+                                  : Rgb8{tonemap_srgb8(c.r / mean), tonemap_srgb8(c.g / mean), tonemap_srgb8(c.b / mean)};
+                canvas.set(label_w + pad + x, y0 + y, p);
+                double err = 0;
+                for (int k = 0; k < 3; ++k) err = std::max(err, std::fabs(double(c[k]) - ref[i][k]));
+                canvas.set(label_w + 2 * pad + sw + x, y0 + y, negative ? magenta : false_colour(err / mean / error_full_scale));
+            }
+    };
+    draw_row(0, "reference", ref);
+    for (size_t c = 0; c < codecs.size(); ++c) {
+        std::vector<std::uint8_t> stored(codecs[c]->size_bytes);
+        codecs[c]->encode(input.probes[0], options, stored.data(), nullptr);
+        draw_row(static_cast<int>(c) + 1, std::string(codecs[c]->name), codec_irradiance(*codecs[c], stored.data(), options, pixel_dirs));
+    }
+    // Legend: the error ramp and the negative marker.
+    const int ly = canvas.height() - legend_h + 8;
+    for (int x = 0; x < sw; ++x)
+        canvas.fill_rect(label_w + 2 * pad + sw + x, ly, 1, 10, false_colour(double(x) / (sw - 1)));
+    canvas.text(label_w + 2 * pad + sw, ly + 14, "0", scale, white);
+    canvas.text(label_w + 2 * pad + 2 * sw - Canvas::text_width("25%", scale), ly + 14, "25%", scale, white);
+    canvas.fill_rect(label_w + pad, ly, 10, 10, magenta);
+    canvas.text(label_w + pad + 16, ly, "NEGATIVE", scale, white);
+    const std::string out = (fs::path(dir) / (fs::path(input.path).stem().string() + ".png")).string();
+    return write_png(out, canvas);
+}
+
+}  // namespace zhc

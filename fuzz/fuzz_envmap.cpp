@@ -1,0 +1,23 @@
+// Environment-map loading (OpenEXR through OpenEXR, Radiance .hdr through stb_image + zhc's
+// scanline validation) from untrusted bytes; a successful load must be finite and in limits.
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+
+#include "formats/envmap.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    zhc::EnvmapReadOptions o;
+    o.max_pixels = 1 << 12;  // keeps executions fast; size checks are still exercised
+    o.max_file_bytes = 1 << 24;
+    auto img = zhc::read_envmap_memory({data, size}, "fuzz-input", o);
+    if (img) {
+        if (static_cast<std::uint64_t>(img->width) * img->height > o.max_pixels) std::abort();
+        if (img->rgb.size() != static_cast<size_t>(img->width) * img->height * 3) std::abort();
+        for (float v : img->rgb)
+            if (!std::isfinite(v)) std::abort();
+    } else if (img.error().message.empty()) {
+        std::abort();
+    }
+    return 0;
+}
