@@ -314,10 +314,12 @@ std::int64_t evaluate(const Target& t, int mode_i, int partition, SubsetFit fit[
                             static_cast<float>(t.h[i][1] - pal[s][0][1]) * axis[s][1] +
                             static_cast<float>(t.h[i][2] - pal[s][0][2]) * axis[s][2]) * inv_len2[s];
         const int j0 = std::clamp(static_cast<int>(proj + 0.5f), 0, lim - 1);  // proj < 0 truncates to 0
-        int best = 0, be = std::numeric_limits<int>::max();
+        // 64-bit: three squared differences of up to 0x7BFF each overflow int32.
+        int best = 0;
+        std::int64_t be = std::numeric_limits<std::int64_t>::max();
         for (int j = std::max(0, j0 - 1); j <= std::min(lim - 1, j0 + 1); ++j) {
-            const int d0 = pal[s][j][0] - t.h[i][0], d1 = pal[s][j][1] - t.h[i][1], d2 = pal[s][j][2] - t.h[i][2];
-            const int e = d0 * d0 + d1 * d1 + d2 * d2;
+            const std::int64_t d0 = pal[s][j][0] - t.h[i][0], d1 = pal[s][j][1] - t.h[i][1], d2 = pal[s][j][2] - t.h[i][2];
+            const std::int64_t e = d0 * d0 + d1 * d1 + d2 * d2;
             if (e < be) be = e, best = j;
         }
         idx[i] = static_cast<std::uint8_t>(best);

@@ -170,6 +170,25 @@ TEST(Bc6hEncode, QualityLevelsAreOrderedOnRealMaps) {
     EXPECT_LE(e[3], e[2]);
 }
 
+TEST(Bc6hEncode, ExtremeRangeBlocksDoNotOverflowTheErrorSum) {
+    // Grey texels at 0 and at the top of the half range (one line fits them exactly): a wrong index
+    // costs 3 * 31571^2 > 2^31, so a 32-bit error sum would overflow and prefer wrong indices.
+    float src[16][3];
+    for (int i = 0; i < 16; ++i)
+        for (int c = 0; c < 3; ++c) src[i][c] = (i % 3 == 0) ? 60000.0f : 0.0f;
+    for (const Quality q : {Quality::kMode11, Quality::kFast, Quality::kDefault, Quality::kExhaustive}) {
+        std::uint8_t blk[16];
+        encode_block(src, q, blk);
+        std::uint16_t px[16][3];
+        decode_block(blk, px);
+        for (int i = 0; i < 16; ++i)
+            for (int c = 0; c < 3; ++c) {
+                const double want = double(float_to_uf16(src[i][c]));
+                EXPECT_NEAR(double(px[i][c]), want, 64) << "q=" << int(q) << " texel " << i << " ch " << c;
+            }
+    }
+}
+
 TEST(Bc6hImage, ThreadCountDoesNotChangeBytesAndEdgesReplicate) {
     const Image img = test::load_envmap(test::envmap_paths().front());
     const int w = 37, h = 23;  // not multiples of 4
