@@ -1,0 +1,174 @@
+// bench_bc6h: BC6H quality (log2-PSNR) and speed (Mpixel/s on one thread) on the eight real maps
+// (as HDR images) and on IrradZ lightmaps baked from them, for the mode-11-only baseline, fast,
+// default and exhaustive; BC4/BC5 (w_a, d planes) beside stb_dxt's stb_compress_bc4/bc5_block.
+// Plain timing main; ratios are against baselines measured in the same run.
+//   bench_bc6h [--maps DIR] [--lightmap-size N] [--exhaustive-rows N]
+#include <algorithm>
+#include <cstring>
+#define STB_DXT_IMPLEMENTATION
+#include <stb_dxt.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "codec/bc45.h"
+#include "codec/bc6h.h"
+#include "codec/lightmap.h"
+#include "formats/envmap.h"
+
+using namespace zhc;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+struct Row {
+    double psnr = 0, mpix = 0;
+};
+
+Row run_bc6h(const std::vector<float>& rgb, int w, int h, bc6h::Quality q) {
+    const auto t0 = Clock::now();
+    const auto blocks = bc6h::encode_image(rgb.data(), w, h, q, 1);
+    const double s = seconds_since(t0);
+    const auto dec = bc6h::decode_image(blocks.data(), blocks.size(), w, h);
+    Row r;
+    r.psnr = lightmap::log2_psnr(rgb.data(), dec.data(), rgb.size());
+    r.mpix = double(w) * h / s / 1e6;
+    return r;
+}
+
+double psnr_unorm(const std::vector<float>& ref, const std::vector<float>& dec) {
+    double m = 0;
+    for (size_t i = 0; i < ref.size(); ++i) m += std::pow(double(std::clamp(ref[i], 0.0f, 1.0f)) - dec[i], 2);
+    m /= double(ref.size());
+    return m > 0 ? 10 * std::log10(1 / m) : 999;
+}
+
+// stb baseline on the same planes (8-bit input, as stb takes it).
+Row run_stb(const std::vector<float>& v, int channels, int w, int h) {
+    const int bw = (w + 3) / 4, bh = (h + 3) / 4;
+    std::vector<std::uint8_t> blocks(static_cast<size_t>(bw) * bh * 8 * channels);
+    const auto t0 = Clock::now();
+    for (int by = 0; by < bh; ++by)
+        for (int bx = 0; bx < bw; ++bx) {
+            unsigned char src[32];
+            for (int i = 0; i < 16; ++i) {
+                const int x = std::min(bx * 4 + (i & 3), w - 1), y = std::min(by * 4 + (i >> 2), h - 1);
+                for (int c = 0; c < channels; ++c)
+                    src[i * channels + c] = static_cast<unsigned char>(
+                        std::lround(std::clamp(v[(static_cast<size_t>(y) * w + x) * channels + c], 0.0f, 1.0f) * 255));
+            }
+            unsigned char* dst = blocks.data() + (static_cast<size_t>(by) * bw + bx) * 8 * channels;
+            if (channels == 1) stb_compress_bc4_block(dst, src);
+            else stb_compress_bc5_block(dst, src);
+        }
+    const double s = seconds_since(t0);
+    const auto dec = bc45::decode_image(blocks.data(), blocks.size(), channels, w, h);
+    return {psnr_unorm(v, dec), double(w) * h / s / 1e6};
+}
+
+Row run_ours45(const std::vector<float>& v, int channels, int w, int h, bc45::Quality q) {
+    const auto t0 = Clock::now();
+    const auto blocks = bc45::encode_image(v.data(), channels, w, h, q, 1);
+    const double s = seconds_since(t0);
+    const auto dec = bc45::decode_image(blocks.data(), blocks.size(), channels, w, h);
+    return {psnr_unorm(v, dec), double(w) * h / s / 1e6};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::string dir = ZHC_ENVMAP_DIR;
+    int lm_size = 256, ex_rows = 0;
+    for (int i = 1; i + 1 < argc; i += 2) {
+        if (!std::strcmp(argv[i], "--maps")) dir = argv[i + 1];
+        if (!std::strcmp(argv[i], "--lightmap-size")) lm_size = std::atoi(argv[i + 1]);
+        if (!std::strcmp(argv[i], "--exhaustive-rows")) ex_rows = std::atoi(argv[i + 1]);
+    }
+    std::vector<std::string> paths;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        if (e.path().extension() == ".exr") paths.push_back(e.path().string());
+    std::sort(paths.begin(), paths.end());
+    const bc6h::Quality qs[4] = {bc6h::Quality::kMode11, bc6h::Quality::kFast, bc6h::Quality::kDefault,
+                                 bc6h::Quality::kExhaustive};
+    const char* qn[4] = {"mode11", "fast", "default", "exhaustive"};
+    std::printf("BC6H log2-PSNR (dB, l(v) = log2(max(v, 2^-14)), peak 30) and Mpixel/s on 1 thread\n");
+    std::printf("%-22s | %-15s | %-15s | %-15s | %-15s\n", "image", qn[0], qn[1], qn[2], qn[3]);
+    double sum[2][4][2] = {};
+    int count[2] = {0, 0};
+    std::vector<std::vector<float>> wa_planes, d_planes;
+    for (int pass = 0; pass < 2; ++pass) {
+        for (const auto& path : paths) {
+            auto img = read_envmap(path);
+            if (!img) {
+                std::fprintf(stderr, "%s\n", img.error().message.c_str());
+                return 1;
+            }
+            std::vector<float> rgb;
+            int w = 0, h = 0;
+            std::string name = std::filesystem::path(path).stem().string();
+            if (pass == 0) {
+                rgb = img->rgb, w = img->width, h = img->height;
+            } else {
+                // A lightmap baked from the map: the sphere lit by its SH3, IrradZ-encoded; the I_z plane.
+                const Sh3Radiance world = project_latlong(img->rgb.data(), img->width, img->height,
+                                                          static_cast<size_t>(img->width) * 3, 2);
+                const auto lm = lightmap::synthesize_sphere(world, lm_size, lm_size, 2);
+                const auto planes = lightmap::encode_planes(lm, {}, 2);
+                rgb = planes.iz, w = lm_size, h = lm_size;
+                wa_planes.push_back(planes.wa);
+                d_planes.push_back(planes.d);
+                name = "lm:" + name;
+            }
+            Row r[4];
+            for (int k = 0; k < 4; ++k) {
+                if (k == 3 && pass == 0 && ex_rows > 0) {
+                    // Exhaustive on the first ex_rows rows only (it is the slow quality reference);
+                    // compare all qualities on that crop then.
+                    h = std::min(h, ex_rows);
+                    rgb.resize(static_cast<size_t>(w) * h * 3);
+                    for (int j = 0; j < 3; ++j) r[j] = run_bc6h(rgb, w, h, qs[j]);
+                }
+                r[k] = run_bc6h(rgb, w, h, qs[k]);
+            }
+            std::printf("%-22s |", name.c_str());
+            for (int k = 0; k < 4; ++k) {
+                std::printf(" %6.2f %6.2f |", r[k].psnr, r[k].mpix);
+                sum[pass][k][0] += r[k].psnr;
+                sum[pass][k][1] += r[k].mpix;
+            }
+            std::printf("\n");
+            ++count[pass];
+            std::fflush(stdout);
+        }
+        std::printf("%-22s |", pass == 0 ? "MEAN real maps" : "MEAN lightmaps");
+        for (int k = 0; k < 4; ++k) std::printf(" %6.2f %6.2f |", sum[pass][k][0] / count[pass], sum[pass][k][1] / count[pass]);
+        std::printf("\n%-22s |", "  dB vs exhaustive");
+        for (int k = 0; k < 4; ++k) std::printf(" %+6.2f        |", (sum[pass][k][0] - sum[pass][3][0]) / count[pass]);
+        std::printf("\n%-22s |", "  speed / mode11");
+        for (int k = 0; k < 4; ++k) std::printf(" %6.3f        |", sum[pass][k][1] / sum[pass][0][1]);
+        std::printf("\n");
+    }
+    std::printf("\nBC4 (w_a plane) and BC5 (d plane) of the lightmaps: PSNR (dB, unorm) and Mpixel/s on 1 thread\n");
+    std::printf("%-22s | %-15s | %-15s | %-15s\n", "plane", "stb", "zhc fast", "zhc default");
+    for (int ch = 1; ch <= 2; ++ch) {
+        double s[3][2] = {};
+        for (size_t i = 0; i < wa_planes.size(); ++i) {
+            const auto& v = ch == 1 ? wa_planes[i] : d_planes[i];
+            const Row a = run_stb(v, ch, lm_size, lm_size), b = run_ours45(v, ch, lm_size, lm_size, bc45::Quality::kFast),
+                      c = run_ours45(v, ch, lm_size, lm_size, bc45::Quality::kDefault);
+            const Row rr[3] = {a, b, c};
+            for (int k = 0; k < 3; ++k) s[k][0] += rr[k].psnr, s[k][1] += rr[k].mpix;
+        }
+        const double n = double(wa_planes.size());
+        std::printf("%-22s | %6.2f %6.2f | %6.2f %6.2f | %6.2f %6.2f\n", ch == 1 ? "BC4 w_a (mean of 8)" : "BC5 d (mean of 8)",
+                    s[0][0] / n, s[0][1] / n, s[1][0] / n, s[1][1] / n, s[2][0] / n, s[2][1] / n);
+    }
+    return 0;
+}

@@ -1,0 +1,142 @@
+// IrradZ lightmap textures (codec/lightmap.h), SH lightmap EXR I/O (formats/lightmap_exr.h) and
+// the `zhc lightmap` verbs.
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
+#include "codec/lightmap.h"
+#include "formats/ktx2.h"
+#include "formats/lightmap_exr.h"
+#include "support.h"
+
+namespace zhc {
+namespace {
+
+using namespace lightmap;
+
+TEST(LightmapHemiOct, RoundTripsAndIsTotal) {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(0, 1);
+    double worst = 0;
+    for (int t = 0; t < 100000; ++t) {
+        Vec3 d = test::uniform_direction(u(rng), u(rng));
+        d.z = std::abs(d.z);
+        const auto uv = encode_hemioct(d);
+        ASSERT_GE(uv[0], 0.0f);
+        ASSERT_LE(uv[0], 1.0f);
+        const Vec3 back = decode_hemioct(uv[0], uv[1]);
+        worst = std::max(worst, std::acos(std::clamp(dot(back, d), -1.0, 1.0)));
+    }
+    EXPECT_LT(worst * 180 / kPi, 1e-3);
+    // Any stored pair (8-bit grid and beyond the range) decodes to a unit upper-hemisphere vector.
+    for (int a = -2; a <= 257; ++a)
+        for (int b = -2; b <= 257; ++b) {
+            const Vec3 d = decode_hemioct(a / 255.0f, b / 255.0f);
+            ASSERT_NEAR(length(d), 1.0, 1e-9);
+            ASSERT_GE(d.z, 0.0);
+        }
+    // 8-bit quantisation error of the mapping (what BC5 can at best keep): max angle.
+    double q = 0;
+    for (int t = 0; t < 20000; ++t) {
+        Vec3 d = test::uniform_direction(u(rng), u(rng));
+        d.z = std::abs(d.z);
+        auto uv = encode_hemioct(d);
+        for (float& c : uv) c = std::round(c * 255) / 255;
+        q = std::max(q, std::acos(std::clamp(dot(decode_hemioct(uv[0], uv[1]), d), -1.0, 1.0)));
+    }
+    std::printf("hemi-octahedral d at 8 bits: max angular error %.3f deg\n", q * 180 / kPi);
+    EXPECT_LT(q * 180 / kPi, 0.6);
+}
+
+TEST(Lightmap, CompressedPlanesKeepTheHemisphericalError) {
+    const Image img = test::load_envmap(test::envmap_paths().front());
+    const Sh3Radiance world = project_latlong(img.rgb.data(), img.width, img.height, static_cast<size_t>(img.width) * 3, 2);
+    const ShLightmap lm = synthesize_sphere(world, 64, 64, 2);
+    ASSERT_EQ(lm.texels.size(), 64u * 64u);
+    // Synthetic texels only see their upper hemisphere: the windowed radiance has (almost) no
+    // irradiance from below, so the SH irradiance at -Z is small compared to +Z on average.
+    const IrradzPlanes search = encode_planes(lm, {}, 2);
+    irradz::EncodeOptions old;
+    old.solve = irradz::Solve::kOld;
+    const IrradzPlanes old_way = encode_planes(lm, old, 1);
+    EXPECT_EQ(encode_planes(lm, {}, 1).wa, search.wa);  // thread count does not matter
+    const Compressed c = compress(search, bc6h::Quality::kDefault, bc45::Quality::kDefault, 2);
+    EXPECT_EQ(c.bc6h.size() + c.bc5.size() + c.bc4.size(), static_cast<size_t>(64 * 64 * 5 / 2));  // 2.5 B/texel
+    const IrradzPlanes after = decompress(c);
+    const Audit a = audit(lm, search, old_way, after, 1);
+    std::printf("64x64 sphere lightmap: hemi RMSE old %.5f search %.5f after BC %.5f (mean Iz %.4f); PSNR Iz %.1f wa %.1f d %.1f\n",
+                a.rmse_old, a.rmse_search, a.rmse_after_bc, a.mean_iz, a.psnr_iz_log2, a.psnr_wa, a.psnr_d);
+    EXPECT_LT(a.rmse_search, a.rmse_old);
+    EXPECT_LT(a.rmse_after_bc, 1.05 * a.rmse_search);  // block compression adds < 5 %
+    EXPECT_GT(a.psnr_iz_log2, 50);
+}
+
+TEST(LightmapExr, RoundTripAndErrors) {
+    const std::string dir = test::temp_dir("lightmap_exr");
+    ShLightmap lm;
+    lm.width = 5;
+    lm.height = 3;
+    lm.texels.resize(15);
+    for (size_t t = 0; t < 15; ++t)
+        for (int i = 0; i < 9; ++i)
+            for (int k = 0; k < 3; ++k) lm.texels[t][i][k] = static_cast<float>(t * 100 + i * 10 + k) * 0.01f;
+    ASSERT_TRUE(write_sh_lightmap_exr(dir + "/a.exr", lm).ok());
+    auto back = read_sh_lightmap_exr(dir + "/a.exr");
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    EXPECT_EQ(back->width, 5);
+    for (size_t t = 0; t < 15; ++t) EXPECT_TRUE(back->texels[t] == lm.texels[t]);
+    LightmapReadOptions small;
+    small.max_texels = 10;
+    EXPECT_EQ(read_sh_lightmap_exr(dir + "/a.exr", small).error().code, ErrorCode::kTooLarge);
+    EXPECT_EQ(read_sh_lightmap_exr(dir + "/missing.exr").error().code, ErrorCode::kIoError);
+    test::write_bytes(dir + "/junk.exr", {1, 2, 3, 4, 5});
+    EXPECT_EQ(read_sh_lightmap_exr(dir + "/junk.exr").error().code, ErrorCode::kBadFormat);
+    // An ordinary RGB EXR is not an SH lightmap: the missing channel is named.
+    const auto env = read_sh_lightmap_exr(test::envmap_paths().front());
+    ASSERT_FALSE(env.ok());
+    EXPECT_NE(env.error().message.find("sh0.R"), std::string::npos);
+    lm.texels[7][3].g = std::nanf("");
+    ASSERT_TRUE(write_sh_lightmap_exr(dir + "/nan.exr", lm).ok());
+    EXPECT_EQ(read_sh_lightmap_exr(dir + "/nan.exr").error().code, ErrorCode::kInvalidValue);
+}
+
+TEST(LightmapCli, EncodeDecodeAuditAndBadInput) {
+    const std::string dir = test::temp_dir("lightmap_cli");
+    auto r = test::run_zhc({"lightmap", "synth", test::envmap_paths().front(), "-o", dir + "/lm.exr", "--size", "32"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/out", "--quality", "fast", "--threads", "2"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const char* s : {".iz.ktx2", ".d.ktx2", ".wa.ktx2"}) {
+        auto k = read_ktx2(dir + "/out" + s);
+        ASSERT_TRUE(k.ok()) << k.error().message;
+        EXPECT_EQ(k->width, 32);
+    }
+    // Same bytes for any thread count.
+    r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/out1", "--quality", "fast"});
+    ASSERT_EQ(r.exit_code, 0);
+    EXPECT_EQ(test::read_bytes(dir + "/out.iz.ktx2"), test::read_bytes(dir + "/out1.iz.ktx2"));
+    r = test::run_zhc({"lightmap", "decode", dir + "/out", "-o", dir + "/dec.exr"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = test::run_zhc({"lightmap", "audit", dir + "/lm.exr", "--json", "--stride", "3"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("\"hemi_rmse\""), std::string::npos);
+    // Bad inputs: documented exit codes, one-line message, nothing written.
+    r = test::run_zhc({"lightmap", "encode", dir + "/nope.exr", "-o", dir + "/x"});
+    EXPECT_EQ(r.exit_code, 3);
+    r = test::run_zhc({"lightmap", "encode", test::envmap_paths().front(), "-o", dir + "/x"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_FALSE(std::filesystem::exists(dir + "/x.iz.ktx2"));
+    auto bytes = test::read_bytes(dir + "/out.d.ktx2");
+    bytes.resize(bytes.size() - 3);
+    test::write_bytes(dir + "/cut.d.ktx2", bytes);
+    for (const char* s : {".iz.ktx2", ".wa.ktx2"}) test::write_bytes(dir + "/cut" + s, test::read_bytes(dir + "/out" + s));
+    r = test::run_zhc({"lightmap", "decode", dir + "/cut", "-o", dir + "/cut.exr"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("cut.d.ktx2"), std::string::npos);
+    EXPECT_FALSE(std::filesystem::exists(dir + "/cut.exr"));
+    r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/y", "--quality", "best"});
+    EXPECT_EQ(r.exit_code, 2);
+}
+
+}  // namespace
+}  // namespace zhc

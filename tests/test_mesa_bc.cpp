@@ -1,0 +1,223 @@
+// A real decoder in the tests: Mesa's software OpenGL (llvmpipe) through headless EGL
+// (EGL_MESA_platform_surfaceless, no display needed) uploads zhc's BC6H / BC4 / BC5 blocks with
+// glCompressedTexImage2D and reads them back with glGetTexImage. BC6H must match zhc's decoder bit
+// for bit (half floats); BC4/BC5 within 1/255.
+#define EGL_EGLEXT_PROTOTYPES
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#define GL_GLEXT_PROTOTYPES
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+
+#include "codec/bc45.h"
+#include "codec/bc6h.h"
+#include "support.h"
+
+namespace zhc {
+namespace {
+
+class MesaContext : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        // Force the software rasteriser whatever GPU the machine has, so results are llvmpipe's.
+        setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+        setenv("GALLIUM_DRIVER", "llvmpipe", 1);
+        auto get_platform_display =
+            reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+        if (!get_platform_display) {
+            why_ = "eglGetPlatformDisplayEXT missing";
+            return;
+        }
+        dpy_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+        EGLint major = 0, minor = 0;
+        if (dpy_ == EGL_NO_DISPLAY || !eglInitialize(dpy_, &major, &minor)) {
+            why_ = "no surfaceless EGL display (eglInitialize failed)";
+            return;
+        }
+        if (!eglBindAPI(EGL_OPENGL_API)) {
+            why_ = "eglBindAPI(EGL_OPENGL_API) failed";
+            return;
+        }
+        const EGLint cfg_attr[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+        EGLConfig cfg = EGL_NO_CONFIG_KHR;
+        EGLint n = 0;
+        // The surfaceless platform may expose no configs; a context without one needs
+        // EGL_KHR_no_config_context (we never render to a surface).
+        if (!eglChooseConfig(dpy_, cfg_attr, &cfg, 1, &n) || n < 1) {
+            const char* ext = eglQueryString(dpy_, EGL_EXTENSIONS);
+            if (!ext || !std::strstr(ext, "EGL_KHR_no_config_context")) {
+                why_ = "no EGL config with EGL_OPENGL_BIT and no EGL_KHR_no_config_context";
+                return;
+            }
+            cfg = EGL_NO_CONFIG_KHR;
+        }
+        ctx_ = eglCreateContext(dpy_, cfg, EGL_NO_CONTEXT, nullptr);
+        if (ctx_ == EGL_NO_CONTEXT || !eglMakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_)) {
+            why_ = "cannot make a surfaceless desktop GL context current";
+            return;
+        }
+        renderer_ = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+        std::printf("GL_RENDERER: %s, GL_VERSION: %s\n", renderer_.c_str(),
+                    reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+    }
+    static void TearDownTestSuite() {
+        if (dpy_ != EGL_NO_DISPLAY) {
+            eglMakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+            if (ctx_ != EGL_NO_CONTEXT) eglDestroyContext(dpy_, ctx_);
+            eglTerminate(dpy_);
+        }
+    }
+    void SetUp() override {
+        ASSERT_TRUE(why_.empty()) << why_;
+        ASSERT_NE(renderer_.find("llvmpipe"), std::string::npos) << renderer_;
+    }
+
+    // Uploads `blocks` as a width x height texture of `format` and reads level 0 back.
+    template <class T>
+    std::vector<T> round_trip(GLenum format, const std::vector<std::uint8_t>& blocks, int w, int h, GLenum read_format,
+                              GLenum read_type, int channels) {
+        GLuint tex = 0;
+        glGenTextures(1, &tex);
+        glBindTexture(GL_TEXTURE_2D, tex);
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glCompressedTexImage2D(GL_TEXTURE_2D, 0, format, w, h, 0, static_cast<GLsizei>(blocks.size()), blocks.data());
+        EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+        std::vector<T> out(static_cast<size_t>(w) * h * channels);
+        glGetTexImage(GL_TEXTURE_2D, 0, read_format, read_type, out.data());
+        EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+        glDeleteTextures(1, &tex);
+        return out;
+    }
+
+    static inline EGLDisplay dpy_ = EGL_NO_DISPLAY;
+    static inline EGLContext ctx_ = EGL_NO_CONTEXT;
+    static inline std::string why_;
+    static inline std::string renderer_;
+};
+
+// Random blocks with every mode code forced in turn (all 14 modes and the 4 reserved codes),
+// followed by blocks zhc's encoder made from a real map at every quality level.
+std::vector<std::uint8_t> bc6h_test_blocks(int* w, int* h) {
+    std::vector<std::uint8_t> blocks;
+    std::mt19937_64 rng(11);
+    const std::uint8_t codes[] = {0x00, 0x01, 0x02, 0x06, 0x0A, 0x0E, 0x12, 0x16, 0x1A, 0x1E,
+                                  0x03, 0x07, 0x0B, 0x0F, 0x13, 0x17, 0x1B, 0x1F};
+    for (int k = 0; k < 18 * 64; ++k) {
+        std::uint8_t b[16];
+        for (int j = 0; j < 16; j += 8) {
+            const std::uint64_t v = rng();
+            std::memcpy(b + j, &v, 8);
+        }
+        const std::uint8_t code = codes[k % 18];
+        b[0] = static_cast<std::uint8_t>((b[0] & (code < 2 ? 0xFC : 0xE0)) | code);
+        blocks.insert(blocks.end(), b, b + 16);
+    }
+    const Image img = test::load_envmap(test::envmap_paths().front());
+    for (const bc6h::Quality q : {bc6h::Quality::kMode11, bc6h::Quality::kFast, bc6h::Quality::kDefault,
+                                  bc6h::Quality::kExhaustive}) {
+        // A 64 x 16 crop (16 x 4 blocks) from a bright, detailed region.
+        std::vector<float> crop(64 * 16 * 3);
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 64 * 3; ++x) crop[static_cast<size_t>(y) * 64 * 3 + x] = img.row(y + 180)[x + 1200];
+        const auto enc = bc6h::encode_image(crop.data(), 64, 16, q);
+        // Re-order the 16 x 4 block grid into the same 1-D list (layout handled below).
+        blocks.insert(blocks.end(), enc.begin(), enc.end());
+    }
+    // 18*64 + 4*64 = 1408 blocks: a 64 x 22 block texture (256 x 88 texels).
+    *w = 256;
+    *h = static_cast<int>(blocks.size() / 16 / 64) * 4;
+    return blocks;
+}
+
+TEST_F(MesaContext, Bc6hMatchesZhcDecoderBitForBit) {
+    int w = 0, h = 0;
+    const auto blocks = bc6h_test_blocks(&w, &h);
+    ASSERT_EQ(blocks.size(), static_cast<size_t>(w / 4) * (h / 4) * 16);
+    const auto gl = round_trip<std::uint16_t>(GL_COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT, blocks, w, h, GL_RGB, GL_HALF_FLOAT, 3);
+    const auto ours = bc6h::decode_image(blocks.data(), blocks.size(), w, h);
+    ASSERT_EQ(gl.size(), ours.size());
+    size_t mismatches = 0;
+    int modes_seen[18] = {};
+    for (size_t b = 0; b < blocks.size() / 16; ++b) {
+        const int m = bc6h::block_mode(blocks.data() + 16 * b);
+        ++modes_seen[m < 0 ? 14 : m];
+    }
+    for (size_t i = 0; i < gl.size(); ++i)
+        if (gl[i] != ours[i]) {
+            if (mismatches < 5)
+                ADD_FAILURE() << "texel " << i / 3 << " channel " << i % 3 << ": mesa 0x" << std::hex << gl[i]
+                              << " zhc 0x" << ours[i];
+            ++mismatches;
+        }
+    EXPECT_EQ(mismatches, 0u) << "of " << gl.size();
+    for (int m = 0; m < 15; ++m) EXPECT_GT(modes_seen[m], 0) << "mode " << m;
+    std::printf("BC6H: %zu blocks (%zu half values) compared with Mesa, %zu mismatches\n", blocks.size() / 16,
+                gl.size(), mismatches);
+}
+
+TEST_F(MesaContext, Bc4AndBc5MatchWithinTwoLevelsAndStructurally) {
+    std::mt19937_64 rng(12);
+    // Random blocks (both palette kinds) and encoded gradients/noise.
+    const int w = 64, h = 64;
+    const int nblocks = (w / 4) * (h / 4);
+    for (const int channels : {1, 2}) {
+        std::vector<std::uint8_t> blocks;
+        for (int b = 0; b < nblocks / 2; ++b)
+            for (int k = 0; k < channels; ++k) {
+                const std::uint64_t v = rng();
+                std::uint8_t blk[8];
+                std::memcpy(blk, &v, 8);
+                blocks.insert(blocks.end(), blk, blk + 8);
+            }
+        std::vector<float> src(static_cast<size_t>(w) * (h / 2) * channels);
+        std::uniform_real_distribution<float> u(0, 1);
+        for (size_t i = 0; i < src.size(); ++i) src[i] = 0.5f * u(rng) + 0.5f * float(i % 97) / 97.0f;
+        const auto enc = bc45::encode_image(src.data(), channels, w, h / 2, bc45::Quality::kDefault);
+        blocks.insert(blocks.end(), enc.begin(), enc.end());
+        const auto gl8 = round_trip<std::uint8_t>(channels == 1 ? GL_COMPRESSED_RED_RGTC1 : GL_COMPRESSED_RG_RGTC2, blocks,
+                                                  w, h, channels == 1 ? GL_RED : GL_RG, GL_UNSIGNED_BYTE, channels);
+        std::vector<float> gl(gl8.size());
+        for (size_t i = 0; i < gl.size(); ++i) gl[i] = float(gl8[i]) / 255.0f;
+        const auto ours = bc45::decode_image(blocks.data(), blocks.size(), channels, w, h);
+        // llvmpipe samples RGTC with gallivm's 8-bit fixed-point lerp, not the format's exact
+        // (7 - j) r0 + j r1) / 7, so it sits up to ~1.6/255 from the exact palette value (e.g. r0 = 255,
+        // r1 = 5, index 7: exact 40.71, llvmpipe 42). We therefore check (a) |mesa - zhc| <= 2/255 and
+        // (b) structurally: Mesa's value is nearer to zhc's palette entry than to any other entry of the
+        // block's palette whenever the entries are > 4/255 apart (so indices and palette kinds agree).
+        double worst = 0;
+        size_t structural = 0;
+        for (size_t i = 0; i < gl.size(); ++i) {
+            const double d = std::abs(double(gl[i]) - double(ours[i]));
+            worst = std::max(worst, d);
+            const size_t t = i / channels, x = t % w, y = t / w, c = i % channels;
+            const std::uint8_t* blk = blocks.data() + ((y / 4) * (w / 4) + x / 4) * (channels * 8) + c * 8;
+            float pal_probe[16];
+            std::uint8_t probe[8];
+            double nearest_other = 1e9, spacing = 1e9;
+            for (int j = 0; j < 8; ++j) {
+                std::memcpy(probe, blk, 2);
+                const std::uint64_t bits = std::uint64_t(j) * 0x249249249249ull;  // index j for all texels
+                for (int k = 0; k < 6; ++k) probe[2 + k] = static_cast<std::uint8_t>(bits >> (8 * k));
+                bc45::decode_bc4_block(probe, pal_probe);
+                if (pal_probe[0] != ours[i]) {
+                    nearest_other = std::min(nearest_other, std::abs(double(pal_probe[0]) - gl[i]));
+                    spacing = std::min(spacing, std::abs(double(pal_probe[0]) - ours[i]));
+                }
+            }
+            // Only palettes whose entries are more than 4 levels apart can tell indices apart.
+            if (spacing > 4.0 / 255.0 && nearest_other <= d) ++structural;
+        }
+        std::printf("BC%d: %d blocks compared with Mesa, max |difference| = %.6f (x255 = %.3f), structural mismatches %zu\n",
+                    channels == 1 ? 4 : 5, nblocks, worst, worst * 255, structural);
+        EXPECT_EQ(structural, 0u);
+        EXPECT_LE(worst, 2.0 / 255.0);
+    }
+}
+
+}  // namespace
+}  // namespace zhc
