@@ -18,31 +18,12 @@
 #include <memory>
 #include <sstream>
 
+#include "exr_memory.h"
 #include "file_io.h"
 
 namespace zhc {
 
 namespace {
-
-// An in-memory Imf::IStream; reading past the end throws, which OpenEXR turns into an error.
-class MemoryIStream final : public Imf::IStream {
-public:
-    MemoryIStream(std::span<const std::uint8_t> bytes, const std::string& name)
-        : Imf::IStream(name.c_str()), bytes_(bytes) {}
-    bool read(char c[], int n) override {
-        if (n < 0 || pos_ + static_cast<std::uint64_t>(n) > bytes_.size())
-            throw std::runtime_error("unexpected end of file");
-        std::memcpy(c, bytes_.data() + pos_, static_cast<size_t>(n));
-        pos_ += static_cast<std::uint64_t>(n);
-        return pos_ < bytes_.size();
-    }
-    std::uint64_t tellg() override { return pos_; }
-    void seekg(std::uint64_t pos) override { pos_ = std::min<std::uint64_t>(pos, bytes_.size()); }
-
-private:
-    std::span<const std::uint8_t> bytes_;
-    std::uint64_t pos_ = 0;
-};
 
 bool is_exr(std::span<const std::uint8_t> b) {
     return b.size() >= 4 && b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01;
@@ -100,76 +81,18 @@ Status check_finite(const std::string& name, Image& img, const EnvmapReadOptions
     return Ok{};
 }
 
-// Walks the OpenEXR header(s) without allocating before OpenEXR sees them: every attribute must
-// fit inside the file (OpenEXR would otherwise allocate an attribute's declared size, up to 2 GiB,
-// before noticing the file is short), and the data window's declared size is checked against
-// zhc's limits first. Header layout: magic, version, then attributes "name\0type\0" int32 size,
-// value; a 0 byte ends a header; multi-part files (version bit 12) end the list with another 0.
-Status validate_exr_header(std::span<const std::uint8_t> b, const std::string& name, const EnvmapReadOptions& o) {
-    if (b.size() < 8) return make_error(ErrorCode::kTruncated, name + ": OpenEXR file ends inside its magic/version");
-    std::uint32_t version;
-    std::memcpy(&version, b.data() + 4, 4);
-    const bool multipart = (version & 0x1000u) != 0;
-    const size_t max_name = (version & 0x400u) ? 255 : 31;
-    size_t pos = 8;
-    auto truncated = [&]() {
-        return make_error(ErrorCode::kTruncated, name + ": OpenEXR header ends early (byte " + std::to_string(pos) + ")");
-    };
-    auto read_cstr = [&](std::string* out) -> bool {
-        out->clear();
-        while (pos < b.size() && b[pos] != 0 && out->size() <= max_name) out->push_back(static_cast<char>(b[pos++]));
-        if (pos >= b.size() || b[pos] != 0) return false;
-        ++pos;
-        return true;
-    };
-    for (int part = 0; part < 64; ++part) {
-        for (int attrs = 0;; ++attrs) {
-            if (pos >= b.size()) return truncated();
-            if (b[pos] == 0) {
-                ++pos;
-                break;
-            }
-            if (attrs >= 1024) return make_error(ErrorCode::kBadFormat, name + ": OpenEXR header has too many attributes");
-            const size_t at = pos;
-            std::string attr, type;
-            if (!read_cstr(&attr) || !read_cstr(&type)) {
-                if (pos >= b.size()) return truncated();
-                return make_error(ErrorCode::kBadFormat,
-                                  name + ": malformed OpenEXR attribute name or type at byte " + std::to_string(at));
-            }
-            if (pos + 4 > b.size()) return truncated();
-            std::int32_t size;
-            std::memcpy(&size, b.data() + pos, 4);
-            pos += 4;
-            if (size < 0) return make_error(ErrorCode::kBadFormat, name + ": OpenEXR attribute '" + attr + "' has a negative size");
-            if (pos + static_cast<size_t>(size) > b.size()) return truncated();
-            if (attr == "dataWindow" && type == "box2i" && size == 16) {
-                std::int32_t v[4];
-                std::memcpy(v, b.data() + pos, 16);
-                const std::int64_t w = std::int64_t(v[2]) - v[0] + 1, h = std::int64_t(v[3]) - v[1] + 1;
-                if (w <= 0 || h <= 0) return make_error(ErrorCode::kBadFormat, name + ": OpenEXR data window is empty");
-                if (Status st = check_size(name, static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), o); !st)
-                    return st;
-            }
-            pos += static_cast<size_t>(size);
-        }
-        if (!multipart) return Ok{};
-        if (pos >= b.size()) return truncated();
-        if (b[pos] == 0) return Ok{};  // end of the header list
-    }
-    return make_error(ErrorCode::kUnsupported, name + ": OpenEXR file has more than 64 parts");
-}
-
 Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& name, const EnvmapReadOptions& o,
                        EnvmapInfo* info) {
-    if (Status s = validate_exr_header(bytes, name, o); !s) return s.error();
+    if (Status s = validate_exr_header(bytes, name, [&](std::uint64_t w, std::uint64_t h) { return check_size(name, w, h, o); });
+        !s)
+        return s.error();
     try {
         // Bound what OpenEXR itself allocates while reading the header (its line-offset table
         // grows with the height): 2^20 per side, far above any real map; zhc's own pixel limit is
         // checked below, before the pixel buffer is allocated.
         Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
         Imf::Header::setMaxTileSize(1 << 20, 1 << 20);
-        MemoryIStream stream(bytes, name);
+        ExrMemoryStream stream(bytes, name);
         Imf::InputFile file(stream);
         const Imath::Box2i dw = file.header().dataWindow();
         const std::int64_t w = std::int64_t(dw.max.x) - dw.min.x + 1, h = std::int64_t(dw.max.y) - dw.min.y + 1;

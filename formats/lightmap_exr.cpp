@@ -12,27 +12,11 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "exr_memory.h"
 #include "file_io.h"
 
 namespace zhc {
 namespace {
-
-class MemoryStream final : public Imf::IStream {
-public:
-    MemoryStream(std::span<const std::uint8_t> bytes, const std::string& name) : Imf::IStream(name.c_str()), b_(bytes) {}
-    bool read(char c[], int n) override {
-        if (n < 0 || pos_ + static_cast<std::uint64_t>(n) > b_.size()) throw std::runtime_error("unexpected end of file");
-        std::memcpy(c, b_.data() + pos_, static_cast<size_t>(n));
-        pos_ += static_cast<std::uint64_t>(n);
-        return pos_ < b_.size();
-    }
-    std::uint64_t tellg() override { return pos_; }
-    void seekg(std::uint64_t pos) override { pos_ = std::min<std::uint64_t>(pos, b_.size()); }
-
-private:
-    std::span<const std::uint8_t> b_;
-    std::uint64_t pos_ = 0;
-};
 
 std::string sh_channel(int i, int k) { return "sh" + std::to_string(i) + "." + "RGB"[k]; }
 
@@ -44,8 +28,16 @@ Result<lightmap::ShLightmap> read_sh_lightmap_exr(const std::string& path, const
     const auto& b = *bytes;
     if (b.size() < 4 || !(b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01))
         return make_error(ErrorCode::kBadFormat, path + ": not an OpenEXR file (bad magic at byte 0)");
+    auto check = [&](std::uint64_t w, std::uint64_t h) -> Status {
+        if (w * h > o.max_texels)
+            return make_error(ErrorCode::kTooLarge, path + ": " + std::to_string(w) + "x" + std::to_string(h) +
+                                                        " texels exceed the limit " + std::to_string(o.max_texels));
+        return Ok{};
+    };
+    if (Status s = validate_exr_header(b, path, check); !s) return s.error();
     try {
-        MemoryStream stream(b, path);
+        Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
+        ExrMemoryStream stream(b, path);
         Imf::InputFile file(stream);
         const Imath::Box2i dw = file.header().dataWindow();
         const std::int64_t w = std::int64_t(dw.max.x) - dw.min.x + 1, h = std::int64_t(dw.max.y) - dw.min.y + 1;

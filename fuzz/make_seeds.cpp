@@ -10,6 +10,9 @@
 #include "codec/sky.h"
 #include "formats/envmap.h"
 #include "formats/file_io.h"
+#include "formats/ktx2.h"
+#include "codec/bc6h.h"
+#include "codec/bc45.h"
 
 using namespace zhc;
 
@@ -41,6 +44,32 @@ int main(int argc, char** argv) {
         store_floats(v, rt.data() + 1);
         ok = ok && write_file_atomic(root + "/fuzz_codec_roundtrip/" + std::string(c.name), rt);
         ++n;
+    }
+    // KTX2: one small texture per format, and block round-trip seeds.
+    fs::create_directories(root + "/fuzz_ktx2");
+    fs::create_directories(root + "/fuzz_bc_roundtrip");
+    std::vector<float> rgb(8 * 8 * 3), one(8 * 8), two(8 * 8 * 2);
+    for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = 0.1f * float(i % 17);
+    for (size_t i = 0; i < one.size(); ++i) one[i] = float(i % 9) / 8.0f;
+    for (size_t i = 0; i < two.size(); ++i) two[i] = float(i % 5) / 4.0f;
+    const std::pair<std::uint32_t, std::vector<std::uint8_t>> textures[] = {
+        {kVkFormatBc6hUfloat, bc6h::encode_image(rgb.data(), 8, 8, bc6h::Quality::kFast)},
+        {kVkFormatBc4Unorm, bc45::encode_image(one.data(), 1, 8, 8, bc45::Quality::kFast)},
+        {kVkFormatBc5Unorm, bc45::encode_image(two.data(), 2, 8, 8, bc45::Quality::kFast)}};
+    for (const auto& [format, blocks] : textures) {
+        Ktx2Image k;
+        k.vk_format = format;
+        k.width = 8;
+        k.height = 8;
+        k.blocks = blocks;
+        auto bytes = encode_ktx2(k);
+        ok = ok && bytes && write_file_atomic(root + "/fuzz_ktx2/format" + std::to_string(format) + ".ktx2", *bytes);
+    }
+    for (int kind = 0; kind < 4; ++kind) {
+        std::vector<std::uint8_t> b(1 + 96);
+        b[0] = static_cast<std::uint8_t>(kind);
+        for (size_t i = 1; i < b.size(); ++i) b[i] = static_cast<std::uint8_t>(i * 37 + kind);
+        ok = ok && write_file_atomic(root + "/fuzz_bc_roundtrip/kind" + std::to_string(kind), b);
     }
     std::printf("%s\n", ok ? "seeds written" : "failed");
     return ok ? 0 : 1;
