@@ -6,6 +6,8 @@
 
 #include "envmap.h"
 #include "file_io.h"
+#include "probe_file.h"
+#include "codec/probe_set.h"
 #include "raster.h"
 
 namespace zhc {
@@ -63,7 +65,29 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
                          std::to_string(in.map.height);
         return in;
     }
-    return make_error(ErrorCode::kUnsupported, path + ": not an environment map zhc audit can read");
+    // Probe files: the reference is each probe's SH3 (decoded from whatever the file stores, so a
+    // quantised file is audited against its own decoded hub).
+    if (looks_like_probe_file(*bytes)) {
+        auto set = parse_probe_set(*bytes, path);
+        if (!set) return set.error();
+        auto hub = decode_probe_set(*set);
+        if (!hub) return hub.error();
+        in.kind = "probes";
+        in.probes = std::move(hub).value();
+        in.description = std::to_string(in.probes.size()) + " probes stored as " + set->representation +
+                         ", reference: their SH3";
+        return in;
+    }
+    if (looks_like_json(*bytes)) {
+        auto list = parse_probe_json(*bytes, path);
+        if (!list) return list.error();
+        in.kind = "probes";
+        in.probes = std::move(list->probes);
+        in.description = std::to_string(in.probes.size()) + " probes (JSON), reference: their SH3";
+        return in;
+    }
+    return make_error(ErrorCode::kUnsupported,
+                      path + ": not an environment map (.exr, .hdr), probe container (.zhp) or JSON probe list");
 }
 
 Status write_audit_images(const std::string& dir, const AuditInput& input, const std::vector<Vec3>&,

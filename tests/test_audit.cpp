@@ -154,11 +154,43 @@ TEST(BenchCli, PrintsJsonRowsAndWritesBothPlots) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     ASSERT_EQ(j["representations"].size(), 2u);
-    EXPECT_EQ(j["representations"][0]["bytes_per_probe"].get<int>(), 108);
-    EXPECT_GT(j["representations"][1]["mean_rmse"].get<double>(), j["representations"][0]["mean_rmse"].get<double>());
+    // Rows follow --representations: sh2 (48 bytes) then sh3 (108 bytes); SH2 has the larger error.
+    EXPECT_EQ(j["representations"][0]["bytes_per_probe"].get<int>(), 48);
+    EXPECT_EQ(j["representations"][1]["bytes_per_probe"].get<int>(), 108);
+    EXPECT_GT(j["representations"][0]["mean_rmse"].get<double>(), j["representations"][1]["mean_rmse"].get<double>());
     EXPECT_GT(j["representations"][0]["encode_ns_per_probe"]["median"].get<double>(), 0.0);
     EXPECT_GT(test::read_bytes(dir + "/error_vs_encode_time.png").size(), 1000u);
     EXPECT_GT(test::read_bytes(dir + "/error_vs_bytes.png").size(), 1000u);
+}
+
+}  // namespace
+}  // namespace zhc
+
+#include "codec/probe_set.h"
+#include "formats/probe_file.h"
+
+namespace zhc {
+namespace {
+
+TEST(AuditCli, AuditsProbeContainersAndNamesFailingProbes) {
+    std::vector<Sh3Radiance> hubs;
+    for (int i = 0; i < 3; ++i)
+        hubs.push_back(project_cone(normalize_or({double(i), 1, 2}, {0, 0, 1}), 0.4, {2, 1, 1}) + project_constant({0.2f, 0.2f, 0.2f}));
+    auto set = encode_probe_set(hubs, "sh3", StorageParams{}, ProbeLayout{});
+    ASSERT_TRUE(set) << set.error().message;
+    const std::string path = test::temp_dir("audit_probes") + "/three.zhp";
+    ASSERT_TRUE(write_probe_file(path, *set));
+    auto ok = test::run_zhc({"audit", path, "--json", "--no-timing", "--representations", "sh3,sh2"});
+    ASSERT_EQ(ok.exit_code, 0) << ok.err;
+    const auto j = nlohmann::json::parse(ok.out);
+    EXPECT_EQ(j["files"][0]["kind"], "probes");
+    EXPECT_EQ(j["files"][0]["probes"].get<int>(), 3);
+    // Against its own SH3 the hub is exact; SH2 is not.
+    EXPECT_LT(j["files"][0]["representations"]["sh3"]["rmse"].get<double>(), 1e-6);
+    EXPECT_GT(j["files"][0]["representations"]["sh2"]["rmse"].get<double>(), 1e-3);
+    auto gate = test::run_zhc({"audit", path, "--no-timing", "--representations", "sh2", "--max-rmse", "1e-6"});
+    EXPECT_EQ(gate.exit_code, cli::kExitGateFailed);
+    EXPECT_NE(gate.err.find("at probe 0,1,2"), std::string::npos) << gate.err;
 }
 
 }  // namespace

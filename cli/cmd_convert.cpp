@@ -1,0 +1,208 @@
+// zhc convert IN -o OUT [--to REPRESENTATION] [quantiser options] [--zstd LEVEL]
+//
+// IN: an environment map (one probe, projected to SH3), a .zhp probe container or a JSON probe
+// list (detected by content). OUT's extension picks the output: .zhp (container) or .json
+// (float SH3 probe list). Outputs are written atomically.
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <vector>
+
+#include "cli.h"
+#include "codec/probe_set.h"
+#include "formats/envmap.h"
+#include "formats/file_io.h"
+#include "formats/probe_file.h"
+
+namespace zhc::cli {
+namespace {
+
+struct Options {
+    std::string input;
+    std::string output;
+    std::string to;
+    int bits = 8;
+    bool sqrt = false;
+    std::string bound = "tight";
+    std::string dc = "r11g11b10f";
+    std::string zonal_map = "affine";
+    std::string axis = "luminance";
+    bool irradiance = false;
+    int zstd = 0;
+    bool replace_non_finite = false;
+    int threads = 1;
+    std::vector<CLI::Option*> storage_flags;  // the options that set StorageParams
+    bool any_storage_flag() const {
+        for (const CLI::Option* opt : storage_flags)
+            if (opt->count() > 0) return true;
+        return false;
+    }
+};
+
+// What any input turns into: hub probes + layout, and the set itself when it was a container.
+struct Loaded {
+    ProbeList list;
+    std::optional<ProbeSet> set;
+    std::string kind;  // "envmap", "zhp", "json"
+};
+
+Result<Loaded> load_input(const Options& o) {
+    auto bytes = read_file_bytes(o.input, std::uint64_t(2) << 30);
+    if (!bytes) return bytes.error();
+    Loaded in;
+    if (looks_like_probe_file(*bytes)) {
+        auto set = parse_probe_set(*bytes, o.input);
+        if (!set) return set.error();
+        auto hub = decode_probe_set(*set);
+        if (!hub) return make_error(ErrorCode::kBadFormat, o.input + ": " + hub.error().message);
+        in.list.probes = std::move(hub).value();
+        in.list.layout = set->layout;
+        in.set = std::move(set).value();
+        in.kind = "zhp";
+    } else if (looks_like_envmap(*bytes)) {
+        EnvmapReadOptions ro;
+        if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
+        auto img = read_envmap_memory(*bytes, o.input, ro);
+        if (!img) return img.error();
+        in.list.probes.push_back(project_latlong(img->rgb.data(), img->width, img->height,
+                                                 static_cast<size_t>(img->width) * 3, std::max(1, o.threads)));
+        in.kind = "envmap";
+    } else if (looks_like_json(*bytes)) {
+        auto list = parse_probe_json(*bytes, o.input);
+        if (!list) return list.error();
+        in.list = std::move(list).value();
+        in.kind = "json";
+    } else {
+        return make_error(ErrorCode::kBadFormat,
+                          o.input + ": not an environment map (EXR/.hdr), .zhp probe file or JSON probe list");
+    }
+    return in;
+}
+
+Result<StorageParams> params_from(const Options& o) {
+    StorageParams p;
+    p.bits = o.bits;
+    p.sqrt_encoding = o.sqrt;
+    p.l2_bound = o.bound == "loose" ? L2Bound::kLoose : L2Bound::kTight;
+    p.dc_format = o.dc == "rgb9e5" ? DcFormat::kRGB9E5 : (o.dc == "half" ? DcFormat::kHalf : DcFormat::kR11G11B10F);
+    p.zonal_mapping = o.zonal_map == "zero" ? ZonalMapping::kZeroPreserving
+                                            : (o.zonal_map == "symmetric" ? ZonalMapping::kSymmetric : ZonalMapping::kAffine);
+    p.axis_mode = o.axis == "channel" ? ZonalAxisMode::kPerChannel : ZonalAxisMode::kLuminance;
+    p.kind = o.irradiance ? StoredKind::kIrradiance : StoredKind::kRadiance;
+    return p;
+}
+
+bool same_params(const StorageParams& a, const StorageParams& b) {
+    return a.bits == b.bits && a.sqrt_encoding == b.sqrt_encoding && a.l2_bound == b.l2_bound &&
+           a.dc_format == b.dc_format && a.kind == b.kind && a.zonal_mapping == b.zonal_mapping &&
+           a.axis_mode == b.axis_mode && a.luminance.r == b.luminance.r && a.luminance.g == b.luminance.g &&
+           a.luminance.b == b.luminance.b;
+}
+
+int run(const Options& o) {
+    const std::string ext = file_extension(o.output);
+    if (ext != ".zhp" && ext != ".json") {
+        std::fprintf(stderr, "zhc: error: %s: output extension must be .zhp or .json\n", o.output.c_str());
+        return kExitUsage;
+    }
+    if (!o.to.empty() && !find_codec(o.to)) {
+        std::string names;
+        for (const Codec& c : codecs()) names += (names.empty() ? "" : ", ") + std::string(c.name);
+        std::fprintf(stderr, "zhc: error: unknown representation '%s' (known: %s)\n", o.to.c_str(), names.c_str());
+        return kExitUsage;
+    }
+    auto params = params_from(o);
+    if (!params) return report(params.error());
+    auto in = load_input(o);
+    if (!in) return report(in.error());
+
+    std::string rep = o.to;
+    if (rep.empty() && ext == ".zhp") {
+        if (!in->set) {
+            std::fprintf(stderr, "zhc: error: --to REPRESENTATION is required to write a .zhp from %s input\n",
+                         in->kind.c_str());
+            return kExitUsage;
+        }
+        rep = in->set->representation;
+        // Same representation, no quantiser flags: keep the input's parameters too.
+        if (!o.any_storage_flag()) *params = in->set->params;
+    }
+    if (Status st = validate_quant_params(*params, rep.empty() ? "sh3" : rep); !st) {
+        std::fprintf(stderr, "zhc: error: %s\n", st.error().message.c_str());
+        return kExitUsage;
+    }
+
+    EncodeStats stats;
+    if (ext == ".zhp") {
+        ProbeSet out;
+        if (in->set && in->set->representation == rep && same_params(in->set->params, *params)) {
+            out = *in->set;  // same representation and parameters: keep the bytes (no re-quantisation)
+        } else {
+            auto set = encode_probe_set(in->list.probes, rep, *params, in->list.layout, &stats);
+            if (!set) return report(set.error());
+            out = std::move(set).value();
+        }
+        ProbeFileWriteOptions wo;
+        wo.zstd_level = o.zstd;
+        auto bytes = serialize_probe_set(out, wo);
+        if (!bytes) return report(bytes.error());
+        if (Status st = write_file_atomic(o.output, *bytes); !st) return report_output(st.error());
+        const size_t per = out.codec()->size_bytes;
+        std::printf("%s: %llu probes as %s (%zu bytes/probe), %zu bytes (%llu payload + %zu header%s), "
+                    "clamped ratios: %d\n",
+                    o.output.c_str(), static_cast<unsigned long long>(out.count), rep.c_str(), per, bytes->size(),
+                    static_cast<unsigned long long>(out.count * per), kProbeFileHeaderBytes,
+                    o.zstd > 0 ? ", body zstd-compressed" : "", stats.clamped_ratios);
+        return kExitOk;
+    }
+    // JSON: float SH3; through the representation first when --to is given (a lossy preview).
+    ProbeList list = in->list;
+    if (!rep.empty()) {
+        auto set = encode_probe_set(list.probes, rep, *params, list.layout, &stats);
+        if (!set) return report(set.error());
+        auto hub = decode_probe_set(*set);
+        if (!hub) return report(hub.error());
+        list.probes = std::move(hub).value();
+    }
+    if (Status st = write_probe_json(o.output, list); !st) {
+        if (st.error().code == ErrorCode::kInvalidValue) return report(st.error());
+        return report_output(st.error());
+    }
+    std::printf("%s: %zu probes as JSON float SH3%s%s, clamped ratios: %d\n", o.output.c_str(), list.probes.size(),
+                rep.empty() ? "" : " via ", rep.c_str(), stats.clamped_ratios);
+    return kExitOk;
+}
+
+const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()> {
+    auto o = std::make_shared<Options>();
+    CLI::App* sub = app.add_subcommand(
+        "convert", "Convert probes between environment maps, .zhp containers and JSON probe lists");
+    sub->add_option("IN", o->input, "environment map (EXR/.hdr: one probe), .zhp container or JSON probe list")
+        ->required();
+    sub->add_option("-o,--output", o->output, "output file: .zhp (container) or .json (float SH3 probe list)")
+        ->required();
+    sub->add_option("--to", o->to, "representation (a codec table name, e.g. zh3_q16, sh3_q28, sh2_q, sh3)");
+    auto& f = o->storage_flags;
+    f.push_back(sub->add_option("--bits", o->bits, "bits per quantised ratio (2..8, default 8)")->check(CLI::Range(2, 8)));
+    f.push_back(sub->add_flag("--sqrt", o->sqrt, "sign-preserving square-root encoding of the ratios"));
+    f.push_back(sub->add_option("--bound", o->bound, "non-zonal L2 bound: tight (sqrt(15)/2, default) or loose (sqrt(5))")
+        ->check(CLI::IsMember({"tight", "loose"})));
+    f.push_back(sub->add_option("--dc", o->dc, "DC format: r11g11b10f (default), rgb9e5, half (sh2_q only)")
+        ->check(CLI::IsMember({"r11g11b10f", "rgb9e5", "half"})));
+    f.push_back(sub->add_option("--zonal-map", o->zonal_map,
+                    "zonal L2 interval mapping: affine (default), zero (zero-preserving), symmetric (+-sqrt(5))")
+        ->check(CLI::IsMember({"affine", "zero", "symmetric"})));
+    f.push_back(sub->add_option("--axis", o->axis, "zh3_q16/hall_curve_q zonal axis: luminance (default) or channel")
+        ->check(CLI::IsMember({"luminance", "channel"})));
+    f.push_back(sub->add_flag("--irradiance", o->irradiance,
+                              "store irradiance SH (irradiance-scaled bounds) instead of radiance"));
+    sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")
+        ->check(CLI::Range(0, 22));
+    sub->add_flag("--replace-non-finite", o->replace_non_finite, "env map input: replace NaN/Inf pixels by 0");
+    sub->add_option("--threads", o->threads, "env map projection threads (result identical for any count)")
+        ->check(CLI::Range(1, 256));
+    return [o] { return run(*o); };
+});
+
+}  // namespace
+}  // namespace zhc::cli

@@ -1,0 +1,165 @@
+// zhc info FILE [--json]: describe any file zhc reads (environment map, .zhp, JSON probe list).
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include "cli.h"
+#include "codec/probe_set.h"
+#include "formats/envmap.h"
+#include "formats/file_io.h"
+#include "formats/probe_file.h"
+
+namespace zhc::cli {
+namespace {
+
+struct Options {
+    std::string path;
+    bool json = false;
+};
+
+const char* layout_name(ProbeLayoutKind k) {
+    switch (k) {
+        case ProbeLayoutKind::kNone: return "none";
+        case ProbeLayoutKind::kGrid: return "grid";
+        case ProbeLayoutKind::kPositions: return "positions";
+    }
+    return "?";
+}
+const char* dc_name(DcFormat f) {
+    switch (f) {
+        case DcFormat::kR11G11B10F: return "r11g11b10f";
+        case DcFormat::kRGB9E5: return "rgb9e5";
+        case DcFormat::kHalf: return "half";
+    }
+    return "?";
+}
+const char* zonal_name(ZonalMapping m) {
+    switch (m) {
+        case ZonalMapping::kAffine: return "affine";
+        case ZonalMapping::kZeroPreserving: return "zero";
+        case ZonalMapping::kSymmetric: return "symmetric";
+    }
+    return "?";
+}
+
+nlohmann::ordered_json layout_json(const ProbeLayout& l) {
+    nlohmann::ordered_json j;
+    j["type"] = layout_name(l.kind);
+    if (l.kind == ProbeLayoutKind::kGrid) {
+        j["origin"] = {l.grid.origin.x, l.grid.origin.y, l.grid.origin.z};
+        j["spacing"] = {l.grid.spacing.x, l.grid.spacing.y, l.grid.spacing.z};
+        j["counts"] = {l.grid.counts[0], l.grid.counts[1], l.grid.counts[2]};
+    }
+    return j;
+}
+
+// Mean radiance (DC / (2 sqrt(pi))) range over probes, and probes that decode to non-finite values.
+void probe_stats(const std::vector<Sh3Radiance>& hub, nlohmann::ordered_json& j) {
+    double lo = INFINITY, hi = -INFINITY;
+    std::uint64_t non_finite = 0;
+    const LuminanceWeights w;
+    for (const Sh3Radiance& sh : hub) {
+        bool finite = true;
+        for (int i = 0; i < 9; ++i)
+            for (int k = 0; k < 3; ++k) finite = finite && std::isfinite(sh[i][k]);
+        if (!finite) {
+            ++non_finite;
+            continue;
+        }
+        const double mean = luminance(sh[0], w) / (2.0 * std::sqrt(kPi));
+        lo = std::min(lo, mean);
+        hi = std::max(hi, mean);
+    }
+    if (lo <= hi) j["mean_radiance_luminance"] = {lo, hi};
+    j["non_finite_probes"] = non_finite;
+}
+
+void print_json_or_text(const nlohmann::ordered_json& j, bool as_json) {
+    if (as_json) {
+        std::cout << j.dump() << "\n";
+        return;
+    }
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        if (it.value().is_string()) std::printf("%-24s %s\n", it.key().c_str(), it.value().get<std::string>().c_str());
+        else std::printf("%-24s %s\n", it.key().c_str(), it.value().dump().c_str());
+    }
+}
+
+int run(const Options& o) {
+    auto bytes = read_file_bytes(o.path, std::uint64_t(2) << 30);
+    if (!bytes) return report(bytes.error());
+    nlohmann::ordered_json j;
+    j["path"] = o.path;
+    j["file_bytes"] = bytes->size();
+    if (looks_like_probe_file(*bytes)) {
+        ProbeFileInfo info;
+        auto set = parse_probe_set(*bytes, o.path, {}, &info);
+        if (!set) return report(set.error());
+        const Codec* codec = set->codec();
+        const StorageParams& p = set->params;
+        j["type"] = "zhp probe container";
+        j["version"] = info.version;
+        j["representation"] = set->representation;
+        j["summary"] = std::string(codec->summary);
+        j["probes"] = set->count;
+        j["bytes_per_probe"] = codec->size_bytes;
+        j["payload_bytes"] = set->payload.size();
+        j["header_bytes"] = kProbeFileHeaderBytes;
+        j["body_bytes"] = info.raw_body_bytes;
+        j["stored_body_bytes"] = info.stored_body_bytes;
+        j["compression"] = info.compressed ? "zstd" : "none";
+        j["layout"] = layout_json(set->layout);
+        j["kind"] = p.kind == StoredKind::kIrradiance ? "irradiance" : "radiance";
+        PackedLayout packed;
+        if (packed_layout_from_name(set->representation, &packed)) {
+            j["bits"] = p.bits;
+            j["sqrt"] = p.sqrt_encoding;
+            j["l2_bound"] = p.l2_bound == L2Bound::kTight ? "tight" : "loose";
+            j["dc_format"] = dc_name(p.dc_format);
+            j["zonal_mapping"] = zonal_name(p.zonal_mapping);
+            j["axis"] = p.axis_mode == ZonalAxisMode::kLuminance ? "luminance" : "channel";
+        }
+        j["luminance_weights"] = {p.luminance.r, p.luminance.g, p.luminance.b};
+        auto hub = decode_probe_set(*set);
+        if (!hub) return report(hub.error());
+        probe_stats(*hub, j);
+    } else if (looks_like_envmap(*bytes)) {
+        EnvmapInfo info;
+        auto img = read_envmap_memory(*bytes, o.path, {}, &info);
+        if (!img) return report(img.error());
+        j["type"] = "environment map (lat-long)";
+        j["format"] = info.format;
+        j["width"] = img->width;
+        j["height"] = img->height;
+        j["channels"] = info.channels;
+        j["compression"] = info.compression;
+        const Sh3Radiance sh = project_latlong(img->rgb.data(), img->width, img->height,
+                                               static_cast<size_t>(img->width) * 3);
+        probe_stats({sh}, j);
+    } else if (looks_like_json(*bytes)) {
+        auto list = parse_probe_json(*bytes, o.path);
+        if (!list) return report(list.error());
+        j["type"] = "JSON probe list (float SH3 radiance)";
+        j["probes"] = list->probes.size();
+        j["layout"] = layout_json(list->layout);
+        probe_stats(list->probes, j);
+    } else {
+        return report(make_error(ErrorCode::kBadFormat,
+                                 o.path + ": not an environment map (EXR/.hdr), .zhp probe file or JSON probe list"));
+    }
+    print_json_or_text(j, o.json);
+    return kExitOk;
+}
+
+const VerbRegistration registration(45, [](CLI::App& app) -> std::function<int()> {
+    auto o = std::make_shared<Options>();
+    CLI::App* sub = app.add_subcommand("info", "Describe an environment map, .zhp probe container or JSON probe list");
+    sub->add_option("FILE", o->path, "file to describe (type detected from its content)")->required();
+    sub->add_flag("--json", o->json, "print one JSON object");
+    return [o] { return run(*o); };
+});
+
+}  // namespace
+}  // namespace zhc::cli
