@@ -18,9 +18,10 @@ namespace zhc {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// BFGS runs from the best start axis only (by profile error, see solve_luminance): on the bench set
-// (8 maps x 64 rotations + 512 random lightings) a second start never lowered the converged error
-// and doubled the cost.
+// L-BFGS runs from the best start axis only (ranked by profile error, see solve_luminance). On the
+// bench set (8 maps x 64 rotations + 512 random lightings) a second start left the converged mean
+// error of the shared-axis solve unchanged (to 6 digits) and lowered the per-channel one by 3e-5
+// (relative), each at twice the cost.
 constexpr int kLumStarts = 1;
 constexpr int kChannelStarts = 1;
 // |Y2(a)|^2 = 5 / (4 pi) on the unit sphere (Eq. 8/9).
@@ -60,6 +61,18 @@ Vec3 axis_source(const Rgb* c, ZonalAxisMode mode, int k, const LuminanceWeights
 }
 
 bool usable_length(double len) { return len > 0.0 && std::isfinite(len); }
+
+// The three channels' zonal axes, the shared luminance axis computed once.
+struct Axes {
+    Vec3 a[3];
+    Axes(const Sh2Radiance& linear, ZonalAxisMode mode, const LuminanceWeights& w) {
+        if (mode == ZonalAxisMode::kLuminance) {
+            a[0] = a[1] = a[2] = normalize_or(luminance_l1(linear.c.data(), w), {0, 0, 1});
+        } else {
+            for (int k = 0; k < 3; ++k) a[k] = normalize_or(l1_vector(linear.c.data(), k), {0, 0, 1});
+        }
+    }
+};
 
 // ---- the solve's target in irradiance vector form ------------------------------------------
 
@@ -300,10 +313,11 @@ void sort_candidates(Candidate* list, int count) {
 double stored_error(const Target& t, const Sh2Radiance& linear, ZonalAxisMode mode, const LuminanceWeights& w,
                     int channel_only = -1) {
     double e = 0;
+    const Axes axes(linear, mode, w);
     for (int k = 0; k < 3; ++k) {
         if (channel_only >= 0 && k != channel_only) continue;
         const Vec3 d = kIrradianceBandScale[1] * l1_vector(linear.c.data(), k) - t.t1[k];
-        e += dot(d, d) + l2_residual(t, k, zh3_axis(linear, mode, k, w));
+        e += dot(d, d) + l2_residual(t, k, axes.a[k]);
     }
     return e;
 }
@@ -614,18 +628,17 @@ bool has_zonal_axis(const Sh2Radiance& linear, ZonalAxisMode mode, int channel, 
 Zh3 zh3_fit(const Sh3Radiance& sh, ZonalAxisMode mode, const LuminanceWeights& w) {
     Zh3 z;
     z.linear = truncate_to_sh2(sh);
-    const Vec3 shared = mode == ZonalAxisMode::kLuminance ? zh3_axis(z.linear, mode, 0, w) : Vec3{};
-    for (int k = 0; k < 3; ++k)
-        z.zonal[k] = static_cast<float>(
-            fit_zonal(sh, k, mode == ZonalAxisMode::kLuminance ? shared : zh3_axis(z.linear, mode, k, w)));
+    const Axes axes(z.linear, mode, w);
+    for (int k = 0; k < 3; ++k) z.zonal[k] = static_cast<float>(fit_zonal(sh, k, axes.a[k]));
     return z;
 }
 
 Sh3Radiance zh3_expand(const Zh3& zh3, ZonalAxisMode mode, const LuminanceWeights& w) {
     Sh3Radiance out = extend_to_sh3(zh3.linear);
+    const Axes axes(zh3.linear, mode, w);
     for (int k = 0; k < 3; ++k) {
         // Eq. 2 on a zonal function: f_2^m = f_2^0 sqrt(4 pi / 5) Y_2^m(axis).
-        const auto q = y2(zh3_axis(zh3.linear, mode, k, w));
+        const auto q = y2(axes.a[k]);
         for (int m = 0; m < 5; ++m) out[4 + m][k] = static_cast<float>(zh3.zonal[k] * kSqrtFourPiOverFive * q[static_cast<size_t>(m)]);
     }
     return out;
@@ -634,10 +647,9 @@ Sh3Radiance zh3_expand(const Zh3& zh3, ZonalAxisMode mode, const LuminanceWeight
 Rgb zh3_irradiance(const Zh3& zh3, ZonalAxisMode mode, const LuminanceWeights& w, Vec3 n) {
     Rgb out;
     const Rgb* c = zh3.linear.c.data();
-    Vec3 shared{};
-    if (mode == ZonalAxisMode::kLuminance) shared = zh3_axis(zh3.linear, mode, 0, w);
+    const Axes axes(zh3.linear, mode, w);
     for (int k = 0; k < 3; ++k) {
-        const Vec3 a = mode == ZonalAxisMode::kLuminance ? shared : zh3_axis(zh3.linear, mode, k, w);
+        const Vec3 a = axes.a[k];
         const double z = dot(a, n);
         // Listing 1: linear SH with the L1 band scaled by 2/3, plus 1/4 of the zonal L2 term.
         const double e = kY00 * c[0][k] + kIrradianceBandScale[1] * kY1 * dot(l1_vector(c, k), n) +
@@ -699,9 +711,10 @@ double hallucinate_zonal(Hallucination model, double f0, double f1_zonal, double
 Zh3 zh3_hallucinate(const Sh2Radiance& linear, Hallucination model, ZonalAxisMode mode, const CodecOptions& o) {
     Zh3 z;
     z.linear = linear;
+    const Axes axes(linear, mode, o.luminance);
     for (int k = 0; k < 3; ++k) {
         // Listing 1: f1^0 = L1 projected on the zonal axis (the channel's |L1| for per-channel axes).
-        const double f1 = dot(l1_vector(linear.c.data(), k), zh3_axis(linear, mode, k, o.luminance));
+        const double f1 = dot(l1_vector(linear.c.data(), k), axes.a[k]);
         z.zonal[k] = static_cast<float>(hallucinate_zonal(model, linear[0][k], f1, o.hallucinate_a, o.hallucinate_b));
     }
     return z;
@@ -736,10 +749,11 @@ ZonalInterval zh3_dering_interval(double f0, double f1_zonal) {
 
 bool zh3_dering(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w) {
     bool clamped = false;
+    const Axes axes(zh3->linear, mode, w);
     for (int k = 0; k < 3; ++k) {
         // Only the L1 component along the zonal axis enters g(z); see docs/zh3.md for what that
         // guarantees when the channel's L1 is not parallel to the axis.
-        const double f1 = dot(l1_vector(zh3->linear.c.data(), k), zh3_axis(zh3->linear, mode, k, w));
+        const double f1 = dot(l1_vector(zh3->linear.c.data(), k), axes.a[k]);
         const ZonalInterval iv = zh3_dering_interval(zh3->linear[0][k], f1);
         const double f20 = zh3->zonal[k];
         const double c = std::isfinite(f20) ? std::clamp(f20, iv.lo, iv.hi) : iv.lo;
@@ -851,8 +865,9 @@ double zh3_dering_sphere_zonal(double f0, double f1_zonal, double f1_perp, doubl
 
 bool zh3_dering_sphere(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w) {
     bool any = false;
+    const Axes axes(zh3->linear, mode, w);
     for (int k = 0; k < 3; ++k) {
-        const Vec3 axis = zh3_axis(zh3->linear, mode, k, w);
+        const Vec3 axis = axes.a[k];
         const Vec3 v = l1_vector(zh3->linear.c.data(), k);
         const double along = dot(v, axis);
         const double across = length(v - along * axis);
