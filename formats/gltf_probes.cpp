@@ -31,7 +31,7 @@ namespace zhc {
 namespace {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
+using json = nlohmann::ordered_json;
 
 constexpr std::uint32_t kGlbMagic = 0x46546C67;     // "glTF"
 constexpr std::uint32_t kChunkJson = 0x4E4F534A;    // "JSON"
@@ -52,6 +52,7 @@ std::uint32_t le32(const std::uint8_t* p) {
 struct GlbParts {
     std::string json_text;
     bool has_bin = false;
+    std::uint64_t bin_offset = 0;
     std::uint64_t bin_bytes = 0;
 };
 
@@ -73,6 +74,7 @@ Result<GlbParts> split_glb(std::span<const std::uint8_t> b, const std::string& p
         if (le32(b.data() + at + 4) == kChunkBin) {
             if (at + 8 + bin_len > total) return fail(ErrorCode::kTruncated, path, "GLB BIN chunk (" + std::to_string(bin_len) + " bytes) runs past the end");
             parts.has_bin = true;
+            parts.bin_offset = at + 8;
             parts.bin_bytes = bin_len;
         }
     } else if (at != total) {
@@ -242,6 +244,68 @@ bool no_image_decode(tinygltf::Image*, const int, std::string*, std::string*, in
     return true;
 }
 
+// A primitive whose index accessor has no bufferView (a Draco-compressed mesh), with a buffer 0
+// for the placeholder to point at.
+bool needs_draco_index_patch(const json& doc) {
+    if (!doc.contains("meshes") || !doc["meshes"].is_array() || !doc.contains("accessors") || !doc["accessors"].is_array() ||
+        !doc.contains("buffers") || !doc["buffers"].is_array() || doc["buffers"].empty())
+        return false;
+    if (doc.contains("bufferViews") && !doc["bufferViews"].is_array()) return false;
+    for (const json& mesh : doc["meshes"]) {
+        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+        for (const json& prim : mesh["primitives"]) {
+            if (!prim.is_object() || !prim.contains("indices") || !prim["indices"].is_number_unsigned()) continue;
+            const std::uint64_t a = prim["indices"].get<std::uint64_t>();
+            if (a < doc["accessors"].size() && doc["accessors"][a].is_object() && !doc["accessors"][a].contains("bufferView"))
+                return true;
+        }
+    }
+    return false;
+}
+
+void put32(std::vector<std::uint8_t>& out, std::uint32_t v) {
+    for (int b = 0; b < 4; ++b) out.push_back(static_cast<std::uint8_t>(v >> (8 * b)));
+}
+
+// GLB 2.0: header, JSON chunk padded with spaces, optional BIN chunk padded with zeros.
+std::vector<std::uint8_t> make_glb(const std::string& json_text, std::span<const std::uint8_t> bin) {
+    const std::size_t json_len = (json_text.size() + 3) & ~std::size_t(3);
+    const std::size_t bin_len = (bin.size() + 3) & ~std::size_t(3);
+    std::vector<std::uint8_t> out;
+    out.reserve(12 + 8 + json_len + (bin.empty() ? 0 : 8 + bin_len));
+    put32(out, kGlbMagic);
+    put32(out, 2);
+    put32(out, static_cast<std::uint32_t>(12 + 8 + json_len + (bin.empty() ? 0 : 8 + bin_len)));
+    put32(out, static_cast<std::uint32_t>(json_len));
+    put32(out, kChunkJson);
+    out.insert(out.end(), json_text.begin(), json_text.end());
+    out.resize(20 + json_len, ' ');
+    if (!bin.empty()) {
+        put32(out, static_cast<std::uint32_t>(bin_len));
+        put32(out, kChunkBin);
+        out.insert(out.end(), bin.begin(), bin.end());
+        out.resize(out.size() + (bin_len - bin.size()), 0);
+    }
+    return out;
+}
+
+std::string base64(std::span<const std::uint8_t> b) {
+    static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((b.size() + 2) / 3 * 4);
+    for (std::size_t i = 0; i < b.size(); i += 3) {
+        const std::uint32_t v = std::uint32_t(b[i]) << 16 | (i + 1 < b.size() ? std::uint32_t(b[i + 1]) << 8 : 0) |
+                                (i + 2 < b.size() ? std::uint32_t(b[i + 2]) : 0);
+        out.push_back(k[(v >> 18) & 63]);
+        out.push_back(k[(v >> 12) & 63]);
+        out.push_back(i + 1 < b.size() ? k[(v >> 6) & 63] : '=');
+        out.push_back(i + 2 < b.size() ? k[v & 63] : '=');
+    }
+    return out;
+}
+
+std::string data_uri(std::span<const std::uint8_t> b) { return "data:application/octet-stream;base64," + base64(b); }
+
 struct Loaded {
     json doc;
     tinygltf::Model model;
@@ -277,6 +341,34 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     guard.max_bytes = limits.max_buffer_bytes;
     guard.max_total = limits.max_total_bytes;
 
+    // tinygltf 2.7 refuses primitives whose index accessor has no bufferView, which is exactly
+    // how KHR_draco_mesh_compression meshes are written (the data is in the Draco stream). Give
+    // such accessors a placeholder bufferView (appended last, so no index of the asset moves)
+    // for tinygltf's eyes only; the model is used for buffer bytes, never written back.
+    std::vector<std::uint8_t> patched_glb;
+    std::string patched_text;
+    if (needs_draco_index_patch(out.doc)) {
+        json patched = out.doc;
+        const std::size_t fake = patched["bufferViews"].size();
+        patched["bufferViews"].push_back(json{{"buffer", 0}, {"byteLength", 1}});
+        for (const json& mesh : patched["meshes"])
+            for (const json& prim : mesh.value("primitives", json::array()))
+                if (prim.is_object() && prim.contains("indices") && prim["indices"].is_number_unsigned()) {
+                    json& acc = patched["accessors"][prim["indices"].get<size_t>()];
+                    if (acc.is_object() && !acc.contains("bufferView")) acc["bufferView"] = fake;
+                }
+        patched_text = patched.dump();
+        if (out.binary) {
+            const std::span<const std::uint8_t> bin =
+                glb.has_bin ? bytes.subspan(glb.bin_offset, glb.bin_bytes)
+                            : std::span<const std::uint8_t>();
+            patched_glb = make_glb(patched_text, bin);
+        } else {
+            text = patched_text;
+        }
+    }
+    const std::span<const std::uint8_t> glb_bytes = patched_glb.empty() ? bytes : std::span<const std::uint8_t>(patched_glb);
+
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks(tinygltf::FsCallbacks{&fs_exists, &fs_expand, &fs_read, &fs_write, &guard});
     loader.SetImageLoader(&no_image_decode, nullptr);
@@ -285,7 +377,7 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     const std::string base = guard.base.string();
     bool loaded;
     if (out.binary)
-        loaded = loader.LoadBinaryFromMemory(&out.model, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()), base);
+        loaded = loader.LoadBinaryFromMemory(&out.model, &err, &warn, glb_bytes.data(), static_cast<unsigned>(glb_bytes.size()), base);
     else
         loaded = loader.LoadASCIIFromString(&out.model, &err, &warn, text.data(), static_cast<unsigned>(text.size()), base);
     if (!guard.error.empty()) return fail(ErrorCode::kBadFormat, path, guard.error);
@@ -346,65 +438,6 @@ const char* zonal_name(ZonalMapping m) {
         case ZonalMapping::kSymmetric: return "symmetric";
     }
     return "affine";
-}
-
-tinygltf::Value to_value(const json& j) {
-    if (j.is_boolean()) return tinygltf::Value(j.get<bool>());
-    if (j.is_number_integer()) return tinygltf::Value(static_cast<int>(j.get<std::int64_t>()));
-    if (j.is_number()) return tinygltf::Value(j.get<double>());
-    if (j.is_string()) return tinygltf::Value(j.get<std::string>());
-    if (j.is_array()) {
-        tinygltf::Value::Array a;
-        for (const json& e : j) a.push_back(to_value(e));
-        return tinygltf::Value(std::move(a));
-    }
-    tinygltf::Value::Object o;
-    for (auto it = j.begin(); it != j.end(); ++it) o[it.key()] = to_value(it.value());
-    return tinygltf::Value(std::move(o));
-}
-
-json from_value(const tinygltf::Value& v) {
-    if (v.IsBool()) return v.Get<bool>();
-    if (v.IsInt()) return v.Get<int>();
-    if (v.IsNumber()) return v.GetNumberAsDouble();
-    if (v.IsString()) return v.Get<std::string>();
-    if (v.IsArray()) {
-        json a = json::array();
-        for (size_t i = 0; i < v.ArrayLen(); ++i) a.push_back(from_value(v.Get(static_cast<int>(i))));
-        return a;
-    }
-    if (v.IsObject()) {
-        json o = json::object();
-        for (const std::string& k : v.Keys()) o[k] = from_value(v.Get(k));
-        return o;
-    }
-    return nullptr;
-}
-
-// Appends bytes to a buffer, aligned to 8, and adds a bufferView; returns its index.
-int append_view(tinygltf::Model& m, int buffer, const std::vector<std::uint8_t>& bytes, const std::string& name) {
-    std::vector<unsigned char>& data = m.buffers[static_cast<size_t>(buffer)].data;
-    while (data.size() % 8 != 0) data.push_back(0);
-    tinygltf::BufferView view;
-    view.name = name;
-    view.buffer = buffer;
-    view.byteOffset = data.size();
-    view.byteLength = bytes.size();
-    data.insert(data.end(), bytes.begin(), bytes.end());
-    m.bufferViews.push_back(view);
-    return static_cast<int>(m.bufferViews.size() - 1);
-}
-
-int add_accessor(tinygltf::Model& m, int view, int component, int type, std::size_t count, const std::string& name) {
-    tinygltf::Accessor a;
-    a.name = name;
-    a.bufferView = view;
-    a.byteOffset = 0;
-    a.componentType = component;
-    a.type = type;
-    a.count = count;
-    m.accessors.push_back(a);
-    return static_cast<int>(m.accessors.size() - 1);
 }
 
 std::vector<std::uint8_t> float_bytes(const std::vector<std::array<float, 3>>& v) {
@@ -706,9 +739,14 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
                                                     const GltfLimits& limits) {
     auto valid = validate_probe_set(input_set);
     if (!valid) return valid.error();
+    if (options.draco && (input_set.layout.kind != ProbeLayoutKind::kPositions || !is_float_vec3_encoding(input_set.representation)))
+        return make_error(ErrorCode::kInvalidArgument, "--draco needs a probe set with explicit positions in a float encoding (sh3, sh2)");
     auto loaded = load(scene_bytes, scene_path, limits);
     if (!loaded) return loaded.error();
-    tinygltf::Model& m = loaded->model;
+    // The output is the input's own JSON (order and values kept by ordered_json) with our
+    // additions; tinygltf's model only supplies the bytes of each buffer.
+    json doc = loaded->doc;
+    const tinygltf::Model& m = loaded->model;
     const Codec* codec = input_set.codec();
     const std::size_t size = codec->size_bytes;
 
@@ -759,75 +797,97 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
             break;
         case ProbeLayoutKind::kNone: vol["layout"] = "none"; break;
     }
-    if (options.draco && (set.layout.kind != ProbeLayoutKind::kPositions || !is_float_vec3_encoding(set.representation)))
-        return make_error(ErrorCode::kInvalidArgument, "--draco needs a probe set with explicit positions in a float encoding (sh3, sh2)");
 
-    // Target buffer: the GLB binary buffer (existing bytes stay a prefix) or a new buffer.
-    int buffer = -1;
+    // Buffers: GLB output keeps buffer 0 as the BIN chunk (its bytes stay a prefix) and appends
+    // there; .gltf output appends a new buffer. Every other buffer keeps its bytes; buffers that
+    // lived in a GLB chunk or an external file become data URIs so the output is self-contained.
+    if (!doc.contains("buffers")) doc["buffers"] = json::array();
+    if (!doc.contains("bufferViews")) doc["bufferViews"] = json::array();
+    if (!doc.contains("accessors")) doc["accessors"] = json::array();
+    json& buffers = doc["buffers"];
+    if (m.buffers.size() != buffers.size()) return fail(ErrorCode::kBadFormat, scene_path, "buffers could not all be loaded");
+    std::vector<std::uint8_t> target;  // the buffer we append to
+    std::size_t target_index = 0;
     if (options.binary) {
-        if (m.buffers.empty()) m.buffers.emplace_back();
-        m.buffers[0].uri.clear();  // buffer 0 becomes (stays) the BIN chunk
-        buffer = 0;
+        if (buffers.empty()) buffers.push_back(json::object());
+        else target.assign(m.buffers[0].data.begin(), m.buffers[0].data.end());
+        target_index = 0;
     } else {
-        m.buffers.emplace_back();
-        m.buffers.back().name = options.name;
-        buffer = static_cast<int>(m.buffers.size() - 1);
+        target_index = buffers.size();
+        buffers.push_back(json{{"name", options.name}});
     }
+    for (std::size_t i = 0; i < m.buffers.size(); ++i) {
+        if (options.binary && i == 0) continue;
+        json& b = buffers[i];
+        const bool data = b.contains("uri") && b["uri"].get<std::string>().rfind("data:", 0) == 0;
+        if (!data) b["uri"] = data_uri(m.buffers[i].data);
+    }
+    auto append_view = [&](const std::vector<std::uint8_t>& bytes, const std::string& name) {
+        while (target.size() % 8 != 0) target.push_back(0);
+        doc["bufferViews"].push_back(json{{"buffer", target_index}, {"byteOffset", target.size()}, {"byteLength", bytes.size()}, {"name", name}});
+        target.insert(target.end(), bytes.begin(), bytes.end());
+        return doc["bufferViews"].size() - 1;
+    };
+    auto add_accessor = [&](std::size_t view, int component, const char* type, std::size_t count, const std::string& name) {
+        doc["accessors"].push_back(json{{"bufferView", view}, {"componentType", component}, {"count", count}, {"type", type}, {"name", name}});
+        return doc["accessors"].size() - 1;
+    };
     if (options.draco) {
         auto encoded = encode_probe_point_cloud(positions, payload, set.representation, options.draco_bits);
         if (!encoded) return encoded.error();
-        const int view = append_view(m, buffer, encoded->bytes, options.name + " draco");
-        vol["draco"] = {{"bufferView", view}, {"quantizationBits", options.draco_bits}, {"attributes", encoded->attributes}};
+        const std::size_t view = append_view(encoded->bytes, options.name + " draco");
+        json attrs = json::object();
+        for (const auto& [k, v] : encoded->attributes) attrs[k] = v;
+        vol["draco"] = {{"bufferView", view}, {"quantizationBits", options.draco_bits}, {"attributes", attrs}};
     } else {
         if (set.layout.kind == ProbeLayoutKind::kPositions) {
-            const int view = append_view(m, buffer, float_bytes(positions), options.name + " positions");
-            const int acc = add_accessor(m, view, kFloat, TINYGLTF_TYPE_VEC3, positions.size(), options.name + " positions");
-            std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+            const std::size_t view = append_view(float_bytes(positions), options.name + " positions");
+            const std::size_t acc = add_accessor(view, kFloat, "VEC3", positions.size(), options.name + " positions");
+            std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
             for (const auto& p : positions)
                 for (size_t k = 0; k < 3; ++k) {
-                    lo[k] = std::min(lo[k], double(p[k]));
-                    hi[k] = std::max(hi[k], double(p[k]));
+                    lo[k] = std::min(lo[k], p[k]);
+                    hi[k] = std::max(hi[k], p[k]);
                 }
-            m.accessors[static_cast<size_t>(acc)].minValues.assign(lo.begin(), lo.end());
-            m.accessors[static_cast<size_t>(acc)].maxValues.assign(hi.begin(), hi.end());
+            doc["accessors"][acc]["min"] = lo;
+            doc["accessors"][acc]["max"] = hi;
             vol["positions"] = acc;
         }
-        const int view = append_view(m, buffer, payload, options.name + " coefficients");
-        const int acc = is_float_vec3_encoding(set.representation)
-                            ? add_accessor(m, view, kFloat, TINYGLTF_TYPE_VEC3, set.count * (size / 12), options.name + " coefficients")
-                            : add_accessor(m, view, kUbyte, TINYGLTF_TYPE_SCALAR, set.count * size, options.name + " coefficients");
-        vol["coefficients"] = acc;
+        const std::size_t view = append_view(payload, options.name + " coefficients");
+        vol["coefficients"] = is_float_vec3_encoding(set.representation)
+                                  ? add_accessor(view, kFloat, "VEC3", set.count * (size / 12), options.name + " coefficients")
+                                  : add_accessor(view, kUbyte, "SCALAR", set.count * size, options.name + " coefficients");
     }
-    std::vector<unsigned char>& data = m.buffers[static_cast<size_t>(buffer)].data;
-    while (data.size() % 4 != 0) data.push_back(0);
-    m.buffers[static_cast<size_t>(buffer)].uri.clear();
+    while (target.size() % 4 != 0) target.push_back(0);
+    json& tb = buffers[target_index];
+    tb["byteLength"] = target.size();
+    if (options.binary) tb.erase("uri");
+    else tb["uri"] = data_uri(target);
 
-    // The extension object (volumes appended to any existing ones).
-    json ext = json::object();
-    auto it = m.extensions.find(kGltfProbeExtension);
-    if (it != m.extensions.end()) ext = from_value(it->second);
+    // The extension object (volumes appended to any existing ones), extensionsUsed, the node.
+    if (!doc.contains("extensions") || !doc["extensions"].is_object()) doc["extensions"] = json::object();
+    json& ext = doc["extensions"][kGltfProbeExtension];
     if (!ext.is_object()) ext = json::object();
     if (!ext.contains("volumes") || !ext["volumes"].is_array()) ext["volumes"] = json::array();
-    const int volume_index = static_cast<int>(ext["volumes"].size());
+    const std::size_t volume_index = ext["volumes"].size();
     ext["volumes"].push_back(vol);
-    m.extensions[kGltfProbeExtension] = to_value(ext);
-    if (std::find(m.extensionsUsed.begin(), m.extensionsUsed.end(), kGltfProbeExtension) == m.extensionsUsed.end())
-        m.extensionsUsed.push_back(kGltfProbeExtension);
+    if (!doc.contains("extensionsUsed") || !doc["extensionsUsed"].is_array()) doc["extensionsUsed"] = json::array();
+    json& used = doc["extensionsUsed"];
+    if (std::find(used.begin(), used.end(), json(kGltfProbeExtension)) == used.end()) used.push_back(kGltfProbeExtension);
     if (options.add_node) {
-        tinygltf::Node node;
-        node.name = options.name;
-        node.extensions[kGltfProbeExtension] = to_value(json{{"volume", volume_index}});
-        m.nodes.push_back(node);
-        for (tinygltf::Scene& scene : m.scenes) scene.nodes.push_back(static_cast<int>(m.nodes.size() - 1));
+        if (!doc.contains("nodes") || !doc["nodes"].is_array()) doc["nodes"] = json::array();
+        doc["nodes"].push_back(json{{"name", options.name}, {"extensions", {{kGltfProbeExtension, {{"volume", volume_index}}}}}});
+        const std::size_t node = doc["nodes"].size() - 1;
+        if (doc.contains("scenes") && doc["scenes"].is_array())
+            for (json& scene : doc["scenes"]) {
+                if (!scene.is_object()) continue;
+                if (!scene.contains("nodes")) scene["nodes"] = json::array();
+                scene["nodes"].push_back(node);
+            }
     }
-    if (m.asset.version.empty()) m.asset.version = "2.0";
-
-    tinygltf::TinyGLTF writer;
-    std::ostringstream os;
-    if (!writer.WriteGltfSceneToStream(&m, os, /*prettyPrint=*/!options.binary, options.binary))
-        return make_error(ErrorCode::kInternal, scene_path + ": tinygltf could not serialise the asset");
-    const std::string s = os.str();
-    return std::vector<std::uint8_t>(s.begin(), s.end());
+    if (options.binary) return make_glb(doc.dump(), target);
+    const std::string text = doc.dump(2) + "\n";
+    return std::vector<std::uint8_t>(text.begin(), text.end());
 }
 
 }  // namespace zhc
