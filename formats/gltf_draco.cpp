@@ -91,6 +91,18 @@ Result<DecodedProbeCloud> decode_probe_point_cloud(std::span<const std::uint8_t>
     auto bad = [&](const std::string& what) { return make_error(ErrorCode::kBadFormat, where + ": Draco: " + what); };
     const int ngroups = groups_for(representation);
     if (ngroups == 0) return make_error(ErrorCode::kUnsupported, where + ": Draco payload needs encoding sh3 or sh2");
+    // Draco allocates from the point count in its own header before anything can be checked, so
+    // read the header first (Draco 2.x bitstream: "DRACO", major, minor, encoder type, method,
+    // u16 flags, then for a sequential point cloud the i32 point count) and insist on exactly
+    // what zhc writes: a point cloud, sequential method, no metadata, the volume's count.
+    if (bytes.size() < 15 || std::memcmp(bytes.data(), "DRACO", 5) != 0) return bad("not a Draco bitstream");
+    if (bytes[7] != 0 || bytes[8] != 0)
+        return make_error(ErrorCode::kUnsupported, where + ": Draco: only sequential point clouds are supported");
+    if (bytes[9] != 0 || bytes[10] != 0) return make_error(ErrorCode::kUnsupported, where + ": Draco: metadata/flags not supported");
+    std::int32_t header_points;
+    std::memcpy(&header_points, bytes.data() + 11, 4);
+    if (header_points < 0 || static_cast<std::uint64_t>(header_points) != count)
+        return bad("header declares " + std::to_string(header_points) + " points, the volume " + std::to_string(count));
     draco::DecoderBuffer buffer;
     buffer.Init(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     draco::Decoder decoder;

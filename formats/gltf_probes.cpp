@@ -592,6 +592,8 @@ struct VolumeReader {
             if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
                 return bad(ErrorCode::kBadFormat, "draco bufferView range outside its buffer");
             out.stored_bytes = bv.byteLength;
+            if (set.count > limits.max_buffer_bytes / size)
+                return bad(ErrorCode::kTooLarge, "Draco volume decodes to more than the buffer size limit");
             if (!d.contains("attributes") || !d["attributes"].is_object()) return bad(ErrorCode::kBadFormat, "draco.attributes is not an object");
             std::map<std::string, int> attrs;
             for (auto a = d["attributes"].begin(); a != d["attributes"].end(); ++a) {
