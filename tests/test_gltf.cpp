@@ -588,6 +588,35 @@ TEST(GltfProbes, DracoRejectsGridOrQuantisedInput) {
     ASSERT_FALSE(b);
 }
 
+// A Draco stream whose header claims another point count (or another method) is rejected before
+// the Draco decoder sees it (it would allocate from that count).
+TEST(GltfProbes, DracoHeaderCheckedBeforeDecoding) {
+    GltfEmbedOptions o;
+    o.draco = true;
+    auto out = embed_probes_gltf(write_model(make_scene(false), true), "s.glb", scattered_set(12, "sh3"), o);
+    ASSERT_TRUE(out);
+    const json doc = gltf_json(*out);
+    const json& vol = doc["extensions"][kGltfProbeExtension]["volumes"][0];
+    std::uint32_t json_len;
+    std::memcpy(&json_len, out->data() + 12, 4);
+    const size_t at = 20 + json_len + 8 + doc["bufferViews"][vol["draco"]["bufferView"].get<size_t>()]["byteOffset"].get<size_t>();
+    ASSERT_EQ(0, std::memcmp(out->data() + at, "DRACO", 5));
+    Bytes b = *out;
+    const std::int32_t huge = 1 << 30;
+    std::memcpy(b.data() + at + 11, &huge, 4);
+    auto r = read_gltf_probes(b, "count.glb");
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("header declares 1073741824 points"), std::string::npos) << r.error().message;
+    b = *out;
+    b[at + 8] = 1;  // k-d tree method
+    r = read_gltf_probes(b, "method.glb");
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kUnsupported);
+    b = *out;
+    b[at + 40] ^= 0x5A;  // damage inside the stream: an error or a (checked) decode, never a crash
+    (void)read_gltf_probes(b, "flip.glb");
+}
+
 // ---- hostile inputs ---------------------------------------------------------------------------
 
 Bytes text_bytes(const json& j) {
