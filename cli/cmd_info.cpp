@@ -9,6 +9,7 @@
 #include "codec/probe_set.h"
 #include "formats/envmap.h"
 #include "formats/file_io.h"
+#include "formats/gltf_probes.h"
 #include "formats/probe_file.h"
 
 namespace zhc::cli {
@@ -76,6 +77,12 @@ void probe_stats(const std::vector<Sh3Radiance>& hub, nlohmann::ordered_json& j)
     j["non_finite_probes"] = non_finite;
 }
 
+// A JSON document with an "asset" object is glTF, not a probe list.
+bool is_gltf_json(const std::vector<std::uint8_t>& bytes) {
+    const auto doc = nlohmann::json::parse(bytes.begin(), bytes.end(), nullptr, false);
+    return doc.is_object() && doc.contains("asset") && doc["asset"].is_object();
+}
+
 void print_json_or_text(const nlohmann::ordered_json& j, bool as_json) {
     if (as_json) {
         std::cout << j.dump() << "\n";
@@ -138,6 +145,36 @@ int run(const Options& o) {
         const Sh3Radiance sh = project_latlong(img->rgb.data(), img->width, img->height,
                                                static_cast<size_t>(img->width) * 3);
         probe_stats({sh}, j);
+    } else if (looks_like_glb(*bytes) || (looks_like_json(*bytes) && is_gltf_json(*bytes))) {
+        // glTF (issue 8): the asset's outline and its ZHC_light_probes volumes.
+        auto s = read_gltf_probes(*bytes, o.path);
+        if (!s) return report(s.error());
+        j["type"] = s->binary ? "glTF 2.0 binary (GLB)" : "glTF 2.0 (JSON)";
+        j["generator"] = s->generator;
+        j["meshes"] = s->meshes;
+        j["materials"] = s->materials;
+        j["nodes"] = s->nodes;
+        j["buffers"] = s->buffers;
+        j["extensions_used"] = s->extensions_used;
+        j["extensions_required"] = s->extensions_required;
+        nlohmann::ordered_json vols = nlohmann::ordered_json::array();
+        for (const GltfProbeVolume& v : s->volumes) {
+            nlohmann::ordered_json vj;
+            vj["name"] = v.name;
+            vj["encoding"] = v.set.representation;
+            vj["probes"] = v.set.count;
+            vj["kind"] = v.set.params.kind == StoredKind::kIrradiance ? "irradiance" : "radiance";
+            vj["layout"] = layout_json(v.set.layout);  // converted back to zhc axes
+            vj["sh_axes"] = v.sh_axes == GltfShAxes::kZhc ? "zhc" : "gltf";
+            vj["payload"] = v.draco ? "draco point cloud" : "accessors";
+            vj["stored_bytes"] = v.stored_bytes;
+            vj["nodes"] = v.nodes;
+            auto hub = decode_probe_set(v.set);
+            if (!hub) return report(hub.error());
+            probe_stats(*hub, vj);
+            vols.push_back(vj);
+        }
+        j["volumes"] = vols;
     } else if (looks_like_json(*bytes)) {
         auto list = parse_probe_json(*bytes, o.path);
         if (!list) return report(list.error());
@@ -155,7 +192,7 @@ int run(const Options& o) {
 
 const VerbRegistration registration(45, [](CLI::App& app) -> std::function<int()> {
     auto o = std::make_shared<Options>();
-    CLI::App* sub = app.add_subcommand("info", "Describe an environment map, .zhp probe container or JSON probe list");
+    CLI::App* sub = app.add_subcommand("info", "Describe an environment map, .zhp probe container, JSON probe list or glTF asset");
     sub->add_option("FILE", o->path, "file to describe (type detected from its content)")->required();
     sub->add_flag("--json", o->json, "print one JSON object");
     return [o] { return run(*o); };

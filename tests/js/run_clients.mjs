@@ -1,0 +1,144 @@
+// Real glTF clients against files zhc writes (CTest: js.gltf_clients).
+// Usage: node run_clients.mjs ZHC_BINARY WORK_DIR
+//  1. writes a small scene (GLB, a triangle + material) and probe lists (grid, scattered);
+//  2. `zhc gltf embed` them in every mode (grid sh3 / zh3_q16 / .gltf, scattered sh3, Draco,
+//     --sh-axes gltf);
+//  3. Khronos glTF-Validator: 0 errors on every output;
+//  4. three.js GLTFLoader + ZhcLightProbesPlugin: loads each GLB, finds the volume and its node, and
+//     the irradiance it evaluates in several directions equals `zhc gltf eval` (zhc's own numbers).
+import fs from 'node:fs';
+import path from 'node:path';
+import { execFileSync } from 'node:child_process';
+import validator from 'gltf-validator';
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { ZhcLightProbesPlugin } from './zhc_light_probes_plugin.mjs';
+
+const [zhc, work] = process.argv.slice(2);
+if (!zhc || !work) {
+  console.error('usage: node run_clients.mjs ZHC_BINARY WORK_DIR');
+  process.exit(2);
+}
+fs.mkdirSync(work, { recursive: true });
+let failures = 0;
+const check = (ok, what) => {
+  if (!ok) {
+    failures++;
+    console.log(`FAIL: ${what}`);
+  }
+};
+
+// --- inputs -------------------------------------------------------------------------------
+function glb(jsonObj, bin) {
+  let jsonBytes = Buffer.from(JSON.stringify(jsonObj));
+  jsonBytes = Buffer.concat([jsonBytes, Buffer.alloc((4 - (jsonBytes.length % 4)) % 4, 0x20)]);
+  const binPadded = Buffer.concat([bin, Buffer.alloc((4 - (bin.length % 4)) % 4)]);
+  const header = Buffer.alloc(12);
+  header.writeUInt32LE(0x46546c67, 0);
+  header.writeUInt32LE(2, 4);
+  header.writeUInt32LE(12 + 8 + jsonBytes.length + 8 + binPadded.length, 8);
+  const c0 = Buffer.alloc(8);
+  c0.writeUInt32LE(jsonBytes.length, 0);
+  c0.writeUInt32LE(0x4e4f534a, 4);
+  const c1 = Buffer.alloc(8);
+  c1.writeUInt32LE(binPadded.length, 0);
+  c1.writeUInt32LE(0x004e4942, 4);
+  return Buffer.concat([header, c0, jsonBytes, c1, binPadded]);
+}
+const tri = Buffer.from(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]).buffer);
+const scene = {
+  asset: { version: '2.0', generator: 'zhc tests/js' },
+  scene: 0,
+  scenes: [{ nodes: [0] }],
+  nodes: [{ mesh: 0, name: 'tri' }],
+  meshes: [{ primitives: [{ attributes: { POSITION: 0 }, material: 0 }] }],
+  materials: [{ name: 'red', pbrMetallicRoughness: { baseColorFactor: [0.8, 0.1, 0.1, 1] } }],
+  buffers: [{ byteLength: tri.length }],
+  bufferViews: [{ buffer: 0, byteOffset: 0, byteLength: tri.length, target: 34962 }],
+  accessors: [{ bufferView: 0, componentType: 5126, count: 3, type: 'VEC3', min: [0, 0, 0], max: [1, 1, 0] }],
+};
+fs.writeFileSync(path.join(work, 'scene.glb'), glb(scene, tri));
+
+// Deterministic, physically plausible probes: a sky-ish DC plus directional lobes.
+let seed = 12345;
+const rand = () => ((seed = (seed * 1103515245 + 12345) % 2147483648) / 2147483648);
+const probe = () => Array.from({ length: 9 }, (_, i) =>
+  Array.from({ length: 3 }, () => (i === 0 ? 1 + rand() : (rand() - 0.5) * (i < 4 ? 0.8 : 0.4))));
+const grid = { format: 'zhc-probes', version: 1, kind: 'radiance',
+  layout: { type: 'grid', origin: [-1, 0.5, 2], spacing: [0.5, 1, 2], counts: [3, 2, 4] },
+  probes: Array.from({ length: 24 }, () => ({ sh3: probe() })) };
+const points = { format: 'zhc-probes', version: 1, kind: 'radiance', layout: { type: 'positions' },
+  probes: Array.from({ length: 200 }, () => ({ position: [rand() * 10 - 5, rand() * 4, rand() * 10 - 5], sh3: probe() })) };
+fs.writeFileSync(path.join(work, 'grid.json'), JSON.stringify(grid));
+fs.writeFileSync(path.join(work, 'points.json'), JSON.stringify(points));
+
+// --- zhc writes every mode ------------------------------------------------------------------
+const cases = [
+  { out: 'grid_sh3.glb', probes: 'grid.json', args: [] },
+  { out: 'grid_zh3_q16.glb', probes: 'grid.json', args: ['--encoding', 'zh3_q16'] },
+  { out: 'grid_sh3_q28.gltf', probes: 'grid.json', args: ['--encoding', 'sh3_q28'] },
+  { out: 'points_sh3.glb', probes: 'points.json', args: [] },
+  { out: 'points_gltf_axes.glb', probes: 'points.json', args: ['--sh-axes', 'gltf'] },
+  { out: 'points_draco.glb', probes: 'points.json', args: ['--draco'] },
+  { out: 'points_draco14.glb', probes: 'points.json', args: ['--draco', '--draco-bits', '14'] },
+];
+for (const c of cases) {
+  execFileSync(zhc, ['gltf', 'embed', path.join(work, 'scene.glb'), path.join(work, c.probes), '-o', path.join(work, c.out), ...c.args]);
+}
+
+// --- 1. Khronos glTF-Validator -----------------------------------------------------------------
+for (const c of cases) {
+  const file = path.join(work, c.out);
+  const report = await validator.validateBytes(new Uint8Array(fs.readFileSync(file)), {
+    uri: c.out,
+    externalResourceFunction: (uri) => Promise.reject(new Error(`unexpected external resource ${uri}`)),
+  });
+  const n = report.issues;
+  console.log(`validator ${c.out}: errors ${n.numErrors}, warnings ${n.numWarnings}, infos ${n.numInfos}`);
+  for (const m of n.messages) if (m.severity <= 1) console.log(`  ${m.code} ${m.pointer ?? ''}: ${m.message}`);
+  check(n.numErrors === 0, `${c.out}: validator errors`);
+  check(n.numWarnings === 0, `${c.out}: validator warnings`);
+}
+
+// --- 2. three.js GLTFLoader with the plugin ----------------------------------------------------
+async function loadThree(file) {
+  const bytes = fs.readFileSync(file);
+  const ab = bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength);
+  const loader = new GLTFLoader();
+  loader.register((parser) => new ZhcLightProbesPlugin(parser));
+  return new Promise((resolve, reject) => loader.parse(ab, '', resolve, reject));
+}
+const dirs = [[0, 1, 0], [0, -1, 0], [1, 0, 0], [0, 0, 1], [0.3, 0.8, -0.52], [-0.6, 0.2, 0.77]];
+for (const c of cases.filter((c) => c.out.endsWith('.glb'))) {
+  const file = path.join(work, c.out);
+  const gltf = await loadThree(file);
+  const vols = gltf.userData.zhcLightProbes;
+  check(Array.isArray(vols) && vols.length === 1, `${c.out}: three.js plugin found the volume`);
+  if (!vols || !vols.length) continue;
+  const v = vols[0];
+  // The node that references the volume is in the scene graph.
+  let anchor = null;
+  gltf.scene.traverse((o) => { if (o.userData.zhcLightProbeVolume !== undefined) anchor = o; });
+  check(anchor && anchor.userData.zhcLightProbeVolume === 0, `${c.out}: node attachment for the volume`);
+  check(gltf.scene.getObjectByName('tri') !== undefined, `${c.out}: the original mesh node still loads`);
+  if (v.draco) continue;
+  if (!v.irradiance) {
+    const bytesPerProbe = { zh3_q16: 16, sh3_q28: 28 }[v.encoding];
+    check(v.bytes && v.bytes.length === v.count * bytesPerProbe, `${c.out}: raw ${v.encoding} bytes length`);
+    continue;
+  }
+  let worst = 0;
+  const probes = v.layout === 'grid' ? [0, 5, 23] : [0, 17, 199];
+  for (const p of probes) {
+    for (const d of dirs) {
+      const got = v.irradiance(p, d);
+      const out = execFileSync(zhc, ['gltf', 'eval', file, '--probe', String(p), '--dir', d.join(',')]).toString();
+      const want = out.trim().split(/\s+/).map(Number);
+      for (let k = 0; k < 3; k++) worst = Math.max(worst, Math.abs(got[k] - want[k]) / (1e-6 + Math.abs(want[k])));
+    }
+  }
+  console.log(`three.js ${c.out}: ${v.encoding} ${v.layout} shAxes=${v.shAxes}, worst relative irradiance difference vs zhc ${worst.toExponential(2)}`);
+  check(worst < 1e-5, `${c.out}: three.js irradiance equals zhc's`);
+}
+
+console.log(failures === 0 ? 'all glTF client checks passed' : `${failures} glTF client checks FAILED`);
+process.exit(failures === 0 ? 0 : 1);
