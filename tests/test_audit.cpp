@@ -6,6 +6,7 @@
 
 #include "cli/cli.h"
 #include "codec/audit.h"
+#include "codec/benchmark.h"
 #include "support.h"
 
 namespace zhc {
@@ -131,6 +132,35 @@ TEST(AuditCli, WritesMarkdownAndImagesAndIsDeterministic) {
     ASSERT_GT(png.size(), 1000u);
     EXPECT_EQ(png[1], 'P');
     EXPECT_EQ(png[2], 'N');
+}
+
+}  // namespace
+}  // namespace zhc
+
+namespace zhc {
+namespace {
+
+TEST(Benchmark, ParetoFrontierKeepsOnlyUndominatedPoints) {
+    // cost, error: (1, 5) (2, 3) (3, 4) dominated by (2,3); (4, 1); (5, 1) dominated by (4, 1)
+    const auto f = pareto_frontier({1, 2, 3, 4, 5}, {5, 3, 4, 1, 1});
+    EXPECT_EQ(f, (std::vector<std::size_t>{0, 1, 3}));
+}
+
+TEST(BenchCli, PrintsJsonRowsAndWritesBothPlots) {
+    const std::string dir = test::temp_dir("bench_plots");
+    std::filesystem::remove_all(dir);
+    const auto r = test::run_zhc({"bench", test::envmap_paths()[0], "--representations", "sh2,sh3", "--repeats", "2",
+                                  "--directions", "64", "--plots", dir, "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["representations"].size(), 2u);
+    // Rows follow --representations: sh2 (48 bytes) then sh3 (108 bytes); SH2 has the larger error.
+    EXPECT_EQ(j["representations"][0]["bytes_per_probe"].get<int>(), 48);
+    EXPECT_EQ(j["representations"][1]["bytes_per_probe"].get<int>(), 108);
+    EXPECT_GT(j["representations"][0]["mean_rmse"].get<double>(), j["representations"][1]["mean_rmse"].get<double>());
+    EXPECT_GT(j["representations"][0]["encode_ns_per_probe"]["median"].get<double>(), 0.0);
+    EXPECT_GT(test::read_bytes(dir + "/error_vs_encode_time.png").size(), 1000u);
+    EXPECT_GT(test::read_bytes(dir + "/error_vs_bytes.png").size(), 1000u);
 }
 
 }  // namespace

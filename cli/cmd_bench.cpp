@@ -1,0 +1,132 @@
+// zhc bench [MAPS...]: what accuracy costs in time, per representation, with Pareto plots.
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "cli.h"
+#include "codec/benchmark.h"
+#include "formats/audit_inputs.h"
+#include "formats/plot.h"
+
+namespace zhc::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Options {
+    std::vector<std::string> inputs;
+    std::string representations;
+    bool json = false;
+    std::string plots = "zhc-bench";
+    bool no_plots = false;
+    int repeats = 7;
+    int directions = 1024;
+};
+
+int run(const Options& o) {
+    std::vector<std::string> inputs = o.inputs;
+    if (inputs.empty()) {
+        if (!fs::exists(fs::path(ZHC_SAMPLE_ENVMAP_DIR) / "city.exr"))
+            return report(make_error(ErrorCode::kInvalidArgument,
+                                     "no maps given and the sample maps are not at " + std::string(ZHC_SAMPLE_ENVMAP_DIR)));
+        inputs.push_back(ZHC_SAMPLE_ENVMAP_DIR);
+    }
+    auto files = expand_audit_inputs(inputs);
+    if (!files) return report(files.error());
+    std::vector<const Codec*> selected;
+    if (o.representations.empty()) {
+        for (const Codec& c : codecs()) selected.push_back(&c);
+    } else {
+        std::stringstream ss(o.representations);
+        for (std::string n; std::getline(ss, n, ',');) {
+            const Codec* c = find_codec(n);
+            if (!c) return report(make_error(ErrorCode::kInvalidArgument, "--representations: unknown representation '" + n + "'"));
+            selected.push_back(c);
+        }
+    }
+    const std::vector<Vec3> dirs = fibonacci_sphere(o.directions);
+    std::vector<BenchProbe> probes;
+    AuditLoadOptions lo;
+    lo.threads = 2;
+    for (const std::string& f : *files) {
+        auto in = load_audit_input(f, dirs, lo);
+        if (!in) return report(in.error());
+        for (size_t p = 0; p < in->probes.size(); ++p) probes.push_back({in->probes[p], in->reference_for(p, dirs)});
+    }
+    if (probes.empty()) return report(make_error(ErrorCode::kInvalidArgument, "no probes to benchmark"));
+    const auto rows = benchmark_codecs(probes, dirs, selected, CodecOptions{}, o.repeats);
+
+    if (o.json) {
+        nlohmann::json j;
+        j["probes"] = probes.size();
+        j["directions"] = o.directions;
+        j["repeats"] = o.repeats;
+        j["representations"] = nlohmann::json::array();
+        for (const BenchRow& r : rows) {
+            auto spread = [](const Spread& s) { return nlohmann::json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
+            j["representations"].push_back({{"name", r.codec->name},
+                                             {"bytes_per_probe", r.codec->size_bytes},
+                                             {"mean_rmse", r.mean_rmse},
+                                             {"mean_relative_rmse", r.mean_relative_rmse},
+                                             {"encode_ns_per_probe", spread(r.encode_ns)},
+                                             {"decode_ns_per_probe", spread(r.decode_ns)},
+                                             {"eval_ns_per_sample", spread(r.eval_ns)}});
+        }
+        std::cout << j.dump(2) << "\n";
+    } else {
+        std::printf("%zu probes, %d directions, medians of %d repeats [min-max], single thread\n", probes.size(),
+                    o.directions, o.repeats);
+        std::printf("%-22s %6s %10s %9s %22s %18s %16s\n", "representation", "bytes", "mean_rmse", "rel_rmse",
+                    "encode ns/probe", "decode ns/probe", "eval ns/sample");
+        for (const BenchRow& r : rows) {
+            char enc[64], dec[64], ev[64];
+            std::snprintf(enc, sizeof enc, "%.0f [%.0f-%.0f]", r.encode_ns.median, r.encode_ns.min, r.encode_ns.max);
+            std::snprintf(dec, sizeof dec, "%.0f [%.0f-%.0f]", r.decode_ns.median, r.decode_ns.min, r.decode_ns.max);
+            std::snprintf(ev, sizeof ev, "%.1f [%.1f-%.1f]", r.eval_ns.median, r.eval_ns.min, r.eval_ns.max);
+            std::printf("%-22s %6zu %10.4g %9.4f %22s %18s %16s\n", std::string(r.codec->name).c_str(),
+                        r.codec->size_bytes, r.mean_rmse, r.mean_relative_rmse, enc, dec, ev);
+        }
+    }
+    std::fflush(stdout);
+    if (!o.no_plots) {
+        std::error_code ec;
+        fs::create_directories(o.plots, ec);
+        ScatterPlot by_time{"ERROR VS ENCODE TIME", "ENCODE NS PER PROBE (LOG)", "MEAN RELATIVE IRRADIANCE RMSE (LOG)", {}, {}};
+        ScatterPlot by_bytes{"ERROR VS BYTES PER PROBE", "BYTES PER PROBE (LOG)", "MEAN RELATIVE IRRADIANCE RMSE (LOG)", {}, {}};
+        std::vector<double> t, b, e;
+        for (const BenchRow& r : rows) {
+            by_time.points.push_back({std::string(r.codec->name), std::max(r.encode_ns.median, 0.1), r.mean_relative_rmse});
+            by_bytes.points.push_back({std::string(r.codec->name), double(r.codec->size_bytes), r.mean_relative_rmse});
+            t.push_back(r.encode_ns.median);
+            b.push_back(double(r.codec->size_bytes));
+            e.push_back(r.mean_relative_rmse);
+        }
+        by_time.frontier = pareto_frontier(t, e);
+        by_bytes.frontier = pareto_frontier(b, e);
+        const std::string p1 = (fs::path(o.plots) / "error_vs_encode_time.png").string();
+        const std::string p2 = (fs::path(o.plots) / "error_vs_bytes.png").string();
+        if (Status s = write_scatter_png(p1, by_time); !s) return report_output(s.error());
+        if (Status s = write_scatter_png(p2, by_bytes); !s) return report_output(s.error());
+        std::fprintf(stderr, "plots: %s, %s\n", p1.c_str(), p2.c_str());
+    }
+    return kExitOk;
+}
+
+const VerbRegistration registration(50, [](CLI::App& app) -> std::function<int()> {
+    auto o = std::make_shared<Options>();
+    CLI::App* sub = app.add_subcommand("bench", "Bytes, encode/decode/evaluation time and error of every representation, with Pareto plots");
+    sub->add_option("MAPS", o->inputs, "environment maps or folders (default: the eight sample maps)");
+    sub->add_option("--representations", o->representations, "comma-separated subset of the codec table");
+    sub->add_flag("--json", o->json, "print one JSON object on stdout");
+    sub->add_option("--plots", o->plots, "folder for error_vs_encode_time.png and error_vs_bytes.png")->capture_default_str();
+    sub->add_flag("--no-plots", o->no_plots, "do not write plots");
+    sub->add_option("--repeats", o->repeats, "timing repeats (median and spread are reported)")->check(CLI::Range(1, 1000));
+    sub->add_option("--directions", o->directions, "Fibonacci directions for error and evaluation")->check(CLI::Range(16, 1 << 20));
+    return [o] { return run(*o); };
+});
+
+}  // namespace
+}  // namespace zhc::cli

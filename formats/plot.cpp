@@ -1,0 +1,83 @@
+#include "plot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "raster.h"
+
+namespace zhc {
+
+namespace {
+std::string tick_label(double v) {
+    char b[32];
+    if (v >= 1e4 || v < 1e-2) std::snprintf(b, sizeof b, "%.0E", v);
+    else std::snprintf(b, sizeof b, "%g", v);
+    return b;
+}
+}  // namespace
+
+Status write_scatter_png(const std::string& path, const ScatterPlot& plot) {
+    const int W = 1100, H = 720, left = 110, right = 40, top = 60, bottom = 80;
+    Canvas c(W, H, {255, 255, 255});
+    const Rgb8 ink{30, 30, 30}, grid{225, 225, 225}, dot{40, 90, 200}, front{220, 60, 40};
+    auto tx = [&](double v) { return plot.log_x ? std::log10(std::max(v, 1e-30)) : v; };
+    auto ty = [&](double v) { return plot.log_y ? std::log10(std::max(v, 1e-30)) : v; };
+    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+    for (const PlotPoint& p : plot.points) {
+        if (!std::isfinite(tx(p.x)) || !std::isfinite(ty(p.y))) continue;
+        x0 = std::min(x0, tx(p.x));
+        x1 = std::max(x1, tx(p.x));
+        y0 = std::min(y0, ty(p.y));
+        y1 = std::max(y1, ty(p.y));
+    }
+    if (x0 > x1) x0 = 0, x1 = 1;
+    if (y0 > y1) y0 = 0, y1 = 1;
+    if (plot.log_x) x0 = std::floor(x0 - 0.05), x1 = std::ceil(x1 + 0.05);
+    else { const double m = 0.08 * std::max(x1 - x0, 1e-9); x0 -= m; x1 += m; }
+    if (plot.log_y) y0 = std::floor(y0 - 0.05), y1 = std::ceil(y1 + 0.05);
+    else { const double m = 0.08 * std::max(y1 - y0, 1e-9); y0 -= m; y1 += m; }
+    const int pw = W - left - right, ph = H - top - bottom;
+    auto px = [&](double v) { return left + (tx(v) - x0) / (x1 - x0) * pw; };
+    auto py = [&](double v) { return top + ph - (ty(v) - y0) / (y1 - y0) * ph; };
+    // Grid and ticks: decades on log axes, 5 divisions on linear ones.
+    auto ticks = [](double a, double b, bool log) {
+        std::vector<double> t;
+        if (log) for (double e = std::ceil(a); e <= b + 1e-9; e += 1) t.push_back(std::pow(10.0, e));
+        else for (int i = 0; i <= 5; ++i) t.push_back(a + (b - a) * i / 5);
+        return t;
+    };
+    for (double v : ticks(x0, x1, plot.log_x)) {
+        const double x = left + ((plot.log_x ? std::log10(v) : v) - x0) / (x1 - x0) * pw;
+        c.line(x, top, x, top + ph, grid);
+        c.text(static_cast<int>(x) - Canvas::text_width(tick_label(v), 2) / 2, top + ph + 10, tick_label(v), 2, ink);
+    }
+    for (double v : ticks(y0, y1, plot.log_y)) {
+        const double y = top + ph - ((plot.log_y ? std::log10(v) : v) - y0) / (y1 - y0) * ph;
+        c.line(left, y, left + pw, y, grid);
+        c.text(left - 8 - Canvas::text_width(tick_label(v), 2), static_cast<int>(y) - 5, tick_label(v), 2, ink);
+    }
+    c.line(left, top, left, top + ph, ink, 2);
+    c.line(left, top + ph, left + pw, top + ph, ink, 2);
+    c.text(left, 18, plot.title, 3, ink);
+    c.text(left + pw / 2 - Canvas::text_width(plot.x_label, 2) / 2, H - 35, plot.x_label, 2, ink);
+    c.text(10, top - 22, plot.y_label, 2, ink);
+    // Frontier first (under the points).
+    for (size_t i = 1; i < plot.frontier.size(); ++i) {
+        const PlotPoint& a = plot.points[plot.frontier[i - 1]];
+        const PlotPoint& b = plot.points[plot.frontier[i]];
+        c.line(px(a.x), py(a.y), px(b.x), py(b.y), front, 3);
+    }
+    std::vector<bool> on_front(plot.points.size(), false);
+    for (size_t i : plot.frontier) on_front[i] = true;
+    for (size_t i = 0; i < plot.points.size(); ++i) {
+        const PlotPoint& p = plot.points[i];
+        const int x = static_cast<int>(std::lround(px(p.x))), y = static_cast<int>(std::lround(py(p.y)));
+        c.fill_rect(x - 4, y - 4, 9, 9, on_front[i] ? front : dot);
+        c.text(x + 8, y - 12, p.label, 2, on_front[i] ? front : ink);
+    }
+    c.text(left + pw - 330, top + 8, "RED: PARETO FRONTIER", 2, front);
+    return write_png(path, c);
+}
+
+}  // namespace zhc
