@@ -470,6 +470,12 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
             const double sigma = l.kind == LightKind::kHemisphere ? kPi / 2 : l.angular_radius_rad;
             e.unit_cone = cone_sample_directions({0, 0, 1}, sigma, l.shadow_samples);
         }
+        if (!e.traced && (l.kind == LightKind::kDirectional || l.kind == LightKind::kHemisphere)) {
+            // Distant lights do not depend on the probe position: evaluate once, add everywhere
+            // (the same additions as per probe, so the same bytes).
+            e.kind = Effect::kConstantSh;
+            add_light_closed_form(l, {0, 0, 0}, e.sh);
+        }
         effects.push_back(std::move(e));
         info.push_back({effect_name(l), "closed form", 0, 0});
     }
