@@ -124,14 +124,37 @@ std::uint32_t OccluderBvh::build(std::uint32_t first, std::uint32_t count, int d
 
 bool OccluderBvh::occluded(Vec3 o, Vec3 d, double t_min, double t_max) const {
     if (nodes_.empty()) return false;
+    // Per-ray constants of the slab test (ZERO direction components handled by the origin test).
+    const double org[3] = {o.x, o.y, o.z}, dir[3] = {d.x, d.y, d.z};
+    double inv[3];
+    for (int a = 0; a < 3; ++a) inv[a] = dir[a] != 0.0 ? 1.0 / dir[a] : 0.0;
+    auto node_hit = [&](const Node& n) {
+        double t0 = t_min, t1 = t_max;
+        for (int a = 0; a < 3; ++a) {
+            if (dir[a] == 0.0) {
+                if (org[a] < n.lo[a] || org[a] > n.hi[a]) return false;
+                continue;
+            }
+            double ta = (n.lo[a] - org[a]) * inv[a], tb = (n.hi[a] - org[a]) * inv[a];
+            if (ta > tb) std::swap(ta, tb);
+            t0 = ta > t0 ? ta : t0;
+            t1 = tb < t1 ? tb : t1;
+            if (t0 > t1) return false;
+        }
+        return true;
+    };
     std::uint32_t stack[128];
     int top = 0;
     stack[top++] = 0;
     while (top > 0) {
         const Node& n = nodes_[stack[--top]];
-        bool inside = true;
-        for (int a = 0; a < 3; ++a) inside = inside && o[a] >= n.lo[a] && o[a] <= n.hi[a];
-        if (!inside && !slab(n.lo, n.hi, o, d, t_min, t_max, nullptr)) continue;
+        // A node is entered when the clipped ray overlaps its box (this includes an origin inside
+        // it: then t0 <= t_min <= t1).
+        if (!node_hit(n)) {
+            bool inside = true;
+            for (int a = 0; a < 3; ++a) inside = inside && org[a] >= n.lo[a] && org[a] <= n.hi[a];
+            if (!inside) continue;
+        }
         if (n.count > 0) {
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i)
                 if (ray_hits(prims_[i], o, d, t_min, t_max)) return true;

@@ -326,6 +326,7 @@ struct Effect {
     const SceneLight* light = nullptr;
     bool traced = false;           // light with shadows and a non-empty occluder set
     std::vector<Vec3> unit_cone;   // cone samples around +Z (rotated per probe), traced cone lights
+    std::vector<double> cos_phi, sin_phi;  // sphere lights: the spiral's azimuths (sigma varies per probe)
 };
 
 // Shadowed contribution of a light at p: closed form minus the occluded sample directions.
@@ -390,7 +391,6 @@ void add_light_shadowed(const Effect& e, const OccluderBvh& bvh, Vec3 p, double 
     const double solid_angle = 2.0 * kPi * (1.0 - cos_s);
     const double w = solid_angle / n;
     const Mat3 frame = frame_from_z(axis);
-    const double golden = kPi * (3.0 - std::sqrt(5.0));
     int blocked = 0;
     double removed[27] = {};
     for (int k = 0; k < n; ++k) {
@@ -400,7 +400,7 @@ void add_light_shadowed(const Effect& e, const OccluderBvh& bvh, Vec3 p, double 
         } else {
             const double z = 1.0 - (k + 0.5) / n * (1.0 - cos_s);
             const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-            local_dir = {r * std::cos(golden * k), r * std::sin(golden * k), z};
+            local_dir = {r * e.cos_phi[static_cast<size_t>(k)], r * e.sin_phi[static_cast<size_t>(k)], z};
         }
         const Vec3 d = frame * local_dir;
         double t_max = std::numeric_limits<double>::infinity();
@@ -469,6 +469,14 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
             !(l.kind == LightKind::kDirectional && l.angular_radius_rad <= 0)) {
             const double sigma = l.kind == LightKind::kHemisphere ? kPi / 2 : l.angular_radius_rad;
             e.unit_cone = cone_sample_directions({0, 0, 1}, sigma, l.shadow_samples);
+        }
+        if (e.traced && l.kind == LightKind::kSphere) {
+            // The same azimuths as cone_sample_directions (golden-angle steps).
+            const double golden = kPi * (3.0 - std::sqrt(5.0));
+            for (int k = 0; k < l.shadow_samples; ++k) {
+                e.cos_phi.push_back(std::cos(golden * k));
+                e.sin_phi.push_back(std::sin(golden * k));
+            }
         }
         if (!e.traced && (l.kind == LightKind::kDirectional || l.kind == LightKind::kHemisphere)) {
             // Distant lights do not depend on the probe position: evaluate once, add everywhere
