@@ -160,6 +160,9 @@ int run(const Options& o) {
     // 5. Pictures of a few probes: the brightest (in the sun, near a light), the darkest
     // (shadowed), the grid's first and last.
     std::vector<size_t> pick{0, probes.size() - 1};
+    std::vector<std::string> role(probes.size());
+    role[0] = "first";
+    role[probes.size() - 1] = "last";
     size_t bright = 0, dark = 0;
     for (size_t p = 0; p < probes.size(); ++p) {
         const double v = luminance(probes[p][0], LuminanceWeights{});
@@ -168,6 +171,8 @@ int run(const Options& o) {
     }
     pick.push_back(bright);
     pick.push_back(dark);
+    role[bright] = "brightest";
+    role[dark] = "darkest";
     std::sort(pick.begin(), pick.end());
     pick.erase(std::unique(pick.begin(), pick.end()), pick.end());
     const std::string img_dir = path("images");
@@ -181,7 +186,7 @@ int run(const Options& o) {
         if (Status s = write_audit_images(img_dir, in, dirs, all, copt); !s) return report_output(s.error());
         const Vec3 pos = positions[p];
         outputs.push_back({(fs::path(img_dir) / (in.path + ".png")).string(),
-                           "probe " + std::to_string(p) + " at (" + fmt(pos.x, "%.2f") + ", " + fmt(pos.y, "%.2f") + ", " +
+                           role[p] + " probe " + std::to_string(p) + " at (" + fmt(pos.x, "%.2f") + ", " + fmt(pos.y, "%.2f") + ", " +
                                fmt(pos.z, "%.2f") + "): irradiance and error per representation"});
     }
 

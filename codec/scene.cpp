@@ -187,9 +187,9 @@ Scene default_scene() {
         q.shadow_samples = 32;
         s.lights.push_back(q);
     };
-    sphere("red", {-2.5, -1.5, 1.2}, 0.35, {40, 6, 3}, true);
+    sphere("red", {-2.3, -1.2, 1.7}, 0.35, {40, 6, 3}, true);
     sphere("green", {2.2, -2.4, 0.8}, 0.3, {4, 30, 6}, false);
-    sphere("blue", {0.8, 2.6, 2.2}, 0.4, {4, 10, 36}, true);
+    sphere("blue", {1.2, 2.3, 2.7}, 0.4, {4, 10, 36}, true);
     // A roof over one corner (shades the sun there) and a pillar-like sphere between lights.
     Occluder roof;
     roof.kind = OccluderKind::kBox;

@@ -497,6 +497,25 @@ TEST(SceneCli, ParserErrorsAreClearWithExitCodes) {
     EXPECT_EQ(test::run_zhc({"bake", ok, "-o", dir + "/missing_dir/x.zhp"}).exit_code, 7);
 }
 
+TEST(SceneBake, DefaultSceneProbesAreOutsideLightsAndOccluders) {
+    // The demo's pictures should show lighting, not a probe buried in a lamp or a wall.
+    const Scene s = default_scene();
+    for (const Vec3& p : probe_positions(s.probes)) {
+        for (const SceneLight& l : s.lights)
+            if (l.kind == LightKind::kSphere) EXPECT_GT(length(p - l.center), 1.5 * l.radius);
+        for (const Occluder& o : s.occluders) EXPECT_FALSE(ray_hits(o, p, {0, 0, 1}, 0, 1e-6));
+    }
+    // Its shadows do something: some probes see the sun, some do not.
+    Scene no_occ = s;
+    no_occ.occluders.clear();
+    auto a = bake_scene(s), b = bake_scene(no_occ);
+    ASSERT_TRUE(a.ok() && b.ok());
+    int changed = 0;
+    for (size_t i = 0; i < a->size(); ++i) changed += max_abs_diff((*a)[i], (*b)[i]) > 1e-3;
+    EXPECT_GT(changed, 5);
+    EXPECT_LT(changed, static_cast<int>(a->size()) - 5);
+}
+
 TEST(SceneJson, RoundTripBakesTheSame) {
     Scene s = default_scene();
     SceneLight spot;
