@@ -177,15 +177,31 @@ int run(const Options& o) {
     pick.erase(std::unique(pick.begin(), pick.end()), pick.end());
     const std::string img_dir = path("images");
     const std::vector<Vec3> positions = probe_positions(scene.probes);
+    // One picture per worker at a time (each is independent; files are written atomically).
+    const auto t_images = Clock::now();
+    std::vector<Status> image_status(pick.size(), Status(Ok{}));
+    {
+        std::vector<std::thread> pool;
+        for (int t = 0; t < threads; ++t)
+            pool.emplace_back([&, t] {
+                for (size_t i = static_cast<size_t>(t); i < pick.size(); i += static_cast<size_t>(threads)) {
+                    AuditInput in;
+                    in.path = "probe_" + std::to_string(pick[i]);
+                    in.kind = "probes";
+                    in.description = "baked probe " + std::to_string(pick[i]);
+                    in.probes = {probes[pick[i]]};
+                    image_status[i] = write_audit_images(img_dir, in, dirs, all, copt);
+                }
+            });
+        for (auto& th : pool) th.join();
+    }
+    for (const Status& s : image_status)
+        if (!s) return report_output(s.error());
+    std::printf("\npictures: %zu probes in %.0f ms\n", pick.size(), ms_since(t_images));
     for (size_t p : pick) {
-        AuditInput in;
-        in.path = "probe_" + std::to_string(p);
-        in.kind = "probes";
-        in.description = "baked probe " + std::to_string(p);
-        in.probes = {probes[p]};
-        if (Status s = write_audit_images(img_dir, in, dirs, all, copt); !s) return report_output(s.error());
+        const std::string stem = "probe_" + std::to_string(p);
         const Vec3 pos = positions[p];
-        outputs.push_back({(fs::path(img_dir) / (in.path + ".png")).string(),
+        outputs.push_back({(fs::path(img_dir) / (stem + ".png")).string(),
                            role[p] + " probe " + std::to_string(p) + " at (" + fmt(pos.x, "%.2f") + ", " + fmt(pos.y, "%.2f") + ", " +
                                fmt(pos.z, "%.2f") + "): irradiance and error per representation"});
     }
