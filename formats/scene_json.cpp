@@ -352,8 +352,10 @@ Result<Scene> parse_scene_json(std::span<const std::uint8_t> bytes, const std::s
     json doc;
     try {
         doc = json::parse(bytes.begin(), bytes.end());
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e999
         return make_error(ErrorCode::kBadFormat, name + ": not valid JSON (" + e.what() + ")");
+    } catch (const std::bad_alloc&) {
+        return make_error(ErrorCode::kTooLarge, name + ": out of memory while reading the scene");
     }
     const Reader r(name);
     try {

@@ -468,6 +468,7 @@ TEST(SceneCli, ParserErrorsAreClearWithExitCodes) {
          "probes.grid.counts: grid holds more than the limit"},
         {"unknown_field", R"({"version":1,"probes":{"positions":[[0,0,0]]},"lihgts":[]})", 4, "lihgts: unknown field"},
         {"not_json", R"({"version":1,)", 4, "not valid JSON"},
+        {"number_overflow", R"({"version":1,"probes":{"positions":[[0,0,1e999]]}})", 4, "not valid JSON"},
         {"bad_version", R"({"version":2,"probes":{"positions":[[0,0,0]]}})", 5, "version: unsupported scene version 2"},
         {"negative_colour", R"({"version":1,"probes":{"positions":[[0,0,0]]},"sky":{"type":"constant","radiance":[1,-1,1]}})", 4,
          "sky.radiance[1]: must be >= 0"},
