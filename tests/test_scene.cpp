@@ -126,12 +126,15 @@ TEST(SceneBake, PointLightFollowsInverseSquare) {
     const Sh3Radiance& b = (*baked)[1];
     for (int i = 0; i < 9; ++i)
         for (int k = 0; k < 3; ++k)
-            if (std::abs(a[i][k]) > 1e-6) EXPECT_NEAR(a[i][k] / b[i][k], (d2 * d2) / (d1 * d1), 1e-5);
+            if (std::abs(a[i][k]) > 1e-6) {
+                EXPECT_NEAR(a[i][k] / b[i][k], (d2 * d2) / (d1 * d1), 1e-5);
+            }
     // And it is the delta of integral I / d^2 towards the light.
     const Sh3Radiance closed = project_directional(-1.0 * w, {float(5 / (d1 * d1)), float(4 / (d1 * d1)), float(3 / (d1 * d1))});
     EXPECT_LT(max_abs_diff(a, closed), 1e-6);
-    // Irradiance of a surface facing the light: (1/pi) I / d^2 (zhc's normalised kernel).
-    EXPECT_NEAR(irradiance(a, -1.0 * w).r, 5 / (d1 * d1) / kPi * (1 + 0.0), 0.35 * 5 / (d1 * d1) / kPi);
+    // SH3 irradiance of a surface facing the light: the delta's band energies sum_m Y_lm(w)^2 =
+    // (2l + 1) / 4pi times the band scales 1, 2/3, 1/4: (I / d^2) (1 + 2 + 5/4) / (4 pi).
+    EXPECT_NEAR(irradiance(a, -1.0 * w).r, 5 / (d1 * d1) * 4.25 / (4 * kPi), 1e-5);
 }
 
 TEST(SceneBake, DirectionalAndHemisphereMatchClosedForms) {
@@ -310,6 +313,32 @@ TEST(SceneBake, PartialShadowMatchesDenseVisibleProjection) {
     EXPECT_NEAR(full[3].r, 0.0, 1e-6);
     EXPECT_GT(dense[3].r, 0.02 * max_abs(full));
     EXPECT_NEAR(baked[3].r, dense[3].r, 0.1 * dense[3].r);
+}
+
+TEST(SceneBake, ShadowedProbeInsideSphereLight) {
+    // Inside a sphere light with a slab just above the probe: only the lower half of the light's
+    // surrounding radiance arrives (rays go to the far side of the sphere) — a downward hemisphere.
+    Scene s = at_positions({{0, 0, 0}});
+    SceneLight l = sphere_light({0.1, 0, 0}, 1.0, {2, 3, 4});
+    l.shadows = true;
+    l.shadow_samples = 4096;
+    s.lights = {l};
+    Occluder slab;
+    slab.kind = OccluderKind::kBox;
+    slab.min = {-3, -3, 0.05};
+    slab.max = {3, 3, 0.1};
+    s.occluders = {slab};
+    const Sh3Radiance baked = bake_one(s);
+    // Slow twin: dense directions, visible unless the slab is hit before the ray leaves the sphere
+    // (near-horizontal upward rays pass under the slab's far edge: not exactly a hemisphere).
+    const Sh3Radiance dense = dense_projection(400000, [&](Vec3 w) {
+        const Vec3 v = l.center;  // centre - probe
+        const double b = dot(w, v), t_exit = b + std::sqrt(b * b - dot(v, v) + l.radius * l.radius);
+        return ray_hits(slab, {0, 0, 0}, w, 1e-9, t_exit) ? Rgb{} : l.color;
+    });
+    const Sh3Radiance hemisphere = project_hemisphere({0, 0, -1}, l.color);
+    EXPECT_LT(max_abs_diff(baked, dense), 0.01 * max_abs(hemisphere));
+    EXPECT_LT(max_abs_diff(baked, hemisphere), 0.1 * max_abs(hemisphere));  // and close to the half
 }
 
 TEST(Occluders, BvhAgreesWithBruteForce) {
@@ -503,7 +532,9 @@ TEST(SceneBake, DefaultSceneProbesAreOutsideLightsAndOccluders) {
     const Scene s = default_scene();
     for (const Vec3& p : probe_positions(s.probes)) {
         for (const SceneLight& l : s.lights)
-            if (l.kind == LightKind::kSphere) EXPECT_GT(length(p - l.center), 1.5 * l.radius);
+            if (l.kind == LightKind::kSphere) {
+                EXPECT_GT(length(p - l.center), 1.5 * l.radius);
+            }
         for (const Occluder& o : s.occluders) EXPECT_FALSE(ray_hits(o, p, {0, 0, 1}, 0, 1e-6));
     }
     // Its shadows do something: some probes see the sun, some do not.
