@@ -1,0 +1,156 @@
+// Scene-bake throughput (issue 9), plain timing main: ./build/bench/bench_bake [probes_per_axis]
+//
+//  * closed-form scenes: probe-lights per second on ONE thread, per light type and for a mixed
+//    scene, against the target of 10^6 per second per core (ratio printed), and against a floor
+//    measured in the same run: one SH3 basis evaluation + 27 multiply-adds per probe-light;
+//  * occluded scenes: shadow rays per second (one thread) for the default scene's occluders and
+//    for 1000 random spheres/boxes (BVH stress), plus the brute-force (no BVH) rate for contrast.
+// Medians over 5 runs; the spread (min..max) is printed. Numbers never gate tests.
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+
+#include "codec/occluders.h"
+#include "codec/scene.h"
+#include "timing.h"
+
+using namespace zhc;
+
+namespace {
+
+Scene grid_scene(std::uint32_t n) {
+    Scene s;
+    s.probes.kind = ProbePlacementKind::kGrid;
+    s.probes.min = {-4, -4, 0.1};
+    s.probes.max = {4, 4, 3.1};
+    s.probes.counts = {n, n, std::max<std::uint32_t>(1, n / 4)};
+    return s;
+}
+
+SceneLight light_of(LightKind kind, int i) {
+    SceneLight l;
+    l.kind = kind;
+    const double a = 0.7 * i;
+    const Vec3 where{5.5 * std::cos(a), 5.5 * std::sin(a), 1.0 + 0.2 * i};  // outside the probe bounds
+    l.position = where;
+    l.center = where;
+    l.radius = 0.3;
+    l.direction = normalize_or({std::cos(a), std::sin(a), 0.8}, {0, 0, 1});
+    if (kind == LightKind::kSpot) l.direction = -1.0 * where;
+    l.angular_radius_rad = 0.01;
+    l.inner_angle_rad = 0.4;
+    l.outer_angle_rad = 0.7;
+    l.color = {1.0f + i, 2.0f, 3.0f};
+    return l;
+}
+
+double probe_count(const Scene& s) {
+    return double(s.probes.counts[0]) * s.probes.counts[1] * s.probes.counts[2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::uint32_t n = argc > 1 ? static_cast<std::uint32_t>(std::atoi(argv[1])) : 64;
+    const int lights = 16, repeats = 5;
+    const double target = 1e6;
+    std::printf("bench_bake: %ux%ux%u probes, %d lights per scene, 1 thread, median of %d runs\n\n", n, n,
+                std::max<std::uint32_t>(1, n / 4), lights, repeats);
+
+    // Floor: one basis evaluation and 27 multiply-adds per probe-light.
+    {
+        const Scene s = grid_scene(n);
+        const std::vector<Vec3> pos = probe_positions(s.probes);
+        std::vector<double> acc(pos.size() * 27);
+        const auto t = bench::time_repeats(repeats, [&] {
+            for (int l = 0; l < lights; ++l)
+                for (size_t p = 0; p < pos.size(); ++p) {
+                    const auto y = sh3_basis(normalize_or(pos[p] - Vec3{1.0 * l, 2, 3}, {0, 0, 1}));
+                    for (int i = 0; i < 27; ++i) acc[p * 27 + i] += y[i / 3] * (1 + i % 3);
+                }
+            bench::keep(acc);
+        });
+        std::printf("floor (basis + 27 madds)   %10.3g probe-lights/s  (%.1f ns each)\n\n",
+                    pos.size() * lights / t.median_s, t.median_s * 1e9 / (pos.size() * lights));
+    }
+
+    std::printf("%-24s %14s %9s %10s %18s\n", "closed form", "probe-lights/s", "ns each", "vs 1e6/s", "spread (ms)");
+    struct Case {
+        const char* name;
+        std::vector<LightKind> kinds;
+    };
+    const Case cases[] = {{"directional (delta)", {LightKind::kDirectional}},
+                          {"sun (cone)", {LightKind::kDirectional}},
+                          {"point", {LightKind::kPoint}},
+                          {"spot", {LightKind::kSpot}},
+                          {"sphere", {LightKind::kSphere}},
+                          {"hemisphere", {LightKind::kHemisphere}},
+                          {"mixed (all five)",
+                           {LightKind::kDirectional, LightKind::kPoint, LightKind::kSpot, LightKind::kSphere,
+                            LightKind::kHemisphere}}};
+    for (const Case& c : cases) {
+        Scene s = grid_scene(n);
+        for (int i = 0; i < lights; ++i) {
+            SceneLight l = light_of(c.kinds[static_cast<size_t>(i) % c.kinds.size()], i);
+            if (std::string(c.name) == "directional (delta)") l.angular_radius_rad = 0;
+            s.lights.push_back(l);
+        }
+        const auto t = bench::time_repeats(repeats, [&] { bench::keep(bake_scene(s)); });
+        const double rate = probe_count(s) * lights / t.median_s;
+        std::printf("%-24s %14.3g %9.1f %9.2fx %8.1f..%-8.1f\n", c.name, rate, 1e9 / rate, rate / target,
+                    t.min_s * 1e3, t.max_s * 1e3);
+    }
+
+    std::printf("\n%-40s %12s %12s %10s\n", "occluded", "rays/s", "ns per ray", "ms");
+    {
+        Scene s = default_scene();
+        s.probes.counts = {n, n, std::max<std::uint32_t>(1, n / 4)};
+        BakeReport rep;
+        const auto t = bench::time_repeats(repeats, [&] { bench::keep(bake_scene(s, {}, &rep)); });
+        std::printf("%-40s %12.3g %12.1f %10.1f  (%llu rays; whole bake incl. closed forms)\n",
+                    "default scene (2 occluders, 3 traced)", rep.rays / t.median_s, t.median_s * 1e9 / rep.rays,
+                    t.median_s * 1e3, static_cast<unsigned long long>(rep.rays));
+    }
+    {
+        std::mt19937 rng(3);
+        std::uniform_real_distribution<double> u(-6, 6), u01(0, 1);
+        Scene s = grid_scene(n / 2);
+        for (int i = 0; i < 1000; ++i) {
+            Occluder o;
+            o.kind = i % 2 ? OccluderKind::kSphere : OccluderKind::kBox;
+            o.center = {u(rng), u(rng), 4 + 0.5 * u(rng)};
+            o.radius = 0.1 + 0.2 * u01(rng);
+            o.min = o.center;
+            o.max = o.center + Vec3{0.4 * u01(rng), 0.4 * u01(rng), 0.1};
+            s.occluders.push_back(o);
+        }
+        SceneLight sun = light_of(LightKind::kDirectional, 0);
+        sun.direction = {0.2, 0.1, 1};
+        sun.angular_radius_rad = 0.05;
+        sun.shadows = true;
+        sun.shadow_samples = 64;
+        s.lights = {sun};
+        BakeReport rep;
+        const auto t = bench::time_repeats(repeats, [&] { bench::keep(bake_scene(s, {}, &rep)); });
+        std::printf("%-40s %12.3g %12.1f %10.1f  (%llu rays)\n", "1000 random occluders, sun 64 samples",
+                    rep.rays / t.median_s, t.median_s * 1e9 / rep.rays, t.median_s * 1e3,
+                    static_cast<unsigned long long>(rep.rays));
+        // Brute force over the same rays (no BVH), for contrast: a subset of probes.
+        const std::vector<Vec3> pos = probe_positions(s.probes);
+        const auto dirs = cone_sample_directions(sun.direction, sun.angular_radius_rad, 64);
+        const size_t probes = std::min<size_t>(pos.size(), 512);
+        int hits = 0;
+        const auto tb = bench::time_repeats(3, [&] {
+            for (size_t p = 0; p < probes; ++p)
+                for (const Vec3& d : dirs) {
+                    bool h = false;
+                    for (const Occluder& o : s.occluders) h = h || ray_hits(o, pos[p], d, 1e-9, 1e30);
+                    hits += h;
+                }
+        });
+        bench::keep(hits);
+        std::printf("%-40s %12.3g %12.1f\n", "  same rays, brute force (no BVH)", probes * 64 / tb.median_s,
+                    tb.median_s * 1e9 / (probes * 64));
+    }
+    return 0;
+}
