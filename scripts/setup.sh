@@ -16,6 +16,12 @@ if [ "${1:-}" = "--test" ] && [ -f scripts/packages-test.txt ]; then
   while read -r p; do [ -n "$p" ] && [ "${p#\#}" = "$p" ] && PACKAGES+=("$p"); done < scripts/packages-test.txt
 fi
 
+# Node.js + npm for the glTF client tests (tests/js): only when the commands are missing, since a
+# machine may already have them from another packaging of Node.js (which provides npm itself).
+if [ "${1:-}" = "--test" ] && { ! command -v node >/dev/null || ! command -v npm >/dev/null; }; then
+  PACKAGES+=(nodejs npm)
+fi
+
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
