@@ -16,6 +16,7 @@
 #include "codec/scene.h"
 #include "formats/audit_inputs.h"
 #include "formats/file_io.h"
+#include "formats/gltf_probes.h"
 #include "formats/probe_file.h"
 #include "formats/scene_json.h"
 
@@ -95,9 +96,11 @@ int run(const Options& o) {
 
     // 3. Containers: the SH3 hub and the 16-byte zh3_q16.
     const ProbeLayout layout = probe_layout(scene.probes);
+    ProbeSet q16_set;
     for (const char* rep_name : {"sh3", "zh3_q16"}) {
         auto set = encode_probe_set(probes, rep_name, StorageParams{}, layout);
         if (!set) return report(set.error());
+        if (std::string(rep_name) == "zh3_q16") q16_set = *set;
         if (Status s = write_probe_file(path(std::string("probes_") + rep_name + ".zhp"), *set); !s)
             return report_output(s.error());
         outputs.push_back({path(std::string("probes_") + rep_name + ".zhp"),
@@ -206,7 +209,18 @@ int run(const Options& o) {
                                fmt(pos.z, "%.2f") + "): irradiance and error per representation"});
     }
 
-    std::printf("\nglTF with embedded probes: skipped (the glTF extension has not landed in this build)\n");
+    // 6. The zh3_q16 grid embedded in a glTF (ZHC_light_probes, docs/gltf-extension.md) of an
+    // otherwise empty scene; `zhc gltf embed` does the same into a real scene.
+    {
+        const std::string empty_scene =
+            R"({"asset":{"version":"2.0","generator":"zhc demo"},"scene":0,"scenes":[{"name":"zhc demo","nodes":[]}]})";
+        const std::vector<std::uint8_t> scene_bytes(empty_scene.begin(), empty_scene.end());
+        auto glb = embed_probes_gltf(scene_bytes, path("scene.gltf"), q16_set);
+        if (!glb) return report(glb.error());
+        if (Status s = write_file_atomic(path("probes.glb"), *glb); !s) return report_output(s.error());
+        outputs.push_back({path("probes.glb"), "glTF with the zh3_q16 probe grid (ZHC_light_probes extension)"});
+        std::printf("\nglTF: %s (%zu bytes)\n", path("probes.glb").c_str(), glb->size());
+    }
     std::printf("\noutputs (%.1f s in all):\n", ms_since(t_all) / 1000.0);
     for (const auto& [p, what] : outputs) std::printf("  %-34s %s\n", p.c_str(), what.c_str());
     std::printf("re-bake: zhc bake %s -o probes.zhp\n", path("scene.json").c_str());

@@ -278,10 +278,14 @@ TEST(Cli, VersionHelpAndUsageErrors) {
     EXPECT_EQ(test::run_zhc({"project", "a.exr", "--bogus"}).exit_code, cli::kExitUsage);
 }
 
-TEST(Cli, DemoPrintsTheCoefficients) {
-    auto d = test::run_zhc({"demo"});
+TEST(Cli, DemoRunsThePipelineAndListsItsOutputs) {
+    const std::string dir = test::temp_dir("demo_out");
+    auto d = test::run_zhc({"demo", "-o", dir});
     EXPECT_EQ(d.exit_code, 0) << d.err;
-    EXPECT_NE(d.out.find("L22"), std::string::npos);
+    for (const char* f : {"probes_sh3.zhp", "probes_zh3_q16.zhp", "probes.glb", "audit.md", "scene.json"}) {
+        EXPECT_NE(d.out.find(f), std::string::npos) << f;
+        EXPECT_TRUE(std::filesystem::exists(dir + "/" + f)) << f;
+    }
 }
 
 }  // namespace
