@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <initializer_list>
 #include <new>
@@ -82,16 +83,24 @@ public:
         if (!(length(v) > 0)) fail(ErrorCode::kInvalidValue, path, "must be a non-zero vector");
         return v;
     }
+    // One colour channel: finite, >= 0 and representable as a 32-bit float (colours are stored as
+    // floats; a larger value would become Inf and could not be written back).
+    float channel(const json& j, const std::string& path) const {
+        const double v = non_negative(j, path);
+        if (v > std::numeric_limits<float>::max())
+            fail(ErrorCode::kInvalidValue, path, "must fit in a 32-bit float (got " + fmt(v) + ")");
+        return static_cast<float>(v);
+    }
     // A colour: [r, g, b] or one number for grey; every channel finite and >= 0.
     Rgb colour(const json& j, const std::string& path) const {
         if (j.is_number()) {
-            const float v = static_cast<float>(non_negative(j, path));
+            const float v = channel(j, path);
             return {v, v, v};
         }
         if (!j.is_array() || j.size() != 3)
             fail(ErrorCode::kInvalidValue, path, "must be [r, g, b] or one number (got " + type_of(j) + ")");
         Rgb c;
-        for (int k = 0; k < 3; ++k) c[k] = static_cast<float>(non_negative(j[static_cast<size_t>(k)], index(path, size_t(k))));
+        for (int k = 0; k < 3; ++k) c[k] = channel(j[static_cast<size_t>(k)], index(path, size_t(k)));
         return c;
     }
     bool boolean(const json& j, const std::string& path) const {
