@@ -12,6 +12,7 @@
 
 #include "formats/audit_inputs.h"
 #include "cli.h"
+#include "table.h"
 #include "codec/audit.h"
 #include "formats/file_io.h"
 
@@ -57,26 +58,6 @@ std::vector<std::string> row_of(const RepresentationResult& r) {
             fmt(r.encode_ns, "%.0f"), fmt(r.decode_ns, "%.0f")};
 }
 
-void print_table(std::ostream& os, const std::vector<std::vector<std::string>>& rows, bool markdown) {
-    std::vector<size_t> width(rows[0].size(), 0);
-    for (const auto& r : rows)
-        for (size_t i = 0; i < r.size(); ++i) width[i] = std::max(width[i], r[i].size());
-    for (size_t ri = 0; ri < rows.size(); ++ri) {
-        std::string line = markdown ? "|" : "";
-        for (size_t i = 0; i < rows[ri].size(); ++i) {
-            const std::string& c = rows[ri][i];
-            const std::string pad(width[i] - c.size(), ' ');
-            const std::string cell = i == 0 ? c + pad : pad + c;
-            line += markdown ? " " + cell + " |" : (i ? "  " : "") + cell;
-        }
-        os << line << "\n";
-        if (markdown && ri == 0) {
-            std::string sep = "|";
-            for (size_t i = 0; i < width.size(); ++i) sep += (i == 0 ? " :" : " ") + std::string(width[i] - 1, '-') + (i == 0 ? " |" : ": |");
-            os << sep << "\n";
-        }
-    }
-}
 
 nlohmann::json metrics_json(const RepresentationResult& r) {
     const ErrorMetrics& m = r.metrics;
