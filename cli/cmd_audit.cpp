@@ -75,23 +75,9 @@ nlohmann::json metrics_json(const RepresentationResult& r) {
 }
 
 int run(const Options& o) {
-    // Which representations.
-    std::vector<const Codec*> selected;
-    if (o.representations.empty()) {
-        for (const Codec& c : codecs()) selected.push_back(&c);
-    } else {
-        std::stringstream ss(o.representations);
-        for (std::string name; std::getline(ss, name, ',');) {
-            const Codec* c = find_codec(name);
-            if (!c) {
-                std::string known;
-                for (const Codec& k : codecs()) known += (known.empty() ? "" : ", ") + std::string(k.name);
-                return report(make_error(ErrorCode::kInvalidArgument,
-                                         "--representations: unknown representation '" + name + "' (known: " + known + ")"));
-            }
-            selected.push_back(c);
-        }
-    }
+    auto chosen = select_codecs(o.representations);
+    if (!chosen) return report(chosen.error());
+    const std::vector<const Codec*>& selected = *chosen;
     auto files = expand_audit_inputs(o.inputs);
     if (!files) return report(files.error());
     if (files->empty()) return report(make_error(ErrorCode::kInvalidArgument, "no audit inputs found"));

@@ -36,17 +36,9 @@ int run(const Options& o) {
     }
     auto files = expand_audit_inputs(inputs);
     if (!files) return report(files.error());
-    std::vector<const Codec*> selected;
-    if (o.representations.empty()) {
-        for (const Codec& c : codecs()) selected.push_back(&c);
-    } else {
-        std::stringstream ss(o.representations);
-        for (std::string n; std::getline(ss, n, ',');) {
-            const Codec* c = find_codec(n);
-            if (!c) return report(make_error(ErrorCode::kInvalidArgument, "--representations: unknown representation '" + n + "'"));
-            selected.push_back(c);
-        }
-    }
+    auto chosen = select_codecs(o.representations);
+    if (!chosen) return report(chosen.error());
+    const std::vector<const Codec*>& selected = *chosen;
     const std::vector<Vec3> dirs = fibonacci_sphere(o.directions);
     std::vector<BenchProbe> probes;
     AuditLoadOptions lo;

@@ -17,6 +17,9 @@
 #include <cstdint>
 #include <span>
 #include <string_view>
+#include <vector>
+
+#include "status.h"
 
 #include "sh.h"
 
@@ -68,6 +71,9 @@ struct Codec {
 std::span<const Codec> codecs();
 // nullptr when no entry has that name.
 const Codec* find_codec(std::string_view name);
+// A comma-separated list of names ("sh3,zh3_lum") -> entries in that order; empty -> the whole
+// table. An unknown name is kInvalidArgument naming it and listing the known ones.
+Result<std::vector<const Codec*>> select_codecs(std::string_view comma_separated_names);
 
 // Parts of the table, one per codec module; codecs() concatenates them.
 std::span<const Codec> core_codecs();       // sh3, sh2 (codec/core_codecs.cpp)

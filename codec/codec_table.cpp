@@ -1,5 +1,7 @@
 // The codec table: concatenation of each module's entries, built once.
+#include <algorithm>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "codec.h"
@@ -20,6 +22,28 @@ const Codec* find_codec(std::string_view name) {
     for (const Codec& c : codecs())
         if (c.name == name) return &c;
     return nullptr;
+}
+
+Result<std::vector<const Codec*>> select_codecs(std::string_view names) {
+    std::vector<const Codec*> out;
+    if (names.empty()) {
+        for (const Codec& c : codecs()) out.push_back(&c);
+        return out;
+    }
+    for (size_t begin = 0; begin <= names.size();) {
+        const size_t end = std::min(names.find(',', begin), names.size());
+        const std::string_view name = names.substr(begin, end - begin);
+        const Codec* c = find_codec(name);
+        if (!c) {
+            std::string known;
+            for (const Codec& k : codecs()) known += (known.empty() ? "" : ", ") + std::string(k.name);
+            return make_error(ErrorCode::kInvalidArgument, "--representations: unknown representation '" +
+                                                               std::string(name) + "' (known: " + known + ")");
+        }
+        out.push_back(c);
+        begin = end + 1;
+    }
+    return out;
 }
 
 void store_floats(std::span<const float> values, std::uint8_t* out) {

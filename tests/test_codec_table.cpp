@@ -33,6 +33,22 @@ TEST(CodecTable, NamesAreUniqueAndFindable) {
     EXPECT_NE(find_codec("sh2"), nullptr);
 }
 
+TEST(CodecTable, SelectCodecsKeepsOrderAndNamesUnknownEntries) {
+    auto all = select_codecs("");
+    ASSERT_TRUE(all);
+    EXPECT_EQ(all->size(), codecs().size());
+    auto two = select_codecs("sh2,sh3");
+    ASSERT_TRUE(two);
+    ASSERT_EQ(two->size(), 2u);
+    EXPECT_EQ((*two)[0]->name, "sh2");
+    EXPECT_EQ((*two)[1]->name, "sh3");
+    auto bad = select_codecs("sh3,nope");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(bad.error().message.find("'nope'"), std::string::npos);
+    EXPECT_FALSE(select_codecs("sh3,"));  // an empty name is unknown too
+}
+
 TEST(CodecTable, EncodeWritesExactlySizeBytesAndIsDeterministic) {
     const CodecOptions o;
     for (const Codec& c : codecs()) {
