@@ -53,7 +53,10 @@ struct Generator {
     std::uniform_real_distribution<double> u{0.0, 1.0};
     explicit Generator(std::uint64_t seed) : rng(seed) {}
     double uni() { return u(rng); }
-    Vec3 dir() { return test::uniform_direction(uni(), uni()); }
+    Vec3 dir() {  // sequenced: argument evaluation order differs between compilers
+        const double u1 = uni();
+        return test::uniform_direction(u1, uni());
+    }
     Rgb colour(double scale) {
         return {static_cast<float>(scale * (0.2 + uni())), static_cast<float>(scale * (0.2 + uni())),
                 static_cast<float>(scale * (0.2 + uni()))};
