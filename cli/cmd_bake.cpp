@@ -61,7 +61,13 @@ int run(const Options& o) {
     BakeReport rep;
     auto probes = bake_scene(*scene, bo, &rep);
     if (!probes) return report(probes.error());
-    if (!o.quiet) print_report(rep);
+    if (!o.quiet) {
+        print_report(rep);
+        size_t triangles = 0;
+        for (const Occluder& oc : scene->occluders) triangles += oc.kind == OccluderKind::kTriangle;
+        if (!scene->occluders.empty())
+            std::printf("occluders: %zu (%zu mesh triangles)\n", scene->occluders.size(), triangles);
+    }
 
     const ProbeLayout layout = probe_layout(scene->probes);
     if (ext == ".json") {

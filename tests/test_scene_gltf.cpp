@@ -380,6 +380,29 @@ TEST(SceneGltfCli, BakeGltfAndEmbedEqualsZhp) {
         ASSERT_EQ(again.exit_code, 0) << again.err;
         EXPECT_EQ(decode_zhp(dir + "/again.zhp"), ref);
     }
+    // A .gltf whose buffer is an external file next to it: read through the guarded loader, and
+    // the output is self-contained (the buffer becomes part of the GLB).
+    {
+        json d = json::parse(a.text());
+        d["buffers"][0]["uri"] = "room.bin";
+        const std::string t = d.dump();
+        test::write_bytes(dir + "/room_ext.gltf", std::vector<std::uint8_t>(t.begin(), t.end()));
+        test::write_bytes(dir + "/room.bin", a.bin);
+        const auto r = test::run_zhc({"bake", dir + "/room_ext.gltf", "-o", dir + "/room_ext.glb"});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_NE(r.out.find("occluders: 2 (2 mesh triangles)"), std::string::npos) << r.out;
+        auto g = read_gltf_probes_file(dir + "/room_ext.glb");
+        ASSERT_TRUE(g.ok()) << g.error().message;
+        EXPECT_EQ(*decode_probe_set(g->volumes[0].set), ref);
+        // A buffer URI leaving the directory is refused (exit 4), nothing written.
+        d["buffers"][0]["uri"] = "../room.bin";
+        const std::string bad = d.dump();
+        test::write_bytes(dir + "/room_escape.gltf", std::vector<std::uint8_t>(bad.begin(), bad.end()));
+        const auto e = test::run_zhc({"bake", dir + "/room_escape.gltf", "-o", dir + "/room_escape.glb"});
+        EXPECT_EQ(e.exit_code, 4) << e.err;
+        EXPECT_NE(e.err.find("'..' escapes the input's directory"), std::string::npos) << e.err;
+        EXPECT_FALSE(fs::exists(dir + "/room_escape.glb"));
+    }
     // A quantised representation: the embedded bytes are the .zhp payload.
     ASSERT_EQ(test::run_zhc({"bake", dir + "/room.gltf", "-o", dir + "/q.zhp", "--to", "zh3_q16", "--quiet"}).exit_code, 0);
     ASSERT_EQ(test::run_zhc({"bake", dir + "/room.gltf", "-o", dir + "/q.glb", "--to", "zh3_q16", "--quiet"}).exit_code, 0);
