@@ -182,6 +182,28 @@ std::vector<BadFileCase> bad_files() {
         std::memcpy(&huge[at + 12], &big, 4);
         cases.push_back({"exr_huge_window", huge, ErrorCode::kTooLarge, cli::kExitTooLarge});
     }
+    // Declared attribute sizes that disagree with the value's own length (OpenEXR's typed readers
+    // ignore the declared size, so it would continue parsing from the wrong byte; a fuzzer turned
+    // that into a 1.7 GB allocation from a 263-byte file).
+    auto patch_size = [&](const char* key, size_t key_len, std::int32_t delta) {
+        auto bytes = exr;
+        auto it = std::search(bytes.begin(), bytes.end(), key, key + key_len);
+        EXPECT_NE(it, bytes.end());
+        const size_t at = static_cast<size_t>(it - bytes.begin()) + key_len;
+        std::int32_t size;
+        std::memcpy(&size, &bytes[at], 4);
+        size += delta;
+        std::memcpy(&bytes[at], &size, 4);
+        return bytes;
+    };
+    {
+        const char chlist[] = "channels\0chlist";
+        cases.push_back({"exr_chlist_size_short", patch_size(chlist, sizeof chlist, -1), ErrorCode::kBadFormat,
+                         cli::kExitInvalidInput});
+        const char aspect[] = "pixelAspectRatio\0float";
+        cases.push_back({"exr_float_size_long", patch_size(aspect, sizeof aspect, 4), ErrorCode::kBadFormat,
+                         cli::kExitInvalidInput});
+    }
     const std::string hdr_huge = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n";
     cases.push_back({"hdr_huge", {hdr_huge.begin(), hdr_huge.end()}, ErrorCode::kTooLarge, cli::kExitTooLarge});
     {
