@@ -448,8 +448,9 @@ json default_probes(const Reader& r) {
 
 }  // namespace
 
-Result<Scene> parse_scene_gltf(std::span<const std::uint8_t> bytes, const std::string& path, const SceneLoadOptions& options,
-                               const GltfLimits& gltf_limits) {
+namespace {
+Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::string& path, const SceneLoadOptions& options,
+                              const GltfLimits& gltf_limits) {
     auto raw = load_gltf_raw(bytes, path, gltf_limits);
     if (!raw) return raw.error();
     try {
@@ -492,6 +493,16 @@ Result<Scene> parse_scene_gltf(std::span<const std::uint8_t> bytes, const std::s
     } catch (const std::bad_alloc&) {
         return make_error(ErrorCode::kTooLarge, path + ": out of memory while reading the scene");
     }
+}
+
+}  // namespace
+
+Result<Scene> parse_scene_gltf(std::span<const std::uint8_t> bytes, const std::string& path, const SceneLoadOptions& options,
+                               const GltfLimits& gltf_limits) {
+    // Messages echo names and values from the asset (and tinygltf's text): keep them one line.
+    auto s = parse_unchecked(bytes, path, options, gltf_limits);
+    if (!s) return make_error(s.error().code, one_line_message(s.error().message));
+    return s;
 }
 
 Result<Scene> read_scene_gltf_file(const std::string& path, const SceneLoadOptions& options, const GltfLimits& gltf_limits) {

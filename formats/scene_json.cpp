@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <filesystem>
 #include <initializer_list>
@@ -398,8 +399,25 @@ Status check_ray_budget(const Scene& s, const SceneJsonLimits& limits, const std
     return Ok{};
 }
 
-Result<Scene> parse_scene_json(std::span<const std::uint8_t> bytes, const std::string& name,
-                               const std::string& base_dir, const SceneLoadOptions& options) {
+std::string one_line_message(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    for (const char c : text) {
+        const auto u = static_cast<unsigned char>(c);
+        if (u < 0x20 || u == 0x7f) {
+            char b[8];
+            std::snprintf(b, sizeof b, "\\x%02x", u);
+            out += b;
+        } else {
+            out += c;
+        }
+    }
+    return out;
+}
+
+namespace {
+Result<Scene> parse_scene_json_unchecked(std::span<const std::uint8_t> bytes, const std::string& name,
+                                         const std::string& base_dir, const SceneLoadOptions& options) {
     if (bytes.size() > options.limits.max_file_bytes)
         return make_error(ErrorCode::kTooLarge, name + ": scene file larger than the limit of " +
                                                     std::to_string(options.limits.max_file_bytes) + " bytes");
@@ -423,6 +441,15 @@ Result<Scene> parse_scene_json(std::span<const std::uint8_t> bytes, const std::s
     } catch (const std::bad_alloc&) {
         return make_error(ErrorCode::kTooLarge, name + ": out of memory while reading the scene");
     }
+}
+}  // namespace
+
+Result<Scene> parse_scene_json(std::span<const std::uint8_t> bytes, const std::string& name,
+                               const std::string& base_dir, const SceneLoadOptions& options) {
+    // Messages echo field names and values from the input: keep them one line.
+    auto s = parse_scene_json_unchecked(bytes, name, base_dir, options);
+    if (!s) return make_error(s.error().code, one_line_message(s.error().message));
+    return s;
 }
 
 Result<Scene> read_scene_file(const std::string& path, const SceneLoadOptions& options) {

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "codec/scene.h"
 #include "codec/status.h"
@@ -40,6 +41,10 @@ struct SceneLoadOptions {
 Result<Scene> parse_scene_json(std::span<const std::uint8_t> bytes, const std::string& name,
                                const std::string& base_dir, const SceneLoadOptions& options = {});
 Result<Scene> read_scene_file(const std::string& path, const SceneLoadOptions& options = {});
+
+// `text` with control characters (a newline in a JSON string or key echoed into an error)
+// written as \xNN, so an error message stays one line.
+std::string one_line_message(std::string_view text);
 
 // kTooLarge ("NAME: lights: the bake would cast P x S shadow rays, above the limit of ...") when
 // the shadowed lights of `s` would trace more than limits.max_rays rays; Ok without occluders.

@@ -309,6 +309,10 @@ TEST(SceneGltf, StrictErrorsNameTheFileAndField) {
          ErrorCode::kInvalidValue, "test.gltf: extras.zhc: probes.grid.max: missing required field"},
         {"extras unknown", [](Asset& a) { a.doc["extras"]["zhc"] = {{"lihgts", json::array()}}; }, ErrorCode::kInvalidValue,
          "extras.zhc: lihgts: unknown field"},
+        {"newline echoed", [](Asset& a) { a.node(Asset::light_node(a.light({{"type", "are\na"}}))); }, ErrorCode::kUnsupported,
+         "unknown light type \"are\\x0aa\""},  // fuzzer: a JSON "\n" made the message two lines
+        {"newline in extras", [](Asset& a) { a.doc["extras"]["zhc"] = {{"sky", {{"type", "const\nt"}}}}; }, ErrorCode::kUnsupported,
+         "sky.type: unknown sky type \"const\\x0at\""},
         {"no scenes", [](Asset& a) { a.doc.erase("scenes"); a.doc.erase("scene"); }, ErrorCode::kInvalidValue, "scenes: the asset has no scene"},
     };
     for (const Case& c : cases) {
