@@ -1,12 +1,18 @@
-// zhc bake SCENE.json -o PROBES.zhp|.json [--threads N] [--to REPRESENTATION] [--zstd LEVEL]:
-// bakes the scene's probes (only the effects it lists; docs/scene.md) and writes them.
+// zhc bake SCENE.json|SCENE.gltf|SCENE.glb -o PROBES.zhp|.json|.glb|.gltf [--threads N]
+//          [--to REPRESENTATION] [--zstd LEVEL]:
+// bakes the scene's probes (only the effects it lists; docs/scene.md) and writes them: a probe
+// container, a JSON probe list, or a glTF with the probes embedded (ZHC_light_probes,
+// docs/gltf-extension.md) — into a copy of the input asset when the scene is glTF, else into a
+// minimal asset.
 #include <cstdio>
 #include <thread>
 
 #include "cli.h"
 #include "codec/scene.h"
 #include "formats/file_io.h"
+#include "formats/gltf_probes.h"
 #include "formats/probe_file.h"
+#include "formats/scene_gltf.h"
 #include "formats/scene_json.h"
 
 namespace zhc::cli {
@@ -34,9 +40,10 @@ void print_report(const BakeReport& r) {
 
 int run(const Options& o) {
     const std::string ext = file_extension(o.output);
-    if (ext != ".zhp" && ext != ".json") {
-        std::fprintf(stderr, "zhc: error: -o %s: the output must end in .zhp (container) or .json (probe list)%s\n",
-                     o.output.c_str(), ext == ".glb" || ext == ".gltf" ? "; glTF embedding is not available in this build" : "");
+    const bool gltf_out = ext == ".glb" || ext == ".gltf";
+    if (ext != ".zhp" && ext != ".json" && !gltf_out) {
+        std::fprintf(stderr, "zhc: error: -o %s: the output must end in .zhp (container), .json (probe list) or .glb/.gltf (glTF with embedded probes)\n",
+                     o.output.c_str());
         return kExitUsage;
     }
     const Codec* codec = find_codec(o.to);
@@ -47,14 +54,20 @@ int run(const Options& o) {
     const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     SceneLoadOptions lo;
     lo.threads = threads;
-    auto scene = read_scene_file(o.scene, lo);
+    auto scene = read_any_scene_file(o.scene, lo);
     if (!scene) return report(scene.error());
     BakeOptions bo;
     bo.threads = threads;
     BakeReport rep;
     auto probes = bake_scene(*scene, bo, &rep);
     if (!probes) return report(probes.error());
-    if (!o.quiet) print_report(rep);
+    if (!o.quiet) {
+        print_report(rep);
+        size_t triangles = 0;
+        for (const Occluder& oc : scene->occluders) triangles += oc.kind == OccluderKind::kTriangle;
+        if (!scene->occluders.empty())
+            std::printf("occluders: %zu (%zu mesh triangles)\n", scene->occluders.size(), triangles);
+    }
 
     const ProbeLayout layout = probe_layout(scene->probes);
     if (ext == ".json") {
@@ -77,6 +90,31 @@ int run(const Options& o) {
     }
     auto set = encode_probe_set(*probes, o.to, StorageParams{}, layout);
     if (!set) return report(set.error());
+    if (gltf_out) {
+        // Into a copy of the input asset (everything of it kept, docs/gltf-extension.md), or into
+        // a minimal asset for a JSON scene.
+        std::vector<std::uint8_t> host;
+        std::string host_path = o.output;
+        if (is_gltf_path(o.scene)) {
+            auto bytes = read_file_bytes(o.scene, GltfLimits{}.max_file_bytes);
+            if (!bytes) return report(bytes.error());
+            host = std::move(bytes).value();
+            host_path = o.scene;
+        } else {
+            const std::string minimal =
+                R"({"asset":{"version":"2.0","generator":"zhc bake"},"scene":0,"scenes":[{"name":"zhc bake","nodes":[]}]})";
+            host.assign(minimal.begin(), minimal.end());
+        }
+        GltfEmbedOptions eo;
+        eo.binary = ext == ".glb";
+        auto out = embed_probes_gltf(host, host_path, *set, eo);
+        if (!out) return report(out.error());
+        if (Status st = write_file_atomic(o.output, *out); !st) return report_output(st.error());
+        std::printf("%s: %llu probes as %s embedded in %s (%zu bytes)\n", o.output.c_str(),
+                    static_cast<unsigned long long>(set->count), o.to.c_str(),
+                    is_gltf_path(o.scene) ? "a copy of the input asset" : "a minimal glTF", out->size());
+        return kExitOk;
+    }
     ProbeFileWriteOptions wo;
     wo.zstd_level = o.zstd;
     auto bytes = serialize_probe_set(*set, wo);
@@ -89,9 +127,9 @@ int run(const Options& o) {
 
 const VerbRegistration registration(15, [](CLI::App& app) -> std::function<int()> {
     auto o = std::make_shared<Options>();
-    CLI::App* sub = app.add_subcommand("bake", "Bake a JSON scene (sky/envmap, lights, occluders) into SH3 radiance probes");
-    sub->add_option("SCENE", o->scene, "scene description (JSON, docs/scene.md)")->required();
-    sub->add_option("-o,--output", o->output, "output: .zhp (probe container) or .json (float SH3 probe list)")->required();
+    CLI::App* sub = app.add_subcommand("bake", "Bake a scene (JSON, or glTF lights and meshes) into SH3 radiance probes");
+    sub->add_option("SCENE", o->scene, "scene: JSON (docs/scene.md) or glTF .gltf/.glb (KHR_lights_punctual lights, meshes as occluders)")->required();
+    sub->add_option("-o,--output", o->output, "output: .zhp (probe container), .json (float SH3 probe list), .glb/.gltf (probes embedded in glTF)")->required();
     sub->add_option("--threads", o->threads, "worker threads (output identical for any count; 0 = all cores)")
         ->check(CLI::Range(0, 256));
     sub->add_option("--to", o->to, "stored representation of the .zhp (a codec table name; default sh3)");

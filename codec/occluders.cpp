@@ -12,6 +12,9 @@ void bounds_of(const Occluder& o, double lo[3], double hi[3]) {
         if (o.kind == OccluderKind::kSphere) {
             lo[a] = o.center[a] - o.radius;
             hi[a] = o.center[a] + o.radius;
+        } else if (o.kind == OccluderKind::kTriangle) {
+            lo[a] = std::min({o.v0[a], o.v1[a], o.v2[a]});
+            hi[a] = std::max({o.v0[a], o.v1[a], o.v2[a]});
         } else {
             lo[a] = o.min[a];
             hi[a] = o.max[a];
@@ -40,9 +43,43 @@ bool slab(const double lo[3], const double hi[3], Vec3 o, Vec3 d, double t0, dou
     return true;
 }
 
+// Moller-Trumbore (1997): solve o + t d = v0 + u e1 + v e2 by Cramer's rule with
+// det = e1 . (d x e2). Policy in occluders.h: det == 0 (parallel, or a degenerate triangle) misses;
+// inclusive barycentric bounds widened by 1e-10; t in the open interval (t_min, t_max); both faces.
+bool ray_hits_triangle(const Occluder& tri, Vec3 o, Vec3 d, double t_min, double t_max) {
+    const Vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+    const Vec3 p = cross(d, e2);
+    const double det = dot(e1, p);
+    if (det == 0.0 || !std::isfinite(det)) return false;
+    const double inv = 1.0 / det;
+    const Vec3 s = o - tri.v0;
+    // Barycentric tolerance: Moller-Trumbore computes u, v per triangle, so on a shared edge the
+    // two neighbours can both reject by a few ulps (not watertight). Growing every triangle by a
+    // relative 1e-10 of its edges closes such cracks (rounding errors are ~1e-15 for well-posed
+    // rays) while moving its boundary by far less than any scene feature.
+    constexpr double kBary = 1e-10;
+    const double u = dot(s, p) * inv;
+    if (u < -kBary || u > 1.0 + kBary) return false;
+    const Vec3 q = cross(s, e1);
+    const double v = dot(d, q) * inv;
+    if (v < -kBary || u + v > 1.0 + kBary) return false;
+    const double t = dot(e2, q) * inv;
+    return t > t_min && t < t_max;
+}
+
 }  // namespace
 
+Occluder triangle_occluder(Vec3 a, Vec3 b, Vec3 c) {
+    Occluder o;
+    o.kind = OccluderKind::kTriangle;
+    o.v0 = a;
+    o.v1 = b;
+    o.v2 = c;
+    return o;
+}
+
 bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
+    if (occ.kind == OccluderKind::kTriangle) return ray_hits_triangle(occ, o, d, t_min, t_max);
     if (occ.kind == OccluderKind::kSphere) {
         // |o + t d - c|^2 = r^2 with |d| = 1: t^2 + 2 b t + c = 0, b = d.(o - c), c = |o - c|^2 - r^2.
         const Vec3 oc = o - occ.center;
@@ -65,36 +102,52 @@ bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
     return enter < t_max;
 }
 
-OccluderBvh::OccluderBvh(std::vector<Occluder> occluders) : prims_(std::move(occluders)) {
-    if (prims_.empty()) return;
-    nodes_.reserve(2 * prims_.size());
-    build(0, static_cast<std::uint32_t>(prims_.size()), 0);
+OccluderBvh::OccluderBvh(std::vector<Occluder> occluders) {
+    if (occluders.empty()) return;
+    // Boxes and centroids once; the build permutes indices, then the primitives are stored in
+    // leaf order (each leaf a contiguous range).
+    std::vector<Bounds> bounds(occluders.size());
+    for (size_t i = 0; i < occluders.size(); ++i) {
+        bounds_of(occluders[i], bounds[i].lo, bounds[i].hi);
+        for (int a = 0; a < 3; ++a) bounds[i].centroid[a] = 0.5 * (bounds[i].lo[a] + bounds[i].hi[a]);
+    }
+    std::vector<std::uint32_t> order(occluders.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+    nodes_.reserve(occluders.size() + 1);  // leaves of 2..4 primitives: < n nodes
+    build(order, bounds, 0, static_cast<std::uint32_t>(order.size()), 0);
+    prims_.reserve(occluders.size());
+    for (std::uint32_t i : order) prims_.push_back(occluders[i]);
 }
 
-std::uint32_t OccluderBvh::build(std::uint32_t first, std::uint32_t count, int depth) {
+std::uint32_t OccluderBvh::build(std::vector<std::uint32_t>& order, const std::vector<Bounds>& bounds,
+                                 std::uint32_t first, std::uint32_t count, int depth) {
     const std::uint32_t index = static_cast<std::uint32_t>(nodes_.size());
     nodes_.push_back({});
     Node n;
-    for (int a = 0; a < 3; ++a) {
-        n.lo[a] = std::numeric_limits<double>::infinity();
-        n.hi[a] = -std::numeric_limits<double>::infinity();
-    }
     double clo[3], chi[3];  // centroid bounds
     for (int a = 0; a < 3; ++a) {
-        clo[a] = std::numeric_limits<double>::infinity();
-        chi[a] = -std::numeric_limits<double>::infinity();
+        n.lo[a] = clo[a] = std::numeric_limits<double>::infinity();
+        n.hi[a] = chi[a] = -std::numeric_limits<double>::infinity();
     }
     for (std::uint32_t i = first; i < first + count; ++i) {
-        double lo[3], hi[3];
-        bounds_of(prims_[i], lo, hi);
+        const Bounds& b = bounds[order[i]];
         for (int a = 0; a < 3; ++a) {
-            n.lo[a] = std::min(n.lo[a], lo[a]);
-            n.hi[a] = std::max(n.hi[a], hi[a]);
-            const double c = 0.5 * (lo[a] + hi[a]);
-            clo[a] = std::min(clo[a], c);
-            chi[a] = std::max(chi[a], c);
+            n.lo[a] = std::min(n.lo[a], b.lo[a]);
+            n.hi[a] = std::max(n.hi[a], b.hi[a]);
+            clo[a] = std::min(clo[a], b.centroid[a]);
+            chi[a] = std::max(chi[a], b.centroid[a]);
         }
     }
+    // Conservative node boxes: widened by a relative 1e-9 so rounding in the slab test never
+    // rejects a ray that grazes a box face where a primitive's own (widened) test would hit, e.g.
+    // a ray through the rim of a flat mesh whose box has zero thickness.
+    for (int a = 0; a < 3; ++a) {
+        const double pad = 1e-9 * std::max({n.hi[a] - n.lo[a], std::abs(n.lo[a]), std::abs(n.hi[a]), 1e-300});
+        n.lo[a] -= pad;
+        n.hi[a] += pad;
+    }
+    // Depth cap: median splits halve the count, so depth <= log2(n) + 1 < 40 for any n < 2^32;
+    // the cap only guards the traversal stack.
     if (count <= 4 || depth > 40) {
         n.first = first;
         n.count = count;
@@ -105,19 +158,17 @@ std::uint32_t OccluderBvh::build(std::uint32_t first, std::uint32_t count, int d
     for (int a = 1; a < 3; ++a)
         if (chi[a] - clo[a] > chi[axis] - clo[axis]) axis = a;
     const std::uint32_t mid = first + count / 2;
-    // nth_element is deterministic for a given input; ties broken by the original order via a
-    // stable key (centroid, then index is not needed: equal keys in any order give the same tree
-    // bounds, and the query result is order independent).
-    std::nth_element(prims_.begin() + first, prims_.begin() + mid, prims_.begin() + first + count,
-                     [axis](const Occluder& a, const Occluder& b) {
-                         double alo[3], ahi[3], blo[3], bhi[3];
-                         bounds_of(a, alo, ahi);
-                         bounds_of(b, blo, bhi);
-                         return alo[axis] + ahi[axis] < blo[axis] + bhi[axis];
+    // Median split by centroid, ties broken by the primitive's index: a strict total order, so the
+    // partition (and the whole tree) is the same for the same input on every run.
+    std::nth_element(order.begin() + first, order.begin() + mid, order.begin() + first + count,
+                     [&bounds, axis](std::uint32_t a, std::uint32_t b) {
+                         const double ca = bounds[a].centroid[axis], cb = bounds[b].centroid[axis];
+                         return ca < cb || (ca == cb && a < b);
                      });
     n.count = 0;
-    n.left = build(first, mid - first, depth + 1);
-    n.right = build(mid, first + count - mid, depth + 1);
+    n.axis = static_cast<std::uint8_t>(axis);
+    n.left = build(order, bounds, first, mid - first, depth + 1);
+    n.right = build(order, bounds, mid, first + count - mid, depth + 1);
     nodes_[index] = n;
     return index;
 }
@@ -159,8 +210,15 @@ bool OccluderBvh::occluded(Vec3 o, Vec3 d, double t_min, double t_max) const {
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i)
                 if (ray_hits(prims_[i], o, d, t_min, t_max)) return true;
         } else if (top + 2 <= 128) {
-            stack[top++] = n.left;
-            stack[top++] = n.right;
+            // Nearer child (along the ray on the split axis) popped first: an any-hit query stops
+            // sooner when the closer half blocks.
+            if (dir[n.axis] < 0) {
+                stack[top++] = n.left;
+                stack[top++] = n.right;
+            } else {
+                stack[top++] = n.right;
+                stack[top++] = n.left;
+            }
         }
     }
     return false;

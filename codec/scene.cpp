@@ -297,6 +297,8 @@ Status validate_scene(const Scene& s) {
         if (o.kind == OccluderKind::kSphere) {
             if (!finite3(o.center) || !(o.radius > 0) || !std::isfinite(o.radius))
                 return bad(at + ": sphere needs a finite centre and radius > 0");
+        } else if (o.kind == OccluderKind::kTriangle) {
+            if (!finite3(o.v0) || !finite3(o.v1) || !finite3(o.v2)) return bad(at + ": triangle vertex is not finite");
         } else {
             if (!finite3(o.min) || !finite3(o.max)) return bad(at + ": box bounds are not finite");
             for (int a = 0; a < 3; ++a)

@@ -18,7 +18,8 @@
 //    the whole sphere (L00 only);
 //  * hemisphere light: constant radiance over the hemisphere around `direction` (Eq. 15, pi/2).
 //
-// Occluders (spheres and axis-aligned boxes) only matter for lights with `shadows` on. Then:
+// Occluders (spheres, axis-aligned boxes, triangles of meshes) only matter for lights with
+// `shadows` on. Then:
 //  * point, spot and zero-radius directional lights: one shadow ray (to the light / to infinity);
 //  * cone lights (sun with a radius, sphere lights, hemisphere lights): a fixed set of
 //    `shadow_samples` equal-solid-angle directions inside the cone (a spherical-Fibonacci spiral

@@ -730,6 +730,17 @@ Result<GltfSummary> read_gltf_probes(std::span<const std::uint8_t> bytes, const 
     return s;
 }
 
+Result<GltfRaw> load_gltf_raw(std::span<const std::uint8_t> bytes, const std::string& path, const GltfLimits& limits) {
+    auto loaded = load(bytes, path, limits);
+    if (!loaded) return loaded.error();
+    GltfRaw raw;
+    raw.binary = loaded->binary;
+    raw.json = loaded->doc.dump();
+    raw.buffers.reserve(loaded->model.buffers.size());
+    for (tinygltf::Buffer& b : loaded->model.buffers) raw.buffers.push_back(std::move(b.data));
+    return raw;
+}
+
 Result<GltfSummary> read_gltf_probes_file(const std::string& path, const GltfLimits& limits) {
     auto bytes = read_file_bytes(path, limits.max_file_bytes);
     if (!bytes) return bytes.error();

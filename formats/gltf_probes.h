@@ -81,6 +81,16 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
 Result<GltfSummary> read_gltf_probes(std::span<const std::uint8_t> bytes, const std::string& path,
                                      const GltfLimits& limits = {});
 
+// An asset loaded with the reader's checks (GLB framing, URIs confined to the input's directory,
+// declared sizes before allocating; images never decoded): its JSON text and every buffer's
+// bytes, for readers of other parts of an asset (formats/scene_gltf.h).
+struct GltfRaw {
+    std::string json;
+    std::vector<std::vector<std::uint8_t>> buffers;
+    bool binary = false;
+};
+Result<GltfRaw> load_gltf_raw(std::span<const std::uint8_t> bytes, const std::string& path, const GltfLimits& limits = {});
+
 // File helpers (atomic write).
 Result<GltfSummary> read_gltf_probes_file(const std::string& path, const GltfLimits& limits = {});
 

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <filesystem>
 #include <initializer_list>
@@ -264,7 +265,9 @@ SceneLight read_light(const Reader& r, const json& j, const std::string& p, cons
     return l;
 }
 
-Occluder read_occluder(const Reader& r, const json& j, const std::string& p) {
+// Appends the occluder(s) of one "occluders" entry; `triangles` counts mesh triangles so far.
+void read_occluder(const Reader& r, const json& j, const std::string& p, const SceneJsonLimits& limits,
+                   std::vector<Occluder>& out, std::uint64_t& triangles) {
     if (!j.is_object()) r.object(j, p, {});
     const std::string type = r.string(r.field(j, p, "type"), p + ".type");
     Occluder o;
@@ -280,11 +283,49 @@ Occluder read_occluder(const Reader& r, const json& j, const std::string& p) {
         o.max = r.vec3(r.field(j, p, "max"), p + ".max");
         for (int a = 0; a < 3; ++a)
             if (o.min[a] > o.max[a]) r.fail(ErrorCode::kInvalidValue, p, "min must be <= max on every axis");
+    } else if (type == "mesh") {
+        // Flat vertex list [x0, y0, z0, x1, ...] and optional flat triangle list [i0, i1, i2, ...]
+        // (without indices, consecutive vertex triples are the triangles).
+        r.object(j, p, {"type", "name", "positions", "indices"});
+        const std::string pp = p + ".positions";
+        const json& pos = r.array(r.field(j, p, "positions"), pp, 9 * limits.max_triangles, "numbers");
+        if (pos.size() % 3 != 0 || pos.empty())
+            r.fail(ErrorCode::kInvalidValue, pp, "must hold 3 numbers per vertex (got " + std::to_string(pos.size()) + " numbers)");
+        std::vector<Vec3> v(pos.size() / 3);
+        for (size_t i = 0; i < v.size(); ++i)
+            v[i] = {r.number(pos[3 * i], Reader::index(pp, 3 * i)), r.number(pos[3 * i + 1], Reader::index(pp, 3 * i + 1)),
+                    r.number(pos[3 * i + 2], Reader::index(pp, 3 * i + 2))};
+        std::vector<std::uint32_t> idx;
+        if (j.contains("indices")) {
+            const std::string ip = p + ".indices";
+            const json& ind = r.array(j["indices"], ip, 3 * limits.max_triangles, "indices");
+            if (ind.size() % 3 != 0 || ind.empty())
+                r.fail(ErrorCode::kInvalidValue, ip, "must hold 3 vertex indices per triangle (got " + std::to_string(ind.size()) + ")");
+            idx.reserve(ind.size());
+            for (size_t i = 0; i < ind.size(); ++i) {
+                const json& x = ind[i];
+                if (!x.is_number_unsigned() || x.get<std::uint64_t>() >= v.size())
+                    r.fail(ErrorCode::kInvalidValue, Reader::index(ip, i),
+                           "must be an integer vertex index in [0, " + std::to_string(v.size()) + ") (got " + x.dump() + ")");
+                idx.push_back(static_cast<std::uint32_t>(x.get<std::uint64_t>()));
+            }
+        } else {
+            if (v.size() % 3 != 0)
+                r.fail(ErrorCode::kInvalidValue, pp, "without \"indices\", the vertex count must be a multiple of 3 (got " +
+                                                         std::to_string(v.size()) + " vertices)");
+            for (size_t i = 0; i < v.size(); ++i) idx.push_back(static_cast<std::uint32_t>(i));
+        }
+        triangles += idx.size() / 3;
+        if (triangles > limits.max_triangles)
+            r.fail(ErrorCode::kTooLarge, p, "mesh triangles exceed the limit of " + std::to_string(limits.max_triangles) + " in all");
+        for (size_t t = 0; t + 2 < idx.size(); t += 3) out.push_back(triangle_occluder(v[idx[t]], v[idx[t + 1]], v[idx[t + 2]]));
+        if (j.contains("name")) (void)r.string(j["name"], p + ".name");
+        return;
     } else {
-        r.fail(ErrorCode::kUnsupported, p + ".type", "unknown occluder type \"" + type + "\" (known: sphere, box)");
+        r.fail(ErrorCode::kUnsupported, p + ".type", "unknown occluder type \"" + type + "\" (known: sphere, box, mesh)");
     }
     if (j.contains("name")) (void)r.string(j["name"], p + ".name");
-    return o;
+    out.push_back(o);
 }
 
 Scene parse(const Reader& r, const json& doc, const std::string& name, const std::string& base_dir,
@@ -326,25 +367,10 @@ Scene parse(const Reader& r, const json& doc, const std::string& name, const std
     }
     if (doc.contains("occluders")) {
         const json& a = r.array(doc["occluders"], "occluders", limits.max_occluders, "occluders");
-        for (size_t i = 0; i < a.size(); ++i) s.occluders.push_back(read_occluder(r, a[i], Reader::index("occluders", i)));
+        std::uint64_t triangles = 0;
+        for (size_t i = 0; i < a.size(); ++i) read_occluder(r, a[i], Reader::index("occluders", i), limits, s.occluders, triangles);
     }
-    // Ray budget: probes x samples over the lights that trace.
-    if (!s.occluders.empty()) {
-        const std::uint64_t probes = s.probes.kind == ProbePlacementKind::kGrid
-                                         ? std::uint64_t(s.probes.counts[0]) * s.probes.counts[1] * s.probes.counts[2]
-                                         : s.probes.positions.size();
-        std::uint64_t per_probe = 0;
-        for (const SceneLight& l : s.lights) {
-            if (!l.shadows) continue;
-            const bool punctual = l.kind == LightKind::kPoint || l.kind == LightKind::kSpot ||
-                                  (l.kind == LightKind::kDirectional && l.angular_radius_rad == 0);
-            per_probe += punctual ? 1 : static_cast<std::uint64_t>(l.shadow_samples);
-        }
-        if (per_probe > 0 && probes > limits.max_rays / per_probe)
-            r.fail(ErrorCode::kTooLarge, "lights",
-                   "the bake would cast " + std::to_string(probes) + " x " + std::to_string(per_probe) +
-                       " shadow rays, above the limit of " + std::to_string(limits.max_rays));
-    }
+    if (Status budget = check_ray_budget(s, limits, ""); !budget) throw Fail{make_error(budget.error().code, name + ": " + budget.error().message)};
     return s;
 }
 
@@ -353,8 +379,45 @@ json rgb_json(Rgb c) { return json::array({c.r, c.g, c.b}); }
 
 }  // namespace
 
-Result<Scene> parse_scene_json(std::span<const std::uint8_t> bytes, const std::string& name,
-                               const std::string& base_dir, const SceneLoadOptions& options) {
+Status check_ray_budget(const Scene& s, const SceneJsonLimits& limits, const std::string& name) {
+    // Probes x samples over the lights that trace.
+    if (s.occluders.empty()) return Ok{};
+    const std::uint64_t probes = s.probes.kind == ProbePlacementKind::kGrid
+                                     ? std::uint64_t(s.probes.counts[0]) * s.probes.counts[1] * s.probes.counts[2]
+                                     : s.probes.positions.size();
+    std::uint64_t per_probe = 0;
+    for (const SceneLight& l : s.lights) {
+        if (!l.shadows) continue;
+        const bool punctual = l.kind == LightKind::kPoint || l.kind == LightKind::kSpot ||
+                              (l.kind == LightKind::kDirectional && l.angular_radius_rad == 0);
+        per_probe += punctual ? 1 : static_cast<std::uint64_t>(l.shadow_samples);
+    }
+    if (per_probe > 0 && probes > limits.max_rays / per_probe)
+        return make_error(ErrorCode::kTooLarge, (name.empty() ? "" : name + ": ") + "lights: the bake would cast " +
+                                                    std::to_string(probes) + " x " + std::to_string(per_probe) +
+                                                    " shadow rays, above the limit of " + std::to_string(limits.max_rays));
+    return Ok{};
+}
+
+std::string one_line_message(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    for (const char c : text) {
+        const auto u = static_cast<unsigned char>(c);
+        if (u < 0x20 || u == 0x7f) {
+            char b[8];
+            std::snprintf(b, sizeof b, "\\x%02x", u);
+            out += b;
+        } else {
+            out += c;
+        }
+    }
+    return out;
+}
+
+namespace {
+Result<Scene> parse_scene_json_unchecked(std::span<const std::uint8_t> bytes, const std::string& name,
+                                         const std::string& base_dir, const SceneLoadOptions& options) {
     if (bytes.size() > options.limits.max_file_bytes)
         return make_error(ErrorCode::kTooLarge, name + ": scene file larger than the limit of " +
                                                     std::to_string(options.limits.max_file_bytes) + " bytes");
@@ -378,6 +441,15 @@ Result<Scene> parse_scene_json(std::span<const std::uint8_t> bytes, const std::s
     } catch (const std::bad_alloc&) {
         return make_error(ErrorCode::kTooLarge, name + ": out of memory while reading the scene");
     }
+}
+}  // namespace
+
+Result<Scene> parse_scene_json(std::span<const std::uint8_t> bytes, const std::string& name,
+                               const std::string& base_dir, const SceneLoadOptions& options) {
+    // Messages echo field names and values from the input: keep them one line.
+    auto s = parse_scene_json_unchecked(bytes, name, base_dir, options);
+    if (!s) return make_error(s.error().code, one_line_message(s.error().message));
+    return s;
 }
 
 Result<Scene> read_scene_file(const std::string& path, const SceneLoadOptions& options) {
@@ -453,11 +525,20 @@ std::string scene_json(const Scene& s) {
     }
     if (!lights.empty()) doc["lights"] = lights;
     json occ = json::array();
-    for (const Occluder& o : s.occluders) {
-        if (o.kind == OccluderKind::kSphere)
+    for (size_t i = 0; i < s.occluders.size(); ++i) {
+        const Occluder& o = s.occluders[i];
+        if (o.kind == OccluderKind::kSphere) {
             occ.push_back({{"type", "sphere"}, {"center", vec_json(o.center)}, {"radius", o.radius}});
-        else
+        } else if (o.kind == OccluderKind::kBox) {
             occ.push_back({{"type", "box"}, {"min", vec_json(o.min)}, {"max", vec_json(o.max)}});
+        } else {
+            json pos = json::array();
+            for (; i < s.occluders.size() && s.occluders[i].kind == OccluderKind::kTriangle; ++i)
+                for (const Vec3& v : {s.occluders[i].v0, s.occluders[i].v1, s.occluders[i].v2})
+                    for (int a = 0; a < 3; ++a) pos.push_back(v[a]);
+            --i;
+            occ.push_back({{"type", "mesh"}, {"positions", pos}});
+        }
     }
     if (!occ.empty()) doc["occluders"] = occ;
     return doc.dump(2) + "\n";

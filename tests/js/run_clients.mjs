@@ -5,7 +5,9 @@
 //     --sh-axes gltf);
 //  3. Khronos glTF-Validator: 0 errors on every output;
 //  4. three.js GLTFLoader + ZhcLightProbesPlugin: loads each GLB, finds the volume and its node, and
-//     the irradiance it evaluates in several directions equals `zhc gltf eval` (zhc's own numbers).
+//     the irradiance it evaluates in several directions equals `zhc gltf eval` (zhc's own numbers);
+//  5. `zhc bake -o OUT.glb|.gltf` of a glTF scene (lights + mesh) and of a JSON scene: validator
+//     clean, the plugin finds the volume.
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
@@ -138,6 +140,45 @@ for (const c of cases.filter((c) => c.out.endsWith('.glb'))) {
   }
   console.log(`three.js ${c.out}: ${v.encoding} ${v.layout} shAxes=${v.shAxes}, worst relative irradiance difference vs zhc ${worst.toExponential(2)}`);
   check(worst < 1e-5, `${c.out}: three.js irradiance equals zhc's`);
+}
+
+// --- 3. zhc bake -o OUT.glb|.gltf (issue 9): a glTF scene with a KHR_lights_punctual light over the
+// triangle (the mesh occludes), and a JSON scene into a minimal asset; every output validates and
+// the three.js plugin finds the baked volume.
+const litScene = JSON.parse(JSON.stringify(scene));
+litScene.nodes.push({ name: 'lamp', translation: [0.3, 0.2, 2], extensions: { KHR_lights_punctual: { light: 0 } } });
+litScene.scenes[0].nodes.push(1);
+litScene.extensionsUsed = ['KHR_lights_punctual'];
+litScene.extensions = { KHR_lights_punctual: { lights: [{ type: 'point', intensity: 20, color: [1, 0.9, 0.8] }] } };
+litScene.extras = { zhc: { sky: { type: 'constant', radiance: 0.1 } } };
+fs.writeFileSync(path.join(work, 'lit_scene.glb'), glb(litScene, tri));
+fs.writeFileSync(path.join(work, 'bake_scene.json'), JSON.stringify({
+  version: 1, probes: { grid: { min: [-1, -1, 0], max: [1, 1, 1], counts: [3, 3, 2] } }, sky: { type: 'gradient' },
+  lights: [{ type: 'point', position: [0, 0, 2], intensity: 5, shadows: true }],
+  occluders: [{ type: 'mesh', positions: [-0.5, -0.5, 1.5, 0.5, -0.5, 1.5, 0, 0.5, 1.5] }] }));
+const bakes = [
+  { out: 'baked_lit_scene.glb', input: 'lit_scene.glb', args: [] },
+  { out: 'baked_lit_scene_q16.gltf', input: 'lit_scene.glb', args: ['--to', 'zh3_q16'] },
+  { out: 'baked_json_scene.glb', input: 'bake_scene.json', args: [] },
+];
+for (const b of bakes) {
+  execFileSync(zhc, ['bake', path.join(work, b.input), '-o', path.join(work, b.out), '--quiet', ...b.args]);
+  const file = path.join(work, b.out);
+  const report = await validator.validateBytes(new Uint8Array(fs.readFileSync(file)), {
+    uri: b.out,
+    externalResourceFunction: (uri) => Promise.reject(new Error(`unexpected external resource ${uri}`)),
+  });
+  const n = report.issues;
+  console.log(`validator ${b.out}: errors ${n.numErrors}, warnings ${n.numWarnings}, infos ${n.numInfos}`);
+  for (const m of n.messages) if (m.severity <= 1) console.log(`  ${m.code} ${m.pointer ?? ''}: ${m.message}`);
+  check(n.numErrors === 0, `${b.out}: validator errors`);
+  check(n.numWarnings === 0, `${b.out}: validator warnings`);
+  if (b.out.endsWith('.glb')) {
+    const gltf = await loadThree(file);
+    const vols = gltf.userData.zhcLightProbes;
+    check(Array.isArray(vols) && vols.length === 1, `${b.out}: three.js plugin found the baked volume`);
+    if (b.input.endsWith('.glb')) check(gltf.scene.getObjectByName('tri') !== undefined, `${b.out}: the input's mesh is kept`);
+  }
 }
 
 console.log(failures === 0 ? 'all glTF client checks passed' : `${failures} glTF client checks FAILED`);

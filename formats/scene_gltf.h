@@ -1,0 +1,48 @@
+// zhc/formats/scene_gltf.h — a lighting scene from a glTF 2.0 asset (docs/scene.md "glTF input").
+//
+// Read from the asset's default scene (`scene`, else scene 0), walking the node tree with each
+// node's matrix or TRS:
+//  * KHR_lights_punctual lights: directional (intensity in lux), point and spot (candela), colour,
+//    spot innerConeAngle/outerConeAngle; lights shine down their node's local -Z;
+//  * mesh primitives of mode TRIANGLES (POSITION, indices optional) as triangle occluders, with the
+//    node's world transform applied; POINTS/LINES primitives block nothing and are skipped;
+//  * probe placement, sky, environment and extra lights/occluders from the optional root
+//    `extras.zhc` object: a zhc JSON scene (docs/scene.md, zhc axes) whose `version` and `probes`
+//    may be omitted (default probes: an 8 x 8 x 8 grid of cell centres over the bounds of the
+//    meshes and point/spot lights),
+//    plus `"gltf_light_shadows": bool` (default: true when the asset has triangle occluders).
+// Axes: glTF is +Y up, zhc +Z up: (x, y, z)_zhc = (z, x, y)_glTF, the rotation ZHC_light_probes
+// uses (formats/gltf_probes.h), so probes baked from an asset embed back where they were.
+// Units: 1 glTF nit (cd/m^2) = 1 zhc radiance unit: point/spot intensity I_zhc = I_cd * colour,
+// directional E_zhc = E_lux * colour / pi (zhc's irradiance is normalised, integral L dw = pi E).
+//
+// Loading goes through the ZHC_light_probes reader's checks (formats/gltf_probes.h load_gltf_raw:
+// bounded sizes, URIs confined to the asset's directory, no image decoding); every index, count,
+// stride and byte range used here is bound-checked. Errors are one line naming the file and the
+// JSON path: kBadFormat (not glTF), kInvalidValue (a bad field or index), kUnsupported (an unknown
+// light type, sparse/Draco/non-float positions, strip/fan primitives), kTooLarge (a limit).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "codec/scene.h"
+#include "codec/status.h"
+#include "formats/gltf_probes.h"
+#include "formats/scene_json.h"
+
+namespace zhc {
+
+// `path` names the asset in messages and locates external buffers and the environment map.
+Result<Scene> parse_scene_gltf(std::span<const std::uint8_t> bytes, const std::string& path,
+                               const SceneLoadOptions& options = {}, const GltfLimits& gltf_limits = {});
+Result<Scene> read_scene_gltf_file(const std::string& path, const SceneLoadOptions& options = {},
+                                   const GltfLimits& gltf_limits = {});
+
+// True for paths ending in .gltf or .glb (any case).
+bool is_gltf_path(const std::string& path);
+// A scene file by extension: .gltf/.glb -> read_scene_gltf_file, anything else -> read_scene_file.
+Result<Scene> read_any_scene_file(const std::string& path, const SceneLoadOptions& options = {});
+
+}  // namespace zhc

@@ -1,0 +1,449 @@
+// glTF scene input (formats/scene_gltf.h) and `zhc bake -o OUT.glb|.gltf`: glTF files written by
+// the test (JSON + a base64 buffer) against the same scene written as zhc JSON (the twin), spot
+// cones, directional lights, mesh occluders with node transforms, strict errors, and the embedded
+// probes equal to the .zhp output.
+#include <cmath>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "codec/scene.h"
+#include "formats/gltf_probes.h"
+#include "formats/probe_file.h"
+#include "formats/scene_gltf.h"
+#include "formats/scene_json.h"
+#include "support.h"
+
+namespace zhc {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+std::string base64(const std::vector<std::uint8_t>& b) {
+    static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (size_t i = 0; i < b.size(); i += 3) {
+        const std::uint32_t v = std::uint32_t(b[i]) << 16 | (i + 1 < b.size() ? std::uint32_t(b[i + 1]) << 8 : 0) |
+                                (i + 2 < b.size() ? std::uint32_t(b[i + 2]) : 0);
+        out += k[(v >> 18) & 63];
+        out += k[(v >> 12) & 63];
+        out += i + 1 < b.size() ? k[(v >> 6) & 63] : '=';
+        out += i + 2 < b.size() ? k[v & 63] : '=';
+    }
+    return out;
+}
+
+// A glTF asset built by hand: one buffer (data URI), accessors appended as needed.
+struct Asset {
+    json doc = {{"asset", {{"version", "2.0"}, {"generator", "zhc test_scene_gltf"}}},
+                {"scene", 0},
+                {"scenes", json::array({json{{"nodes", json::array()}}})},
+                {"nodes", json::array()}};
+    std::vector<std::uint8_t> bin;
+
+    size_t view(const void* data, size_t bytes) {
+        while (bin.size() % 4) bin.push_back(0);
+        const size_t off = bin.size();
+        bin.insert(bin.end(), static_cast<const std::uint8_t*>(data), static_cast<const std::uint8_t*>(data) + bytes);
+        doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", off}, {"byteLength", bytes}});
+        return doc["bufferViews"].size() - 1;
+    }
+    size_t positions(const std::vector<float>& xyz) {
+        const size_t v = view(xyz.data(), xyz.size() * 4);
+        std::array<float, 3> lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+        for (size_t i = 0; i < xyz.size(); ++i) {
+            lo[i % 3] = std::min(lo[i % 3], xyz[i]);
+            hi[i % 3] = std::max(hi[i % 3], xyz[i]);
+        }
+        doc["accessors"].push_back({{"bufferView", v}, {"componentType", 5126}, {"count", xyz.size() / 3}, {"type", "VEC3"}, {"min", lo}, {"max", hi}});
+        return doc["accessors"].size() - 1;
+    }
+    size_t indices16(const std::vector<std::uint16_t>& idx) {
+        const size_t v = view(idx.data(), idx.size() * 2);
+        doc["accessors"].push_back({{"bufferView", v}, {"componentType", 5123}, {"count", idx.size()}, {"type", "SCALAR"}});
+        return doc["accessors"].size() - 1;
+    }
+    // A mesh of one TRIANGLES primitive; returns the mesh index.
+    size_t mesh(const std::vector<float>& xyz, const std::vector<std::uint16_t>& idx) {
+        json prim = {{"attributes", {{"POSITION", positions(xyz)}}}};
+        if (!idx.empty()) prim["indices"] = indices16(idx);
+        doc["meshes"].push_back({{"primitives", json::array({prim})}});
+        return doc["meshes"].size() - 1;
+    }
+    size_t light(json l) {
+        doc["extensionsUsed"] = json::array({"KHR_lights_punctual"});
+        doc["extensions"]["KHR_lights_punctual"]["lights"].push_back(std::move(l));
+        return doc["extensions"]["KHR_lights_punctual"]["lights"].size() - 1;
+    }
+    // A node (optionally a root of the scene); returns its index.
+    size_t node(json n, bool root = true) {
+        doc["nodes"].push_back(std::move(n));
+        const size_t i = doc["nodes"].size() - 1;
+        if (root) doc["scenes"][0]["nodes"].push_back(i);
+        return i;
+    }
+    static json light_node(size_t light, json extra = json::object()) {
+        extra["extensions"]["KHR_lights_punctual"]["light"] = light;
+        return extra;
+    }
+    std::string text() const {
+        json d = doc;
+        if (!bin.empty()) d["buffers"] = json::array({{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+        return d.dump(1);
+    }
+    std::vector<std::uint8_t> bytes() const {
+        const std::string t = text();
+        return {t.begin(), t.end()};
+    }
+};
+
+Result<Scene> parse(const Asset& a, const std::string& name = "test.gltf") {
+    return parse_scene_gltf(a.bytes(), name);
+}
+Result<Scene> parse_json(const json& j) {
+    const std::string t = j.dump();
+    return parse_scene_json(std::vector<std::uint8_t>(t.begin(), t.end()), "twin.json", "");
+}
+
+std::vector<Sh3Radiance> bake(const Scene& s) {
+    auto r = bake_scene(s);
+    EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
+    return r.ok() ? *r : std::vector<Sh3Radiance>{};
+}
+double max_abs_diff(const Sh3Radiance& a, const Sh3Radiance& b) {
+    double m = 0;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) m = std::max(m, std::abs(double(a[i][k]) - b[i][k]));
+    return m;
+}
+double max_abs(const Sh3Radiance& a) { return max_abs_diff(a, Sh3Radiance{}); }
+
+const json kProbes = {{"positions", {{0, 0, 0}, {1, -2, 0.5}, {-1.5, 0.5, 2.5}}}};  // zhc axes
+
+TEST(SceneGltf, PointLightEqualsTheSameSceneInJson) {
+    Asset a;
+    const size_t l = a.light({{"type", "point"}, {"name", "bulb"}, {"color", {1.0, 0.5, 0.25}}, {"intensity", 40.0}});
+    a.node(Asset::light_node(l, {{"translation", {1.0, 2.0, 3.0}}}));  // glTF (1, 2, 3) = zhc (3, 1, 2)
+    a.doc["extras"]["zhc"] = {{"probes", kProbes}};
+    auto g = parse(a);
+    ASSERT_TRUE(g.ok()) << g.error().message;
+    ASSERT_EQ(g->lights.size(), 1u);
+    EXPECT_EQ(g->lights[0].name, "bulb");
+    EXPECT_FALSE(g->lights[0].shadows);  // no meshes: nothing to trace
+    auto j = parse_json({{"version", 1}, {"probes", kProbes},
+                         {"lights", {{{"type", "point"}, {"position", {3, 1, 2}}, {"intensity", {40, 20, 10}}}}}});
+    ASSERT_TRUE(j.ok()) << j.error().message;
+    const auto bg = bake(*g), bj = bake(*j);
+    ASSERT_EQ(bg.size(), 3u);
+    for (size_t p = 0; p < 3; ++p) {
+        EXPECT_GT(max_abs(bj[p]), 0.1);
+        EXPECT_EQ(bg[p], bj[p]) << "probe " << p;  // same numbers in, same bytes out
+    }
+}
+
+TEST(SceneGltf, NodeHierarchyMatrixAndTrs) {
+    // Parent: rotation of 90 degrees about glTF +Y then translation (10, 0, 0); child: a matrix
+    // translating by (0, 1, 2). The light sits at parent (R * (0, 1, 2) + (10, 0, 0)):
+    // R_y(90) (x, y, z) = (z, y, -x) -> (2, 1, 0) -> glTF (12, 1, 0) -> zhc (0, 12, 1).
+    Asset a;
+    const size_t l = a.light({{"type", "point"}, {"intensity", 5.0}});
+    const double h = std::sqrt(0.5);
+    const size_t child = a.node(Asset::light_node(l, {{"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 1, 2, 1}}}), false);
+    a.node({{"rotation", {0.0, h, 0.0, h}}, {"translation", {10.0, 0.0, 0.0}}, {"children", {child}}});
+    a.doc["extras"]["zhc"] = {{"probes", kProbes}};
+    auto g = parse(a);
+    ASSERT_TRUE(g.ok()) << g.error().message;
+    ASSERT_EQ(g->lights.size(), 1u);
+    EXPECT_NEAR(g->lights[0].position.x, 0.0, 1e-12);
+    EXPECT_NEAR(g->lights[0].position.y, 12.0, 1e-12);
+    EXPECT_NEAR(g->lights[0].position.z, 1.0, 1e-12);
+}
+
+TEST(SceneGltf, SpotConeMatchesJsonTwin) {
+    // A spot 4 m above the origin pointing down: its node is rotated -90 degrees about glTF +X,
+    // which turns the light's local -Z into glTF -Y (zhc -Z).
+    Asset a;
+    const double h = std::sqrt(0.5);
+    const size_t l = a.light({{"type", "spot"}, {"intensity", 10.0}, {"spot", {{"innerConeAngle", 20 * kPi / 180}, {"outerConeAngle", 30 * kPi / 180}}}});
+    a.node(Asset::light_node(l, {{"translation", {0.0, 4.0, 0.0}}, {"rotation", {-h, 0.0, 0.0, h}}}));
+    auto at = [](double deg) {
+        const double r = deg * kPi / 180;
+        return json::array({2 * std::sin(r), 0.0, 4 - 2 * std::cos(r)});
+    };
+    const json probes = {{"positions", {at(10), at(25), at(35)}}};
+    a.doc["extras"]["zhc"] = {{"probes", probes}};
+    auto g = parse(a);
+    ASSERT_TRUE(g.ok()) << g.error().message;
+    EXPECT_NEAR(g->lights[0].direction.z, -1.0, 1e-12);
+    auto j = parse_json({{"version", 1}, {"probes", probes},
+                         {"lights", {{{"type", "spot"}, {"position", {0, 0, 4}}, {"direction", {0, 0, -1}}, {"intensity", 10},
+                                      {"inner_angle_deg", 20}, {"outer_angle_deg", 30}}}}});
+    ASSERT_TRUE(j.ok()) << j.error().message;
+    const auto bg = bake(*g), bj = bake(*j);
+    for (size_t p = 0; p < 3; ++p) EXPECT_LT(max_abs_diff(bg[p], bj[p]), 1e-6 * (max_abs(bj[p]) + 1)) << p;
+    EXPECT_GT(max_abs(bg[0]), 0.1);    // inside the inner cone
+    EXPECT_GT(max_abs(bg[1]), 0.01);   // in the falloff
+    EXPECT_LT(max_abs(bg[1]), max_abs(bg[0]));
+    EXPECT_EQ(max_abs(bg[2]), 0.0);    // outside the outer cone
+}
+
+TEST(SceneGltf, DirectionalLightIsLuxOverPi) {
+    // Sun straight overhead: the node turns local -Z into glTF -Y; towards the light is zhc +Z.
+    Asset a;
+    const double h = std::sqrt(0.5);
+    const size_t l = a.light({{"type", "directional"}, {"intensity", 3.0}, {"color", {1.0, 0.9, 0.8}}});
+    a.node(Asset::light_node(l, {{"rotation", {-h, 0.0, 0.0, h}}}));
+    a.doc["extras"]["zhc"] = {{"probes", kProbes}};
+    auto g = parse(a);
+    ASSERT_TRUE(g.ok()) << g.error().message;
+    EXPECT_NEAR(g->lights[0].direction.z, 1.0, 1e-12);
+    auto j = parse_json({{"version", 1}, {"probes", kProbes},
+                         {"lights", {{{"type", "directional"}, {"direction", {0, 0, 1}}, {"irradiance", {3 / kPi, 2.7 / kPi, 2.4 / kPi}}}}}});
+    ASSERT_TRUE(j.ok());
+    const auto bg = bake(*g), bj = bake(*j);
+    for (size_t p = 0; p < 3; ++p) EXPECT_LT(max_abs_diff(bg[p], bj[p]), 1e-6) << p;
+    // Physically: a surface facing the sun receives E_v = 3 lux = integral L cos; zhc's normalised
+    // SH3 irradiance of a delta keeps 4.25 / (4 pi) of it (bands 1 + 2 + 5/4), times 1 / pi.
+    EXPECT_NEAR(irradiance(bg[0], {0, 0, 1}).r, 3.0 * 4.25 / (4 * kPi), 1e-5);
+}
+
+// A quad (two triangles) in local [-0.5, 0.5]^2 at y = 0, scaled by 2 and moved to glTF y = 2 by
+// its node: zhc z = 2, x and y in [-1, 1].
+size_t add_quad(Asset& a) {
+    const size_t m = a.mesh({-0.5f, 0, -0.5f, 0.5f, 0, -0.5f, 0.5f, 0, 0.5f, -0.5f, 0, 0.5f}, {0, 1, 2, 0, 2, 3});
+    return a.node({{"mesh", m}, {"translation", {0.0, 2.0, 0.0}}, {"scale", {2.0, 1.0, 2.0}}});
+}
+
+TEST(SceneGltf, MeshOccluderBlocksTheLight) {
+    Asset a;
+    add_quad(a);
+    const size_t l = a.light({{"type", "point"}, {"intensity", 8.0}});
+    a.node(Asset::light_node(l, {{"translation", {0.0, 4.0, 0.0}}}));  // zhc (0, 0, 4)
+    a.doc["extras"]["zhc"] = {{"probes", {{"positions", {{0, 0, 0}, {3, 0, 0}}}}}};
+    auto g = parse(a);
+    ASSERT_TRUE(g.ok()) << g.error().message;
+    ASSERT_EQ(g->occluders.size(), 2u);
+    EXPECT_TRUE(g->lights[0].shadows);  // the asset has meshes: glTF lights cast shadows
+    for (const Occluder& o : g->occluders) {
+        EXPECT_EQ(o.kind, OccluderKind::kTriangle);
+        for (const Vec3& v : {o.v0, o.v1, o.v2}) {
+            EXPECT_EQ(v.z, 2.0);
+            EXPECT_EQ(std::abs(v.x), 1.0);
+            EXPECT_EQ(std::abs(v.y), 1.0);
+        }
+    }
+    const auto b = bake(*g);
+    EXPECT_EQ(max_abs(b[0]), 0.0);  // behind the quad: the light's contribution is gone
+    // Probe 1 sees the light: equal to the unshadowed twin.
+    auto j = parse_json({{"version", 1}, {"probes", {{"positions", {{0, 0, 0}, {3, 0, 0}}}}},
+                         {"lights", {{{"type", "point"}, {"position", {0, 0, 4}}, {"intensity", 8}}}}});
+    ASSERT_TRUE(j.ok());
+    const auto bj = bake(*j);
+    EXPECT_GT(max_abs(bj[0]), 0.1);
+    EXPECT_EQ(b[1], bj[1]);
+    // extras.zhc.gltf_light_shadows = false switches the shadows off.
+    a.doc["extras"]["zhc"]["gltf_light_shadows"] = false;
+    auto off = parse(a);
+    ASSERT_TRUE(off.ok()) << off.error().message;
+    EXPECT_EQ(bake(*off)[0], bj[0]);
+}
+
+TEST(SceneGltf, ExtrasAddSkyAndDefaultProbesCoverTheMeshes) {
+    Asset a;
+    add_quad(a);
+    auto g = parse(a);
+    ASSERT_TRUE(g.ok()) << g.error().message;
+    // Bounds x, y in [-1, 1], z = 2 (flat): 8 x 8 x 1 cell centres.
+    EXPECT_EQ(g->probes.kind, ProbePlacementKind::kGrid);
+    EXPECT_EQ(g->probes.counts, (std::array<std::uint32_t, 3>{8, 8, 1}));
+    EXPECT_NEAR(g->probes.min.x, -1 + 1.0 / 8, 1e-12);
+    EXPECT_NEAR(g->probes.max.y, 1 - 1.0 / 8, 1e-12);
+    EXPECT_EQ(g->probes.min.z, 2.0);
+    EXPECT_FALSE(g->sky.has_value());
+    a.doc["extras"]["zhc"] = {{"sky", {{"type", "constant"}, {"radiance", 0.5}}},
+                              {"lights", {{{"type", "sphere"}, {"center", {0, 0, 5}}, {"radius", 0.5}, {"radiance", 3}}}}};
+    auto s = parse(a);
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    EXPECT_TRUE(s->sky.has_value());
+    EXPECT_EQ(s->lights.size(), 1u);
+}
+
+TEST(SceneGltf, StrictErrorsNameTheFileAndField) {
+    struct Case {
+        const char* what;
+        std::function<void(Asset&)> edit;
+        ErrorCode code;
+        const char* message;
+    };
+    const Case cases[] = {
+        {"light index", [](Asset& a) { a.node(Asset::light_node(7)); }, ErrorCode::kInvalidValue,
+         "nodes[0].extensions.KHR_lights_punctual.light: must be an index into KHR_lights_punctual.lights"},
+        {"light type", [](Asset& a) { a.node(Asset::light_node(a.light({{"type", "area"}}))); }, ErrorCode::kUnsupported,
+         "extensions.KHR_lights_punctual.lights[0].type: unknown light type \"area\""},
+        {"spot cone", [](Asset& a) { a.node(Asset::light_node(a.light({{"type", "spot"}, {"spot", {{"innerConeAngle", 0.5}, {"outerConeAngle", 0.5}}}}))); },
+         ErrorCode::kInvalidValue, "lights[0].spot: need 0 <= innerConeAngle < outerConeAngle <= pi/2"},
+        {"negative intensity", [](Asset& a) { a.node(Asset::light_node(a.light({{"type", "point"}, {"intensity", -1}}))); },
+         ErrorCode::kInvalidValue, "lights[0].intensity: must be >= 0"},
+        {"cycle", [](Asset& a) { a.node({{"children", {0}}}); }, ErrorCode::kInvalidValue, "nodes[0]: reached twice"},
+        {"matrix and trs", [](Asset& a) { a.node({{"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}, {"scale", {1, 1, 1}}}); },
+         ErrorCode::kInvalidValue, "nodes[0]: has both matrix and translation/rotation/scale"},
+        {"index out of range", [](Asset& a) { a.node({{"mesh", a.mesh({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 3})}}); }, ErrorCode::kInvalidValue,
+         "accessors[1]: index 2 = 3 is not below the vertex count 3"},
+        {"accessor overrun", [](Asset& a) {
+             a.node({{"mesh", a.mesh({0, 0, 0, 1, 0, 0, 0, 1, 0}, {})}});
+             a.doc["accessors"][0]["count"] = 6;
+         }, ErrorCode::kInvalidValue, "accessors[0]: 6 elements run past the end of bufferViews[0]"},
+        {"not triangles", [](Asset& a) {
+             a.node({{"mesh", a.mesh({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, {})}});
+         }, ErrorCode::kInvalidValue, "TRIANGLES need a multiple of 3 vertices (got 4)"},
+        {"strip", [](Asset& a) {
+             a.node({{"mesh", a.mesh({0, 0, 0, 1, 0, 0, 0, 1, 0}, {})}});
+             a.doc["meshes"][0]["primitives"][0]["mode"] = 5;
+         }, ErrorCode::kUnsupported, "meshes[0].primitives[0].mode: TRIANGLE_STRIP/TRIANGLE_FAN"},
+        {"short positions", [](Asset& a) {
+             a.node({{"mesh", a.mesh({0, 0, 0, 1, 0, 0, 0, 1, 0}, {})}});
+             a.doc["accessors"][0]["componentType"] = 5123;
+         }, ErrorCode::kUnsupported, "accessors[0]: POSITION must be a VEC3 FLOAT accessor"},
+        {"extras probes", [](Asset& a) { a.doc["extras"]["zhc"] = {{"probes", {{"grid", {{"min", {0, 0, 0}}}}}}}; },
+         ErrorCode::kInvalidValue, "test.gltf: extras.zhc: probes.grid.max: missing required field"},
+        {"extras unknown", [](Asset& a) { a.doc["extras"]["zhc"] = {{"lihgts", json::array()}}; }, ErrorCode::kInvalidValue,
+         "extras.zhc: lihgts: unknown field"},
+        {"newline echoed", [](Asset& a) { a.node(Asset::light_node(a.light({{"type", "are\na"}}))); }, ErrorCode::kUnsupported,
+         "unknown light type \"are\\x0aa\""},  // fuzzer: a JSON "\n" made the message two lines
+        {"newline in extras", [](Asset& a) { a.doc["extras"]["zhc"] = {{"sky", {{"type", "const\nt"}}}}; }, ErrorCode::kUnsupported,
+         "sky.type: unknown sky type \"const\\x0at\""},
+        {"no scenes", [](Asset& a) { a.doc.erase("scenes"); a.doc.erase("scene"); }, ErrorCode::kInvalidValue, "scenes: the asset has no scene"},
+    };
+    for (const Case& c : cases) {
+        Asset a;
+        c.edit(a);
+        auto s = parse(a);
+        ASSERT_FALSE(s.ok()) << c.what;
+        EXPECT_EQ(s.error().code, c.code) << c.what << ": " << s.error().message;
+        EXPECT_NE(s.error().message.find(c.message), std::string::npos) << c.what << ": " << s.error().message;
+        EXPECT_EQ(s.error().message.rfind("test.gltf: ", 0), 0u) << s.error().message;
+        EXPECT_EQ(s.error().message.find('\n'), std::string::npos) << s.error().message;
+    }
+    // Not glTF at all, and a triangle limit.
+    const std::string junk = "{\"asset\": 3}";
+    EXPECT_EQ(parse_scene_gltf(std::vector<std::uint8_t>(junk.begin(), junk.end()), "junk.gltf").error().code, ErrorCode::kBadFormat);
+    Asset big;
+    add_quad(big);
+    add_quad(big);
+    SceneLoadOptions small;
+    small.limits.max_triangles = 3;
+    auto s = parse_scene_gltf(big.bytes(), "big.gltf", small);
+    ASSERT_FALSE(s.ok());
+    EXPECT_EQ(s.error().code, ErrorCode::kTooLarge);
+    EXPECT_NE(s.error().message.find("exceed the limit of 3"), std::string::npos) << s.error().message;
+}
+
+// ---- the CLI: glTF in, glTF out ----------------------------------------------------------------
+
+std::vector<Sh3Radiance> decode_zhp(const std::string& path) {
+    auto set = read_probe_file(path);
+    EXPECT_TRUE(set.ok()) << (set.ok() ? "" : set.error().message);
+    if (!set.ok()) return {};
+    auto hub = decode_probe_set(*set);
+    return hub.ok() ? *hub : std::vector<Sh3Radiance>{};
+}
+
+TEST(SceneGltfCli, BakeGltfAndEmbedEqualsZhp) {
+    const std::string dir = test::temp_dir("scene_gltf_cli");
+    Asset a;
+    add_quad(a);
+    const size_t l = a.light({{"type", "point"}, {"intensity", 8.0}, {"color", {1.0, 0.8, 0.6}}});
+    a.node(Asset::light_node(l, {{"translation", {0.5, 4.0, 0.3}}}));
+    const size_t sun = a.light({{"type", "directional"}, {"intensity", 2.0}});
+    a.node(Asset::light_node(sun, {{"rotation", {-0.5, 0.1, 0.0, 0.86}}}));
+    a.doc["extras"]["zhc"] = {{"sky", {{"type", "gradient"}}}};
+    test::write_bytes(dir + "/room.gltf", a.bytes());
+    const auto zhp = test::run_zhc({"bake", dir + "/room.gltf", "-o", dir + "/room.zhp"});
+    ASSERT_EQ(zhp.exit_code, 0) << zhp.err;
+    EXPECT_NE(zhp.out.find("point 'gltf light 0'"), std::string::npos) << zhp.out;
+    EXPECT_NE(zhp.out.find("shadowed: "), std::string::npos) << zhp.out;
+    const auto ref = decode_zhp(dir + "/room.zhp");
+    ASSERT_EQ(ref.size(), 512u);  // default 8 x 8 x 8 grid over the quad and the point light
+    for (const char* out : {"room_lit.glb", "room_lit.gltf"}) {
+        const auto r = test::run_zhc({"bake", dir + "/room.gltf", "-o", dir + "/" + out, "--threads", "2"});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_NE(r.out.find("a copy of the input asset"), std::string::npos) << r.out;
+        auto summary = read_gltf_probes_file(dir + "/" + out);
+        ASSERT_TRUE(summary.ok()) << summary.error().message;
+        EXPECT_EQ(summary->meshes, 1u);  // the input asset is kept
+        EXPECT_NE(std::find(summary->extensions_used.begin(), summary->extensions_used.end(), "KHR_lights_punctual"),
+                  summary->extensions_used.end());
+        ASSERT_EQ(summary->volumes.size(), 1u);
+        auto hub = decode_probe_set(summary->volumes[0].set);
+        ASSERT_TRUE(hub.ok());
+        EXPECT_EQ(*hub, ref) << out;
+        EXPECT_EQ(summary->volumes[0].set.layout.kind, ProbeLayoutKind::kGrid);
+        // And the output is still a scene zhc bakes the same (the lights and mesh are intact).
+        const auto again = test::run_zhc({"bake", dir + "/" + out, "-o", dir + "/again.zhp", "--quiet"});
+        ASSERT_EQ(again.exit_code, 0) << again.err;
+        EXPECT_EQ(decode_zhp(dir + "/again.zhp"), ref);
+    }
+    // A .gltf whose buffer is an external file next to it: read through the guarded loader, and
+    // the output is self-contained (the buffer becomes part of the GLB).
+    {
+        json d = json::parse(a.text());
+        d["buffers"][0]["uri"] = "room.bin";
+        const std::string t = d.dump();
+        test::write_bytes(dir + "/room_ext.gltf", std::vector<std::uint8_t>(t.begin(), t.end()));
+        test::write_bytes(dir + "/room.bin", a.bin);
+        const auto r = test::run_zhc({"bake", dir + "/room_ext.gltf", "-o", dir + "/room_ext.glb"});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_NE(r.out.find("occluders: 2 (2 mesh triangles)"), std::string::npos) << r.out;
+        auto g = read_gltf_probes_file(dir + "/room_ext.glb");
+        ASSERT_TRUE(g.ok()) << g.error().message;
+        EXPECT_EQ(*decode_probe_set(g->volumes[0].set), ref);
+        // A buffer URI leaving the directory is refused (exit 4), nothing written.
+        d["buffers"][0]["uri"] = "../room.bin";
+        const std::string bad = d.dump();
+        test::write_bytes(dir + "/room_escape.gltf", std::vector<std::uint8_t>(bad.begin(), bad.end()));
+        const auto e = test::run_zhc({"bake", dir + "/room_escape.gltf", "-o", dir + "/room_escape.glb"});
+        EXPECT_EQ(e.exit_code, 4) << e.err;
+        EXPECT_NE(e.err.find("'..' escapes the input's directory"), std::string::npos) << e.err;
+        EXPECT_FALSE(fs::exists(dir + "/room_escape.glb"));
+    }
+    // A quantised representation: the embedded bytes are the .zhp payload.
+    ASSERT_EQ(test::run_zhc({"bake", dir + "/room.gltf", "-o", dir + "/q.zhp", "--to", "zh3_q16", "--quiet"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"bake", dir + "/room.gltf", "-o", dir + "/q.glb", "--to", "zh3_q16", "--quiet"}).exit_code, 0);
+    auto qset = read_probe_file(dir + "/q.zhp");
+    auto qg = read_gltf_probes_file(dir + "/q.glb");
+    ASSERT_TRUE(qset.ok() && qg.ok());
+    EXPECT_EQ(qg->volumes[0].set.payload, qset->payload);
+    EXPECT_EQ(qg->volumes[0].set.representation, "zh3_q16");
+}
+
+TEST(SceneGltfCli, JsonSceneToMinimalGlb) {
+    const std::string dir = test::temp_dir("scene_gltf_min");
+    Scene s = default_scene();
+    s.probes.counts = {4, 3, 2};
+    const std::string text = scene_json(s);
+    test::write_bytes(dir + "/scene.json", std::vector<std::uint8_t>(text.begin(), text.end()));
+    ASSERT_EQ(test::run_zhc({"bake", dir + "/scene.json", "-o", dir + "/p.zhp", "--quiet"}).exit_code, 0);
+    const auto r = test::run_zhc({"bake", dir + "/scene.json", "-o", dir + "/p.glb"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("a minimal glTF"), std::string::npos);
+    auto g = read_gltf_probes_file(dir + "/p.glb");
+    ASSERT_TRUE(g.ok()) << g.error().message;
+    ASSERT_EQ(g->volumes.size(), 1u);
+    auto hub = decode_probe_set(g->volumes[0].set);
+    ASSERT_TRUE(hub.ok());
+    EXPECT_EQ(*hub, decode_zhp(dir + "/p.zhp"));
+    EXPECT_EQ(hub->size(), 24u);
+    // Errors: a broken glTF input is one line with the input-error exit codes; nothing written.
+    test::write_bytes(dir + "/bad.gltf", {'{', '}'});
+    const auto bad = test::run_zhc({"bake", dir + "/bad.gltf", "-o", dir + "/bad.glb"});
+    EXPECT_EQ(bad.exit_code, 4) << bad.err;
+    EXPECT_NE(bad.err.find("bad.gltf"), std::string::npos);
+    EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+    EXPECT_FALSE(fs::exists(dir + "/bad.glb"));
+    EXPECT_EQ(test::run_zhc({"bake", dir + "/absent.glb", "-o", dir + "/x.glb"}).exit_code, 3);
+    EXPECT_EQ(test::run_zhc({"bake", dir + "/scene.json", "-o", dir + "/x.obj"}).exit_code, 2);
+}
+
+}  // namespace
+}  // namespace zhc

@@ -1,0 +1,306 @@
+// Triangle-mesh occluders (codec/occluders.h) and mesh scenes (formats/scene_json.h "mesh"):
+// Moller-Trumbore against a slow twin (plane intersection + edge functions), the BVH against a
+// brute-force loop over every triangle, seams without leaks, and a quad of two triangles removing
+// exactly the light it hides.
+#include <cmath>
+#include <random>
+
+#include <nlohmann/json.hpp>
+
+#include "codec/occluders.h"
+#include "codec/scene.h"
+#include "formats/scene_json.h"
+#include "support.h"
+
+namespace zhc {
+namespace {
+
+// UV sphere of n_lat x n_lon quads (two triangles each; the pole rows degenerate to one).
+std::vector<Occluder> uv_sphere(Vec3 c, double r, int n_lat, int n_lon) {
+    std::vector<Occluder> out;
+    auto at = [&](int i, int j) {
+        const double th = kPi * i / n_lat, ph = 2 * kPi * j / n_lon;
+        return c + r * Vec3{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
+    };
+    for (int i = 0; i < n_lat; ++i)
+        for (int j = 0; j < n_lon; ++j) {
+            const Vec3 a = at(i, j), b = at(i + 1, j), cc = at(i + 1, j + 1), d = at(i, j + 1);
+            if (i != n_lat - 1) out.push_back(triangle_occluder(a, b, cc));
+            if (i != 0) out.push_back(triangle_occluder(a, cc, d));
+        }
+    return out;
+}
+
+// Slow twin of the ray/triangle test: intersect the supporting plane, then the three edge
+// functions (n . ((b - a) x (q - a))) must share the sign of n . n. Returns the signed distance
+// of q to the nearest edge relative to the triangle's size through *margin (for skipping
+// rays that graze an edge, where rounding legitimately decides).
+bool slow_hit(const Occluder& t, Vec3 o, Vec3 d, double t_min, double t_max, double* margin) {
+    const Vec3 n = cross(t.v1 - t.v0, t.v2 - t.v0);
+    const double nn = dot(n, n), dn = dot(d, n);
+    *margin = 1.0;
+    if (nn == 0 || dn == 0) return false;
+    const double dist = dot(n, t.v0 - o) / dn;
+    const Vec3 q = o + dist * d;
+    const Vec3 v[3] = {t.v0, t.v1, t.v2};
+    bool inside = true;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 a = v[k], b = v[(k + 1) % 3];
+        const double e = dot(n, cross(b - a, q - a)) / nn;  // barycentric weight of the opposite vertex
+        *margin = std::min(*margin, std::abs(e));
+        inside = inside && e >= 0;
+    }
+    const double scale = std::max({1.0, std::abs(t_min), std::abs(dist)});
+    *margin = std::min(*margin, std::abs(dist - t_min) / scale);
+    if (std::isfinite(t_max)) *margin = std::min(*margin, std::abs(dist - t_max) / scale);
+    return inside && dist > t_min && dist < t_max;
+}
+
+TEST(TriangleOccluder, MatchesSlowTwinOnRandomRays) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-2, 2), u01(0, 1);
+    int hits = 0, compared = 0;
+    for (int i = 0; i < 200000; ++i) {
+        const Occluder t = triangle_occluder({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+        const Vec3 o{3 * u(rng), 3 * u(rng), 3 * u(rng)};
+        // Aim at a random point of the triangle's neighbourhood so about half the rays hit.
+        const double a = 1.4 * u01(rng) - 0.2, b = (1.2 - a) * u01(rng) - 0.1;
+        const Vec3 target = t.v0 + a * (t.v1 - t.v0) + b * (t.v2 - t.v0);
+        const Vec3 d = normalize_or(target - o, {0, 0, 1});
+        const double t_max = i % 4 ? 1e30 : 4 * u01(rng);
+        double margin = 0;
+        const bool slow = slow_hit(t, o, d, 1e-9, t_max, &margin);
+        if (margin < 1e-9) continue;  // grazing an edge or an end of the interval
+        ++compared;
+        ASSERT_EQ(ray_hits(t, o, d, 1e-9, t_max), slow) << "ray " << i;
+        hits += slow;
+    }
+    EXPECT_GT(compared, 190000);
+    EXPECT_GT(hits, compared / 5);
+    EXPECT_LT(hits, compared * 4 / 5);
+}
+
+TEST(TriangleOccluder, PolicyCases) {
+    const Occluder t = triangle_occluder({-1, -1, 2}, {1, -1, 2}, {0, 1, 2});
+    const Occluder flipped = triangle_occluder({-1, -1, 2}, {0, 1, 2}, {1, -1, 2});
+    EXPECT_TRUE(ray_hits(t, {0, 0, 0}, {0, 0, 1}, 1e-9, 1e30));        // front
+    EXPECT_TRUE(ray_hits(flipped, {0, 0, 0}, {0, 0, 1}, 1e-9, 1e30));  // either winding
+    EXPECT_TRUE(ray_hits(t, {0, 0, 4}, {0, 0, -1}, 1e-9, 1e30));       // back face blocks too
+    EXPECT_FALSE(ray_hits(t, {0, 0, 0}, {0, 0, -1}, 1e-9, 1e30));      // behind the origin
+    EXPECT_FALSE(ray_hits(t, {0, 0, 0}, {0, 0, 1}, 1e-9, 2.0));        // open interval: t == t_max misses
+    EXPECT_TRUE(ray_hits(t, {0, 0, 0}, {0, 0, 1}, 1e-9, 2.0 + 1e-12));
+    EXPECT_FALSE(ray_hits(t, {-3, 0, 2}, {1, 0, 0}, 1e-9, 1e30));      // in the plane: edge-on, misses
+    EXPECT_TRUE(ray_hits(t, {-1, -1, 0}, {0, 0, 1}, 1e-9, 1e30));      // exactly through a vertex
+    EXPECT_TRUE(ray_hits(t, {0, -1, 0}, {0, 0, 1}, 1e-9, 1e30));       // exactly through an edge
+    const Occluder degenerate = triangle_occluder({0, 0, 2}, {1, 0, 2}, {2, 0, 2});
+    EXPECT_FALSE(ray_hits(degenerate, {0.5, 0, 0}, {0, 0, 1}, 1e-9, 1e30));
+}
+
+TEST(TriangleOccluder, BvhAgreesWithBruteForceOnMeshes) {
+    // A 20k-triangle sphere, a random triangle soup and a few spheres/boxes in one tree.
+    std::vector<Occluder> occ = uv_sphere({0.5, -0.3, 0.2}, 1.5, 100, 100);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-4, 4), u01(0, 1);
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 a{u(rng), u(rng), u(rng)};
+        occ.push_back(triangle_occluder(a, a + Vec3{0.3 * u01(rng), 0.3 * u01(rng), 0}, a + Vec3{0, 0.2 * u01(rng), 0.3 * u01(rng)}));
+    }
+    Occluder s;
+    s.kind = OccluderKind::kSphere;
+    s.center = {3, 3, 3};
+    s.radius = 0.4;
+    occ.push_back(s);
+    Occluder b;
+    b.kind = OccluderKind::kBox;
+    b.min = {-3.5, 2, -1};
+    b.max = {-3, 2.5, 1};
+    occ.push_back(b);
+    ASSERT_GT(occ.size(), 22000u);
+    const OccluderBvh bvh(occ);
+    EXPECT_LT(bvh.node_count(), occ.size());
+    int hits = 0;
+    for (int i = 0; i < 6000; ++i) {
+        const Vec3 o{0.75 * u(rng), 0.75 * u(rng), 0.75 * u(rng)};
+        const Vec3 d = test::uniform_direction(u01(rng), u01(rng));
+        const double t_max = i % 3 ? 1e30 : 5 * u01(rng);
+        bool brute = false;
+        for (const Occluder& x : occ) brute = brute || ray_hits(x, o, d, 1e-9, t_max);
+        ASSERT_EQ(bvh.occluded(o, d, 1e-9, t_max), brute) << "ray " << i;
+        hits += brute;
+    }
+    EXPECT_GT(hits, 1000);  // both outcomes well represented
+    EXPECT_LT(hits, 5000);
+    // Same tree from the same input: same structure (deterministic build).
+    EXPECT_EQ(OccluderBvh(occ).node_count(), bvh.node_count());
+}
+
+TEST(TriangleOccluder, ClosedMeshHasNoLeaksAlongSeams) {
+    // Rays from the centre of a tessellated sphere aimed exactly at its vertices and edge
+    // midpoints (the seams where two triangles meet) are all blocked.
+    const int n_lat = 24, n_lon = 48;
+    const Vec3 c{0.1, 0.2, 0.3};
+    const std::vector<Occluder> mesh = uv_sphere(c, 2.0, n_lat, n_lon);
+    const OccluderBvh bvh(mesh);
+    int rays = 0;
+    for (const Occluder& t : mesh)
+        for (const Vec3& target : {t.v0, t.v1, t.v2, 0.5 * (t.v0 + t.v1), 0.5 * (t.v1 + t.v2), 0.5 * (t.v2 + t.v0)}) {
+            const Vec3 d = normalize_or(target - c, {0, 0, 1});
+            ASSERT_TRUE(bvh.occluded(c, d, 1e-9, 1e30)) << "leak towards (" << target.x << ", " << target.y << ", " << target.z << ")";
+            ++rays;
+        }
+    EXPECT_GT(rays, 6000);
+    // A plane tiled with 2 x 10 x 10 triangles, hit exactly at every grid vertex and edge midpoint.
+    std::vector<Occluder> plane;
+    for (int i = 0; i < 10; ++i)
+        for (int j = 0; j < 10; ++j) {
+            const Vec3 a{i - 5.0, j - 5.0, 3}, b{i - 4.0, j - 5.0, 3}, cc{i - 4.0, j - 4.0, 3}, d{i - 5.0, j - 4.0, 3};
+            plane.push_back(triangle_occluder(a, b, cc));
+            plane.push_back(triangle_occluder(a, cc, d));
+        }
+    const OccluderBvh pb(plane);
+    for (int i = 0; i <= 20; ++i)
+        for (int j = 0; j <= 20; ++j) {
+            const Vec3 target{-5 + 0.5 * i, -5 + 0.5 * j, 3};
+            const Vec3 o{0.3, -0.2, 0};
+            ASSERT_TRUE(pb.occluded(o, normalize_or(target - o, {0, 0, 1}), 1e-9, 1e30)) << i << " " << j;
+        }
+}
+
+// ---- a quad of two triangles between a light and a probe ---------------------------------------
+
+Scene two_probes() {
+    Scene s;
+    s.probes.kind = ProbePlacementKind::kPositions;
+    s.probes.positions = {{0, 0, 0}, {3, 0, 0}};
+    return s;
+}
+
+double max_abs_diff(const Sh3Radiance& a, const Sh3Radiance& b) {
+    double m = 0;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) m = std::max(m, std::abs(double(a[i][k]) - b[i][k]));
+    return m;
+}
+
+TEST(TriangleOccluder, QuadRemovesExactlyTheLightItHides) {
+    Scene s = two_probes();
+    SceneSky sky;
+    sky.kind = SkyKind::kGradient;
+    s.sky = sky;
+    SceneLight a;  // above probe 0, hidden by the quad
+    a.kind = LightKind::kPoint;
+    a.position = {0, 0, 4};
+    a.color = {6, 5, 4};
+    a.shadows = true;
+    SceneLight b;  // to the side: visible from both probes
+    b.kind = LightKind::kSphere;
+    b.center = {-3, 1, 0.5};
+    b.radius = 0.4;
+    b.color = {3, 9, 3};
+    b.shadows = true;
+    SceneLight c;  // also above the quad but not shadowed
+    c.kind = LightKind::kSphere;
+    c.center = {0, 0, 6};
+    c.radius = 0.5;
+    c.color = {1, 1, 8};
+    s.lights = {a, b, c};
+    // The quad [-1, 1]^2 at z = 2, as two triangles sharing the diagonal the ray to A crosses
+    // (the ray from (0,0,0) to (0,0,4) passes exactly through the shared edge).
+    const Vec3 q0{-1, -1, 2}, q1{1, -1, 2}, q2{1, 1, 2}, q3{-1, 1, 2};
+    s.occluders = {triangle_occluder(q0, q1, q2), triangle_occluder(q0, q2, q3)};
+    BakeReport rep;
+    auto with = bake_scene(s, {}, &rep);
+    Scene without_a = s;
+    without_a.lights = {b, c};
+    without_a.occluders.clear();
+    Scene no_occluders = s;
+    no_occluders.occluders.clear();
+    auto ref_without = bake_scene(without_a), ref_all = bake_scene(no_occluders);
+    ASSERT_TRUE(with.ok() && ref_without.ok() && ref_all.ok());
+    EXPECT_GT(max_abs_diff((*ref_all)[0], (*ref_without)[0]), 0.1);  // A matters at probe 0
+    EXPECT_LT(max_abs_diff((*with)[0], (*ref_without)[0]), 1e-6);    // and is removed there
+    EXPECT_LT(max_abs_diff((*with)[1], (*ref_all)[1]), 1e-6);        // probe 1: unchanged
+    EXPECT_GT(rep.rays, 0u);
+    // The same quad as a box of zero thickness gives the same bake (two twins of one plane).
+    Scene as_box = s;
+    Occluder box;
+    box.kind = OccluderKind::kBox;
+    box.min = {-1, -1, 2};
+    box.max = {1, 1, 2};
+    as_box.occluders = {box};
+    auto boxed = bake_scene(as_box);
+    ASSERT_TRUE(boxed.ok());
+    for (size_t p = 0; p < 2; ++p) EXPECT_LT(max_abs_diff((*with)[p], (*boxed)[p]), 1e-6) << p;
+}
+
+// ---- JSON "mesh" occluders ---------------------------------------------------------------------
+
+Result<Scene> parse_text(const std::string& t) {
+    return parse_scene_json(std::vector<std::uint8_t>(t.begin(), t.end()), "mesh.json", "");
+}
+
+TEST(SceneJsonMesh, ParsesIndexedAndUnindexedMeshes) {
+    auto s = parse_text(R"({"version":1,"probes":{"positions":[[0,0,0]]},
+        "occluders":[{"type":"mesh","name":"quad","positions":[-1,-1,2, 1,-1,2, 1,1,2, -1,1,2],"indices":[0,1,2, 0,2,3]},
+                     {"type":"box","min":[5,5,5],"max":[6,6,6]},
+                     {"type":"mesh","positions":[0,0,9, 1,0,9, 0,1,9]}]})");
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    ASSERT_EQ(s->occluders.size(), 4u);
+    EXPECT_EQ(s->occluders[0].kind, OccluderKind::kTriangle);
+    EXPECT_EQ(s->occluders[1].v2.y, 1.0);  // second triangle: vertices 0, 2, 3
+    EXPECT_EQ(s->occluders[1].v2.x, -1.0);
+    EXPECT_EQ(s->occluders[2].kind, OccluderKind::kBox);
+    EXPECT_EQ(s->occluders[3].v1.x, 1.0);
+    // Round trip: runs of triangles become one unindexed mesh each, same triangles.
+    const std::string text = scene_json(*s);
+    auto back = parse_text(text);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    ASSERT_EQ(back->occluders.size(), 4u);
+    for (size_t i = 0; i < 4; ++i) {
+        EXPECT_EQ(back->occluders[i].kind, s->occluders[i].kind);
+        EXPECT_EQ(back->occluders[i].v2.x, s->occluders[i].v2.x);
+    }
+    EXPECT_EQ(nlohmann::json::parse(text)["occluders"][0]["positions"].size(), 18u);
+}
+
+TEST(SceneJsonMesh, StrictErrors) {
+    struct Case {
+        const char* occluder;
+        ErrorCode code;
+        const char* message;
+    };
+    const Case cases[] = {
+        {R"({"type":"mesh","positions":[0,0,0, 1,0,0, 0,1]})", ErrorCode::kInvalidValue, "occluders[0].positions: must hold 3 numbers per vertex"},
+        {R"({"type":"mesh","positions":[0,0,0, 1,0,0, 0,1,0],"indices":[0,1,3]})", ErrorCode::kInvalidValue,
+         "occluders[0].indices[2]: must be an integer vertex index in [0, 3) (got 3)"},
+        {R"({"type":"mesh","positions":[0,0,0, 1,0,0, 0,1,0],"indices":[0,1,-1]})", ErrorCode::kInvalidValue, "occluders[0].indices[2]"},
+        {R"({"type":"mesh","positions":[0,0,0, 1,0,0, 0,1,0],"indices":[0,1]})", ErrorCode::kInvalidValue,
+         "occluders[0].indices: must hold 3 vertex indices per triangle"},
+        {R"({"type":"mesh","positions":[0,0,0, 1,0,0, 0,1,0, 1,1,1]})", ErrorCode::kInvalidValue, "vertex count must be a multiple of 3"},
+        {R"({"type":"mesh","positions":[0,0,0, 1,0,"x", 0,1,0]})", ErrorCode::kInvalidValue, "occluders[0].positions[5]: must be a number"},
+        {R"({"type":"mesh","positions":[]})", ErrorCode::kInvalidValue, "occluders[0].positions: must hold 3 numbers per vertex"},
+        {R"({"type":"mesh","positions":[0,0,0, 1,0,0, 0,1,0],"normals":[]})", ErrorCode::kInvalidValue, "occluders[0].normals: unknown field"},
+        {R"({"type":"mesh"})", ErrorCode::kInvalidValue, "occluders[0].positions: missing required field"},
+        {R"({"type":"cone"})", ErrorCode::kUnsupported, "(known: sphere, box, mesh)"},
+    };
+    for (const Case& c : cases) {
+        auto s = parse_text(std::string(R"({"version":1,"probes":{"positions":[[0,0,0]]},"occluders":[)") + c.occluder + "]}");
+        ASSERT_FALSE(s.ok()) << c.occluder;
+        EXPECT_EQ(s.error().code, c.code) << c.occluder << ": " << s.error().message;
+        EXPECT_NE(s.error().message.find(c.message), std::string::npos) << s.error().message;
+        EXPECT_EQ(s.error().message.find('\n'), std::string::npos);
+    }
+    // The triangle limit counts over all meshes.
+    SceneLoadOptions small;
+    small.limits.max_triangles = 3;
+    const std::string two = R"({"version":1,"probes":{"positions":[[0,0,0]]},"occluders":[
+        {"type":"mesh","positions":[0,0,0, 1,0,0, 0,1,0, 0,0,1, 1,0,1, 0,1,1]},
+        {"type":"mesh","positions":[0,0,0, 1,0,0, 0,1,0, 0,0,1, 1,0,1, 0,1,1]}]})";
+    auto s = parse_scene_json(std::vector<std::uint8_t>(two.begin(), two.end()), "mesh.json", "", small);
+    ASSERT_FALSE(s.ok());
+    EXPECT_EQ(s.error().code, ErrorCode::kTooLarge);
+    EXPECT_NE(s.error().message.find("occluders[1]: mesh triangles exceed the limit of 3"), std::string::npos) << s.error().message;
+}
+
+}  // namespace
+}  // namespace zhc
