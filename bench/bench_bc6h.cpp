@@ -5,7 +5,9 @@
 // thread's CPU time (CLOCK_THREAD_CPUTIME_ID; every encode runs on that one thread): Mpixel/s per
 // thread, not depressed by other processes taking the CPU away (the 2 shared cores are often
 // loaded); cache and SMT contention still show.
-//   bench_bc6h [--maps DIR] [--lightmap-size N] [--exhaustive-rows N]
+//   bench_bc6h [--maps DIR] [--lightmap-size N] [--exhaustive-rows N] [--only QUALITY]
+// --only runs the listed qualities (e.g. "mode11,fast"; the others print 0): for profiling
+// and quick tuning runs (the ratios and dB differences then need a full run).
 #include <algorithm>
 #include <cstring>
 #define STB_DXT_IMPLEMENTATION
@@ -94,10 +96,12 @@ Row run_ours45(const std::vector<float>& v, int channels, int w, int h, bc45::Qu
 int main(int argc, char** argv) {
     std::string dir = ZHC_ENVMAP_DIR;
     int lm_size = 256, ex_rows = 0;
+    std::string only;
     for (int i = 1; i + 1 < argc; i += 2) {
         if (!std::strcmp(argv[i], "--maps")) dir = argv[i + 1];
         if (!std::strcmp(argv[i], "--lightmap-size")) lm_size = std::atoi(argv[i + 1]);
         if (!std::strcmp(argv[i], "--exhaustive-rows")) ex_rows = std::atoi(argv[i + 1]);
+        if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
     }
     std::vector<std::string> paths;
     for (const auto& e : std::filesystem::directory_iterator(dir))
@@ -141,9 +145,10 @@ int main(int argc, char** argv) {
                     // compare all qualities on that crop then.
                     h = std::min(h, ex_rows);
                     rgb.resize(static_cast<size_t>(w) * h * 3);
-                    for (int j = 0; j < 3; ++j) r[j] = run_bc6h(rgb, w, h, qs[j]);
+                    for (int j = 0; j < 3; ++j)
+                        if (only.empty() || only.find(qn[j]) != std::string::npos) r[j] = run_bc6h(rgb, w, h, qs[j]);
                 }
-                r[k] = run_bc6h(rgb, w, h, qs[k]);
+                if (only.empty() || only.find(qn[k]) != std::string::npos) r[k] = run_bc6h(rgb, w, h, qs[k]);
             }
             std::printf("%-22s |", name.c_str());
             for (int k = 0; k < 4; ++k) {

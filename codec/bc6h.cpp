@@ -445,11 +445,17 @@ int best_delta_mode(const SubsetFit& f) {
     return -1;
 }
 
+// Index selection for try_mode: projected (kProject) or searched (kSearch), see evaluate.
+// (Projected indices during default's refinement rounds and one search on the best endpoints at
+// the end was tried: +0.02 dB but 4 % more instructions; the search exits early, projection not.)
+enum class Indices { kProject, kSearch };
+
 // Fit one (mode, partition) with `iters` refinement rounds; updates `best`.
 void try_mode(const Target& t, int mode_i, int partition, const SubsetFit init[2], int iters, Encoded& best,
-              bool search = true) {
+              Indices ind = Indices::kSearch) {
     SubsetFit fit[2] = {init[0], init[1]};
     Encoded local;
+    const bool search = ind == Indices::kSearch;
     evaluate(t, mode_i, partition, fit, local, search);
     for (int it = 0; it < iters; ++it) {
         refine(t, local, fit);
@@ -501,24 +507,42 @@ struct PartitionMoments {
     float s1[9][32];
 };
 
-void partition_scores(const Target& t, const float ax0[3], float score[32], PartitionMoments& pm) {
-    const PartitionTables& tb = partition_tables();
+// The block part of PartitionMoments (mean, x, total) and the per-texel moments mom[i][k].
+void block_moments(const Target& t, PartitionMoments& pm, float mom[16][9]) {
     float* mean = pm.mean;
     float* total = pm.total;
-    auto& s1 = pm.s1;
     for (int c = 0; c < 3; ++c) {
         mean[c] = 0;
         for (int i = 0; i < 16; ++i) mean[c] += t.u[c][i];
         mean[c] *= 1.0f / 16;
         for (int i = 0; i < 16; ++i) pm.x[c][i] = (t.u[c][i] - mean[c]) * (1.0f / 256);
     }
-    float mom[16][9];
     std::fill(total, total + 9, 0.0f);
     for (int i = 0; i < 16; ++i) {
         const float x = pm.x[0][i], y = pm.x[1][i], z = pm.x[2][i];
         const float v[9] = {x, y, z, x * x, x * y, x * z, y * y, y * z, z * z};
         for (int k = 0; k < 9; ++k) mom[i][k] = v[k], total[k] += v[k];
     }
+}
+
+// Subset 1's moment sums pm.s1[.][p] for one partition, bit-identical to partition_scores' (the
+// same additions in the same order: members' terms in texel order, non-members add 0 * m = 0), so
+// fit_partition gives the same lines whichever function filled them.
+void partition_moments(const float mom[16][9], int p, PartitionMoments& pm) {
+    const PartitionTables& tb = partition_tables();
+    for (int k = 0; k < 9; ++k) {
+        float acc = 0;
+        for (int i = 0; i < 16; ++i) acc += tb.in1[i][p] * mom[i][k];
+        pm.s1[k][p] = acc;
+    }
+}
+
+void partition_scores(const Target& t, const float ax0[3], float score[32], PartitionMoments& pm) {
+    const PartitionTables& tb = partition_tables();
+    float* total = pm.total;
+    auto& s1 = pm.s1;
+    float mom[16][9];
+    block_moments(t, pm, mom);
     // One moment at a time with a 32-wide accumulator (8 vector registers), not a read-modify-
     // write of the whole 9 x 32 table per texel.
     for (int k = 0; k < 9; ++k) {
@@ -550,6 +574,90 @@ void partition_scores(const Target& t, const float ax0[3], float score[32], Part
                                   total[8] - s1[8][p], 1.0f / tb.n0[p]);
         score[p] = r0 + r1;
     }
+}
+
+// A cheaper score of every partition (fast and default): the texels projected onto the plane of
+// the block's two principal axes e1, e2 (t = x . e1, s = x . e2), and per subset the residual of
+// the best line in that plane, in closed form: the subset's 2 x 2 covariance [[a, b], [b, c]] has
+// the eigenvalues (a + c) / 2 +- sqrt(((a - c) / 2)^2 + b^2), the residual is the smaller one.
+// 5 moment sums per partition instead of 9 and no power steps; it ignores the spread along the
+// block's least axis e3 (the smallest of the three by construction). e1 is the block's axis ax0,
+// e2 the principal axis of the block covariance restricted to the plane orthogonal to e1.
+// Fills pm's block part and mom (for partition_moments); not pm.s1.
+void partition_scores_2d(const Target& t, const float ax0[3], float score[32], PartitionMoments& pm,
+                         float mom[16][9]) {
+    const PartitionTables& tb = partition_tables();
+    block_moments(t, pm, mom);
+    const float* T = pm.total;  // block sums about the mean: T[3..8] is the covariance (times 16)
+    float e1[3] = {ax0[0], ax0[1], ax0[2]};
+    {
+        const float l2 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+        const float il = l2 > 0 ? 1.0f / std::sqrt(l2) : 0.0f;
+        for (float& v : e1) v *= il;
+    }
+    // u: the coordinate axis least aligned with e1, made orthogonal to it; v = e1 x u.
+    const int k = (std::abs(e1[0]) <= std::abs(e1[1]) && std::abs(e1[0]) <= std::abs(e1[2])) ? 0
+                  : (std::abs(e1[1]) <= std::abs(e1[2]))                                  ? 1
+                                                                                          : 2;
+    float u[3] = {-e1[k] * e1[0], -e1[k] * e1[1], -e1[k] * e1[2]};
+    u[k] += 1.0f;
+    {
+        const float l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+        const float il = l2 > 0 ? 1.0f / std::sqrt(l2) : 0.0f;
+        for (float& x : u) x *= il;
+    }
+    const float v[3] = {e1[1] * u[2] - e1[2] * u[1], e1[2] * u[0] - e1[0] * u[2], e1[0] * u[1] - e1[1] * u[0]};
+    auto quad = [&](const float p[3], const float q[3]) {  // p^T C q
+        return p[0] * (T[3] * q[0] + T[4] * q[1] + T[5] * q[2]) + p[1] * (T[4] * q[0] + T[6] * q[1] + T[7] * q[2]) +
+               p[2] * (T[5] * q[0] + T[7] * q[1] + T[8] * q[2]);
+    };
+    const float a = quad(u, u), b = quad(u, v), c = quad(v, v);
+    const float lam = 0.5f * (a + c) + std::sqrt(0.25f * (a - c) * (a - c) + b * b);
+    // Eigenvector for lam: (b, lam - a) or (lam - c, b), whichever is longer (both vanish only
+    // when the plane's covariance is isotropic: then any direction, u).
+    float w0 = b, w1 = lam - a;
+    if (std::abs(lam - c) + std::abs(b) > std::abs(b) + std::abs(lam - a)) w0 = lam - c, w1 = b;
+    if (w0 == 0 && w1 == 0) w0 = 1;
+    float e2[3] = {w0 * u[0] + w1 * v[0], w0 * u[1] + w1 * v[1], w0 * u[2] + w1 * v[2]};
+    {
+        const float l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+        const float il = l2 > 0 ? 1.0f / std::sqrt(l2) : 0.0f;
+        for (float& x : e2) x *= il;
+    }
+    float m5[5][16];
+    float tot[5] = {0, 0, 0, 0, 0};
+    for (int i = 0; i < 16; ++i) {
+        const float ti = pm.x[0][i] * e1[0] + pm.x[1][i] * e1[1] + pm.x[2][i] * e1[2];
+        const float si = pm.x[0][i] * e2[0] + pm.x[1][i] * e2[1] + pm.x[2][i] * e2[2];
+        m5[0][i] = ti, m5[1][i] = si, m5[2][i] = ti * ti, m5[3][i] = ti * si, m5[4][i] = si * si;
+    }
+    for (int q = 0; q < 5; ++q)
+        for (int i = 0; i < 16; ++i) tot[q] += m5[q][i];
+    float s1[5][32];
+    for (int q = 0; q < 5; ++q) {
+        float acc[32] = {};
+        for (int i = 0; i < 16; ++i) {
+            const float m = m5[q][i];
+            for (int p = 0; p < 32; ++p) acc[p] += tb.in1[i][p] * m;
+        }
+        std::copy(acc, acc + 32, s1[q]);
+    }
+    // Residual per subset: (a + c) / 2 - sqrt(((a - c) / 2)^2 + b^2); the square roots in a
+    // separate pass over a vector of arguments >= 0.
+    float half_tr[64], disc[64];
+    for (int p = 0; p < 32; ++p) {
+        const float i1 = 1.0f / tb.n1[p], i0 = 1.0f / tb.n0[p];
+        const float t1 = s1[0][p], q1 = s1[1][p];
+        const float a1 = s1[2][p] - t1 * t1 * i1, b1 = s1[3][p] - t1 * q1 * i1, c1 = s1[4][p] - q1 * q1 * i1;
+        const float t0 = tot[0] - t1, q0 = tot[1] - q1;
+        const float a0 = (tot[2] - s1[2][p]) - t0 * t0 * i0, b0 = (tot[3] - s1[3][p]) - t0 * q0 * i0,
+                    c0 = (tot[4] - s1[4][p]) - q0 * q0 * i0;
+        half_tr[p] = 0.5f * (a1 + c1), disc[p] = 0.25f * (a1 - c1) * (a1 - c1) + b1 * b1;
+        half_tr[32 + p] = 0.5f * (a0 + c0), disc[32 + p] = 0.25f * (a0 - c0) * (a0 - c0) + b0 * b0;
+    }
+    float res[64];
+    for (int j = 0; j < 64; ++j) res[j] = std::max(0.0f, half_tr[j] - std::sqrt(disc[j]));
+    for (int p = 0; p < 32; ++p) score[p] = res[p] + res[32 + p];
 }
 
 // Both subsets' lines for partition p from the moments partition_scores kept (instead of two
@@ -832,13 +940,52 @@ void encode_block(const float rgb[16][3], Quality quality, std::uint8_t out[16])
     // try, most precise first (11-bit endpoints with 5/4/4 deltas ... 7-bit with 6-bit deltas),
     // those whose delta range holds the initial endpoints; the absolute 6-bit mode if none does.
     PartitionMoments pm;
-    auto two_subsets = [&](int p, int max_modes, int iters, bool search) {
+    auto two_subsets = [&](int p, int max_modes, int iters, Indices search) {
         SubsetFit two[2];
         fit_partition(pm, p, axis, two);
         int list[9];
         const int count = fitting_two_subset_modes(two, max_modes, list);
         for (int k = 0; k < count; ++k) try_mode(t, list[k], p, two, iters, best, search);
         if (count == 0) try_mode(t, 9, p, two, iters, best, search);
+    };
+    // The default search (also the first candidate set of exhaustive, which so stays a superset).
+    auto run_default = [&] {
+        // One subset: the most precise fitting mode (mode 11 if none fits), up to 3
+        // refinements (they stop when the error stops dropping).
+        const int iters = 3;
+        const int dm = best_delta_mode(one[0]);
+        try_mode(t, dm >= 0 ? dm : 10, 0, one, iters, best, Indices::kSearch);
+        // Two subsets only for blocks above ~3 half ULPs rms per value (tuned with bench_bc6h).
+        if (best.err <= 48 * 9) return;
+        // Screen the kScreen partitions whose subsets are closest to lines with one cheap
+        // evaluation each (most precise fitting mode, projected indices, no refinement), then
+        // fit the best of them properly (index search, up to 3 refinements). Tuned with
+        // bench_bc6h: screening 6 and refining 1 is as good as refining 3 unscreened (the old
+        // default) at about half the time; refining 2 or trying the second fitting mode
+        // gained <= 0.02 dB.
+        constexpr int kScreen = 6, kRefine = 1;
+        float score[32];
+        partition_scores(t, axis, score, pm);
+        int order[32];
+        for (int p = 0; p < 32; ++p) order[p] = p;
+        std::partial_sort(order, order + kScreen, order + 32,
+                          [&](int a, int b) { return score[a] < score[b] || (score[a] == score[b] && a < b); });
+        std::int64_t screen_err[kScreen];
+        for (int k = 0; k < kScreen; ++k) {
+            const int p = order[k];
+            SubsetFit two[2];
+            fit_partition(pm, p, axis, two);
+            int list[1];
+            const int m = fitting_two_subset_modes(two, 1, list) ? list[0] : 9;
+            Encoded e;
+            screen_err[k] = evaluate(t, m, p, two, e, false);
+        }
+        int rank[kScreen];
+        for (int k = 0; k < kScreen; ++k) rank[k] = k;
+        std::partial_sort(rank, rank + kRefine, rank + kScreen, [&](int a, int b) {
+            return screen_err[a] < screen_err[b] || (screen_err[a] == screen_err[b] && a < b);
+        });
+        for (int k = 0; k < kRefine; ++k) two_subsets(order[rank[k]], 1, iters, Indices::kSearch);
     };
     switch (quality) {
         case Quality::kMode11:
@@ -850,60 +997,28 @@ void encode_block(const float rgb[16][3], Quality quality, std::uint8_t out[16])
             // evaluation with projected indices, no refinement (refining costs ~2x the time for
             // ~0.4 dB, measured with bench_bc6h).
             const int dm = best_delta_mode(one[0]);
-            try_mode(t, dm >= 0 ? dm : 10, 0, one, 0, best, false);
+            try_mode(t, dm >= 0 ? dm : 10, 0, one, 0, best, Indices::kProject);
             // Blocks with a large error (> 12 half ULPs rms per value): the single best-scoring
             // partition with its most precise fitting mode, evaluated the same way. (Tuned with
             // bench_bc6h: from 6 ULPs the maps gain 0.01 dB, the lightmaps 0.3 dB, for 1.5x the
             // time on lightmaps. Guessing the partition from a split along the principal axis
             // instead of scoring was 1.1 dB worse.)
             if (best.err > 48 * 144) {
-                float score[32];
-                partition_scores(t, axis, score, pm);
-                two_subsets(static_cast<int>(std::min_element(score, score + 32) - score), 1, 0, false);
+                float score[32], mom[16][9];
+                partition_scores_2d(t, axis, score, pm, mom);
+                const int p = static_cast<int>(std::min_element(score, score + 32) - score);
+                partition_moments(mom, p, pm);
+                two_subsets(p, 1, 0, Indices::kProject);
             }
             break;
         }
-        case Quality::kDefault: {
-            // One subset: the most precise fitting mode (mode 11 if none fits), up to 3
-            // refinements (they stop when the error stops dropping).
-            const int iters = 3;
-            const int dm = best_delta_mode(one[0]);
-            try_mode(t, dm >= 0 ? dm : 10, 0, one, iters, best);
-            // Two subsets only for blocks above ~3 half ULPs rms per value (tuned with bench_bc6h).
-            if (best.err <= 48 * 9) break;
-            // Screen the kScreen partitions whose subsets are closest to lines with one cheap
-            // evaluation each (most precise fitting mode, projected indices, no refinement), then
-            // fit the best of them properly (index search, up to 3 refinements). Tuned with
-            // bench_bc6h: screening 6 and refining 1 is as good as refining 3 unscreened (the old
-            // default) at about half the time; refining 2 or trying the second fitting mode
-            // gained <= 0.02 dB.
-            constexpr int kScreen = 6, kRefine = 1;
-            float score[32];
-            partition_scores(t, axis, score, pm);
-            int order[32];
-            for (int p = 0; p < 32; ++p) order[p] = p;
-            std::partial_sort(order, order + kScreen, order + 32,
-                              [&](int a, int b) { return score[a] < score[b] || (score[a] == score[b] && a < b); });
-            std::int64_t screen_err[kScreen];
-            for (int k = 0; k < kScreen; ++k) {
-                const int p = order[k];
-                SubsetFit two[2];
-                fit_partition(pm, p, axis, two);
-                int list[1];
-                const int m = fitting_two_subset_modes(two, 1, list) ? list[0] : 9;
-                Encoded e;
-                screen_err[k] = evaluate(t, m, p, two, e, false);
-            }
-            int rank[kScreen];
-            for (int k = 0; k < kScreen; ++k) rank[k] = k;
-            std::partial_sort(rank, rank + kRefine, rank + kScreen, [&](int a, int b) {
-                return screen_err[a] < screen_err[b] || (screen_err[a] == screen_err[b] && a < b);
-            });
-            for (int k = 0; k < kRefine; ++k) two_subsets(order[rank[k]], 1, iters, true);
+        case Quality::kDefault:
+            run_default();
             break;
-        }
         case Quality::kExhaustive: {
-            // Every one-subset mode, every partition with every two-subset mode.
+            // Default's candidates (so that exhaustive is never worse, whichever index selection
+            // default uses), then every one-subset mode, every partition with every two-subset mode.
+            run_default();
             const int iters = 4;
             for (int m = 10; m < 14; ++m) try_mode(t, m, 0, one, iters, best);
             float score[32];
