@@ -711,21 +711,24 @@ void make_target(const float rgb[16][3], Target& t) {
     std::memcpy(x, rgb, sizeof x);
     const float* f = &rgb[0][0];
     int h[48];
-    bool small = false;
     for (int k = 0; k < 48; ++k) {
         const std::uint32_t r = (x[k] - (112u << 23) + 0xFFFu + ((x[k] >> 13) & 1u)) >> 13;
         h[k] = f[k] >= 0x1p-14f ? static_cast<int>(std::min(r, 0x7BFFu)) : 0;
     }
-    for (int k = 0; k < 48; ++k) small |= f[k] > 0 && f[k] < 0x1p-14f;
+    // 0 < f < 2^-14 on the bits: 1 <= x <= 0x387FFFFF (negatives and NaNs have larger bits as
+    // unsigned), an integer compare that vectorises.
+    int small = 0;
+    for (int k = 0; k < 48; ++k) small |= (x[k] - 1u) < 0x387FFFFFu;
     if (small)
         for (int k = 0; k < 48; ++k)
             if (f[k] > 0 && f[k] < 0x1p-14f) h[k] = float_to_uf16(f[k]);
     int differ = 0;
     for (int i = 0; i < 16; ++i)
-        for (int c = 0; c < 3; ++c) {
-            t.h[c][i] = h[3 * i + c];
-            t.u[c][i] = static_cast<float>(h[3 * i + c]) * (64.0f / 31.0f);
-            differ |= h[3 * i + c] ^ h[c];
+        for (int c = 0; c < 3; ++c) t.h[c][i] = h[3 * i + c];
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < 16; ++i) {
+            t.u[c][i] = static_cast<float>(t.h[c][i]) * (64.0f / 31.0f);
+            differ |= t.h[c][i] ^ t.h[c][0];
         }
     t.constant = differ == 0;
 }
