@@ -341,6 +341,7 @@ std::int64_t evaluate(const Target& t, int mode_i, int partition, SubsetFit fit[
             idx[i] = static_cast<std::uint8_t>(j);
             // Each square is < 2^30; sum them in 64 bits (three overflow int32).
             err += static_cast<std::int64_t>(d0 * d0) + d1 * d1 + static_cast<std::int64_t>(d2 * d2);
+            if (err >= out.err) return err;  // cannot win any more
             continue;
         }
         const int j0 = std::clamp(static_cast<int>(proj + 0.5f), 0, lim - 1);  // proj < 0 truncates to 0
@@ -975,7 +976,10 @@ void encode_block(const float rgb[16][3], Quality quality, std::uint8_t out[16])
         for (int p = 0; p < 32; ++p) order[p] = p;
         std::partial_sort(order, order + kScreen, order + 32,
                           [&](int a, int b) { return score[a] < score[b] || (score[a] == score[b] && a < b); });
+        // One Encoded for all screens: each evaluation stops once it reaches the best screen so
+        // far (its error then is >= that best, so the minimum and its first index are unchanged).
         std::int64_t screen_err[kScreen];
+        Encoded screen;
         for (int k = 0; k < kScreen; ++k) {
             const int p = order[k];
             partition_moments(mom, p, pm);
@@ -983,8 +987,7 @@ void encode_block(const float rgb[16][3], Quality quality, std::uint8_t out[16])
             fit_partition(pm, p, axis, two);
             int list[1];
             const int m = fitting_two_subset_modes(two, 1, list) ? list[0] : 9;
-            Encoded e;
-            screen_err[k] = evaluate(t, m, p, two, e, false);
+            screen_err[k] = evaluate(t, m, p, two, screen, false);
         }
         int rank[kScreen];
         for (int k = 0; k < kScreen; ++k) rank[k] = k;
