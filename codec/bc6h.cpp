@@ -107,6 +107,15 @@ constexpr std::uint8_t kAnchor2[32] = {15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 1
                                        15, 2,  8,  2,  2,  8,  8,  15, 2,  8,  2,  2,  8,  8,  2,  2};
 constexpr int kWeights3[8] = {0, 9, 18, 27, 37, 46, 55, 64};
 constexpr int kWeights4[16] = {0, 4, 9, 13, 17, 21, 26, 30, 34, 38, 43, 47, 51, 55, 60, 64};
+// evaluate's vectorised search computes the weights as round(64 j / (n - 1)) in floats: checked
+// here against the tables, with the same float expression.
+template <int N>
+constexpr bool weights_are_rounded_ramp(const int (&w)[N]) {
+    for (int j = 0; j < N; ++j)
+        if (static_cast<int>(static_cast<float>(j) * (64.0f / static_cast<float>(N - 1)) + 0.5f) != w[j]) return false;
+    return true;
+}
+static_assert(weights_are_rounded_ramp(kWeights3) && weights_are_rounded_ramp(kWeights4));
 
 // Nearest index to a palette position: entry k holds the index whose weight w_j / 64 is nearest
 // to k / 128 (ties to the lower index). Used by the fast index selection.
@@ -327,7 +336,72 @@ std::int64_t evaluate(const Target& t, int mode_i, int partition, SubsetFit fit[
     const std::uint8_t* nearest = md.two_subsets ? kNearest3.data() : kNearest4.data();
     std::int64_t err = 0;
     std::uint8_t idx[16];
-    for (int i = 0; i < 16; ++i) {
+    if (search) {
+        // The same search, as straight-line passes over the 16 texels that vectorise (no early
+        // exit; callers only use the error when it wins). Per texel: both subsets' projections
+        // (the same float expression as the scalar version), the texel's one selected, the three
+        // candidate indices, and their palette entries computed instead of looked up: the weight
+        // w_j = round(64 j / (n - 1)) (the format's tables; 64 j / (n - 1) is never within 1/30 of
+        // a half-integer, so the float product rounds correctly), and finish(a, b, w) in floats,
+        // exact because every intermediate is an integer below 2^24 (a, b <= 65535). Squared
+        // differences are < 2^30, their sum over 3 channels < 2^32: unsigned 32-bit.
+        float pr[2][16];
+        for (int ss = 0; ss < 2; ++ss) {
+            const int so = ss < ns ? ss : 0;
+            for (int i = 0; i < 16; ++i)
+                pr[ss][i] = (static_cast<float>(t.h[0][i] - pal[so][0][0]) * axis[so][0] +
+                             static_cast<float>(t.h[1][i] - pal[so][1][0]) * axis[so][1] +
+                             static_cast<float>(t.h[2][i] - pal[so][2][0]) * axis[so][2]) * inv_len2[so];
+        }
+        float ua[2][3], ub[2][3];
+        for (int ss = 0; ss < 2; ++ss)
+            for (int c = 0; c < 3; ++c) {
+                const int so = ss < ns ? ss : 0;
+                ua[ss][c] = static_cast<float>(unquantize(q[2 * so][c], md.ep_bits));
+                ub[ss][c] = static_cast<float>(unquantize(q[2 * so + 1][c], md.ep_bits));
+            }
+        int limm1[16];
+        for (int i = 0; i < 16; ++i) limm1[i] = n - 1;
+        limm1[0] = n / 2 - 1;  // texel 0 is subset 0's anchor (subset 0 in every partition)
+        if (ns == 2) limm1[anchor[1]] = n / 2 - 1;
+        const float wscale = 64.0f / static_cast<float>(n - 1);
+        // Per texel its subset's endpoints and projection (selects, no branches).
+        float A[3][16], B[3][16], proj[16];
+        for (int i = 0; i < 16; ++i) {
+            const int one = pmask >> i & 1;
+            proj[i] = one ? pr[1][i] : pr[0][i];
+            for (int c = 0; c < 3; ++c) A[c][i] = one ? ua[1][c] : ua[0][c], B[c][i] = one ? ub[1][c] : ub[0][c];
+        }
+        std::uint32_t errs[16];
+        int bidx[16];
+        auto cand = [&](int i, int j) {
+            const float w = static_cast<float>(static_cast<int>(static_cast<float>(j) * wscale + 0.5f));
+            std::uint32_t e = 0;
+            for (int c = 0; c < 3; ++c) {
+                const int v = static_cast<int>((A[c][i] * (64.0f - w) + B[c][i] * w + 32.0f) * (1.0f / 64.0f));
+                const int d = ((v * 31) >> 6) - t.h[c][i];
+                e += static_cast<std::uint32_t>(d * d);
+            }
+            return e;
+        };
+        for (int i = 0; i < 16; ++i) {
+            int j0 = static_cast<int>(proj[i] + 0.5f);
+            j0 = j0 < 0 ? 0 : j0;
+            j0 = j0 > limm1[i] ? limm1[i] : j0;
+            const int jl = j0 - 1 < 0 ? 0 : j0 - 1, jh = j0 + 1 > limm1[i] ? limm1[i] : j0 + 1;
+            const std::uint32_t el = cand(i, jl), em = cand(i, j0), eh = cand(i, jh);
+            std::uint32_t be = el;
+            int bj = jl;
+            bj = em < be ? j0 : bj;
+            be = em < be ? em : be;
+            bj = eh < be ? jh : bj;
+            be = eh < be ? eh : be;
+            errs[i] = be;
+            bidx[i] = bj;
+        }
+        for (int i = 0; i < 16; ++i) err += errs[i], idx[i] = static_cast<std::uint8_t>(bidx[i]);
+    }
+    for (int i = 0; i < 16 && !search; ++i) {
         const int s = pmask >> i & 1;
         const int lim = (i == anchor[s]) ? n / 2 : n;
         const float proj = (static_cast<float>(t.h[0][i] - pal[s][0][0]) * axis[s][0] +
