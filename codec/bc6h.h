@@ -20,9 +20,10 @@ namespace zhc::bc6h {
 
 enum class Quality {
     kMode11,      // baseline: one-subset 10-bit mode (mode code 00011) only, one refinement
-    kFast,        // one-subset modes, few refinements
-    kDefault,     // one-subset modes, then the best few partitions for high-variance blocks
+    kFast,        // one fitting one-subset mode, no refinement; poorly fitting blocks: + the best-scoring partition
+    kDefault,     // one-subset mode refined; poorly fitting blocks: 6 partitions screened, the best refined
     kExhaustive,  // all 14 modes x all 32 partitions, more refinement: the quality reference
+    // All but kMode11 encode constant blocks exactly (mode 14, zero error) without a search.
 };
 
 // Half-float bits <-> float (round to nearest even; no dependence on the FPU's half support).
