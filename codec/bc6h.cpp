@@ -122,10 +122,11 @@ static_assert(weights_are_rounded_ramp(kWeights3) && weights_are_rounded_ramp(kW
 template <int N>
 constexpr std::array<std::uint8_t, 129> make_nearest(const int (&w)[N]) {
     std::array<std::uint8_t, 129> lut{};
+    auto dist = [](int v) { return v < 0 ? -v : v; };  // std::abs is not constexpr before C++23 (clang rejects it)
     for (int k = 0; k <= 128; ++k) {
         int best = 0;
         for (int j = 1; j < N; ++j)
-            if (std::abs(2 * w[j] - k) < std::abs(2 * w[best] - k)) best = j;
+            if (dist(2 * w[j] - k) < dist(2 * w[best] - k)) best = j;
         lut[static_cast<size_t>(k)] = static_cast<std::uint8_t>(best);
     }
     return lut;

@@ -12,4 +12,10 @@ if [ ! -f build-san/build.ninja ]; then
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
     -DZHC_SANITIZE=ON -DZHC_BUILD_FUZZERS=ON -DZHC_BUILD_TESTS=ON -DZHC_BUILD_BENCH=OFF >/dev/null
 fi
-cmake --build build-san -j "$(nproc)" >/dev/null
+# The build log is kept quiet but shown when the build fails (a failed build must never leave
+# stale binaries to be tested).
+if ! cmake --build build-san -j "$(nproc)" >build-san/build.log 2>&1; then
+  grep -v '^\[' build-san/build.log | head -n 60
+  echo "build_san: the sanitized build failed (full log: build-san/build.log)" >&2
+  exit 1
+fi
