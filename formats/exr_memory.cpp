@@ -24,8 +24,26 @@ std::uint32_t load_u32(const std::uint8_t* p) {
 // declared size (a fuzzer found a 1.7 GB allocation from a 263-byte file this way). So the value
 // of every type OpenEXR knows must parse to exactly its declared size. Unknown types are kept as
 // opaque bytes of the declared size, which the caller has already bounded by the file.
-Status check_attribute_value(std::span<const std::uint8_t> v, const std::string& name, const std::string& attr,
-                             const std::string& type) {
+// Attribute names and types come from the file: control and non-ASCII bytes are shown as \xNN so
+// an error message stays one printable line.
+std::string printable(const std::string& s) {
+    std::string out;
+    for (unsigned char c : s) {
+        if (c >= 0x20 && c < 0x7f) {
+            out.push_back(static_cast<char>(c));
+        } else {
+            static const char* hex = "0123456789abcdef";
+            out += "\\x";
+            out.push_back(hex[c >> 4]);
+            out.push_back(hex[c & 15]);
+        }
+    }
+    return out;
+}
+
+Status check_attribute_value(std::span<const std::uint8_t> v, const std::string& name, const std::string& raw_attr,
+                             const std::string& raw_type) {
+    const std::string attr = printable(raw_attr), type = printable(raw_type);
     auto bad = [&](const char* what) {
         return make_error(ErrorCode::kBadFormat, name + ": OpenEXR attribute '" + attr + "' of type '" + type + "' " +
                                                      what + " (declared size " + std::to_string(v.size()) + ")");
@@ -42,8 +60,8 @@ Status check_attribute_value(std::span<const std::uint8_t> v, const std::string&
         {"v3i", 12},    {"v3f", 12},      {"v3d", 24},            {"deepImageState", 1},
     };
     for (const Fixed& f : kFixed)
-        if (type == f.type) return v.size() == f.size ? Status(Ok{}) : Status(bad("has the wrong size for its type"));
-    if (type == "chlist") {
+        if (raw_type == f.type) return v.size() == f.size ? Status(Ok{}) : Status(bad("has the wrong size for its type"));
+    if (raw_type == "chlist") {
         // Entries: name\0, pixel type (4), pLinear + 3 reserved (4), x/y sampling (4 + 4); an
         // empty name ends the list.
         size_t p = 0;
@@ -57,12 +75,12 @@ Status check_attribute_value(std::span<const std::uint8_t> v, const std::string&
             if (p > v.size()) return bad("ends inside a channel");
         }
     }
-    if (type == "preview") {
+    if (raw_type == "preview") {
         if (v.size() < 8) return bad("is too short");
         const std::uint64_t w = load_u32(v.data()), h = load_u32(v.data() + 4);
         return w * h * 4 + 8 == v.size() ? Status(Ok{}) : Status(bad("does not match its width x height"));
     }
-    if (type == "stringvector") {
+    if (raw_type == "stringvector") {
         size_t p = 0;
         while (p < v.size()) {
             if (p + 4 > v.size()) return bad("ends inside a string length");
@@ -73,8 +91,13 @@ Status check_attribute_value(std::span<const std::uint8_t> v, const std::string&
         }
         return Ok{};
     }
-    if (type == "floatvector" && v.size() % 4 != 0) return bad("is not a whole number of floats");
-    if (type == "idmanifest" && v.size() < 4) return bad("is too short");
+    if (raw_type == "floatvector" && v.size() % 4 != 0) return bad("is not a whole number of floats");
+    // OpenEXR 3.1 reads an idmanifest as an 8-byte size plus (declared size - 4) bytes, 4 bytes
+    // past its end (found by fuzzing: the next "size" became 1.9 GB). ID manifests belong to ID
+    // and deep images, not environment maps or lightmaps: refuse them rather than model the quirk.
+    if (raw_type == "idmanifest")
+        return make_error(ErrorCode::kUnsupported, name + ": OpenEXR attribute '" + attr +
+                                                       "' has type idmanifest, which zhc does not read");
     return Ok{};
 }
 
@@ -117,7 +140,7 @@ Status validate_exr_header(std::span<const std::uint8_t> b, const std::string& n
             std::int32_t size;
             std::memcpy(&size, b.data() + pos, 4);
             pos += 4;
-            if (size < 0) return make_error(ErrorCode::kBadFormat, name + ": OpenEXR attribute '" + attr + "' has a negative size");
+            if (size < 0) return make_error(ErrorCode::kBadFormat, name + ": OpenEXR attribute '" + printable(attr) + "' has a negative size");
             if (pos + static_cast<size_t>(size) > b.size()) return truncated();
             if (Status st = check_attribute_value(b.subspan(pos, static_cast<size_t>(size)), name, attr, type); !st)
                 return st;

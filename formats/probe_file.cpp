@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
@@ -390,6 +391,10 @@ Result<Vec3> json_vec3(const json& j, const std::string& name, const std::string
         if (!j[i].is_number()) return err(ErrorCode::kBadFormat, name, where + " must be an array of 3 numbers");
         v[i] = j[i].get<double>();
         if (!std::isfinite(v[i])) return err(ErrorCode::kInvalidValue, name, where + " is not finite");
+        // Stored as 32-bit floats: a larger magnitude would become infinity (and be written back
+        // as null; found by fuzzing with a 160-digit position).
+        if (std::fabs(v[i]) > std::numeric_limits<float>::max())
+            return err(ErrorCode::kInvalidValue, name, where + " is outside the 32-bit float range");
     }
     return Vec3{v[0], v[1], v[2]};
 }
