@@ -10,7 +10,7 @@ if [ ! -f build-san/build.ninja ]; then
     -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
-    -DZHC_SANITIZE=ON -DZHC_BUILD_FUZZERS=ON -DZHC_BUILD_TESTS=ON -DZHC_BUILD_BENCH=OFF >/dev/null
+    -DZHC_SANITIZE=ON -DZHC_BUILD_FUZZERS=ON -DZHC_REQUIRE_MESA_TEST=ON -DZHC_BUILD_TESTS=ON -DZHC_BUILD_BENCH=OFF >/dev/null
 fi
 # The build log is kept quiet but shown when the build fails (a failed build must never leave
 # stale binaries to be tested).
