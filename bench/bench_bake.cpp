@@ -48,22 +48,6 @@ SceneLight light_of(LightKind kind, int i) {
     return l;
 }
 
-// UV sphere of n_lat x n_lon quads (two triangles each; one at the poles): 2 n_lat n_lon - 2 n_lon.
-std::vector<Occluder> uv_sphere(Vec3 c, double r, int n_lat, int n_lon) {
-    std::vector<Occluder> out;
-    auto at = [&](int i, int j) {
-        const double th = kPi * i / n_lat, ph = 2 * kPi * j / n_lon;
-        return c + r * Vec3{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
-    };
-    for (int i = 0; i < n_lat; ++i)
-        for (int j = 0; j < n_lon; ++j) {
-            const Vec3 a = at(i, j), b = at(i + 1, j), cc = at(i + 1, j + 1), d = at(i, j + 1);
-            if (i != n_lat - 1) out.push_back(triangle_occluder(a, b, cc));
-            if (i != 0) out.push_back(triangle_occluder(a, cc, d));
-        }
-    return out;
-}
-
 double probe_count(const Scene& s) {
     return double(s.probes.counts[0]) * s.probes.counts[1] * s.probes.counts[2];
 }
@@ -177,7 +161,7 @@ int main(int argc, char** argv) {
         // A sphere of radius 1.5 hovering over the middle of the probe grid, lit by a sun with a
         // 3-degree radius and 64 samples: a mix of blocked rays (under it) and misses.
         Scene s = grid_scene(n / 2);
-        s.occluders = uv_sphere({0.3, -0.2, 4.5}, 1.5, res, res);
+        s.occluders = uv_sphere_triangles({0.3, -0.2, 4.5}, 1.5, res, res);
         SceneLight sun = light_of(LightKind::kDirectional, 0);
         sun.direction = {0.2, 0.1, 1};
         sun.angular_radius_rad = 3 * kPi / 180;

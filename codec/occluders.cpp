@@ -78,6 +78,21 @@ Occluder triangle_occluder(Vec3 a, Vec3 b, Vec3 c) {
     return o;
 }
 
+std::vector<Occluder> uv_sphere_triangles(Vec3 c, double r, int n_lat, int n_lon) {
+    std::vector<Occluder> out;
+    auto at = [&](int i, int j) {
+        const double th = kPi * i / n_lat, ph = 2 * kPi * j / n_lon;
+        return c + r * Vec3{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
+    };
+    for (int i = 0; i < n_lat; ++i)
+        for (int j = 0; j < n_lon; ++j) {
+            const Vec3 a = at(i, j), b = at(i + 1, j), cc = at(i + 1, j + 1), d = at(i, j + 1);
+            if (i != n_lat - 1) out.push_back(triangle_occluder(a, b, cc));
+            if (i != 0) out.push_back(triangle_occluder(a, cc, d));
+        }
+    return out;
+}
+
 bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
     if (occ.kind == OccluderKind::kTriangle) return ray_hits_triangle(occ, o, d, t_min, t_max);
     if (occ.kind == OccluderKind::kSphere) {

@@ -43,6 +43,10 @@ struct Occluder {
 
 // A triangle occluder with vertices a, b, c.
 Occluder triangle_occluder(Vec3 a, Vec3 b, Vec3 c);
+// Triangles of a UV sphere (centre c, radius r) with n_lat x n_lon quads of two triangles each
+// (one at the poles): 2 n_lat n_lon - 2 n_lon triangles. A closed mesh occluder for scenes,
+// tests and benchmarks.
+std::vector<Occluder> uv_sphere_triangles(Vec3 c, double r, int n_lat, int n_lon);
 
 // Ray o + t d (d unit) against one occluder: true when it is hit for some t in (t_min, t_max).
 // A ray starting inside a sphere or box is blocked (the probe is inside solid matter); triangles

@@ -47,6 +47,14 @@ Vec3 uniform_direction(double u1, double u2) {
     return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
+double max_abs_diff(const Sh3Radiance& a, const Sh3Radiance& b) {
+    double m = 0;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) m = std::max(m, std::fabs(double(a[i][k]) - b[i][k]));
+    return m;
+}
+double max_abs(const Sh3Radiance& a) { return max_abs_diff(a, Sh3Radiance{}); }
+
 Sh3Radiance project_latlong_reference(const Image& img, int sub) {
     // Each pixel split into sub x sub sub-pixels, each contributing value * Y(centre) * its exact
     // solid angle (a lat-long map of sub-times the resolution, nearest-sampled).

@@ -25,6 +25,9 @@ Vec3 uniform_direction(double u1, double u2);
 // Slow, obviously-correct twin of project_latlong: evaluates all nine basis functions at the
 // centres of sub x sub sub-pixels of every pixel, times their exact solid angles.
 Sh3Radiance project_latlong_reference(const Image& img, int sub = 1);
+// Largest coefficient difference (and largest coefficient) over the 27 numbers of SH3 radiance.
+double max_abs_diff(const Sh3Radiance& a, const Sh3Radiance& b);
+double max_abs(const Sh3Radiance& a);
 // Irradiance at n by direct integration of the map: (1/pi) sum L max(0, n.w) dw.
 Rgb integrate_irradiance(const Image& img, Vec3 n);
 // A box downsample that keeps total flux (solid-angle weighted), by integer factors.

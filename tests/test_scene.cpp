@@ -34,13 +34,6 @@ Scene at_positions(std::vector<Vec3> ps) {
     return s;
 }
 
-double max_abs_diff(const Sh3Radiance& a, const Sh3Radiance& b) {
-    double m = 0;
-    for (int i = 0; i < 9; ++i)
-        for (int k = 0; k < 3; ++k) m = std::max(m, std::abs(double(a[i][k]) - b[i][k]));
-    return m;
-}
-double max_abs(const Sh3Radiance& a) { return max_abs_diff(a, Sh3Radiance{}); }
 
 // Slow twin: radiance of the scene's lights as a function of direction, integrated over a dense
 // Fibonacci sphere (each direction stands for 4 pi / n sr). `visible(d, t_max)` masks occlusion.
@@ -93,17 +86,17 @@ TEST(SceneBake, SphereLightEqualsClosedFormAndDenseSampling) {
         const Vec3 v = c - probes[i];
         const double d = length(v);
         const Sh3Radiance closed = project_cone((1.0 / d) * v, std::asin(r / d), L);
-        EXPECT_LT(max_abs_diff((*baked)[i], closed), 1e-5 * max_abs(closed)) << "probe " << i;
+        EXPECT_LT(test::max_abs_diff((*baked)[i], closed), 1e-5 * test::max_abs(closed)) << "probe " << i;
         // Slow twin: the sphere's radiance where a ray hits it, dense sampling (400k directions).
         const Sh3Radiance dense = dense_projection(400000, [&](Vec3 w) {
             return hit_sphere(probes[i], w, c, r) > 0 ? L : Rgb{};
         });
-        EXPECT_LT(max_abs_diff((*baked)[i], dense), 2e-3 * max_abs(closed) + 1e-4) << "probe " << i;
+        EXPECT_LT(test::max_abs_diff((*baked)[i], dense), 2e-3 * test::max_abs(closed) + 1e-4) << "probe " << i;
         // A single cone light is zonal about one axis for all channels: the luminance-axis ZH3 fit
         // reproduces it exactly (ZH3 paper Sec. 3).
         const Zh3 z = zh3_fit((*baked)[i], ZonalAxisMode::kLuminance, LuminanceWeights{});
         const Sh3Radiance back = zh3_expand(z, ZonalAxisMode::kLuminance, LuminanceWeights{});
-        EXPECT_LT(max_abs_diff(back, (*baked)[i]), 1e-5 * max_abs(closed)) << "probe " << i;
+        EXPECT_LT(test::max_abs_diff(back, (*baked)[i]), 1e-5 * test::max_abs(closed)) << "probe " << i;
     }
 }
 
@@ -111,7 +104,7 @@ TEST(SceneBake, ProbeInsideSphereLightSeesConstantRadiance) {
     Scene s = at_positions({{0.1, 0.0, 0.0}});
     s.lights.push_back(sphere_light({0, 0, 0}, 1.0, {2, 3, 4}));
     const Sh3Radiance sh = bake_one(s);
-    EXPECT_LT(max_abs_diff(sh, project_constant({2, 3, 4})), 1e-6);
+    EXPECT_LT(test::max_abs_diff(sh, project_constant({2, 3, 4})), 1e-6);
 }
 
 TEST(SceneBake, PointLightFollowsInverseSquare) {
@@ -131,7 +124,7 @@ TEST(SceneBake, PointLightFollowsInverseSquare) {
             }
     // And it is the delta of integral I / d^2 towards the light.
     const Sh3Radiance closed = project_directional(-1.0 * w, {float(5 / (d1 * d1)), float(4 / (d1 * d1)), float(3 / (d1 * d1))});
-    EXPECT_LT(max_abs_diff(a, closed), 1e-6);
+    EXPECT_LT(test::max_abs_diff(a, closed), 1e-6);
     // SH3 irradiance of a surface facing the light: the delta's band energies sum_m Y_lm(w)^2 =
     // (2l + 1) / 4pi times the band scales 1, 2/3, 1/4: (I / d^2) (1 + 2 + 5/4) / (4 pi).
     EXPECT_NEAR(irradiance(a, -1.0 * w).r, 5 / (d1 * d1) * 4.25 / (4 * kPi), 1e-5);
@@ -146,10 +139,10 @@ TEST(SceneBake, DirectionalAndHemisphereMatchClosedForms) {
     sun.angular_radius_rad = ref.angular_radius_rad;
     sun.color = ref.irradiance;
     s.lights.push_back(sun);
-    EXPECT_LT(max_abs_diff(bake_one(s), project_sun(ref)), 1e-5 * max_abs(project_sun(ref)));
+    EXPECT_LT(test::max_abs_diff(bake_one(s), project_sun(ref)), 1e-5 * test::max_abs(project_sun(ref)));
     // Zero radius: a delta with integral pi E.
     s.lights[0].angular_radius_rad = 0;
-    EXPECT_LT(max_abs_diff(bake_one(s), project_directional(ref.towards_sun, {float(kPi * 3.2), float(kPi * 3.0), float(kPi * 2.7)})), 1e-5);
+    EXPECT_LT(test::max_abs_diff(bake_one(s), project_directional(ref.towards_sun, {float(kPi * 3.2), float(kPi * 3.0), float(kPi * 2.7)})), 1e-5);
     // Hemisphere light vs its dense twin.
     SceneLight h;
     h.kind = LightKind::kHemisphere;
@@ -157,8 +150,8 @@ TEST(SceneBake, DirectionalAndHemisphereMatchClosedForms) {
     h.color = {0.5f, 0.7f, 1.0f};
     s.lights = {h};
     const Sh3Radiance dense = dense_projection(200000, [&](Vec3 w) { return dot(w, h.direction) > 0 ? h.color : Rgb{}; });
-    EXPECT_LT(max_abs_diff(bake_one(s), dense), 2e-3);
-    EXPECT_LT(max_abs_diff(bake_one(s), project_hemisphere(h.direction, h.color)), 1e-6);
+    EXPECT_LT(test::max_abs_diff(bake_one(s), dense), 2e-3);
+    EXPECT_LT(test::max_abs_diff(bake_one(s), project_hemisphere(h.direction, h.color)), 1e-6);
 }
 
 TEST(SceneBake, SpotConeAttenuationIsTheDocumentedSmoothstep) {
@@ -182,8 +175,8 @@ TEST(SceneBake, SpotConeAttenuationIsTheDocumentedSmoothstep) {
     auto a = bake_scene(s);
     auto b = bake_scene(sp);
     ASSERT_TRUE(a.ok() && b.ok());
-    EXPECT_LT(max_abs_diff((*a)[0], (*b)[0]), 1e-7);  // inside the inner cone: the point light
-    EXPECT_EQ(max_abs((*a)[2]), 0.0);                  // outside the outer cone: nothing
+    EXPECT_LT(test::max_abs_diff((*a)[0], (*b)[0]), 1e-7);  // inside the inner cone: the point light
+    EXPECT_EQ(test::max_abs((*a)[2]), 0.0);                  // outside the outer cone: nothing
     const double c0 = std::cos(spot.outer_angle_rad), c1 = std::cos(spot.inner_angle_rad);
     const double t = (std::cos(25 * kPi / 180) - c0) / (c1 - c0), expected = t * t * (3 - 2 * t);
     EXPECT_NEAR((*a)[1][0].r / (*b)[1][0].r, expected, 1e-6);
@@ -233,7 +226,7 @@ TEST(SceneBake, EnvironmentIntensityAndRotation) {
     ASSERT_TRUE(scene.ok()) << scene.error().message;
     const Sh3Radiance baked = bake_one(*scene);
     const Sh3Radiance expected = scale(rotate(sh, rotation_axis_angle({0, 0, 1}, kPi / 2)), 2.5);
-    EXPECT_LT(max_abs_diff(baked, expected), 1e-5 * max_abs(expected));
+    EXPECT_LT(test::max_abs_diff(baked, expected), 1e-5 * test::max_abs(expected));
     // Rotating by 90 degrees about +Z moves what was along +X to +Y: L1 (-y, z, -x) components swap.
     EXPECT_NEAR(baked[1].g, -(-2.5f * sh[3].g), 1e-4 * std::abs(sh[3].g) + 1e-6);
 }
@@ -271,9 +264,9 @@ TEST(SceneBake, BoxOccluderRemovesOnlyTheShadowedLight) {
     auto ref_without = bake_scene(without_a);
     auto ref_all = bake_scene(no_occluders);
     ASSERT_TRUE(ref_without.ok() && ref_all.ok());
-    EXPECT_GT(max_abs_diff((*ref_all)[0], (*ref_without)[0]), 0.1);            // A matters there
-    EXPECT_LT(max_abs_diff((*with)[0], (*ref_without)[0]), 1e-6);              // and is gone
-    EXPECT_LT(max_abs_diff((*with)[1], (*ref_all)[1]), 1e-6);                  // probe 1: nothing changed
+    EXPECT_GT(test::max_abs_diff((*ref_all)[0], (*ref_without)[0]), 0.1);            // A matters there
+    EXPECT_LT(test::max_abs_diff((*with)[0], (*ref_without)[0]), 1e-6);              // and is gone
+    EXPECT_LT(test::max_abs_diff((*with)[1], (*ref_all)[1]), 1e-6);                  // probe 1: nothing changed
     EXPECT_GT(rep.rays, 0u);
     // Same with a sphere light behind the wall (cone sampling, all samples blocked -> exactly 0).
     Scene cone = at_positions({{0, 0, 0}});
@@ -281,7 +274,7 @@ TEST(SceneBake, BoxOccluderRemovesOnlyTheShadowedLight) {
     big.shadows = true;
     cone.lights = {big};
     cone.occluders = {wall};
-    EXPECT_EQ(max_abs(bake_one(cone)), 0.0);
+    EXPECT_EQ(test::max_abs(bake_one(cone)), 0.0);
 }
 
 TEST(SceneBake, PartialShadowMatchesDenseVisibleProjection) {
@@ -307,11 +300,11 @@ TEST(SceneBake, PartialShadowMatchesDenseVisibleProjection) {
     const Sh3Radiance full = project_cone({0, 0, 1}, std::asin(r / 4), l.color);
     EXPECT_GT(baked[0].r, 0.3 * full[0].r);
     EXPECT_LT(baked[0].r, 0.7 * full[0].r);
-    EXPECT_LT(max_abs_diff(baked, dense), 0.01 * max_abs(full));
+    EXPECT_LT(test::max_abs_diff(baked, dense), 0.01 * test::max_abs(full));
     // The shadow moves the L1 direction: the visible half lies at x < 0, so L11 (= -sqrt(3/4pi) x
     // weighted) turns positive where the unshadowed cone (axis +Z) has none; the bake keeps that.
     EXPECT_NEAR(full[3].r, 0.0, 1e-6);
-    EXPECT_GT(dense[3].r, 0.02 * max_abs(full));
+    EXPECT_GT(dense[3].r, 0.02 * test::max_abs(full));
     EXPECT_NEAR(baked[3].r, dense[3].r, 0.1 * dense[3].r);
 }
 
@@ -337,8 +330,8 @@ TEST(SceneBake, ShadowedProbeInsideSphereLight) {
         return ray_hits(slab, {0, 0, 0}, w, 1e-9, t_exit) ? Rgb{} : l.color;
     });
     const Sh3Radiance hemisphere = project_hemisphere({0, 0, -1}, l.color);
-    EXPECT_LT(max_abs_diff(baked, dense), 0.01 * max_abs(hemisphere));
-    EXPECT_LT(max_abs_diff(baked, hemisphere), 0.1 * max_abs(hemisphere));  // and close to the half
+    EXPECT_LT(test::max_abs_diff(baked, dense), 0.01 * test::max_abs(hemisphere));
+    EXPECT_LT(test::max_abs_diff(baked, hemisphere), 0.1 * test::max_abs(hemisphere));  // and close to the half
 }
 
 TEST(Occluders, BvhAgreesWithBruteForce) {
@@ -543,7 +536,7 @@ TEST(SceneBake, DefaultSceneProbesAreOutsideLightsAndOccluders) {
     auto a = bake_scene(s), b = bake_scene(no_occ);
     ASSERT_TRUE(a.ok() && b.ok());
     int changed = 0;
-    for (size_t i = 0; i < a->size(); ++i) changed += max_abs_diff((*a)[i], (*b)[i]) > 1e-3;
+    for (size_t i = 0; i < a->size(); ++i) changed += test::max_abs_diff((*a)[i], (*b)[i]) > 1e-3;
     EXPECT_GT(changed, 5);
     EXPECT_LT(changed, static_cast<int>(a->size()) - 5);
 }
@@ -566,7 +559,7 @@ TEST(SceneJson, RoundTripBakesTheSame) {
     ASSERT_TRUE(a.ok() && b.ok());
     ASSERT_EQ(a->size(), b->size());
     double worst = 0;
-    for (size_t i = 0; i < a->size(); ++i) worst = std::max(worst, max_abs_diff((*a)[i], (*b)[i]));
+    for (size_t i = 0; i < a->size(); ++i) worst = std::max(worst, test::max_abs_diff((*a)[i], (*b)[i]));
     EXPECT_LT(worst, 1e-4);
 }
 

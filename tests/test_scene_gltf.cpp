@@ -111,13 +111,6 @@ std::vector<Sh3Radiance> bake(const Scene& s) {
     EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
     return r.ok() ? *r : std::vector<Sh3Radiance>{};
 }
-double max_abs_diff(const Sh3Radiance& a, const Sh3Radiance& b) {
-    double m = 0;
-    for (int i = 0; i < 9; ++i)
-        for (int k = 0; k < 3; ++k) m = std::max(m, std::abs(double(a[i][k]) - b[i][k]));
-    return m;
-}
-double max_abs(const Sh3Radiance& a) { return max_abs_diff(a, Sh3Radiance{}); }
 
 const json kProbes = {{"positions", {{0, 0, 0}, {1, -2, 0.5}, {-1.5, 0.5, 2.5}}}};  // zhc axes
 
@@ -137,7 +130,7 @@ TEST(SceneGltf, PointLightEqualsTheSameSceneInJson) {
     const auto bg = bake(*g), bj = bake(*j);
     ASSERT_EQ(bg.size(), 3u);
     for (size_t p = 0; p < 3; ++p) {
-        EXPECT_GT(max_abs(bj[p]), 0.1);
+        EXPECT_GT(test::max_abs(bj[p]), 0.1);
         EXPECT_EQ(bg[p], bj[p]) << "probe " << p;  // same numbers in, same bytes out
     }
 }
@@ -181,11 +174,11 @@ TEST(SceneGltf, SpotConeMatchesJsonTwin) {
                                       {"inner_angle_deg", 20}, {"outer_angle_deg", 30}}}}});
     ASSERT_TRUE(j.ok()) << j.error().message;
     const auto bg = bake(*g), bj = bake(*j);
-    for (size_t p = 0; p < 3; ++p) EXPECT_LT(max_abs_diff(bg[p], bj[p]), 1e-6 * (max_abs(bj[p]) + 1)) << p;
-    EXPECT_GT(max_abs(bg[0]), 0.1);    // inside the inner cone
-    EXPECT_GT(max_abs(bg[1]), 0.01);   // in the falloff
-    EXPECT_LT(max_abs(bg[1]), max_abs(bg[0]));
-    EXPECT_EQ(max_abs(bg[2]), 0.0);    // outside the outer cone
+    for (size_t p = 0; p < 3; ++p) EXPECT_LT(test::max_abs_diff(bg[p], bj[p]), 1e-6 * (test::max_abs(bj[p]) + 1)) << p;
+    EXPECT_GT(test::max_abs(bg[0]), 0.1);    // inside the inner cone
+    EXPECT_GT(test::max_abs(bg[1]), 0.01);   // in the falloff
+    EXPECT_LT(test::max_abs(bg[1]), test::max_abs(bg[0]));
+    EXPECT_EQ(test::max_abs(bg[2]), 0.0);    // outside the outer cone
 }
 
 TEST(SceneGltf, DirectionalLightIsLuxOverPi) {
@@ -202,7 +195,7 @@ TEST(SceneGltf, DirectionalLightIsLuxOverPi) {
                          {"lights", {{{"type", "directional"}, {"direction", {0, 0, 1}}, {"irradiance", {3 / kPi, 2.7 / kPi, 2.4 / kPi}}}}}});
     ASSERT_TRUE(j.ok());
     const auto bg = bake(*g), bj = bake(*j);
-    for (size_t p = 0; p < 3; ++p) EXPECT_LT(max_abs_diff(bg[p], bj[p]), 1e-6) << p;
+    for (size_t p = 0; p < 3; ++p) EXPECT_LT(test::max_abs_diff(bg[p], bj[p]), 1e-6) << p;
     // Physically: a surface facing the sun receives E_v = 3 lux = integral L cos; zhc's normalised
     // SH3 irradiance of a delta keeps 4.25 / (4 pi) of it (bands 1 + 2 + 5/4), times 1 / pi.
     EXPECT_NEAR(irradiance(bg[0], {0, 0, 1}).r, 3.0 * 4.25 / (4 * kPi), 1e-5);
@@ -234,13 +227,13 @@ TEST(SceneGltf, MeshOccluderBlocksTheLight) {
         }
     }
     const auto b = bake(*g);
-    EXPECT_EQ(max_abs(b[0]), 0.0);  // behind the quad: the light's contribution is gone
+    EXPECT_EQ(test::max_abs(b[0]), 0.0);  // behind the quad: the light's contribution is gone
     // Probe 1 sees the light: equal to the unshadowed twin.
     auto j = parse_json({{"version", 1}, {"probes", {{"positions", {{0, 0, 0}, {3, 0, 0}}}}},
                          {"lights", {{{"type", "point"}, {"position", {0, 0, 4}}, {"intensity", 8}}}}});
     ASSERT_TRUE(j.ok());
     const auto bj = bake(*j);
-    EXPECT_GT(max_abs(bj[0]), 0.1);
+    EXPECT_GT(test::max_abs(bj[0]), 0.1);
     EXPECT_EQ(b[1], bj[1]);
     // extras.zhc.gltf_light_shadows = false switches the shadows off.
     a.doc["extras"]["zhc"]["gltf_light_shadows"] = false;

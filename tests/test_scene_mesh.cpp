@@ -15,22 +15,6 @@
 namespace zhc {
 namespace {
 
-// UV sphere of n_lat x n_lon quads (two triangles each; the pole rows degenerate to one).
-std::vector<Occluder> uv_sphere(Vec3 c, double r, int n_lat, int n_lon) {
-    std::vector<Occluder> out;
-    auto at = [&](int i, int j) {
-        const double th = kPi * i / n_lat, ph = 2 * kPi * j / n_lon;
-        return c + r * Vec3{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
-    };
-    for (int i = 0; i < n_lat; ++i)
-        for (int j = 0; j < n_lon; ++j) {
-            const Vec3 a = at(i, j), b = at(i + 1, j), cc = at(i + 1, j + 1), d = at(i, j + 1);
-            if (i != n_lat - 1) out.push_back(triangle_occluder(a, b, cc));
-            if (i != 0) out.push_back(triangle_occluder(a, cc, d));
-        }
-    return out;
-}
-
 // Slow twin of the ray/triangle test: intersect the supporting plane, then the three edge
 // functions (n . ((b - a) x (q - a))) must share the sign of n . n. Returns the signed distance
 // of q to the nearest edge relative to the triangle's size through *margin (for skipping
@@ -98,7 +82,7 @@ TEST(TriangleOccluder, PolicyCases) {
 
 TEST(TriangleOccluder, BvhAgreesWithBruteForceOnMeshes) {
     // A 20k-triangle sphere, a random triangle soup and a few spheres/boxes in one tree.
-    std::vector<Occluder> occ = uv_sphere({0.5, -0.3, 0.2}, 1.5, 100, 100);
+    std::vector<Occluder> occ = uv_sphere_triangles({0.5, -0.3, 0.2}, 1.5, 100, 100);
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-4, 4), u01(0, 1);
     for (int i = 0; i < 3000; ++i) {
@@ -139,7 +123,7 @@ TEST(TriangleOccluder, ClosedMeshHasNoLeaksAlongSeams) {
     // midpoints (the seams where two triangles meet) are all blocked.
     const int n_lat = 24, n_lon = 48;
     const Vec3 c{0.1, 0.2, 0.3};
-    const std::vector<Occluder> mesh = uv_sphere(c, 2.0, n_lat, n_lon);
+    const std::vector<Occluder> mesh = uv_sphere_triangles(c, 2.0, n_lat, n_lon);
     const OccluderBvh bvh(mesh);
     int rays = 0;
     for (const Occluder& t : mesh)
@@ -175,12 +159,6 @@ Scene two_probes() {
     return s;
 }
 
-double max_abs_diff(const Sh3Radiance& a, const Sh3Radiance& b) {
-    double m = 0;
-    for (int i = 0; i < 9; ++i)
-        for (int k = 0; k < 3; ++k) m = std::max(m, std::abs(double(a[i][k]) - b[i][k]));
-    return m;
-}
 
 TEST(TriangleOccluder, QuadRemovesExactlyTheLightItHides) {
     Scene s = two_probes();
@@ -217,9 +195,9 @@ TEST(TriangleOccluder, QuadRemovesExactlyTheLightItHides) {
     no_occluders.occluders.clear();
     auto ref_without = bake_scene(without_a), ref_all = bake_scene(no_occluders);
     ASSERT_TRUE(with.ok() && ref_without.ok() && ref_all.ok());
-    EXPECT_GT(max_abs_diff((*ref_all)[0], (*ref_without)[0]), 0.1);  // A matters at probe 0
-    EXPECT_LT(max_abs_diff((*with)[0], (*ref_without)[0]), 1e-6);    // and is removed there
-    EXPECT_LT(max_abs_diff((*with)[1], (*ref_all)[1]), 1e-6);        // probe 1: unchanged
+    EXPECT_GT(test::max_abs_diff((*ref_all)[0], (*ref_without)[0]), 0.1);  // A matters at probe 0
+    EXPECT_LT(test::max_abs_diff((*with)[0], (*ref_without)[0]), 1e-6);    // and is removed there
+    EXPECT_LT(test::max_abs_diff((*with)[1], (*ref_all)[1]), 1e-6);        // probe 1: unchanged
     EXPECT_GT(rep.rays, 0u);
     // The same quad as a box of zero thickness gives the same bake (two twins of one plane).
     Scene as_box = s;
@@ -230,7 +208,7 @@ TEST(TriangleOccluder, QuadRemovesExactlyTheLightItHides) {
     as_box.occluders = {box};
     auto boxed = bake_scene(as_box);
     ASSERT_TRUE(boxed.ok());
-    for (size_t p = 0; p < 2; ++p) EXPECT_LT(max_abs_diff((*with)[p], (*boxed)[p]), 1e-6) << p;
+    for (size_t p = 0; p < 2; ++p) EXPECT_LT(test::max_abs_diff((*with)[p], (*boxed)[p]), 1e-6) << p;
 }
 
 // ---- JSON "mesh" occluders ---------------------------------------------------------------------

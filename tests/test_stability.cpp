@@ -73,18 +73,11 @@ std::vector<HardCase> hard_cases() {
     return c;
 }
 
-double max_abs(const Sh3Radiance& s) {
-    double m = 0;
-    for (int i = 0; i < 9; ++i)
-        for (int k = 0; k < 3; ++k) m = std::max(m, std::fabs(double(s[i][k])));
-    return m;
-}
-
 TEST(Stability, EveryCodecGivesFiniteBoundedDeterministicOutputOnHardCases) {
     const CodecOptions o;
     const auto dirs = fibonacci_sphere(64);
     for (const HardCase& hc : hard_cases()) {
-        const double in_max = max_abs(hc.hub);
+        const double in_max = test::max_abs(hc.hub);
         for (const Codec& c : codecs()) {
             SCOPED_TRACE(hc.name + " / " + std::string(c.name));
             std::vector<std::uint8_t> a(c.size_bytes), b(c.size_bytes);
