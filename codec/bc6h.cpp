@@ -584,6 +584,18 @@ struct PartitionMoments {
 };
 
 // The block part of PartitionMoments (mean, x, total) and the per-texel moments mom[i][k].
+// Sums of one per-texel moment over subset 1 of all 32 partitions: out[p] = sum_i in1[i][p] m_i,
+// with m_i = m[i * stride]. A 32-wide accumulator (8 vector registers) per moment, not a
+// read-modify-write of a whole moments x 32 table per texel.
+inline void subset1_sums(const PartitionTables& tb, const float* m, int stride, float out[32]) {
+    float acc[32] = {};
+    for (int i = 0; i < 16; ++i) {
+        const float v = m[i * stride];
+        for (int p = 0; p < 32; ++p) acc[p] += tb.in1[i][p] * v;
+    }
+    std::copy(acc, acc + 32, out);
+}
+
 void block_moments(const Target& t, PartitionMoments& pm, float mom[16][9]) {
     float* mean = pm.mean;
     float* total = pm.total;
@@ -619,16 +631,7 @@ void partition_scores(const Target& t, const float ax0[3], float score[32], Part
     auto& s1 = pm.s1;
     float mom[16][9];
     block_moments(t, pm, mom);
-    // One moment at a time with a 32-wide accumulator (8 vector registers), not a read-modify-
-    // write of the whole 9 x 32 table per texel.
-    for (int k = 0; k < 9; ++k) {
-        float acc[32] = {};
-        for (int i = 0; i < 16; ++i) {
-            const float m = mom[i][k];
-            for (int p = 0; p < 32; ++p) acc[p] += tb.in1[i][p] * m;
-        }
-        std::copy(acc, acc + 32, s1[k]);
-    }
+    for (int k = 0; k < 9; ++k) subset1_sums(tb, &mom[0][k], 9, s1[k]);
     const float v0x = ax0[0], v0y = ax0[1], v0z = ax0[2];
     // Straight-line per partition (no branches) so that the loop vectorises.
     auto residual = [=](float a0, float a1, float a2, float a3, float a4, float a5, float a6, float a7, float a8,
@@ -710,14 +713,7 @@ void partition_scores_2d(const Target& t, const float ax0[3], float score[32], P
     for (int q = 0; q < 5; ++q)
         for (int i = 0; i < 16; ++i) tot[q] += m5[q][i];
     float s1[5][32];
-    for (int q = 0; q < 5; ++q) {
-        float acc[32] = {};
-        for (int i = 0; i < 16; ++i) {
-            const float m = m5[q][i];
-            for (int p = 0; p < 32; ++p) acc[p] += tb.in1[i][p] * m;
-        }
-        std::copy(acc, acc + 32, s1[q]);
-    }
+    for (int q = 0; q < 5; ++q) subset1_sums(tb, m5[q], 1, s1[q]);
     // Residual per subset: (a + c) / 2 - sqrt(((a - c) / 2)^2 + b^2); the square roots in a
     // separate pass over a vector of arguments >= 0.
     float half_tr[64], disc[64];
