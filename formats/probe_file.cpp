@@ -480,16 +480,18 @@ Result<ProbeList> parse_probe_json_impl(std::span<const std::uint8_t> bytes, con
         for (size_t r = 0; r < 9; ++r) {
             auto row = json_vec3(sh[r], name, where + ".sh3[" + std::to_string(r) + "]");
             if (!row) return row.error();
-            for (int k = 0; k < 3; ++k) {
-                const double v = (*row)[k];
-                if (std::fabs(v) > 3.0e38) return err(ErrorCode::kInvalidValue, name, where + ": value outside float range");
-                c[static_cast<int>(r)][k] = static_cast<float>(v);
-            }
+            for (int k = 0; k < 3; ++k) c[static_cast<int>(r)][k] = static_cast<float>((*row)[k]);  // in range (json_vec3)
         }
         if (irradiance) {
             Sh3Irradiance e;
             e.c = c.c;
             c = to_radiance(e);
+            // Radiance is irradiance divided by the band scales (x 3/2, x 4): it can leave the range.
+            for (const Rgb& row : c.c)
+                for (int k = 0; k < 3; ++k)
+                    if (!std::isfinite(row[k]))
+                        return err(ErrorCode::kInvalidValue, name,
+                                   where + ".sh3 as radiance (irradiance / band scale) is outside the 32-bit float range");
         }
         list.probes[i] = c;
         if (list.layout.kind == ProbeLayoutKind::kPositions) {

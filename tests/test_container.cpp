@@ -349,6 +349,12 @@ TEST(ProbeJson, RoundTripsExactlyAndChecksTheSchema) {
               ErrorCode::kBadFormat);
     EXPECT_EQ(code(R"({"probes":[{"sh3":[[1e39,1,1],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0]]}]})"),
               ErrorCode::kInvalidValue);
+    // Positions must fit a float too (a fuzzer's 160-digit position became inf), and irradiance
+    // must still fit once converted to radiance (L2 x 4).
+    EXPECT_EQ(code(R"({"probes":[{"position":[1,2,1e39],"sh3":[[1,1,1],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0]]}]})"),
+              ErrorCode::kInvalidValue);
+    EXPECT_EQ(code(R"({"kind":"irradiance","probes":[{"sh3":[[1,1,1],[0,0,0],[0,0,0],[0,0,0],[1e38,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0]]}]})"),
+              ErrorCode::kInvalidValue);
     ProbeJsonLimits lim;
     lim.max_probes = 2;
     EXPECT_EQ(parse_probe_json(as_bytes(text), "mem", lim).error().code, ErrorCode::kTooLarge);
