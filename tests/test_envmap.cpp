@@ -211,6 +211,22 @@ std::vector<BadFileCase> bad_files() {
         const char attr[] = "manifest\0idmanifest\0\x08\0\0\0\0\0\0\0\0\0\0\0";
         with_manifest.insert(with_manifest.begin() + 8, attr, attr + sizeof attr - 1);
         cases.push_back({"exr_idmanifest", with_manifest, ErrorCode::kUnsupported, cli::kExitUnsupported});
+        // Self-delimiting values that disagree with their declared size.
+        auto with_attribute = [&](const std::string& bytes) {
+            auto out = exr;
+            out.insert(out.begin() + 8, bytes.begin(), bytes.end());
+            return out;
+        };
+        using namespace std::string_literals;
+        // preview: 2 x 2 RGBA needs 8 + 16 bytes, 12 declared
+        cases.push_back({"exr_preview_size", with_attribute("thumb\0preview\0\x0c\0\0\0\x02\0\0\0\x02\0\0\0\0\0\0\0"s),
+                         ErrorCode::kBadFormat, cli::kExitInvalidInput});
+        // stringvector: an entry of 100 bytes in an 8-byte value
+        cases.push_back({"exr_stringvector_entry", with_attribute("names\0stringvector\0\x08\0\0\0\x64\0\0\0abcd"s),
+                         ErrorCode::kBadFormat, cli::kExitInvalidInput});
+        // floatvector: 6 bytes is not a whole number of floats
+        cases.push_back({"exr_floatvector_size", with_attribute("weights\0floatvector\0\x06\0\0\0\0\0\0\0\0\0"s),
+                         ErrorCode::kBadFormat, cli::kExitInvalidInput});
     }
     const std::string hdr_huge = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n";
     cases.push_back({"hdr_huge", {hdr_huge.begin(), hdr_huge.end()}, ErrorCode::kTooLarge, cli::kExitTooLarge});
