@@ -54,7 +54,15 @@ int run(const Options& o) {
     const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     SceneLoadOptions lo;
     lo.threads = threads;
-    auto scene = read_any_scene_file(o.scene, lo);
+    // A glTF input is read once: it is both the scene and, for -o .glb/.gltf, the host asset.
+    const bool gltf_in = is_gltf_path(o.scene);
+    std::vector<std::uint8_t> input_asset;
+    if (gltf_in) {
+        auto bytes = read_file_bytes(o.scene, GltfLimits{}.max_file_bytes);
+        if (!bytes) return report(bytes.error());
+        input_asset = std::move(bytes).value();
+    }
+    auto scene = gltf_in ? parse_scene_gltf(input_asset, o.scene, lo) : read_scene_file(o.scene, lo);
     if (!scene) return report(scene.error());
     BakeOptions bo;
     bo.threads = threads;
@@ -95,10 +103,8 @@ int run(const Options& o) {
         // a minimal asset for a JSON scene.
         std::vector<std::uint8_t> host;
         std::string host_path = o.output;
-        if (is_gltf_path(o.scene)) {
-            auto bytes = read_file_bytes(o.scene, GltfLimits{}.max_file_bytes);
-            if (!bytes) return report(bytes.error());
-            host = std::move(bytes).value();
+        if (gltf_in) {
+            host = std::move(input_asset);
             host_path = o.scene;
         } else {
             const std::string minimal =
@@ -112,7 +118,7 @@ int run(const Options& o) {
         if (Status st = write_file_atomic(o.output, *out); !st) return report_output(st.error());
         std::printf("%s: %llu probes as %s embedded in %s (%zu bytes)\n", o.output.c_str(),
                     static_cast<unsigned long long>(set->count), o.to.c_str(),
-                    is_gltf_path(o.scene) ? "a copy of the input asset" : "a minimal glTF", out->size());
+                    gltf_in ? "a copy of the input asset" : "a minimal glTF", out->size());
         return kExitOk;
     }
     ProbeFileWriteOptions wo;

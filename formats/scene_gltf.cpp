@@ -517,8 +517,4 @@ bool is_gltf_path(const std::string& path) {
     return ext == ".gltf" || ext == ".glb";
 }
 
-Result<Scene> read_any_scene_file(const std::string& path, const SceneLoadOptions& options) {
-    return is_gltf_path(path) ? read_scene_gltf_file(path, options) : read_scene_file(path, options);
-}
-
 }  // namespace zhc

@@ -42,7 +42,5 @@ Result<Scene> read_scene_gltf_file(const std::string& path, const SceneLoadOptio
 
 // True for paths ending in .gltf or .glb (any case).
 bool is_gltf_path(const std::string& path);
-// A scene file by extension: .gltf/.glb -> read_scene_gltf_file, anything else -> read_scene_file.
-Result<Scene> read_any_scene_file(const std::string& path, const SceneLoadOptions& options = {});
 
 }  // namespace zhc
