@@ -1,15 +1,18 @@
 // zhc lightmap {encode, decode, audit, synth}: IrradZ directional lightmaps (docs/irradz.md,
 // docs/lightmap-formats.md). Input: an SH lightmap EXR (channels sh0.R .. sh8.B, tangent-frame SH3
 // radiance). Output: PREFIX.iz.ktx2 (BC6H_UFLOAT), PREFIX.d.ktx2 (BC5_UNORM), PREFIX.wa.ktx2
-// (BC4_UNORM): 2.5 bytes per texel.
+// (BC4_UNORM): 2.5 bytes per texel; with --container dds the same blocks in PREFIX.{iz,d,wa}.dds.
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
 #include "codec/lightmap.h"
+#include "formats/dds.h"
 #include "formats/envmap.h"
+#include "formats/file_io.h"
 #include "formats/ktx2.h"
 #include "formats/lightmap_exr.h"
 
@@ -21,6 +24,7 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 
 struct Options {
     std::string input, output, quality = "default", solve = "search";
+    std::string container;  // encode: "" = ktx2; decode: "" = auto
     int threads = 1, size = 256, stride = 17;
     bool json = false;
 };
@@ -50,14 +54,22 @@ int run_encode(const Options& o) {
     const auto t1 = Clock::now();
     const auto c = lightmap::compress(planes, bc6h_quality(o.quality), bc45_quality(o.quality), o.threads);
     const double t_bc = since(t1);
-    const std::pair<std::string, Ktx2Image> files[3] = {{o.output + ".iz.ktx2", ktx(kVkFormatBc6hUfloat, c, c.bc6h)},
-                                                        {o.output + ".d.ktx2", ktx(kVkFormatBc5Unorm, c, c.bc5)},
-                                                        {o.output + ".wa.ktx2", ktx(kVkFormatBc4Unorm, c, c.bc4)}};
-    for (const auto& [path, img] : files)
-        if (auto s = write_ktx2(path, img); !s) return report_output(s.error());
+    const bool dds = o.container == "dds";
+    const std::string ext = dds ? ".dds" : ".ktx2";
+    const std::pair<std::string, Ktx2Image> images[3] = {{o.output + ".iz" + ext, ktx(kVkFormatBc6hUfloat, c, c.bc6h)},
+                                                         {o.output + ".d" + ext, ktx(kVkFormatBc5Unorm, c, c.bc5)},
+                                                         {o.output + ".wa" + ext, ktx(kVkFormatBc4Unorm, c, c.bc4)}};
+    // All three files or none: encoded in memory first, then written as one unit.
+    std::vector<std::pair<std::string, std::vector<std::uint8_t>>> files;
+    for (const auto& [path, img] : images) {
+        auto bytes = dds ? encode_dds(img) : encode_ktx2(img);
+        if (!bytes) return report_output(make_error(bytes.error().code, path + ": " + bytes.error().message));
+        files.emplace_back(path, std::move(*bytes));
+    }
+    if (auto s = write_files_atomic(files); !s) return report_output(s.error());
     const double texels = double(lm->width) * lm->height;
-    std::printf("%s: %dx%d texels -> %s.{iz,d,wa}.ktx2 (%zu bytes of blocks, %.3f bytes/texel)\n", o.input.c_str(),
-                lm->width, lm->height, o.output.c_str(), c.bc6h.size() + c.bc5.size() + c.bc4.size(),
+    std::printf("%s: %dx%d texels -> %s.{iz,d,wa}%s (%zu bytes of blocks, %.3f bytes/texel)\n", o.input.c_str(),
+                lm->width, lm->height, o.output.c_str(), ext.c_str(), c.bc6h.size() + c.bc5.size() + c.bc4.size(),
                 double(c.bc6h.size() + c.bc5.size() + c.bc4.size()) / texels);
     std::printf("IrradZ fit %.3f s (%.2f Mtexel/s), block compression (%s) %.3f s (%.2f Mtexel/s), %d thread(s)\n", t_fit,
                 texels / t_fit / 1e6, o.quality.c_str(), t_bc, texels / t_bc / 1e6, o.threads);
@@ -65,15 +77,29 @@ int run_encode(const Options& o) {
 }
 
 int run_decode(const Options& o) {
+    // --container auto: KTX2 (the default container) when PREFIX.iz.ktx2 exists, else DDS when
+    // PREFIX.iz.dds exists; with both sets present KTX2 wins (--container dds reads the DDS set).
+    std::string container = o.container;
+    if (container.empty() || container == "auto") {
+        std::error_code ec;
+        if (std::filesystem::exists(o.input + ".iz.ktx2", ec)) container = "ktx2";
+        else if (std::filesystem::exists(o.input + ".iz.dds", ec)) container = "dds";
+        else return report(make_error(ErrorCode::kIoError, o.input + ": neither " + o.input + ".iz.ktx2 nor " + o.input + ".iz.dds exists"));
+    }
+    const bool dds = container == "dds";
+    const std::string ext = dds ? ".dds" : ".ktx2";
     lightmap::Compressed c;
     const std::pair<std::string, std::uint32_t> files[3] = {
-        {o.input + ".iz.ktx2", kVkFormatBc6hUfloat}, {o.input + ".d.ktx2", kVkFormatBc5Unorm}, {o.input + ".wa.ktx2", kVkFormatBc4Unorm}};
+        {o.input + ".iz" + ext, kVkFormatBc6hUfloat}, {o.input + ".d" + ext, kVkFormatBc5Unorm}, {o.input + ".wa" + ext, kVkFormatBc4Unorm}};
     for (int f = 0; f < 3; ++f) {
-        auto img = read_ktx2(files[f].first);
+        auto img = dds ? read_dds(files[f].first) : read_ktx2(files[f].first);
         if (!img) return report(img.error());
         if (img->vk_format != files[f].second)
-            return report(make_error(ErrorCode::kBadFormat, files[f].first + ": vkFormat " + std::to_string(img->vk_format) +
-                                                                 ", expected " + std::to_string(files[f].second)));
+            return report(make_error(ErrorCode::kBadFormat,
+                                     files[f].first + (dds ? ": dxgiFormat " + std::to_string(dxgi_format_for_vk(img->vk_format)) +
+                                                                 ", expected " + std::to_string(dxgi_format_for_vk(files[f].second))
+                                                           : ": vkFormat " + std::to_string(img->vk_format) + ", expected " +
+                                                                 std::to_string(files[f].second))));
         if (f == 0) {
             c.width = img->width;
             c.height = img->height;
@@ -85,7 +111,7 @@ int run_decode(const Options& o) {
     }
     const auto planes = lightmap::decompress(c);
     if (auto s = write_irradz_exr(o.output, planes); !s) return report_output(s.error());
-    std::printf("%s.{iz,d,wa}.ktx2: %dx%d -> %s (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)\n", o.input.c_str(), c.width, c.height,
+    std::printf("%s.{iz,d,wa}%s: %dx%d -> %s (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)\n", o.input.c_str(), ext.c_str(), c.width, c.height,
                 o.output.c_str());
     return kExitOk;
 }
@@ -153,13 +179,17 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
             ->check(CLI::IsMember({"fast", "default", "slow"}));
         s->add_option("--threads", o->threads, "worker threads (output identical for any count)")->check(CLI::Range(1, 256));
     };
-    CLI::App* enc = lm->add_subcommand("encode", "SH lightmap EXR -> PREFIX.iz.ktx2 (BC6H) + PREFIX.d.ktx2 (BC5) + PREFIX.wa.ktx2 (BC4)");
+    CLI::App* enc = lm->add_subcommand("encode", "SH lightmap EXR -> PREFIX.iz.ktx2 (BC6H) + PREFIX.d.ktx2 (BC5) + PREFIX.wa.ktx2 (BC4), or .dds");
     enc->add_option("IN", o->input, "SH lightmap EXR (channels sh0.R .. sh8.B)")->required();
     enc->add_option("-o,--output", o->output, "output prefix")->required();
+    enc->add_option("--container", o->container, "ktx2 (default) | dds (DX10 header): PREFIX.{iz,d,wa}.ktx2 or .dds")
+        ->check(CLI::IsMember({"ktx2", "dds"}));
     enc->add_option("--solve", o->solve, "search (hemispherical Gram + golden section) | old")->check(CLI::IsMember({"search", "old"}));
     quality(enc);
-    CLI::App* dec = lm->add_subcommand("decode", "PREFIX.{iz,d,wa}.ktx2 -> IrradZ EXR (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)");
+    CLI::App* dec = lm->add_subcommand("decode", "PREFIX.{iz,d,wa}.ktx2 or .dds -> IrradZ EXR (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)");
     dec->add_option("PREFIX", o->input, "prefix given to encode")->required();
+    dec->add_option("--container", o->container, "auto (default: .ktx2 if PREFIX.iz.ktx2 exists, else .dds) | ktx2 | dds")
+        ->check(CLI::IsMember({"auto", "ktx2", "dds"}));
     dec->add_option("-o,--output", o->output, "output EXR")->required();
     CLI::App* aud = lm->add_subcommand("audit", "hemispherical error before/after block compression, PSNR per texture, speed");
     aud->add_option("IN", o->input, "SH lightmap EXR")->required();

@@ -80,6 +80,49 @@ Status write_file_atomic(const std::string& path, const std::vector<std::uint8_t
     });
 }
 
+Status write_files_atomic(const std::vector<std::pair<std::string, std::vector<std::uint8_t>>>& files) {
+    std::vector<std::string> temps;
+    std::error_code ec;
+    auto remove_all = [&](const std::vector<std::string>& paths) {
+        for (const auto& p : paths) fs::remove(p, ec);
+    };
+    for (const auto& [path, bytes] : files) {
+        const std::string tmp = temporary_name_for(path);
+        std::FILE* f = std::fopen(tmp.c_str(), "wb");
+        if (!f) {
+            remove_all(temps);
+            return make_error(ErrorCode::kIoError, path + ": cannot create (" + std::strerror(errno) + ")");
+        }
+        temps.push_back(tmp);
+        const bool ok = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+        const bool flushed = std::fflush(f) == 0;
+        const bool closed = std::fclose(f) == 0;
+        if (!ok || !flushed || !closed) {
+            remove_all(temps);
+            return make_error(ErrorCode::kIoError, path + ": write failed");
+        }
+    }
+    // A directory in the way would only show at the rename; look first so that the common case
+    // fails before anything is replaced.
+    for (const auto& [path, bytes] : files)
+        if (fs::is_directory(path, ec)) {
+            remove_all(temps);
+            return make_error(ErrorCode::kIoError, path + ": is a directory");
+        }
+    std::vector<std::string> renamed;
+    for (size_t i = 0; i < files.size(); ++i) {
+        std::error_code rec;
+        fs::rename(temps[i], files[i].first, rec);
+        if (rec) {
+            remove_all(std::vector<std::string>(temps.begin() + static_cast<std::ptrdiff_t>(i), temps.end()));
+            remove_all(renamed);
+            return make_error(ErrorCode::kIoError, files[i].first + ": cannot write (" + rec.message() + ")");
+        }
+        renamed.push_back(files[i].first);
+    }
+    return Ok{};
+}
+
 std::string file_extension(const std::string& path) {
     std::string ext = fs::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
