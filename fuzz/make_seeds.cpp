@@ -1,5 +1,6 @@
 // Writes the seed corpora of the fuzzers into fuzz/corpus/ (run from the repository root:
 // build/fuzz/zhc_make_fuzz_seeds fuzz/corpus). Seeds are small valid inputs; libFuzzer mutates them.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include "codec/sky.h"
 #include "formats/envmap.h"
 #include "formats/file_io.h"
+#include "formats/dds.h"
 #include "formats/ktx2.h"
 #include "codec/bc6h.h"
 #include "codec/bc45.h"
@@ -64,6 +66,34 @@ int main(int argc, char** argv) {
         k.blocks = blocks;
         auto bytes = encode_ktx2(k);
         ok = ok && bytes && write_file_atomic(root + "/fuzz_ktx2/format" + std::to_string(format) + ".ktx2", *bytes);
+    }
+    // DDS: the same three textures (DX10 header), one with partial blocks, and the legacy
+    // FourCC layouts ('ATI1' BC4, 'ATI2' BC5: no extension header, data at byte 128).
+    fs::create_directories(root + "/fuzz_dds");
+    for (const auto& [format, blocks] : textures) {
+        Ktx2Image k;
+        k.vk_format = format;
+        k.width = 8;
+        k.height = 8;
+        k.blocks = blocks;
+        auto bytes = encode_dds(k);
+        ok = ok && bytes && write_file_atomic(root + "/fuzz_dds/dxgi" + std::to_string(dxgi_format_for_vk(format)) + ".dds", *bytes);
+        if (bytes && format != kVkFormatBc6hUfloat) {
+            std::vector<std::uint8_t> legacy(bytes->begin(), bytes->begin() + 128);
+            legacy.insert(legacy.end(), bytes->begin() + static_cast<std::ptrdiff_t>(kDdsDataOffset), bytes->end());
+            const char* four = format == kVkFormatBc4Unorm ? "ATI1" : "ATI2";
+            std::copy(four, four + 4, legacy.begin() + 84);
+            ok = ok && write_file_atomic(root + "/fuzz_dds/" + four + ".dds", legacy);
+        }
+    }
+    {
+        Ktx2Image k;
+        k.vk_format = kVkFormatBc6hUfloat;
+        k.width = 5;
+        k.height = 3;
+        k.blocks = bc6h::encode_image(rgb.data(), 5, 3, bc6h::Quality::kFast);
+        auto bytes = encode_dds(k);
+        ok = ok && bytes && write_file_atomic(root + "/fuzz_dds/odd5x3.dds", *bytes);
     }
     for (int kind = 0; kind < 4; ++kind) {
         std::vector<std::uint8_t> b(1 + 96);
