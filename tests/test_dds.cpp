@@ -20,16 +20,25 @@ bool g_watch_allocations = false;
 std::size_t g_largest_allocation = 0;
 }  // namespace
 
-void* operator new(std::size_t n) {
+// noinline: GCC would otherwise see free() applied to operator new's result and warn.
+[[gnu::noinline]] void* operator new(std::size_t n) {
     if (g_watch_allocations && n > g_largest_allocation) g_largest_allocation = n;
     if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
     throw std::bad_alloc();
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace zhc {
 namespace {
+
+// test::temp_dir keeps what earlier runs left; these tests check which files exist, so they start empty.
+std::string fresh_dir(const std::string& name) {
+    const std::string dir = test::temp_dir(name);
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
 
 Ktx2Image sample(std::uint32_t fmt, int w, int h) {
     Ktx2Image img;
@@ -54,8 +63,8 @@ void put_fourcc(std::vector<std::uint8_t>& b, size_t off, const char* s) {
 // A legacy (no DX10 header) file: the DX10 file with its extension header cut out and the FourCC
 // replaced, data at byte 128.
 std::vector<std::uint8_t> legacy(const std::vector<std::uint8_t>& dx10, const char* four) {
-    std::vector<std::uint8_t> b(dx10.begin(), dx10.begin() + 128);
-    b.insert(b.end(), dx10.begin() + 148, dx10.end());
+    std::vector<std::uint8_t> b = dx10;
+    b.erase(b.begin() + 128, b.begin() + 148);
     put_fourcc(b, 84, four);
     return b;
 }
@@ -95,7 +104,7 @@ TEST(Dds, HeaderFieldsAsDocumented) {
 }
 
 TEST(Dds, RoundTripsAllThreeFormatsAtOddSizes) {
-    const std::string dir = test::temp_dir("dds");
+    const std::string dir = fresh_dir("dds");
     for (const auto fmt : {kVkFormatBc4Unorm, kVkFormatBc5Unorm, kVkFormatBc6hUfloat})
         for (auto [w, h] : {std::pair{5, 3}, std::pair{1, 1}, std::pair{17, 9}, std::pair{4, 4}, std::pair{64, 32}}) {
             const Ktx2Image img = sample(fmt, w, h);
@@ -343,7 +352,7 @@ TEST(Dds, SamePayloadAsKtx2OnRealLightmaps) {
 }
 
 TEST(WriteFilesAtomic, AllOrNothing) {
-    const std::string dir = test::temp_dir("write_files_atomic");
+    const std::string dir = fresh_dir("write_files_atomic");
     const std::vector<std::uint8_t> x{1, 2, 3}, y{4, 5};
     ASSERT_TRUE(write_files_atomic({{dir + "/a", x}, {dir + "/b", y}}).ok());
     EXPECT_EQ(test::read_bytes(dir + "/a"), x);
@@ -366,7 +375,7 @@ TEST(WriteFilesAtomic, AllOrNothing) {
 }
 
 TEST(LightmapCliDds, EncodeDecodeMatchesKtx2OnRealData) {
-    const std::string dir = test::temp_dir("lightmap_cli_dds");
+    const std::string dir = fresh_dir("lightmap_cli_dds");
     const std::string map = test::envmap_paths().back();
     // 37 x 37: partial blocks at the right and bottom edges.
     auto r = test::run_zhc({"lightmap", "synth", map, "-o", dir + "/lm.exr", "--size", "37"});
@@ -452,6 +461,12 @@ TEST(LightmapCliDds, EncodeDecodeMatchesKtx2OnRealData) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/p.d.dds"));
     for (const auto& e : std::filesystem::directory_iterator(dir))
         EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+    // The KTX2 path goes through the same all-or-nothing write.
+    std::filesystem::create_directory(dir + "/p.wa.ktx2");
+    r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/p", "--quality", "fast"});
+    EXPECT_EQ(r.exit_code, 7);
+    EXPECT_FALSE(std::filesystem::exists(dir + "/p.iz.ktx2"));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/p.d.ktx2"));
     r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/q", "--container", "png"});
     EXPECT_EQ(r.exit_code, 2);
     r = test::run_zhc({"lightmap", "decode", dir + "/d", "-o", dir + "/q.exr", "--container", "png"});
