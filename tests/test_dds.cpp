@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <new>
 #include <random>
@@ -349,6 +350,107 @@ TEST(Dds, SamePayloadAsKtx2OnRealLightmaps) {
             EXPECT_EQ(a->height, b->height);
         }
     }
+}
+
+// An independent DDS reader: Pillow (Debian's python3-pil, scripts/packages-test.txt) opens the
+// files zhc writes and decodes their blocks with its own BCn decoder; every 8-bit value it returns
+// must be exactly what zhc's decoder predicts under Pillow's documented conversions (BC4/BC5:
+// integer palette (6 a0 + a1) / 7 etc. truncated, i.e. floor(255 v); BC6H: the same half bits,
+// then (uint8)(min(v, 1) * 255), truncated). Pillow 9.4 reads BC4 only as legacy 'ATI1', so the
+// BC4 plane is also written that way; the DX10 BC4 file is checked when the Pillow at hand reads it.
+constexpr const char* kPillowScript = R"PY(
+import struct, sys
+from PIL import Image
+failures = 0
+for spec in sys.argv[1:]:
+    kind, dds, ref = spec.split(",")
+    try:
+        im = Image.open(dds)
+        im.load()
+    except NotImplementedError as e:
+        if kind == "bc4_optional":
+            print("%s: not read by this Pillow (%s)" % (dds, e))
+            continue
+        raise
+    w, h = im.size
+    data = open(ref, "rb").read()
+    bad = below = 0
+    for i in range(w * h):
+        p = im.getpixel((i % w, i // w))
+        if kind == "bc6h":
+            bits = struct.unpack_from("<3H", data, 6 * i)
+            f = lambda b: 255 if struct.unpack("<e", struct.pack("<H", b))[0] > 1 else int(struct.unpack("<e", struct.pack("<H", b))[0] * 255)
+            want = [f(b) for b in bits]
+            got = list(p[:3])
+            # Pillow interpolates BC6H endpoints as (a (64 - w) + b w) >> 6, without the format's
+            # + 32 rounding (zhc and Mesa round), so its half can be one unit below zhc's.
+            if got != want and all(g == x or (b > 0 and g == f(b - 1)) for g, x, b in zip(got, want, bits)):
+                below += 1
+                continue
+        elif kind == "bc5":
+            zhc = struct.unpack_from("<2f", data, 8 * i)
+            want = [int(255 * v + 1e-3) for v in zhc]
+            got = list(p[:2])
+        else:
+            zhc = struct.unpack_from("<f", data, 4 * i)
+            want = [int(255 * zhc[0] + 1e-3)]
+            got = [p if isinstance(p, int) else p[0]]
+        if got != want:
+            bad += 1
+            if bad <= 3:
+                print("%s texel %d: pillow %s, zhc predicts %s" % (dds, i, got, want))
+    print("%s: %dx%d %s, %d of %d texels differ%s" % (dds, w, h, im.mode, bad, w * h,
+          ", %d one half-float unit below (Pillow's unrounded interpolation)" % below if kind == "bc6h" else ""))
+    failures += bad
+sys.exit(1 if failures else 0)
+)PY";
+
+TEST(Dds, PillowReadsWhatZhcWrites) {
+    const std::string python = "/usr/bin/python3";
+    if (std::system((python + " -c 'import PIL.DdsImagePlugin' > /dev/null 2>&1").c_str()) != 0)
+        GTEST_SKIP() << "Debian's python3-pil is not installed (scripts/packages-test.txt)";
+    const std::string dir = fresh_dir("dds_pillow");
+    const Image img = test::load_envmap(test::envmap_paths().front());
+    const Sh3Radiance world = project_latlong(img.rgb.data(), img.width, img.height, static_cast<size_t>(img.width) * 3, 2);
+    const auto c = lightmap::compress(lightmap::encode_planes(lightmap::synthesize_sphere(world, 37, 23, 2), {}, 2),
+                                      bc6h::Quality::kFast, bc45::Quality::kFast, 2);
+    auto write = [&](const std::string& name, std::uint32_t fmt, const std::vector<std::uint8_t>& blocks) {
+        Ktx2Image k;
+        k.vk_format = fmt;
+        k.width = c.width;
+        k.height = c.height;
+        k.blocks = blocks;
+        EXPECT_TRUE(write_dds(dir + "/" + name, k).ok());
+    };
+    write("iz.dds", kVkFormatBc6hUfloat, c.bc6h);
+    write("d.dds", kVkFormatBc5Unorm, c.bc5);
+    write("wa.dds", kVkFormatBc4Unorm, c.bc4);
+    test::write_bytes(dir + "/wa_ati1.dds", legacy(test::read_bytes(dir + "/wa.dds"), "ATI1"));
+    // zhc's decoded values, little-endian: BC6H as half bits, BC4/BC5 as floats.
+    const auto halfs = bc6h::decode_image(c.bc6h.data(), c.bc6h.size(), c.width, c.height);
+    std::vector<std::uint8_t> ref(halfs.size() * 2);
+    for (size_t i = 0; i < halfs.size(); ++i) ref[2 * i] = halfs[i] & 0xFF, ref[2 * i + 1] = halfs[i] >> 8;
+    test::write_bytes(dir + "/iz.ref", ref);
+    for (int ch : {1, 2}) {
+        const auto& blocks = ch == 1 ? c.bc4 : c.bc5;
+        const auto v = bc45::decode_image(blocks.data(), blocks.size(), ch, c.width, c.height);
+        std::vector<std::uint8_t> bytes(v.size() * 4);
+        std::memcpy(bytes.data(), v.data(), bytes.size());  // x86-64 and every Debian target zhc builds on: little-endian
+        test::write_bytes(dir + (ch == 1 ? "/wa.ref" : "/d.ref"), bytes);
+    }
+    {
+        std::FILE* f = std::fopen((dir + "/check.py").c_str(), "w");
+        ASSERT_NE(f, nullptr);
+        std::fputs(kPillowScript, f);
+        std::fclose(f);
+    }
+    const std::string cmd = python + " " + dir + "/check.py bc6h," + dir + "/iz.dds," + dir + "/iz.ref bc5," + dir + "/d.dds," +
+                            dir + "/d.ref bc4," + dir + "/wa_ati1.dds," + dir + "/wa.ref bc4_optional," + dir + "/wa.dds," +
+                            dir + "/wa.ref > " + dir + "/out.txt 2>&1";
+    const int rc = std::system(cmd.c_str());
+    const auto out = test::read_bytes(dir + "/out.txt");
+    std::printf("%s", std::string(out.begin(), out.end()).c_str());
+    EXPECT_EQ(rc, 0);
 }
 
 TEST(WriteFilesAtomic, AllOrNothing) {
