@@ -5,7 +5,8 @@
 // thread's CPU time (CLOCK_THREAD_CPUTIME_ID; every encode runs on that one thread): Mpixel/s per
 // thread, not depressed by other processes taking the CPU away (the 2 shared cores are often
 // loaded); cache and SMT contention still show.
-//   bench_bc6h [--maps DIR] [--lightmap-size N] [--exhaustive-rows N] [--only QUALITY]
+//   bench_bc6h [--maps DIR] [--lightmap-size N] [--exhaustive-rows N] [--only QUALITY] [--isa baseline|avx2]
+// --isa picks the encoder twin (default: the best this CPU runs; both write the same bytes).
 // --only runs the listed qualities (e.g. "mode11,fast"; the others print 0): for profiling
 // and quick tuning runs (the ratios and dB differences then need a full run).
 #include <algorithm>
@@ -42,9 +43,11 @@ struct Row {
     double psnr = 0, mpix = 0;
 };
 
+bc6h::Isa g_isa = bc6h::best_isa();
+
 Row run_bc6h(const std::vector<float>& rgb, int w, int h, bc6h::Quality q) {
     const double t0 = thread_seconds();
-    const auto blocks = bc6h::encode_image(rgb.data(), w, h, q, 1);
+    const auto blocks = bc6h::encode_image(rgb.data(), w, h, q, 1, g_isa);
     const double s = seconds_since(t0);
     const auto dec = bc6h::decode_image(blocks.data(), blocks.size(), w, h);
     Row r;
@@ -102,6 +105,7 @@ int main(int argc, char** argv) {
         if (!std::strcmp(argv[i], "--lightmap-size")) lm_size = std::atoi(argv[i + 1]);
         if (!std::strcmp(argv[i], "--exhaustive-rows")) ex_rows = std::atoi(argv[i + 1]);
         if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
+        if (!std::strcmp(argv[i], "--isa")) g_isa = std::strcmp(argv[i + 1], "baseline") ? bc6h::Isa::kAvx2 : bc6h::Isa::kBaseline;
     }
     std::vector<std::string> paths;
     for (const auto& e : std::filesystem::directory_iterator(dir))
@@ -110,7 +114,9 @@ int main(int argc, char** argv) {
     const bc6h::Quality qs[4] = {bc6h::Quality::kMode11, bc6h::Quality::kFast, bc6h::Quality::kDefault,
                                  bc6h::Quality::kExhaustive};
     const char* qn[4] = {"mode11", "fast", "default", "exhaustive"};
-    std::printf("BC6H log2-PSNR (dB, l(v) = log2(max(v, 2^-14)), peak 30) and Mpixel/s on 1 thread (thread CPU time)\n");
+    if (!bc6h::isa_supported(g_isa)) g_isa = bc6h::Isa::kBaseline;
+    std::printf("BC6H log2-PSNR (dB, l(v) = log2(max(v, 2^-14)), peak 30) and Mpixel/s on 1 thread (thread CPU time); encoder: %s\n",
+                bc6h::isa_name(g_isa));
     std::printf("%-22s | %-15s | %-15s | %-15s | %-15s\n", "image", qn[0], qn[1], qn[2], qn[3]);
     double sum[2][4][2] = {};
     int count[2] = {0, 0};
