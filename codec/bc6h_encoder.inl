@@ -33,6 +33,10 @@ struct Encoded {
     return q;
 }
 
+struct SubsetFit {
+    float a[3], b[3];  // unquantized-domain endpoints
+};
+
 // Endpoints of the line that best fits the subset's texels (principal axis by power iteration),
 // spanning the extreme projections. In the unquantized domain.
 // Branch-free over the mask (texels outside weigh 0), one pass for the moments: coordinates are
@@ -84,9 +88,6 @@ void initial_endpoints(const Target& t, std::uint16_t mask, float a[3], float b[
     }
 }
 
-struct SubsetFit {
-    float a[3], b[3];  // unquantized-domain endpoints
-};
 
 // Quantize endpoints for mode `md` (resolving the delta constraints by clamping), assign indices
 // (anchor texels restricted to the first half) and measure the error exactly.
@@ -96,10 +97,13 @@ struct SubsetFit {
 // projection (kNearest, computed by nearest_index). The palette points lie on a line up to the decoder's integer
 // rounding (< 1 half ULP), and for collinear points the squared distance is |d|^2 (t - t*)^2 +
 // const, so the nearest weight to the projection t* is the best index up to that rounding.
-std::int64_t evaluate(const Target& t, int mode_i, int partition, SubsetFit fit[2], Encoded& out, bool search = true) {
+// Compiled per subset count NS (= md.two_subsets + 1) and index selection, so that the one-subset
+// loops carry no second subset and no selects (evaluate below picks the instance).
+template <int NS, bool search>
+std::int64_t evaluate_ns(const Target& t, int mode_i, int partition, SubsetFit fit[2], Encoded& out) {
     const Mode& md = modes()[static_cast<size_t>(mode_i)];
-    const int ns = md.two_subsets ? 2 : 1;
-    const int ib = md.two_subsets ? 3 : 4, n = 1 << ib;
+    constexpr int ns = NS;
+    constexpr int ib = NS == 2 ? 3 : 4, n = 1 << ib;
     const std::uint16_t pmask = md.two_subsets ? kPartition[partition] : 0;
     const int anchor[2] = {0, md.two_subsets ? kAnchor2[partition] : 0};
     int q[4][3];
@@ -162,31 +166,33 @@ std::int64_t evaluate(const Target& t, int mode_i, int partition, SubsetFit fit[
         // intermediate is an integer below 2^24 (a, b <= 65535). Squared differences are < 2^30,
         // their sum over 3 channels < 2^32: unsigned 32-bit.
         float pr[2][16];
-        for (int ss = 0; ss < 2; ++ss) {
-            const int so = ss < ns ? ss : 0;
+        for (int ss = 0; ss < ns; ++ss)
             for (int i = 0; i < 16; ++i)
-                pr[ss][i] = (static_cast<float>(t.h[0][i] - pal0[so][0]) * axis[so][0] +
-                             static_cast<float>(t.h[1][i] - pal0[so][1]) * axis[so][1] +
-                             static_cast<float>(t.h[2][i] - pal0[so][2]) * axis[so][2]) * inv_len2[so];
-        }
+                pr[ss][i] = (static_cast<float>(t.h[0][i] - pal0[ss][0]) * axis[ss][0] +
+                             static_cast<float>(t.h[1][i] - pal0[ss][1]) * axis[ss][1] +
+                             static_cast<float>(t.h[2][i] - pal0[ss][2]) * axis[ss][2]) * inv_len2[ss];
         float ua[2][3], ub[2][3];
-        for (int ss = 0; ss < 2; ++ss)
+        for (int ss = 0; ss < ns; ++ss)
             for (int c = 0; c < 3; ++c) {
-                const int so = ss < ns ? ss : 0;
-                ua[ss][c] = static_cast<float>(unquantize(q[2 * so][c], md.ep_bits));
-                ub[ss][c] = static_cast<float>(unquantize(q[2 * so + 1][c], md.ep_bits));
+                ua[ss][c] = static_cast<float>(unquantize(q[2 * ss][c], md.ep_bits));
+                ub[ss][c] = static_cast<float>(unquantize(q[2 * ss + 1][c], md.ep_bits));
             }
         int limm1[16];
         for (int i = 0; i < 16; ++i) limm1[i] = n - 1;
         limm1[0] = n / 2 - 1;  // texel 0 is subset 0's anchor (subset 0 in every partition)
-        if (ns == 2) limm1[anchor[1]] = n / 2 - 1;
+        if constexpr (ns == 2) limm1[anchor[1]] = n / 2 - 1;
         const float wscale = 64.0f / static_cast<float>(n - 1);
         // Per texel its subset's endpoints and projection (selects, no branches).
         float A[3][16], B[3][16], proj[16];
         for (int i = 0; i < 16; ++i) {
-            const int one = pmask >> i & 1;
-            proj[i] = one ? pr[1][i] : pr[0][i];
-            for (int c = 0; c < 3; ++c) A[c][i] = one ? ua[1][c] : ua[0][c], B[c][i] = one ? ub[1][c] : ub[0][c];
+            if constexpr (ns == 2) {
+                const int one = pmask >> i & 1;
+                proj[i] = one ? pr[1][i] : pr[0][i];
+                for (int c = 0; c < 3; ++c) A[c][i] = one ? ua[1][c] : ua[0][c], B[c][i] = one ? ub[1][c] : ub[0][c];
+            } else {
+                proj[i] = pr[0][i];
+                for (int c = 0; c < 3; ++c) A[c][i] = ua[0][c], B[c][i] = ub[0][c];
+            }
         }
         std::uint32_t errs[16];
         int bidx[16];
@@ -200,7 +206,7 @@ std::int64_t evaluate(const Target& t, int mode_i, int partition, SubsetFit fit[
             }
             return e;
         };
-        if (search) {
+        if constexpr (search) {
             for (int i = 0; i < 16; ++i) {
                 int j0 = static_cast<int>(proj[i] + 0.5f);
                 j0 = j0 < 0 ? 0 : j0;
@@ -240,6 +246,12 @@ std::int64_t evaluate(const Target& t, int mode_i, int partition, SubsetFit fit[
         std::memcpy(out.idx, idx, sizeof idx);
     }
     return err;
+}
+
+std::int64_t evaluate(const Target& t, int mode_i, int partition, SubsetFit fit[2], Encoded& out, bool search = true) {
+    if (modes()[static_cast<size_t>(mode_i)].two_subsets)
+        return search ? evaluate_ns<2, true>(t, mode_i, partition, fit, out) : evaluate_ns<2, false>(t, mode_i, partition, fit, out);
+    return search ? evaluate_ns<1, true>(t, mode_i, partition, fit, out) : evaluate_ns<1, false>(t, mode_i, partition, fit, out);
 }
 
 // Least-squares endpoints for the given indices (per subset, per channel 2x2 normal equations).
@@ -650,13 +662,13 @@ void pack(const Encoded& e, std::uint8_t out[16]) {
     WordWriter w;
     w.bits(md.code, md.code_bits);
     const int ns = md.two_subsets ? 2 : 1;
-    int stored[4][3];
+    int stored[12];  // indexed by Seg::field = endpoint * 3 + channel
     for (int i = 0; i < 2 * ns; ++i)
         for (int c = 0; c < 3; ++c)
-            stored[i][c] = (md.transformed && i > 0) ? ((e.q[i][c] - e.q[0][c]) & ((1 << md.delta_bits[c]) - 1)) : e.q[i][c];
+            stored[3 * i + c] = (md.transformed && i > 0) ? ((e.q[i][c] - e.q[0][c]) & ((1 << md.delta_bits[c]) - 1)) : e.q[i][c];
     for (int s = 0; s < md.nsegs; ++s) {
         const Seg& g = md.segs[static_cast<size_t>(s)];
-        const int v = stored[g.field / 3][g.field % 3];
+        const int v = stored[g.field];
         if (g.last >= g.first) {
             w.bits(static_cast<std::uint32_t>(v >> g.first), g.last - g.first + 1);
         } else {
