@@ -24,7 +24,9 @@ struct Encoded {
     u = std::clamp(u, 0.0f, 65535.0f);
     if (bits >= 15) return std::clamp(static_cast<int>(u + 0.5f), 0, maxq);
     const float step = static_cast<float>(1 << (16 - bits));
-    const int q = static_cast<int>(u * (1.0f / step));
+    // 1 / step = 2^-(16 - bits) exactly, built from its exponent bits (no division).
+    const float inv_step = std::bit_cast<float>(static_cast<std::uint32_t>(127 - (16 - bits)) << 23);
+    const int q = static_cast<int>(u * inv_step);
     if (q == 0) return std::abs(1.5f * step - u) < u ? 1 : 0;
     if (q >= maxq) {
         const float below = static_cast<float>(maxq) * step - 0.5f * step;  // level of maxq - 1
@@ -36,6 +38,19 @@ struct Encoded {
 struct SubsetFit {
     float a[3], b[3];  // unquantized-domain endpoints
 };
+
+// The minimum and maximum of 16 values and 0 (returns the minimum, the maximum in `hi`) by halving:
+// elementwise min/max of the two halves vectorise. The same values as a running std::min/max from
+// 0 (min and max are exact; only the sign of a zero result may differ, and the callers only add
+// it to or scale it into other values).
+[[gnu::always_inline]] inline float min_max16(const float v[16], float& hi) {
+    float mn[8], mx[8];
+    for (int i = 0; i < 8; ++i) mn[i] = std::min(v[i], v[i + 8]), mx[i] = std::max(v[i], v[i + 8]);
+    for (int i = 0; i < 4; ++i) mn[i] = std::min(mn[i], mn[i + 4]), mx[i] = std::max(mx[i], mx[i + 4]);
+    for (int i = 0; i < 2; ++i) mn[i] = std::min(mn[i], mn[i + 2]), mx[i] = std::max(mx[i], mx[i + 2]);
+    hi = std::max(std::max(mx[0], mx[1]), 0.0f);
+    return std::min(std::min(mn[0], mn[1]), 0.0f);
+}
 
 // Endpoints of the line that best fits the subset's texels (principal axis by power iteration),
 // spanning the extreme projections. In the unquantized domain.
@@ -78,8 +93,8 @@ void initial_endpoints(const Target& t, std::uint16_t mask, float a[3], float b[
     float proj[16];
     for (int i = 0; i < 16; ++i)
         proj[i] = ((d[0][i] - mr[0]) * ax[0] + (d[1][i] - mr[1]) * ax[1] + (d[2][i] - mr[2]) * ax[2]) * in[i];
-    float lo = 0, hi = 0;  // texels outside the mask project to 0, inside [lo, hi] already
-    for (const float p : proj) lo = std::min(lo, p), hi = std::max(hi, p);
+    float hi;  // texels outside the mask project to 0, inside [lo, hi] already
+    float lo = min_max16(proj, hi);
     lo *= inv_len2, hi *= inv_len2;
     for (int c = 0; c < 3; ++c) {
         const float mean = t.u[c][0] + mr[c];
@@ -574,8 +589,10 @@ void fit_partition(const PartitionMoments& pm, int p, const float ax0[3], Subset
             const float in = s ? tb.in1[i][p] : 1.0f - tb.in1[i][p];
             proj[i] = ((pm.x[0][i] - m[0]) * ax[0] + (pm.x[1][i] - m[1]) * ax[1] + (pm.x[2][i] - m[2]) * ax[2]) * in;
         }
-        float lo = 0, hi = 0;  // members' projections about their mean straddle 0
-        for (const float v : proj) lo = std::min(lo, v), hi = std::max(hi, v);
+        float hi_out;
+        // members' projections about their mean straddle 0 (non-members project to 0)
+        float lo = min_max16(proj, hi_out);
+        float hi = hi_out;
         lo *= inv_l2, hi *= inv_l2;
         for (int c = 0; c < 3; ++c) {
             two[s].a[c] = std::clamp(pm.mean[c] + 256.0f * (m[c] + lo * ax[c]), 0.0f, 65535.0f);
