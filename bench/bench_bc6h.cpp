@@ -5,7 +5,10 @@
 // thread's CPU time (CLOCK_THREAD_CPUTIME_ID; every encode runs on that one thread): Mpixel/s per
 // thread, not depressed by other processes taking the CPU away (the 2 shared cores are often
 // loaded); cache and SMT contention still show.
-//   bench_bc6h [--maps DIR] [--lightmap-size N] [--exhaustive-rows N] [--only QUALITY]
+//   bench_bc6h [--maps DIR] [--lightmap-size N] [--sample-stride K] [--only QUALITY] [--isa baseline|avx2]
+// The maps' speed (and dB) is measured on the whole maps; the dB differences to exhaustive (too slow
+// for whole maps) on every K-th band of 4 rows (default 8), spread over the whole map.
+// --isa picks the encoder twin (default: the best this CPU runs; both write the same bytes).
 // --only runs the listed qualities (e.g. "mode11,fast"; the others print 0): for profiling
 // and quick tuning runs (the ratios and dB differences then need a full run).
 #include <algorithm>
@@ -42,9 +45,11 @@ struct Row {
     double psnr = 0, mpix = 0;
 };
 
+bc6h::Isa g_isa = bc6h::best_isa();
+
 Row run_bc6h(const std::vector<float>& rgb, int w, int h, bc6h::Quality q) {
     const double t0 = thread_seconds();
-    const auto blocks = bc6h::encode_image(rgb.data(), w, h, q, 1);
+    const auto blocks = bc6h::encode_image(rgb.data(), w, h, q, 1, g_isa);
     const double s = seconds_since(t0);
     const auto dec = bc6h::decode_image(blocks.data(), blocks.size(), w, h);
     Row r;
@@ -95,13 +100,14 @@ Row run_ours45(const std::vector<float>& v, int channels, int w, int h, bc45::Qu
 
 int main(int argc, char** argv) {
     std::string dir = ZHC_ENVMAP_DIR;
-    int lm_size = 256, ex_rows = 0;
+    int lm_size = 256, stride = 8;
     std::string only;
     for (int i = 1; i + 1 < argc; i += 2) {
         if (!std::strcmp(argv[i], "--maps")) dir = argv[i + 1];
         if (!std::strcmp(argv[i], "--lightmap-size")) lm_size = std::atoi(argv[i + 1]);
-        if (!std::strcmp(argv[i], "--exhaustive-rows")) ex_rows = std::atoi(argv[i + 1]);
+        if (!std::strcmp(argv[i], "--sample-stride")) stride = std::max(1, std::atoi(argv[i + 1]));
         if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
+        if (!std::strcmp(argv[i], "--isa")) g_isa = std::strcmp(argv[i + 1], "baseline") ? bc6h::Isa::kAvx2 : bc6h::Isa::kBaseline;
     }
     std::vector<std::string> paths;
     for (const auto& e : std::filesystem::directory_iterator(dir))
@@ -110,11 +116,29 @@ int main(int argc, char** argv) {
     const bc6h::Quality qs[4] = {bc6h::Quality::kMode11, bc6h::Quality::kFast, bc6h::Quality::kDefault,
                                  bc6h::Quality::kExhaustive};
     const char* qn[4] = {"mode11", "fast", "default", "exhaustive"};
-    std::printf("BC6H log2-PSNR (dB, l(v) = log2(max(v, 2^-14)), peak 30) and Mpixel/s on 1 thread (thread CPU time)\n");
+    auto wanted = [&](int k) { return only.empty() || only.find(qn[k]) != std::string::npos; };
+    if (!bc6h::isa_supported(g_isa)) g_isa = bc6h::Isa::kBaseline;
+    std::printf("BC6H log2-PSNR (dB, l(v) = log2(max(v, 2^-14)), peak 30) and Mpixel/s on 1 thread (thread CPU time); encoder: %s\n",
+                bc6h::isa_name(g_isa));
+    std::printf("Real maps: mode11, fast and default on the whole map; every quality (exhaustive, the slow reference,\n"
+                "included) on a sample of every %d-th band of 4 rows spread over the whole map (\"rows/%d\" lines), for\n"
+                "the dB differences. Lightmaps (%d x %d): every quality on the whole image.\n", stride, stride, lm_size, lm_size);
     std::printf("%-22s | %-15s | %-15s | %-15s | %-15s\n", "image", qn[0], qn[1], qn[2], qn[3]);
-    double sum[2][4][2] = {};
-    int count[2] = {0, 0};
+    // sum[set][quality][dB, Mpix/s]; set 0 = whole maps, 1 = sampled map rows, 2 = lightmaps.
+    double sum[3][4][2] = {};
+    int count[3] = {0, 0, 0};
     std::vector<std::vector<float>> wa_planes, d_planes;
+    auto print_row = [&](const std::string& name, const Row r[4], int set) {
+        std::printf("%-22s |", name.c_str());
+        for (int k = 0; k < 4; ++k) {
+            std::printf(" %6.2f %6.2f |", r[k].psnr, r[k].mpix);
+            sum[set][k][0] += r[k].psnr;
+            sum[set][k][1] += r[k].mpix;
+        }
+        std::printf("\n");
+        ++count[set];
+        std::fflush(stdout);
+    };
     for (int pass = 0; pass < 2; ++pass) {
         for (const auto& path : paths) {
             auto img = read_envmap(path);
@@ -122,49 +146,53 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "%s\n", img.error().message.c_str());
                 return 1;
             }
-            std::vector<float> rgb;
-            int w = 0, h = 0;
-            std::string name = std::filesystem::path(path).stem().string();
+            const std::string name = std::filesystem::path(path).stem().string();
             if (pass == 0) {
-                rgb = img->rgb, w = img->width, h = img->height;
+                const std::vector<float>& rgb = img->rgb;
+                const int w = img->width, h = img->height;
+                Row full[4], sampled[4];
+                for (int k = 0; k < 3; ++k)
+                    if (wanted(k)) full[k] = run_bc6h(rgb, w, h, qs[k]);
+                // The sample: block rows 0, stride, 2 stride, ... (whole 4-row bands, so the
+                // blocks are the map's own), stacked into one image.
+                std::vector<float> band;
+                int hs = 0;
+                for (int y0 = 0; y0 < h; y0 += 4 * stride) {
+                    const int rows = std::min(4, h - y0);
+                    band.insert(band.end(), rgb.begin() + static_cast<std::ptrdiff_t>(y0) * w * 3,
+                                rgb.begin() + static_cast<std::ptrdiff_t>(y0 + rows) * w * 3);
+                    hs += rows;
+                }
+                for (int k = 0; k < 4; ++k)
+                    if (wanted(k)) sampled[k] = run_bc6h(band, w, hs, qs[k]);
+                print_row(name, full, 0);
+                print_row("  rows/" + std::to_string(stride), sampled, 1);
             } else {
                 // A lightmap baked from the map: the sphere lit by its SH3, IrradZ-encoded; the I_z plane.
                 const Sh3Radiance world = project_latlong(img->rgb.data(), img->width, img->height,
                                                           static_cast<size_t>(img->width) * 3, 2);
                 const auto lm = lightmap::synthesize_sphere(world, lm_size, lm_size, 2);
                 const auto planes = lightmap::encode_planes(lm, {}, 2);
-                rgb = planes.iz, w = lm_size, h = lm_size;
                 wa_planes.push_back(planes.wa);
                 d_planes.push_back(planes.d);
-                name = "lm:" + name;
+                Row r[4];
+                for (int k = 0; k < 4; ++k)
+                    if (wanted(k)) r[k] = run_bc6h(planes.iz, lm_size, lm_size, qs[k]);
+                print_row("lm:" + name, r, 2);
             }
-            if (pass == 0 && ex_rows > 0) {
-                // Every quality on the first ex_rows rows only (exhaustive, the quality reference,
-                // is slow). The top rows of a lat-long map are mostly sky: smoother than the whole
-                // map, so both dB and speed are higher there than on full maps.
-                h = std::min(h, ex_rows);
-                rgb.resize(static_cast<size_t>(w) * h * 3);
-            }
-            Row r[4];
-            for (int k = 0; k < 4; ++k)
-                if (only.empty() || only.find(qn[k]) != std::string::npos) r[k] = run_bc6h(rgb, w, h, qs[k]);
-            std::printf("%-22s |", name.c_str());
-            for (int k = 0; k < 4; ++k) {
-                std::printf(" %6.2f %6.2f |", r[k].psnr, r[k].mpix);
-                sum[pass][k][0] += r[k].psnr;
-                sum[pass][k][1] += r[k].mpix;
-            }
-            std::printf("\n");
-            ++count[pass];
-            std::fflush(stdout);
         }
-        std::printf("%-22s |", pass == 0 ? "MEAN real maps" : "MEAN lightmaps");
-        for (int k = 0; k < 4; ++k) std::printf(" %6.2f %6.2f |", sum[pass][k][0] / count[pass], sum[pass][k][1] / count[pass]);
-        std::printf("\n%-22s |", "  dB vs exhaustive");
-        for (int k = 0; k < 4; ++k) std::printf(" %+6.2f        |", (sum[pass][k][0] - sum[pass][3][0]) / count[pass]);
-        std::printf("\n%-22s |", "  speed / mode11");
-        for (int k = 0; k < 4; ++k) std::printf(" %6.3f        |", sum[pass][k][1] / sum[pass][0][1]);
-        std::printf("\n");
+        for (int set : pass == 0 ? std::vector<int>{0, 1} : std::vector<int>{2}) {
+            const char* label = set == 0 ? "MEAN real maps" : set == 1 ? "MEAN map rows sample" : "MEAN lightmaps";
+            std::printf("%-22s |", label);
+            for (int k = 0; k < 4; ++k) std::printf(" %6.2f %6.2f |", sum[set][k][0] / count[set], sum[set][k][1] / count[set]);
+            if (set != 0) {
+                std::printf("\n%-22s |", "  dB vs exhaustive");
+                for (int k = 0; k < 4; ++k) std::printf(" %+6.2f        |", (sum[set][k][0] - sum[set][3][0]) / count[set]);
+            }
+            std::printf("\n%-22s |", "  speed / mode11");
+            for (int k = 0; k < 4; ++k) std::printf(" %6.3f        |", sum[set][k][1] / sum[set][0][1]);
+            std::printf("\n");
+        }
     }
     std::printf("\nBC4 (w_a plane) and BC5 (d plane) of the lightmaps: PSNR (dB, unorm) and Mpixel/s on 1 thread (CPU time)\n");
     std::printf("%-22s | %-15s | %-15s | %-15s\n", "plane", "stb", "zhc fast", "zhc default");

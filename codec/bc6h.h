@@ -47,6 +47,16 @@ bool layout_is_consistent();
 // Whole images (interleaved RGB float, width x height, any size: edge blocks replicate the last
 // row/column). Blocks are row-major; the result does not depend on `threads`.
 std::vector<std::uint8_t> encode_image(const float* rgb, int width, int height, Quality quality, int threads = 1);
+
+// The encoder exists twice: for baseline x86-64 (SSE2) and for AVX2 (x86-64 only), chosen at run
+// time (best_isa). Both write the same bytes (the same float operations in the same order; tested),
+// AVX2 is faster (wider vectors). encode_block and the encode_image above use best_isa().
+enum class Isa { kBaseline, kAvx2 };
+bool isa_supported(Isa isa);
+Isa best_isa();
+const char* isa_name(Isa isa);
+// encode_image with a given instruction set (unsupported: baseline). For tests and benchmarks.
+std::vector<std::uint8_t> encode_image(const float* rgb, int width, int height, Quality quality, int threads, Isa isa);
 // Decodes into interleaved RGB half bits (width x height).
 std::vector<std::uint16_t> decode_image(const std::uint8_t* blocks, std::size_t size, int width, int height);
 

@@ -262,5 +262,32 @@ TEST(Bc6hImage, ThreadCountDoesNotChangeBytesAndEdgesReplicate) {
     EXPECT_LT(worst, 400);  // within a few hundred half ULPs (~log2 error < 0.4) everywhere
 }
 
+// The encoder's baseline and AVX2 twins (codec/bc6h.cpp) must write the same bytes: crops of every
+// real map, from the detailed middle rows, at every quality.
+TEST(Bc6hIsa, BaselineAndAvx2WriteTheSameBytesOnRealMaps) {
+    if (!isa_supported(Isa::kAvx2)) GTEST_SKIP() << "this CPU has no AVX2: only the baseline encoder runs here";
+    const auto paths = test::envmap_paths();
+    ASSERT_FALSE(paths.empty());
+    size_t blocks = 0;
+    for (const auto& path : paths) {
+        const Image img = test::load_envmap(path);
+        for (const Quality q : {Quality::kMode11, Quality::kFast, Quality::kDefault, Quality::kExhaustive}) {
+            // Exhaustive is ~100x slower: a smaller crop.
+            const int w = q == Quality::kExhaustive ? 32 : 256, h = q == Quality::kExhaustive ? 16 : 64;
+            const int x0 = img.width / 2 - w / 2, y0 = img.height / 2 - h / 2;
+            std::vector<float> crop(static_cast<size_t>(w) * h * 3);
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w * 3; ++x) crop[static_cast<size_t>(y) * w * 3 + x] = img.row(y0 + y)[x0 * 3 + x];
+            const auto base = encode_image(crop.data(), w, h, q, 1, Isa::kBaseline);
+            const auto avx2 = encode_image(crop.data(), w, h, q, 1, Isa::kAvx2);
+            ASSERT_EQ(base.size(), avx2.size());
+            EXPECT_TRUE(base == avx2) << path << " quality " << static_cast<int>(q);
+            blocks += base.size() / 16;
+        }
+    }
+    std::printf("baseline == AVX2 on %zu blocks\n", blocks);
+    EXPECT_EQ(best_isa(), Isa::kAvx2);
+}
+
 }  // namespace
 }  // namespace zhc
