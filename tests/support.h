@@ -59,7 +59,10 @@ struct CommandResult {
 // Runs the zhc binary with the given arguments (shell-quoted here), capturing output.
 CommandResult run_zhc(const std::vector<std::string>& args);
 
-// A fresh empty directory under the build tree for one test.
+// A directory for one test's files: $TMPDIR/zhc_tests_<uid>/<name>, created if missing. It is NOT
+// emptied (it is shared across runs, builds and parallel test processes: run_zhc's "cli_runs"
+// holds every process's outputs under pid-unique names); a test that needs an empty folder clears
+// its own sub-folder (as test_dds does).
 std::string temp_dir(const std::string& name);
 void write_bytes(const std::string& path, const std::vector<std::uint8_t>& bytes);
 std::vector<std::uint8_t> read_bytes(const std::string& path);
