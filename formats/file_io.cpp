@@ -68,16 +68,22 @@ Status write_via_temporary(const std::string& path, const std::function<Status(c
     return Ok{};
 }
 
+namespace {
+// Writes `bytes` to the temporary file `tmp` (messages name `path`, the file the user asked for).
+// On failure `tmp` may exist; the caller removes it.
+Status write_temporary(const std::string& tmp, const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) return make_error(ErrorCode::kIoError, path + ": cannot create (" + std::strerror(errno) + ")");
+    const bool ok = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    const bool flushed = std::fflush(f) == 0;
+    const bool closed = std::fclose(f) == 0;
+    if (!ok || !flushed || !closed) return make_error(ErrorCode::kIoError, path + ": write failed");
+    return Ok{};
+}
+}  // namespace
+
 Status write_file_atomic(const std::string& path, const std::vector<std::uint8_t>& bytes) {
-    return write_via_temporary(path, [&](const std::string& tmp) -> Status {
-        std::FILE* f = std::fopen(tmp.c_str(), "wb");
-        if (!f) return make_error(ErrorCode::kIoError, path + ": cannot create (" + std::strerror(errno) + ")");
-        const bool ok = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-        const bool flushed = std::fflush(f) == 0;
-        const bool closed = std::fclose(f) == 0;
-        if (!ok || !flushed || !closed) return make_error(ErrorCode::kIoError, path + ": write failed");
-        return Ok{};
-    });
+    return write_via_temporary(path, [&](const std::string& tmp) { return write_temporary(tmp, path, bytes); });
 }
 
 Status write_files_atomic(const std::vector<std::pair<std::string, std::vector<std::uint8_t>>>& files) {
@@ -87,19 +93,10 @@ Status write_files_atomic(const std::vector<std::pair<std::string, std::vector<s
         for (const auto& p : paths) fs::remove(p, ec);
     };
     for (const auto& [path, bytes] : files) {
-        const std::string tmp = temporary_name_for(path);
-        std::FILE* f = std::fopen(tmp.c_str(), "wb");
-        if (!f) {
+        temps.push_back(temporary_name_for(path));
+        if (Status st = write_temporary(temps.back(), path, bytes); !st) {
             remove_all(temps);
-            return make_error(ErrorCode::kIoError, path + ": cannot create (" + std::strerror(errno) + ")");
-        }
-        temps.push_back(tmp);
-        const bool ok = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-        const bool flushed = std::fflush(f) == 0;
-        const bool closed = std::fclose(f) == 0;
-        if (!ok || !flushed || !closed) {
-            remove_all(temps);
-            return make_error(ErrorCode::kIoError, path + ": write failed");
+            return st;
         }
     }
     // A directory in the way would only show at the rename; look first so that the common case
