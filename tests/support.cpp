@@ -1,5 +1,7 @@
 #include "support.h"
 
+#include <random>
+
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -130,7 +132,10 @@ CommandResult run_zhc(const std::vector<std::string>& args) {
     const std::string dir = temp_dir("cli_runs");
     const std::string base = dir + "/run" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
     std::string cmd = quote(ZHC_CLI_PATH);
-    for (const auto& a : args) cmd += " " + quote(a);
+    for (const auto& a : args) {
+        cmd += ' ';  // (not " " + quote(a): g++ 12 warns a false -Wrestrict on that temporary)
+        cmd += quote(a);
+    }
     cmd += " > " + quote(base + ".out") + " 2> " + quote(base + ".err") + " < /dev/null";
     const int status = std::system(cmd.c_str());
     CommandResult r;
@@ -145,6 +150,52 @@ std::string temp_dir(const std::string& name) {
     std::error_code ec;
     fs::create_directories(p, ec);
     return p.string();
+}
+
+std::string fresh_dir(const std::string& name) {
+    const std::string dir = temp_dir(name);
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    fs::create_directories(dir, ec);
+    return dir;
+}
+
+std::uint32_t get32(const std::vector<std::uint8_t>& b, std::size_t off) {
+    return std::uint32_t(b[off]) | std::uint32_t(b[off + 1]) << 8 | std::uint32_t(b[off + 2]) << 16 | std::uint32_t(b[off + 3]) << 24;
+}
+void put32(std::vector<std::uint8_t>& b, std::size_t off, std::uint32_t v) {
+    for (int k = 0; k < 4; ++k) b[off + static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(v >> (8 * k));
+}
+
+Ktx2Image sample_block_image(std::uint32_t vk_format, int w, int h) {
+    Ktx2Image img;
+    img.vk_format = vk_format;
+    img.width = w;
+    img.height = h;
+    img.blocks.resize(static_cast<size_t>((w + 3) / 4) * static_cast<size_t>((h + 3) / 4) * ktx2_block_bytes(vk_format));
+    for (size_t i = 0; i < img.blocks.size(); ++i) img.blocks[i] = static_cast<std::uint8_t>(i * 37 + 11);
+    return img;
+}
+
+int decode_corrupted_copies(const std::vector<std::uint8_t>& good, unsigned seed, int n,
+                            const std::function<Result<Ktx2Image>(std::span<const std::uint8_t>)>& decode) {
+    std::mt19937 rng(seed);
+    int accepted = 0;
+    for (int t = 0; t < n; ++t) {
+        auto b = good;
+        const int flips = 1 + t % 4;
+        for (int k = 0; k < flips; ++k) b[rng() % b.size()] = static_cast<std::uint8_t>(rng());
+        if (t % 7 == 0) b.resize(rng() % b.size());
+        auto r = decode(b);
+        if (r.ok()) {
+            ++accepted;
+            EXPECT_EQ(r->blocks.size(), static_cast<size_t>((r->width + 3) / 4) * static_cast<size_t>((r->height + 3) / 4) *
+                                            ktx2_block_bytes(r->vk_format));
+        } else {
+            EXPECT_EQ(r.error().message.find('\n'), std::string::npos) << r.error().message;
+        }
+    }
+    return accepted;
 }
 
 void write_bytes(const std::string& path, const std::vector<std::uint8_t>& bytes) {

@@ -3,11 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "codec/sh.h"
 #include "formats/envmap.h"
+#include "formats/ktx2.h"
 
 namespace zhc::test {
 
@@ -61,10 +64,26 @@ CommandResult run_zhc(const std::vector<std::string>& args);
 
 // A directory for one test's files: $TMPDIR/zhc_tests_<uid>/<name>, created if missing. It is NOT
 // emptied (it is shared across runs, builds and parallel test processes: run_zhc's "cli_runs"
-// holds every process's outputs under pid-unique names); a test that needs an empty folder clears
-// its own sub-folder (as test_dds does).
+// holds every process's outputs under pid-unique names). Tests that check which files exist use
+// fresh_dir instead.
 std::string temp_dir(const std::string& name);
+// temp_dir(name), emptied first (for one test's own folder only).
+std::string fresh_dir(const std::string& name);
 void write_bytes(const std::string& path, const std::vector<std::uint8_t>& bytes);
 std::vector<std::uint8_t> read_bytes(const std::string& path);
+
+// Little-endian 32-bit fields in a byte buffer (container header tests).
+std::uint32_t get32(const std::vector<std::uint8_t>& b, std::size_t off);
+void put32(std::vector<std::uint8_t>& b, std::size_t off, std::uint32_t v);
+
+// A block-compressed image of the given vkFormat and size whose block bytes are a fixed pattern
+// (i * 37 + 11): for container round trips.
+Ktx2Image sample_block_image(std::uint32_t vk_format, int w, int h);
+
+// Decodes `n` corrupted copies of `good` (1 to 4 random bytes overwritten, every 7th also cut
+// short; seeded, so the same copies every run) with `decode`. Every accepted image must hold
+// exactly its blocks, every refusal a one-line message. Returns how many were accepted.
+int decode_corrupted_copies(const std::vector<std::uint8_t>& good, unsigned seed, int n,
+                            const std::function<Result<Ktx2Image>(std::span<const std::uint8_t>)>& decode);
 
 }  // namespace zhc::test
