@@ -58,24 +58,25 @@ int main(int argc, char** argv) {
         {kVkFormatBc6hUfloat, bc6h::encode_image(rgb.data(), 8, 8, bc6h::Quality::kFast)},
         {kVkFormatBc4Unorm, bc45::encode_image(one.data(), 1, 8, 8, bc45::Quality::kFast)},
         {kVkFormatBc5Unorm, bc45::encode_image(two.data(), 2, 8, 8, bc45::Quality::kFast)}};
+    std::vector<Ktx2Image> images;  // the three textures, 8 x 8, for both containers
     for (const auto& [format, blocks] : textures) {
         Ktx2Image k;
         k.vk_format = format;
         k.width = 8;
         k.height = 8;
         k.blocks = blocks;
+        images.push_back(k);
+    }
+    for (const Ktx2Image& k : images) {
+        const std::uint32_t format = k.vk_format;
         auto bytes = encode_ktx2(k);
         ok = ok && bytes && write_file_atomic(root + "/fuzz_ktx2/format" + std::to_string(format) + ".ktx2", *bytes);
     }
     // DDS: the same three textures (DX10 header), one with partial blocks, and the legacy
     // FourCC layouts ('ATI1' BC4, 'ATI2' BC5: no extension header, data at byte 128).
     fs::create_directories(root + "/fuzz_dds");
-    for (const auto& [format, blocks] : textures) {
-        Ktx2Image k;
-        k.vk_format = format;
-        k.width = 8;
-        k.height = 8;
-        k.blocks = blocks;
+    for (const Ktx2Image& k : images) {
+        const std::uint32_t format = k.vk_format;
         auto bytes = encode_dds(k);
         ok = ok && bytes && write_file_atomic(root + "/fuzz_dds/dxgi" + std::to_string(dxgi_format_for_vk(format)) + ".dds", *bytes);
         if (bytes && format != kVkFormatBc6hUfloat) {
