@@ -9,6 +9,8 @@
 // The maps' speed (and dB) is measured on the whole maps; the dB differences to exhaustive (too slow
 // for whole maps) on every K-th band of 4 rows (default 8), spread over the whole map.
 // --isa picks the encoder twin (default: the best this CPU runs; both write the same bytes).
+// Each summary also prints the encode's user-space instructions per pixel (perf counter, pooled
+// over the images), where the kernel allows the counter.
 // --only runs the listed qualities (e.g. "mode11,fast"; the others print 0): for profiling
 // and quick tuning runs (the ratios and dB differences then need a full run).
 #include <algorithm>
@@ -23,7 +25,11 @@
 #include <string>
 #include <vector>
 
+#include <linux/perf_event.h>
+#include <sys/ioctl.h>
+#include <sys/syscall.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "codec/bc45.h"
 #include "codec/bc6h.h"
@@ -41,20 +47,60 @@ double thread_seconds() {
 }
 double seconds_since(double t0) { return thread_seconds() - t0; }
 
+// User-space instructions retired by this thread (Linux perf counter): exact and repeatable, unlike
+// the times on a shared machine. -1 where the counter is not available (no perf support, or
+// perf_event_paranoid forbids it); the bench then prints n/a.
+class InstructionCounter {
+   public:
+    InstructionCounter() {
+        perf_event_attr a{};
+        a.type = PERF_TYPE_HARDWARE;
+        a.size = sizeof a;
+        a.config = PERF_COUNT_HW_INSTRUCTIONS;
+        a.disabled = 1;
+        a.exclude_kernel = 1;
+        a.exclude_hv = 1;
+        fd_ = static_cast<int>(syscall(SYS_perf_event_open, &a, 0, -1, -1, 0));
+    }
+    ~InstructionCounter() {
+        if (fd_ >= 0) close(fd_);
+    }
+    void start() {
+        if (fd_ < 0) return;
+        ioctl(fd_, PERF_EVENT_IOC_RESET, 0);
+        ioctl(fd_, PERF_EVENT_IOC_ENABLE, 0);
+    }
+    double stop() {
+        if (fd_ < 0) return -1;
+        ioctl(fd_, PERF_EVENT_IOC_DISABLE, 0);
+        long long n = 0;
+        return read(fd_, &n, sizeof n) == sizeof n ? double(n) : -1;
+    }
+
+   private:
+    int fd_ = -1;
+};
+
 struct Row {
     double psnr = 0, mpix = 0;
+    double instructions = -1, pixels = 0;  // of the encode; -1: no counter
 };
 
 bc6h::Isa g_isa = bc6h::best_isa();
 
 Row run_bc6h(const std::vector<float>& rgb, int w, int h, bc6h::Quality q) {
+    static InstructionCounter counter;
+    counter.start();
     const double t0 = thread_seconds();
     const auto blocks = bc6h::encode_image(rgb.data(), w, h, q, 1, g_isa);
     const double s = seconds_since(t0);
+    const double instructions = counter.stop();
     const auto dec = bc6h::decode_image(blocks.data(), blocks.size(), w, h);
     Row r;
     r.psnr = lightmap::log2_psnr(rgb.data(), dec.data(), rgb.size());
     r.mpix = double(w) * h / s / 1e6;
+    r.instructions = instructions;
+    r.pixels = double(w) * h;
     return r;
 }
 
@@ -126,6 +172,7 @@ int main(int argc, char** argv) {
     std::printf("%-22s | %-15s | %-15s | %-15s | %-15s\n", "image", qn[0], qn[1], qn[2], qn[3]);
     // sum[set][quality][dB, Mpix/s]; set 0 = whole maps, 1 = sampled map rows, 2 = lightmaps.
     double sum[3][4][2] = {};
+    double instr[3][4][2] = {};  // [set][quality][instructions, pixels], pooled over the images
     int count[3] = {0, 0, 0};
     std::vector<std::vector<float>> wa_planes, d_planes;
     auto print_row = [&](const std::string& name, const Row r[4], int set) {
@@ -134,6 +181,7 @@ int main(int argc, char** argv) {
             std::printf(" %6.2f %6.2f |", r[k].psnr, r[k].mpix);
             sum[set][k][0] += r[k].psnr;
             sum[set][k][1] += r[k].mpix;
+            if (r[k].instructions >= 0) instr[set][k][0] += r[k].instructions, instr[set][k][1] += r[k].pixels;
         }
         std::printf("\n");
         ++count[set];
@@ -191,6 +239,11 @@ int main(int argc, char** argv) {
             }
             std::printf("\n%-22s |", "  speed / mode11");
             for (int k = 0; k < 4; ++k) std::printf(" %6.3f        |", sum[set][k][1] / sum[set][0][1]);
+            std::printf("\n%-22s |", "  instr/pixel (pooled)");
+            for (int k = 0; k < 4; ++k) {
+                if (instr[set][k][1] > 0) std::printf(" %8.0f      |", instr[set][k][0] / instr[set][k][1]);
+                else std::printf(" %8s      |", "n/a");
+            }
             std::printf("\n");
         }
     }
