@@ -104,6 +104,51 @@ const std::array<Mode, 14>& modes() {
     return m;
 }
 
+// The encoder's view of a mode's header: runs of bits at fixed stream positions, so that packing
+// needs no position bookkeeping. Stream bits [64 word + pos, + len) = bits [shift, shift + len)
+// of the field; reversed runs ("rw11-10") are split into single bits, and runs that cross the
+// 64-bit boundary into two ops.
+struct PackOp {
+    std::uint8_t field, shift, word, pos;
+    std::uint32_t mask;  // (1 << len) - 1
+};
+struct PackPlan {
+    std::array<PackOp, 40> ops{};
+    int nops = 0;
+    int header_bits = 0;  // mode bits + endpoint bits
+};
+const std::array<PackPlan, 14>& pack_plans() {
+    static const std::array<PackPlan, 14> plans = [] {
+        std::array<PackPlan, 14> out{};
+        for (size_t m = 0; m < 14; ++m) {
+            const Mode& md = modes()[m];
+            PackPlan& pl = out[m];
+            int pos = md.code_bits;
+            auto add = [&](int field, int shift, int len) {
+                while (len > 0) {
+                    const int here = std::min(len, 64 - pos % 64);
+                    pl.ops[static_cast<size_t>(pl.nops++)] = {
+                        static_cast<std::uint8_t>(field), static_cast<std::uint8_t>(shift),
+                        static_cast<std::uint8_t>(pos / 64), static_cast<std::uint8_t>(pos % 64),
+                        static_cast<std::uint32_t>((std::uint64_t{1} << here) - 1)};
+                    pos += here, shift += here, len -= here;
+                }
+            };
+            for (int k = 0; k < md.nsegs; ++k) {
+                const Seg& g = md.segs[static_cast<size_t>(k)];
+                if (g.last >= g.first) {
+                    add(g.field, g.first, g.last - g.first + 1);
+                } else {
+                    for (int b = g.first; b >= g.last; --b) add(g.field, b, 1);
+                }
+            }
+            pl.header_bits = pos;
+        }
+        return out;
+    }();
+    return plans;
+}
+
 // Two-subset partitions (the first 32 of BC7's): bit t set = texel t belongs to subset 1.
 constexpr std::uint16_t kPartition[32] = {
     0xcccc, 0x8888, 0xeeee, 0xecc8, 0xc880, 0xfeec, 0xfec8, 0xec80, 0xc800, 0xffec, 0xfe80,
@@ -338,6 +383,10 @@ void decode_block(const std::uint8_t in[16], std::uint16_t out[16][3]) {
 // to vectorise; AVX2 doubles their width. It uses no FMA (the target adds none, and the library is
 // built with -ffp-contract=off) and no reassociation, so both versions compute the same floats in
 // the same order and write the same bytes (tested on real maps for every quality).
+// The encoder's 16-lane vector types never cross a function boundary (always inlined), so GCC's
+// note that passing them by value would change with AVX-512 does not apply (clang reads this
+// pragma too).
+#pragma GCC diagnostic ignored "-Wpsabi"
 namespace isa_baseline {
 namespace {
 #include "bc6h_encoder.inl"
