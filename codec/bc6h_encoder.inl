@@ -68,6 +68,16 @@ typedef std::int32_t V16i __attribute__((vector_size(64)));
     return (b[0] + b[2]) + (b[1] + b[3]);
 }
 
+// The bitwise OR of the 16 lanes (folded by halves; bitwise operations only, which GCC keeps in
+// vector registers, unlike 16-lane compares).
+[[gnu::always_inline]] inline std::int32_t or16(V16i v) {
+    typedef std::int32_t V8i __attribute__((vector_size(32)));
+    typedef std::int32_t V4i __attribute__((vector_size(16)));
+    const V8i a = __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7) | __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15);
+    const V4i b = __builtin_shufflevector(a, a, 0, 1, 2, 3) | __builtin_shufflevector(a, a, 4, 5, 6, 7);
+    return (b[0] | b[2]) | (b[1] | b[3]);
+}
+
 // The minimum and maximum of 16 values and 0 (returns the minimum, the maximum in `hi`) by halving:
 // elementwise min/max of the two halves vectorise. The same values as a running std::min/max from
 // 0 (min and max are exact; only the sign of a zero result may differ, and the callers only add
@@ -327,43 +337,58 @@ void refine(const Target& t, const Encoded& e, SubsetFit fit[2]) {
     }
 }
 
-// Whether quantized endpoints q (at the mode's ep_bits) fit the mode's delta precision.
-bool deltas_fit(const Mode& md, const int q[4][3]) {
-    if (!md.transformed) return true;
-    // Either orientation of subset 0 may become the base after the anchor fix: test both.
-    for (int base = 0; base < 2; ++base) {
-        bool ok = true;
-        for (int e = 0; e < 4 && ok; ++e) {
-            if (e == base) continue;
-            for (int c = 0; c < 3; ++c) {
-                const int d = sign_extend(q[e][c] - q[base][c], md.ep_bits);
-                const int lim = 1 << (md.delta_bits[c] - 1);
-                if (d < -lim || d >= lim) ok = false;
-            }
-        }
-        if (ok) return true;
-    }
-    return false;
-}
-
 // The two-subset transformed modes, most precise first (11-bit endpoints with 5/4/4-bit deltas
 // ... 7-bit with 6-bit deltas), whose delta range holds the quantized initial endpoints of both
-// subsets; writes up to `max` of them to `out` and returns how many. Each endpoint precision is
-// quantized once (modes 2-4 share 11 bits, 6-8 share 8).
+// subsets; writes up to `max` of them to `out` and returns how many. Either orientation of subset
+// 0 may become the base after evaluate's anchor fix, so a mode fits if its deltas fit from either
+// endpoint of subset 0. All 12 values in one vector (lane 3 e + c: endpoint e, channel c; the pad
+// lanes repeat lane 0), quantized once per precision (modes 2-4 share 11 bits, 6-8 share 8):
+// when every value lies in the interior bins [S, maxq S), quantize() is the plain floor(u / S);
+// otherwise lane by lane. A delta d fits db signed bits iff (d + 2^(db-1)) & ~(2^db - 1) == 0.
 int fitting_two_subset_modes(const SubsetFit fit[2], int max, int out[9]) {
+    float v[16];
+    for (int s = 0; s < 2; ++s)
+        for (int c = 0; c < 3; ++c) v[6 * s + c] = fit[s].a[c], v[6 * s + 3 + c] = fit[s].b[c];
+    for (int k = 12; k < 16; ++k) v[k] = v[0];
+    const V16 u = load16(v);
+    float vmin = v[0], vmax = v[0];
+    for (int k = 1; k < 12; ++k) vmin = std::min(vmin, v[k]), vmax = std::max(vmax, v[k]);
+    struct Limits {
+        V16i add[14], keep[14];  // per mode and lane: 2^(db-1) and ~(2^db - 1) of the lane's channel
+    };
+    static const Limits lims = [] {
+        Limits l{};
+        for (int m = 0; m < 14; ++m)
+            for (int k = 0; k < 16; ++k) {
+                const int db = modes()[static_cast<size_t>(m)].delta_bits[k % 3];
+                l.add[m][k] = 1 << (db - 1);
+                l.keep[m][k] = ~((1 << db) - 1);
+            }
+        return l;
+    }();
     int count = 0, qbits = -1;
-    int q[4][3];
+    V16i d0 = {}, d1 = {};  // every lane's delta from subset 0's endpoint a (d0) and b (d1)
     for (const int m : {2, 3, 4, 0, 5, 6, 7, 8, 1}) {
         const Mode& md = modes()[static_cast<size_t>(m)];
         if (md.ep_bits != qbits) {
             qbits = md.ep_bits;
-            for (int s = 0; s < 2; ++s)
-                for (int c = 0; c < 3; ++c) {
-                    q[2 * s][c] = quantize(fit[s].a[c], qbits);
-                    q[2 * s + 1][c] = quantize(fit[s].b[c], qbits);
-                }
+            const float step = static_cast<float>(1 << (16 - qbits));
+            const float inv_step = std::bit_cast<float>(static_cast<std::uint32_t>(127 - (16 - qbits)) << 23);
+            V16i q;
+            if (vmin >= step && vmax < static_cast<float>((1 << qbits) - 1) * step) {
+                q = __builtin_convertvector(u * inv_step, V16i);
+            } else {
+                for (int k = 0; k < 16; ++k) q[k] = quantize(v[k], qbits);
+            }
+            // (the pad lanes, copies of lane 0, are compared with lane 0: delta 0)
+            const V16i base0 = __builtin_shufflevector(q, q, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 0, 0, 0);
+            const V16i base1 = __builtin_shufflevector(q, q, 3, 4, 5, 3, 4, 5, 3, 4, 5, 3, 4, 5, 0, 0, 0, 0);
+            const std::int32_t mask = (1 << qbits) - 1, sign = 1 << (qbits - 1);
+            d0 = (((q - base0) & mask) ^ sign) - sign;  // sign_extend(q - base, qbits)
+            d1 = (((q - base1) & mask) ^ sign) - sign;
         }
-        if (!deltas_fit(md, q)) continue;
+        const V16i add = lims.add[m], keep = lims.keep[m];
+        if (or16((d0 + add) & keep) != 0 && or16((d1 + add) & keep) != 0) continue;
         out[count++] = m;
         if (count == max) break;
     }
@@ -669,13 +694,15 @@ void make_target(const float rgb[16][3], Target& t) {
         for (int c = 0; c < 3; ++c) hc[16 * c + i] = h[3 * i + c];
     float uc[48];
     for (int k = 0; k < 48; ++k) uc[k] = static_cast<float>(hc[k]) * (64.0f / 31.0f);
-    int differ = 0;
-    // (Not fully unrolled first: GCC's straight-line vectoriser leaves the reduction scalar.)
-#pragma GCC unroll 1
-    for (int k = 0; k < 48; ++k) differ |= hc[k] ^ hc[k & ~15];
+    V16i differ = {};
+    for (int c = 0; c < 3; ++c) {
+        V16i v;
+        std::memcpy(&v, hc + 16 * c, sizeof v);
+        differ |= v ^ hc[16 * c];
+    }
     std::memcpy(t.h, hc, sizeof hc);
     std::memcpy(t.u, uc, sizeof uc);
-    t.constant = differ == 0;
+    t.constant = or16(differ) == 0;
 }
 
 // A constant block exactly, in mode 14 (code 01111: 16-bit endpoints, 4-bit deltas): both
