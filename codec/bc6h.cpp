@@ -460,10 +460,17 @@ std::vector<std::uint8_t> encode_image(const float* rgb, int width, int height, 
         float block[16][3];
         for (int by = row_begin; by < row_end; ++by)
             for (int bx = 0; bx < bw; ++bx) {
-                for (int i = 0; i < 16; ++i) {
-                    const int x = std::min(bx * 4 + (i & 3), width - 1), y = std::min(by * 4 + (i >> 2), height - 1);
-                    const float* p = rgb + (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)) * 3;
-                    block[i][0] = p[0], block[i][1] = p[1], block[i][2] = p[2];
+                if (bx * 4 + 3 < width && by * 4 + 3 < height) {  // interior: four runs of 4 texels
+                    for (int r = 0; r < 4; ++r)
+                        std::memcpy(block[4 * r],
+                                    rgb + (static_cast<size_t>(by * 4 + r) * static_cast<size_t>(width) + static_cast<size_t>(bx * 4)) * 3,
+                                    sizeof(float) * 12);
+                } else {  // edge: texels past the image repeat the last row / column
+                    for (int i = 0; i < 16; ++i) {
+                        const int x = std::min(bx * 4 + (i & 3), width - 1), y = std::min(by * 4 + (i >> 2), height - 1);
+                        const float* p = rgb + (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)) * 3;
+                        block[i][0] = p[0], block[i][1] = p[1], block[i][2] = p[2];
+                    }
                 }
                 encode(block, quality, out.data() + (static_cast<size_t>(by) * static_cast<size_t>(bw) + static_cast<size_t>(bx)) * 16);
             }
