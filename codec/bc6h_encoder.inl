@@ -49,7 +49,7 @@ typedef std::int32_t V16i __attribute__((vector_size(64)));
     std::memcpy(&v, p, sizeof v);
     return v;
 }
-[[gnu::always_inline]] inline void store16(float* p, V16 v) { std::memcpy(p, &v, sizeof v); }
+[[gnu::always_inline]] inline void store16(float* p, const V16& v) { std::memcpy(p, &v, sizeof v); }
 // Lane i = 1.0f if bit i of `bits` is set, else 0.0f: the bit itself (0 or 2^i) converted and
 // scaled by 2^-i, both exact (only and, convert and multiply: GCC scalarises 16-lane compares).
 [[gnu::always_inline]] inline V16 mask16(unsigned bits) {
@@ -60,7 +60,7 @@ typedef std::int32_t V16i __attribute__((vector_size(64)));
     return __builtin_convertvector(bit & static_cast<std::int32_t>(bits), V16) * scale;
 }
 // The sum of the 16 lanes by halves: (v[0..7] + v[8..15]), then 4, 2 and 1 lanes.
-[[gnu::always_inline]] inline float sum16(V16 v) {
+[[gnu::always_inline]] inline float sum16(const V16& v) {
     typedef float V8 __attribute__((vector_size(32)));
     typedef float V4 __attribute__((vector_size(16)));
     const V8 a = __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7) + __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -70,7 +70,7 @@ typedef std::int32_t V16i __attribute__((vector_size(64)));
 
 // The bitwise OR of the 16 lanes (folded by halves; bitwise operations only, which GCC keeps in
 // vector registers, unlike 16-lane compares).
-[[gnu::always_inline]] inline std::int32_t or16(V16i v) {
+[[gnu::always_inline]] inline std::int32_t or16(const V16i& v) {
     typedef std::int32_t V8i __attribute__((vector_size(32)));
     typedef std::int32_t V4i __attribute__((vector_size(16)));
     const V8i a = __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7) | __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15);
