@@ -341,54 +341,60 @@ void refine(const Target& t, const Encoded& e, SubsetFit fit[2]) {
 // ... 7-bit with 6-bit deltas), whose delta range holds the quantized initial endpoints of both
 // subsets; writes up to `max` of them to `out` and returns how many. Either orientation of subset
 // 0 may become the base after evaluate's anchor fix, so a mode fits if its deltas fit from either
-// endpoint of subset 0. All 12 values in one vector (lane 3 e + c: endpoint e, channel c; the pad
-// lanes repeat lane 0), quantized once per precision (modes 2-4 share 11 bits, 6-8 share 8):
-// when every value lies in the interior bins [S, maxq S), quantize() is the plain floor(u / S);
-// otherwise lane by lane. A delta d fits db signed bits iff (d + 2^(db-1)) & ~(2^db - 1) == 0.
+// endpoint of subset 0. One 4-lane vector per endpoint (r, g, b, unused), quantized once per
+// precision (modes 2-4 share 11 bits, 6-8 share 8): when every value lies in the interior bins
+// [S, maxq S), quantize() is the plain floor(u / S); otherwise lane by lane. A delta d fits db
+// signed bits iff (d + 2^(db-1)) & ~(2^db - 1) == 0 (lane 3 is masked out by a zero `keep`).
+// (4-lane vectors are native to SSE2 and AVX2 alike; GCC builds 16-lane ones from scalars
+// through memory, which stalled on store forwarding.)
 int fitting_two_subset_modes(const SubsetFit fit[2], int max, int out[9]) {
-    float v[16];
-    for (int s = 0; s < 2; ++s)
-        for (int c = 0; c < 3; ++c) v[6 * s + c] = fit[s].a[c], v[6 * s + 3 + c] = fit[s].b[c];
-    for (int k = 12; k < 16; ++k) v[k] = v[0];
-    const V16 u = load16(v);
-    float vmin = v[0], vmax = v[0];
-    for (int k = 1; k < 12; ++k) vmin = std::min(vmin, v[k]), vmax = std::max(vmax, v[k]);
+    typedef float V4 __attribute__((vector_size(16)));
+    typedef std::int32_t V4i __attribute__((vector_size(16)));
+    const float* ep[4] = {fit[0].a, fit[0].b, fit[1].a, fit[1].b};
+    V4 u[4];
+    float vmin = ep[0][0], vmax = ep[0][0];
+    for (int e = 0; e < 4; ++e) {
+        u[e] = V4{ep[e][0], ep[e][1], ep[e][2], 0.0f};
+        for (int c = 0; c < 3; ++c) vmin = std::min(vmin, ep[e][c]), vmax = std::max(vmax, ep[e][c]);
+    }
     struct Limits {
-        V16i add[14], keep[14];  // per mode and lane: 2^(db-1) and ~(2^db - 1) of the lane's channel
+        V4i add[14], keep[14];  // per mode and channel: 2^(db-1) and ~(2^db - 1); lane 3: 0
     };
     static const Limits lims = [] {
         Limits l{};
         for (int m = 0; m < 14; ++m)
-            for (int k = 0; k < 16; ++k) {
-                const int db = modes()[static_cast<size_t>(m)].delta_bits[k % 3];
-                l.add[m][k] = 1 << (db - 1);
-                l.keep[m][k] = ~((1 << db) - 1);
+            for (int c = 0; c < 3; ++c) {
+                const int db = modes()[static_cast<size_t>(m)].delta_bits[c];
+                l.add[m][c] = 1 << (db - 1);
+                l.keep[m][c] = ~((1 << db) - 1);
             }
         return l;
     }();
     int count = 0, qbits = -1;
-    V16i d0 = {}, d1 = {};  // every lane's delta from subset 0's endpoint a (d0) and b (d1)
+    V4i d0[4] = {}, d1[4] = {};  // each endpoint's delta from subset 0's endpoint a (d0) and b (d1)
     for (const int m : {2, 3, 4, 0, 5, 6, 7, 8, 1}) {
         const Mode& md = modes()[static_cast<size_t>(m)];
         if (md.ep_bits != qbits) {
             qbits = md.ep_bits;
             const float step = static_cast<float>(1 << (16 - qbits));
             const float inv_step = std::bit_cast<float>(static_cast<std::uint32_t>(127 - (16 - qbits)) << 23);
-            V16i q;
+            V4i q[4];
             if (vmin >= step && vmax < static_cast<float>((1 << qbits) - 1) * step) {
-                q = __builtin_convertvector(u * inv_step, V16i);
+                for (int e = 0; e < 4; ++e) q[e] = __builtin_convertvector(u[e] * inv_step, V4i);
             } else {
-                for (int k = 0; k < 16; ++k) q[k] = quantize(v[k], qbits);
+                for (int e = 0; e < 4; ++e)
+                    q[e] = V4i{quantize(ep[e][0], qbits), quantize(ep[e][1], qbits), quantize(ep[e][2], qbits), 0};
             }
-            // (the pad lanes, copies of lane 0, are compared with lane 0: delta 0)
-            const V16i base0 = __builtin_shufflevector(q, q, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 0, 0, 0);
-            const V16i base1 = __builtin_shufflevector(q, q, 3, 4, 5, 3, 4, 5, 3, 4, 5, 3, 4, 5, 0, 0, 0, 0);
             const std::int32_t mask = (1 << qbits) - 1, sign = 1 << (qbits - 1);
-            d0 = (((q - base0) & mask) ^ sign) - sign;  // sign_extend(q - base, qbits)
-            d1 = (((q - base1) & mask) ^ sign) - sign;
+            for (int e = 0; e < 4; ++e) {
+                d0[e] = (((q[e] - q[0]) & mask) ^ sign) - sign;  // sign_extend(q - base, qbits)
+                d1[e] = (((q[e] - q[1]) & mask) ^ sign) - sign;
+            }
         }
-        const V16i add = lims.add[m], keep = lims.keep[m];
-        if (or16((d0 + add) & keep) != 0 && or16((d1 + add) & keep) != 0) continue;
+        const V4i add = lims.add[m], keep = lims.keep[m];
+        const V4i f0 = ((d0[0] + add) & keep) | ((d0[1] + add) & keep) | ((d0[2] + add) & keep) | ((d0[3] + add) & keep);
+        const V4i f1 = ((d1[0] + add) & keep) | ((d1[1] + add) & keep) | ((d1[2] + add) & keep) | ((d1[3] + add) & keep);
+        if ((f0[0] | f0[1] | f0[2]) != 0 && (f1[0] | f1[1] | f1[2]) != 0) continue;
         out[count++] = m;
         if (count == max) break;
     }
