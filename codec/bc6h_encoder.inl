@@ -476,16 +476,16 @@ struct PartitionMoments {
     float s1[9][32];
 };
 
-// Sums of one per-texel moment over subset 1 of all 32 partitions: out[p] = sum_i in1[i][p] m[i].
-// A 32-wide accumulator (8 vector registers) per moment, not a read-modify-write of a whole
-// moments x 32 table per texel.
+// Sums of one per-texel moment over subset 1 of all 32 partitions: out[p] = sum_i in1[i][p] m[i],
+// added in sum16's order (texel i + texel i + 8, then by halves), each step for all 32
+// partitions at once (8 vector registers per step; the halving shortens the dependency chains).
 inline void subset1_sums(const PartitionTables& tb, const float m[16], float out[32]) {
-    float acc[32] = {};
-    for (int i = 0; i < 16; ++i) {
-        const float v = m[i];
-        for (int p = 0; p < 32; ++p) acc[p] += tb.in1[i][p] * v;
-    }
-    std::copy(acc, acc + 32, out);
+    float t8[8][32];
+    for (int i = 0; i < 8; ++i)
+        for (int p = 0; p < 32; ++p) t8[i][p] = tb.in1[i][p] * m[i] + tb.in1[i + 8][p] * m[i + 8];
+    for (int i = 0; i < 4; ++i)
+        for (int p = 0; p < 32; ++p) t8[i][p] += t8[i + 4][p];
+    for (int p = 0; p < 32; ++p) out[p] = (t8[0][p] + t8[2][p]) + (t8[1][p] + t8[3][p]);
 }
 
 // The 9 per-texel moments (x, y, z, xx, xy, xz, yy, yz, zz) of pm.x, channel-major: m[k][i].
@@ -510,17 +510,13 @@ void block_moments(const Target& t, PartitionMoments& pm) {
 }
 
 // Subset 1's moment sums pm.s1[.][p] for one partition, bit-identical to partition_scores' (the
-// same additions in the same order: members' terms in texel order, non-members add 0 * m = 0), so
+// same products, mask16's lanes being the table's 0/1 values, added in the same order), so
 // fit_partition gives the same lines whichever function filled them.
 void partition_moments(int p, PartitionMoments& pm) {
-    const PartitionTables& tb = partition_tables();
     float m[9][16];
     texel_moments(pm, m);
-    for (int k = 0; k < 9; ++k) {
-        float acc = 0;
-        for (int i = 0; i < 16; ++i) acc += tb.in1[i][p] * m[k][i];
-        pm.s1[k][p] = acc;
-    }
+    const V16 in = mask16(kPartition[p]);
+    for (int k = 0; k < 9; ++k) pm.s1[k][p] = sum16(in * load16(m[k]));
 }
 
 void partition_scores(const Target& t, const float ax0[3], float score[32], PartitionMoments& pm) {
@@ -602,14 +598,13 @@ void partition_scores_2d(const Target& t, const float ax0[3], float score[32], P
         for (float& x : e2) x *= il;
     }
     float m5[5][16];
-    float tot[5] = {0, 0, 0, 0, 0};
+    float tot[5];
     for (int i = 0; i < 16; ++i) {
         const float ti = pm.x[0][i] * e1[0] + pm.x[1][i] * e1[1] + pm.x[2][i] * e1[2];
         const float si = pm.x[0][i] * e2[0] + pm.x[1][i] * e2[1] + pm.x[2][i] * e2[2];
         m5[0][i] = ti, m5[1][i] = si, m5[2][i] = ti * ti, m5[3][i] = ti * si, m5[4][i] = si * si;
     }
-    for (int q = 0; q < 5; ++q)
-        for (int i = 0; i < 16; ++i) tot[q] += m5[q][i];
+    for (int q = 0; q < 5; ++q) tot[q] = sum16(load16(m5[q]));
     float s1[5][32];
     for (int q = 0; q < 5; ++q) subset1_sums(tb, m5[q], s1[q]);
     // Residual per subset: (a + c) / 2 - sqrt(((a - c) / 2)^2 + b^2); the square roots in a
