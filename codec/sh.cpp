@@ -61,21 +61,6 @@ Mat3 frame_from_z(Vec3 z_axis) {
     return r;
 }
 
-std::array<double, 9> sh3_basis(Vec3 d) {
-    const double x = d.x, y = d.y, z = d.z;
-    return {kY00,
-            -kY1 * y,
-            kY1 * z,
-            -kY1 * x,
-            kY2 * x * y,
-            -kY2 * y * z,
-            kY20 * (3.0 * z * z - 1.0),
-            -kY2 * x * z,
-            kY22 * (x * x - y * y)};
-}
-
-std::array<double, 4> sh2_basis(Vec3 d) { return {kY00, -kY1 * d.y, kY1 * d.z, -kY1 * d.x}; }
-
 namespace {
 template <int Order, class From, class To>
 ShRgb<Order, To> scale_bands(const ShRgb<Order, From>& in, bool inverse) {

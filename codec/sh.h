@@ -91,10 +91,22 @@ inline const double kY22 = std::sqrt(15.0 / (16.0 * kPi));      // sqrt(15/16pi)
 // Band scales of the normalised clamped-cosine convolution (radiance -> irradiance).
 inline constexpr double kIrradianceBandScale[3] = {1.0, 2.0 / 3.0, 1.0 / 4.0};
 
-// The nine SH3 basis functions at a unit direction.
-std::array<double, 9> sh3_basis(Vec3 d);
+// The nine SH3 basis functions at a unit direction (inline: the IrradZ direction search calls it
+// tens of times per texel).
+inline std::array<double, 9> sh3_basis(Vec3 d) {
+    const double x = d.x, y = d.y, z = d.z;
+    return {kY00,
+            -kY1 * y,
+            kY1 * z,
+            -kY1 * x,
+            kY2 * x * y,
+            -kY2 * y * z,
+            kY20 * (3.0 * z * z - 1.0),
+            -kY2 * x * z,
+            kY22 * (x * x - y * y)};
+}
 // The four SH2 basis functions at a unit direction.
-std::array<double, 4> sh2_basis(Vec3 d);
+inline std::array<double, 4> sh2_basis(Vec3 d) { return {kY00, -kY1 * d.y, kY1 * d.z, -kY1 * d.x}; }
 
 // ---- RGB SH types --------------------------------------------------------------------------
 

@@ -241,6 +241,30 @@ TEST(IrradzEncode, RecoversAmbientPlusDirectionalExactly) {
     }
 }
 
+TEST(IrradzEncode, SearchErrorEqualsTheGeneralErrorOfItsResult) {
+    // The search scores directions with a per-texel evaluator (constant products hoisted, a.G a
+    // over G's non-zero entries); its reported error must be the general closed form
+    // (sh_hemispherical_error: the model's SH3, then r.G r) of the I_z, w_a, d it returns. The
+    // returned parameters are stored in floats, hence the relative tolerance.
+    const auto texels = real_texels();
+    ASSERT_FALSE(texels.empty());
+    int checked = 0;
+    for (const Model model : {Model::kHhd, Model::kAhd})
+        for (size_t t = 0; t < texels.size(); ++t) {
+            EncodeOptions o;
+            o.model = model;
+            double e_search = -1;
+            const IrradZ p = encode(texels[t], o, &e_search);
+            const Sh3Irradiance irr = to_irradiance(texels[t]);
+            const double e_general = sh_hemispherical_error(irr, p, model);
+            double scale = 0;  // the squared DC irradiance, for texels that fit almost exactly
+            for (int k = 0; k < 3; ++k) scale += double(irr[0][k]) * double(irr[0][k]);
+            EXPECT_NEAR(e_search, e_general, 1e-5 * e_general + 1e-9 * scale) << t;
+            ++checked;
+        }
+    EXPECT_EQ(checked, 2 * static_cast<int>(texels.size()));
+}
+
 TEST(IrradzEncode, GoldenSectionIsCloseToABruteForceDirectionGrid) {
     // Brute twin of the direction search: a 1-degree grid over the whole (theta, phi) range,
     // w_a by the same least squares at every grid point.
