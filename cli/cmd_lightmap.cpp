@@ -43,8 +43,15 @@ Ktx2Image ktx(std::uint32_t fmt, const lightmap::Compressed& c, const std::vecto
     return k;
 }
 
+// The SH lightmap, its EXR blocks decompressed on the verb's threads.
+Result<lightmap::ShLightmap> read_input(const Options& o) {
+    LightmapReadOptions ro;
+    ro.threads = o.threads;
+    return read_sh_lightmap_exr(o.input, ro);
+}
+
 int run_encode(const Options& o) {
-    auto lm = read_sh_lightmap_exr(o.input);
+    auto lm = read_input(o);
     if (!lm) return report(lm.error());
     irradz::EncodeOptions eo;
     eo.solve = o.solve == "old" ? irradz::Solve::kOld : irradz::Solve::kSearch;
@@ -117,7 +124,7 @@ int run_decode(const Options& o) {
 }
 
 int run_audit(const Options& o) {
-    auto lm = read_sh_lightmap_exr(o.input);
+    auto lm = read_input(o);
     if (!lm) return report(lm.error());
     const double texels = double(lm->width) * lm->height;
     irradz::EncodeOptions eo;

@@ -1,6 +1,7 @@
 // zhc/formats/lightmap_exr.cpp — SH lightmap and IrradZ OpenEXR files (see lightmap_exr.h).
 #include "lightmap_exr.h"
 
+#include <IlmThreadPool.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -8,6 +9,7 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -38,7 +40,10 @@ Result<lightmap::ShLightmap> read_sh_lightmap_exr(const std::string& path, const
     try {
         Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
         ExrMemoryStream stream(b, path);
-        Imf::InputFile file(stream);
+        const int threads = std::max(1, o.threads);
+        if (threads > 1 && IlmThread::ThreadPool::globalThreadPool().numThreads() < threads)
+            IlmThread::ThreadPool::globalThreadPool().setNumThreads(threads);
+        Imf::InputFile file(stream, threads > 1 ? threads : 0);
         const Imath::Box2i dw = file.header().dataWindow();
         const std::int64_t w = std::int64_t(dw.max.x) - dw.min.x + 1, h = std::int64_t(dw.max.y) - dw.min.y + 1;
         if (w <= 0 || h <= 0) return make_error(ErrorCode::kBadFormat, path + ": empty data window");

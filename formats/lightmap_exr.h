@@ -20,6 +20,9 @@ namespace zhc {
 struct LightmapReadOptions {
     std::uint64_t max_texels = std::uint64_t(1) << 24;  // 4096 x 4096; checked before allocating
     std::uint64_t max_file_bytes = std::uint64_t(4) << 30;
+    // Threads for OpenEXR's block decompression (> 1 grows OpenEXR's process-wide thread pool to
+    // this size). The pixels read are the same for any count.
+    int threads = 1;
 };
 
 Result<lightmap::ShLightmap> read_sh_lightmap_exr(const std::string& path, const LightmapReadOptions& options = {});
