@@ -17,6 +17,7 @@
 #include "formats/file_io.h"
 
 namespace zhc::cli {
+namespace cmd_audit {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 namespace fs = std::filesystem;
@@ -257,4 +258,5 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_audit
 }  // namespace zhc::cli

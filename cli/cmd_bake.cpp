@@ -16,6 +16,7 @@
 #include "formats/scene_json.h"
 
 namespace zhc::cli {
+namespace cmd_bake {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 struct Options {
@@ -145,4 +146,5 @@ const VerbRegistration registration(15, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_bake
 }  // namespace zhc::cli

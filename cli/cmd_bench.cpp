@@ -12,6 +12,7 @@
 #include "formats/plot.h"
 
 namespace zhc::cli {
+namespace cmd_bench {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 namespace fs = std::filesystem;
@@ -121,4 +122,5 @@ const VerbRegistration registration(50, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_bench
 }  // namespace zhc::cli

@@ -15,6 +15,7 @@
 #include "formats/probe_file.h"
 
 namespace zhc::cli {
+namespace cmd_convert {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 struct Options {
@@ -205,4 +206,5 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_convert
 }  // namespace zhc::cli

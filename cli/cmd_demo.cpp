@@ -22,6 +22,7 @@
 #include "formats/scene_json.h"
 
 namespace zhc::cli {
+namespace cmd_demo {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 namespace fs = std::filesystem;
@@ -219,4 +220,5 @@ const VerbRegistration registration(10, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_demo
 }  // namespace zhc::cli

@@ -17,6 +17,7 @@
 #include "formats/file_io.h"
 
 namespace zhc::cli {
+namespace cmd_dering {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 constexpr std::uint64_t kMaxInputBytes = std::uint64_t(1) << 30;
@@ -170,4 +171,5 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_dering
 }  // namespace zhc::cli

@@ -17,6 +17,7 @@
 #include "formats/probe_file.h"
 
 namespace zhc::cli {
+namespace cmd_gltf {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 struct Options {
@@ -169,4 +170,5 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_gltf
 }  // namespace zhc::cli

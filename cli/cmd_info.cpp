@@ -13,6 +13,7 @@
 #include "formats/probe_file.h"
 
 namespace zhc::cli {
+namespace cmd_info {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 struct Options {
@@ -199,4 +200,5 @@ const VerbRegistration registration(45, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_info
 }  // namespace zhc::cli

@@ -17,6 +17,7 @@
 #include "formats/lightmap_exr.h"
 
 namespace zhc::cli {
+namespace cmd_lightmap {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -218,4 +219,5 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_lightmap
 }  // namespace zhc::cli

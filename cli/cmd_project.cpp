@@ -10,6 +10,7 @@
 #include "formats/envmap.h"
 
 namespace zhc::cli {
+namespace cmd_project {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 struct Options {
@@ -69,4 +70,5 @@ const VerbRegistration registration(20, [](CLI::App& app) -> std::function<int()
 });
 
 }  // namespace
+}  // namespace cmd_project
 }  // namespace zhc::cli
