@@ -384,7 +384,9 @@ TEST(GltfProbes, VolumesAppendAndNodesReference) {
 void expect_preserved(const tinygltf::Model& original, const Bytes& in, const Bytes& out) {
     const json a = gltf_json(in), b = gltf_json(out);
     for (const char* key : {"meshes", "materials", "extensionsRequired", "asset"}) {
-        if (a.contains(key)) EXPECT_EQ(a[key], b[key]) << key;
+        if (a.contains(key)) {
+            EXPECT_EQ(a[key], b[key]) << key;
+        }
     }
     EXPECT_EQ(a["extensions"]["VENDOR_unknown_top"], b["extensions"]["VENDOR_unknown_top"]);
     for (size_t i = 0; i < a["accessors"].size(); ++i) EXPECT_EQ(a["accessors"][i], b["accessors"][i]);
@@ -414,7 +416,9 @@ TEST(GltfProbes, SceneContentSurvivesByteForByte) {
                 SCOPED_TRACE(std::string(draco ? "draco mesh " : "") + (in_binary ? "glb->" : "gltf->") + (out_binary ? "glb" : "gltf"));
                 expect_preserved(scene_model, scene, *out);
                 // The Draco mesh's compressed bytes are still decodable (same bytes as before).
-                if (draco) EXPECT_EQ(gltf_json(*out)["meshes"][0]["primitives"][1]["extensions"]["KHR_draco_mesh_compression"]["bufferView"], 1);
+                if (draco) {
+                    EXPECT_EQ(gltf_json(*out)["meshes"][0]["primitives"][1]["extensions"]["KHR_draco_mesh_compression"]["bufferView"], 1);
+                }
             }
         }
     }
