@@ -104,8 +104,8 @@ const std::array<Mode, 14>& modes() {
     return m;
 }
 
-// The encoder's view of a mode's header: runs of bits at fixed stream positions, so that packing
-// needs no position bookkeeping. Stream bits [64 word + pos, + len) = bits [shift, shift + len)
+// A mode's header as runs of bits at fixed stream positions, so that packing (encoder) and
+// unpacking (decode_block) need no position bookkeeping. Stream bits [64 word + pos, + len) = bits [shift, shift + len)
 // of the field; reversed runs ("rw11-10") are split into single bits, and runs that cross the
 // 64-bit boundary into two ops.
 struct PackOp {
@@ -239,20 +239,6 @@ int sign_extend(int v, int bits) {
 // Decoded half bits of a palette entry: interpolate unquantized endpoints, then scale by 31/64.
 inline int finish(int a, int b, int w) { return (((a * (64 - w) + b * w + 32) >> 6) * 31) >> 6; }
 
-struct BitReader {
-    const std::uint8_t* p;
-    int pos = 0;
-    int bit() {
-        const int b = (p[pos >> 3] >> (pos & 7)) & 1;
-        ++pos;
-        return b;
-    }
-    int bits(int n) {
-        int v = 0;
-        for (int i = 0; i < n; ++i) v |= bit() << i;
-        return v;
-    }
-};
 }  // namespace
 
 std::uint16_t float_to_half(float f) {
@@ -344,15 +330,14 @@ void decode_block(const std::uint8_t in[16], std::uint16_t out[16][3]) {
         return;
     }
     const Mode& md = modes()[static_cast<size_t>(mi)];
-    BitReader r{in, md.code_bits};
+    // The block as two little-endian words; the header's bit runs read at their fixed positions.
+    std::uint64_t w[2] = {0, 0};
+    for (int k = 0; k < 16; ++k) w[k >> 3] |= static_cast<std::uint64_t>(in[k]) << (8 * (k & 7));
+    const PackPlan& plan = pack_plans()[static_cast<size_t>(mi)];
     int e[4][3] = {};
-    for (int s = 0; s < md.nsegs; ++s) {
-        const Seg& g = md.segs[static_cast<size_t>(s)];
-        const int step = g.last >= g.first ? 1 : -1;
-        for (int b = g.first;; b += step) {
-            e[g.field / 3][g.field % 3] |= r.bit() << b;
-            if (b == g.last) break;
-        }
+    for (int k = 0; k < plan.nops; ++k) {
+        const PackOp& op = plan.ops[static_cast<size_t>(k)];
+        e[op.field / 3][op.field % 3] |= static_cast<int>((w[op.word] >> op.pos) & op.mask) << op.shift;
     }
     const int ns = md.two_subsets ? 2 : 1;
     if (md.transformed) {
@@ -362,13 +347,19 @@ void decode_block(const std::uint8_t in[16], std::uint16_t out[16][3]) {
     }
     for (int i = 0; i < 2 * ns; ++i)
         for (int c = 0; c < 3; ++c) e[i][c] = unquantize(e[i][c], md.ep_bits);
-    const int partition = md.two_subsets ? r.bits(5) : 0;
+    // After the header (which ends at bit 65 or 77) the rest of the block is word 1's top bits:
+    // the partition (two subsets), then the indices.
+    std::uint64_t rest = w[1] >> (plan.header_bits - 64);
+    int partition = 0;
+    if (md.two_subsets) partition = static_cast<int>(rest & 31), rest >>= 5;
     const std::uint16_t pmask = md.two_subsets ? kPartition[partition] : 0;
     const int anchor2 = md.two_subsets ? kAnchor2[partition] : -1;
     const int ib = md.two_subsets ? 3 : 4;
     const int* wts = md.two_subsets ? kWeights3 : kWeights4;
     for (int i = 0; i < 16; ++i) {
-        const int idx = r.bits((i == 0 || i == anchor2) ? ib - 1 : ib);
+        const int nb = (i == 0 || i == anchor2) ? ib - 1 : ib;
+        const int idx = static_cast<int>(rest & ((1u << nb) - 1));
+        rest >>= nb;
         const int s = pmask >> i & 1;
         for (int c = 0; c < 3; ++c)
             out[i][c] = static_cast<std::uint16_t>(finish(e[2 * s][c], e[2 * s + 1][c], wts[idx]));
