@@ -167,6 +167,28 @@ Target make_target(const Sh3Irradiance& irr, const Mat9& g, const Rgb* sampled_i
 struct Fit {
     double w = 1, err = 0;
 };
+// w_a (least squares, clamped to [0, 1]) and the error for one d, from the products the closed
+// form needs: aga = a.G a, agh = a.G h, hgh = h.G h, agt_k = a.G t_k, hgt_k = h.G t_k.
+Fit fit_from_products(const Target& tg, double aga, double agh, double hgh, const double agt[3], const double hgt[3]) {
+    const double bgb = hgh - 2 * agh + aga;
+    double r0[3], bgr[3], num = 0, den = 0;
+    for (size_t k = 0; k < 3; ++k) {
+        const double i = tg.iz[k];
+        r0[k] = tg.tgt[k] - 2 * i * agt[k] + i * i * aga;
+        bgr[k] = hgt[k] - i * agh - agt[k] + i * aga;
+        num += i * bgr[k];
+        den += i * i * bgb;
+    }
+    Fit f;
+    f.w = den > 0 ? std::clamp(num / den, 0.0, 1.0) : 1.0;
+    for (size_t k = 0; k < 3; ++k) {
+        const double i = tg.iz[k];
+        f.err += r0[k] - 2 * f.w * i * bgr[k] + f.w * f.w * i * i * bgb;
+    }
+    f.err = std::max(0.0, f.err);
+    return f;
+}
+
 Fit fit_direction(const Target& tg, Vec3 d, Model model, const Mat9& g) {
     const Tables& tb = tables();
     const Vec9& h = model == Model::kHhd ? tb.hemi : tb.ambient;
@@ -183,25 +205,9 @@ Fit fit_direction(const Target& tg, Vec3 d, Model model, const Mat9& g) {
     }
     // G h is constant; reuse the precomputed product for the hemispherical Gram matrix.
     const Vec9 gh = &g == &tb.g_hemi ? (model == Model::kHhd ? tb.g_hemi_hemi : tb.g_hemi_ambient) : mul(g, h);
-    const double aga = dot9(a, ga), agh = dot9(a, gh), hgh = dot9(h, gh);
-    const double bgb = hgh - 2 * agh + aga;
-    double r0[3], bgr[3], num = 0, den = 0;
-    for (size_t k = 0; k < 3; ++k) {
-        const double i = tg.iz[k];
-        const double agt = dot9(a, tg.gt[k]), hgt = dot9(h, tg.gt[k]);
-        r0[k] = tg.tgt[k] - 2 * i * agt + i * i * aga;
-        bgr[k] = hgt - i * agh - agt + i * aga;
-        num += i * bgr[k];
-        den += i * i * bgb;
-    }
-    Fit f;
-    f.w = den > 0 ? std::clamp(num / den, 0.0, 1.0) : 1.0;
-    for (size_t k = 0; k < 3; ++k) {
-        const double i = tg.iz[k];
-        f.err += r0[k] - 2 * f.w * i * bgr[k] + f.w * f.w * i * i * bgb;
-    }
-    f.err = std::max(0.0, f.err);
-    return f;
+    double agt[3], hgt[3];
+    for (size_t k = 0; k < 3; ++k) agt[k] = dot9(a, tg.gt[k]), hgt[k] = dot9(h, tg.gt[k]);
+    return fit_from_products(tg, dot9(a, ga), dot9(a, gh), dot9(h, gh), agt, hgt);
 }
 
 // fit_direction for the hemispherical Gram matrix, as the search calls it ~60 times per texel:
@@ -222,10 +228,6 @@ public:
         }
         hgh_ = dot9(h, gh);
         for (size_t k = 0; k < 3; ++k) hgt_[k] = dot9(h, tg.gt[k]);
-        for (size_t i = 0; i < 9; ++i) {
-            const int l = i == 0 ? 0 : (i < 4 ? 1 : 2);
-            band_[i] = kPi * kIrradianceBandScale[l];
-        }
         // a.G a over G's non-zero entries: the diagonal, and each symmetric pair i < j once, doubled.
         for (int k = 0; k < tb.nnz; ++k) {
             const size_t i = tb.nz_i[static_cast<size_t>(k)], j = tb.nz_j[static_cast<size_t>(k)];
@@ -235,10 +237,9 @@ public:
         }
     }
     Fit operator()(Vec3 d) const {
-        const Vec9 y = sh3_basis(d);
-        Vec9 a;
+        Vec9 a = clamped_cosine_sh(d);
         const double inv_dz = 1.0 / d.z;
-        for (size_t i = 0; i < 9; ++i) a[i] = band_[i] * y[i] * inv_dz;
+        for (double& v : a) v *= inv_dz;
         double aga = 0;
         for (size_t i = 0; i < 9; ++i) aga += diag_[i] * a[i] * a[i];
         for (int k = 0; k < npairs_; ++k) {
@@ -249,25 +250,8 @@ public:
         // in j order, as a scalar loop would).
         V2d d01 = {0, 0}, d23 = {0, 0};
         for (size_t j = 0; j < 9; ++j) d01 += a[j] * cols_[j][0], d23 += a[j] * cols_[j][1];
-        const double dots[4] = {d01[0], d01[1], d23[0], d23[1]};
-        const double agh = dots[3];
-        const double bgb = hgh_ - 2 * agh + aga;
-        double r0[3], bgr[3], num = 0, den = 0;
-        for (size_t k = 0; k < 3; ++k) {
-            const double i = tg_.iz[k], agt = dots[k];
-            r0[k] = tg_.tgt[k] - 2 * i * agt + i * i * aga;
-            bgr[k] = hgt_[k] - i * agh - agt + i * aga;
-            num += i * bgr[k];
-            den += i * i * bgb;
-        }
-        Fit f;
-        f.w = den > 0 ? std::clamp(num / den, 0.0, 1.0) : 1.0;
-        for (size_t k = 0; k < 3; ++k) {
-            const double i = tg_.iz[k];
-            f.err += r0[k] - 2 * f.w * i * bgr[k] + f.w * f.w * i * i * bgb;
-        }
-        f.err = std::max(0.0, f.err);
-        return f;
+        const double agt[3] = {d01[0], d01[1], d23[0]};
+        return fit_from_products(tg_, aga, d23[1], hgh_, agt, hgt_);
     }
 
 private:
@@ -279,7 +263,7 @@ private:
     const Target& tg_;
     V2d cols_[9][2];
     double hgh_ = 0, hgt_[3] = {};
-    Vec9 band_{}, diag_{};
+    Vec9 diag_{};
     std::array<Pair, 36> pairs_{};
     int npairs_ = 0;
 };
