@@ -105,9 +105,9 @@ const std::array<Mode, 14>& modes() {
 }
 
 // A mode's header as runs of bits at fixed stream positions, so that packing (encoder) and
-// unpacking (decode_block) need no position bookkeeping. Stream bits [64 word + pos, + len) = bits [shift, shift + len)
-// of the field; reversed runs ("rw11-10") are split into single bits, and runs that cross the
-// 64-bit boundary into two ops.
+// unpacking (decode_block) need no position bookkeeping. Stream bits [64 word + pos, + len) =
+// bits [shift, shift + len) of the field; reversed runs ("rw11-10") are split into single bits,
+// and runs that cross the 64-bit boundary into two ops.
 struct PackOp {
     std::uint8_t field, shift, word, pos;
     std::uint32_t mask;  // (1 << len) - 1

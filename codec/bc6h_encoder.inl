@@ -467,11 +467,12 @@ const PartitionTables& partition_tables() {
 // after two power steps from the block's principal axis `ax0`: v1 = C ax0, v2 = C v1,
 // lambda ~ (v1 . v2) / (v1 . v1), a lower bound that converges quadratically in the power steps.
 // Per-partition moments kept from partition_scores for fit_partition: texel coordinates are
-// x_i = (u_i - mean) / 256 (u domain, about the block mean); total = sums over the block of
-// (x, y, z, xx, xy, xz, yy, yz, zz); s1[k][p] = the same sums over subset 1 of partition p.
+// x_i = (u_i - mean) / 256 (u domain, about the block mean); m[k][i] = texel i's moment k of
+// (x, y, z, xx, xy, xz, yy, yz, zz) (so m[0..2] are the coordinates); total = their sums over the
+// block; s1[k][p] = the same sums over subset 1 of partition p.
 struct PartitionMoments {
     float mean[3];
-    float x[3][16];
+    float m[9][16];
     float total[9];
     float s1[9][32];
 };
@@ -488,35 +489,26 @@ inline void subset1_sums(const PartitionTables& tb, const float m[16], float out
     for (int p = 0; p < 32; ++p) out[p] = (t8[0][p] + t8[2][p]) + (t8[1][p] + t8[3][p]);
 }
 
-// The 9 per-texel moments (x, y, z, xx, xy, xz, yy, yz, zz) of pm.x, channel-major: m[k][i].
-void texel_moments(const PartitionMoments& pm, float m[9][16]) {
-    const V16 x = load16(pm.x[0]), y = load16(pm.x[1]), z = load16(pm.x[2]);
-    store16(m[0], x), store16(m[1], y), store16(m[2], z);
-    store16(m[3], x * x), store16(m[4], x * y), store16(m[5], x * z);
-    store16(m[6], y * y), store16(m[7], y * z), store16(m[8], z * z);
-}
-
-// The block part of PartitionMoments: mean, x, total (each total[k] summed in texel order).
+// The block part of PartitionMoments: mean, the per-texel moments m and their totals (summed by
+// halves, sum16).
 void block_moments(const Target& t, PartitionMoments& pm) {
+    V16 x[3];
     for (int c = 0; c < 3; ++c) {
         const V16 u = load16(t.u[c]);
         const float mean = sum16(u) * (1.0f / 16);
         pm.mean[c] = mean;
-        store16(pm.x[c], (u - mean) * (1.0f / 256));
+        x[c] = (u - mean) * (1.0f / 256);
     }
-    float m[9][16];
-    texel_moments(pm, m);
-    for (int k = 0; k < 9; ++k) pm.total[k] = sum16(load16(m[k]));
+    const V16 m[9] = {x[0], x[1], x[2], x[0] * x[0], x[0] * x[1], x[0] * x[2], x[1] * x[1], x[1] * x[2], x[2] * x[2]};
+    for (int k = 0; k < 9; ++k) store16(pm.m[k], m[k]), pm.total[k] = sum16(m[k]);
 }
 
 // Subset 1's moment sums pm.s1[.][p] for one partition, bit-identical to partition_scores' (the
 // same products, mask16's lanes being the table's 0/1 values, added in the same order), so
 // fit_partition gives the same lines whichever function filled them.
 void partition_moments(int p, PartitionMoments& pm) {
-    float m[9][16];
-    texel_moments(pm, m);
     const V16 in = mask16(kPartition[p]);
-    for (int k = 0; k < 9; ++k) pm.s1[k][p] = sum16(in * load16(m[k]));
+    for (int k = 0; k < 9; ++k) pm.s1[k][p] = sum16(in * load16(pm.m[k]));
 }
 
 void partition_scores(const Target& t, const float ax0[3], float score[32], PartitionMoments& pm) {
@@ -524,9 +516,7 @@ void partition_scores(const Target& t, const float ax0[3], float score[32], Part
     float* total = pm.total;
     auto& s1 = pm.s1;
     block_moments(t, pm);
-    float mom[9][16];
-    texel_moments(pm, mom);
-    for (int k = 0; k < 9; ++k) subset1_sums(tb, mom[k], s1[k]);
+    for (int k = 0; k < 9; ++k) subset1_sums(tb, pm.m[k], s1[k]);
     const float v0x = ax0[0], v0y = ax0[1], v0z = ax0[2];
     // Straight-line per partition (no branches) so that the loop vectorises.
     auto residual = [=](float a0, float a1, float a2, float a3, float a4, float a5, float a6, float a7, float a8,
@@ -600,8 +590,8 @@ void partition_scores_2d(const Target& t, const float ax0[3], float score[32], P
     float m5[5][16];
     float tot[5];
     for (int i = 0; i < 16; ++i) {
-        const float ti = pm.x[0][i] * e1[0] + pm.x[1][i] * e1[1] + pm.x[2][i] * e1[2];
-        const float si = pm.x[0][i] * e2[0] + pm.x[1][i] * e2[1] + pm.x[2][i] * e2[2];
+        const float ti = pm.m[0][i] * e1[0] + pm.m[1][i] * e1[1] + pm.m[2][i] * e1[2];
+        const float si = pm.m[0][i] * e2[0] + pm.m[1][i] * e2[1] + pm.m[2][i] * e2[2];
         m5[0][i] = ti, m5[1][i] = si, m5[2][i] = ti * ti, m5[3][i] = ti * si, m5[4][i] = si * si;
     }
     for (int q = 0; q < 5; ++q) tot[q] = sum16(load16(m5[q]));
@@ -653,8 +643,8 @@ void fit_partition(const PartitionMoments& pm, int p, const float ax0[3], Subset
         // Membership from the mask bits: the same 0/1 values as tb.in1[i][p] and 1 - tb.in1[i][p].
         const V16 in = mask16(s ? kPartition[p] : ~static_cast<unsigned>(kPartition[p]));
         float proj[16];
-        store16(proj, ((load16(pm.x[0]) - m[0]) * ax[0] + (load16(pm.x[1]) - m[1]) * ax[1] +
-                       (load16(pm.x[2]) - m[2]) * ax[2]) * in);
+        store16(proj, ((load16(pm.m[0]) - m[0]) * ax[0] + (load16(pm.m[1]) - m[1]) * ax[1] +
+                       (load16(pm.m[2]) - m[2]) * ax[2]) * in);
         float hi_out;
         // members' projections about their mean straddle 0 (non-members project to 0)
         float lo = min_max16(proj, hi_out);
