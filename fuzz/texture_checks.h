@@ -1,9 +1,13 @@
 // Shared by the container fuzzers (fuzz_ktx2, fuzz_dds): what every accepted lightmap texture must
-// satisfy, whichever container it came in. Aborts (a libFuzzer finding) on any violation.
+// satisfy, whichever container it came in, and the whole per-input check. Aborts (a libFuzzer
+// finding) on any violation.
 #pragma once
 
+#include <cstdint>
 #include <cstdlib>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "codec/bc45.h"
 #include "codec/bc6h.h"
@@ -30,6 +34,28 @@ inline void check_texture(const Ktx2Image& img) {
         for (float f : v)
             if (!(f >= 0.0f && f <= 1.0f)) std::abort();
     }
+}
+
+// One fuzz input through a container's reader and writer (decode_ktx2/encode_ktx2 or
+// decode_dds/encode_dds): a refusal is one line; an accepted texture passes check_texture and
+// survives a write/read round trip with the same blocks and format.
+template <class Limits>
+int fuzz_container(const std::uint8_t* data, std::size_t size,
+                   Result<Ktx2Image> (*decode)(std::span<const std::uint8_t>, const std::string&, const Limits&),
+                   Result<std::vector<std::uint8_t>> (*encode)(const Ktx2Image&)) {
+    Limits limits;
+    limits.max_dimension = 1024;
+    auto img = decode({data, size}, "fuzz-input", limits);
+    if (!img) {
+        check_refusal(img.error());
+        return 0;
+    }
+    check_texture(*img);
+    auto again = encode(*img);
+    if (!again) std::abort();
+    auto back = decode(*again, "fuzz-reencoded", limits);
+    if (!back || back->blocks != img->blocks || back->vk_format != img->vk_format) std::abort();
+    return 0;
 }
 
 }  // namespace zhc::fuzz
