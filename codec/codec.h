@@ -79,6 +79,7 @@ Result<std::vector<const Codec*>> select_codecs(std::string_view comma_separated
 std::span<const Codec> core_codecs();       // sh3, sh2 (codec/core_codecs.cpp)
 std::span<const Codec> zh3_codecs();        // ZH3 fits, solves, hallucination (codec/zh3.cpp)
 std::span<const Codec> dering_codecs();     // sh3_dering, zh3_lum_dering (codec/dering.cpp)
+std::span<const Codec> zh3_window_codecs();  // zh3_dering, zh3_dering_q16 (codec/zh3_window.cpp)
 std::span<const Codec> quantized_codecs();  // zh3_q16, sh3_q28, sh2_q (codec/quantize.cpp)
 
 // Little-endian float storage helpers shared by the float representations.

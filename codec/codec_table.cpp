@@ -5,13 +5,14 @@
 #include <vector>
 
 #include "codec.h"
+#include "zh3_window.h"
 
 namespace zhc {
 
 std::span<const Codec> codecs() {
     static const std::vector<Codec> table = [] {
         std::vector<Codec> all;
-        for (auto part : {core_codecs(), zh3_codecs(), dering_codecs(), quantized_codecs()})
+        for (auto part : {core_codecs(), zh3_codecs(), dering_codecs(), zh3_window_codecs(), quantized_codecs()})
             all.insert(all.end(), part.begin(), part.end());
         return all;
     }();

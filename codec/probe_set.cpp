@@ -89,6 +89,7 @@ void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radi
     if (packed_layout_from_name(codec.name, &packed)) {
         QuantEncodeControls controls;  // the table entry's encoder choices
         controls.solve_axis = codec.name == "zh3_solved_q16";
+        controls.dering = codec.name == "zh3_dering_q16";
         controls.solver = codec_options(params, base);
         encode_packed(packed, hub, params, out, stats, controls);  // handles kind itself (scaled bounds)
         return;

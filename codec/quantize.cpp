@@ -7,6 +7,8 @@
 // Byte layouts: docs/quantization.md.
 #include "quantize.h"
 
+#include "zh3_window.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -301,7 +303,7 @@ std::size_t packed_size_bytes(PackedLayout layout) {
 }
 
 bool packed_layout_from_name(std::string_view name, PackedLayout* out) {
-    if (name == "zh3_q16" || name == "zh3_solved_q16") *out = PackedLayout::kZh3Q16;
+    if (name == "zh3_q16" || name == "zh3_solved_q16" || name == "zh3_dering_q16") *out = PackedLayout::kZh3Q16;
     else if (name == "sh3_q28") *out = PackedLayout::kSh3Q28;
     else if (name == "sh2_q" || name == "hall_curve_q") *out = PackedLayout::kSh2Q;
     else return false;
@@ -449,11 +451,62 @@ void encode_impl(PackedLayout layout, const Sh3Radiance& hub, const QuantParams&
 
 }  // namespace
 
+namespace {
+// Certified: every channel with a positive DC has a non-negative irradiance minimum once decoded.
+bool decoded_non_negative(const std::uint8_t* bytes, const QuantParams& p) {
+    const Zh3 d = decode_zh3_q16(bytes, p);
+    for (int k = 0; k < 3; ++k)
+        if (d.linear[0][k] > 0.0f && zh3_min_irradiance_bound(d, p.axis_mode, p.luminance, k) < 0.0) return false;
+    return true;
+}
+
+// zh3_dering_q16 (codec/zh3_window.h): window, quantise, decode, check; window further while the
+// decoded probe goes negative (the DC's rounding, the L1 codes and the decoder's axis all move
+// it). The caps after the float window s: s (1 - 2^-12), s (1 - 2^-8), s (1 - 2^-4), then halving
+// down to 0, where only the DC and the zonal code nearest 0 are left (always non-negative: the
+// zonal step is far below the DC).
+void encode_dering_q16(const Sh3Radiance& hub, const QuantParams& p, std::uint8_t* out, EncodeStats* stats,
+                       const QuantEncodeControls& controls) {
+    QuantEncodeControls inner = controls;
+    inner.dering = false;
+    const Zh3 fit = zh3_fit(hub, p.axis_mode, p.luminance);
+    double cap = 1.0, first = 1.0;
+    for (int attempt = 0;; ++attempt) {
+        Zh3 z = fit;
+        const double s = zh3_dering_window(&z, p.axis_mode, p.luminance, cap);
+        if (attempt == 0) first = s;
+        EncodeStats round_stats;
+        encode_impl(PackedLayout::kZh3Q16, zh3_expand(z, p.axis_mode, p.luminance), p, out, &round_stats, inner,
+                    nullptr);
+        if (decoded_non_negative(out, p) || s == 0.0 || attempt >= 16) {
+            if (stats) {
+                stats->clamped_ratios += round_stats.clamped_ratios;
+                stats->dering_clamped = stats->dering_clamped || s < 1.0;
+            }
+            return;
+        }
+        cap = attempt < 3 ? first * (1.0 - std::ldexp(1.0, -12 + 4 * attempt)) : (attempt < 15 ? s * 0.5 : 0.0);
+    }
+}
+}  // namespace
+
 void encode_packed(PackedLayout layout, const Sh3Radiance& hub, const QuantParams& params, std::uint8_t* out,
                    EncodeStats* stats, const QuantEncodeControls& controls) {
     QuantEncodeControls stored = controls;
     stored.exact_dc = false;  // the bytes always hold the quantised DC
+    if (layout == PackedLayout::kZh3Q16 && controls.dering) return encode_dering_q16(hub, params, out, stats, stored);
     encode_impl(layout, hub, params, out, stats, stored, nullptr);
+}
+
+Zh3 decode_zh3_q16(const std::uint8_t* in, const QuantParams& p) {
+    const Sh3Radiance hub = decode_packed(PackedLayout::kZh3Q16, in, p);
+    const Rgb dc = load_dc(in, effective_dc_format(PackedLayout::kZh3Q16, p.dc_format));
+    const RatioCoder coder = zonal_coder(p);
+    Zh3 z;
+    z.linear = truncate_to_sh2(hub);
+    for (int k = 0; k < 3; ++k)
+        z.zonal[k] = static_cast<float>(coder.decode(in[zonal_offset(k)]) * dc[k] / band_scale(p.kind, 2));
+    return z;
 }
 
 Sh3Radiance decode_packed(PackedLayout layout, const std::uint8_t* in, const QuantParams& p) {

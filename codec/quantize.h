@@ -134,7 +134,7 @@ enum class PackedLayout : std::uint8_t {
     kSh2Q = 2,    // 16 bytes: DC slot (6) + per channel [L1-1, L10, L11] + 1 zero byte
 };
 std::size_t packed_size_bytes(PackedLayout layout);
-// "zh3_q16", "zh3_solved_q16" (zh3_q16 bytes), "sh3_q28", "sh2_q", "hall_curve_q" (sh2_q bytes)
+// "zh3_q16", "zh3_solved_q16", "zh3_dering_q16" (zh3_q16 bytes), "sh3_q28", "sh2_q", "hall_curve_q" (sh2_q bytes)
 // -> layout; false for other names.
 bool packed_layout_from_name(std::string_view name, PackedLayout* out);
 // True for the entries whose decoder adds a hallucinated zonal L2 to the decoded linear SH
@@ -153,6 +153,10 @@ struct QuantEncodeControls {
     // bytes decode with the ordinary zh3_q16 decoder (entry "zh3_solved_q16"). Slower encode.
     bool solve_axis = false;
     CodecOptions solver;  // iterations, tolerance (luminance weights come from QuantParams)
+    // zh3_q16: whole-sphere deringing (entry "zh3_dering_q16", codec/zh3_window.h): the probe is
+    // windowed, quantised, decoded, and windowed further while the DECODED irradiance has a
+    // negative certified minimum anywhere on the sphere.
+    bool dering = false;
     // Analysis only (the output is then not a valid layout): keep the DC exact instead of
     // quantising it, to split the error budget between DC and ratios. Used via quantize_roundtrip.
     bool exact_dc = false;
@@ -164,6 +168,10 @@ void encode_packed(PackedLayout layout, const Sh3Radiance& hub, const QuantParam
                    EncodeStats* stats, const QuantEncodeControls& controls = {});
 // Decodes any packed_size_bytes(layout) bytes to the hub (radiance SH3). Total: never traps.
 Sh3Radiance decode_packed(PackedLayout layout, const std::uint8_t* in, const QuantParams& params);
+
+// zh3_q16 bytes as the ZH3 they stand for (radiance linear SH and zonal coefficients, before the
+// zonal is expanded along the axis): what the decoder's irradiance is made of.
+Zh3 decode_zh3_q16(const std::uint8_t* in, const QuantParams& params);
 
 // encode_packed followed by decode_packed, except that controls.exact_dc keeps the float DC
 // (what the decoder would see if the DC were stored exactly). For error-budget studies.
