@@ -252,21 +252,23 @@ vec3 zhcIrradianceZh3(ZhcSh3 linear, vec3 zonal, vec3 axis[3], vec3 n, vec3 s) {
 }
 
 // Hallucinated zonal coefficients (ZH3 paper Sec. 3.4, codec hallucinate_zonal / zh3_hallucinate):
-// f1_k = v_k . a_k (the L1 along the zonal axis), p = clamp(|f1| / f0, 0, sqrt3); Eq. 14 needs no
-// f0; Eq. 20 / 21 give 0 when f0 <= 0 or not finite. ~15 flops + 3 divisions.
+// f1_k = v_k . a_k (the L1 along the zonal axis), p = clamp(|f1| / f0, 0, sqrt3), f20 = (A p^2 +
+// B p) f0 (Eq. 20: A = 2 sqrt5/3, B = -sqrt(5/3); Eq. 21: A, B = f.curve); Eq. 14: sqrt15/3 |f1|.
+// f0 <= 0 or not finite gives 0 (Eq. 20/21). Below the clamp the same value is computed as
+// (A p + B) |f1|: p * f0 would lose everything when p underflows binary32 (|f1| / f0 < 2^-126
+// happens for probes with a tiny L1 next to a huge DC), |f1| itself never does.
+// ~15 flops + 3 divisions.
 vec3 zhcHallucinateZonal(ZhcSh3 linear, vec3 axis[3], ZhcFormat f) {
     vec3 zonal = vec3(0.0);
+    vec2 ab = f.hallucination == ZHC_HALL_SPHERE ? vec2(2.0 * ZHC_SQRT5 / 3.0, -sqrt(5.0 / 3.0)) : f.curve;
     for (int k = 0; k < 3; ++k) {
         float f1 = abs(dot(zhcL1Vector(linear, k), axis[k]));
         float f0 = linear.c[0][k];
         if (f.hallucination == ZHC_HALL_AMBDIR) {
             zonal[k] = (ZHC_SQRT15 / 3.0) * f1;
         } else if (f.hallucination != ZHC_HALL_NONE && zhcIsFinite(f0) && f0 > 0.0) {
-            float r = f1 / f0;
-            float p = zhcIsFinite(r) ? min(r, ZHC_SQRT3) : (r > 0.0 ? ZHC_SQRT3 : r);  // NaN stays NaN
-            zonal[k] = f.hallucination == ZHC_HALL_SPHERE
-                           ? ((2.0 * ZHC_SQRT5 / 3.0) * p * p - sqrt(5.0 / 3.0) * p) * f0
-                           : (f.curve.x * p * p + f.curve.y * p) * f0;
+            float p = f1 / f0;  // >= 0, +Inf or NaN (NaN only from NaN inputs: stays NaN)
+            zonal[k] = p >= ZHC_SQRT3 ? (ab.x * 3.0 + ab.y * ZHC_SQRT3) * f0 : (ab.x * p + ab.y) * f1;
         }
     }
     return zonal;
