@@ -415,8 +415,8 @@ Scale probe_scale(const GlslEntry& e, const StorageParams& p, const Sh3Radiance&
     // G = max over p in [0, sqrt3] of the sum of both factors.
     double g = 0;
     auto g_of = [](double a, double b) {
-        const double p = std::sqrt(3.0);
-        return std::fabs(a) * p + std::fabs(b) + std::max(std::fabs(b), std::fabs(2 * a * p + b));
+        const double pmax = std::sqrt(3.0);
+        return std::fabs(a) * pmax + std::fabs(b) + std::max(std::fabs(b), std::fabs(2 * a * pmax + b));
     };
     if (e.hallucination == kHallAmbdir) g = 2 * std::sqrt(15.0) / 3;
     if (e.hallucination == kHallSphere) g = g_of(2 * std::sqrt(5.0) / 3, -std::sqrt(5.0 / 3));
