@@ -77,7 +77,7 @@ constexpr double kCFloat = 16, kCQuant = 32, kCDecode = 16, kCLightmap = 16;
 constexpr int kOutFloats = 30;  // per item: 27 SH3 radiance + 3 irradiance
 
 // The test main appended after zhc.glsl. Modes: 0 probe decode + irradiance, 1 IrradZ texel,
-// 2 DC unpacking.
+// 2 DC unpacking, 3 HLSH.
 const char* kTestMain = R"(
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Words { uint words[]; };
@@ -114,6 +114,13 @@ void main() {
         outv[o] = e.x; outv[o + 1u] = e.y; outv[o + 2u] = e.z;
         vec3 d = zhcDecodeHemiOct(uv);
         outv[o + 3u] = d.x; outv[o + 4u] = d.y; outv[o + 5u] = d.z;
+    } else if (uMode == 3u) {
+        uint b = i * 12u;
+        vec3 v[4];
+        for (uint k = 0u; k < 4u; ++k)
+            v[k] = uintBitsToFloat(uvec3(words[b + 3u * k], words[b + 3u * k + 1u], words[b + 3u * k + 2u]));
+        vec3 e = zhcHlshIrradiance(v[0], v[1], v[2], v[3], n);
+        outv[o] = e.x; outv[o + 1u] = e.y; outv[o + 2u] = e.z;
     } else {
         uint w = words[i];
         vec3 a = zhcUnpackR11G11B10F(w), b = zhcUnpackRGB9E5(w);
@@ -732,6 +739,52 @@ TEST_F(RuntimeGl, IrradZLightmapMatchesTheCodec) {
         EXPECT_LE(max_dir, 8.0);  // hemi-oct: 4 roundings + normalisation (inversesqrt 2 ulp, 3 ops)
         EXPECT_EQ(t.compared, 3L * kTexels);
     }
+}
+
+// HLSH (probe occlusion): I(m) = I_z m_z + C_a (1 - m_z) + c_x m_x + c_y m_y against
+// irradz::evaluate(Hlsh); scale = sum of the four terms' magnitudes, 4 products + 3 sums + the
+// codec's float rounding: bound 8 u S.
+TEST_F(RuntimeGl, HlshMatchesTheCodec) {
+    constexpr int kCount = 100000;
+    std::mt19937_64 rng(0x4151);
+    std::normal_distribution<double> g(0, 1);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<std::uint32_t> w(kCount * 12);
+    std::vector<float> normals(kCount * 3), in(kCount * 12);
+    for (int i = 0; i < kCount; ++i) {
+        const double ex = std::pow(10.0, -3 + 6 * u(rng));
+        for (int j = 0; j < 12; ++j) {
+            in[12 * i + j] = static_cast<float>(ex * g(rng));
+            std::memcpy(&w[12 * i + j], &in[12 * i + j], 4);
+        }
+        const Vec3 n = test::uniform_direction(u(rng), u(rng));
+        normals[3 * i] = static_cast<float>(n.x);
+        normals[3 * i + 1] = static_cast<float>(n.y);
+        normals[3 * i + 2] = static_cast<float>(n.z);
+    }
+    Uniforms un;
+    un.mode = 3;
+    const std::vector<float> gpu = run(un, w, normals, kCount);
+    Tally t;
+    for (int i = 0; i < kCount; ++i) {
+        const float* v = in.data() + 12 * i;
+        irradz::Hlsh h;
+        h.i_z = Rgb{v[0], v[1], v[2]};
+        h.c_a = Rgb{v[3], v[4], v[5]};
+        h.c_x = Rgb{v[6], v[7], v[8]};
+        h.c_y = Rgb{v[9], v[10], v[11]};
+        const Vec3 m{normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]};
+        const Rgb ref = irradz::evaluate(h, m);
+        for (int k = 0; k < 3; ++k) {
+            const double scale = std::fabs(v[k] * m.z) + std::fabs(v[3 + k] * (1 - m.z)) + std::fabs(v[6 + k] * m.x) +
+                                 std::fabs(v[9 + k] * m.y);
+            check_value(t, &t.max_irr, ref[k], gpu[static_cast<size_t>(i) * kOutFloats + static_cast<size_t>(k)], scale,
+                        8, "HLSH " + std::to_string(i) + " channel " + std::to_string(k));
+        }
+    }
+    std::printf("HLSH: %d evaluations, max error %.3f u S (bound 8)\n", kCount, t.max_irr);
+    EXPECT_EQ(t.failures, 0) << t.first_failure;
+    EXPECT_EQ(t.compared, 3L * kCount);
 }
 
 }  // namespace
