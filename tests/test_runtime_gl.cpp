@@ -7,7 +7,7 @@
 // (decode_probe / Codec::irradiance) on >= 100,000 probes (coloured lights + ambient, random SH, the
 // eight sample maps under random rotations) spread over header parameter sets, plus 20,000 probes of
 // random bytes. DC unpacking (R11G11B10F, RGB9E5, half) must be bit-exact; the IrradZ lightmap
-// evaluator is compared with irradz::evaluate on 200,000 texels.
+// evaluator is compared with irradz::evaluate on 200,000 texels, the HLSH one on 100,000 inputs.
 //
 // Error metric. The GPU computes in binary32 (u = 2^-24), the codec in double (then rounds to float).
 // A sum of terms computed in float has an absolute error of a few u times the sum of the terms'
@@ -16,10 +16,12 @@
 //   S = Y00 |c0| + (2/3) Y1 sum_i M_i + (1/4) [0.631 sum_{L2} M_i  |  3 Y20 Z]      (irradiance)
 // with M_i = |c_i|, or max(|c_i|, R_i |c0|) for quantised coefficients (R_i the ratio bound: a ratio
 // decoded in float is off by a few u of R_i, not of the ratio), and for the zonal (ZH3) families
-// Z = (|f20| + G |v|) (1 + kappa): f20 the zonal coefficient, v the L1 vector, G the largest slope of
-// the hallucination curve (0 when the zonal is stored), kappa the condition number of the axis
-// (|sum w_k| |v_k| / |sum w_k v_k| for the luminance axis: the float error of the normalised axis is
-// ~ kappa u). A decoded coefficient is measured against its own M (sqrt3 Z for expanded zonal L2).
+// Z = (|f20| + G |v|) (1 + kappa): f20 the zonal coefficient, v the L1 vector, G the hallucination's
+// coefficient magnitude plus slope over p in [0, sqrt3] (0 when the zonal is stored), kappa the
+// condition number of the axis (sum |w_k| |v_k| / |sum w_k v_k| for the luminance axis: the float
+// error of the normalised axis is ~ kappa u; 1 per channel, and 1 when every L1 is exactly 0, where
+// both sides take +Z exactly). A decoded coefficient is measured against its own M (sqrt3 Z for an
+// expanded zonal L2 coefficient).
 //
 // The bounds (in u S) come from counting roundings on the longest path, first order, with the GLSL
 // 4.50 precision rules (+, * correctly rounded; / 2.5 ulp; inversesqrt 2 ulp):
