@@ -16,6 +16,25 @@
 // is bits 8 (j % 4) .. 8 (j % 4) + 7 of word j / 4). 16-byte layouts are one uvec4, sh3_q28 seven
 // uints, the float layouts 12 / 15 / 27 uints (uintBitsToFloat of each word).
 //
+// Example #1: irradiance from a zh3_q16 probe set in a compute or fragment shader.
+//
+//   layout(std430, binding = 0) readonly buffer Probes { uvec4 probes[]; };   // .zhp payload as-is
+//   uniform ZhcFormat uFormat;  // family ZHC_LAYOUT_ZH3_Q16, other fields from the .zhp header
+//   ...
+//   vec3 e = zhcIrradianceZh3Q16(probes[probeIndex], uFormat, worldNormal);
+//
+// Example #2: decode to SH3 radiance first (to blend neighbouring probes, rotate, ...), then
+// evaluate: irradiance is linear in the coefficients, so blending decoded probes is exact.
+//
+//   ZhcSh3 a = zhcDecodeSh3Q28(wordsA, uFormat), b = zhcDecodeSh3Q28(wordsB, uFormat);
+//   for (int i = 0; i < 9; ++i) a.c[i] = mix(a.c[i], b.c[i], t);
+//   vec3 e = zhcIrradianceSh3(a, worldNormal);
+//
+// Example #3: an IrradZ lightmap texel (three BC textures, tangent-space normal).
+//
+//   vec3 e = zhcIrradZIrradiance(texture(uBc6hIz, uv).rgb, texture(uBc4Wa, uv).r,
+//                                texture(uBc5Dir, uv).rg, tangentNormal, ZHC_IRRADZ_HHD);
+//
 // Robustness: every function is total. Garbage words give finite-or-NaN/Inf results, never a
 // hang: there are no data-dependent loops; shifts and array indices are clamped.
 //
