@@ -54,12 +54,12 @@ precision highp int;
 // Layout families (how the words are laid out). Codec table name -> layout, hallucination, axis:
 //   sh3, sh3_dering                      ZHC_LAYOUT_SH3_F32  (27 words)
 //   sh2                                  ZHC_LAYOUT_SH2_F32  (12 words)
-//   zh3_lum, zh3_solved_lum, zh3_lum_dering, zh3_lum_dering_sphere
+//   zh3_lum, zh3_solved_lum, zh3_lum_dering, zh3_lum_dering_sphere, zh3_dering
 //                                        ZHC_LAYOUT_ZH3_F32  (15 words), axis luminance
 //   zh3_channel, zh3_solved_channel      ZHC_LAYOUT_ZH3_F32, axis per channel
 //   hall_{ambdir,sphere,curve}           ZHC_LAYOUT_SH2_F32 + hallucination, axis luminance
 //   hall_{ambdir,sphere,curve}_channel   ZHC_LAYOUT_SH2_F32 + hallucination, axis per channel
-//   zh3_q16, zh3_solved_q16              ZHC_LAYOUT_ZH3_Q16  (uvec4)
+//   zh3_q16, zh3_solved_q16, zh3_dering_q16  ZHC_LAYOUT_ZH3_Q16  (uvec4)
 //   sh3_q28                              ZHC_LAYOUT_SH3_Q28  (7 uints)
 //   sh2_q                                ZHC_LAYOUT_SH2_Q    (uvec4)
 //   hall_curve_q                         ZHC_LAYOUT_SH2_Q + ZHC_HALL_CURVE (axis from the header)
