@@ -53,17 +53,17 @@ function randomDir(rand) {
 // A mix of probes: mostly projections of non-negative lighting (ambient + a few coloured delta
 // lights of random strength, as bakes produce), some with arbitrary coefficients (ratios outside
 // the bounds: clamped by the quantiser) and special cases (black, tiny / huge DC, zero L1,
-// one dark channel).
+// one dark channel, one negative DC channel).
 export function randomProbes(count, seed) {
   const rand = makeRand(seed);
   const probes = [];
   for (let p = 0; p < count; p++) {
     const sh = Array.from({ length: 9 }, () => [0, 0, 0]);
     const kind = p % 10;
-    if (p < 6) {
-      const dc = [[0, 0, 0], [1e-6, 2e-6, 5e-7], [3e3, 2e3, 4e3], [1, 1, 1], [0.5, 0, 0.2], [2, 1.5, 1]][p];
+    if (p < 7) {
+      const dc = [[0, 0, 0], [1e-6, 2e-6, 5e-7], [3e3, 2e3, 4e3], [1, 1, 1], [0.5, 0, 0.2], [2, 1.5, 1], [-0.4, 1, 0.3]][p];
       for (let k = 0; k < 3; k++) sh[0][k] = dc[k];
-      if (p === 4 || p === 5) for (let i = 1; i < 9; i++) for (let k = 0; k < 3; k++) sh[i][k] = 0.3 * (rand() - 0.5) * (sh[0][k] + 0.1);
+      if (p >= 4) for (let i = 1; i < 9; i++) for (let k = 0; k < 3; k++) sh[i][k] = 0.3 * (rand() - 0.5) * (sh[0][k] + 0.1);
     } else if (kind < 8) {
       const amb = 0.05 + rand();
       for (let k = 0; k < 3; k++) sh[0][k] = 2 * Math.sqrt(Math.PI) * amb * (0.5 + rand());

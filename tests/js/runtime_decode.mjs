@@ -101,6 +101,7 @@ for (const flags of [[], ['--dc', 'half'], ['--dc', 'rgb9e5', '--bits', '7', '--
 for (const flags of [[], ['--axis', 'channel', '--dc', 'half'], ['--irradiance', '--sqrt']]) cases.push({ enc: 'hall_curve_q', flags });
 
 let totalCoefficients = 0, totalCases = 0;
+const ENC_PACKED = new Set(['zh3_q16', 'zh3_solved_q16', 'sh3_q28', 'sh2_q', 'hall_curve_q']);
 cases.forEach((c, idx) => {
   c.name = `c${idx}_${c.enc}`;
   run('convert', W('points.json'), '-o', W(`${c.name}.zhp`), '--to', c.enc, ...c.flags);
@@ -133,6 +134,40 @@ for (const c of cases.filter((c) => ['zh3_q16', 'zh3_lum', 'hall_curve_q', 'hall
   check(r.bad === 0, `${c.name}: luminance weights decode equals zhc's`);
   check(base.bad > 0, `${c.name}: the luminance weights matter (the check can fail)`);
   totalCoefficients += r.n;
+  totalCases++;
+}
+
+// --- arbitrary stored bytes: the decoders are total and still equal zhc's ----------------------
+// The payload of a packed .zhp is replaced by random bytes (CRCs fixed): ratio codes above 2 bv
+// (and with high bits set for bits < 8), any DC mantissa/exponent. DC exponent fields are kept
+// below 31 (Inf/NaN decode fine but zhc refuses to print non-finite JSON).
+for (const c of cases.filter((c) => ENC_PACKED.has(c.enc))) {
+  const bytes = new Uint8Array(fs.readFileSync(W(`${c.name}.zhp`)));
+  const z = runtime.parseZhp(bytes);
+  const r = makeRand(c.name.length * 7919 + 1);
+  const payload = z.payload;  // a view into `bytes`
+  for (let j = 0; j < payload.length; j++) payload[j] = Math.floor(r() * 256);
+  for (let p = 0; p < z.count; p++) {
+    const o = p * z.bytesPerProbe;
+    if (z.params.dcFormat === 'half') {  // sh2_q / hall_curve_q only (6-byte DC slot)
+      for (let k = 0; k < 3; k++) if (((payload[o + 2 * k + 1] >> 2) & 31) === 31) payload[o + 2 * k + 1] &= ~0x04;
+    } else if (z.params.dcFormat !== 'rgb9e5') {
+      let w = (payload[o] | (payload[o + 1] << 8) | (payload[o + 2] << 16) | (payload[o + 3] << 24)) >>> 0;
+      for (const [shift, mb] of [[0, 6], [11, 6], [22, 5]]) if (((w >>> (shift + mb)) & 31) === 31) w = (w & ~(1 << (shift + mb))) >>> 0;
+      [0, 1, 2, 3].forEach((b) => { payload[o + b] = (w >>> (8 * b)) & 255; });
+    }
+  }
+  const dv = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  const body = Number(dv.getBigUint64(160, true));
+  dv.setUint32(176, runtime.crc32(bytes, 184, 184 + body), true);
+  dv.setUint32(180, runtime.crc32(bytes, 0, 180), true);
+  fs.writeFileSync(W(`${c.name}_rnd.zhp`), bytes);
+  run('convert', W(`${c.name}_rnd.zhp`), '-o', W(`${c.name}_rnd.json`));
+  const z2 = runtime.parseZhp(bytes);
+  const res = compareWithJson(`${c.name}_rnd`, runtime.decodeAll(z2.encoding, z2.payload, z2.count, z2.params), W(`${c.name}_rnd.json`));
+  console.log(`decode ${c.enc} ${c.flags.join(' ') || '(defaults)'} random stored bytes: ${res.n - res.bad}/${res.n} bit-identical`);
+  check(res.bad === 0, `${c.name}: random bytes decode equals zhc's`);
+  totalCoefficients += res.n;
   totalCases++;
 }
 

@@ -65,6 +65,7 @@ async function main() {
       fragmentShader: `precision highp float;
 precision highp int;
 precision highp usampler2D;
+precision highp sampler2D;
 uniform usampler2D uWords;
 uniform sampler2D uSh;
 uniform sampler2D uDirs;
