@@ -11,7 +11,9 @@
 //     RGBA32F render target read back) is compared with zhc's; the page POSTs the numbers;
 //  4. asserts: no console error/warning or exception, WebGL2 + EXT_color_buffer_float present, every
 //     probe compared, JS bit-identical to zhc, shader within 2e-6 of the probe's DC irradiance term
-//     (32 float ulps; see the bound in the notes below) for the packed words AND the float SH3.
+//     (32 float ulps; see the bound in the notes below) for the packed words AND the float SH3;
+//     a white MeshLambertMaterial lit only by volume.lightProbe(p) (three.js's own LightProbe
+//     shading, i.e. the SphericalHarmonics3 conversion) renders zhc's irradiance within 2e-5.
 // Time bounded: the whole browser part times out after 120 s (Chromium killed).
 import fs from 'node:fs';
 import path from 'node:path';
@@ -172,6 +174,11 @@ for (const r of report.files ?? []) {
   check(f && r.count === f.count && r.jsCompared === f.count * DZ && r.gpuCompared === f.count * dirs.length, `${r.glb}: every probe compared`);
   check(r.jsBitExact === r.jsCompared, `${r.glb}: JS irradiance bit-identical to zhc gltf eval`);
   check(r.gpuNonFinite === 0, `${r.glb}: shader output finite`);
+  console.log(`${r.glb}: three.js MeshLambertMaterial lit by volume.lightProbe(p), ${r.threeCompared} renders vs zhc: worst ` +
+    `${r.threeWorst.toExponential(2)} (|diff| / (Y00 max|DC|))`);
+  // three.js's basis constants have 6 significant digits (relative errors up to 1.3e-6 per band)
+  // and it shades in float32 with its own pi constants: 2e-5 of the DC term.
+  check(r.threeCompared >= Math.min(16, r.count) * DZ && r.threeWorst < 2e-5, `${r.glb}: three.js LightProbe shading equals zhc's irradiance`);
   check(r.gpuZh3Worst < GPU_BOUND && r.gpuSh3Worst < GPU_BOUND && r.gpuVsJsWorst < GPU_BOUND, `${r.glb}: WebGL2 irradiance within ${GPU_BOUND} of the DC term`);
 }
 console.log(failures === 0 ? 'all runtime/web browser checks passed' : `${failures} runtime/web browser checks FAILED`);

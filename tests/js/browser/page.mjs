@@ -111,6 +111,40 @@ void main() {
           }
         }
     }
+    // three.js itself: a white MeshLambertMaterial plane lit only by volume.lightProbe(p) (three's
+    // LightProbe shading, pi-scaled irradiance times BRDF_Lambert = albedo / pi) shows E(n) in a
+    // linear float target. Plane normal = the direction (glTF = three.js world axes).
+    r.threeCompared = 0;
+    r.threeWorst = 0;
+    {
+      const lit = new THREE.Scene();
+      const plane = new THREE.Mesh(new THREE.PlaneGeometry(4, 4), new THREE.MeshLambertMaterial({ color: 0xffffff }));
+      lit.add(plane);
+      const cam = new THREE.OrthographicCamera(-1, 1, 1, -1, 0.1, 10);
+      const rt = new THREE.WebGLRenderTarget(2, 2, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true });
+      const px = new Float32Array(4);
+      const step = Math.max(1, Math.floor(count / 16));
+      for (let p = 0; p < count; p += step) {
+        const probe = v.lightProbe(p);
+        probe.position.set(0, 0, 0);
+        lit.add(probe);
+        for (let d = 0; d < DZ; d++) {
+          const n = new THREE.Vector3(...dirs[d]).normalize();
+          plane.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), n);
+          cam.position.copy(n).multiplyScalar(2);
+          cam.up.set(Math.abs(n.y) > 0.9 ? 1 : 0, Math.abs(n.y) > 0.9 ? 0 : 1, 0);
+          cam.lookAt(0, 0, 0);
+          cam.updateMatrixWorld();
+          renderer.setRenderTarget(rt);
+          renderer.render(lit, cam);
+          renderer.readRenderTargetPixels(rt, 1, 1, 1, 1, px);
+          renderer.setRenderTarget(null);
+          r.threeCompared++;
+          for (let k = 0; k < 3; k++) if (scale(p) > 0) r.threeWorst = Math.max(r.threeWorst, Math.abs(px[k] - f.expected[p][d][k]) / scale(p));
+        }
+        lit.remove(probe);
+      }
+    }
     report.files.push(r);
   }
   return report;
