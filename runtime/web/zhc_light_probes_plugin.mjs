@@ -88,6 +88,7 @@ export class ZhcProbeVolume {
   }
 
   #check(p) {
+    if (!this.sh) throw new Error(`zhc: volume '${this.name}' is not decoded (Draco point clouds need the Draco decoder)`);
     if (!Number.isInteger(p) || p < 0 || p >= this.count) throw new RangeError(`zhc: probe ${p} out of range (${this.count} probes)`);
   }
 }
