@@ -17,7 +17,7 @@
 // world directions by the inverse of the anchor's world rotation before a lookup.
 import * as THREE from 'three';
 import {
-  decodeAll, encodingInfo, gltfToZhcDir, irradiance as shIrradiance, makeParams, normalizeOr,
+  PACKED_LAYOUTS, decodeAll, encodingInfo, gltfToZhcDir, irradiance as shIrradiance, makeParams, normalizeOr,
   rotateZhcToGltf, toThreeConvention,
 } from './zhc_runtime.mjs';
 
@@ -108,8 +108,8 @@ export function buildVolume(v, coefficientsArray, positionsArray) {
   });
   const shAxes = v.shAxes ?? 'gltf';
   if (shAxes !== 'gltf' && shAxes !== 'zhc') throw new Error('ZHC_light_probes: shAxes must be gltf or zhc');
-  if (enc.packed && params.dcFormat === 'half' && v.encoding !== 'sh2_q')
-    throw new Error(`ZHC_light_probes: a half DC needs 6 bytes; only sh2_q has it (${v.encoding})`);
+  if (enc.packed && params.dcFormat === 'half' && PACKED_LAYOUTS[v.encoding] !== 'sh2_q')
+    throw new Error(`ZHC_light_probes: a half DC needs 6 bytes; only the sh2_q layout has it (${v.encoding})`);
   // The stored bytes: float accessors are viewed as their little-endian bytes (every browser
   // and Node platform is little-endian).
   const a = coefficientsArray;

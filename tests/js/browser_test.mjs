@@ -1,8 +1,9 @@
 // runtime/web in headless Chromium (CTest: js.browser).
 // Usage: node browser_test.mjs ZHC_BINARY WORK_DIR [CHROMIUM]
 //
-//  1. `zhc bake --to zh3_q16` a small JSON scene (a 4x4x3 probe grid) and `zhc gltf embed --encoding
-//     zh3_q16` 120 random probes (points, special cases included) into .glb files;
+//  1. `zhc bake --to zh3_q16` a small JSON scene (a 4x4x3 probe grid), `zhc gltf embed --encoding
+//     zh3_q16` 120 random probes (points, special cases included), and 60 random probes converted to
+//     zh3_q16 / sh3_q28 / sh2_q / hall_curve_q with non-default parameters and embedded;
 //  2. zhc's own irradiance for EVERY probe in 3 directions (`zhc gltf eval`) -> WORK/spec.json;
 //  3. a loopback HTTP server (127.0.0.1, ephemeral port, serves only runtime/web, three from
 //     tests/js/node_modules, tests/js/browser and WORK) and headless Chromium (SwiftShader WebGL2,
@@ -10,7 +11,8 @@
 //     each file; irradiance of every probe in JS and in a WebGL2 shader (zhc_irradiance.glsl.mjs,
 //     RGBA32F render target read back) is compared with zhc's; the page POSTs the numbers;
 //  4. asserts: no console error/warning or exception, WebGL2 + EXT_color_buffer_float present, every
-//     probe compared, JS bit-identical to zhc, shader within 2e-6 of the probe's DC irradiance term
+//     probe compared, JS bit-identical to zhc, shader (the GLSL function of the file's encoding)
+//     within 2e-6 of the probe's DC irradiance term
 //     (32 float ulps; see the bound in the notes below) for the packed words AND the float SH3;
 //     a white MeshLambertMaterial lit only by volume.lightProbe(p) (three.js's own LightProbe
 //     shading, i.e. the SphericalHarmonics3 conversion) renders zhc's irradiance within 2e-5.
@@ -54,6 +56,24 @@ const rand = makeRand(31337);
 fs.writeFileSync(W('points.json'), JSON.stringify({ format: 'zhc-probes', version: 1, kind: 'radiance', layout: { type: 'positions' },
   probes: randomProbes(120, 2024).map((sh) => ({ position: [rand() * 8 - 4, rand() * 8 - 4, rand() * 3], sh3: sh })) }));
 execFileSync(zhc, ['gltf', 'embed', W('scene.glb'), W('points.json'), '-o', W('points_q16.glb'), '--encoding', 'zh3_q16']);
+// The other packed layouts and non-default parameters (60 probes each): .zhp by `zhc convert`, embedded.
+fs.writeFileSync(W('points60.json'), JSON.stringify({ format: 'zhc-probes', version: 1, kind: 'radiance', layout: { type: 'positions' },
+  probes: randomProbes(60, 77).map((sh) => ({ position: [rand() * 8 - 4, rand() * 8 - 4, rand() * 3], sh3: sh })) }));
+const packedCases = [
+  { glb: 'q16_params.glb', enc: 'zh3_q16', flags: ['--bits', '5', '--sqrt', '--dc', 'rgb9e5', '--zonal-map', 'zero', '--axis', 'channel'] },
+  { glb: 'q16_irradiance.glb', enc: 'zh3_q16', flags: ['--irradiance', '--zonal-map', 'symmetric', '--bits', '7'] },
+  { glb: 'sh3_q28.glb', enc: 'sh3_q28', flags: ['--bits', '6', '--sqrt', '--bound', 'loose', '--irradiance', '--zonal-map', 'symmetric'] },
+  { glb: 'sh3_q28_default.glb', enc: 'sh3_q28', flags: [] },
+  { glb: 'sh2_q.glb', enc: 'sh2_q', flags: ['--dc', 'half', '--bits', '7'] },
+  { glb: 'hall_curve_q.glb', enc: 'hall_curve_q', flags: ['--irradiance', '--dc', 'half'] },
+  { glb: 'hall_curve_q_channel.glb', enc: 'hall_curve_q', flags: ['--axis', 'channel', '--sqrt'] },
+];
+for (const c of packedCases) {
+  const zhp = W(c.glb.replace('.glb', '.zhp'));
+  execFileSync(zhc, ['convert', W('points60.json'), '-o', zhp, '--to', c.enc, ...c.flags]);
+  execFileSync(zhc, ['gltf', 'embed', W('scene.glb'), zhp, '-o', W(c.glb)]);
+}
+const allFiles = [{ glb: 'baked_q16.glb', enc: 'zh3_q16' }, { glb: 'points_q16.glb', enc: 'zh3_q16' }, ...packedCases];
 
 // --- 2. zhc's irradiance for every probe -----------------------------------------------------
 // Directions in glTF axes: 3 evaluated by zhc for every probe, 29 more that the page compares
@@ -77,11 +97,11 @@ async function pool(jobs, width) {
   return out;
 }
 const files = [];
-for (const glb of ['baked_q16.glb', 'points_q16.glb']) {
+for (const { glb, enc } of allFiles) {
   const info = JSON.parse(execFileSync(zhc, ['info', W(glb), '--json']).toString());
   const vols = info.volumes ?? [];
   const count = vols[0]?.probes;
-  check(Number.isInteger(count) && count > 0 && vols[0].encoding === 'zh3_q16', `${glb}: zhc info reports a zh3_q16 volume`);
+  check(Number.isInteger(count) && count > 0 && vols[0].encoding === enc, `${glb}: zhc info reports a ${enc} volume`);
   const jobs = [];
   for (let p = 0; p < count; p++)
     for (let d = 0; d < DZ; d++)
@@ -168,7 +188,7 @@ const GPU_BOUND = 2e-6;
 for (const r of report.files ?? []) {
   const f = files.find((x) => x.glb === r.glb);
   console.log(`${r.glb}: ${r.count} probes x ${r.zhcDirections} directions vs zhc gltf eval: JS bit-identical ${r.jsBitExact}/${r.jsCompared} ` +
-    `(worst ${r.jsWorst.toExponential(2)}); WebGL2 zh3_q16 words worst ${r.gpuZh3Worst.toExponential(2)}, float SH3 worst ` +
+    `(worst ${r.jsWorst.toExponential(2)}); WebGL2 ${r.encoding} words worst ${r.gpuPackedWorst.toExponential(2)}, float SH3 worst ` +
     `${r.gpuSh3Worst.toExponential(2)} (|diff| / (Y00 max|DC|)); WebGL2 vs JS over ${r.directions} directions worst ` +
     `${r.gpuVsJsWorst.toExponential(2)}; non-finite ${r.gpuNonFinite}`);
   check(f && r.count === f.count && r.jsCompared === f.count * DZ && r.gpuCompared === f.count * dirs.length, `${r.glb}: every probe compared`);
@@ -179,7 +199,7 @@ for (const r of report.files ?? []) {
   // three.js's basis constants have 6 significant digits (relative errors up to 1.3e-6 per band)
   // and it shades in float32 with its own pi constants: 2e-5 of the DC term.
   check(r.threeCompared >= Math.min(16, r.count) * DZ && r.threeWorst < 2e-5, `${r.glb}: three.js LightProbe shading equals zhc's irradiance`);
-  check(r.gpuZh3Worst < GPU_BOUND && r.gpuSh3Worst < GPU_BOUND && r.gpuVsJsWorst < GPU_BOUND, `${r.glb}: WebGL2 irradiance within ${GPU_BOUND} of the DC term`);
+  check(r.gpuPackedWorst < GPU_BOUND && r.gpuSh3Worst < GPU_BOUND && r.gpuVsJsWorst < GPU_BOUND, `${r.glb}: WebGL2 irradiance within ${GPU_BOUND} of the DC term`);
 }
 console.log(failures === 0 ? 'all runtime/web browser checks passed' : `${failures} runtime/web browser checks FAILED`);
 process.exit(failures === 0 ? 0 : 1);

@@ -185,7 +185,7 @@ const samples = [0, 1, 2, 3, 4, 5, 17, 404, 1234, 2999];
 const pointsJson = JSON.parse(fs.readFileSync(W('points.json'), 'utf8'));
 let evalCount = 0, evalBad = 0;
 let threeWorst = 0;
-for (const c of cases.filter((c, i) => i % 3 === 0 || c.enc === 'zh3_q16')) {
+for (const c of cases.filter((c, i) => i % 3 === 0 || c.enc === 'zh3_q16' || c.flags.includes('half'))) {
   const file = W(`${c.name}.glb`);
   run('gltf', 'embed', W('scene.glb'), W(`${c.name}.zhp`), '-o', file);
   const gltf = await loadThree(file);

@@ -1,11 +1,11 @@
-// The browser side of tests/js/browser_test.mjs: loads each zh3_q16 .glb with three.js's
+// The browser side of tests/js/browser_test.mjs: loads each packed-encoding .glb with three.js's
 // GLTFLoader + ZhcLightProbesPlugin, evaluates irradiance for every probe in JS and in a WebGL2
 // shader (zhc_irradiance.glsl.mjs, rendered into an RGBA32F target and read back), compares with
 // zhc's values from /work/spec.json and POSTs the measurements to /result.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { ZhcLightProbesPlugin } from '/runtime/web/zhc_light_probes_plugin.mjs';
-import { zhcIrradianceGlsl, zh3Q16Words } from '/runtime/web/zhc_irradiance.glsl.mjs';
+import { zhcIrradianceGlsl, packedWords } from '/runtime/web/zhc_irradiance.glsl.mjs';
 import { gltfToZhcDir, kY00, normalizeOr } from '/runtime/web/zhc_runtime.mjs';
 
 async function main() {
@@ -27,7 +27,7 @@ async function main() {
     const v = gltf.userData.zhcLightProbes[0];
     const count = v.count, dirs = spec.dirs, D = dirs.length, DZ = f.expected[0].length;
     const r = { glb: f.glb, encoding: v.encoding, count, directions: D, zhcDirections: DZ, jsCompared: 0, jsBitExact: 0,
-      jsWorst: 0, gpuCompared: 0, gpuZh3Worst: 0, gpuSh3Worst: 0, gpuVsJsWorst: 0, gpuNonFinite: 0 };
+      jsWorst: 0, gpuCompared: 0, gpuPackedWorst: 0, gpuSh3Worst: 0, gpuVsJsWorst: 0, gpuNonFinite: 0 };
     // Per probe scale: the DC term of the irradiance, Y00 * max_k |c0_k|.
     const scale = (p) => kY00 * Math.max(Math.abs(v.sh[p * 27]), Math.abs(v.sh[p * 27 + 1]), Math.abs(v.sh[p * 27 + 2]));
     const js = [];
@@ -40,8 +40,16 @@ async function main() {
         for (let k = 0; k < 3; k++) if (scale(p) > 0) r.jsWorst = Math.max(r.jsWorst, Math.abs(got[k] - Math.fround(want[k])) / scale(p));
       }
     }
-    // GPU: row d < D: zh3_q16 words; row D + d: the float SH3 hub (decoded by zhc_runtime.mjs).
-    const words = new THREE.DataTexture(zh3Q16Words(v.bytes, count), count, 1, THREE.RGBAIntegerFormat, THREE.UnsignedIntType);
+    // GPU: row d < D: the packed words (zhcIrradiance<Encoding>); row D + d: the float SH3 hub (decoded by zhc_runtime.mjs).
+    const texels = Math.ceil(v.bytesPerProbe / 16);
+    const words = new THREE.DataTexture(packedWords(v.bytes, count, v.bytesPerProbe), count * texels, 1, THREE.RGBAIntegerFormat, THREE.UnsignedIntType);
+    const call = {
+      zh3_q16: 'zhcIrradianceZh3Q16(texelFetch(uWords, ivec2(px.x, 0), 0), n)',
+      zh3_solved_q16: 'zhcIrradianceZh3Q16(texelFetch(uWords, ivec2(px.x, 0), 0), n)',
+      sh3_q28: 'zhcIrradianceSh3Q28(texelFetch(uWords, ivec2(2 * px.x, 0), 0), texelFetch(uWords, ivec2(2 * px.x + 1, 0), 0), n)',
+      sh2_q: 'zhcIrradianceSh2Q(texelFetch(uWords, ivec2(px.x, 0), 0), n)',
+      hall_curve_q: 'zhcIrradianceHallCurveQ(texelFetch(uWords, ivec2(px.x, 0), 0), n)',
+    }[v.encoding];
     words.internalFormat = 'RGBA32UI';
     const shData = new Float32Array(count * 9 * 4);
     for (let p = 0; p < count; p++)
@@ -77,7 +85,7 @@ void main() {
   vec3 n = texelFetch(uDirs, ivec2(px.y % uD, 0), 0).xyz;
   vec3 e;
   if (px.y < uD) {
-    e = zhcIrradianceZh3Q16(texelFetch(uWords, ivec2(px.x, 0), 0), n);
+    e = ${call};
   } else {
     vec3 c[9];
     for (int i = 0; i < 9; ++i) c[i] = texelFetch(uSh, ivec2(i, px.x), 0).xyz;
@@ -100,7 +108,7 @@ void main() {
     for (let p = 0; p < count; p++) {
       const s = scale(p);
       for (let d = 0; d < D; d++)
-        for (const [row, key] of [[d, 'gpuZh3Worst'], [D + d, 'gpuSh3Worst']]) {
+        for (const [row, key] of [[d, 'gpuPackedWorst'], [D + d, 'gpuSh3Worst']]) {
           const px = pixels.subarray((row * count + p) * 4, (row * count + p) * 4 + 3);
           if (!px.every(Number.isFinite)) r.gpuNonFinite++;
           if (row === d) r.gpuCompared++;
