@@ -252,12 +252,17 @@ check(threeWorst < 2e-5, 'three.js conversion agrees with zhc within its 6-digit
   const vg = (await loadThree(W('points_sh3_gltfaxes.glb'))).userData.zhcLightProbes[0];
   const vz = (await loadThree(W('points_sh3.glb'))).userData.zhcLightProbes[0];
   check(vg.shAxes === 'gltf' && vz.shAxes === 'zhc', 'shAxes read');
-  let worstRot = 0, worstEval = 0;
+  let worstRot = 0, worstEval = 0, worstInv = 0;
   for (let p = 0; p < N; p++) {
     const a = vz.probeSHGltf(p), b = vg.probeSH(p);
+    // and back: rotateGltfToZhc of zhc's glTF-axes coefficients is the original (zhc axes).
+    const back = runtime.rotateGltfToZhc(b), orig = vz.probeSH(p);
     let scale = 0;
     for (let j = 0; j < 27; j++) scale = Math.max(scale, Math.abs(b[j]));
-    for (let j = 0; j < 27; j++) if (scale > 0) worstRot = Math.max(worstRot, Math.abs(a[j] - b[j]) / scale);
+    for (let j = 0; j < 27; j++) if (scale > 0) {
+      worstRot = Math.max(worstRot, Math.abs(a[j] - b[j]) / scale);
+      worstInv = Math.max(worstInv, Math.abs(back[j] - orig[j]) / scale);
+    }
   }
   for (const p of samples)
     for (const d of dirs) {
@@ -268,6 +273,8 @@ check(threeWorst < 2e-5, 'three.js conversion agrees with zhc within its 6-digit
   console.log(`shAxes gltf: runtime rotation vs zhc's rotated coefficients, worst |diff| / max|c| = ${worstRot.toExponential(2)}; ` +
     `irradiance vs zhc gltf eval worst |diff| / (Y00 DC) = ${worstEval.toExponential(2)}`);
   check(worstRot < 2.4e-7, 'rotateZhcToGltf agrees with zhc\'s rotation within 2 float roundings');
+  console.log(`rotateGltfToZhc(zhc's glTF-axes coefficients) vs the zhc-axes original: worst |diff| / max|c| = ${worstInv.toExponential(2)}`);
+  check(worstInv < 3.6e-7, 'rotateGltfToZhc inverts the rotation within 3 float roundings');
   check(worstEval < 1e-6, 'shAxes gltf irradiance agrees with zhc gltf eval');
 }
 
