@@ -245,6 +245,25 @@ check(threeWorst < 2e-5, 'three.js conversion agrees with zhc within its 6-digit
   check(bad === 0, 'grid volume: plugin irradiance equals zhc gltf eval for every probe');
 }
 
+// Custom luminance weights through glTF (the volume's "luminanceWeights"): plugin decode and eval.
+for (const c of cases.filter((c) => ['zh3_q16', 'hall_curve_q'].includes(c.enc) && c.flags.length === 0)) {
+  const file = W(`${c.name}_lw.glb`);
+  run('gltf', 'embed', W('scene.glb'), W(`${c.name}_lw.zhp`), '-o', file);
+  const doc = await loadThree(file);
+  const v = doc.userData.zhcLightProbes[0];
+  check(v.params.luminanceWeights.join() === '0.3,0.59,0.11', `${c.name}_lw.glb: luminanceWeights read from glTF`);
+  const r = compareWithJson(`${c.name}_lw.glb`, v.sh, W(`${c.name}_lw.json`));
+  let bad = 0;
+  for (const p of samples) {
+    const want = evalZhc(file, p, dirs[1]).map(Math.fround), got = v.irradiance(p, dirs[1]);
+    if (!want.every((w, k) => Object.is(w, got[k]))) bad++;
+  }
+  evalCount += samples.length;
+  evalBad += bad;
+  console.log(`glTF ${c.enc} luminanceWeights (0.3, 0.59, 0.11): plugin decode ${r.n - r.bad}/${r.n} bit-identical; irradiance = zhc gltf eval in ${samples.length - bad}/${samples.length}`);
+  check(r.bad === 0 && bad === 0, `${c.name}_lw.glb: plugin with luminance weights equals zhc`);
+}
+
 // shAxes "gltf" (coefficients rotated by zhc in double, rounded once) and the runtime's rotation.
 {
   run('gltf', 'embed', W('scene.glb'), W('points.json'), '-o', W('points_sh3_gltfaxes.glb'), '--sh-axes', 'gltf');
