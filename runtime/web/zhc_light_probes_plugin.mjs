@@ -1,0 +1,181 @@
+// A three.js GLTFLoader plugin for ZHC_light_probes (docs/gltf-extension.md).
+//
+//   import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+//   import { ZhcLightProbesPlugin } from './zhc_light_probes_plugin.mjs';
+//   const loader = new GLTFLoader();
+//   loader.register((parser) => new ZhcLightProbesPlugin(parser));
+//   const gltf = await loader.loadAsync('lit.glb');
+//   const volume = gltf.userData.zhcLightProbes[0];        // a ZhcProbeVolume
+//   volume.irradiance(7, [0, 1, 0]);                        // RGB, glTF / three.js axes
+//   scene.add(volume.lightProbe(7));                        // THREE.LightProbe for probe 7
+//
+// Every volume is decoded at load by zhc_runtime.mjs into SH3 radiance (bit exact with zhc's own
+// decoder). Nodes that reference a volume get a child Object3D named "ZHC_light_probes" with
+// userData.zhcLightProbeVolume (the index) and userData.zhcLightProbes (the ZhcProbeVolume); three.js
+// may use it as the node object itself when the node has nothing else. Positions and SH are in that
+// node's local space: for world space, transform positions by anchor.matrixWorld and rotate
+// world directions by the inverse of the anchor's world rotation before a lookup.
+import * as THREE from 'three';
+import {
+  PACKED_LAYOUTS, decodeAll, encodingInfo, gltfToZhcDir, irradiance as shIrradiance, makeParams, normalizeOr,
+  rotateZhcToGltf, toThreeConvention,
+} from './zhc_runtime.mjs';
+
+export const EXTENSION = 'ZHC_light_probes';
+
+// One decoded volume.
+export class ZhcProbeVolume {
+  constructor(desc) {
+    Object.assign(this, desc);
+  }
+
+  // SH3 radiance of probe p (Float32Array(27), index i*3+k) in the STORED axes (`shAxes`): the
+  // values zhc's decoder gives, bit for bit. A view into this.sh.
+  probeSH(p) {
+    this.#check(p);
+    return this.sh.subarray(p * 27, p * 27 + 27);
+  }
+
+  // SH3 radiance of probe p in glTF axes (= three.js axes), zhc's basis and signs. For shAxes
+  // "zhc" this is a rotation (exact except Y20/Y22, see zhc_runtime.mjs).
+  probeSHGltf(p) {
+    const sh = this.probeSH(p);
+    return this.shAxes === 'zhc' ? rotateZhcToGltf(sh) : new Float32Array(sh);
+  }
+
+  // Irradiance (normalised kernel: constant radiance 1 gives 1; multiply by albedo for the diffuse
+  // exit radiance) of probe p at direction `dir` given in glTF / three.js axes (node-local). The
+  // direction is normalised as zhc does (zero -> +Y). For shAxes "zhc" the result is bit exact with
+  // `zhc gltf eval FILE --probe p --dir x,y,z`.
+  irradiance(p, dir) {
+    const d = normalizeOr([dir[0], dir[1], dir[2]], [0, 1, 0]);
+    return shIrradiance(this.probeSH(p), this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
+  }
+
+  // Position of probe p in glTF axes (node-local), [x, y, z].
+  position(p) {
+    this.#check(p);
+    return [this.positions[p * 3], this.positions[p * 3 + 1], this.positions[p * 3 + 2]];
+  }
+
+  // THREE.SphericalHarmonics3 of probe p in three.js's convention (its basis has no
+  // Condon-Shortley phase: coefficients 1, 3, 5, 7 change sign) and axes (glTF axes), holding
+  // RADIANCE coefficients: what THREE.LightProbe expects. three.js evaluates
+  // sh.getIrradianceAt(n) = pi * E(n) with its 6-digit basis constants.
+  threeSH(p, target = new THREE.SphericalHarmonics3()) {
+    const c = toThreeConvention(this.probeSHGltf(p));
+    for (let i = 0; i < 9; i++) target.coefficients[i].set(c[i * 3], c[i * 3 + 1], c[i * 3 + 2]);
+    return target;
+  }
+
+  // A THREE.LightProbe of probe p placed at its (node-local) position.
+  lightProbe(p, intensity = 1) {
+    const probe = new THREE.LightProbe(this.threeSH(p), intensity);
+    probe.position.fromArray(this.position(p));
+    probe.name = `${this.name ?? 'zhc'}#${p}`;
+    return probe;
+  }
+
+  // Index of the probe nearest to `pos` (glTF axes, node-local); -1 for an empty volume.
+  nearestProbe(pos) {
+    let best = -1, bestD = Infinity;
+    for (let p = 0; p < this.count; p++) {
+      const dx = this.positions[p * 3] - pos[0], dy = this.positions[p * 3 + 1] - pos[1], dz = this.positions[p * 3 + 2] - pos[2];
+      const d = dx * dx + dy * dy + dz * dz;
+      if (d < bestD) { bestD = d; best = p; }
+    }
+    return best;
+  }
+
+  #check(p) {
+    if (!this.sh) throw new Error(`zhc: volume '${this.name}' is not decoded (Draco point clouds need the Draco decoder)`);
+    if (!Number.isInteger(p) || p < 0 || p >= this.count) throw new RangeError(`zhc: probe ${p} out of range (${this.count} probes)`);
+  }
+}
+
+// Parses one volume's JSON (and the accessor arrays already loaded) into a ZhcProbeVolume.
+// Throws Error naming the problem on malformed input.
+export function buildVolume(v, coefficientsArray, positionsArray) {
+  if (typeof v.encoding !== 'string') throw new Error('ZHC_light_probes: missing encoding');
+  const enc = encodingInfo(v.encoding);
+  const count = v.count;
+  if (!Number.isInteger(count) || count < 1) throw new Error('ZHC_light_probes: count must be an integer >= 1');
+  const q = v.quantization ?? {};
+  const params = makeParams({
+    bits: q.bits ?? 8, sqrt: q.sqrt ?? false, l2Bound: q.l2Bound ?? 'tight', dcFormat: q.dcFormat ?? 'r11g11b10f',
+    zonalMapping: q.zonalMapping ?? 'affine', axisMode: q.axisMode ?? 'luminance', kind: v.kind ?? 'radiance',
+    luminanceWeights: v.luminanceWeights ?? undefined,
+  });
+  const shAxes = v.shAxes ?? 'gltf';
+  if (shAxes !== 'gltf' && shAxes !== 'zhc') throw new Error('ZHC_light_probes: shAxes must be gltf or zhc');
+  if (enc.packed && params.dcFormat === 'half' && PACKED_LAYOUTS[v.encoding] !== 'sh2_q')
+    throw new Error(`ZHC_light_probes: a half DC needs 6 bytes; only the sh2_q layout has it (${v.encoding})`);
+  // The stored bytes: float accessors are viewed as their little-endian bytes (every browser
+  // and Node platform is little-endian).
+  const a = coefficientsArray;
+  const bytes = new Uint8Array(a.buffer, a.byteOffset, a.byteLength);
+  if (bytes.length !== count * enc.bytes)
+    throw new Error(`ZHC_light_probes: coefficients hold ${bytes.length} bytes, expected ${count} x ${enc.bytes}`);
+  let positions;
+  if (v.layout === 'grid') {
+    const g = v.grid;
+    if (!g || !Array.isArray(g.origin) || !Array.isArray(g.spacing) || !Array.isArray(g.counts)) throw new Error('ZHC_light_probes: bad grid');
+    const [nx, ny, nz] = g.counts;
+    if (nx * ny * nz !== count) throw new Error('ZHC_light_probes: grid counts do not multiply to count');
+    positions = new Float32Array(count * 3);
+    for (let p = 0; p < count; p++) {
+      const x = p % nx, y = Math.floor(p / nx) % ny, z = Math.floor(p / (nx * ny));
+      positions[p * 3] = g.origin[0] + x * g.spacing[0];
+      positions[p * 3 + 1] = g.origin[1] + y * g.spacing[1];
+      positions[p * 3 + 2] = g.origin[2] + z * g.spacing[2];
+    }
+  } else if (v.layout === 'points') {
+    if (!positionsArray || positionsArray.length !== count * 3) throw new Error('ZHC_light_probes: positions accessor size');
+    positions = new Float32Array(positionsArray);
+  } else {
+    positions = new Float32Array(count * 3);  // layout none: every probe at the node origin
+  }
+  return new ZhcProbeVolume({
+    name: v.name, encoding: v.encoding, kind: params.kind, count, shAxes, layout: v.layout, grid: v.grid,
+    params, bytesPerProbe: enc.bytes, bytes, positions, sh: decodeAll(v.encoding, bytes, count, params),
+  });
+}
+
+export class ZhcLightProbesPlugin {
+  constructor(parser) {
+    this.parser = parser;
+    this.name = EXTENSION;
+    this.anchors = [];
+  }
+
+  createNodeAttachment(nodeIndex) {
+    const node = this.parser.json.nodes[nodeIndex];
+    const ext = node.extensions && node.extensions[EXTENSION];
+    if (!ext) return null;
+    const anchor = new THREE.Object3D();
+    anchor.name = EXTENSION;
+    anchor.userData.zhcLightProbeVolume = ext.volume;
+    this.anchors.push(anchor);
+    return Promise.resolve(anchor);
+  }
+
+  async afterRoot(result) {
+    const root = this.parser.json.extensions && this.parser.json.extensions[EXTENSION];
+    if (!root) return;
+    const volumes = [];
+    for (const v of root.volumes ?? []) {
+      if (v.draco) {
+        // Draco point clouds need the Draco decoder (KHR_draco_mesh_compression's); not decoded here.
+        volumes.push(new ZhcProbeVolume({ name: v.name, encoding: v.encoding, kind: v.kind ?? 'radiance', count: v.count,
+          shAxes: v.shAxes ?? 'gltf', layout: v.layout, grid: v.grid, draco: true }));
+        continue;
+      }
+      const coeffs = (await this.parser.getDependency('accessor', v.coefficients)).array;
+      const pos = v.positions !== undefined ? (await this.parser.getDependency('accessor', v.positions)).array : null;
+      volumes.push(buildVolume(v, coeffs, pos));
+    }
+    for (const anchor of this.anchors) anchor.userData.zhcLightProbes = volumes[anchor.userData.zhcLightProbeVolume];
+    result.userData = result.userData || {};
+    result.userData.zhcLightProbes = volumes;
+  }
+}
