@@ -10,6 +10,7 @@
 #include "codec/benchmark.h"
 #include "formats/audit_inputs.h"
 #include "formats/plot.h"
+#include "formats/runtime_cost.h"
 
 namespace zhc::cli {
 namespace cmd_bench {  // one namespace per verb file: the CLI is a unity build
@@ -25,6 +26,7 @@ struct Options {
     bool no_plots = false;
     int repeats = 7;
     int directions = 1024;
+    std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
 };
 
 int run(const Options& o) {
@@ -50,6 +52,16 @@ int run(const Options& o) {
         for (size_t p = 0; p < in->probes.size(); ++p) probes.push_back({in->probes[p], in->reference_for(p, dirs)});
     }
     if (probes.empty()) return report(make_error(ErrorCode::kInvalidArgument, "no probes to benchmark"));
+    RuntimeCostTable gpu;
+    if (!o.runtime_cost.empty()) {
+        auto t = read_runtime_cost(o.runtime_cost);
+        if (!t) return report(t.error());
+        gpu = std::move(*t);
+    }
+    auto gpu_cost = [&](const BenchRow& r) -> const RuntimeCost* {
+        auto it = gpu.by_name.find(std::string(r.codec->name));
+        return it == gpu.by_name.end() ? nullptr : &it->second;
+    };
     const auto rows = benchmark_codecs(probes, dirs, selected, CodecOptions{}, o.repeats);
 
     if (o.json) {
@@ -57,6 +69,7 @@ int run(const Options& o) {
         j["probes"] = probes.size();
         j["directions"] = o.directions;
         j["repeats"] = o.repeats;
+        if (!o.runtime_cost.empty()) j["runtime_cost_device"] = gpu.device;
         j["representations"] = nlohmann::json::array();
         for (const BenchRow& r : rows) {
             auto spread = [](const Spread& s) { return nlohmann::json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
@@ -67,21 +80,31 @@ int run(const Options& o) {
                                              {"encode_ns_per_probe", spread(r.encode_ns)},
                                              {"decode_ns_per_probe", spread(r.decode_ns)},
                                              {"eval_ns_per_sample", spread(r.eval_ns)}});
+            if (const RuntimeCost* c = gpu_cost(r))
+                j["representations"].back()["runtime_cost"] = {{"spirv_instructions", c->spirv_instructions},
+                                                               {"gpu_ns_per_eval", c->ns_per_eval},
+                                                               {"gpu_ratio_to_sh3", c->ratio_to_sh3}};
         }
         std::cout << j.dump(2) << "\n";
     } else {
         std::printf("%zu probes, %d directions, medians of %d repeats [min-max], single thread\n", probes.size(),
                     o.directions, o.repeats);
-        std::printf("%-22s %6s %10s %9s %22s %18s %16s\n", "representation", "bytes", "mean_rmse", "rel_rmse",
+        std::printf("%-22s %6s %10s %9s %22s %18s %16s", "representation", "bytes", "mean_rmse", "rel_rmse",
                     "encode ns/probe", "decode ns/probe", "eval ns/sample");
+        if (!o.runtime_cost.empty()) std::printf(" %7s %11s %7s", "SPIR-V", "GPU ns/eval", "vs sh3");
+        std::printf("\n");
         for (const BenchRow& r : rows) {
             char enc[64], dec[64], ev[64];
             std::snprintf(enc, sizeof enc, "%.0f [%.0f-%.0f]", r.encode_ns.median, r.encode_ns.min, r.encode_ns.max);
             std::snprintf(dec, sizeof dec, "%.0f [%.0f-%.0f]", r.decode_ns.median, r.decode_ns.min, r.decode_ns.max);
             std::snprintf(ev, sizeof ev, "%.1f [%.1f-%.1f]", r.eval_ns.median, r.eval_ns.min, r.eval_ns.max);
-            std::printf("%-22s %6zu %10.4g %9.4f %22s %18s %16s\n", std::string(r.codec->name).c_str(),
+            std::printf("%-22s %6zu %10.4g %9.4f %22s %18s %16s", std::string(r.codec->name).c_str(),
                         r.codec->size_bytes, r.mean_rmse, r.mean_relative_rmse, enc, dec, ev);
+            if (const RuntimeCost* c = gpu_cost(r)) std::printf(" %7d %11.3f %7.2f", c->spirv_instructions, c->ns_per_eval, c->ratio_to_sh3);
+            else if (!o.runtime_cost.empty()) std::printf(" %7s %11s %7s", "-", "-", "-");
+            std::printf("\n");
         }
+        if (!o.runtime_cost.empty()) std::printf("GPU cost: %s (%s)\n", gpu.device.c_str(), o.runtime_cost.c_str());
     }
     std::fflush(stdout);
     if (!o.no_plots) {
@@ -104,6 +127,22 @@ int run(const Options& o) {
         if (Status s = write_scatter_png(p1, by_time); !s) return report_output(s.error());
         if (Status s = write_scatter_png(p2, by_bytes); !s) return report_output(s.error());
         std::fprintf(stderr, "plots: %s, %s\n", p1.c_str(), p2.c_str());
+        // The ZH3 paper's argument: error against what the runtime pays per evaluation.
+        ScatterPlot by_runtime{"ERROR VS RUNTIME COST", "SPIR-V INSTRUCTIONS PER IRRADIANCE EVALUATION (LOG)",
+                               "MEAN RELATIVE IRRADIANCE RMSE (LOG)", {}, {}};
+        std::vector<double> cost, err;
+        for (const BenchRow& r : rows)
+            if (const RuntimeCost* c = gpu_cost(r)) {
+                by_runtime.points.push_back({std::string(r.codec->name), double(c->spirv_instructions), r.mean_relative_rmse});
+                cost.push_back(c->spirv_instructions);
+                err.push_back(r.mean_relative_rmse);
+            }
+        if (!by_runtime.points.empty()) {
+            by_runtime.frontier = pareto_frontier(cost, err);
+            const std::string p3 = (fs::path(o.plots) / "error_vs_runtime_cost.png").string();
+            if (Status s = write_scatter_png(p3, by_runtime); !s) return report_output(s.error());
+            std::fprintf(stderr, "plot: %s\n", p3.c_str());
+        }
     }
     return kExitOk;
 }
@@ -118,6 +157,9 @@ const VerbRegistration registration(50, [](CLI::App& app) -> std::function<int()
     sub->add_flag("--no-plots", o->no_plots, "do not write plots");
     sub->add_option("--repeats", o->repeats, "timing repeats (median and spread are reported)")->check(CLI::Range(1, 1000));
     sub->add_option("--directions", o->directions, "Fibonacci directions for error and evaluation")->check(CLI::Range(16, 1 << 20));
+    sub->add_option("--runtime-cost", o->runtime_cost,
+                    "GPU cost per encoding from build/bench/bench_runtime --json FILE: adds SPIR-V instructions and "
+                    "lavapipe ns/eval, and error_vs_runtime_cost.png");
     return [o] { return run(*o); };
 });
 

@@ -163,6 +163,38 @@ TEST(BenchCli, PrintsJsonRowsAndWritesBothPlots) {
     EXPECT_GT(test::read_bytes(dir + "/error_vs_bytes.png").size(), 1000u);
 }
 
+// bench_runtime's JSON (GPU cost per encoding) joins the table, the JSON and a third plot; a bad
+// file is a one-line error with the README's exit code.
+TEST(BenchCli, RuntimeCostFileAddsGpuCostAndPlot) {
+    const std::string dir = test::fresh_dir("bench_runtime_cost");
+    const std::string cost = dir + "/cost.json";
+    const std::string text = R"json({"benchmark": "runtime", "device": "llvmpipe (test)", "rows": [
+        {"encoding": "sh3", "bytes": 108, "spirv_instructions": 120, "ns_per_eval": 2.5, "ratio_to_sh3": 1.0},
+        {"encoding": "sh2", "bytes": 48, "spirv_instructions": 60, "ns_per_eval": 1.5, "ratio_to_sh3": 0.6}]})json";
+    test::write_bytes(cost, std::vector<std::uint8_t>(text.begin(), text.end()));
+    const auto r = test::run_zhc({"bench", test::envmap_paths()[0], "--representations", "sh2,sh3,zh3_lum", "--repeats",
+                                  "1", "--directions", "64", "--plots", dir, "--json", "--runtime-cost", cost});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["runtime_cost_device"], "llvmpipe (test)");
+    EXPECT_EQ(j["representations"][0]["runtime_cost"]["spirv_instructions"].get<int>(), 60);
+    EXPECT_EQ(j["representations"][1]["runtime_cost"]["gpu_ns_per_eval"].get<double>(), 2.5);
+    EXPECT_FALSE(j["representations"][2].contains("runtime_cost"));  // zh3_lum not in the file
+    EXPECT_GT(test::read_bytes(dir + "/error_vs_runtime_cost.png").size(), 1000u);
+
+    const std::string bad = dir + "/bad.json";
+    const std::string bad_text = R"({"rows": [{"encoding": "sh3", "spirv_instructions": -4}]})";
+    test::write_bytes(bad, std::vector<std::uint8_t>(bad_text.begin(), bad_text.end()));
+    const auto b = test::run_zhc({"bench", test::envmap_paths()[0], "--representations", "sh3", "--repeats", "1",
+                                  "--directions", "64", "--no-plots", "--runtime-cost", bad});
+    EXPECT_EQ(b.exit_code, 4) << b.err;
+    EXPECT_NE(b.err.find("rows[0].spirv_instructions"), std::string::npos) << b.err;
+    EXPECT_EQ(std::count(b.err.begin(), b.err.end(), '\n'), 1) << b.err;
+    const auto m = test::run_zhc({"bench", test::envmap_paths()[0], "--representations", "sh3", "--repeats", "1",
+                                  "--no-plots", "--runtime-cost", dir + "/missing.json"});
+    EXPECT_EQ(m.exit_code, 3) << m.err;
+}
+
 }  // namespace
 }  // namespace zhc
 
