@@ -36,7 +36,7 @@ Result<std::vector<std::uint8_t>> decode_meshopt_view(std::span<const std::uint8
     const int kind = header & 0xf0;
     const int expected_kind = v.mode == MeshoptMode::kAttributes ? 0xa0 : v.mode == MeshoptMode::kTriangles ? 0xe0 : 0xd0;
     if (kind != expected_kind) return make_error(ErrorCode::kBadFormat, where + ": meshopt: header does not match the view's mode");
-    const int known = v.mode == MeshoptMode::kTriangles ? 1 : 0;  // libmeshoptimizer 0.18
+    const int known = v.mode == MeshoptMode::kAttributes ? 0 : 1;  // libmeshoptimizer 0.18: vertex v0, index/sequence v0-v1
     if (version > known)
         return make_error(ErrorCode::kUnsupported, where + ": meshopt codec version " + std::to_string(version) +
                                                        " (this build decodes up to version " + std::to_string(known) + ")");

@@ -96,7 +96,13 @@ function build(mode, { texture = false } = {}) {
     const add = (indices, m, acc = positions) => {
       const p = doc.createPrimitive().setAttribute('POSITION', acc).setMode(m);
       if (indices) p.setIndices(doc.createAccessor().setType('SCALAR').setArray(new Uint16Array(indices)).setBuffer(buffer));
-      if (material) p.setMaterial(material);
+      if (material) {
+        // a textured material needs TEXCOORD_0: (0,0) (1,0) (1,1) (0,1) around each quad
+        const uv = [];
+        for (let i = 0; i < acc.getCount() / 4; ++i) uv.push(0, 0, 1, 0, 1, 1, 0, 1);
+        p.setAttribute('TEXCOORD_0', doc.createAccessor().setType('VEC2').setArray(new Float32Array(uv)).setBuffer(buffer));
+        p.setMaterial(material);
+      }
       mesh.addPrimitive(p);
     };
     if (mode === 'list') {
