@@ -41,6 +41,7 @@ Result<std::vector<std::uint8_t>> decode_meshopt_view(std::span<const std::uint8
         return make_error(ErrorCode::kUnsupported, where + ": meshopt codec version " + std::to_string(version) +
                                                        " (this build decodes up to version " + std::to_string(known) + ")");
     std::vector<std::uint8_t> out(static_cast<size_t>(v.count * v.stride));
+    if (out.empty()) return out;  // nothing to decode (and no null destination for the library)
     const size_t n = static_cast<size_t>(v.count), stride = static_cast<size_t>(v.stride);
     int rc = 0;
     switch (v.mode) {

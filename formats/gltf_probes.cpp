@@ -4,8 +4,11 @@
 // asset; everything untrusted is checked by us first: the GLB framing, every URI (no absolute
 // paths, schemes, `..` or backslashes, also percent-encoded), declared buffer sizes and data-URI
 // lengths (before tinygltf allocates), and file reads go through FsCallbacks that refuse paths
-// outside the input's directory. Images are never decoded (the image loader callback keeps
-// nothing). The extension itself is read from our own nlohmann parse of the same JSON, so every
+// outside the input's directory. External buffers resolve in the input's directory only (a
+// missing one is kIoError naming it; tinygltf's extra search of the working directory always
+// finds nothing). Images are never read nor decoded: they are removed from the JSON tinygltf
+// sees (their URIs are still checked). glTF 2.x only (asset.version / minVersion). Uri-less
+// meshopt fallback buffers load no bytes (formats/scene_gltf.cpp decodes the compressed views). The extension itself is read from our own nlohmann parse of the same JSON, so every
 // index it holds is bound-checked against the arrays tinygltf loaded.
 #define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE

@@ -49,7 +49,7 @@ struct GltfEmbedOptions {
     // when the output goes to the input's folder; else they are referenced relative to the
     // output's folder when they lie inside it, else embedded (GLB: a bufferView of the binary
     // chunk; .gltf: a data: URI). Empty: URIs are copied verbatim.
-    std::string output_path;
+    std::string output_path = {};
 };
 
 // One volume as read back: the set in zhc axes (grid order and positions converted back).
