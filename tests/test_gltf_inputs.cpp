@@ -289,6 +289,36 @@ TEST(GltfInputs, HostileCompressedViewsRefused) {
     EXPECT_EQ(test::run_zhc({"bake", same, "-o", dir + "/same.json", "--quiet"}).exit_code, 0);
 }
 
+// KHR_meshopt_compression (the Khronos successor, same fields) read like EXT_: the glTF-Transform
+// file with the extension renamed.
+TEST(GltfInputs, KhrMeshoptNameReadLikeExt) {
+    const std::string file = test::temp_dir("gltf_inputs_hostile") + "/khr_meshopt.glb";
+    test::write_bytes(file, edit_glb(data("gt_meshopt.glb"), [](json& j, auto&) {
+        std::string text = j.dump();
+        for (size_t at; (at = text.find("EXT_meshopt_compression")) != std::string::npos;) text.replace(at, 3, "KHR");
+        j = json::parse(text);
+    }));
+    EXPECT_EQ(max_diff(bake(file, "khr_meshopt"), bake(data("gt_list.glb"), "gt_list_khr")), 0.0);
+}
+
+// Probes baked into a copy of a compressed asset: the fallback buffer stays uri-less, the copy
+// reads back (its own probes and, baked again, the same probes).
+TEST(GltfInputs, BakeIntoCompressedAssetsRoundTrips) {
+    const std::string dir = test::fresh_dir("gltf_inputs_embed");
+    const auto reference = bake(data("gt_list.glb"), "gt_list_embed");
+    for (const char* name : {"gt_meshopt.glb", "gt_draco.glb"})
+        for (const char* ext : {".glb", ".gltf"}) {
+            SCOPED_TRACE(std::string(name) + " -> " + ext);
+            const std::string out = dir + "/" + name + ext;
+            ASSERT_EQ(test::run_zhc({"bake", data(name), "-o", out, "--quiet"}).exit_code, 0);
+            auto s = read_gltf_probes_file(out);
+            ASSERT_TRUE(s.ok()) << s.error().message;
+            ASSERT_EQ(s->volumes.size(), 1u);
+            EXPECT_EQ(s->volumes[0].set.count, reference.size());
+            EXPECT_EQ(max_diff(bake(out, std::string(name) + ext), reference), 0.0);
+        }
+}
+
 // zhc bake IN.gltf -o OTHER/out.gltf|.glb: the output's image references resolve from its folder.
 TEST(GltfInputs, OutputImagesResolveFromTheOutputFolder) {
     const std::string root = test::fresh_dir("gltf_inputs_out");
