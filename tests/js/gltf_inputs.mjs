@@ -42,7 +42,8 @@ function check(file, issues, what) {
 
 // 1. The corpus inputs.
 for (const name of ['gt_list.glb', 'gt_list.gltf', 'gt_strip.glb', 'gt_fan.glb', 'gt_meshopt.glb', 'gt_meshopt_strip.glb',
-  'gt_draco.glb', 'gp_list.glb', 'gp_meshopt.glb', 'noscene.gltf', 'datauri_image.gltf']) {
+  'gt_draco.glb', 'gp_list.glb', 'gp_meshopt.glb', 'gp_quant.glb', 'gp_quant_norm.glb', 'gp_quant_meshopt.glb', 'gp_fallback.gltf',
+  'noscene.gltf', 'datauri_image.gltf']) {
   const file = path.join(corpus, name);
   if (!fs.existsSync(file)) continue;  // gltfpack's files are optional
   check(file, await validate(file), 'corpus input');

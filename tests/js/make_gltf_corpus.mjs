@@ -15,6 +15,8 @@
 //   gt_draco.glb        KHR_draco_mesh_compression (edgebreaker, 16-bit positions)
 //   gp_meshopt.glb      gltfpack -c -noq of gt_list.glb (if gltfpack is installed)
 //   gp_list.glb         gltfpack -noq of gt_list.glb (gltfpack's own plain version)
+//   gp_quant.glb, gp_quant_norm.glb, gp_quant_meshopt.glb, gp_fallback.gltf (+.bin,
+//                       .fallback.bin)  gltfpack's quantised defaults (KHR_mesh_quantization)
 // Variants edited from those (hostile or unusual but legal):
 //   noscene.gltf        no `scene`/`scenes` (legal: nothing needs rendering)
 //   datauri_image.gltf  the image as a data: URI
@@ -177,7 +179,14 @@ await write('gt_fan.glb', build('fan'));
 try {
   execFileSync('gltfpack', ['-noq', '-i', path.join(out, 'gt_list.glb'), '-o', path.join(out, 'gp_list.glb')], { stdio: 'inherit' });
   execFileSync('gltfpack', ['-c', '-noq', '-i', path.join(out, 'gt_list.glb'), '-o', path.join(out, 'gp_meshopt.glb')], { stdio: 'inherit' });
-  console.log('wrote gp_list.glb gp_meshopt.glb');
+  // gltfpack's defaults: KHR_mesh_quantization (14-bit UNSIGNED_SHORT positions, dequantised by
+  // the node's scale/translation), also normalized (-vpn), also with meshopt (-c), and a .gltf
+  // with an external fallback buffer file (-cf).
+  execFileSync('gltfpack', ['-i', path.join(out, 'gt_list.glb'), '-o', path.join(out, 'gp_quant.glb')], { stdio: 'inherit' });
+  execFileSync('gltfpack', ['-vpn', '-i', path.join(out, 'gt_list.glb'), '-o', path.join(out, 'gp_quant_norm.glb')], { stdio: 'inherit' });
+  execFileSync('gltfpack', ['-c', '-i', path.join(out, 'gt_list.glb'), '-o', path.join(out, 'gp_quant_meshopt.glb')], { stdio: 'inherit' });
+  execFileSync('gltfpack', ['-cf', '-i', path.join(out, 'gt_list.glb'), '-o', path.join(out, 'gp_fallback.gltf')], { stdio: 'inherit' });
+  console.log('wrote gp_list.glb gp_meshopt.glb gp_quant*.glb gp_fallback.gltf');
 } catch (e) {
   console.log('gltfpack not run:', e.message);
 }
