@@ -64,6 +64,7 @@ int run_embed(const Options& o) {
     eo.sh_axes = o.sh_axes == "gltf" ? GltfShAxes::kGltf : GltfShAxes::kZhc;
     eo.draco = o.draco;
     eo.draco_bits = o.draco_bits;
+    eo.output_path = o.output;
     auto out = embed_probes_gltf(*scene, o.scene, *set, eo);
     if (!out) {
         if (out.error().code == ErrorCode::kInvalidArgument) {

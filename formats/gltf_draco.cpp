@@ -3,6 +3,7 @@
 
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
+#include <draco/mesh/mesh.h>
 #include <draco/point_cloud/point_cloud_builder.h>
 
 #include <cstring>
@@ -148,6 +149,43 @@ Result<DecodedProbeCloud> decode_probe_point_cloud(std::span<const std::uint8_t>
     }
     out.payload.resize(values.size() * 4);
     std::memcpy(out.payload.data(), values.data(), out.payload.size());
+    return out;
+}
+
+Result<DecodedDracoMesh> decode_draco_mesh(std::span<const std::uint8_t> bytes, int position_id, std::uint64_t expected_points,
+                                           std::uint64_t expected_faces, const std::string& where) {
+    auto bad = [&](const std::string& what) { return make_error(ErrorCode::kBadFormat, where + ": Draco: " + what); };
+    // Header (Draco 2.x): "DRACO", major, minor, encoder type (1 = triangular mesh), method.
+    if (bytes.size() < 11 || std::memcmp(bytes.data(), "DRACO", 5) != 0) return bad("not a Draco bitstream");
+    if (bytes[7] != 1) return make_error(ErrorCode::kUnsupported, where + ": Draco: the bitstream is not a triangular mesh");
+    draco::DecoderBuffer buffer;
+    buffer.Init(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    draco::Decoder decoder;
+    auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
+    if (!decoded.ok()) return bad(decoded.status().error_msg_string());
+    std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
+    if (mesh->num_points() != expected_points)
+        return make_error(ErrorCode::kInvalidValue, where + ": Draco mesh has " + std::to_string(mesh->num_points()) +
+                                                        " points, the POSITION accessor's count is " + std::to_string(expected_points));
+    if (mesh->num_faces() != expected_faces)
+        return make_error(ErrorCode::kInvalidValue, where + ": Draco mesh has " + std::to_string(mesh->num_faces()) +
+                                                        " triangles, the indices accessor declares " + std::to_string(expected_faces));
+    if (position_id < 0) return bad("no POSITION attribute id");
+    const draco::PointAttribute* pos = mesh->GetAttributeByUniqueId(static_cast<uint32_t>(position_id));
+    if (!pos || pos->num_components() != 3) return bad("POSITION attribute " + std::to_string(position_id) + " missing or not 3 components");
+    DecodedDracoMesh out;
+    out.positions.resize(mesh->num_points());
+    for (draco::PointIndex p(0); p < mesh->num_points(); ++p)
+        if (!pos->ConvertValue<float>(pos->mapped_index(p), 3, out.positions[p.value()].data())) return bad("cannot read POSITION");
+    out.faces.resize(mesh->num_faces());
+    for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f) {
+        const draco::Mesh::Face& face = mesh->face(f);
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = face[k].value();
+            if (v >= mesh->num_points()) return bad("face " + std::to_string(f.value()) + " names point " + std::to_string(v));
+            out.faces[f.value()][static_cast<size_t>(k)] = v;
+        }
+    }
     return out;
 }
 

@@ -37,4 +37,16 @@ Result<DecodedProbeCloud> decode_probe_point_cloud(std::span<const std::uint8_t>
                                                    std::uint64_t count, const std::map<std::string, int>& attributes,
                                                    const std::string& where);
 
+// A KHR_draco_mesh_compression primitive's triangles (the extension text): positions (glTF axes,
+// dequantised to float) of the Draco attribute with unique id `position_id`, and the faces as
+// point indices. Only triangular-mesh bitstreams are read (kUnsupported otherwise); the point
+// and face counts must equal `expected_points` / `expected_faces` (the primitive's accessors,
+// checked against zhc's limits before this is called) or the result is kInvalidValue.
+struct DecodedDracoMesh {
+    std::vector<std::array<float, 3>> positions;
+    std::vector<std::array<std::uint32_t, 3>> faces;
+};
+Result<DecodedDracoMesh> decode_draco_mesh(std::span<const std::uint8_t> bytes, int position_id, std::uint64_t expected_points,
+                                           std::uint64_t expected_faces, const std::string& where);
+
 }  // namespace zhc

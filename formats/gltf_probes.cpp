@@ -4,8 +4,11 @@
 // asset; everything untrusted is checked by us first: the GLB framing, every URI (no absolute
 // paths, schemes, `..` or backslashes, also percent-encoded), declared buffer sizes and data-URI
 // lengths (before tinygltf allocates), and file reads go through FsCallbacks that refuse paths
-// outside the input's directory. Images are never decoded (the image loader callback keeps
-// nothing). The extension itself is read from our own nlohmann parse of the same JSON, so every
+// outside the input's directory. External buffers resolve in the input's directory only (a
+// missing one is kIoError naming it; tinygltf's extra search of the working directory always
+// finds nothing). Images are never read nor decoded: they are removed from the JSON tinygltf
+// sees (their URIs are still checked). glTF 2.x only (asset.version / minVersion). Uri-less
+// meshopt fallback buffers load no bytes (formats/scene_gltf.cpp decodes the compressed views). The extension itself is read from our own nlohmann parse of the same JSON, so every
 // index it holds is bound-checked against the arrays tinygltf loaded.
 #define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE
@@ -17,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -83,6 +87,16 @@ Result<GlbParts> split_glb(std::span<const std::uint8_t> b, const std::string& p
     return parts;
 }
 
+// A buffer marked as the fallback of EXT_meshopt_compression / KHR_meshopt_compression.
+bool is_meshopt_fallback(const json& buffer) {
+    if (!buffer.is_object() || !buffer.contains("extensions") || !buffer["extensions"].is_object()) return false;
+    for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
+        const json& e = buffer["extensions"].contains(name) ? buffer["extensions"][name] : json();
+        if (e.is_object() && e.contains("fallback") && e["fallback"].is_boolean() && e["fallback"].get<bool>()) return true;
+    }
+    return false;
+}
+
 int hex_value(char c) {
     if (c >= '0' && c <= '9') return c - '0';
     if (c >= 'a' && c <= 'f') return c - 'a' + 10;
@@ -120,6 +134,20 @@ std::string uri_problem(const std::string& uri) {
     return "";
 }
 
+// The path a relative URI names (percent escapes decoded; call after uri_problem accepted it).
+std::string uri_path(const std::string& uri) {
+    std::string d;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && hex_value(uri[i + 1]) >= 0 && hex_value(uri[i + 2]) >= 0) {
+            d.push_back(static_cast<char>(hex_value(uri[i + 1]) * 16 + hex_value(uri[i + 2])));
+            i += 2;
+        } else {
+            d.push_back(uri[i]);
+        }
+    }
+    return d;
+}
+
 Result<std::uint64_t> json_size(const json& j, const char* key, const std::string& path, const std::string& where) {
     if (!j.contains(key)) return fail(ErrorCode::kBadFormat, path, where + ": missing " + key);
     const json& v = j[key];
@@ -128,11 +156,42 @@ Result<std::uint64_t> json_size(const json& j, const char* key, const std::strin
     return v.get<std::uint64_t>();
 }
 
+// glTF 2.x only (asset.version "2.<minor>"; asset.minVersion, when given, at most "2.0").
+Status check_version(const json& asset, const std::string& path) {
+    auto parse = [](const json& v, int* major, int* minor) {
+        if (!v.is_string()) return false;
+        const std::string s = v.get<std::string>();
+        const size_t dot = s.find('.');
+        if (dot == std::string::npos || dot == 0 || dot + 1 == s.size() || dot > 4 || s.size() - dot - 1 > 4) return false;
+        for (size_t i = 0; i < s.size(); ++i)
+            if (i != dot && (s[i] < '0' || s[i] > '9')) return false;
+        *major = std::stoi(s.substr(0, dot));
+        *minor = std::stoi(s.substr(dot + 1));
+        return true;
+    };
+    int major = 0, minor = 0;
+    if (!asset.contains("version")) return fail(ErrorCode::kBadFormat, path, "asset.version missing (asset.version)");
+    if (!parse(asset["version"], &major, &minor))
+        return fail(ErrorCode::kBadFormat, path, "asset.version is not \"<major>.<minor>\" (asset.version)");
+    if (major != 2)
+        return fail(ErrorCode::kUnsupported, path, "glTF version " + asset["version"].get<std::string>() + " (zhc reads glTF 2.x) (asset.version)");
+    if (asset.contains("minVersion")) {
+        int min_major = 0, min_minor = 0;
+        if (!parse(asset["minVersion"], &min_major, &min_minor))
+            return fail(ErrorCode::kBadFormat, path, "asset.minVersion is not \"<major>.<minor>\" (asset.minVersion)");
+        if (min_major != 2 || min_minor > 0)
+            return fail(ErrorCode::kUnsupported, path, "the asset needs a glTF " + asset["minVersion"].get<std::string>() +
+                                                           " reader (zhc reads 2.0) (asset.minVersion)");
+    }
+    return Ok{};
+}
+
 // Checks every declared size and URI before tinygltf allocates anything.
 Status precheck(const json& doc, const std::string& path, const GltfLimits& limits, const GlbParts* glb) {
     if (!doc.is_object()) return fail(ErrorCode::kBadFormat, path, "glTF JSON is not an object");
     if (!doc.contains("asset") || !doc["asset"].is_object())
         return fail(ErrorCode::kBadFormat, path, "not a glTF asset (no \"asset\" object)");
+    if (Status v = check_version(doc["asset"], path); !v) return v;
     std::uint64_t total = 0;
     if (doc.contains("buffers")) {
         const json& bufs = doc["buffers"];
@@ -154,6 +213,9 @@ Status precheck(const json& doc, const std::string& path, const GltfLimits& limi
                 if (!why.empty()) return fail(ErrorCode::kBadFormat, path, where + ": uri rejected: " + why);
                 if (uri.rfind("data:", 0) == 0 && uri.size() > limits.max_buffer_bytes / 3 * 4 + 256)
                     return fail(ErrorCode::kTooLarge, path, where + ": data URI above the size limit");
+            } else if (is_meshopt_fallback(bufs[i]) && !(i == 0 && glb && glb->has_bin)) {
+                // EXT/KHR_meshopt_compression: a fallback buffer needs no bytes (every view of it
+                // is decoded from a compressed buffer); nothing is loaded for it.
             } else if (i == 0 && glb) {
                 if (!glb->has_bin) return fail(ErrorCode::kBadFormat, path, where + ": no uri and the GLB has no BIN chunk");
                 if (*len > glb->bin_bytes) return fail(ErrorCode::kTruncated, path, where + ": byteLength " + std::to_string(*len) + " larger than the BIN chunk (" + std::to_string(glb->bin_bytes) + ")");
@@ -183,6 +245,7 @@ struct FsGuard {
     std::uint64_t read_total = 0;
     std::uint64_t max_total = 0;
     std::string error;
+    ErrorCode code = ErrorCode::kBadFormat;
 };
 
 bool inside(const fs::path& base, const fs::path& p) {
@@ -204,11 +267,14 @@ bool guard_resolve(FsGuard* g, const std::string& abs, fs::path* out) {
     return true;
 }
 
+// tinygltf looks for a file in the asset's directory and then in the working directory: only
+// the first can succeed here (a probe elsewhere is answered "no", it is not an error), so where
+// a URI resolves never depends on the working directory.
 bool fs_exists(const std::string& abs, void* user) {
     auto* g = static_cast<FsGuard*>(user);
-    fs::path p;
-    if (!guard_resolve(g, abs, &p)) return false;
     std::error_code ec;
+    const fs::path p = fs::weakly_canonical(fs::path(abs), ec);
+    if (ec || !inside(g->base, p)) return false;
     return fs::is_regular_file(p, ec);
 }
 std::string fs_expand(const std::string& p, void*) { return p; }
@@ -221,13 +287,21 @@ bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::strin
     }
     std::error_code ec;
     const std::uintmax_t size = fs::file_size(p, ec);
-    if (ec || size > g->max_bytes || g->read_total + size > g->max_total) {
-        g->error = "external file '" + abs + "' missing or above the size limit";
+    if (ec) {
+        g->code = ErrorCode::kIoError;
+        g->error = "cannot read external file '" + abs + "'";
+        if (err) *err += g->error + "\n";
+        return false;
+    }
+    if (size > g->max_bytes || g->read_total + size > g->max_total) {
+        g->code = ErrorCode::kTooLarge;
+        g->error = "external file '" + abs + "' (" + std::to_string(size) + " bytes) above the size limit";
         if (err) *err += g->error + "\n";
         return false;
     }
     auto bytes = read_file_bytes(p.string(), g->max_bytes);
     if (!bytes) {
+        g->code = bytes.error().code;
         g->error = bytes.error().message;
         if (err) *err += g->error + "\n";
         return false;
@@ -310,6 +384,7 @@ struct Loaded {
     json doc;
     tinygltf::Model model;
     bool binary = false;
+    std::vector<size_t> fallback_buffers;  // uri-less meshopt fallback buffers (no bytes loaded)
 };
 
 Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path, const GltfLimits& limits) {
@@ -340,23 +415,49 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     if (ec) return fail(ErrorCode::kIoError, path, "cannot resolve the input's directory");
     guard.max_bytes = limits.max_buffer_bytes;
     guard.max_total = limits.max_total_bytes;
+    // External buffers resolve in the asset's directory (never the working directory); a missing
+    // one is named here (exit 3), before tinygltf's own search.
+    if (out.doc.contains("buffers"))
+        for (size_t i = 0; i < out.doc["buffers"].size(); ++i) {
+            const json& b = out.doc["buffers"][i];
+            if (!b.contains("uri") || b["uri"].get<std::string>().rfind("data:", 0) == 0) continue;
+            const std::string rel = uri_path(b["uri"].get<std::string>());
+            std::error_code fe;
+            if (!fs::is_regular_file(guard.base / rel, fe))
+                return fail(ErrorCode::kIoError, path,
+                            "referenced file '" + rel + "' not found in " + guard.base.string() + " (buffers[" + std::to_string(i) + "].uri)");
+        }
 
     // tinygltf 2.7 refuses primitives whose index accessor has no bufferView, which is exactly
     // how KHR_draco_mesh_compression meshes are written (the data is in the Draco stream). Give
     // such accessors a placeholder bufferView (appended last, so no index of the asset moves)
     // for tinygltf's eyes only; the model is used for buffer bytes, never written back.
+    // Two more changes for tinygltf's eyes only: images are dropped (never decoded nor needed;
+    // their URIs were checked above, and a data: URI of any MIME type is data, not a path), and a
+    // uri-less meshopt fallback buffer gets a 4-byte stand-in (its bytes are never read: every
+    // view of it is decoded from the compressed buffer, formats/scene_gltf.cpp).
     std::vector<std::uint8_t> patched_glb;
     std::string patched_text;
-    if (needs_draco_index_patch(out.doc)) {
+    std::vector<size_t> fallback_buffers;
+    if (out.doc.contains("buffers"))
+        for (size_t i = 0; i < out.doc["buffers"].size(); ++i)
+            if (!out.doc["buffers"][i].contains("uri") && is_meshopt_fallback(out.doc["buffers"][i]) && !(i == 0 && out.binary && glb.has_bin))
+                fallback_buffers.push_back(i);
+    const bool draco_patch = needs_draco_index_patch(out.doc);
+    if (draco_patch || out.doc.contains("images") || !fallback_buffers.empty()) {
         json patched = out.doc;
-        const std::size_t fake = patched["bufferViews"].size();
-        patched["bufferViews"].push_back(json{{"buffer", 0}, {"byteLength", 1}});
-        for (const json& mesh : patched["meshes"])
-            for (const json& prim : mesh.value("primitives", json::array()))
-                if (prim.is_object() && prim.contains("indices") && prim["indices"].is_number_unsigned()) {
-                    json& acc = patched["accessors"][prim["indices"].get<size_t>()];
-                    if (acc.is_object() && !acc.contains("bufferView")) acc["bufferView"] = fake;
-                }
+        patched.erase("images");
+        for (size_t i : fallback_buffers) patched["buffers"][i] = json{{"byteLength", 4}, {"uri", "data:application/octet-stream;base64,AAAAAA=="}};
+        if (draco_patch) {
+            const std::size_t fake = patched["bufferViews"].size();
+            patched["bufferViews"].push_back(json{{"buffer", 0}, {"byteLength", 1}});
+            for (const json& mesh : patched["meshes"])
+                for (const json& prim : mesh.value("primitives", json::array()))
+                    if (prim.is_object() && prim.contains("indices") && prim["indices"].is_number_unsigned()) {
+                        json& acc = patched["accessors"][prim["indices"].get<size_t>()];
+                        if (acc.is_object() && !acc.contains("bufferView")) acc["bufferView"] = fake;
+                    }
+        }
         patched_text = patched.dump();
         if (out.binary) {
             const std::span<const std::uint8_t> bin =
@@ -380,12 +481,15 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
         loaded = loader.LoadBinaryFromMemory(&out.model, &err, &warn, glb_bytes.data(), static_cast<unsigned>(glb_bytes.size()), base);
     else
         loaded = loader.LoadASCIIFromString(&out.model, &err, &warn, text.data(), static_cast<unsigned>(text.size()), base);
-    if (!guard.error.empty()) return fail(ErrorCode::kBadFormat, path, guard.error);
+    if (!guard.error.empty()) return fail(guard.code, path, guard.error);
     if (!loaded) {
         std::string first = err.substr(0, err.find('\n'));
         if (first.empty()) first = "tinygltf could not load the asset";
         return fail(ErrorCode::kBadFormat, path, first);
     }
+    for (size_t i : fallback_buffers)
+        if (i < out.model.buffers.size()) out.model.buffers[i].data.clear();
+    out.fallback_buffers = fallback_buffers;
     return out;
 }
 
@@ -699,7 +803,7 @@ Result<GltfSummary> read_gltf_probes(std::span<const std::uint8_t> bytes, const 
     s.nodes = m.nodes.size();
     s.buffers = m.buffers.size();
     s.accessors = m.accessors.size();
-    s.images = m.images.size();
+    s.images = in.doc.contains("images") && in.doc["images"].is_array() ? in.doc["images"].size() : 0;
     s.extensions_used = m.extensionsUsed;
     s.extensions_required = m.extensionsRequired;
     if (!in.doc.contains("extensions") || !in.doc["extensions"].is_object() || !in.doc["extensions"].contains(kGltfProbeExtension))
@@ -746,6 +850,91 @@ Result<GltfSummary> read_gltf_probes_file(const std::string& path, const GltfLim
     if (!bytes) return bytes.error();
     return read_gltf_probes(*bytes, path, limits);
 }
+
+namespace {
+
+// The MIME type of an image to embed: its mimeType, else from its first bytes.
+std::string image_mime(const json& image, const std::vector<std::uint8_t>& b) {
+    if (image.contains("mimeType") && image["mimeType"].is_string()) return image["mimeType"].get<std::string>();
+    auto starts = [&](std::initializer_list<int> m, size_t at = 0) {
+        if (b.size() < at + m.size()) return false;
+        size_t i = at;
+        for (int c : m)
+            if (b[i++] != c) return false;
+        return true;
+    };
+    if (starts({0x89, 'P', 'N', 'G'})) return "image/png";
+    if (starts({0xFF, 0xD8, 0xFF})) return "image/jpeg";
+    if (starts({'R', 'I', 'F', 'F'}) && starts({'W', 'E', 'B', 'P'}, 8)) return "image/webp";
+    if (starts({0xAB, 'K', 'T', 'X', ' ', '2', '0'})) return "image/ktx2";
+    return "";
+}
+
+// A relative URI for `rel` (a relative path): '/'-separated, percent-encoding all but RFC 3986
+// unreserved characters.
+std::string path_uri(const fs::path& rel) {
+    static const char* hex = "0123456789ABCDEF";
+    std::string out;
+    for (const char c : rel.generic_string()) {
+        const auto u = static_cast<unsigned char>(c);
+        if (std::isalnum(u) || c == '-' || c == '.' || c == '_' || c == '~' || c == '/') {
+            out.push_back(c);
+        } else {
+            out.push_back('%');
+            out.push_back(hex[u >> 4]);
+            out.push_back(hex[u & 15]);
+        }
+    }
+    return out;
+}
+
+// Images referenced by relative URIs, made to resolve from the output (GltfEmbedOptions::output_path).
+template <class AppendView>
+Status relocate_images(json& doc, const std::string& scene_path, const GltfEmbedOptions& options, const GltfLimits& limits,
+                       AppendView&& append_view) {
+    if (!doc.contains("images") || !doc["images"].is_array()) return Ok{};
+    std::error_code ec;
+    fs::path in_dir = fs::path(scene_path).parent_path();
+    if (in_dir.empty()) in_dir = ".";
+    fs::path out_dir = fs::absolute(fs::path(options.output_path), ec).parent_path();
+    const fs::path in_base = fs::weakly_canonical(in_dir, ec);
+    if (ec) return fail(ErrorCode::kIoError, scene_path, "cannot resolve the input's directory");
+    const fs::path out_base = fs::weakly_canonical(out_dir, ec);
+    if (ec) return fail(ErrorCode::kIoError, options.output_path, "cannot resolve the output's directory");
+    if (in_base == out_base) return Ok{};
+    std::uint64_t total = 0;
+    for (size_t i = 0; i < doc["images"].size(); ++i) {
+        json& image = doc["images"][i];
+        if (!image.is_object() || !image.contains("uri") || !image["uri"].is_string()) continue;
+        const std::string uri = image["uri"].get<std::string>();
+        if (uri.rfind("data:", 0) == 0) continue;
+        const std::string where = "images[" + std::to_string(i) + "].uri";
+        const fs::path file = fs::weakly_canonical(in_base / uri_path(uri), ec);
+        if (ec || !inside(in_base, file)) return fail(ErrorCode::kBadFormat, scene_path, "image '" + uri + "' resolves outside the input's directory (" + where + ")");
+        if (!fs::is_regular_file(file, ec))
+            return fail(ErrorCode::kIoError, scene_path, "referenced file '" + uri_path(uri) + "' not found in " + in_base.string() + " (" + where + ")");
+        if (inside(out_base, file)) {  // reachable from the output's folder without '..'
+            image["uri"] = path_uri(file.lexically_relative(out_base));
+            continue;
+        }
+        auto bytes = read_file_bytes(file.string(), limits.max_buffer_bytes);
+        if (!bytes) return bytes.error();
+        total += bytes->size();
+        if (total > limits.max_total_bytes) return fail(ErrorCode::kTooLarge, scene_path, "images to embed exceed the limit of " + std::to_string(limits.max_total_bytes) + " bytes");
+        const std::string mime = image_mime(image, *bytes);
+        if (mime.empty()) return fail(ErrorCode::kUnsupported, scene_path, "image '" + uri + "' has no mimeType and is not PNG, JPEG, WebP or KTX2: cannot embed it (" + where + ")");
+        image.erase("uri");
+        if (options.binary) {
+            image["bufferView"] = append_view(*bytes, "image " + std::to_string(i));
+            image["mimeType"] = mime;
+        } else {
+            image["uri"] = "data:" + mime + ";base64," + base64(*bytes);
+        }
+    }
+    return Ok{};
+}
+
+}  // namespace
 
 Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t> scene_bytes, const std::string& scene_path,
                                                     const ProbeSet& input_set, const GltfEmbedOptions& options,
@@ -829,8 +1018,12 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
         target_index = buffers.size();
         buffers.push_back(json{{"name", options.name}});
     }
+    const auto& fallback = loaded->fallback_buffers;
+    if (options.binary && !fallback.empty() && fallback[0] == 0)
+        return fail(ErrorCode::kUnsupported, scene_path, "buffer 0 is a meshopt fallback buffer without bytes: embed into a .gltf output (buffers[0])");
     for (std::size_t i = 0; i < m.buffers.size(); ++i) {
         if (options.binary && i == 0) continue;
+        if (std::find(fallback.begin(), fallback.end(), i) != fallback.end()) continue;  // stays uri-less
         json& b = buffers[i];
         const bool data = b.contains("uri") && b["uri"].get<std::string>().rfind("data:", 0) == 0;
         if (!data) b["uri"] = data_uri(m.buffers[i].data);
@@ -870,6 +1063,10 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
         vol["coefficients"] = is_float_vec3_encoding(set.representation)
                                   ? add_accessor(view, kFloat, "VEC3", set.count * (size / 12), options.name + " coefficients")
                                   : add_accessor(view, kUbyte, "SCALAR", set.count * size, options.name + " coefficients");
+    }
+    if (!options.output_path.empty()) {
+        auto st = relocate_images(doc, scene_path, options, limits, append_view);
+        if (!st) return st.error();
     }
     while (target.size() % 4 != 0) target.push_back(0);
     json& tb = buffers[target_index];

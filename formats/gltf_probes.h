@@ -45,6 +45,11 @@ struct GltfEmbedOptions {
     std::string name = "zhc_probes";     // volume (and node) name
     bool draco = false;                  // Draco point cloud (points layout, float sh3/sh2 only)
     int draco_bits = 0;                  // Draco quantisation bits, 0 = lossless
+    // Where the output will be written. Images the input references by a relative URI keep it
+    // when the output goes to the input's folder; else they are referenced relative to the
+    // output's folder when they lie inside it, else embedded (GLB: a bufferView of the binary
+    // chunk; .gltf: a data: URI). Empty: URIs are copied verbatim.
+    std::string output_path = {};
 };
 
 // One volume as read back: the set in zhc axes (grid order and positions converted back).

@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(
   cmake ninja-build g++ pkg-config
-  libopenexr-dev libtinygltf-dev libdraco-dev libzstd-dev libcli11-dev nlohmann-json3-dev libstb-dev
+  libopenexr-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev libzstd-dev libcli11-dev nlohmann-json3-dev libstb-dev
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev
 )
