@@ -173,6 +173,10 @@ const std::vector<Sh3Radiance>& envmap_probes() {
 
 Sh3Radiance random_envmap(std::mt19937_64& rng) {
     const auto& maps = envmap_probes();
+    if (maps.empty()) {  // load_envmap has already failed the test; keep going without dividing by 0
+        ADD_FAILURE() << "no sample maps";
+        return random_lights(rng);
+    }
     std::uniform_real_distribution<double> u(0.0, 1.0);
     const Sh3Radiance& base = maps[static_cast<size_t>(u(rng) * maps.size()) % maps.size()];
     return rotate(base, rotation_axis_angle(random_direction(rng), 2.0 * kPi * u(rng)));
@@ -216,7 +220,8 @@ struct Stats {
     std::size_t items = 0, nonfinite = 0, ill_conditioned = 0, failures = 0;
     double max_rel = 0;       // max error / (eps T): how much of the bound was used (x 32)
     double max_abs_irr = 0;   // max |irradiance error|
-    double max_rel_irr = 0;   // max |irradiance error| / max(|E|, tiny)... over finite items with |E| > 1e-3 T
+    double max_rel_irr = 0;   // max |irradiance error| / |E| over the encoded probes (not random bytes)
+                              // where E >= 1% of the channel's DC irradiance kY00 |c0|
     std::string first_failure;
 };
 
@@ -226,11 +231,12 @@ struct Case {
     std::vector<std::uint8_t> bytes;  // count * size
     std::vector<float> normals;       // count * 4
     std::size_t count = 0;
+    bool encoded = true;              // false: random bytes
 };
 
 // Compares one item; returns false (with a message) on a bound violation.
 bool compare_item(const Codec& codec, const StorageParams& p, const std::uint8_t* bytes, Vec3 n, const float* gpu,
-                  Stats* st, std::string* msg) {
+                  bool encoded, Stats* st, std::string* msg) {
     const Sh3Radiance d = decode_probe(codec, p, bytes);
     Rgb e;
     if (is_default(p)) e = codec.irradiance(bytes, codec_options(p), n);
@@ -298,7 +304,8 @@ bool compare_item(const Codec& codec, const StorageParams& p, const std::uint8_t
         if (std::isfinite(e[k]) && std::isfinite(t[k])) {
             const double err = std::fabs(double(gpu[27 + k]) - e[k]);
             st->max_abs_irr = std::max(st->max_abs_irr, err);
-            if (std::fabs(e[k]) > 1e-3 * t[k]) st->max_rel_irr = std::max(st->max_rel_irr, err / std::fabs(e[k]));
+            if (encoded && std::fabs(e[k]) >= 0.01 * kY00 * std::fabs(double(d[0][k])) && e[k] != 0)
+                st->max_rel_irr = std::max(st->max_rel_irr, err / std::fabs(e[k]));
         }
     }
     return true;
@@ -334,7 +341,7 @@ void run_case(const Codec& codec, const Case& c, Stats* st) {
     for (std::size_t i = 0; i < c.count; ++i) {
         const Vec3 n{c.normals[4 * i], c.normals[4 * i + 1], c.normals[4 * i + 2]};
         std::string msg;
-        if (!compare_item(codec, p, c.bytes.data() + i * codec.size_bytes, n, out.data() + i * kOutFloats, st, &msg)) {
+        if (!compare_item(codec, p, c.bytes.data() + i * codec.size_bytes, n, out.data() + i * kOutFloats, c.encoded, st, &msg)) {
             if (st->failures++ == 0) st->first_failure = c.label + " item " + std::to_string(i) + ": " + msg;
         }
     }
@@ -353,6 +360,7 @@ Case make_case(const Codec& codec, const StorageParams& p, int source, std::size
     c.label = std::string(codec.name) + " / " + kSources[source];
     c.params = p;
     c.count = count;
+    c.encoded = source != 3;
     c.bytes.resize(count * codec.size_bytes);
     std::mt19937_64 rng(seed);
     for (std::size_t i = 0; i < count; ++i) {
@@ -396,16 +404,15 @@ TEST(RuntimeVkTable, EveryCodecHasAnHlslEncoding) {
 // sample maps under random rotations, 20k random bytes.
 TEST_F(RuntimeVk, EveryEncodingMatchesTheCodec) {
     const std::size_t counts[4] = {30000, 20000, 30000, 20000};
-    std::printf("%-22s %8s %10s %12s %12s %9s %9s\n", "encoding", "items", "err/epsT", "max|dE|", "max|dE|/E", "nonfinite",
-                "ill-cond");
+    std::printf("%-22s %8s %10s %12s %9s %9s\n", "encoding", "items", "err/epsT", "max|dE|/E", "nonfinite", "ill-cond");
     for (const Codec& codec : codecs()) {
         Stats st;
         for (int source = 0; source < 4; ++source) {
             const Case c = make_case(codec, StorageParams{}, source, counts[source], 1000u * static_cast<unsigned>(source) + 17u);
             run_case(codec, c, &st);
         }
-        std::printf("%-22s %8zu %10.3f %12.3g %12.3g %9zu %9zu\n", std::string(codec.name).c_str(), st.items, st.max_rel,
-                    st.max_abs_irr, st.max_rel_irr, st.nonfinite, st.ill_conditioned);
+        std::printf("%-22s %8zu %10.3f %12.3g %9zu %9zu\n", std::string(codec.name).c_str(), st.items, st.max_rel,
+                    st.max_rel_irr, st.nonfinite, st.ill_conditioned);
         EXPECT_GE(st.items, 100000u);
         EXPECT_EQ(st.failures, 0u) << st.failures << " items out of bound; first: " << st.first_failure;
         EXPECT_LE(st.ill_conditioned, st.items / 1000) << codec.name;
@@ -458,8 +465,8 @@ TEST_F(RuntimeVk, EveryFormatMatchesTheCodec) {
             }
         }
         total += st.items;
-        std::printf("%-22s %8zu variants' items, err/epsT %.3f, max|dE| %.3g\n", std::string(codec.name).c_str(), st.items,
-                    st.max_rel, st.max_abs_irr);
+        std::printf("%-22s %8zu items over the formats, err/epsT %.3f, max|dE|/E %.3g\n", std::string(codec.name).c_str(),
+                    st.items, st.max_rel, st.max_rel_irr);
         EXPECT_EQ(st.failures, 0u) << st.failures << " items out of bound; first: " << st.first_failure;
         EXPECT_LE(st.ill_conditioned, st.items / 1000) << codec.name;
     }
