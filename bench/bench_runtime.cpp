@@ -4,9 +4,10 @@
 //       instructions inside the function bodies of the spirv-dis listing (after -O everything is
 //       inlined into main; OpFunction/OpFunctionParameter/OpLabel/OpFunctionEnd are not counted),
 //       in total and minus the skeleton (an "empty" kernel that reads the normal and writes it);
-//   (b) timed on Mesa lavapipe: one dispatch of N evaluations (N = 2^20 by default; probe i mod P of
+//   (b) timed on Mesa lavapipe: one dispatch of N evaluations (N = 2^18 by default; probe i mod P of
 //       P = 65536 encoded probes, one of P normals), wall clock around submit + vkQueueWaitIdle,
-//       median of R repeats after a warm-up; the plain sh3 float evaluation in the same run is the
+//       median of R = 9 repeats after a warm-up, the kernels timed in
+//       interleaved rounds; the plain sh3 float evaluation in the same run is the
 //       baseline, so the ratio column survives a noisy machine.
 // The format of each kernel is a compile-time constant (zhc_default_format), as a shader specialised
 // for its asset's format would have it. Benchmarks never decide pass/fail.
@@ -154,8 +155,8 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::uint32_t evals = 1u << 20;
-    int repeats = 7;
+    std::uint32_t evals = 1u << 18;
+    int repeats = 9;
     std::string json, keep;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -195,35 +196,38 @@ int main(int argc, char** argv) {
         }
     }
 
-    // Time one kernel: warm-up + `repeats` dispatches, median ns per evaluation.
-    auto time_kernel = [&](const Compiled& c, const std::vector<std::uint8_t>& probes, double* ns) {
-        const std::size_t sizes[3] = {std::max<std::size_t>(16, probes.size()), normals.size() * 4, std::size_t(evals) * 16};
-        auto kernel = context->make_kernel(c.spirv, sizes, &error);
-        if (!kernel) return false;
-        if (!probes.empty()) std::memcpy(kernel->data(0), probes.data(), probes.size());
-        std::memcpy(kernel->data(1), normals.data(), normals.size() * 4);
-        std::vector<double> t;
-        for (int r = 0; r <= repeats; ++r) {
-            const double s = kernel->dispatch(evals / 64, &error);
-            if (s < 0) return false;
-            if (r > 0) t.push_back(s);
-        }
-        std::sort(t.begin(), t.end());
-        *ns = t[t.size() / 2] / evals * 1e9;
-        return true;
+    // Every kernel is built first, then timed in interleaved rounds (one dispatch of each per round,
+    // after a warm-up round): load changes on a shared machine then hit all rows alike.
+    struct Timed {
+        Row row;
+        std::unique_ptr<vk::Kernel> kernel;
+        std::vector<double> seconds;
     };
-
-    std::vector<Row> rows;
+    std::vector<Timed> timed;
+    auto add = [&](Row row, const Compiled& c, const std::vector<std::uint8_t>& probes) {
+        Timed t;
+        t.row = std::move(row);
+        if (!c.spirv.empty()) {
+            const std::size_t sizes[3] = {std::max<std::size_t>(16, probes.size()), normals.size() * 4, std::size_t(evals) * 16};
+            t.kernel = context->make_kernel(c.spirv, sizes, &error);
+            if (!t.kernel) std::fprintf(stderr, "%s: %s\n", t.row.name.c_str(), error.c_str());
+            else {
+                if (!probes.empty()) std::memcpy(t.kernel->data(0), probes.data(), probes.size());
+                std::memcpy(t.kernel->data(1), normals.data(), normals.size() * 4);
+            }
+        }
+        timed.push_back(std::move(t));
+    };
     const Compiled skeleton = compile(dir.string(), "skeleton", kernel_source(-1, 0));
+    if (skeleton.spirv.empty()) {
+        std::fprintf(stderr, "skeleton kernel failed to compile\n");
+        return 1;
+    }
     Row sk;
     sk.name = "(skeleton)";
     sk.instructions = skeleton.instructions;
     sk.eval_instructions = 0;
-    if (skeleton.spirv.empty() || !time_kernel(skeleton, {}, &sk.ns)) {
-        std::fprintf(stderr, "skeleton kernel failed: %s\n", error.c_str());
-        return 1;
-    }
-    rows.push_back(sk);
+    add(sk, skeleton, {});
     for (const Codec& codec : codecs()) {
         Row row;
         row.name = std::string(codec.name);
@@ -231,16 +235,34 @@ int main(int argc, char** argv) {
         const int id = hlsl_encoding(codec.name);
         if (id < 0) {
             std::fprintf(stderr, "%s: no HLSL encoding\n", row.name.c_str());
-            rows.push_back(row);
+            add(row, Compiled{}, {});
             continue;
         }
         const Compiled c = compile(dir.string(), row.name, kernel_source(id, codec.size_bytes));
         row.instructions = c.instructions;
         row.eval_instructions = c.instructions >= 0 ? c.instructions - skeleton.instructions : -1;
-        if (c.spirv.empty() || !time_kernel(c, make_probes(codec), &row.ns))
-            std::fprintf(stderr, "%s: %s\n", row.name.c_str(), error.c_str());
-        rows.push_back(row);
+        add(row, c, make_probes(codec));
     }
+    for (int r = 0; r <= repeats; ++r)
+        for (Timed& t : timed) {
+            if (!t.kernel) continue;
+            const double s = t.kernel->dispatch(evals / 64, &error);
+            if (s < 0) {
+                std::fprintf(stderr, "%s: %s\n", t.row.name.c_str(), error.c_str());
+                t.kernel.reset();
+                continue;
+            }
+            if (r > 0) t.seconds.push_back(s);
+        }
+    std::vector<Row> rows;
+    for (Timed& t : timed) {
+        if (t.kernel && !t.seconds.empty()) {
+            std::sort(t.seconds.begin(), t.seconds.end());
+            t.row.ns = t.seconds[t.seconds.size() / 2] / evals * 1e9;
+        }
+        rows.push_back(t.row);
+    }
+    timed.clear();  // kernels before the context
     double base = NAN;
     for (const Row& r : rows)
         if (r.name == "sh3") base = r.ns;

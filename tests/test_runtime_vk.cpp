@@ -88,26 +88,33 @@ public:
     bool ok() const { return context_ != nullptr; }
     const std::string& error() const { return error_; }
     const std::string& device_name() const { return context_->device_name(); }
-    // Runs the kernel over `count` items; returns kOutFloats floats per item (empty on failure).
+    // Runs the kernel over `count` <= kCapacity items; returns kOutFloats floats per item (empty on
+    // failure). One pipeline and one set of buffers serve every call (pipeline creation is the slow part).
+    static constexpr std::size_t kCapacity = 1u << 17;
     std::vector<float> run(const std::uint32_t params[16], const std::vector<std::uint32_t>& words,
                            const std::vector<float>& normals4, std::size_t count) {
-        const std::size_t sizes[4] = {16 * 4, std::max<std::size_t>(4, words.size() * 4),
-                                      std::max<std::size_t>(16, normals4.size() * 4), std::max<std::size_t>(4, count * kOutFloats * 4)};
         std::string err;
-        auto kernel = context_->make_kernel(spirv_, sizes, &err);
-        if (!kernel) {
-            ADD_FAILURE() << err;
+        if (!kernel_) {
+            const std::size_t sizes[4] = {16 * 4, kCapacity * 27 * 4, kCapacity * 16, kCapacity * kOutFloats * 4};
+            kernel_ = context_->make_kernel(spirv_, sizes, &err);
+            if (!kernel_) {
+                ADD_FAILURE() << err;
+                return {};
+            }
+        }
+        if (count > kCapacity || words.size() > kCapacity * 27 || normals4.size() < count * 4) {
+            ADD_FAILURE() << "batch too large: " << count;
             return {};
         }
-        std::memcpy(kernel->data(0), params, 16 * 4);
-        if (!words.empty()) std::memcpy(kernel->data(1), words.data(), words.size() * 4);
-        std::memcpy(kernel->data(2), normals4.data(), normals4.size() * 4);
-        if (kernel->dispatch(static_cast<std::uint32_t>((count + 63) / 64), &err) < 0) {
+        std::memcpy(kernel_->data(0), params, 16 * 4);
+        if (!words.empty()) std::memcpy(kernel_->data(1), words.data(), words.size() * 4);
+        std::memcpy(kernel_->data(2), normals4.data(), count * 16);
+        if (kernel_->dispatch(static_cast<std::uint32_t>((count + 63) / 64), &err) < 0) {
             ADD_FAILURE() << err;
             return {};
         }
         std::vector<float> out(count * kOutFloats);
-        std::memcpy(out.data(), kernel->data(3), out.size() * 4);
+        std::memcpy(out.data(), kernel_->data(3), out.size() * 4);
         return out;
     }
 
@@ -123,6 +130,7 @@ private:
     }
     std::vector<std::uint32_t> spirv_;
     std::unique_ptr<vk::Context> context_;
+    std::unique_ptr<vk::Kernel> kernel_;  // destroyed before context_ (declared after it)
     std::string error_;
 };
 
