@@ -8,7 +8,10 @@
 //       P = 65536 encoded probes, one of P normals), wall clock around submit + vkQueueWaitIdle,
 //       median of R = 9 repeats after a warm-up, the kernels timed in
 //       interleaved rounds; the plain sh3 float evaluation in the same run is the
-//       baseline, so the ratio column survives a noisy machine.
+//       baseline, so the ratio column survives a noisy machine. A second timing has every
+//       invocation read probe 0 (uniform loads): what remains is per-invocation overhead and
+//       arithmetic, which separates the fetch cost (bytes) from the decode cost (instructions).
+// Two more rows: IrradZ lightmap reconstruction (HHD, AHD) from the three textures' sampled values.
 // The format of each kernel is a compile-time constant (zhc_default_format), as a shader specialised
 // for its asset's format would have it. Benchmarks never decide pass/fail.
 //
@@ -49,25 +52,39 @@ int hlsl_encoding(std::string_view name) {
 
 constexpr std::uint32_t kProbes = 1u << 16;
 
-// The kernel: encoding < 0 is the skeleton (normal in, normal out).
-std::string kernel_source(int encoding, std::size_t size_bytes) {
+// The kernel. encoding >= 0: a probe encoding; kSkeleton: normal in, normal out; kIrradzHhd/Ahd:
+// an IrradZ texel (I_z rgb, w_a, d uv as 6 floats: the three textures' sampled values). one_probe:
+// every invocation reads probe 0 (the loads become uniform: what is left is mostly arithmetic).
+constexpr int kSkeleton = -1, kIrradzHhd = -2, kIrradzAhd = -3;
+std::string kernel_source(int encoding, std::size_t size_bytes, bool one_probe) {
     std::ostringstream s;
     s << "#include \"zhc.hlsl\"\n"
          "[[vk::binding(0, 0)]] ByteAddressBuffer probes;\n"
          "[[vk::binding(1, 0)]] StructuredBuffer<float4> normals;\n"
          "[[vk::binding(2, 0)]] RWStructuredBuffer<float4> result;\n"
          "static const uint kMask = "
-      << (kProbes - 1) << "u;\n";
+      << (kProbes - 1) << "u;\n"
+      << "static const uint kProbeMask = " << (one_probe ? 0u : kProbes - 1) << "u;\n";
     s << "[numthreads(64, 1, 1)]\nvoid main(uint3 id : SV_DispatchThreadID)\n{\n"
          "    uint i = id.x;\n"
          "    float3 n = normals[(i + (i >> 16)) & kMask].xyz;\n";
-    if (encoding < 0) {
+    if (encoding == kSkeleton) {
         s << "    result[i] = float4(n, 0.0f);\n}\n";
+        return s.str();
+    }
+    if (encoding == kIrradzHhd || encoding == kIrradzAhd) {
+        s << "    uint base = (i & kProbeMask) * 24u;\n"
+             "    float3 iz = asfloat(probes.Load3(base));\n"
+             "    float wa = asfloat(probes.Load(base + 12u));\n"
+             "    float2 uv = asfloat(probes.Load2(base + 16u));\n"
+             "    n.z = abs(n.z);\n"
+          << "    result[i] = float4(zhc_irradz_irradiance(iz, wa, uv, "
+          << (encoding == kIrradzHhd ? "ZHC_IRRADZ_HHD" : "ZHC_IRRADZ_AHD") << ", n), 0.0f);\n}\n";
         return s.str();
     }
     const std::size_t words = size_bytes / 4;
     s << "    const ZhcFormat f = zhc_default_format(" << encoding << "u);\n"
-      << "    uint base = (i & kMask) * " << size_bytes << "u;\n"
+      << "    uint base = (i & kProbeMask) * " << size_bytes << "u;\n"
       << "    uint w[27];\n"
       << "    [unroll] for (uint j = 0u; j < 27u; ++j) w[j] = j < " << words << "u ? probes.Load(base + 4u * j) : 0u;\n"
       << "    result[i] = float4(zhc_irradiance(w, f, n), 0.0f);\n}\n";
@@ -144,13 +161,27 @@ std::vector<std::uint8_t> make_probes(const Codec& codec) {
     return bytes;
 }
 
+double finite_or(double v) { return std::isfinite(v) ? v : -1.0; }
+
 struct Row {
     std::string name;
-    std::size_t bytes = 0;
+    double bytes = 0;            // stored bytes per probe (IrradZ: BC6H + BC4 + BC5 bytes per texel)
     int instructions = -1;
     int eval_instructions = -1;
-    double ns = NAN;
+    double ns = NAN;             // P distinct probes
+    double ns_one = NAN;         // every invocation on probe 0
 };
+
+// IrradZ texels: I_z, w_a, d (hemi-octahedral uv) as the sampled textures would give them.
+std::vector<std::uint8_t> make_texels() {
+    std::mt19937_64 rng(13);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<float> v(static_cast<std::size_t>(kProbes) * 6);
+    for (float& x : v) x = static_cast<float>(u(rng));
+    std::vector<std::uint8_t> bytes(v.size() * 4);
+    std::memcpy(bytes.data(), v.data(), bytes.size());
+    return bytes;
+}
 
 }  // namespace
 
@@ -200,80 +231,101 @@ int main(int argc, char** argv) {
     // after a warm-up round): load changes on a shared machine then hit all rows alike.
     struct Timed {
         Row row;
-        std::unique_ptr<vk::Kernel> kernel;
-        std::vector<double> seconds;
+        std::unique_ptr<vk::Kernel> kernel[2];  // P probes, one probe
+        std::vector<double> seconds[2];
     };
     std::vector<Timed> timed;
-    auto add = [&](Row row, const Compiled& c, const std::vector<std::uint8_t>& probes) {
-        Timed t;
-        t.row = std::move(row);
-        if (!c.spirv.empty()) {
-            const std::size_t sizes[3] = {std::max<std::size_t>(16, probes.size()), normals.size() * 4, std::size_t(evals) * 16};
-            t.kernel = context->make_kernel(c.spirv, sizes, &error);
-            if (!t.kernel) std::fprintf(stderr, "%s: %s\n", t.row.name.c_str(), error.c_str());
-            else {
-                if (!probes.empty()) std::memcpy(t.kernel->data(0), probes.data(), probes.size());
-                std::memcpy(t.kernel->data(1), normals.data(), normals.size() * 4);
-            }
+    auto make = [&](const Compiled& c, const std::vector<std::uint8_t>& probes, const std::string& name) {
+        std::unique_ptr<vk::Kernel> k;
+        if (c.spirv.empty()) return k;
+        const std::size_t sizes[3] = {std::max<std::size_t>(16, probes.size()), normals.size() * 4, std::size_t(evals) * 16};
+        k = context->make_kernel(c.spirv, sizes, &error);
+        if (!k) {
+            std::fprintf(stderr, "%s: %s\n", name.c_str(), error.c_str());
+            return k;
         }
+        if (!probes.empty()) std::memcpy(k->data(0), probes.data(), probes.size());
+        std::memcpy(k->data(1), normals.data(), normals.size() * 4);
+        return k;
+    };
+    const std::string d = dir.string();
+    // One row: compile both variants, count the P-probe one.
+    auto add = [&](Row row, int encoding, std::size_t load_bytes, const std::vector<std::uint8_t>& probes, int skeleton_count) {
+        Timed t;
+        const Compiled c = compile(d, row.name, kernel_source(encoding, load_bytes, false));
+        const Compiled c1 = compile(d, row.name + ".one", kernel_source(encoding, load_bytes, true));
+        row.instructions = c.instructions;
+        row.eval_instructions = c.instructions >= 0 && skeleton_count >= 0 ? c.instructions - skeleton_count : -1;
+        t.kernel[0] = make(c, probes, row.name);
+        t.kernel[1] = make(c1, probes, row.name);
+        t.row = std::move(row);
         timed.push_back(std::move(t));
     };
-    const Compiled skeleton = compile(dir.string(), "skeleton", kernel_source(-1, 0));
+    const Compiled skeleton = compile(d, "skeleton", kernel_source(kSkeleton, 0, false));
     if (skeleton.spirv.empty()) {
         std::fprintf(stderr, "skeleton kernel failed to compile\n");
         return 1;
     }
     Row sk;
     sk.name = "(skeleton)";
-    sk.instructions = skeleton.instructions;
-    sk.eval_instructions = 0;
-    add(sk, skeleton, {});
+    add(sk, kSkeleton, 0, {}, skeleton.instructions);
     for (const Codec& codec : codecs()) {
         Row row;
         row.name = std::string(codec.name);
-        row.bytes = codec.size_bytes;
+        row.bytes = static_cast<double>(codec.size_bytes);
         const int id = hlsl_encoding(codec.name);
         if (id < 0) {
             std::fprintf(stderr, "%s: no HLSL encoding\n", row.name.c_str());
-            add(row, Compiled{}, {});
+            timed.push_back(Timed{row, {}, {}});
             continue;
         }
-        const Compiled c = compile(dir.string(), row.name, kernel_source(id, codec.size_bytes));
-        row.instructions = c.instructions;
-        row.eval_instructions = c.instructions >= 0 ? c.instructions - skeleton.instructions : -1;
-        add(row, c, make_probes(codec));
+        add(row, id, codec.size_bytes, make_probes(codec), skeleton.instructions);
+    }
+    const std::vector<std::uint8_t> texels = make_texels();
+    for (int model = 0; model < 2; ++model) {
+        Row row;
+        row.name = model == 0 ? "irradz_hhd (lightmap)" : "irradz_ahd (lightmap)";
+        row.bytes = 2.5;  // BC6H 1 + BC4 0.5 + BC5 1 byte per texel
+        add(row, model == 0 ? kIrradzHhd : kIrradzAhd, 24, texels, skeleton.instructions);
     }
     for (int r = 0; r <= repeats; ++r)
-        for (Timed& t : timed) {
-            if (!t.kernel) continue;
-            const double s = t.kernel->dispatch(evals / 64, &error);
-            if (s < 0) {
-                std::fprintf(stderr, "%s: %s\n", t.row.name.c_str(), error.c_str());
-                t.kernel.reset();
-                continue;
+        for (Timed& t : timed)
+            for (int v = 0; v < 2; ++v) {
+                if (!t.kernel[v]) continue;
+                const double sec = t.kernel[v]->dispatch(evals / 64, &error);
+                if (sec < 0) {
+                    std::fprintf(stderr, "%s: %s\n", t.row.name.c_str(), error.c_str());
+                    t.kernel[v].reset();
+                    continue;
+                }
+                if (r > 0) t.seconds[v].push_back(sec);
             }
-            if (r > 0) t.seconds.push_back(s);
-        }
     std::vector<Row> rows;
     for (Timed& t : timed) {
-        if (t.kernel && !t.seconds.empty()) {
-            std::sort(t.seconds.begin(), t.seconds.end());
-            t.row.ns = t.seconds[t.seconds.size() / 2] / evals * 1e9;
+        for (int v = 0; v < 2; ++v) {
+            if (!t.kernel[v] || t.seconds[v].empty()) continue;
+            std::sort(t.seconds[v].begin(), t.seconds[v].end());
+            (v == 0 ? t.row.ns : t.row.ns_one) = t.seconds[v][t.seconds[v].size() / 2] / evals * 1e9;
         }
         rows.push_back(t.row);
     }
     timed.clear();  // kernels before the context
-    double base = NAN;
+    double base = NAN, base_one = NAN;
     for (const Row& r : rows)
-        if (r.name == "sh3") base = r.ns;
+        if (r.name == "sh3") {
+            base = r.ns;
+            base_one = r.ns_one;
+        }
 
     std::printf("bench_runtime: irradiance from stored words, runtime/zhc.hlsl on %s\n", context->device_name().c_str());
     std::printf("%u evaluations per dispatch, median of %d; SPIR-V after spirv-opt -O (function-body instructions)\n\n", evals,
                 repeats);
-    std::printf("%-22s %6s %10s %12s %12s %10s\n", "encoding", "bytes", "SPIR-V", "SPIR-V-skel", "ns/eval", "vs sh3");
+    std::printf("ns/eval: %u distinct probes; ns/eval (1 probe): all invocations on probe 0 (loads uniform)\n\n", kProbes);
+    std::printf("%-22s %6s %8s %11s %10s %8s %14s %8s\n", "encoding", "bytes", "SPIR-V", "SPIR-V-skel", "ns/eval", "vs sh3",
+                "ns/eval(1 pr.)", "vs sh3");
     for (const Row& r : rows)
-        std::printf("%-22s %6zu %10d %12d %12.2f %10.2f\n", r.name.c_str(), r.bytes, r.instructions, r.eval_instructions, r.ns,
-                    r.ns / base);
+        std::printf("%-22s %6.1f %8d %11d %10.2f %8.2f %14.2f %8.2f\n", r.name.c_str(), r.bytes, r.instructions,
+                    r.eval_instructions, r.ns, r.ns / base, r.ns_one, r.ns_one / base_one);
     if (!json.empty()) {
         std::ofstream out(json);
         out << "{\n  \"benchmark\": \"runtime\",\n  \"device\": \"" << context->device_name() << "\",\n  \"evaluations\": "
@@ -282,10 +334,11 @@ int main(int argc, char** argv) {
             const Row& r = rows[i];
             char buf[512];
             std::snprintf(buf, sizeof buf,
-                          "    {\"encoding\": \"%s\", \"bytes\": %zu, \"spirv_instructions\": %d, "
-                          "\"spirv_instructions_minus_skeleton\": %d, \"ns_per_eval\": %.4f, \"ratio_to_sh3\": %.4f}%s\n",
-                          r.name.c_str(), r.bytes, r.instructions, r.eval_instructions, std::isfinite(r.ns) ? r.ns : -1.0,
-                          std::isfinite(r.ns / base) ? r.ns / base : -1.0, i + 1 < rows.size() ? "," : "");
+                          "    {\"encoding\": \"%s\", \"bytes\": %g, \"spirv_instructions\": %d, "
+                          "\"spirv_instructions_minus_skeleton\": %d, \"ns_per_eval\": %.4f, \"ratio_to_sh3\": %.4f, "
+                          "\"ns_per_eval_one_probe\": %.4f, \"ratio_to_sh3_one_probe\": %.4f}%s\n",
+                          r.name.c_str(), r.bytes, r.instructions, r.eval_instructions, finite_or(r.ns), finite_or(r.ns / base),
+                          finite_or(r.ns_one), finite_or(r.ns_one / base_one), i + 1 < rows.size() ? "," : "");
             out << buf;
         }
         out << "  ]\n}\n";
