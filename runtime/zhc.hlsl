@@ -553,43 +553,72 @@ float3 zhc_irradiance(uint w[27], ZhcFormat f, float3 n)
     return zhc_irradiance_floats(w, f, n);
 }
 
-// Decode to the hub: SH3 RADIANCE (what decode_probe returns), for any encoding.
-ZhcSH3 zhc_decode_sh3(uint w[27], ZhcFormat f)
+// ---- decode to the hub: SH3 RADIANCE (what decode_probe returns) ---------------------------------
+
+// DC + L1 + zonal L2 along the axes, stored domain -> radiance SH3.
+ZhcSH3 zhc_sh3_from_zh3(float3 c[4], float3 f20, float3 a[3], uint kind)
 {
     ZhcSH3 s;
+    [unroll] for (int i = 0; i < 4; ++i) s.c[i] = c[i];
+    zhc_expand_zonal(s, f20, a);
+    return zhc_radiance_from_stored(s, kind);
+}
+
+ZhcSH3 zhc_decode_zh3_q16(uint4 p, ZhcFormat f)
+{
+    float3 c[4], f20, a[3];
+    zhc_zh3_q16(p, f, c, f20, a);
+    return zhc_sh3_from_zh3(c, f20, a, f.kind);
+}
+
+ZhcSH3 zhc_decode_sh2_q(uint4 p, ZhcFormat f)
+{
+    float3 c[4];
+    zhc_sh2_q(p, f, c);
+    ZhcSH3 s;
+    [unroll] for (int i = 0; i < 9; ++i) s.c[i] = i < 4 ? c[i] : 0.0f;
+    return zhc_radiance_from_stored(s, f.kind);
+}
+
+// sh2_q bytes; the zonal L2 is hallucinated (Eq. 21) on the radiance linear SH.
+ZhcSH3 zhc_decode_hall_curve_q(uint4 p, ZhcFormat f)
+{
+    float3 c[4], a[3];
+    zhc_sh2_q(p, f, c);
+    float s1 = f.kind == ZHC_KIND_IRRADIANCE ? 1.5f : 1.0f;
+    c[1] *= s1; c[2] *= s1; c[3] *= s1;
+    zhc_zonal_axes(c[1], c[2], c[3], f.axisMode, float3(f.lumR, f.lumG, f.lumB), a);
+    float3 f20 = zhc_hallucinate(ZHC_HALL_MODEL_CURVE, c[0], c[1], c[2], c[3], a, f);
+    return zhc_sh3_from_zh3(c, f20, a, ZHC_KIND_RADIANCE);  // already radiance
+}
+
+ZhcSH3 zhc_decode_sh3_q28(uint w[7], ZhcFormat f) { return zhc_radiance_from_stored(zhc_sh3_q28_stored(w, f), f.kind); }
+
+// Float layouts (sh3, sh2, sh3_dering, the 15-float ZH3 and 12-float hall_* layouts).
+ZhcSH3 zhc_decode_floats(uint w[27], ZhcFormat f)
+{
     uint e = f.encoding;
     if (e == ZHC_SH3 || e == ZHC_SH3_DERING || e == ZHC_SH2)
         return zhc_radiance_from_stored(zhc_stored_sh3_floats(w, e == ZHC_SH2 ? 4u : 9u), f.kind);
+    float3 c[4], f20, a[3];
+    zhc_zh3_floats(w, e, f, c, f20, a);
+    return zhc_sh3_from_zh3(c, f20, a, f.kind);
+}
+
+// Any encoding from up to 27 words (f.encoding selects).
+ZhcSH3 zhc_decode_sh3(uint w[27], ZhcFormat f)
+{
+    uint e = f.encoding;
+    uint4 p = uint4(w[0], w[1], w[2], w[3]);
+    if (e == ZHC_ZH3_Q16 || e == ZHC_ZH3_SOLVED_Q16) return zhc_decode_zh3_q16(p, f);
+    if (e == ZHC_SH2_Q) return zhc_decode_sh2_q(p, f);
+    if (e == ZHC_HALL_CURVE_Q) return zhc_decode_hall_curve_q(p, f);
     if (e == ZHC_SH3_Q28)
     {
         uint q[7] = { w[0], w[1], w[2], w[3], w[4], w[5], w[6] };
-        return zhc_radiance_from_stored(zhc_sh3_q28_stored(q, f), f.kind);
+        return zhc_decode_sh3_q28(q, f);
     }
-    float3 c[4], f20, a[3];
-    uint4 p = uint4(w[0], w[1], w[2], w[3]);
-    if (e == ZHC_SH2_Q || e == ZHC_HALL_CURVE_Q)
-    {
-        zhc_sh2_q(p, f, c);
-        f20 = 0.0f;
-        a[0] = a[1] = a[2] = float3(0.0f, 0.0f, 1.0f);
-        if (e == ZHC_HALL_CURVE_Q)
-        {
-            float s1 = f.kind == ZHC_KIND_IRRADIANCE ? 1.5f : 1.0f;
-            c[1] *= s1; c[2] *= s1; c[3] *= s1;
-            zhc_zonal_axes(c[1], c[2], c[3], f.axisMode, float3(f.lumR, f.lumG, f.lumB), a);
-            f20 = zhc_hallucinate(ZHC_HALL_MODEL_CURVE, c[0], c[1], c[2], c[3], a, f);
-            [unroll] for (int i = 0; i < 4; ++i) s.c[i] = c[i];
-            zhc_expand_zonal(s, f20, a);
-            return s;  // already radiance
-        }
-    }
-    else if (e == ZHC_ZH3_Q16 || e == ZHC_ZH3_SOLVED_Q16)
-        zhc_zh3_q16(p, f, c, f20, a);
-    else
-        zhc_zh3_floats(w, e, f, c, f20, a);
-    [unroll] for (int i = 0; i < 4; ++i) s.c[i] = c[i];
-    zhc_expand_zonal(s, f20, a);
-    return zhc_radiance_from_stored(s, f.kind);
+    return zhc_decode_floats(w, f);
 }
 
 // ---- IrradZ lightmaps (codec/irradz.h, Roughton SIGGRAPH 2024 Advances) ------------------------------
