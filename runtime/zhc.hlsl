@@ -20,6 +20,32 @@
 //   sh3_q28                             seven uints
 // Byte b of a probe is bits 8 (b & 3) .. of word b >> 2.
 //
+// Irradiance here is E / pi of libraries that use the unnormalised kernel (e.g. SHforHLSL's
+// CalculateIrradiance): multiply by pi for those, or by albedo for diffuse radiance directly.
+//
+// Example 1: a 16-byte zh3_q16 probe set in a ByteAddressBuffer, format fixed at compile time
+// (the constant folds away: see the instruction counts in docs/runtime.md).
+//
+//   ByteAddressBuffer probes;
+//   float3 ProbeIrradiance(uint probe, float3 n)
+//   {
+//       const ZhcFormat f = zhc_default_format(ZHC_ZH3_Q16);
+//       return zhc_irradiance_zh3_q16(probes.Load4(16u * probe), f, n);
+//   }
+//
+// Example 2: any encoding, format from the probe container's header (a constant buffer), and the
+// decoded SH3 radiance for blending probes before evaluating:
+//
+//   uint w[27];
+//   [unroll] for (uint j = 0u; j < 27u; ++j) w[j] = j < zhc_encoding_bytes(f.encoding) / 4u ? probes.Load(base + 4u * j) : 0u;
+//   ZhcSH3 sh = zhc_decode_sh3(w, f);            // radiance SH3, what zhc's decode_probe gives
+//   float3 e = zhc_sh3_irradiance(sh, n);        // == zhc_irradiance(w, f, n) up to rounding
+//
+// Example 3: an IrradZ lightmap texel (tangent frame, normal-mapped n):
+//
+//   float3 e = zhc_irradz_irradiance(izTex.Sample(s, uv).rgb, waTex.Sample(s, uv).r,
+//                                    dTex.Sample(s, uv).rg, ZHC_IRRADZ_HHD, nTangent);
+//
 // Cost notes are per call after inlining, counted in SPIR-V instructions by bench/bench_runtime.cpp
 // (HLSL -> SPIR-V -> spirv-opt -O); see docs/runtime.md for the table.
 #ifndef ZHC_HLSL_INCLUDED
