@@ -46,8 +46,12 @@
 //   float3 e = zhc_irradz_irradiance(izTex.Sample(s, uv).rgb, waTex.Sample(s, uv).r,
 //                                    dTex.Sample(s, uv).rg, ZHC_IRRADZ_HHD, nTangent);
 //
-// Cost notes are per call after inlining, counted in SPIR-V instructions by bench/bench_runtime.cpp
-// (HLSL -> SPIR-V -> spirv-opt -O); see docs/runtime.md for the table.
+// Cost (bench/bench_runtime.cpp): SPIR-V instructions of "load the probe's words, irradiance at n"
+// after spirv-opt -O with the default format as a constant, the kernel skeleton subtracted:
+//   sh3 174, sh2 100, zh3 (luminance axis) 120, zh3 (per-channel axes) 182,
+//   hall_ambdir 134 / 178 (channel), hall_sphere 188 / 232, hall_curve 185 / 229,
+//   zh3_q16 220, sh3_q28 313, sh2_q 160, hall_curve_q 276, IrradZ texel (HHD / AHD) 123 / 121.
+// Other per-function notes below are estimates of the arithmetic.
 #ifndef ZHC_HLSL_INCLUDED
 #define ZHC_HLSL_INCLUDED
 
