@@ -12,7 +12,8 @@ namespace zhc {
 std::span<const Codec> codecs() {
     static const std::vector<Codec> table = [] {
         std::vector<Codec> all;
-        for (auto part : {core_codecs(), zh3_codecs(), dering_codecs(), zh3_window_codecs(), quantized_codecs()})
+        // New entries go last: the runtime decoders (runtime/) number encodings by table order.
+        for (auto part : {core_codecs(), zh3_codecs(), dering_codecs(), quantized_codecs(), zh3_window_codecs()})
             all.insert(all.end(), part.begin(), part.end());
         return all;
     }();

@@ -1,0 +1,576 @@
+// runtime/zhc.hlsl on Vulkan (Mesa lavapipe, headless) against the C++ codec.
+//
+// The test kernel tests/vk/runtime_test.hlsl (#include "zhc.hlsl") is compiled to SPIR-V at build
+// time by glslangValidator's HLSL front end (tests/vk/CMakeLists.txt) and dispatched once per
+// encoding and format on lavapipe (the CPU Vulkan driver; the test forces its ICD and checks the
+// device name). For every item the kernel writes the decoded SH3 radiance (zhc_decode_sh3) and the
+// irradiance at a normal straight from the words (zhc_irradiance); the C++ reference is
+// decode_probe and the codec table's irradiance (or irradiance(decode_probe) for non-default
+// formats, where the table's irradiance does not apply).
+//
+// Error bound (float against double). The C++ decoders compute in double from the stored floats and
+// bytes and round the result to float; the shader does the same operations in float. Each output
+// of channel k is a short chain (<= ~20 operations: a ratio decode t * scale + offset, the product
+// with the DC, a normalisation, a 9-term sum) over terms whose magnitudes are bounded by
+//   T_k = sum_i |c_ik| + P_k + kappa * Z_k,
+// c the decoded radiance coefficients of channel k, P_k = 8 sqrt(5) |DC_k| / s for the quantised
+// layouts (the affine ratio map adds an offset of up to sqrt(5) |DC| that cancels: the absolute
+// error is relative to it, not to the coefficient; s = the stored-kind L2 scale), and kappa * Z_k the
+// zonal part whose axis comes from the luminance-weighted L1: its direction is computed from
+// sum_j w_j v_j, which loses relative precision kappa = sum_j w_j |v_j| / |sum_j w_j v_j| when the
+// channels cancel (kappa = 1 for per-channel axes); Z_k = |L1_k| + |L2_k|. Standard forward error
+// analysis gives |error| <= n u T_k with u = 2^-24 per basic operation (add/mul/fma correctly
+// rounded) and n the depth; Vulkan allows 2.5 ulp for division and 2 ulp for inverse sqrt, so with
+// n <= ~25 operations and those wider ops the bound is 64 u T_k = 32 FLT_EPSILON T_k. Plus an
+// absolute 1e-35 for results lavapipe may flush below FLT_MIN (Vulkan permits flushing denormals).
+// Non-finite results (random bytes with an Inf/NaN DC) must be non-finite on both sides.
+// Random float words are drawn with |value| in [2^-60, 2^60]: outside that, products and squares
+// leave float's normal range where the double reference does not.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "codec/codec.h"
+#include "codec/irradz.h"
+#include "codec/lightmap.h"
+#include "codec/probe_set.h"
+#include "codec/quantize.h"
+#include "codec/zh3.h"
+#include "support.h"
+#include "vk_compute.h"
+
+namespace zhc {
+namespace {
+
+using vk::hlsl_encoding;
+using vk::kHlslEncodings;
+
+constexpr double kBoundEps = 32.0 * FLT_EPSILON;  // 64 u, see the header comment
+constexpr double kFlushFloor = 1e-35;
+constexpr std::size_t kOutFloats = 32;
+
+std::uint32_t float_bits(float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return u;
+}
+float bits_float(std::uint32_t u) {
+    float f;
+    std::memcpy(&f, &u, 4);
+    return f;
+}
+
+// One lavapipe device and the test kernel for the whole test program.
+class Gpu {
+public:
+    static Gpu& get() {
+        static Gpu g;
+        return g;
+    }
+    bool ok() const { return context_ != nullptr; }
+    const std::string& error() const { return error_; }
+    const std::string& device_name() const { return context_->device_name(); }
+    // Runs the kernel over `count` <= kCapacity items; returns kOutFloats floats per item (empty on
+    // failure). One pipeline and one set of buffers serve every call (pipeline creation is the slow part).
+    static constexpr std::size_t kCapacity = 1u << 17;
+    std::vector<float> run(const std::uint32_t params[16], const std::vector<std::uint32_t>& words,
+                           const std::vector<float>& normals4, std::size_t count) {
+        std::string err;
+        if (!kernel_) {
+            const std::size_t sizes[4] = {16 * 4, kCapacity * 27 * 4, kCapacity * 16, kCapacity * kOutFloats * 4};
+            kernel_ = context_->make_kernel(spirv_, sizes, &err);
+            if (!kernel_) {
+                ADD_FAILURE() << err;
+                return {};
+            }
+        }
+        if (count > kCapacity || words.size() > kCapacity * 27 || normals4.size() < count * 4) {
+            ADD_FAILURE() << "batch too large: " << count;
+            return {};
+        }
+        std::memcpy(kernel_->data(0), params, 16 * 4);
+        if (!words.empty()) std::memcpy(kernel_->data(1), words.data(), words.size() * 4);
+        std::memcpy(kernel_->data(2), normals4.data(), count * 16);
+        if (kernel_->dispatch(static_cast<std::uint32_t>((count + 63) / 64), &err) < 0) {
+            ADD_FAILURE() << err;
+            return {};
+        }
+        std::vector<float> out(count * kOutFloats);
+        std::memcpy(out.data(), kernel_->data(3), out.size() * 4);
+        return out;
+    }
+
+private:
+    Gpu() {
+        vk::force_icd(ZHC_LVP_ICD);
+        spirv_ = vk::read_spirv(ZHC_RUNTIME_TEST_SPV);
+        if (spirv_.empty()) {
+            error_ = std::string("cannot read ") + ZHC_RUNTIME_TEST_SPV;
+            return;
+        }
+        context_ = vk::Context::create(true, &error_);
+    }
+    std::vector<std::uint32_t> spirv_;
+    std::unique_ptr<vk::Context> context_;
+    std::unique_ptr<vk::Kernel> kernel_;  // destroyed before context_ (declared after it)
+    std::string error_;
+};
+
+// ---- probe sources -------------------------------------------------------------------------------
+
+Vec3 random_direction(std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    return test::uniform_direction(u(rng), u(rng));
+}
+
+// Ambient plus 1..4 coloured lights (directional or cone), random directions and strengths.
+Sh3Radiance random_lights(std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    auto colour = [&](double scale) {
+        return Rgb{static_cast<float>(scale * u(rng)), static_cast<float>(scale * u(rng)), static_cast<float>(scale * u(rng))};
+    };
+    const double level = std::exp2(12.0 * u(rng) - 6.0);
+    Sh3Radiance sh = project_constant(colour(0.3 * level * u(rng)));
+    const int lights = 1 + static_cast<int>(u(rng) * 4);
+    for (int i = 0; i < lights; ++i) {
+        if (u(rng) < 0.5) sh = sh + project_directional(random_direction(rng), colour(10.0 * level));
+        else sh = sh + project_cone(random_direction(rng), 0.05 + 1.5 * u(rng), colour(level));
+    }
+    return sh;
+}
+
+// Random SH (not necessarily a non-negative function): the clamping paths of the quantisers.
+Sh3Radiance random_sh(std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const double scale = std::exp2(8.0 * u(rng));
+    Sh3Radiance sh;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) sh[i][k] = static_cast<float>(scale * u(rng) * (i == 0 ? 2.0 : 1.0));
+    return sh;
+}
+
+const std::vector<Sh3Radiance>& envmap_probes() {
+    static const std::vector<Sh3Radiance> probes = [] {
+        std::vector<Sh3Radiance> out;
+        for (const std::string& path : test::envmap_paths()) {
+            const Image img = test::load_envmap(path);
+            out.push_back(project_latlong(img.rgb.data(), img.width, img.height, static_cast<size_t>(img.width) * 3, 2));
+        }
+        return out;
+    }();
+    return probes;
+}
+
+Sh3Radiance random_envmap(std::mt19937_64& rng) {
+    const auto& maps = envmap_probes();
+    if (maps.empty()) {  // load_envmap has already failed the test; keep going without dividing by 0
+        ADD_FAILURE() << "no sample maps";
+        return random_lights(rng);
+    }
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const Sh3Radiance& base = maps[static_cast<size_t>(u(rng) * maps.size()) % maps.size()];
+    return rotate(base, rotation_axis_angle(random_direction(rng), 2.0 * kPi * u(rng)));
+}
+
+// Arbitrary bytes for the quantised layouts; for float layouts finite floats of random sign with
+// |v| in [2^-60, 2^60] (log-uniform) or exactly 0.
+void random_bytes(std::mt19937_64& rng, bool float_layout, std::uint8_t* out, std::size_t size) {
+    if (!float_layout) {
+        for (std::size_t i = 0; i < size; ++i) out[i] = static_cast<std::uint8_t>(rng());
+        return;
+    }
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (std::size_t i = 0; i + 4 <= size; i += 4) {
+        float v = 0.0f;
+        if (u(rng) > 0.02) v = static_cast<float>((u(rng) < 0.5 ? -1.0 : 1.0) * std::exp2(120.0 * u(rng) - 60.0));
+        const std::uint32_t b = float_bits(v);
+        for (int j = 0; j < 4; ++j) out[i + static_cast<size_t>(j)] = static_cast<std::uint8_t>(b >> (8 * j));
+    }
+}
+
+bool is_packed(std::string_view name) {
+    PackedLayout layout;
+    return packed_layout_from_name(name, &layout);
+}
+bool lum_axis(std::string_view name, const StorageParams& p) {
+    const bool channel = name.find("channel") != std::string_view::npos;
+    if (name == "zh3_q16" || name == "zh3_solved_q16" || name == "zh3_dering_q16" || name == "hall_curve_q")
+        return p.axis_mode == ZonalAxisMode::kLuminance;
+    return !channel && (name.rfind("zh3", 0) == 0 || name.rfind("hall", 0) == 0);
+}
+bool is_default(const StorageParams& p) {
+    const StorageParams d;
+    return p.bits == d.bits && p.sqrt_encoding == d.sqrt_encoding && p.l2_bound == d.l2_bound &&
+           p.dc_format == d.dc_format && p.kind == d.kind && p.zonal_mapping == d.zonal_mapping &&
+           p.axis_mode == d.axis_mode && p.luminance.r == d.luminance.r && p.luminance.g == d.luminance.g &&
+           p.luminance.b == d.luminance.b;
+}
+
+// Per-encoding results.
+struct Stats {
+    std::size_t items = 0, nonfinite = 0, ill_conditioned = 0, failures = 0;
+    double max_rel = 0;       // max error / (eps T): how much of the bound was used (x 32)
+    double max_abs_irr = 0;   // max |irradiance error|
+    double max_rel_irr = 0;   // max |irradiance error| / |E| over the encoded probes (not random bytes)
+                              // where E >= 1% of the channel's DC irradiance kY00 |c0|
+    std::string first_failure;
+};
+
+struct Case {
+    std::string label;
+    StorageParams params;
+    std::vector<std::uint8_t> bytes;  // count * size
+    std::vector<float> normals;       // count * 4
+    std::size_t count = 0;
+    bool encoded = true;              // false: random bytes
+};
+
+// Compares one item; returns false (with a message) on a bound violation.
+bool compare_item(const Codec& codec, const StorageParams& p, const std::uint8_t* bytes, Vec3 n, const float* gpu,
+                  bool encoded, Stats* st, std::string* msg) {
+    const Sh3Radiance d = decode_probe(codec, p, bytes);
+    Rgb e;
+    if (is_default(p)) e = codec.irradiance(bytes, codec_options(p), n);
+    else e = irradiance(d, n);
+    // Per-channel scale T_k.
+    const bool packed = is_packed(codec.name);
+    double kappa = 1.0;
+    if (lum_axis(codec.name, p)) {
+        double num = 0;
+        Vec3 sum{};
+        const double w[3] = {p.luminance.r, p.luminance.g, p.luminance.b};
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 v{-double(d[3][k]), -double(d[1][k]), double(d[2][k])};
+            num += std::fabs(w[k]) * length(v);
+            sum = sum + w[k] * v;
+        }
+        const double den = length(sum);
+        if (num > 0) kappa = den > 0 ? num / den : INFINITY;
+    }
+    // The stored DC (decode_probe returns radiance; DC is band 0, unscaled).
+    double t[3];
+    bool any_nonfinite_ref = false;
+    for (int k = 0; k < 3; ++k) {
+        double s = 0, z = 0;
+        for (int i = 0; i < 9; ++i) {
+            s += std::fabs(double(d[i][k]));
+            if (i > 0) z += std::fabs(double(d[i][k]));
+        }
+        const double l2s = p.kind == StoredKind::kIrradiance ? 4.0 : 1.0;
+        t[k] = s + (packed ? 8.0 * std::sqrt(5.0) * std::fabs(double(d[0][k])) * l2s : 0.0) + kappa * z;
+        if (!std::isfinite(t[k])) any_nonfinite_ref = true;
+    }
+    ++st->items;
+    if (any_nonfinite_ref) {
+        if (std::isinf(kappa)) ++st->ill_conditioned;
+        else ++st->nonfinite;
+    }
+    auto check = [&](double ref, double got, int k, const char* what, int idx) {
+        if (!std::isfinite(ref)) {
+            if (std::isfinite(got)) {
+                *msg = std::string(what) + "[" + std::to_string(idx) + "] channel " + std::to_string(k) +
+                       ": reference non-finite, shader " + std::to_string(got);
+                return false;
+            }
+            return true;
+        }
+        if (!std::isfinite(t[k])) return true;  // ill-conditioned axis (kappa infinite): no bound
+        const double bound = kBoundEps * t[k] + kFlushFloor;
+        const double err = std::fabs(got - ref);
+        if (!(err <= bound)) {
+            char buf[256];
+            std::snprintf(buf, sizeof buf, "%s[%d] channel %d: shader %.9g, C++ %.9g, error %.3g > bound %.3g (T %.3g, kappa %.3g)",
+                          what, idx, k, got, ref, err, bound, t[k], kappa);
+            *msg = buf;
+            return false;
+        }
+        st->max_rel = std::max(st->max_rel, err / (FLT_EPSILON * t[k] + kFlushFloor));
+        return true;
+    };
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!check(d[i][k], gpu[3 * i + k], k, "sh", i)) return false;
+    for (int k = 0; k < 3; ++k) {
+        if (!check(e[k], gpu[27 + k], k, "irradiance", 0)) return false;
+        if (std::isfinite(e[k]) && std::isfinite(t[k])) {
+            const double err = std::fabs(double(gpu[27 + k]) - e[k]);
+            st->max_abs_irr = std::max(st->max_abs_irr, err);
+            if (encoded && std::fabs(e[k]) >= 0.01 * kY00 * std::fabs(double(d[0][k])) && e[k] != 0)
+                st->max_rel_irr = std::max(st->max_rel_irr, err / std::fabs(e[k]));
+        }
+    }
+    return true;
+}
+
+void run_case(const Codec& codec, const Case& c, Stats* st) {
+    const int id = hlsl_encoding(codec.name);
+    ASSERT_GE(id, 0);
+    const StorageParams& p = c.params;
+    std::uint32_t params[16] = {static_cast<std::uint32_t>(id),
+                                static_cast<std::uint32_t>(p.bits),
+                                p.sqrt_encoding ? 1u : 0u,
+                                static_cast<std::uint32_t>(p.l2_bound),
+                                static_cast<std::uint32_t>(p.dc_format),
+                                static_cast<std::uint32_t>(p.zonal_mapping),
+                                static_cast<std::uint32_t>(p.axis_mode),
+                                static_cast<std::uint32_t>(p.kind),
+                                float_bits(static_cast<float>(p.luminance.r)),
+                                float_bits(static_cast<float>(p.luminance.g)),
+                                float_bits(static_cast<float>(p.luminance.b)),
+                                float_bits(static_cast<float>(CodecOptions{}.hallucinate_a)),
+                                float_bits(static_cast<float>(CodecOptions{}.hallucinate_b)),
+                                static_cast<std::uint32_t>(c.count),
+                                static_cast<std::uint32_t>(codec.size_bytes / 4),
+                                0u};
+    ASSERT_EQ(codec.size_bytes % 4, 0u);
+    std::vector<std::uint32_t> words(c.bytes.size() / 4);
+    for (std::size_t i = 0; i < words.size(); ++i)
+        words[i] = std::uint32_t(c.bytes[4 * i]) | std::uint32_t(c.bytes[4 * i + 1]) << 8 |
+                   std::uint32_t(c.bytes[4 * i + 2]) << 16 | std::uint32_t(c.bytes[4 * i + 3]) << 24;
+    const std::vector<float> out = Gpu::get().run(params, words, c.normals, c.count);
+    ASSERT_EQ(out.size(), c.count * kOutFloats);
+    for (std::size_t i = 0; i < c.count; ++i) {
+        const Vec3 n{c.normals[4 * i], c.normals[4 * i + 1], c.normals[4 * i + 2]};
+        std::string msg;
+        if (!compare_item(codec, p, c.bytes.data() + i * codec.size_bytes, n, out.data() + i * kOutFloats, c.encoded, st, &msg)) {
+            if (st->failures++ == 0) st->first_failure = c.label + " item " + std::to_string(i) + ": " + msg;
+        }
+    }
+}
+
+void add_normal(std::mt19937_64& rng, std::vector<float>* normals) {
+    const Vec3 n = random_direction(rng);
+    normals->insert(normals->end(), {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z), 0.0f});
+}
+
+// `count` probes of one source, encoded with `p` (sources: 0 lights, 1 random SH, 2 envmaps,
+// 3 random bytes).
+Case make_case(const Codec& codec, const StorageParams& p, int source, std::size_t count, std::uint64_t seed) {
+    static const char* const kSources[] = {"lights", "random SH", "envmaps", "random bytes"};
+    Case c;
+    c.label = std::string(codec.name) + " / " + kSources[source];
+    c.params = p;
+    c.count = count;
+    c.encoded = source != 3;
+    c.bytes.resize(count * codec.size_bytes);
+    std::mt19937_64 rng(seed);
+    for (std::size_t i = 0; i < count; ++i) {
+        std::uint8_t* out = c.bytes.data() + i * codec.size_bytes;
+        if (source == 3) {
+            random_bytes(rng, !is_packed(codec.name), out, codec.size_bytes);
+        } else {
+            const Sh3Radiance hub = source == 0 ? random_lights(rng) : (source == 1 ? random_sh(rng) : random_envmap(rng));
+            encode_probe(codec, p, hub, out, nullptr);
+        }
+        add_normal(rng, &c.normals);
+    }
+    return c;
+}
+
+std::map<std::string, Stats>& results() {
+    static std::map<std::string, Stats> r;
+    return r;
+}
+
+class RuntimeVk : public ::testing::Test {
+protected:
+    void SetUp() override {
+        Gpu& g = Gpu::get();
+        ASSERT_TRUE(g.ok()) << "Vulkan (lavapipe) unavailable: " << g.error();
+    }
+};
+
+TEST_F(RuntimeVk, RunsOnLavapipe) {
+    const std::string name = Gpu::get().device_name();
+    std::printf("Vulkan device: %s\n", name.c_str());
+    EXPECT_NE(name.find("llvmpipe"), std::string::npos) << name;
+}
+
+TEST(RuntimeVkTable, EveryCodecHasAnHlslEncoding) {
+    for (const Codec& c : codecs()) EXPECT_GE(hlsl_encoding(c.name), 0) << c.name << " has no decoder in runtime/zhc.hlsl";
+    EXPECT_EQ(codecs().size(), std::size(kHlslEncodings));
+}
+
+// >= 100,000 probes per encoding with the codec table's defaults: 30k lights, 20k random SH, 30k
+// sample maps under random rotations, 20k random bytes.
+TEST_F(RuntimeVk, EveryEncodingMatchesTheCodec) {
+    const std::size_t counts[4] = {30000, 20000, 30000, 20000};
+    std::printf("%-22s %8s %10s %12s %9s %9s\n", "encoding", "items", "err/epsT", "max|dE|/E", "nonfinite", "ill-cond");
+    for (const Codec& codec : codecs()) {
+        Stats st;
+        for (int source = 0; source < 4; ++source) {
+            const Case c = make_case(codec, StorageParams{}, source, counts[source], 1000u * static_cast<unsigned>(source) + 17u);
+            run_case(codec, c, &st);
+        }
+        std::printf("%-22s %8zu %10.3f %12.3g %9zu %9zu\n", std::string(codec.name).c_str(), st.items, st.max_rel,
+                    st.max_rel_irr, st.nonfinite, st.ill_conditioned);
+        EXPECT_GE(st.items, 100000u);
+        EXPECT_EQ(st.failures, 0u) << st.failures << " items out of bound; first: " << st.first_failure;
+        EXPECT_LE(st.ill_conditioned, st.items / 1000) << codec.name;
+        results()[std::string(codec.name)] = st;
+    }
+}
+
+// The format fields the probe container stores: bits 2..8, sqrt encoding, L2 bound, DC format,
+// zonal mapping, axis mode, stored kind, luminance weights; every quantised layout, and the stored
+// kind / luminance weights for the float layouts too.
+TEST_F(RuntimeVk, EveryFormatMatchesTheCodec) {
+    std::vector<StorageParams> variants;
+    std::mt19937_64 rng(99);
+    for (int bits = 2; bits <= 8; ++bits)
+        for (int sq = 0; sq < 2; ++sq) {
+            StorageParams p;
+            p.bits = bits;
+            p.sqrt_encoding = sq != 0;
+            p.l2_bound = static_cast<L2Bound>(rng() % 2);
+            p.dc_format = static_cast<DcFormat>(rng() % 3);
+            p.zonal_mapping = static_cast<ZonalMapping>(rng() % 3);
+            p.axis_mode = static_cast<ZonalAxisMode>(rng() % 2);
+            p.kind = static_cast<StoredKind>(rng() % 2);
+            if (rng() % 3 == 0) p.luminance = {0.3, 0.59, 0.11};
+            variants.push_back(p);
+        }
+    for (int dc = 0; dc < 3; ++dc)
+        for (int zm = 0; zm < 3; ++zm)
+            for (int kind = 0; kind < 2; ++kind) {
+                StorageParams p;
+                p.dc_format = static_cast<DcFormat>(dc);
+                p.zonal_mapping = static_cast<ZonalMapping>(zm);
+                p.kind = static_cast<StoredKind>(kind);
+                p.axis_mode = static_cast<ZonalAxisMode>(zm % 2);
+                p.l2_bound = static_cast<L2Bound>(kind);
+                variants.push_back(p);
+            }
+    std::size_t total = 0;
+    for (const Codec& codec : codecs()) {
+        Stats st;
+        int v = 0;
+        for (StorageParams p : variants) {
+            ++v;
+            if (!is_packed(codec.name) && (p.bits != 8 || p.sqrt_encoding)) continue;  // only kind / weights apply
+            if (!validate_quant_params(p, codec.name)) p.dc_format = DcFormat::kRGB9E5;  // half needs sh2_q's slot
+            for (int source = 0; source < 4; ++source) {
+                if (source == 2 && !is_packed(codec.name)) continue;
+                const Case c = make_case(codec, p, source, 1500, 7919u * static_cast<unsigned>(v) + static_cast<unsigned>(source));
+                run_case(codec, c, &st);
+            }
+        }
+        total += st.items;
+        std::printf("%-22s %8zu items over the formats, err/epsT %.3f, max|dE|/E %.3g\n", std::string(codec.name).c_str(),
+                    st.items, st.max_rel, st.max_rel_irr);
+        EXPECT_EQ(st.failures, 0u) << st.failures << " items out of bound; first: " << st.first_failure;
+        EXPECT_LE(st.ill_conditioned, st.items / 1000) << codec.name;
+    }
+    EXPECT_GT(total, 0u);
+}
+
+// Known values of the integer DC unpacking, through the shader: a zh3_q16 probe with ratio codes
+// all at t = 0 decodes to exactly its DC (radiance kind), so the SH3 DC equals the unpacked triple.
+TEST_F(RuntimeVk, DcUnpackingIsExact) {
+    const Codec* codec = find_codec("sh2_q");
+    ASSERT_NE(codec, nullptr);
+    std::mt19937_64 rng(5);
+    for (int f = 0; f < 3; ++f) {
+        Case c;
+        c.label = "dc";
+        c.params.dc_format = static_cast<DcFormat>(f);
+        c.count = 4096;
+        c.bytes.resize(c.count * 16);
+        for (std::size_t i = 0; i < c.count; ++i) {
+            std::uint8_t* b = c.bytes.data() + i * 16;
+            for (int j = 0; j < 16; ++j) b[j] = static_cast<std::uint8_t>(rng());
+            if (i < 2048) {  // every exponent / mantissa pattern of channel 0's low bits appears
+                b[0] = static_cast<std::uint8_t>(i);
+                b[1] = static_cast<std::uint8_t>((b[1] & 0xF8) | ((i >> 8) & 7));
+            }
+            for (int j = 6; j < 15; ++j) b[j] = 127;  // bv: ratio 0
+        }
+        for (std::size_t i = 0; i < c.count; ++i) add_normal(rng, &c.normals);
+        Stats st;
+        run_case(*codec, c, &st);
+        EXPECT_EQ(st.failures, 0u) << st.first_failure;
+        // Exactness: recompute the DC on the CPU and compare bit for bit (finite values).
+        std::uint32_t params[16] = {static_cast<std::uint32_t>(hlsl_encoding("sh2_q")), 8, 0, 0, static_cast<std::uint32_t>(f),
+                                    0, 0, 0, float_bits(0.2126f), float_bits(0.7152f), float_bits(0.0722f),
+                                    float_bits(0.6f), float_bits(0.08f), static_cast<std::uint32_t>(c.count), 4u, 0u};
+        std::vector<std::uint32_t> words(c.count * 4);
+        std::memcpy(words.data(), c.bytes.data(), c.bytes.size());  // little-endian host (x86-64, the test platform)
+        const std::vector<float> out = Gpu::get().run(params, words, c.normals, c.count);
+        ASSERT_EQ(out.size(), c.count * kOutFloats);
+        std::size_t mismatches = 0;
+        for (std::size_t i = 0; i < c.count; ++i) {
+            const Rgb dc = load_dc(c.bytes.data() + i * 16, static_cast<DcFormat>(f));
+            for (int k = 0; k < 3; ++k) {
+                const float g = out[i * kOutFloats + static_cast<size_t>(k)];
+                if (std::isnan(dc[k]) ? !std::isnan(g) : float_bits(g) != float_bits(dc[k])) ++mismatches;
+            }
+        }
+        EXPECT_EQ(mismatches, 0u) << "DC format " << f;
+    }
+}
+
+// IrradZ lightmaps: the three textures' decoded values -> irradiance, both models, against
+// lightmap::decode_hemioct + irradz::evaluate.
+TEST_F(RuntimeVk, IrradzMatchesTheCodec) {
+    std::mt19937_64 rng(4242);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const std::size_t count = 100000;
+    for (int model = 0; model < 2; ++model) {
+        std::vector<std::uint32_t> words(count * 6);
+        std::vector<float> normals;
+        for (std::size_t i = 0; i < count; ++i) {
+            const double level = std::exp2(16.0 * u(rng) - 8.0);
+            const float v[6] = {static_cast<float>(level * u(rng)), static_cast<float>(level * u(rng)),
+                                static_cast<float>(level * u(rng)), static_cast<float>(1.2 * u(rng) - 0.1),
+                                static_cast<float>(1.1 * u(rng) - 0.05), static_cast<float>(1.1 * u(rng) - 0.05)};
+            for (int j = 0; j < 6; ++j) words[6 * i + static_cast<size_t>(j)] = float_bits(v[j]);
+            Vec3 n = random_direction(rng);
+            if (i % 4 != 0) n.z = std::fabs(n.z);  // mostly the upper hemisphere
+            normals.insert(normals.end(), {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z), 0.0f});
+        }
+        std::uint32_t params[16] = {};
+        params[13] = static_cast<std::uint32_t>(count);
+        params[14] = 6;
+        params[15] = model == 0 ? 1u : 2u;
+        const std::vector<float> out = Gpu::get().run(params, words, normals, count);
+        ASSERT_EQ(out.size(), count * kOutFloats);
+        double max_rel = 0;
+        std::size_t failures = 0;
+        std::string first;
+        for (std::size_t i = 0; i < count; ++i) {
+            irradz::IrradZ p;
+            p.i_z = Rgb{bits_float(words[6 * i]), bits_float(words[6 * i + 1]), bits_float(words[6 * i + 2])};
+            p.w_a = bits_float(words[6 * i + 3]);
+            p.d = lightmap::decode_hemioct(bits_float(words[6 * i + 4]), bits_float(words[6 * i + 5]));
+            const Vec3 n{normals[4 * i], normals[4 * i + 1], normals[4 * i + 2]};
+            const irradz::Model m = model == 0 ? irradz::Model::kHhd : irradz::Model::kAhd;
+            const Rgb e = irradz::evaluate(p, m, n);
+            const irradz::Lighting l = irradz::to_lighting(p);
+            for (int k = 0; k < 3; ++k) {
+                // Terms: C_a h and C_d max(0, n.d), each a few operations deep. C_d = (1 - w_a) I_z / d_z
+                // carries d_z's rounding relative to d_z: d is a unit vector (absolute error ~2 ulp
+                // of 1) with d_z >= cos 85 deg = 0.087, so up to ~11.5 x 2 eps relative; with the
+                // rest of the chain that stays below 32 eps T (measured: ~10).
+                const double t = std::fabs(double(l.c_a[k])) + std::fabs(double(l.c_d[k]));
+                const double err = std::fabs(double(out[i * kOutFloats + 27 + static_cast<size_t>(k)]) - e[k]);
+                const double bound = kBoundEps * t + kFlushFloor;
+                if (!(err <= bound) && failures++ == 0)
+                    first = "texel " + std::to_string(i) + " channel " + std::to_string(k) + ": shader " +
+                            std::to_string(out[i * kOutFloats + 27 + static_cast<size_t>(k)]) + " C++ " + std::to_string(e[k]);
+                if (t > 0) max_rel = std::max(max_rel, err / (FLT_EPSILON * t));
+            }
+        }
+        std::printf("irradz %s: %zu texels, max error / (eps T) = %.3f\n", model == 0 ? "HHD" : "AHD", count, max_rel);
+        EXPECT_EQ(failures, 0u) << first;
+    }
+}
+
+}  // namespace
+}  // namespace zhc

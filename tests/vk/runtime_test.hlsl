@@ -1,0 +1,63 @@
+// Test kernel of tests/test_runtime_vk.cpp: one invocation per probe (or lightmap texel).
+//   binding 0  params: 16 uints [encoding, bits, sqrt, l2Bound, dcFormat, zonalMapping, axisMode, kind,
+//              lumR, lumG, lumB, hallA, hallB (float bits), count, strideWords, mode]
+//   binding 1  the probes' words (strideWords per probe), or per texel 6 floats (I_z rgb, w_a, d uv)
+//   binding 2  unit normals (float4, w unused)
+//   binding 3  output, 32 floats per item: decoded SH3 radiance (27), irradiance (3)
+// mode 0: probes; 1: IrradZ HHD; 2: IrradZ AHD (irradiance in floats 27..29).
+#include "zhc.hlsl"
+
+[[vk::binding(0, 0)]] StructuredBuffer<uint> params;
+[[vk::binding(1, 0)]] ByteAddressBuffer words;
+[[vk::binding(2, 0)]] StructuredBuffer<float4> normals;
+[[vk::binding(3, 0)]] RWStructuredBuffer<float> results;
+
+[numthreads(64, 1, 1)]
+void main(uint3 id : SV_DispatchThreadID)
+{
+    uint i = id.x;
+    if (i >= params[13]) return;
+    uint stride = params[14];
+    uint mode = params[15];
+    float3 n = normals[i].xyz;
+    uint o = 32u * i;
+    if (mode != 0u)
+    {
+        uint b = 4u * stride * i;
+        float3 iz = asfloat(words.Load3(b));
+        float wa = asfloat(words.Load(b + 12u));
+        float2 uv = asfloat(words.Load2(b + 16u));
+        float3 e = zhc_irradz_irradiance(iz, wa, uv, mode == 1u ? ZHC_IRRADZ_HHD : ZHC_IRRADZ_AHD, n);
+        results[o + 27u] = e.x;
+        results[o + 28u] = e.y;
+        results[o + 29u] = e.z;
+        return;
+    }
+    ZhcFormat f;
+    f.encoding = params[0];
+    f.bits = params[1];
+    f.sqrtEncoding = params[2];
+    f.l2Bound = params[3];
+    f.dcFormat = params[4];
+    f.zonalMapping = params[5];
+    f.axisMode = params[6];
+    f.kind = params[7];
+    f.lumR = asfloat(params[8]);
+    f.lumG = asfloat(params[9]);
+    f.lumB = asfloat(params[10]);
+    f.hallA = asfloat(params[11]);
+    f.hallB = asfloat(params[12]);
+    uint w[27];
+    [unroll] for (uint j = 0u; j < 27u; ++j) w[j] = j < stride ? words.Load(4u * (stride * i + j)) : 0u;
+    ZhcSH3 sh = zhc_decode_sh3(w, f);
+    [unroll] for (uint c = 0u; c < 9u; ++c)
+    {
+        results[o + 3u * c] = sh.c[c].x;
+        results[o + 3u * c + 1u] = sh.c[c].y;
+        results[o + 3u * c + 2u] = sh.c[c].z;
+    }
+    float3 e = zhc_irradiance(w, f, n);
+    results[o + 27u] = e.x;
+    results[o + 28u] = e.y;
+    results[o + 29u] = e.z;
+}
