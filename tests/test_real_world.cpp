@@ -34,7 +34,7 @@
 namespace zhc {
 namespace {
 
-std::string quote(const std::string& s) {
+[[maybe_unused]] std::string quote(const std::string& s) {
     std::string q = "'";
     for (char c : s) {
         if (c == '\'')
@@ -45,7 +45,7 @@ std::string quote(const std::string& s) {
     return q + "'";
 }
 
-int sh_run(const std::string& cmd) {
+[[maybe_unused]] int sh_run(const std::string& cmd) {
     const int st = std::system((cmd + " > /dev/null 2>&1").c_str());
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128;
 }
