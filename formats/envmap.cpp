@@ -257,7 +257,7 @@ Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& n
             info->channels = std::string(has_rgb ? (channels.findChannel("A") ? "RGBA" : "RGB")
                                                  : (yc ? (channels.findChannel("A") ? "YCA" : "YC") : "Y")) +
                              (c->type == Imf::HALF ? " half" : c->type == Imf::FLOAT ? " float" : " uint");
-            info->layout = map_layout == EnvmapLayout::kCubeOpenExr ? "cube (OpenEXR)" : "lat-long";
+            info->layout = map_layout == EnvmapLayout::kCubeOpenExr ? "cube" : "lat-long";
             info->part = part_label(header, *chosen);
         }
         if (Status s = check_finite(name, img, o, info); !s) return s.error();

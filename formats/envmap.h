@@ -56,7 +56,7 @@ struct EnvmapInfo {
     std::string compression;  // EXR compression name, "rle" or "flat" for .hdr
     std::string channels;     // e.g. "RGBA half"
     std::uint64_t replaced_non_finite = 0;
-    std::string layout = "lat-long";  // or "cube (OpenEXR)"
+    std::string layout = "lat-long";  // or "cube" (OpenEXR layout)
     std::string part;                 // EXR: the part read ("#index" when it has no name)
 };
 
