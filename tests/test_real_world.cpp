@@ -197,6 +197,36 @@ TEST(CubeMap, AnalyticShFunctionConvergesAsOneOverNSquared) {
     EXPECT_GT(err[0] / err[1], 8.0);    // O(1/N^2): 16 expected for 4x the face size
 }
 
+TEST(CubeMap, ResampledToLatLongForTheAuditReference) {
+    // envmap_as_latlong (the audit's lat-long reference of a cube map): the lat-long image of an
+    // analytic cube projects to the function's coefficients (nearest-pixel point samples, 4x4 per
+    // output pixel: measured 6.5e-5 of |L00| at N = 64 -> 256 x 128), and `zhc audit` of the cube
+    // measures sh3 against that reference (relative RMSE 1.5e-5: SH3 holds this map exactly).
+    Sh3Radiance a;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) a[i][k] = i == 0 ? 3.0f : 0.2f * float((i * 3 + k) % 5) - 0.4f;
+    const int n = 64;
+    Image cube;
+    cube.width = n;
+    cube.height = 6 * n;
+    cube.layout = EnvmapLayout::kCubeOpenExr;
+    cube.rgb = render_cube(n, [&](Vec3 d) { return evaluate(a, d); });
+    const Image ll = envmap_as_latlong(cube, 256, 128);
+    ASSERT_EQ(ll.layout, EnvmapLayout::kLatLong);
+    const double d = sh_distance(project_latlong(ll.rgb.data(), 256, 128, 256 * 3), a);
+    std::printf("cube N=64 -> lat-long 256x128: SH3 error %.2e of |L00|\n", d);
+    EXPECT_LT(d, 2e-3);
+    const std::string dir = test::temp_dir("rw_cube_audit");
+    write_float_exr(dir + "/cube.exr", n, 6 * n, cube.rgb, true);
+    const auto r = test::run_zhc({"audit", dir + "/cube.exr", "--representations", "sh3", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    // SH3 represents this map exactly: the audit's error against its reference is small.
+    const double rel = j["files"][0]["representations"]["sh3"]["relative_rmse"].get<double>();
+    std::printf("audit of the analytic cube: sh3 relative_rmse %.2e\n", rel);
+    EXPECT_LT(rel, 5e-3);
+}
+
 #ifdef ZHC_TOOL_EXRENVMAP
 TEST(CubeMap, ExrenvmapCubeOfEachSampleMapProjectsLikeTheLatLong) {
     // exrenvmap (OpenEXR's tool) resamples each lat-long sample map to a 256 x 1536 cube (half
