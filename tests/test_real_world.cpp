@@ -5,6 +5,8 @@
 // declared size, deep JSON). Expected coefficients come from an independent computation: the
 // lat-long original's projection, an analytic function, or OpenEXR's own pixel/direction mapping.
 #include <ImfChannelList.h>
+#include <ImfDeepFrameBuffer.h>
+#include <ImfDeepScanLineOutputFile.h>
 #include <ImfEnvmap.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -493,6 +495,41 @@ TEST(Memory, HugeDeclaredImageInASmallFileIsRefusedWithoutAllocatingIt) {
         EXPECT_EQ(rc, code) << path;
         EXPECT_LT(mb, 64.0 + file_mb) << path;
         expect_one_line_error(test::run_zhc({"project", path}), code, path);
+    }
+}
+
+TEST(TrailingBytes, DeepFilesAreWalkedToTheirEnd) {
+    // Deep scanline files (OpenEXR's API; chunk = y, three 64-bit sizes, offset table + samples):
+    // the chunk walk must find their true end, so the file is refused as unsupported (exit 5: deep
+    // images are not environment maps), and only with a byte appended as trailing data (exit 4).
+    const std::string dir = test::temp_dir("rw_deep");
+    for (const Imf::Compression c : {Imf::NO_COMPRESSION, Imf::ZIPS_COMPRESSION, Imf::RLE_COMPRESSION}) {
+        const std::string path = dir + "/deep" + std::to_string(int(c)) + ".exr";
+        const int w = 16, h = 8;
+        {
+            Imf::Header header(w, h);
+            header.setType(Imf::DEEPSCANLINE);
+            header.compression() = c;
+            for (const char* ch : {"R", "G", "B"}) header.channels().insert(ch, Imf::Channel(Imf::FLOAT));
+            Imf::DeepScanLineOutputFile out(path.c_str(), header);
+            std::vector<unsigned> counts(w * h);
+            std::vector<float> values;
+            for (int i = 0; i < w * h; ++i) counts[static_cast<size_t>(i)] = static_cast<unsigned>(i % 3);
+            values.assign(w * h * 2, 0.5f);
+            std::vector<float*> ptrs(w * h);
+            for (int i = 0; i < w * h; ++i) ptrs[static_cast<size_t>(i)] = values.data() + 2 * i;
+            Imf::DeepFrameBuffer fb;
+            fb.insertSampleCountSlice(Imf::Slice(Imf::UINT, reinterpret_cast<char*>(counts.data()), sizeof(unsigned),
+                                                 sizeof(unsigned) * w));
+            for (const char* ch : {"R", "G", "B"})
+                fb.insert(ch, Imf::DeepSlice(Imf::FLOAT, reinterpret_cast<char*>(ptrs.data()), sizeof(float*), sizeof(float*) * w,
+                                             sizeof(float)));
+            out.setFrameBuffer(fb);
+            out.writePixels(h);
+        }
+        expect_one_line_error(test::run_zhc({"project", path}), cli::kExitUnsupported, path);
+        test::write_bytes(path + ".tail", with_tail(test::read_bytes(path), 1));
+        expect_one_line_error(test::run_zhc({"project", path + ".tail"}), cli::kExitInvalidInput, path + ".tail");
     }
 }
 
