@@ -403,6 +403,14 @@ TEST(TrailingBytes, AfterEveryKindOfExrAndHdrAreExit4) {
                      " -o " + quote(mp)),
               0);
     good.push_back(mp);
+#ifdef ZHC_TOOL_EXRMAKETILED
+    // A tiled mip-mapped part (round up) after a scanline part: the multi-part chunk layout with tiles.
+    const std::string mp_tiled = dir + "/multi_tiled.exr";
+    ASSERT_EQ(sh_run(quote(ZHC_TOOL_EXRMULTIPART) + " -combine -i " + quote(dir + "/scan.exr") + " " + quote(good[6]) + " -o " +
+                     quote(mp_tiled)),
+              0);
+    good.push_back(mp_tiled);
+#endif
 #endif
     const Sh3Radiance ref = project_latlong(img.rgb.data(), 64, 32, 64 * 3);
     for (const std::string& path : good) {
