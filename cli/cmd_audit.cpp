@@ -35,6 +35,7 @@ struct Options {
     double max_rmse = -1, max_relative_rmse = -1;
     bool fail_on_negative = false;
     bool replace_non_finite = false;
+    std::string part;
 };
 
 struct FileReport {
@@ -90,6 +91,7 @@ int run(const Options& o) {
     AuditLoadOptions lopt;
     lopt.threads = threads;
     lopt.replace_non_finite = o.replace_non_finite;
+    lopt.part = o.part;
 
     std::vector<FileReport> reports;
     for (size_t fi = 0; fi < files->size(); ++fi) {
@@ -254,6 +256,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     sub->add_option("--max-relative-rmse", o->max_relative_rmse, "gate: fail (exit 8) if any relative RMSE exceeds this");
     sub->add_flag("--fail-on-negative", o->fail_on_negative, "gate: fail (exit 8) if any reconstruction goes negative");
     sub->add_flag("--replace-non-finite", o->replace_non_finite, "replace NaN/Inf pixels by 0 instead of failing");
+    sub->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
     return [o] { return run(*o); };
 });
 

@@ -31,6 +31,7 @@ struct Options {
     bool irradiance = false;
     int zstd = 0;
     bool replace_non_finite = false;
+    std::string part;
     int threads = 1;
     std::vector<CLI::Option*> storage_flags;  // the options that set StorageParams
     bool any_storage_flag() const {
@@ -63,10 +64,10 @@ Result<Loaded> load_input(const Options& o) {
     } else if (looks_like_envmap(*bytes)) {
         EnvmapReadOptions ro;
         if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
+        ro.part = o.part;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return img.error();
-        in.list.probes.push_back(project_latlong(img->rgb.data(), img->width, img->height,
-                                                 static_cast<size_t>(img->width) * 3, std::max(1, o.threads)));
+        in.list.probes.push_back(project_envmap(*img, std::max(1, o.threads)));
         in.kind = "envmap";
     } else if (looks_like_json(*bytes)) {
         auto list = parse_probe_json(*bytes, o.input);
@@ -200,6 +201,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")
         ->check(CLI::Range(0, 22));
     sub->add_flag("--replace-non-finite", o->replace_non_finite, "env map input: replace NaN/Inf pixels by 0");
+    sub->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
     sub->add_option("--threads", o->threads, "env map projection threads (result identical for any count)")
         ->check(CLI::Range(1, 256));
     return [o] { return run(*o); };

@@ -15,6 +15,7 @@
 #include "codec/sh.h"
 #include "formats/envmap.h"
 #include "formats/file_io.h"
+#include "formats/json_depth.h"
 
 namespace zhc::cli {
 namespace cmd_dering {  // one namespace per verb file: the CLI is a unity build
@@ -28,6 +29,7 @@ struct Options {
     std::string output;
     bool punctual = false;
     bool replace_non_finite = false;
+    std::string part;
     int threads = 0;
 };
 
@@ -60,6 +62,7 @@ Result<Sh3Radiance> parse_sh3(const nlohmann::json& rows, const std::string& whe
 }
 
 Result<std::vector<Probe>> parse_probe_list(const std::vector<std::uint8_t>& bytes, const std::string& path) {
+    if (Status depth = check_json_depth(bytes, path); !depth) return depth.error();
     const nlohmann::json j = nlohmann::json::parse(bytes.begin(), bytes.end(), nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded())
         return make_error(ErrorCode::kBadFormat, path + ": neither an environment map (EXR/.hdr) nor valid JSON");
@@ -107,11 +110,11 @@ int run(const Options& o) {
     if (looks_like_envmap(*bytes)) {
         EnvmapReadOptions ro;
         if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
+        ro.part = o.part;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return report(img.error());
         const int threads = o.threads > 0 ? o.threads : 1;
-        probes.push_back({"", project_latlong(img->rgb.data(), img->width, img->height,
-                                              static_cast<size_t>(img->width) * 3, threads)});
+        probes.push_back({"", project_envmap(*img, threads)});
     } else {
         auto list = parse_probe_list(*bytes, o.input);
         if (!list) return report(list.error());
@@ -165,6 +168,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     sub->add_option("-o,--output", o->output, "output JSON (written atomically)")->required();
     sub->add_flag("--punctual", o->punctual, "source is punctual lights: extra windowing 0.92 / 0.73 first");
     sub->add_flag("--replace-non-finite", o->replace_non_finite, "map input: replace NaN/Inf pixels by 0");
+    sub->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
     sub->add_option("--threads", o->threads, "map input: projection threads (same result for any count)")
         ->check(CLI::Range(0, 256));
     return [o] { return run(*o); };

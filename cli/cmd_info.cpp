@@ -11,6 +11,7 @@
 #include "formats/file_io.h"
 #include "formats/gltf_probes.h"
 #include "formats/probe_file.h"
+#include "formats/json_depth.h"
 
 namespace zhc::cli {
 namespace cmd_info {  // one namespace per verb file: the CLI is a unity build
@@ -80,6 +81,8 @@ void probe_stats(const std::vector<Sh3Radiance>& hub, nlohmann::ordered_json& j)
 
 // A JSON document with an "asset" object is glTF, not a probe list.
 bool is_gltf_json(const std::vector<std::uint8_t>& bytes) {
+    // Too deep for the parser: not sniffed here; the reader it goes to refuses it by the same scan.
+    if (!check_json_depth(bytes, "")) return false;
     const auto doc = nlohmann::json::parse(bytes.begin(), bytes.end(), nullptr, false);
     return doc.is_object() && doc.contains("asset") && doc["asset"].is_object();
 }
@@ -137,14 +140,13 @@ int run(const Options& o) {
         EnvmapInfo info;
         auto img = read_envmap_memory(*bytes, o.path, {}, &info);
         if (!img) return report(img.error());
-        j["type"] = "environment map (lat-long)";
+        j["type"] = "environment map (" + info.layout + ")";
         j["format"] = info.format;
         j["width"] = img->width;
         j["height"] = img->height;
         j["channels"] = info.channels;
         j["compression"] = info.compression;
-        const Sh3Radiance sh = project_latlong(img->rgb.data(), img->width, img->height,
-                                               static_cast<size_t>(img->width) * 3);
+        const Sh3Radiance sh = project_envmap(*img);
         probe_stats({sh}, j);
     } else if (looks_like_glb(*bytes) || (looks_like_json(*bytes) && is_gltf_json(*bytes))) {
         // glTF (issue 8): the asset's outline and its ZHC_light_probes volumes.

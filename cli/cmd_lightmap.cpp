@@ -26,6 +26,7 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 struct Options {
     std::string input, output, quality = "default", solve = "search";
     std::string container;  // encode: "" = ktx2; decode: "" = auto
+    std::string part;       // synth: EXR part of the environment map
     int threads = 1, size = 256, stride = 17;
     bool json = false;
 };
@@ -168,9 +169,11 @@ int run_audit(const Options& o) {
 }
 
 int run_synth(const Options& o) {
-    auto img = read_envmap(o.input);
+    EnvmapReadOptions ro;
+    ro.part = o.part;
+    auto img = read_envmap(o.input, ro);
     if (!img) return report(img.error());
-    const Sh3Radiance world = project_latlong(img->rgb.data(), img->width, img->height, static_cast<size_t>(img->width) * 3, o.threads);
+    const Sh3Radiance world = project_envmap(*img, o.threads);
     const auto lm = lightmap::synthesize_sphere(world, o.size, o.size, o.threads);
     if (auto s = write_sh_lightmap_exr(o.output, lm); !s) return report_output(s.error());
     std::printf("%s -> %s: %dx%d SH lightmap of a sphere lit by the map's SH3 (channels sh0.R .. sh8.B)\n", o.input.c_str(),
@@ -205,7 +208,8 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     aud->add_flag("--json", o->json, "one JSON object");
     quality(aud);
     CLI::App* syn = lm->add_subcommand("synth", "synthetic SH lightmap: a sphere lit by an environment map's SH3");
-    syn->add_option("ENVMAP", o->input, "lat-long EXR or .hdr")->required();
+    syn->add_option("ENVMAP", o->input, "EXR (lat-long or cube) or .hdr environment map")->required();
+    syn->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
     syn->add_option("-o,--output", o->output, "output SH lightmap EXR")->required();
     syn->add_option("--size", o->size, "width = height in texels")->check(CLI::Range(4, 4096));
     syn->add_option("--threads", o->threads, "worker threads")->check(CLI::Range(1, 256));

@@ -17,6 +17,7 @@ struct Options {
     std::string path;
     bool json = false;
     bool replace_non_finite = false;
+    std::string part;
     int threads = 0;
 };
 
@@ -29,13 +30,13 @@ void print_sh3_table(const Sh3Radiance& sh) {
 int run(const Options& o) {
     EnvmapReadOptions ro;
     if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
+    ro.part = o.part;
     EnvmapInfo info;
     auto img = read_envmap(o.path, ro, &info);
     if (!img) return report(img.error());
     const int threads = o.threads > 0 ? o.threads : 1;
     const auto t0 = std::chrono::steady_clock::now();
-    const Sh3Radiance sh = project_latlong(img->rgb.data(), img->width, img->height,
-                                           static_cast<size_t>(img->width) * 3, threads);
+    const Sh3Radiance sh = project_envmap(*img, threads);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (o.json) {
         nlohmann::json j;
@@ -43,6 +44,7 @@ int run(const Options& o) {
         j["width"] = img->width;
         j["height"] = img->height;
         j["format"] = info.format;
+        j["layout"] = info.layout;
         j["kind"] = "radiance";
         j["basis"] = "zhc (ZH3 paper Eq. 4/5), index l(l+1)+m";
         nlohmann::json rows = nlohmann::json::array();
@@ -51,8 +53,8 @@ int run(const Options& o) {
         j["replaced_non_finite"] = info.replaced_non_finite;
         std::cout << j.dump() << "\n";
     } else {
-        std::printf("%s: %dx%d %s (%s, %s)\n", o.path.c_str(), img->width, img->height, info.format.c_str(),
-                    info.channels.c_str(), info.compression.c_str());
+        std::printf("%s: %dx%d %s %s (%s, %s)\n", o.path.c_str(), img->width, img->height, info.format.c_str(),
+                    info.layout.c_str(), info.channels.c_str(), info.compression.c_str());
         print_sh3_table(sh);
         std::printf("projected in %.3f ms\n", ms);
     }
@@ -61,10 +63,11 @@ int run(const Options& o) {
 
 const VerbRegistration registration(20, [](CLI::App& app) -> std::function<int()> {
     auto o = std::make_shared<Options>();
-    CLI::App* sub = app.add_subcommand("project", "Project a lat-long environment map (EXR or .hdr) to SH3 radiance");
+    CLI::App* sub = app.add_subcommand("project", "Project an environment map (EXR lat-long or cube, or .hdr) to SH3 radiance");
     sub->add_option("ENVMAP", o->path, "OpenEXR or Radiance .hdr lat-long map")->required();
     sub->add_flag("--json", o->json, "print one JSON object; key \"sh3\" holds 9 rows of [r, g, b]");
     sub->add_flag("--replace-non-finite", o->replace_non_finite, "replace NaN/Inf pixels by 0 instead of failing");
+    sub->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
     sub->add_option("--threads", o->threads, "worker threads (result is identical for any count)")->check(CLI::Range(0, 256));
     return [o] { return run(*o); };
 });

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <string>
 #include <vector>
 
 #include "cli.h"
@@ -70,8 +71,13 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::fprintf(stderr, "zhc: error: %s\n", e.what());
-        std::fprintf(stderr, "Run 'zhc --help' for usage.\n");
+        // One line (README "Exit codes"): CLI11's message with any line breaks folded, and the
+        // pointer to --help on the same line.
+        std::string what = e.what();
+        for (char& c : what)
+            if (c == '\n' || c == '\r') c = ' ';
+        while (!what.empty() && what.back() == ' ') what.pop_back();
+        std::fprintf(stderr, "zhc: error: %s (run 'zhc --help' for usage)\n", what.c_str());
         return kExitUsage;
     }
     // Each setup adds exactly one top-level subcommand, in `registered` order; run the parsed one.

@@ -53,14 +53,17 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
     if (looks_like_envmap(*bytes)) {
         EnvmapReadOptions ro;
         if (options.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
+        ro.part = options.part;
         auto img = read_envmap_memory(*bytes, path, ro);
         if (!img) return img.error();
         in.kind = "envmap";
-        in.probes.push_back(project_latlong(img->rgb.data(), img->width, img->height,
-                                            static_cast<size_t>(img->width) * 3, options.threads));
-        in.map = downsample_for_audit({img->rgb.data(), img->width, img->height});
+        in.probes.push_back(project_envmap(*img, options.threads));
+        // The reference integrates lat-long pixels: a cube map is resampled to a lat-long of 4N x 2N
+        // (N the face size; at least the audit's 512 x 256).
+        const Image ll = envmap_as_latlong(*img, std::max(512, 4 * img->width), std::max(256, 2 * img->width));
+        in.map = downsample_for_audit({ll.rgb.data(), ll.width, ll.height});
         in.map_reference = integrate_irradiance(in.map.view(), dirs, options.threads);
-        in.description = "environment map " + std::to_string(img->width) + "x" + std::to_string(img->height) +
+        in.description = std::string(img->layout == EnvmapLayout::kCubeOpenExr ? "cube " : "") + "environment map " + std::to_string(img->width) + "x" + std::to_string(img->height) +
                          ", reference: the map integrated at " + std::to_string(in.map.width) + "x" +
                          std::to_string(in.map.height);
         return in;

@@ -12,6 +12,7 @@ namespace zhc {
 struct AuditLoadOptions {
     int threads = 1;
     bool replace_non_finite = false;
+    std::string part;  // EXR part (EnvmapReadOptions::part)
 };
 
 // One audited file: its probes (SH3 radiance hubs) and, for an environment map, the map itself

@@ -6,18 +6,25 @@
 #include <ImfHeader.h>
 #include <ImfIO.h>
 #include <ImfInputFile.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfRgbaFile.h>
+#include <ImfThreading.h>
 #include <ImfOutputFile.h>
+#include <ImfPartType.h>
 #include <ImfStandardAttributes.h>
 #include <ImfTestFile.h>
-#include <stb_image.h>
 #include <stb_image_write.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <memory>
 #include <sstream>
 
+#include "codec/cubemap.h"
 #include "exr_memory.h"
 #include "file_io.h"
 
@@ -81,11 +88,100 @@ Status check_finite(const std::string& name, Image& img, const EnvmapReadOptions
     return Ok{};
 }
 
+std::string one_line(std::string what) {
+    for (char& ch : what)
+        if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = ' ';
+    return what;
+}
+
+bool usable_channels(const Imf::ChannelList& channels) {
+    return (channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B")) ||
+           channels.findChannel("Y") != nullptr;
+}
+
+bool is_deep(const Imf::Header& h) {
+    return h.hasType() && (h.type() == Imf::DEEPSCANLINE || h.type() == Imf::DEEPTILE);
+}
+
+std::string part_label(const Imf::Header& h, int index) {
+    std::string out;
+    if (h.hasName()) {
+        out.push_back('\'');
+        out.append(h.name());
+        out.push_back('\'');
+    } else {
+        out.push_back('#');
+        out.append(std::to_string(index));
+    }
+    return out;
+}
+
+// Chooses the part to read: by name (or index) when asked, else the first non-deep part with
+// R, G, B or Y channels.
+Result<int> choose_part(const Imf::MultiPartInputFile& file, const std::string& name, const std::string& wanted) {
+    const int parts = file.parts();
+    std::string labels;
+    for (int i = 0; i < parts; ++i) labels += (i ? ", " : "") + part_label(file.header(i), i);
+    if (!wanted.empty()) {
+        int found = -1;
+        for (int i = 0; i < parts && found < 0; ++i)
+            if (file.header(i).hasName() && file.header(i).name() == wanted) found = i;
+        if (found < 0 && !wanted.empty() && wanted.size() < 4 &&
+            wanted.find_first_not_of("0123456789") == std::string::npos && std::stoi(wanted) < parts)
+            found = std::stoi(wanted);
+        if (found < 0)
+            return make_error(ErrorCode::kInvalidArgument,
+                              name + ": OpenEXR file has no part named '" + wanted + "' (parts: " + labels + ")");
+        const Imf::Header& h = file.header(found);
+        if (is_deep(h) || !usable_channels(h.channels()))
+            return make_error(ErrorCode::kUnsupported, name + ": OpenEXR part " + part_label(h, found) +
+                                                           " has no R, G, B (or Y) channels or is deep");
+        return found;
+    }
+    for (int i = 0; i < parts; ++i)
+        if (!is_deep(file.header(i)) && usable_channels(file.header(i).channels())) return i;
+    return make_error(ErrorCode::kUnsupported, name + ": OpenEXR file has no part with R, G, B (or Y) channels (parts: " +
+                                                   labels + ")");
+}
+
+// Luminance/chroma (Y, RY, BY as Imf::RgbaOutputFile writes with WRITE_YC/WRITE_YCA): OpenEXR's
+// RgbaInputFile reconstructs full-resolution chroma and converts to RGB with the file's
+// chromaticities (ImfRgbaYca). It reads the first part only.
+Status read_yc(std::span<const std::uint8_t> bytes, const std::string& name, Image& img, const Imath::Box2i& dw) {
+    ExrMemoryStream stream(bytes, name);
+    Imf::RgbaInputFile in(stream);
+    const size_t w = static_cast<size_t>(img.width), h = static_cast<size_t>(img.height);
+    std::vector<Imf::Rgba> px(w * h);
+    // Base pointer such that base + x + y * w addresses pixel (x, y) of the data window; computed
+    // in integers (a pointer outside the buffer would be UB).
+    const std::ptrdiff_t origin = -(std::ptrdiff_t(dw.min.x) + std::ptrdiff_t(dw.min.y) * std::ptrdiff_t(w));
+    in.setFrameBuffer(reinterpret_cast<Imf::Rgba*>(reinterpret_cast<std::uintptr_t>(px.data()) +
+                                                   static_cast<std::uintptr_t>(origin * std::ptrdiff_t(sizeof(Imf::Rgba)))),
+                      1, w);
+    in.readPixels(dw.min.y, dw.max.y);
+    for (size_t i = 0; i < w * h; ++i) {
+        img.rgb[3 * i] = px[i].r;
+        img.rgb[3 * i + 1] = px[i].g;
+        img.rgb[3 * i + 2] = px[i].b;
+    }
+    return Ok{};
+}
+
 Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& name, const EnvmapReadOptions& o,
                        EnvmapInfo* info) {
-    if (Status s = validate_exr_header(bytes, name, [&](std::uint64_t w, std::uint64_t h) { return check_size(name, w, h, o); });
+    ExrLayout layout;
+    if (Status s = validate_exr_header(bytes, name, [&](std::uint64_t w, std::uint64_t h) { return check_size(name, w, h, o); },
+                                       &layout);
         !s)
         return s.error();
+    // Every chunk must lie inside the file before anything sized by the header is allocated, and
+    // the last chunk's end is the file's end: more bytes are an error.
+    auto end = exr_data_end(bytes, name, layout);
+    if (!end) return end.error();
+    if (*end != bytes.size())
+        return make_error(ErrorCode::kTrailingBytes, name + ": " + std::to_string(bytes.size() - *end) +
+                                                         " trailing bytes after the OpenEXR data (which ends at byte " +
+                                                         std::to_string(*end) + ")");
     try {
         // Bound what OpenEXR itself allocates while reading the header (its line-offset table
         // grows with the height): 2^20 per side, far above any real map; zhc's own pixel limit is
@@ -93,17 +189,31 @@ Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& n
         Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
         Imf::Header::setMaxTileSize(1 << 20, 1 << 20);
         ExrMemoryStream stream(bytes, name);
-        Imf::InputFile file(stream);
-        const Imath::Box2i dw = file.header().dataWindow();
+        Imf::MultiPartInputFile file(stream, Imf::globalThreadCount(), /*reconstructChunkOffsetTable=*/false);
+        auto chosen = choose_part(file, name, o.part);
+        if (!chosen) return chosen.error();
+        const Imf::Header& header = file.header(*chosen);
+        const Imath::Box2i dw = header.dataWindow();
         const std::int64_t w = std::int64_t(dw.max.x) - dw.min.x + 1, h = std::int64_t(dw.max.y) - dw.min.y + 1;
         if (w <= 0 || h <= 0) return make_error(ErrorCode::kBadFormat, name + ": empty data window");
         if (Status s = check_size(name, static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), o); !s)
             return s.error();
-        const Imf::ChannelList& channels = file.header().channels();
+        EnvmapLayout map_layout = EnvmapLayout::kLatLong;
+        if (Imf::hasEnvmap(header)) {
+            const int e = static_cast<int>(Imf::envmap(header));
+            if (e == Imf::ENVMAP_CUBE) {
+                if (h != 6 * w)
+                    return make_error(ErrorCode::kBadFormat, name + ": cube-face environment map of " + std::to_string(w) + "x" +
+                                                                 std::to_string(h) + " pixels (a cube map is N x 6N)");
+                map_layout = EnvmapLayout::kCubeOpenExr;
+            } else if (e != Imf::ENVMAP_LATLONG) {
+                return make_error(ErrorCode::kUnsupported, name + ": unknown envmap attribute value " + std::to_string(e) +
+                                                               " (0 lat-long and 1 cube are defined)");
+            }
+        }
+        const Imf::ChannelList& channels = header.channels();
         const bool has_rgb = channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
-        const bool has_y = channels.findChannel("Y") != nullptr;
-        if (!has_rgb && !has_y)
-            return make_error(ErrorCode::kUnsupported, name + ": OpenEXR file has no R, G, B (or Y) channels");
+        const bool yc = !has_rgb && channels.findChannel("Y") && channels.findChannel("RY") && channels.findChannel("BY");
         for (const char* c : {"R", "G", "B", "Y"}) {
             const Imf::Channel* ch = channels.findChannel(c);
             if (ch && (ch->xSampling != 1 || ch->ySampling != 1))
@@ -112,36 +222,48 @@ Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& n
         Image img;
         img.width = static_cast<int>(w);
         img.height = static_cast<int>(h);
+        img.layout = map_layout;
         img.rgb.assign(static_cast<size_t>(w * h * 3), 0.0f);
-        Imf::FrameBuffer fb;
-        // Base pointer such that base + x*xs + y*ys addresses pixel (x, y) of the data window.
-        char* base = reinterpret_cast<char*>(img.rgb.data()) -
-                     (std::int64_t(dw.min.x) + std::int64_t(dw.min.y) * w) * 3 * std::int64_t(sizeof(float));
-        const size_t xs = 3 * sizeof(float), ys = static_cast<size_t>(w) * 3 * sizeof(float);
-        if (has_rgb) {
-            fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-            fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-            fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        if (yc) {
+            if (*chosen != 0)
+                return make_error(ErrorCode::kUnsupported, name + ": luminance/chroma (Y RY BY) part " +
+                                                               part_label(header, *chosen) + " is not the first part");
+            if (Status s = read_yc(bytes, name, img, dw); !s) return s.error();
         } else {
-            fb.insert("Y", Imf::Slice(Imf::FLOAT, base, xs, ys));
+            Imf::InputPart part(file, *chosen);
+            Imf::FrameBuffer fb;
+            // Base such that base + x*xs + y*ys addresses pixel (x, y) of the data window (as an
+            // integer: OpenEXR only adds offsets that land inside the buffer).
+            const std::int64_t origin = -(std::int64_t(dw.min.x) + std::int64_t(dw.min.y) * w) * 3 * std::int64_t(sizeof(float));
+            char* base = reinterpret_cast<char*>(reinterpret_cast<std::uintptr_t>(img.rgb.data()) +
+                                                 static_cast<std::uintptr_t>(origin));
+            const size_t xs = 3 * sizeof(float), ys = static_cast<size_t>(w) * 3 * sizeof(float);
+            if (has_rgb) {
+                fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+                fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+                fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+            } else {
+                fb.insert("Y", Imf::Slice(Imf::FLOAT, base, xs, ys));
+            }
+            part.setFrameBuffer(fb);
+            part.readPixels(dw.min.y, dw.max.y);
+            if (!has_rgb)
+                for (size_t i = 0; i < img.rgb.size(); i += 3) img.rgb[i + 1] = img.rgb[i + 2] = img.rgb[i];
         }
-        file.setFrameBuffer(fb);
-        file.readPixels(dw.min.y, dw.max.y);
-        if (!has_rgb)
-            for (size_t i = 0; i < img.rgb.size(); i += 3) img.rgb[i + 1] = img.rgb[i + 2] = img.rgb[i];
         if (info) {
             info->format = "openexr";
-            info->compression = compression_name(file.header().compression());
+            info->compression = compression_name(header.compression());
             const Imf::Channel* c = channels.findChannel(has_rgb ? "R" : "Y");
-            info->channels = std::string(has_rgb ? (channels.findChannel("A") ? "RGBA" : "RGB") : "Y") +
+            info->channels = std::string(has_rgb ? (channels.findChannel("A") ? "RGBA" : "RGB")
+                                                 : (yc ? (channels.findChannel("A") ? "YCA" : "YC") : "Y")) +
                              (c->type == Imf::HALF ? " half" : c->type == Imf::FLOAT ? " float" : " uint");
+            info->layout = map_layout == EnvmapLayout::kCubeOpenExr ? "cube" : "lat-long";
+            info->part = part_label(header, *chosen);
         }
         if (Status s = check_finite(name, img, o, info); !s) return s.error();
         return img;
     } catch (const std::exception& e) {
-        std::string what = e.what();
-        for (char& ch : what)
-            if (ch == '\n' || ch == '\r') ch = ' ';
+        const std::string what = one_line(e.what());
         if (what.find("exceeds the maximum") != std::string::npos)
             return make_error(ErrorCode::kTooLarge, name + ": OpenEXR image too large (" + what + ")");
         if (what.find("unexpected end of file") != std::string::npos)
@@ -150,92 +272,289 @@ Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& n
     }
 }
 
-// stb_image silently fills rows that a truncated .hdr is missing; walk the scanline structure
-// first (new-style RLE or flat RGBE pixels) so truncation is an error. Header: lines up to an
-// empty line, then the resolution line.
-Status validate_hdr_scanlines(std::span<const std::uint8_t> b, const std::string& name, int width, int height) {
+// Radiance .hdr (Greg Ward's RGBE format, as Radiance's color.c / header.c define it): header
+// lines up to an empty line ("FORMAT=32-bit_rle_rgbe" or "32-bit_rle_xyze"; other variables are
+// ignored), a resolution line of two axes "[+-][XY] N [+-][XY] M" (the first is the scanline
+// order, the second the pixel order within a scanline; any of the eight orientations), then
+// scanlines, each either new-style run-length encoded (2 2 len_hi len_lo, then each of the four
+// components run-length coded) or flat 4-byte pixels with old-style repeat runs (1 1 1 n).
+// RGBE -> float: mantissa * 2^(e - 136), e == 0 is black (as stb_image and Walter's rgbe.c do).
+struct HdrHeader {
+    bool xyz = false;
+    int width = 0, height = 0;         // image size: X extent, Y extent
+    bool major_is_y = true;            // scanlines run along X (rows) when the first axis is Y
+    bool major_plus = false, minor_plus = true;
+    size_t data_start = 0;
+};
+
+Result<HdrHeader> parse_hdr_header(std::span<const std::uint8_t> b, const std::string& name, const EnvmapReadOptions& o) {
+    HdrHeader hh;
     size_t pos = 0;
-    // Skip header lines until the blank line, then the resolution line.
-    bool blank = false;
-    while (pos < b.size() && !blank) {
-        const size_t start = pos;
-        while (pos < b.size() && b[pos] != '\n') ++pos;
-        blank = pos == start;
+    auto next_line = [&](std::string* line) -> bool {
+        line->clear();
+        while (pos < b.size() && b[pos] != '\n') {
+            if (line->size() > 4096) return false;
+            line->push_back(static_cast<char>(b[pos++]));
+        }
+        if (pos >= b.size()) return false;
         ++pos;
-    }
-    while (pos < b.size() && b[pos] != '\n') ++pos;
-    ++pos;
-    auto truncated = [&](int row) {
-        return make_error(ErrorCode::kTruncated, name + ": Radiance .hdr data ends in scanline " + std::to_string(row) +
-                                                     " of " + std::to_string(height));
+        return true;
     };
-    for (int row = 0; row < height; ++row) {
-        if (pos + 4 > b.size()) return truncated(row);
-        const bool rle = width >= 8 && width < 32768 && b[pos] == 2 && b[pos + 1] == 2 && (b[pos + 2] & 0x80) == 0;
-        if (!rle) {
-            // Flat (or old-style RLE, which only shortens data): at most 4 bytes per pixel remain.
-            const std::uint64_t need = static_cast<std::uint64_t>(width) * 4;
-            if (pos + need > b.size()) {
-                // Old-style RLE can be shorter than flat data; let stb decide when this is the last row.
-                return row == height - 1 ? Status(Ok{}) : Status(truncated(row));
+    std::string line;
+    bool format_seen = false;
+    for (int n = 0;; ++n) {
+        if (n > 10000 || !next_line(&line))
+            return make_error(pos >= b.size() ? ErrorCode::kTruncated : ErrorCode::kBadFormat,
+                              name + ": Radiance .hdr header does not end with an empty line (byte " + std::to_string(pos) + ")");
+        if (line.empty()) break;
+        if (line.rfind("FORMAT=", 0) == 0) {
+            std::string f = line.substr(7);
+            while (!f.empty() && (f.back() == ' ' || f.back() == '\t' || f.back() == '\r')) f.pop_back();
+            if (f == "32-bit_rle_rgbe") {
+                hh.xyz = false;
+            } else if (f == "32-bit_rle_xyze") {
+                hh.xyz = true;
+            } else {
+                return make_error(ErrorCode::kBadFormat, name + ": Radiance .hdr FORMAT '" + one_line(f.substr(0, 64)) +
+                                                             "' is neither 32-bit_rle_rgbe nor 32-bit_rle_xyze");
             }
-            pos += need;
-            continue;
-        }
-        pos += 4;
-        for (int channel = 0; channel < 4; ++channel) {
-            int filled = 0;
-            while (filled < width) {
-                if (pos >= b.size()) return truncated(row);
-                int count = b[pos++];
-                if (count > 128) {
-                    count -= 128;
-                    if (pos >= b.size()) return truncated(row);
-                    ++pos;
-                } else {
-                    if (count == 0 || pos + static_cast<size_t>(count) > b.size()) return truncated(row);
-                    pos += static_cast<size_t>(count);
-                }
-                filled += count;
-            }
-            if (filled != width)
-                return make_error(ErrorCode::kBadFormat, name + ": Radiance .hdr run overruns scanline " + std::to_string(row));
+            format_seen = true;
         }
     }
+    (void)format_seen;  // Radiance treats a missing FORMAT as RGBE
+    const size_t res_at = pos;
+    if (!next_line(&line))
+        return make_error(ErrorCode::kTruncated, name + ": Radiance .hdr ends inside its resolution line (byte " +
+                                                     std::to_string(res_at) + ")");
+    // Two axes: sign, axis letter, space(s), decimal size.
+    size_t i = 0;
+    auto bad_res = [&](const std::string& what) {
+        return make_error(ErrorCode::kBadFormat, name + ": Radiance .hdr resolution line '" + one_line(line.substr(0, 64)) +
+                                                     "' " + what + " (byte " + std::to_string(res_at) + ")");
+    };
+    char axes[2];
+    bool plus[2];
+    std::uint64_t size[2];
+    for (int a = 0; a < 2; ++a) {
+        while (i < line.size() && line[i] == ' ') ++i;
+        if (i + 2 > line.size() || (line[i] != '+' && line[i] != '-') || (line[i + 1] != 'X' && line[i + 1] != 'Y'))
+            return bad_res("is not of the form '-Y N +X M'");
+        plus[a] = line[i] == '+';
+        axes[a] = line[i + 1];
+        i += 2;
+        while (i < line.size() && line[i] == ' ') ++i;
+        if (i < line.size() && (line[i] == '-' || line[i] == '+')) return bad_res("has a signed size");
+        if (i >= line.size() || line[i] < '0' || line[i] > '9') return bad_res("has no size");
+        std::uint64_t v = 0;
+        while (i < line.size() && line[i] >= '0' && line[i] <= '9') {
+            v = std::min<std::uint64_t>(v * 10 + static_cast<std::uint64_t>(line[i] - '0'), std::uint64_t(1) << 40);
+            ++i;
+        }
+        size[a] = v;
+    }
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\r')) ++i;
+    if (i != line.size()) return bad_res("has extra characters");
+    if (axes[0] == axes[1]) return bad_res("names the same axis twice");
+    if (size[0] == 0 || size[1] == 0) return bad_res("has a zero size");
+    hh.major_is_y = axes[0] == 'Y';
+    hh.major_plus = plus[0];
+    hh.minor_plus = plus[1];
+    const std::uint64_t w = hh.major_is_y ? size[1] : size[0], h = hh.major_is_y ? size[0] : size[1];
+    if (Status s = check_size(name, w, h, o); !s) return s.error();
+    hh.width = static_cast<int>(w);
+    hh.height = static_cast<int>(h);
+    hh.data_start = pos;
+    return hh;
+}
+
+// Decodes one scanline of `len` pixels at `pos` into out (4 bytes per pixel; out == nullptr only
+// walks the structure); advances pos.
+Status read_hdr_scanline(std::span<const std::uint8_t> b, size_t* pos, int len, std::uint8_t* out, const std::string& name,
+                         int scanline, int scanlines) {
+    auto truncated = [&]() {
+        return make_error(ErrorCode::kTruncated, name + ": Radiance .hdr data ends in scanline " + std::to_string(scanline) +
+                                                     " of " + std::to_string(scanlines));
+    };
+    size_t p = *pos;
+    const size_t n = static_cast<size_t>(len);
+    if (len >= 8 && len <= 0x7fff) {
+        if (p + 4 > b.size()) return truncated();
+        if (b[p] == 2 && b[p + 1] == 2 && (b[p + 2] & 0x80) == 0) {
+            if (((size_t(b[p + 2]) << 8) | b[p + 3]) != n)
+                return make_error(ErrorCode::kBadFormat, name + ": Radiance .hdr scanline " + std::to_string(scanline) +
+                                                             " declares a length other than the image's");
+            p += 4;
+            for (int c = 0; c < 4; ++c) {
+                size_t filled = 0;
+                while (filled < n) {
+                    if (p >= b.size()) return truncated();
+                    size_t count = b[p++];
+                    const bool run = count > 128;
+                    if (run) count -= 128;
+                    if (count == 0 || filled + count > n)
+                        return make_error(ErrorCode::kBadFormat, name + ": Radiance .hdr run overruns scanline " +
+                                                                     std::to_string(scanline));
+                    if (run) {
+                        if (p >= b.size()) return truncated();
+                        const std::uint8_t v = b[p++];
+                        if (out)
+                            for (size_t k = 0; k < count; ++k) out[4 * (filled + k) + static_cast<size_t>(c)] = v;
+                    } else {
+                        if (count > b.size() - p) return truncated();
+                        if (out)
+                            for (size_t k = 0; k < count; ++k) out[4 * (filled + k) + static_cast<size_t>(c)] = b[p + k];
+                        p += count;
+                    }
+                    filled += count;
+                }
+            }
+            *pos = p;
+            return Ok{};
+        }
+    }
+    // Flat pixels with old-style runs: (1, 1, 1, k) repeats the previous pixel k << shift times,
+    // shift growing by 8 over consecutive run pixels.
+    size_t filled = 0;
+    int shift = 0;
+    while (filled < n) {
+        if (p + 4 > b.size()) return truncated();
+        if (b[p] == 1 && b[p + 1] == 1 && b[p + 2] == 1) {
+            if (filled == 0 || shift > 24)
+                return make_error(ErrorCode::kBadFormat, name + ": Radiance .hdr old-style run without a pixel to repeat in scanline " +
+                                                             std::to_string(scanline));
+            const size_t count = size_t(b[p + 3]) << shift;
+            if (count > n - filled)
+                return make_error(ErrorCode::kBadFormat, name + ": Radiance .hdr run overruns scanline " + std::to_string(scanline));
+            if (out)
+                for (size_t k = 0; k < count; ++k) std::memcpy(out + 4 * (filled + k), out + 4 * (filled - 1), 4);
+            filled += count;
+            shift += 8;
+        } else {
+            if (out) std::memcpy(out + 4 * filled, &b[p], 4);
+            ++filled;
+            shift = 0;
+        }
+        p += 4;
+    }
+    *pos = p;
     return Ok{};
 }
 
 Result<Image> read_hdr(std::span<const std::uint8_t> bytes, const std::string& name, const EnvmapReadOptions& o,
                        EnvmapInfo* info) {
-    if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max()))
-        return make_error(ErrorCode::kTooLarge, name + ": file too large for the .hdr reader");
-    const int len = static_cast<int>(bytes.size());
-    int w = 0, h = 0, comp = 0;
-    if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &comp))
-        return make_error(ErrorCode::kBadFormat,
-                          name + ": malformed Radiance .hdr header (" + stbi_failure_reason() + ")");
-    if (Status s = check_size(name, static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), o); !s)
-        return s.error();
-    if (Status s = validate_hdr_scanlines(bytes, name, w, h); !s) return s.error();
-    int x = 0, y = 0, n = 0;
-    std::unique_ptr<float, void (*)(void*)> data(stbi_loadf_from_memory(bytes.data(), len, &x, &y, &n, 3),
-                                                 stbi_image_free);
-    if (!data) return make_error(ErrorCode::kBadFormat, name + ": cannot decode Radiance .hdr (" +
-                                                             std::string(stbi_failure_reason()) + ")");
+    auto header = parse_hdr_header(bytes, name, o);
+    if (!header) return header.error();
+    const HdrHeader& hh = *header;
+    const int scanlines = hh.major_is_y ? hh.height : hh.width, len = hh.major_is_y ? hh.width : hh.height;
+    // First walk every scanline without allocating anything sized by the header (every scanline
+    // takes at least 4 bytes: a short file declaring a huge image fails here), and find the end.
+    size_t pos = hh.data_start;
+    if (static_cast<std::uint64_t>(scanlines) * 4 > bytes.size() - pos)
+        return make_error(ErrorCode::kTruncated, name + ": Radiance .hdr of " + std::to_string(scanlines) +
+                                                     " scanlines cannot fit in the file's " + std::to_string(bytes.size()) +
+                                                     " bytes");
+    for (int s = 0; s < scanlines; ++s)
+        if (Status st = read_hdr_scanline(bytes, &pos, len, nullptr, name, s, scanlines); !st) return st.error();
+    if (pos != bytes.size())
+        return make_error(ErrorCode::kTrailingBytes, name + ": " + std::to_string(bytes.size() - pos) +
+                                                         " trailing bytes after the Radiance .hdr data (which ends at byte " +
+                                                         std::to_string(pos) + ")");
     Image img;
-    img.width = x;
-    img.height = y;
-    img.rgb.assign(data.get(), data.get() + static_cast<size_t>(x) * static_cast<size_t>(y) * 3);
+    img.width = hh.width;
+    img.height = hh.height;
+    img.rgb.assign(static_cast<size_t>(hh.width) * static_cast<size_t>(hh.height) * 3, 0.0f);
+    std::vector<std::uint8_t> line(static_cast<size_t>(len) * 4);
+    pos = hh.data_start;
+    for (int s = 0; s < scanlines; ++s) {
+        if (Status st = read_hdr_scanline(bytes, &pos, len, line.data(), name, s, scanlines); !st) return st.error();
+        // Radiance coordinates: X grows to the right, Y grows upwards; '+' walks an axis from its
+        // low end, '-' from its high end. Image row 0 is the top (highest Y).
+        const int major = hh.major_plus ? s : scanlines - 1 - s;
+        for (int k = 0; k < len; ++k) {
+            const int minor = hh.minor_plus ? k : len - 1 - k;
+            const int x = hh.major_is_y ? minor : major, y = hh.major_is_y ? major : minor;
+            const int row = hh.height - 1 - y;
+            const std::uint8_t* e = &line[static_cast<size_t>(k) * 4];
+            float v[3] = {0, 0, 0};
+            if (e[3] != 0) {
+                const float f = std::ldexp(1.0f, int(e[3]) - 136);
+                for (int c = 0; c < 3; ++c) v[c] = float(e[c]) * f;
+            }
+            float* out = img.row(row) + 3 * static_cast<size_t>(x);
+            if (hh.xyz) {
+                // CIE XYZ -> linear Rec. 709 / sRGB primaries, D65 white (IEC 61966-2-1).
+                out[0] = 3.2404542f * v[0] - 1.5371385f * v[1] - 0.4985314f * v[2];
+                out[1] = -0.9692660f * v[0] + 1.8760108f * v[1] + 0.0415560f * v[2];
+                out[2] = 0.0556434f * v[0] - 0.2040259f * v[1] + 1.0572252f * v[2];
+            } else {
+                out[0] = v[0], out[1] = v[1], out[2] = v[2];
+            }
+        }
+    }
     if (info) {
         info->format = "radiance-hdr";
         info->compression = "rle";
-        info->channels = "RGBE";
+        info->channels = hh.xyz ? "XYZE" : "RGBE";
     }
     if (Status s = check_finite(name, img, o, info); !s) return s.error();
     return img;
 }
 
 }  // namespace
+
+Sh3Radiance project_envmap(const Image& image, int threads) {
+    if (image.layout == EnvmapLayout::kCubeOpenExr)
+        return project_cube_openexr(image.rgb.data(), image.width, static_cast<size_t>(image.width) * 3, threads);
+    return project_latlong(image.rgb.data(), image.width, image.height, static_cast<size_t>(image.width) * 3, threads);
+}
+
+namespace {
+// Pixel of an OpenEXR cube map (face size n) seen in zhc direction d: the inverse of
+// cube_openexr_direction, rounded to the nearest pixel centre.
+const float* cube_pixel(const Image& cube, Vec3 d) {
+    const double x = d.y, y = d.z, z = d.x;  // OpenEXR frame
+    const double ax = std::fabs(x), ay = std::fabs(y), az = std::fabs(z);
+    int face;
+    double u, v;
+    if (ax >= ay && ax >= az) {
+        face = x > 0 ? 0 : 1;
+        u = (x > 0 ? z : -z) / ax;
+        v = -y / ax;
+    } else if (ay >= az) {
+        face = y > 0 ? 2 : 3;
+        u = x / ay;
+        v = (y > 0 ? -z : z) / ay;
+    } else {
+        face = z > 0 ? 4 : 5;
+        u = (z > 0 ? -x : x) / az;
+        v = -y / az;
+    }
+    const int n = cube.width;
+    auto index = [&](double t) { return std::clamp(static_cast<int>(std::lround((t + 1.0) * 0.5 * (n - 1))), 0, n - 1); };
+    return cube.row(face * n + index(v)) + 3 * static_cast<size_t>(index(u));
+}
+}  // namespace
+
+Image envmap_as_latlong(const Image& image, int width, int height) {
+    if (image.layout == EnvmapLayout::kLatLong) return image;
+    Image out;
+    out.width = width;
+    out.height = height;
+    out.rgb.assign(static_cast<size_t>(width) * static_cast<size_t>(height) * 3, 0.0f);
+    constexpr int kSub = 4;
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            double acc[3] = {0, 0, 0};
+            for (int j = 0; j < kSub; ++j)
+                for (int i = 0; i < kSub; ++i) {
+                    const Vec3 d = latlong_direction(x + (i + 0.5) / kSub - 0.5, y + (j + 0.5) / kSub - 0.5, width, height);
+                    const float* p = cube_pixel(image, d);
+                    for (int c = 0; c < 3; ++c) acc[c] += p[c];
+                }
+            for (int c = 0; c < 3; ++c) out.row(y)[3 * x + c] = static_cast<float>(acc[c] / (kSub * kSub));
+        }
+    return out;
+}
 
 bool looks_like_envmap(std::span<const std::uint8_t> bytes) { return is_exr(bytes) || is_radiance(bytes); }
 

@@ -6,6 +6,10 @@
 //   direction = (sin theta cos phi, sin theta sin phi, cos theta).
 // That is OpenEXR's Imf::LatLongMap orientation with (x, y, z)_zhc = (z, x, y)_OpenEXR.
 // Any width and height are accepted (not only 2:1).
+//
+// EXR files whose "envmap" attribute says cube (OpenEXR's cube layout, N x 6N, see
+// codec/cubemap.h) are read as cube maps: Image::layout tells the two apart, and
+// project_envmap projects either with exact per-pixel solid angles.
 #pragma once
 
 #include <cstdint>
@@ -13,14 +17,21 @@
 #include <string>
 #include <vector>
 
+#include "codec/sh.h"
 #include "codec/status.h"
 
 namespace zhc {
+
+enum class EnvmapLayout {
+    kLatLong,     // docs/conventions.md
+    kCubeOpenExr  // OpenEXR's cube layout: width N, height 6N, faces +X -X +Y -Y +Z -Z (codec/cubemap.h)
+};
 
 // An owning RGB float image, interleaved, rows top to bottom.
 struct Image {
     int width = 0;
     int height = 0;
+    EnvmapLayout layout = EnvmapLayout::kLatLong;
     std::vector<float> rgb;  // width * height * 3
     float* row(int y) { return rgb.data() + static_cast<size_t>(y) * static_cast<size_t>(width) * 3; }
     const float* row(int y) const { return rgb.data() + static_cast<size_t>(y) * static_cast<size_t>(width) * 3; }
@@ -35,6 +46,9 @@ struct EnvmapReadOptions {
     std::uint64_t max_pixels = std::uint64_t(1) << 26;  // 8192 x 8192; checked before allocating
     std::uint64_t max_file_bytes = std::uint64_t(2) << 30;
     NonFinitePolicy non_finite = NonFinitePolicy::kReject;
+    // Multi-part EXR: the part to read, by its "name" attribute (or by its index when no part has
+    // that name). Empty: the first part with R, G, B or Y channels that is not deep.
+    std::string part;
 };
 
 struct EnvmapInfo {
@@ -42,15 +56,27 @@ struct EnvmapInfo {
     std::string compression;  // EXR compression name, "rle" or "flat" for .hdr
     std::string channels;     // e.g. "RGBA half"
     std::uint64_t replaced_non_finite = 0;
+    std::string layout = "lat-long";  // or "cube" (OpenEXR layout)
+    std::string part;                 // EXR: the part read ("#index" when it has no name)
 };
 
-// Reads an EXR (RGB or RGBA or Y, half/float/uint, any compression OpenEXR supports, scanline or
-// tiled) or a Radiance .hdr, detected by its magic bytes (not by the extension).
+// Reads an EXR (RGB or RGBA or Y or luminance/chroma Y RY BY, half/float/uint, any compression
+// OpenEXR supports, scanline or tiled, single- or multi-part, lat-long or cube) or a Radiance .hdr
+// (RGBE or XYZE, any of the eight orientations), detected by its magic bytes (not by the
+// extension). Bytes after the data are an error (kTrailingBytes). See docs/inputs.md.
 Result<Image> read_envmap(const std::string& path, const EnvmapReadOptions& options = {},
                           EnvmapInfo* info = nullptr);
 // The same from bytes in memory; `name` is used in messages. Safe for untrusted input.
 Result<Image> read_envmap_memory(std::span<const std::uint8_t> bytes, const std::string& name,
                                  const EnvmapReadOptions& options = {}, EnvmapInfo* info = nullptr);
+
+// SH3 radiance projection of an image read by read_envmap, lat-long or cube.
+Sh3Radiance project_envmap(const Image& image, int threads = 1);
+
+// The image as a width x height lat-long map (a lat-long image is returned unchanged when the
+// size matches). A cube map is resampled: each output pixel is the mean of 4 x 4 point samples of
+// the cube (nearest pixel), for consumers that need lat-long pixels (the audit reference).
+Image envmap_as_latlong(const Image& image, int width, int height);
 
 // True when the bytes start like an EXR or a Radiance file.
 bool looks_like_envmap(std::span<const std::uint8_t> bytes);

@@ -11,6 +11,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "codec/status.h"
 
@@ -36,9 +37,39 @@ private:
     std::uint64_t pos_ = 0;
 };
 
+// What the chunk walk needs from each part's header.
+struct ExrPartLayout {
+    std::string type;               // "type" attribute ("scanlineimage", "tiledimage", "deep..."), or ""
+    bool has_window = false;
+    std::int64_t window[4] = {};    // dataWindow min.x min.y max.x max.y
+    int compression = -1;
+    bool has_tiles = false;
+    std::uint32_t tile_x = 0, tile_y = 0;
+    std::uint8_t tile_mode = 0;     // level mode | rounding mode << 4
+    std::int64_t chunk_count = -1;  // "chunkCount" attribute, -1 when absent
+};
+struct ExrLayout {
+    bool multipart = false;
+    bool single_tiled = false;  // version flag 0x200 (single-part tiled file)
+    bool single_deep = false;   // version flag 0x800 (single-part deep file)
+    size_t tables_start = 0;    // first byte after the header(s): the chunk offset tables
+    std::vector<ExrPartLayout> parts;
+};
+
 // Fails (kTruncated / kBadFormat / kUnsupported) unless every attribute of every header fits in the
 // file; calls check_size(width, height) with the declared data window, whose error is returned.
+// With `layout`, also returns what exr_data_end needs.
 Status validate_exr_header(std::span<const std::uint8_t> bytes, const std::string& name,
-                           const std::function<Status(std::uint64_t, std::uint64_t)>& check_size);
+                           const std::function<Status(std::uint64_t, std::uint64_t)>& check_size,
+                           ExrLayout* layout = nullptr);
+
+// Walks the chunk offset tables and every chunk's own header (part number, coordinates, packed
+// size) of a file whose header(s) validate_exr_header accepted, and returns the byte just past the
+// last chunk: the file's true end. Fails kTruncated when a table or a chunk does not fit in the
+// file (or an offset is 0: an incomplete file), kBadFormat when an offset points into the tables
+// or a chunk names the wrong part, kUnsupported for an unknown compression. Nothing is allocated
+// in proportion to the declared image size: the table size is checked against the file first.
+Result<std::uint64_t> exr_data_end(std::span<const std::uint8_t> bytes, const std::string& name,
+                                   const ExrLayout& layout);
 
 }  // namespace zhc

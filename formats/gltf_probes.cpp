@@ -30,6 +30,7 @@
 
 #include "formats/file_io.h"
 #include "formats/gltf_draco.h"
+#include "formats/json_depth.h"
 
 namespace zhc {
 namespace {
@@ -402,6 +403,7 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     } else {
         text.assign(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     }
+    if (Status depth = check_json_depth(text, path); !depth) return depth.error();
     out.doc = json::parse(text, nullptr, /*allow_exceptions=*/false);
     if (out.doc.is_discarded()) return fail(ErrorCode::kBadFormat, path, "glTF JSON does not parse");
     auto ok = precheck(out.doc, path, limits, out.binary ? &glb : nullptr);

@@ -36,7 +36,15 @@ Result<lightmap::ShLightmap> read_sh_lightmap_exr(const std::string& path, const
                                                         " texels exceed the limit " + std::to_string(o.max_texels));
         return Ok{};
     };
-    if (Status s = validate_exr_header(b, path, check); !s) return s.error();
+    ExrLayout layout;
+    if (Status s = validate_exr_header(b, path, check, &layout); !s) return s.error();
+    // Every chunk inside the file before the texels are allocated; nothing after the last one.
+    auto end = exr_data_end(b, path, layout);
+    if (!end) return end.error();
+    if (*end != b.size())
+        return make_error(ErrorCode::kTrailingBytes, path + ": " + std::to_string(b.size() - *end) +
+                                                         " trailing bytes after the OpenEXR data (which ends at byte " +
+                                                         std::to_string(*end) + ")");
     try {
         Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
         ExrMemoryStream stream(b, path);

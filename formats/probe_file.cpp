@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "file_io.h"
+#include "json_depth.h"
 
 namespace zhc {
 
@@ -405,6 +406,7 @@ Result<ProbeList> parse_probe_json_impl(std::span<const std::uint8_t> bytes, con
                                         const ProbeJsonLimits& limits) {
     if (bytes.size() > limits.max_file_bytes)
         return err(ErrorCode::kTooLarge, name, "JSON larger than the limit of " + std::to_string(limits.max_file_bytes) + " bytes");
+    if (Status depth = check_json_depth(bytes, name); !depth) return depth.error();
     json doc;
     try {
         doc = json::parse(bytes.begin(), bytes.end());

@@ -11,6 +11,7 @@
 
 #include "envmap.h"
 #include "file_io.h"
+#include "json_depth.h"
 
 namespace zhc {
 namespace {
@@ -355,8 +356,7 @@ Scene parse(const Reader& r, const json& doc, const std::string& name, const std
         if (options.load_environment) {
             auto img = read_envmap(env.source);
             if (!img) throw Fail{make_error(img.error().code, name + ": environment.map: " + img.error().message)};
-            env.projected = project_latlong(img->rgb.data(), img->width, img->height,
-                                            static_cast<size_t>(img->width) * 3, std::max(1, options.threads));
+            env.projected = project_envmap(*img, std::max(1, options.threads));
         }
         s.environment = env;
     }
@@ -421,6 +421,7 @@ Result<Scene> parse_scene_json_unchecked(std::span<const std::uint8_t> bytes, co
     if (bytes.size() > options.limits.max_file_bytes)
         return make_error(ErrorCode::kTooLarge, name + ": scene file larger than the limit of " +
                                                     std::to_string(options.limits.max_file_bytes) + " bytes");
+    if (Status depth = check_json_depth(bytes, name); !depth) return depth.error();
     json doc;
     try {
         doc = json::parse(bytes.begin(), bytes.end());
