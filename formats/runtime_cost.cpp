@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "formats/file_io.h"
+#include "formats/json_depth.h"
 
 namespace zhc {
 
@@ -13,6 +14,7 @@ Result<RuntimeCostTable> read_runtime_cost(const std::string& path) {
     auto bytes = read_file_bytes(path, std::uint64_t(16) << 20);
     if (!bytes) return bytes.error();
     auto bad = [&](const std::string& what) { return make_error(ErrorCode::kBadFormat, path + ": " + what); };
+    if (Status depth = check_json_depth(*bytes, path); !depth) return depth.error();
     json doc = json::parse(bytes->begin(), bytes->end(), nullptr, /*allow_exceptions=*/false);
     if (doc.is_discarded() || !doc.is_object()) return bad("not a JSON object (expected bench_runtime --json output)");
     if (!doc.contains("rows") || !doc["rows"].is_array()) return bad("no \"rows\" array");
