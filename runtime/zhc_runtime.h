@@ -655,8 +655,9 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
     uint32_t counts[3];
     double grid[6];
     int c;
-    if (!h) return ZHC_ERR_ARGUMENT;
+    if (info) memset(info, 0, sizeof *info);
     if (size == 0) return ZHC_ERR_TRUNCATED;
+    if (!h) return ZHC_ERR_ARGUMENT;
     if (memcmp(h, magic, size < 8 ? size : 8) != 0) return ZHC_ERR_BAD_FORMAT;
     if (size < 10) return ZHC_ERR_TRUNCATED;
     if ((h[8] | (h[9] << 8)) != 1) return ZHC_ERR_UNSUPPORTED;
@@ -798,7 +799,6 @@ static inline void zhc_decode_hemioct(float u, float v, double d[3]) {
 static inline void zhc_irradz_irradiance(const float i_z[3], double w_a, const double d_in[3], int model,
                                          const double n[3], float rgb[3]) {
     double d[3], w, h, c;
-    float ca[3], cd[3];
     int k;
     zhc__normalize_or_z(d_in, d);
     if (!(d[2] >= cos(ZHC_IRRADZ_MAX_THETA))) {
@@ -808,13 +808,16 @@ static inline void zhc_irradz_irradiance(const float i_z[3], double w_a, const d
         d[2] = cos(ZHC_IRRADZ_MAX_THETA);
     }
     w = zhc__clamp(w_a, 0.0, 1.0);
-    for (k = 0; k < 3; ++k) {
-        ca[k] = (float)(w * i_z[k]);
-        cd[k] = (float)((1 - w) * i_z[k] / d[2]);
-    }
     h = model == ZHC_IRRADZ_AHD ? 1.0 : (1 + n[2]) / 2;
     c = zhc__max(0.0, n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
-    for (k = 0; k < 3; ++k) rgb[k] = (float)(ca[k] * h + cd[k] * c);
+    for (k = 0; k < 3; ++k) {
+        /* volatile: GCC 12 -O3 (SLP vectorizer) was seen to drop these float roundings when this
+         * function is inlined into a loop (wrong code; tests/test_runtime_c.cpp caught 1-ulp
+         * differences); the volatile stores pin them. */
+        volatile float ca = (float)(w * i_z[k]), cd = (float)((1 - w) * i_z[k] / d[2]);
+        const double a = ca, b = cd;
+        rgb[k] = (float)(a * h + b * c);
+    }
 }
 
 /* The texel as stored in the textures: I_z (BC6H), w_a (BC4), d as hemi-octahedral (u, v) (BC5). */

@@ -59,7 +59,7 @@ struct MaxUlp {
         const std::uint64_t d = ulp_distance(runtime, codec);
         if (d > worst) {
             worst = d;
-            char buf[160];
+            char buf[400];
             std::snprintf(buf, sizeof buf, "%s: runtime %.9g codec %.9g", what.c_str(), runtime, codec);
             where = buf;
         }
@@ -386,7 +386,7 @@ TEST(RuntimeC, IrradzFunctionsEqualTheCodec) {
             float e[3];
             zhc_irradz_irradiance(iz, p.w_a, dd, model, nn, e);
             const Rgb ce = irradz::evaluate(p, model == 0 ? irradz::Model::kHhd : irradz::Model::kAhd, n);
-            for (int k = 0; k < 3; ++k) (model == 0 ? hhd : ahd).add(e[k], ce[k], "irradz model " + std::to_string(model));
+            for (int k = 0; k < 3; ++k) (model == 0 ? hhd : ahd).add(e[k], ce[k], model == 0 ? "irradz HHD" : "irradz AHD");
         }
         // The texel path: textures hold I_z, w_a and the hemi-octahedral (u, v).
         lightmap::IrradzPlanes planes;
@@ -431,8 +431,9 @@ TEST(RuntimeC, HlshMultiplyAndItsTablesEqualTheCodec) {
         zhc_hlsh_tables_init(&t, cos_alpha);
         const auto g = irradz::cap_gram(cos_alpha);
         for (int i = 0; i < 81; ++i) ASSERT_EQ(t.gram[i], g[size_t(i)]) << cos_alpha << " " << i;
-        if (cos_alpha == 0.0)
+        if (cos_alpha == 0.0) {
             for (int i = 0; i < 81; ++i) ASSERT_EQ(t.gram[i], irradz::hemisphere_gram()[size_t(i)]);
+        }
         for (int i = 0; i < 20000; ++i) {
             const Sh3Radiance world = random_probe(rng, std::uint64_t(i));
             const Vec3 n = i % 50 == 0 ? Vec3{0.95, 0.1, 0.0} : random_direction(rng);
@@ -488,7 +489,9 @@ void expect_agreement(const std::vector<std::uint8_t>& file, const std::string& 
     const int rt = zhc_zhp_open(&f, &info, file.data(), file.size());
     auto ref = parse_probe_set(file, "x");
     if (rt == ZHC_ERR_COMPRESSED) {
-        if (!ref) EXPECT_EQ(ref.error().code, ErrorCode::kBadFormat) << what << ": " << ref.error().message;
+        if (!ref) {
+            EXPECT_EQ(ref.error().code, ErrorCode::kBadFormat) << what << ": " << ref.error().message;
+        }
         return;
     }
     if (ref) {
@@ -608,7 +611,9 @@ TEST(RuntimeC, EveryHeaderBitFlipAndEveryTruncationIsRejectedLikeZhcsReader) {
             zhc_probe_format f;
             zhc_zhp_info info;
             ASSERT_NE(zhc_zhp_open(&f, &info, good.data(), len), ZHC_OK) << i << " " << len;
-            if (len < ZHC_ZHP_HEADER_BYTES) ASSERT_NE(zhc_probe_format_from_zhp(&f, good.data(), len), ZHC_OK);
+            if (len < ZHC_ZHP_HEADER_BYTES) {
+                ASSERT_NE(zhc_probe_format_from_zhp(&f, good.data(), len), ZHC_OK);
+            }
             expect_agreement(std::vector<std::uint8_t>(good.begin(), good.begin() + std::ptrdiff_t(len)),
                              "truncated to " + std::to_string(len));
             ++truncations;
