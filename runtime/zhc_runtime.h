@@ -32,6 +32,12 @@
  * sin/cos/atan2 (clamp of d below the horizon, the quadrature tables of the HLSH multiply) are bit
  * exact only with the same libm as the encoder (the test measures 0 ulp on glibc); elsewhere expect
  * a few ulp. Without those compiler settings results stay within a few float ulp.
+ * Known compiler issue: GCC 12.2 at -O3 (its SLP vectorizer) changed the results of this header's
+ * irradiance code when inlined into a large test function (dropped float roundings; the codec-equal
+ * result is what the same code gives in isolation at -O3). The codec-side intermediate float
+ * roundings are therefore written through a volatile (zhc__f32_round), and the test is built with
+ * -fno-tree-slp-vectorize; consumers that need bit equality with GCC 12 should add that flag to the
+ * translation units that include this header. Decoding (zhc_decode_probe) was bit exact either way.
  *
  * Sources: Roughton et al. 2024, "ZH3: Quadratic Zonal Harmonics" (Eq. 2, 4, 5, 9, 14, 19-21,
  * Listing 1, App. A.1); Wiederien & Sloan, ATVI-TR-24-02 (tight L2 bound, Listing 1 quantiser);
@@ -201,6 +207,15 @@ static inline size_t zhc_probe_size(const zhc_probe_format* f) { return f ? zhc_
 #define ZHC__BAND1 (2.0 / 3.0)
 #define ZHC__BAND2 (1.0 / 4.0)
 
+/* x rounded to float and back: the codec's intermediate float roundings. Through a volatile
+ * because GCC 12 at -O3 was seen to drop such roundings when vectorizing inlined code (SLP, wrong
+ * code: the tests caught differences of 1 ulp and, after cancellation, far more); a volatile
+ * store cannot be elided. Costs one store and load. */
+static inline double zhc__f32_round(double x) {
+    volatile float f = (float)x;
+    return f;
+}
+
 /* std::clamp / std::max / std::min semantics (NaN behaviour included). */
 static inline double zhc__clamp(double v, double lo, double hi) { return v < lo ? lo : (hi < v ? hi : v); }
 static inline double zhc__max(double a, double b) { return a < b ? b : a; }
@@ -263,7 +278,7 @@ static inline void zhc__sh_irradiance(const float* sh, int count, const double n
     zhc__sh3_basis(n, y);
     for (i = 0; i < count; ++i) {
         const double s = i == 0 ? 1.0 : (i < 4 ? ZHC__BAND1 : ZHC__BAND2);
-        for (k = 0; k < 3; ++k) acc[k] += (double)(float)(sh[i * 3 + k] * s) * y[i];
+        for (k = 0; k < 3; ++k) acc[k] += zhc__f32_round(sh[i * 3 + k] * s) * y[i];
     }
     for (k = 0; k < 3; ++k) rgb[k] = (float)acc[k];
 }
@@ -353,7 +368,7 @@ static inline void zhc__hallucinate(const float lin[12], int model, int per_chan
     for (k = 0; k < 3; ++k) {
         const double vx = -(double)lin[9 + k], vy = -(double)lin[3 + k], vz = (double)lin[6 + k];
         const double f1 = vx * axes[k][0] + vy * axes[k][1] + vz * axes[k][2];
-        zonal[k] = (float)zhc_hallucinate_zonal(model, (double)lin[k], f1, a, b);
+        zonal[k] = (float)zhc__f32_round(zhc_hallucinate_zonal(model, (double)lin[k], f1, a, b));
     }
 }
 
@@ -458,7 +473,7 @@ static inline void zhc__decode_packed(const zhc_probe_format* f, const uint8_t* 
         double axes[3][3], y[9];
         const double s = sqrt(4.0 * ZHC__PI / 5.0);
         for (i = 0; i < 4; ++i)
-            for (k = 0; k < 3; ++k) lin[i * 3 + k] = (float)q[i][k];
+            for (k = 0; k < 3; ++k) lin[i * 3 + k] = (float)zhc__f32_round(q[i][k]);
         zhc__zh3_axes(lin, f->axis_mode == ZHC_AXIS_PER_CHANNEL, f->luminance, axes);
         for (k = 0; k < 3; ++k) {
             const double zq = zhc__ratio_decode(f, 6, 1, in[4 + 4 * k + 3]) * dc[k];
@@ -811,12 +826,9 @@ static inline void zhc_irradz_irradiance(const float i_z[3], double w_a, const d
     h = model == ZHC_IRRADZ_AHD ? 1.0 : (1 + n[2]) / 2;
     c = zhc__max(0.0, n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
     for (k = 0; k < 3; ++k) {
-        /* volatile: GCC 12 -O3 (SLP vectorizer) was seen to drop these float roundings when this
-         * function is inlined into a loop (wrong code; tests/test_runtime_c.cpp caught 1-ulp
-         * differences); the volatile stores pin them. */
-        volatile float ca = (float)(w * i_z[k]), cd = (float)((1 - w) * i_z[k] / d[2]);
-        const double a = ca, b = cd;
-        rgb[k] = (float)(a * h + b * c);
+        /* C_a and C_d are floats in the codec (irradz::Lighting). */
+        const double ca = zhc__f32_round(w * i_z[k]), cd = zhc__f32_round((1 - w) * i_z[k] / d[2]);
+        rgb[k] = (float)(ca * h + cd * c);
     }
 }
 
@@ -1003,13 +1015,13 @@ static inline void zhc_hlsh_multiply(const zhc_hlsh_tables* t, const float sh3[2
         for (i = 0; i < 9; ++i) {
             double s = 0;
             for (j = 0; j < 9; ++j) s += t->gram[i * 9 + j] * tangent[j * 3 + k];
-            occluded[i * 3 + k] = (float)s;
+            occluded[i * 3 + k] = (float)zhc__f32_round(s);
         }
     for (k = 0; k < 3; ++k) {
         double v[9], iz = 0, p1 = 0, px = 0, py = 0;
         for (i = 0; i < 9; ++i) {
             const double s = i == 0 ? 1.0 : (i < 4 ? ZHC__BAND1 : ZHC__BAND2);
-            v[i] = (float)(occluded[i * 3 + k] * s);
+            v[i] = zhc__f32_round(occluded[i * 3 + k] * s);
         }
         for (i = 0; i < 9; ++i) iz += v[i] * t->y_up[i];
         for (i = 0; i < 9; ++i) p1 += v[i] * t->p_one_minus_z[i];

@@ -12,6 +12,7 @@ import json
 import math
 import os
 import random
+import struct
 import subprocess
 import sys
 
@@ -80,6 +81,14 @@ def write_lists(work):
     return lists
 
 
+def f32(x):
+    """The float32 a decimal number reads back as (both sides print floats; Python parses doubles)."""
+    try:
+        return struct.unpack("<f", struct.pack("<f", x))[0]
+    except OverflowError:
+        return x
+
+
 def close(a, b):
     if math.isnan(a) or math.isnan(b):
         return math.isnan(a) and math.isnan(b)
@@ -94,7 +103,7 @@ def main():
         sys.exit("FAILED: no sample maps in %s" % envmaps)
     all_names = PACKED + ["sh3", "sh2", "zh3_lum", "zh3_channel", "hall_curve", "hall_sphere_channel",
                           "zh3_lum_dering", "sh3_dering"]
-    checked = probes_total = 0
+    checked = probes_total = inexact = 0
     worst = 0.0
     for inp in inputs:
         base = os.path.splitext(os.path.basename(inp))[0]
@@ -111,18 +120,20 @@ def main():
                 if len(lines) != len(ref):
                     sys.exit("FAILED: %s: %d probes decoded, zhc has %d" % (zhp, len(lines), len(ref)))
                 for p, (line, probe) in enumerate(zip(lines, ref)):
-                    got = [float(v) for v in line.split()]
-                    want = [float(v) for row in probe["sh3"] for v in row]
+                    got = [f32(float(v)) for v in line.split()]
+                    want = [f32(float(v)) for row in probe["sh3"] for v in row]
                     if len(got) != 27:
                         sys.exit("FAILED: %s probe %d: %d numbers" % (zhp, p, len(got)))
                     for i, (a, b) in enumerate(zip(got, want)):
                         if not close(a, b):
                             sys.exit("FAILED: %s probe %d coefficient %d: C %r, zhc %r" % (zhp, p, i, a, b))
-                        if a != b:
+                        if a != b and not (math.isnan(a) and math.isnan(b)):
                             worst = max(worst, abs(a - b) / max(abs(a), abs(b)))
+                            inexact += 1
                 checked += 1
                 probes_total += len(lines)
-    print("OK: %d files, %d probes; largest relative difference %.3g (limit %g)" % (checked, probes_total, worst, REL))
+    print("OK: %d files, %d probes; %d of %d floats differ as float32, largest relative difference %.3g (limit %g)"
+          % (checked, probes_total, inexact, 27 * probes_total, worst, REL))
 
 
 if __name__ == "__main__":
