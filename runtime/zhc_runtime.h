@@ -32,12 +32,12 @@
  * sin/cos/atan2 (clamp of d below the horizon, the quadrature tables of the HLSH multiply) are bit
  * exact only with the same libm as the encoder (the test measures 0 ulp on glibc); elsewhere expect
  * a few ulp. Without those compiler settings results stay within a few float ulp.
- * Known compiler issue: GCC 12.2 at -O3 (its SLP vectorizer) changed the results of this header's
- * irradiance code when inlined into a large test function (dropped float roundings; the codec-equal
- * result is what the same code gives in isolation at -O3). The codec-side intermediate float
- * roundings are therefore written through a volatile (zhc__f32_round), and the test is built with
- * -fno-tree-slp-vectorize; consumers that need bit equality with GCC 12 should add that flag to the
- * translation units that include this header. Decoding (zhc_decode_probe) was bit exact either way.
+ * Known compiler issue: GCC 12.2 at -O3 (its SLP vectorizer) was seen to drop double -> float ->
+ * double roundings in inlined code (the IrradZ C_a/C_d here; a test's own float normals), which
+ * changes results by 1 ulp or, after cancellation, far more. Every intermediate float rounding the
+ * codec does is therefore written through a volatile here (zhc__f32_round); with that, GCC 12 -O3
+ * and Clang 14 -O3 both give the codec's bits in tests/test_runtime_c.cpp, no extra flags. Code that
+ * rounds its own inputs to float before calling (as a float normal) may want the same care.
  *
  * Sources: Roughton et al. 2024, "ZH3: Quadratic Zonal Harmonics" (Eq. 2, 4, 5, 9, 14, 19-21,
  * Listing 1, App. A.1); Wiederien & Sloan, ATVI-TR-24-02 (tight L2 bound, Listing 1 quantiser);

@@ -161,7 +161,8 @@ zhc_probe_format format_of(std::string_view codec, const StorageParams& p) {
 // A float-representable unit-ish normal (the runtime takes float normals).
 Vec3 random_float_normal(std::mt19937_64& rng) {
     const Vec3 d = random_direction(rng);
-    return {double(float(d.x)), double(float(d.y)), double(float(d.z))};
+    volatile float x = float(d.x), y = float(d.y), z = float(d.z);
+    return {double(x), double(y), double(z)};
 }
 
 // What the codec says the irradiance of stored bytes is, for these params (see zhc_runtime.h):
