@@ -782,7 +782,8 @@ static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const vo
     return ZHC_OK;
 }
 
-/* Legacy-style entry of the API: zhc_zhp_parse_header without the body info. */
+/* The format alone from a .zhp header (>= 184 bytes of it): zhc_zhp_parse_header without the body
+ * info. Non-zero (a zhc_error) for a bad header. Safe for untrusted input. */
 static inline int zhc_probe_format_from_zhp(zhc_probe_format* f, const void* header, size_t size) {
     return zhc_zhp_parse_header(f, NULL, header, size);
 }
