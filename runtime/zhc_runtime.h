@@ -30,8 +30,9 @@
  * no FMA contraction (GCC/Clang: -ffp-contract=off; MSVC: /fp:precise, the default), no
  * -ffast-math, FLT_EVAL_METHOD 0 (SSE2 on x86, any 64-bit target). The IrradZ functions that use
  * sin/cos/atan2 (clamp of d below the horizon, the quadrature tables of the HLSH multiply) are bit
- * exact only with the same libm as the encoder (the test measures 0 ulp on glibc); elsewhere expect
- * a few ulp. Without those compiler settings results stay within a few float ulp.
+ * exact only with the same libm as the encoder (the test measures 0 ulp on glibc); elsewhere they
+ * differ by that libm's rounding. Without those compiler settings the results differ by rounding
+ * only (a few ulp of the largest term; more relative error where terms cancel; not measured).
  * Known compiler issue: GCC 12.2 at -O3 (its SLP vectorizer) was seen to drop double -> float ->
  * double roundings in inlined code (the IrradZ C_a/C_d here; a test's own float normals), which
  * changes results by 1 ulp or, after cancellation, far more. Every intermediate float rounding the
