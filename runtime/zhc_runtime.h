@@ -172,6 +172,44 @@ static inline int zhc_probe_format_init(zhc_probe_format* f, const char* encodin
     return f->encoding < 0 ? ZHC_ERR_ARGUMENT : ZHC_OK;
 }
 
+/* One property of a glTF ZHC_light_probes volume (docs/gltf-extension.md) as its JSON text:
+ *   "kind": "radiance" | "irradiance"        "bits": "2" .. "8"        "sqrt": "true" | "false"
+ *   "l2Bound": "tight" | "loose"             "dcFormat": "r11g11b10f" | "rgb9e5" | "half"
+ *   "zonalMapping": "affine" | "zero" | "symmetric"      "axisMode": "luminance" | "channel"
+ * (the "quantization" object's members and the volume's "kind"; "luminanceWeights" are numbers:
+ * set f->luminance directly). ZHC_OK, ZHC_ERR_UNSUPPORTED for an unknown value (as zhc's glTF
+ * reader), ZHC_ERR_ARGUMENT for an unknown key; f is unchanged on error. Safe for untrusted input
+ * (NUL-terminated strings). */
+static inline int zhc_probe_format_set_gltf(zhc_probe_format* f, const char* key, const char* value) {
+    static const char* const kinds[] = {"radiance", "irradiance"};
+    static const char* const bounds[] = {"tight", "loose"};
+    static const char* const dcs[] = {"r11g11b10f", "rgb9e5", "half"};
+    static const char* const mappings[] = {"affine", "zero", "symmetric"};
+    static const char* const axes[] = {"luminance", "channel"};
+    static const char* const bools[] = {"false", "true"};
+    const char* const* names;
+    int count, i, *field;
+    if (!f || !key || !value) return ZHC_ERR_ARGUMENT;
+    if (strcmp(key, "bits") == 0) {
+        if (value[0] < '2' || value[0] > '8' || value[1] != 0) return ZHC_ERR_UNSUPPORTED;
+        f->bits = value[0] - '0';
+        return ZHC_OK;
+    }
+    if (strcmp(key, "kind") == 0) names = kinds, count = 2, field = &f->kind;
+    else if (strcmp(key, "l2Bound") == 0) names = bounds, count = 2, field = &f->l2_bound;
+    else if (strcmp(key, "dcFormat") == 0) names = dcs, count = 3, field = &f->dc_format;
+    else if (strcmp(key, "zonalMapping") == 0) names = mappings, count = 3, field = &f->zonal_mapping;
+    else if (strcmp(key, "axisMode") == 0) names = axes, count = 2, field = &f->axis_mode;
+    else if (strcmp(key, "sqrt") == 0) names = bools, count = 2, field = &f->sqrt_encoding;
+    else return ZHC_ERR_ARGUMENT;
+    for (i = 0; i < count; ++i)
+        if (strcmp(value, names[i]) == 0) {
+            *field = i;
+            return ZHC_OK;
+        }
+    return ZHC_ERR_UNSUPPORTED;
+}
+
 /* ZHC_OK when f is a format zhc's writer can produce (codec/quantize.cpp validate_quant_params):
  * known encoding, bits 2..8, enums in range, finite luminance weights and curve constants, half DC
  * only with sh2_q / hall_curve_q among the packed encodings. */

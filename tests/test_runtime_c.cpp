@@ -260,6 +260,58 @@ TEST(RuntimeC, EveryCodecTableEntryIsKnownWithItsSizeInOrder) {
     }
 }
 
+TEST(RuntimeC, GltfQuantizationStringsMapToTheStorageParams) {
+    // The strings of docs/gltf-extension.md and formats/gltf_probes.cpp, and the enum values the
+    // codec gives them (QuantParams).
+    struct Case {
+        const char* key;
+        const char* value;
+        int zhc_probe_format::*field;
+        int expected;
+    };
+    const Case cases[] = {
+        {"kind", "radiance", &zhc_probe_format::kind, int(StoredKind::kRadiance)},
+        {"kind", "irradiance", &zhc_probe_format::kind, int(StoredKind::kIrradiance)},
+        {"l2Bound", "tight", &zhc_probe_format::l2_bound, int(L2Bound::kTight)},
+        {"l2Bound", "loose", &zhc_probe_format::l2_bound, int(L2Bound::kLoose)},
+        {"dcFormat", "r11g11b10f", &zhc_probe_format::dc_format, int(DcFormat::kR11G11B10F)},
+        {"dcFormat", "rgb9e5", &zhc_probe_format::dc_format, int(DcFormat::kRGB9E5)},
+        {"dcFormat", "half", &zhc_probe_format::dc_format, int(DcFormat::kHalf)},
+        {"zonalMapping", "affine", &zhc_probe_format::zonal_mapping, int(ZonalMapping::kAffine)},
+        {"zonalMapping", "zero", &zhc_probe_format::zonal_mapping, int(ZonalMapping::kZeroPreserving)},
+        {"zonalMapping", "symmetric", &zhc_probe_format::zonal_mapping, int(ZonalMapping::kSymmetric)},
+        {"axisMode", "luminance", &zhc_probe_format::axis_mode, int(ZonalAxisMode::kLuminance)},
+        {"axisMode", "channel", &zhc_probe_format::axis_mode, int(ZonalAxisMode::kPerChannel)},
+        {"sqrt", "false", &zhc_probe_format::sqrt_encoding, 0},
+        {"sqrt", "true", &zhc_probe_format::sqrt_encoding, 1},
+    };
+    for (const Case& c : cases) {
+        zhc_probe_format f;
+        ASSERT_EQ(zhc_probe_format_init(&f, "sh2_q"), ZHC_OK);
+        f.*c.field = 77;
+        ASSERT_EQ(zhc_probe_format_set_gltf(&f, c.key, c.value), ZHC_OK) << c.key << " " << c.value;
+        EXPECT_EQ(f.*c.field, c.expected) << c.key << " " << c.value;
+        // Unknown values and keys leave the format unchanged.
+        const zhc_probe_format before = f;
+        EXPECT_EQ(zhc_probe_format_set_gltf(&f, c.key, "Half"), ZHC_ERR_UNSUPPORTED);
+        EXPECT_EQ(zhc_probe_format_set_gltf(&f, c.key, ""), ZHC_ERR_UNSUPPORTED);
+        EXPECT_EQ(std::memcmp(&before, &f, sizeof f), 0);
+    }
+    zhc_probe_format f;
+    ASSERT_EQ(zhc_probe_format_init(&f, "sh3_q28"), ZHC_OK);
+    for (int bits = 2; bits <= 8; ++bits) {
+        const std::string v = std::to_string(bits);
+        ASSERT_EQ(zhc_probe_format_set_gltf(&f, "bits", v.c_str()), ZHC_OK);
+        EXPECT_EQ(f.bits, bits);
+    }
+    for (const char* bad : {"1", "9", "10", "08", "", "x", "3 "})
+        EXPECT_EQ(zhc_probe_format_set_gltf(&f, "bits", bad), ZHC_ERR_UNSUPPORTED) << bad;
+    EXPECT_EQ(f.bits, 8);
+    EXPECT_EQ(zhc_probe_format_set_gltf(&f, "encoding", "sh3"), ZHC_ERR_ARGUMENT);
+    EXPECT_EQ(zhc_probe_format_set_gltf(&f, nullptr, "x"), ZHC_ERR_ARGUMENT);
+    EXPECT_EQ(zhc_probe_format_set_gltf(&f, "bits", nullptr), ZHC_ERR_ARGUMENT);
+}
+
 // ---- every entry: encoded probes and random bytes ----------------------------------------------
 
 std::map<std::string, EntryStats>& all_stats() {

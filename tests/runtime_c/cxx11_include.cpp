@@ -13,6 +13,7 @@ int zhc_runtime_cxx11_smoke() {
     zhc_hlsh_tables t;
     int r = zhc_probe_format_init(&f, "zh3_q16");
     r |= zhc_decode_probe(&f, bytes, sh);
+    r |= zhc_probe_format_set_gltf(&f, "dcFormat", "rgb9e5");
     zhc_probe_irradiance(&f, bytes, n, rgb);
     zhc_sh3_irradiance(sh, nd, rgb);
     r |= zhc_probe_format_from_zhp(&f, bytes, sizeof bytes) == ZHC_OK;
