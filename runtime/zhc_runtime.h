@@ -246,10 +246,11 @@ static inline size_t zhc_probe_size(const zhc_probe_format* f) { return f ? zhc_
 #define ZHC__BAND1 (2.0 / 3.0)
 #define ZHC__BAND2 (1.0 / 4.0)
 
-/* x rounded to float and back: the codec's intermediate float roundings. Through a volatile
- * because GCC 12 at -O3 was seen to drop such roundings when vectorizing inlined code (SLP, wrong
- * code: the tests caught differences of 1 ulp and, after cancellation, far more); a volatile
- * store cannot be elided. Costs one store and load. */
+/* x rounded to float and back: the codec's intermediate float roundings (and floats this header
+ * wrote and reads back for more double arithmetic). Through a volatile because GCC 12.2 at -O3 was
+ * seen to drop such roundings when SLP-vectorizing inlined code (wrong code: the tests caught
+ * differences of 1 ulp and, after cancellation, far more; a 40-line reproducer is in the project
+ * notes); a volatile store cannot be elided. Costs one store and load. */
 static inline double zhc__f32_round(double x) {
     volatile float f = (float)x;
     return f;
@@ -585,7 +586,7 @@ static inline int zhc_decode_probe(const zhc_probe_format* f, const void* bytes,
             if (f->encoding == ZHC_ENC_HALL_CURVE_Q) {
                 /* ZH3 paper Sec. 3.4.3, Eq. 21 on the decoder's axis (quantize.cpp hallucinate_curve). */
                 per_channel = f->axis_mode == ZHC_AXIS_PER_CHANNEL;
-                memcpy(lin, radiance_sh3, sizeof lin);
+                for (i = 0; i < 12; ++i) lin[i] = (float)zhc__f32_round(radiance_sh3[i]);
                 zhc__hallucinate(lin, 2, per_channel, f->luminance, f->hallucinate_a, f->hallucinate_b, zonal);
                 zhc__zh3_expand(lin, zonal, per_channel, f->luminance, radiance_sh3);
             }
@@ -595,7 +596,7 @@ static inline int zhc_decode_probe(const zhc_probe_format* f, const void* bytes,
         /* codec/sh.h to_radiance: inverse band scales 1, 1 / (2/3), 1 / (1/4). */
         for (i = 0; i < 9; ++i) {
             const double s = i == 0 ? 1.0 / 1.0 : (i < 4 ? 1.0 / ZHC__BAND1 : 1.0 / ZHC__BAND2);
-            for (k = 0; k < 3; ++k) radiance_sh3[i * 3 + k] = (float)(radiance_sh3[i * 3 + k] * s);
+            for (k = 0; k < 3; ++k) radiance_sh3[i * 3 + k] = (float)(zhc__f32_round(radiance_sh3[i * 3 + k]) * s);
         }
     }
     return ZHC_OK;
@@ -619,6 +620,7 @@ static inline void zhc_probe_irradiance_d(const zhc_probe_format* f, const void*
     dec = zhc__decoder(f->encoding);
     if (f->kind == ZHC_KIND_IRRADIANCE || dec == ZHC__D_PACKED) {
         zhc_decode_probe(f, bytes, sh);
+        for (i = 0; i < 27; ++i) sh[i] = (float)zhc__f32_round(sh[i]); /* see zhc__f32_round */
         zhc__sh_irradiance(sh, 9, n, rgb);
         return;
     }
@@ -1051,6 +1053,7 @@ static inline void zhc_hlsh_multiply(const zhc_hlsh_tables* t, const float sh3[2
     for (i = 0; i < 3; ++i)
         for (j = 0; j < 3; ++j) ft[i * 3 + j] = frame[j * 3 + i];
     zhc_sh3_rotate(sh3, ft, tangent);
+    for (i = 0; i < 27; ++i) tangent[i] = (float)zhc__f32_round(tangent[i]); /* see zhc__f32_round */
     for (k = 0; k < 3; ++k)
         for (i = 0; i < 9; ++i) {
             double s = 0;
