@@ -1,0 +1,106 @@
+// runtime/zhc_runtime.h against the codec on arbitrary input: byte 0 picks the codec table entry,
+// bytes 1-3 the storage parameters (bits, sqrt, bound, DC format, zonal mapping, axis mode, kind,
+// luminance weights), the rest (zero-padded) is the stored probe; the runtime's decode and
+// irradiance must give the codec's bits (any NaN equals any NaN). The whole input is also parsed as
+// a .zhp file by the runtime and by formats/probe_file: same accept/reject and error class.
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "codec/codec.h"
+#include "codec/probe_set.h"
+#include "codec/quantize.h"
+#include "formats/probe_file.h"
+#include "zhc_runtime.h"
+
+namespace {
+
+bool same(float a, float b) {
+    if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b);
+    std::uint32_t ia, ib;
+    std::memcpy(&ia, &a, 4);
+    std::memcpy(&ib, &b, 4);
+    return ia == ib;
+}
+
+int code_of(zhc::ErrorCode c) {
+    switch (c) {
+        case zhc::ErrorCode::kTruncated: return ZHC_ERR_TRUNCATED;
+        case zhc::ErrorCode::kBadFormat: return ZHC_ERR_BAD_FORMAT;
+        case zhc::ErrorCode::kUnsupported: return ZHC_ERR_UNSUPPORTED;
+        case zhc::ErrorCode::kChecksum: return ZHC_ERR_CHECKSUM;
+        case zhc::ErrorCode::kTooLarge: return ZHC_ERR_TOO_LARGE;
+        case zhc::ErrorCode::kInvalidValue: return ZHC_ERR_INVALID_VALUE;
+        case zhc::ErrorCode::kTrailingBytes: return ZHC_ERR_TRAILING_BYTES;
+        default: return -1;
+    }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    using namespace zhc;
+    // .zhp parsing: must never crash and must agree with zhc's reader.
+    {
+        zhc_probe_format f;
+        zhc_zhp_info info{};
+        const int rt = zhc_zhp_open(&f, &info, data, size);
+        const auto ref = parse_probe_set({data, size}, "fuzz");
+        if (rt == ZHC_ERR_COMPRESSED) {
+            if (!ref && ref.error().code != ErrorCode::kBadFormat) std::abort();
+        } else if (ref ? rt != ZHC_OK : rt != code_of(ref.error().code)) {
+            std::abort();
+        }
+        if (rt == ZHC_OK && info.payload_offset + ref->payload.size() != size) std::abort();
+    }
+    const auto table = codecs();
+    if (size < 4 || table.empty()) return 0;
+    const Codec& c = table[data[0] % table.size()];
+    StorageParams p;
+    p.bits = 2 + data[1] % 7;
+    p.sqrt_encoding = (data[1] >> 3) & 1;
+    p.l2_bound = L2Bound((data[1] >> 4) & 1);
+    p.kind = StoredKind((data[1] >> 5) & 1);
+    p.axis_mode = ZonalAxisMode((data[1] >> 6) & 1);
+    p.dc_format = DcFormat(data[2] % 3);
+    p.zonal_mapping = ZonalMapping((data[2] / 3) % 3);
+    if (data[3] & 1) p.luminance = {data[3] / 255.0, 0.5, -0.25};
+    const bool valid = bool(validate_quant_params(p, c.name));
+    zhc_probe_format f;
+    if (zhc_probe_format_init(&f, std::string(c.name).c_str()) != ZHC_OK) std::abort();
+    f.bits = p.bits;
+    f.sqrt_encoding = p.sqrt_encoding;
+    f.l2_bound = int(p.l2_bound);
+    f.dc_format = int(p.dc_format);
+    f.zonal_mapping = int(p.zonal_mapping);
+    f.axis_mode = int(p.axis_mode);
+    f.kind = int(p.kind);
+    f.luminance[0] = p.luminance.r;
+    f.luminance[1] = p.luminance.g;
+    f.luminance[2] = p.luminance.b;
+    if ((zhc_probe_format_validate(&f) == ZHC_OK) != valid) std::abort();
+    std::vector<std::uint8_t> stored(c.size_bytes, 0);
+    std::memcpy(stored.data(), data + 4, std::min(size - 4, stored.size()));
+    float sh[27], e[3];
+    if (!valid) {
+        if (zhc_decode_probe(&f, stored.data(), sh) != ZHC_ERR_ARGUMENT) std::abort();
+        return 0;
+    }
+    if (zhc_decode_probe(&f, stored.data(), sh) != ZHC_OK) std::abort();
+    const Sh3Radiance ref = decode_probe(c, p, stored.data());
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!same(sh[i * 3 + k], ref[i][k])) std::abort();
+    const float n[3] = {0.6f, -0.48f, 0.64f};
+    zhc_probe_irradiance(&f, stored.data(), n, e);
+    const Vec3 nd{n[0], n[1], n[2]};
+    PackedLayout layout;
+    const Rgb ref_e = (p.kind == StoredKind::kRadiance && !packed_layout_from_name(c.name, &layout))
+                          ? c.irradiance(stored.data(), codec_options(p), nd)
+                          : irradiance(decode_probe(c, p, stored.data()), nd);
+    for (int k = 0; k < 3; ++k)
+        if (!same(e[k], ref_e[k])) std::abort();
+    return 0;
+}
