@@ -81,7 +81,9 @@ enum zhc_encoding {
     ZHC_ENC_SH3_Q28 = 17,             /* 28 bytes: DC (4) + per channel [L1-1 .. L22] */
     ZHC_ENC_SH2_Q = 18,               /* 16 bytes: DC slot (6) + per channel [L1-1, L10, L11] + 0 */
     ZHC_ENC_HALL_CURVE_Q = 19,        /* sh2_q bytes, zonal hallucinated at decode (Eq. 21) */
-    ZHC_ENC_COUNT = 20
+    ZHC_ENC_ZH3_DERING = 20,          /* 15 floats: decoded as zh3_lum (deringing happens at encode) */
+    ZHC_ENC_ZH3_DERING_Q16 = 21,      /* zh3_q16 bytes */
+    ZHC_ENC_COUNT = 22
 };
 enum zhc_stored_kind { ZHC_KIND_RADIANCE = 0, ZHC_KIND_IRRADIANCE = 1 };
 enum zhc_dc_format { ZHC_DC_R11G11B10F = 0, ZHC_DC_RGB9E5 = 1, ZHC_DC_HALF = 2 };
@@ -126,7 +128,7 @@ static inline const char* zhc_encoding_name(int e) {
         "sh3", "sh2", "zh3_lum", "zh3_channel", "zh3_solved_lum", "zh3_solved_channel", "hall_ambdir",
         "hall_sphere", "hall_curve", "hall_ambdir_channel", "hall_sphere_channel", "hall_curve_channel",
         "zh3_lum_dering", "zh3_lum_dering_sphere", "sh3_dering", "zh3_q16", "zh3_solved_q16", "sh3_q28",
-        "sh2_q", "hall_curve_q"};
+        "sh2_q", "hall_curve_q", "zh3_dering", "zh3_dering_q16"};
     return (e >= 0 && e < ZHC_ENC_COUNT) ? names[e] : NULL;
 }
 
@@ -142,12 +144,15 @@ static inline int zhc_encoding_from_name(const char* name) {
 /* Stored bytes per probe of encoding e; 0 when e is out of range. */
 static inline size_t zhc_encoding_size(int e) {
     static const unsigned char sizes[ZHC_ENC_COUNT] = {108, 48, 60, 60, 60, 60, 48, 48, 48, 48,
-                                                       48,  48, 60, 60, 108, 16, 16, 28, 16, 16};
+                                                       48,  48, 60, 60, 108, 16, 16, 28, 16, 16, 60, 16};
     return (e >= 0 && e < ZHC_ENC_COUNT) ? sizes[e] : 0;
 }
 
-/* 1 for the packed (quantised) encodings zh3_q16, zh3_solved_q16, sh3_q28, sh2_q, hall_curve_q. */
-static inline int zhc_encoding_is_packed(int e) { return e >= ZHC_ENC_ZH3_Q16 && e < ZHC_ENC_COUNT; }
+/* 1 for the packed (quantised) encodings zh3_q16, zh3_solved_q16, sh3_q28, sh2_q, hall_curve_q,
+ * zh3_dering_q16. */
+static inline int zhc_encoding_is_packed(int e) {
+    return (e >= ZHC_ENC_ZH3_Q16 && e <= ZHC_ENC_HALL_CURVE_Q) || e == ZHC_ENC_ZH3_DERING_Q16;
+}
 
 /* Defaults of `zhc convert --to ENCODING` (cli/cmd_convert.cpp, codec/quantize.h QuantParams):
  * 8 bits, no sqrt, tight bound, R11G11B10F DC, affine zonal mapping, luminance axis, radiance,
@@ -224,7 +229,8 @@ static inline int zhc_probe_format_validate(const zhc_probe_format* f) {
         !isfinite(f->hallucinate_a) || !isfinite(f->hallucinate_b))
         return ZHC_ERR_ARGUMENT;
     if (f->dc_format == ZHC_DC_HALF &&
-        (f->encoding == ZHC_ENC_ZH3_Q16 || f->encoding == ZHC_ENC_ZH3_SOLVED_Q16 || f->encoding == ZHC_ENC_SH3_Q28))
+        (f->encoding == ZHC_ENC_ZH3_Q16 || f->encoding == ZHC_ENC_ZH3_SOLVED_Q16 || f->encoding == ZHC_ENC_SH3_Q28 ||
+         f->encoding == ZHC_ENC_ZH3_DERING_Q16))
         return ZHC_ERR_ARGUMENT;
     return ZHC_OK;
 }
