@@ -2,9 +2,7 @@
 // (EGL_MESA_platform_surfaceless, no display needed) uploads zhc's BC6H / BC4 / BC5 blocks with
 // glCompressedTexImage2D and reads them back with glGetTexImage. BC6H must match zhc's decoder bit
 // for bit (half floats); BC4/BC5 within 1/255.
-#define EGL_EGLEXT_PROTOTYPES
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
+#include "gl/egl_context.h"
 #define GL_GLEXT_PROTOTYPES
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -24,53 +22,14 @@ namespace {
 class MesaContext : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
-        // Force the software rasteriser whatever GPU the machine has, so results are llvmpipe's.
-        setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
-        setenv("GALLIUM_DRIVER", "llvmpipe", 1);
-        auto get_platform_display =
-            reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-        if (!get_platform_display) {
-            why_ = "eglGetPlatformDisplayEXT missing";
-            return;
-        }
-        dpy_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-        EGLint major = 0, minor = 0;
-        if (dpy_ == EGL_NO_DISPLAY || !eglInitialize(dpy_, &major, &minor)) {
-            why_ = "no surfaceless EGL display (eglInitialize failed)";
-            return;
-        }
-        if (!eglBindAPI(EGL_OPENGL_API)) {
-            why_ = "eglBindAPI(EGL_OPENGL_API) failed";
-            return;
-        }
-        const EGLint cfg_attr[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
-        EGLConfig cfg = EGL_NO_CONFIG_KHR;
-        EGLint n = 0;
-        // The surfaceless platform may expose no configs; a context without one needs
-        // EGL_KHR_no_config_context (we never render to a surface).
-        if (!eglChooseConfig(dpy_, cfg_attr, &cfg, 1, &n) || n < 1) {
-            const char* ext = eglQueryString(dpy_, EGL_EXTENSIONS);
-            if (!ext || !std::strstr(ext, "EGL_KHR_no_config_context")) {
-                why_ = "no EGL config with EGL_OPENGL_BIT and no EGL_KHR_no_config_context";
-                return;
-            }
-            cfg = EGL_NO_CONFIG_KHR;
-        }
-        ctx_ = eglCreateContext(dpy_, cfg, EGL_NO_CONTEXT, nullptr);
-        if (ctx_ == EGL_NO_CONTEXT || !eglMakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_)) {
-            why_ = "cannot make a surfaceless desktop GL context current";
-            return;
-        }
+        why_ = test::make_llvmpipe_context(EGL_OPENGL_API, EGL_OPENGL_BIT, nullptr, &egl_);
+        if (!why_.empty()) return;
         renderer_ = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
         std::printf("GL_RENDERER: %s, GL_VERSION: %s\n", renderer_.c_str(),
                     reinterpret_cast<const char*>(glGetString(GL_VERSION)));
     }
     static void TearDownTestSuite() {
-        if (dpy_ != EGL_NO_DISPLAY) {
-            eglMakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-            if (ctx_ != EGL_NO_CONTEXT) eglDestroyContext(dpy_, ctx_);
-            eglTerminate(dpy_);
-        }
+        test::destroy_context(&egl_);
     }
     void SetUp() override {
         ASSERT_TRUE(why_.empty()) << why_;
@@ -94,8 +53,7 @@ protected:
         return out;
     }
 
-    static inline EGLDisplay dpy_ = EGL_NO_DISPLAY;
-    static inline EGLContext ctx_ = EGL_NO_CONTEXT;
+    static inline test::EglContext egl_;
     static inline std::string why_;
     static inline std::string renderer_;
 };

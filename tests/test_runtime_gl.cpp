@@ -38,9 +38,7 @@
 // A codec result that is not finite is not compared (garbage bytes: Inf/NaN DC); when S is within a
 // factor 64 of FLT_MAX the float computation may overflow where double does not, so a non-finite
 // GPU value is accepted there. Everything else must be within the bound.
-#define EGL_EGLEXT_PROTOTYPES
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
+#include "gl/egl_context.h"
 #define GL_GLEXT_PROTOTYPES
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -393,45 +391,13 @@ template <bool kEs>
 class RuntimeContext : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
-        setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
-        setenv("GALLIUM_DRIVER", "llvmpipe", 1);
-        auto get_platform_display =
-            reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-        if (!get_platform_display) {
-            why_ = "eglGetPlatformDisplayEXT missing";
-            return;
-        }
-        dpy_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-        EGLint major = 0, minor = 0;
-        if (dpy_ == EGL_NO_DISPLAY || !eglInitialize(dpy_, &major, &minor)) {
-            why_ = "no surfaceless EGL display (eglInitialize failed)";
-            return;
-        }
-        if (!eglBindAPI(kEs ? EGL_OPENGL_ES_API : EGL_OPENGL_API)) {
-            why_ = "eglBindAPI failed";
-            return;
-        }
-        const EGLint cfg_attr[] = {EGL_RENDERABLE_TYPE, kEs ? EGL_OPENGL_ES3_BIT : EGL_OPENGL_BIT, EGL_NONE};
-        EGLConfig cfg = EGL_NO_CONFIG_KHR;
-        EGLint n = 0;
-        if (!eglChooseConfig(dpy_, cfg_attr, &cfg, 1, &n) || n < 1) {
-            const char* ext = eglQueryString(dpy_, EGL_EXTENSIONS);
-            if (!ext || !std::strstr(ext, "EGL_KHR_no_config_context")) {
-                why_ = "no EGL config for the API and no EGL_KHR_no_config_context";
-                return;
-            }
-            cfg = EGL_NO_CONFIG_KHR;
-        }
         // Desktop GL 4.5 core or ES 3.1: compute shaders and std430 SSBOs are core in both.
         const EGLint gl_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
                                   EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
         const EGLint es_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 1, EGL_NONE};
-        ctx_ = eglCreateContext(dpy_, cfg, EGL_NO_CONTEXT, kEs ? es_attr : gl_attr);
-        if (ctx_ == EGL_NO_CONTEXT || !eglMakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_)) {
-            why_ = kEs ? "cannot make a surfaceless OpenGL ES 3.1 context current"
-                       : "cannot make a surfaceless desktop GL 4.5 core context current";
-            return;
-        }
+        why_ = kEs ? test::make_llvmpipe_context(EGL_OPENGL_ES_API, EGL_OPENGL_ES3_BIT, es_attr, &egl_)
+                   : test::make_llvmpipe_context(EGL_OPENGL_API, EGL_OPENGL_BIT, gl_attr, &egl_);
+        if (!why_.empty()) return;
         renderer_ = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
         std::printf("GL_RENDERER: %s, GL_VERSION: %s\n", renderer_.c_str(),
                     reinterpret_cast<const char*>(glGetString(GL_VERSION)));
@@ -470,11 +436,7 @@ protected:
     static void TearDownTestSuite() {
         if (program_) glDeleteProgram(program_);
         if (buffers_[0]) glDeleteBuffers(3, buffers_);
-        if (dpy_ != EGL_NO_DISPLAY) {
-            eglMakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-            if (ctx_ != EGL_NO_CONTEXT) eglDestroyContext(dpy_, ctx_);
-            eglTerminate(dpy_);
-        }
+        test::destroy_context(&egl_);
     }
     void SetUp() override {
         ASSERT_TRUE(why_.empty()) << why_;
@@ -526,8 +488,7 @@ public:
     }
 
 protected:
-    static inline EGLDisplay dpy_ = EGL_NO_DISPLAY;
-    static inline EGLContext ctx_ = EGL_NO_CONTEXT;
+    static inline test::EglContext egl_;
     static inline GLuint program_ = 0;
     static inline GLuint buffers_[3] = {0, 0, 0};
     static inline std::string why_, renderer_;
