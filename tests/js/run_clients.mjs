@@ -15,6 +15,7 @@ import { execFileSync } from 'node:child_process';
 import { register } from 'node:module';
 import validator from 'gltf-validator';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { glb } from './fixtures.mjs';
 
 // The plugin lives in runtime/web (issue 15); its bare 'three' import resolves to tests/js/node_modules.
 register('./three_resolver.mjs', import.meta.url);
@@ -35,22 +36,6 @@ const check = (ok, what) => {
 };
 
 // --- inputs -------------------------------------------------------------------------------
-function glb(jsonObj, bin) {
-  let jsonBytes = Buffer.from(JSON.stringify(jsonObj));
-  jsonBytes = Buffer.concat([jsonBytes, Buffer.alloc((4 - (jsonBytes.length % 4)) % 4, 0x20)]);
-  const binPadded = Buffer.concat([bin, Buffer.alloc((4 - (bin.length % 4)) % 4)]);
-  const header = Buffer.alloc(12);
-  header.writeUInt32LE(0x46546c67, 0);
-  header.writeUInt32LE(2, 4);
-  header.writeUInt32LE(12 + 8 + jsonBytes.length + 8 + binPadded.length, 8);
-  const c0 = Buffer.alloc(8);
-  c0.writeUInt32LE(jsonBytes.length, 0);
-  c0.writeUInt32LE(0x4e4f534a, 4);
-  const c1 = Buffer.alloc(8);
-  c1.writeUInt32LE(binPadded.length, 0);
-  c1.writeUInt32LE(0x004e4942, 4);
-  return Buffer.concat([header, c0, jsonBytes, c1, binPadded]);
-}
 const tri = Buffer.from(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]).buffer);
 const scene = {
   asset: { version: '2.0', generator: 'zhc tests/js' },
