@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <vector>
 
@@ -132,8 +133,11 @@ TEST(Zh3Window, ProfileMinimumIsCertifiedAgainstDenseSampling) {
 }
 
 // The float and the 16-byte entries: decoded irradiance >= -1e-6 DC everywhere. Certified on
-// every probe, sampled at 100,000 directions on a subset (the slow check of the same claim).
+// every probe, sampled at 100,000 directions on a subset (the slow check of the same claim; with
+// ZHC_ZH3_WINDOW_SAMPLE_ALL set in the environment on every probe, a one-off run of about a minute).
 void expect_non_negative(const Sh3Radiance& probe, bool sample, const char* what) {
+    static const bool sample_all = std::getenv("ZHC_ZH3_WINDOW_SAMPLE_ALL") != nullptr;
+    sample = sample || sample_all;
     {
         const auto bytes = encode("zh3_dering", probe);
         ASSERT_GE(certified_min_over_dc(as_zh3(bytes)), -1e-6) << what;
