@@ -230,8 +230,10 @@ const char* kColumns[] = {"representation", "bytes", "rmse", "relative rmse", "m
 void table_html(std::ostringstream& o, const std::string& id, const std::string& caption, const std::vector<HtmlRow>& rows) {
     o << "<table class=\"sortable\"" << (id.empty() ? "" : " id=\"" + id + "\"") << ">\n";
     if (!caption.empty()) o << "<caption>" << html_escape(caption) << "</caption>\n";
+    const bool eval = std::any_of(rows.begin(), rows.end(), [](const HtmlRow& r) { return r.eval_ns >= 0; });
     o << "<thead><tr>";
     for (const char* c : kColumns) o << "<th scope=\"col\">" << c << "</th>";
+    if (eval) o << "<th scope=\"col\">eval ns/sample</th>";
     o << "</tr></thead>\n<tbody>\n";
     auto cell = [&](double v, const char* f) { o << "<td data-v=\"" << sort_key(v) << "\">" << num(v, f) << "</td>"; };
     auto time = [&](double v) {
@@ -244,12 +246,20 @@ void table_html(std::ostringstream& o, const std::string& id, const std::string&
         cell(static_cast<double>(r.bytes), "%.0f");
         cell(m.rmse, "%.4g");
         cell(m.relative_rmse, "%.4f");
-        cell(m.max_abs, "%.4g");
-        cell(m.min_irradiance, "%.4g");
-        cell(m.negative_fraction, "%.4f");
-        cell(m.chromaticity_error, "%.4f");
+        if (r.all_metrics) {
+            cell(m.max_abs, "%.4g");
+            cell(m.min_irradiance, "%.4g");
+            cell(m.negative_fraction, "%.4f");
+            cell(m.chromaticity_error, "%.4f");
+        } else {
+            for (int k = 0; k < 4; ++k) o << "<td>-</td>";
+        }
         time(r.encode_ns);
         time(r.decode_ns);
+        if (eval) {
+            if (r.eval_ns < 0 || !std::isfinite(r.eval_ns)) o << "<td data-v=\"-1\">-</td>";
+            else cell(r.eval_ns, "%.1f");
+        }
         o << "</tr>\n";
     }
     o << "</tbody></table>\n";

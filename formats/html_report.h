@@ -26,6 +26,9 @@ struct HtmlRow {
     std::size_t bytes = 0;
     ErrorMetrics metrics;
     double encode_ns = -1, decode_ns = -1;  // < 0: not measured (shown as "-")
+    // false: only rmse and relative rmse are known (bench); the other metrics show as "-".
+    bool all_metrics = true;
+    double eval_ns = -1;  // per irradiance sample; the column appears when some row has it
 };
 
 // Lit spheres: orthographic views of a unit sphere whose pixel at normal n shows E(n). Two views,

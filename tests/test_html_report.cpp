@@ -273,3 +273,18 @@ TEST(HtmlReport, Demo) {
     EXPECT_EQ(row_names(summary_table(doc)), codec_names());
     check_in_browser(html, dir, reps, inputs * (1 + 2 * reps));
 }
+
+TEST(HtmlReport, Bench) {
+    const std::string dir = zhc::test::fresh_dir("html_report_bench");
+    const std::string html = dir + "/bench.html";
+    const auto r = zhc::test::run_zhc({"bench", std::string(ZHC_ENVMAP_DIR) + "/city.exr", "--repeats", "1", "--directions", "256",
+                                       "--no-plots", "--html", html});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string doc = slurp(html);
+    check_self_contained(doc, 0);
+    EXPECT_EQ(row_names(summary_table(doc)), codec_names());
+    EXPECT_NE(doc.find("<th scope=\"col\">eval ns/sample</th>"), std::string::npos);
+    EXPECT_EQ(count(doc, "<svg class=\"plot\""), 2u);  // error vs bytes, error vs encode time
+    EXPECT_EQ(count(doc, "red: Pareto frontier"), 2u);
+    check_in_browser(html, dir, codecs().size(), 0);
+}
