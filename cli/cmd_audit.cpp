@@ -15,6 +15,8 @@
 #include "table.h"
 #include "codec/audit.h"
 #include "formats/file_io.h"
+#include "formats/html_report.h"
+#include "codec/benchmark.h"
 
 namespace zhc::cli {
 namespace cmd_audit {  // one namespace per verb file: the CLI is a unity build
@@ -28,6 +30,7 @@ struct Options {
     bool json = false;
     std::string markdown;
     std::string images;
+    std::string html;
     int directions = 2048;
     int threads = 0;
     bool progress = false;
@@ -42,6 +45,7 @@ struct FileReport {
     AuditInput input;
     std::vector<RepresentationResult> results;  // pooled over the file's probes
     std::vector<std::vector<std::size_t>> worst_probes;  // per representation: probe indices failing a gate
+    SpherePictures pictures;  // --html: lit spheres of probe 0
 };
 
 std::string fmt(double v, const char* f = "%.4g") {
@@ -74,6 +78,64 @@ nlohmann::json metrics_json(const RepresentationResult& r) {
             {"decode_ns", r.decode_ns},
             {"clamped_ratios", r.stats.clamped_ratios},
             {"dering_clamped", r.stats.dering_clamped}};
+}
+
+HtmlRow html_row(const RepresentationResult& r, bool timed) {
+    HtmlRow h;
+    h.name = std::string(r.codec->name);
+    h.bytes = r.codec->size_bytes;
+    h.metrics = r.metrics;
+    h.encode_ns = timed ? r.encode_ns : -1;
+    h.decode_ns = timed ? r.decode_ns : -1;
+    return h;
+}
+
+HtmlReport html_of(const Options& o, const std::vector<FileReport>& reports,
+                   const std::vector<RepresentationResult>& aggregate, const std::vector<std::string>& failures) {
+    HtmlReport h;
+    h.title = "zhc audit";
+    h.version = ZHC_VERSION;
+    h.intro = "Irradiance error, size and speed of every representation. Reference: environment maps are integrated "
+              "directly (box-downsampled to at least 512x256); probe files use their probes' SH3 irradiance. Errors at " +
+              std::to_string(o.directions) + " Fibonacci-lattice directions per probe.";
+    std::string inputs;
+    for (const std::string& i : o.inputs) inputs += (inputs.empty() ? "" : " ") + i;
+    h.settings = {{"inputs", inputs},
+                  {"files audited", std::to_string(reports.size())},
+                  {"representations", o.representations.empty() ? "all (" + std::to_string(aggregate.size()) + ")" : o.representations},
+                  {"directions", std::to_string(o.directions)},
+                  {"timing", o.no_timing ? "off (--no-timing)" : "on: median of 5 batches, first 8 probes of each file"}};
+    if (!o.part.empty()) h.settings.push_back({"EXR part", o.part});
+    if (o.replace_non_finite) h.settings.push_back({"non-finite pixels", "replaced by 0"});
+    const bool timed = !o.no_timing;
+    h.summary_caption = reports.size() > 1 ? "Aggregate over " + std::to_string(reports.size()) +
+                                                 " files (mean rmse, relative rmse, fractions and times; worst max abs and min irradiance)"
+                                           : reports[0].input.path;
+    for (const RepresentationResult& r : aggregate) h.summary.push_back(html_row(r, timed));
+    h.gates_configured = o.max_rmse >= 0 || o.max_relative_rmse >= 0 || o.fail_on_negative;
+    if (o.max_rmse >= 0) h.gates.push_back("rmse <= " + fmt(o.max_rmse) + " on every probe");
+    if (o.max_relative_rmse >= 0) h.gates.push_back("relative rmse <= " + fmt(o.max_relative_rmse) + " on every probe");
+    if (o.fail_on_negative) h.gates.push_back("no negative irradiance on any probe");
+    h.gate_failures = failures;
+    // Error against bytes per probe (the summary's relative rmse).
+    ScatterPlot plot{"Error vs bytes per probe", "bytes per probe (log scale)", "relative irradiance rmse (log scale)", {}, {}};
+    std::vector<double> b, e;
+    for (const RepresentationResult& r : aggregate) {
+        plot.points.push_back({std::string(r.codec->name), double(r.codec->size_bytes), r.metrics.relative_rmse});
+        b.push_back(double(r.codec->size_bytes));
+        e.push_back(r.metrics.relative_rmse);
+    }
+    plot.frontier = pareto_frontier(b, e);
+    h.plots.push_back(plot);
+    for (const FileReport& fr : reports) {
+        HtmlInputSection s;
+        s.title = fr.input.path;
+        s.description = fr.input.description + (fr.input.probes.size() > 1 ? "; pictures show probe 0" : "");
+        for (const RepresentationResult& r : fr.results) s.rows.push_back(html_row(r, timed));
+        s.pictures = fr.pictures;
+        h.inputs.push_back(std::move(s));
+    }
+    return h;
 }
 
 int run(const Options& o) {
@@ -138,6 +200,7 @@ int run(const Options& o) {
         if (!o.images.empty()) {
             if (Status s = write_audit_images(o.images, fr.input, dirs, selected, copt); !s) return report_output(s.error());
         }
+        if (!o.html.empty()) fr.pictures = render_sphere_pictures(fr.input, selected, copt, 96);
         reports.push_back(std::move(fr));
     }
 
@@ -233,6 +296,10 @@ int run(const Options& o) {
         if (Status s = write_file_atomic(o.markdown, std::vector<std::uint8_t>(text.begin(), text.end())); !s)
             return report_output(s.error());
     }
+    if (!o.html.empty()) {
+        if (Status s = write_html_report(o.html, html_of(o, reports, aggregate, failures)); !s) return report_output(s.error());
+        std::fprintf(stderr, "report: %s\n", o.html.c_str());
+    }
     if (!failures.empty()) {
         for (const std::string& f : failures) std::fprintf(stderr, "zhc: gate failed: %s\n", f.c_str());
         return kExitGateFailed;
@@ -247,6 +314,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     sub->add_option("--representations", o->representations, "comma-separated subset of the codec table (default: all)");
     sub->add_flag("--json", o->json, "print one JSON object (files, aggregate, gates) on stdout");
     sub->add_option("--markdown", o->markdown, "also write the tables as Markdown to this file");
+    sub->add_option("--html", o->html, "also write one self-contained HTML report (tables, gates, lit spheres, plots) to this file");
     sub->add_option("--images", o->images, "write irradiance/error PNGs per input into this folder");
     sub->add_option("--directions", o->directions, "number of Fibonacci-lattice directions")->check(CLI::Range(16, 1 << 20));
     sub->add_option("--threads", o->threads, "worker threads (results do not depend on it)")->check(CLI::Range(0, 256));

@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "codec/benchmark.h"
 #include "formats/audit_inputs.h"
+#include "formats/html_report.h"
 #include "formats/plot.h"
 #include "formats/runtime_cost.h"
 
@@ -27,6 +28,7 @@ struct Options {
     int repeats = 7;
     int directions = 1024;
     std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
+    std::string html;
 };
 
 int run(const Options& o) {
@@ -107,6 +109,58 @@ int run(const Options& o) {
         if (!o.runtime_cost.empty()) std::printf("GPU cost: %s (%s)\n", gpu.device.c_str(), o.runtime_cost.c_str());
     }
     std::fflush(stdout);
+    if (!o.html.empty()) {
+        HtmlReport h;
+        h.title = "zhc bench";
+        h.version = ZHC_VERSION;
+        h.intro = "What accuracy costs in time, per representation: bytes, mean irradiance error over " +
+                  std::to_string(probes.size()) + " probes (reference: the maps integrated directly), encode, decode and "
+                  "evaluation time (single thread, medians of " + std::to_string(o.repeats) + " repeats).";
+        std::string in;
+        for (const std::string& f : *files) in += (in.empty() ? "" : " ") + f;
+        h.settings = {{"inputs", in},
+                      {"representations", o.representations.empty() ? "all (" + std::to_string(selected.size()) + ")" : o.representations},
+                      {"directions", std::to_string(o.directions)},
+                      {"repeats", std::to_string(o.repeats)}};
+        if (!o.runtime_cost.empty()) h.settings.push_back({"runtime cost", o.runtime_cost + " (" + gpu.device + ")"});
+        h.summary_caption = "Means over " + std::to_string(probes.size()) + " probes; times are medians";
+        std::vector<double> b, t, e, cost, cost_err;
+        ScatterPlot by_bytes{"Error vs bytes per probe", "bytes per probe (log scale)", "mean relative irradiance rmse (log scale)", {}, {}};
+        ScatterPlot by_time{"Error vs encode time", "encode time per probe, ns (log scale)", "mean relative irradiance rmse (log scale)", {}, {}};
+        ScatterPlot by_runtime{"Error vs runtime cost", "SPIR-V instructions per irradiance evaluation (log scale)",
+                               "mean relative irradiance rmse (log scale)", {}, {}};
+        for (const BenchRow& r : rows) {
+            HtmlRow row;
+            row.name = std::string(r.codec->name);
+            row.bytes = r.codec->size_bytes;
+            row.metrics.rmse = r.mean_rmse;
+            row.metrics.relative_rmse = r.mean_relative_rmse;
+            row.all_metrics = false;
+            row.encode_ns = r.encode_ns.median;
+            row.decode_ns = r.decode_ns.median;
+            row.eval_ns = r.eval_ns.median;
+            h.summary.push_back(row);
+            by_bytes.points.push_back({row.name, double(row.bytes), r.mean_relative_rmse});
+            by_time.points.push_back({row.name, r.encode_ns.median, r.mean_relative_rmse});
+            b.push_back(double(row.bytes));
+            t.push_back(r.encode_ns.median);
+            e.push_back(r.mean_relative_rmse);
+            if (const RuntimeCost* c = gpu_cost(r)) {
+                by_runtime.points.push_back({row.name, double(c->spirv_instructions), r.mean_relative_rmse});
+                cost.push_back(c->spirv_instructions);
+                cost_err.push_back(r.mean_relative_rmse);
+            }
+        }
+        by_bytes.frontier = pareto_frontier(b, e);
+        by_time.frontier = pareto_frontier(t, e);
+        h.plots = {by_bytes, by_time};
+        if (!by_runtime.points.empty()) {
+            by_runtime.frontier = pareto_frontier(cost, cost_err);
+            h.plots.push_back(by_runtime);
+        }
+        if (Status s = write_html_report(o.html, h); !s) return report_output(s.error());
+        std::fprintf(stderr, "report: %s\n", o.html.c_str());
+    }
     if (!o.no_plots) {
         std::error_code ec;
         fs::create_directories(o.plots, ec);
@@ -155,6 +209,7 @@ const VerbRegistration registration(50, [](CLI::App& app) -> std::function<int()
     sub->add_flag("--json", o->json, "print one JSON object on stdout");
     sub->add_option("--plots", o->plots, "folder for error_vs_encode_time.png and error_vs_bytes.png")->capture_default_str();
     sub->add_flag("--no-plots", o->no_plots, "do not write plots");
+    sub->add_option("--html", o->html, "also write one self-contained HTML report (table, SVG plots) to this file");
     sub->add_option("--repeats", o->repeats, "timing repeats (median and spread are reported)")->check(CLI::Range(1, 1000));
     sub->add_option("--directions", o->directions, "Fibonacci directions for error and evaluation")->check(CLI::Range(16, 1 << 20));
     sub->add_option("--runtime-cost", o->runtime_cost,

@@ -18,6 +18,8 @@
 #include "formats/audit_inputs.h"
 #include "formats/file_io.h"
 #include "formats/gltf_probes.h"
+#include "formats/html_report.h"
+#include "codec/benchmark.h"
 #include "formats/probe_file.h"
 #include "formats/scene_json.h"
 
@@ -32,6 +34,7 @@ struct Options {
     std::string dir = "zhc-demo";
     int threads = 0;
     int directions = 512;
+    std::string html;  // default: DIR/report.html
 };
 
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
@@ -115,6 +118,7 @@ int run(const Options& o) {
     }
     std::vector<std::vector<std::string>> rows{{"representation", "bytes", "grid_bytes", "rmse", "rel_rmse", "max_abs",
                                                 "min_irr", "neg_frac", "chroma", "clamped"}};
+    std::vector<HtmlRow> html_rows;
     for (size_t k = 0; k < all.size(); ++k) {
         MetricsAccumulator acc;
         int clamped = 0;
@@ -123,6 +127,7 @@ int run(const Options& o) {
             clamped += stats[p][k].clamped_ratios;
         }
         const ErrorMetrics m = acc.result();
+        html_rows.push_back({std::string(all[k]->name), all[k]->size_bytes, m, -1, -1});
         rows.push_back({std::string(all[k]->name), std::to_string(all[k]->size_bytes),
                         std::to_string(all[k]->size_bytes * probes.size()), fmt(m.rmse), fmt(m.relative_rmse, "%.4f"),
                         fmt(m.max_abs), fmt(m.min_irradiance), fmt(m.negative_fraction, "%.4f"),
@@ -191,6 +196,61 @@ int run(const Options& o) {
                                fmt(pos.z, "%.2f") + "): irradiance and error per representation"});
     }
 
+    // 5b. One self-contained HTML report: the table, a plot, lit spheres of the pictured probes.
+    {
+        const auto t_html = Clock::now();
+        HtmlReport h;
+        h.title = "zhc demo";
+        h.version = ZHC_VERSION;
+        h.intro = "Every representation on the " + std::to_string(probes.size()) +
+                  " probes baked from the built-in scene; reference: each probe's baked SH3 irradiance, at " +
+                  std::to_string(o.directions) + " Fibonacci-lattice directions per probe (so sh3 itself is exact).";
+        h.settings = {{"scene", "built-in default scene (written to " + path("scene.json") + ")"},
+                      {"probe grid", std::to_string(c[0]) + "x" + std::to_string(c[1]) + "x" + std::to_string(c[2])},
+                      {"bake", rep.summary()},
+                      {"directions", std::to_string(o.directions)},
+                      {"timing", "not measured by the demo (zhc audit and zhc bench time encode and decode)"},
+                      {"command", "zhc demo -o " + o.dir + " --directions " + std::to_string(o.directions)}};
+        h.summary_caption = "All " + std::to_string(probes.size()) + " probes pooled";
+        h.summary = html_rows;
+        ScatterPlot plot{"Error vs bytes per probe", "bytes per probe (log scale)", "relative irradiance rmse (log scale)", {}, {}};
+        std::vector<double> b, e;
+        for (const HtmlRow& r : html_rows) {
+            plot.points.push_back({r.name, double(r.bytes), r.metrics.relative_rmse});
+            b.push_back(double(r.bytes));
+            e.push_back(r.metrics.relative_rmse);
+        }
+        plot.frontier = pareto_frontier(b, e);
+        h.plots.push_back(plot);
+        h.inputs.resize(pick.size());
+        {
+            std::vector<std::thread> pool;
+            for (int t = 0; t < threads; ++t)
+                pool.emplace_back([&, t] {
+                    for (size_t i = static_cast<size_t>(t); i < pick.size(); i += static_cast<size_t>(threads)) {
+                        const size_t p = pick[i];
+                        const Vec3 pos = positions[p];
+                        HtmlInputSection& s = h.inputs[i];
+                        s.title = role[p] + " probe " + std::to_string(p);
+                        s.description = "at (" + fmt(pos.x, "%.2f") + ", " + fmt(pos.y, "%.2f") + ", " + fmt(pos.z, "%.2f") + ")";
+                        for (size_t k = 0; k < all.size(); ++k)
+                            s.rows.push_back({std::string(all[k]->name), all[k]->size_bytes, compare_irradiance(recon[p][k], refs[p]), -1, -1});
+                        AuditInput in;
+                        in.path = "probe_" + std::to_string(p);
+                        in.kind = "probes";
+                        in.probes = {probes[p]};
+                        s.pictures = render_sphere_pictures(in, all, copt, 96);
+                    }
+                });
+            for (auto& th : pool) th.join();
+        }
+        const std::string html_path = o.html.empty() ? path("report.html") : o.html;
+        const std::string doc = html_report(h);
+        if (Status s = write_text(html_path, doc); !s) return report_output(s.error());
+        outputs.push_back({html_path, "the report: table, plot, lit spheres (open in a browser)"});
+        std::printf("\nreport: %s (%.0f KB, %.0f ms)\n", html_path.c_str(), doc.size() / 1024.0, ms_since(t_html));
+    }
+
     // 6. The zh3_q16 grid embedded in a glTF (ZHC_light_probes, docs/gltf-extension.md) of an
     // otherwise empty scene; `zhc gltf embed` does the same into a real scene.
     {
@@ -216,6 +276,7 @@ const VerbRegistration registration(10, [](CLI::App& app) -> std::function<int()
     sub->add_option("--threads", o->threads, "worker threads (outputs identical for any count; 0 = all cores)")
         ->check(CLI::Range(0, 256));
     sub->add_option("--directions", o->directions, "audit directions per probe")->check(CLI::Range(16, 1 << 16));
+    sub->add_option("--html", o->html, "where to write the HTML report (default: report.html in the output folder)");
     return [o] { return run(*o); };
 });
 
