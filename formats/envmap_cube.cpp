@@ -8,6 +8,9 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <vector>
+
+#include <zstd.h>
 
 #include "codec/bc6h.h"
 #include "codec/cubemap.h"
@@ -229,8 +232,9 @@ Result<Image> read_ktx2_cube(std::span<const std::uint8_t> b, const std::string&
     if (layers > 1)
         return fail(ErrorCode::kUnsupported, name, "KTX2 cube map array of " + std::to_string(layers) +
                                                        " layers (layerCount, byte 32): one cube map is read");
-    if (scheme != 0) {
-        const char* what = scheme == 1 ? "BasisLZ" : scheme == 2 ? "Zstandard" : scheme == 3 ? "ZLIB" : "unknown";
+    const bool zstd = scheme == 2;
+    if (scheme != 0 && !zstd) {
+        const char* what = scheme == 1 ? "BasisLZ" : scheme == 3 ? "ZLIB" : "unknown";
         return fail(ErrorCode::kUnsupported, name, "KTX2 supercompressionScheme " + std::to_string(scheme) + " (" + what +
                                                        ", byte 44) is not supported for cube maps");
     }
@@ -265,14 +269,15 @@ Result<Image> read_ktx2_cube(std::span<const std::uint8_t> b, const std::string&
                                                          ") lie beyond the file's " + std::to_string(size) + " bytes");
         end = std::max(end, r.offset + r.length);
     }
-    std::uint64_t level0_offset = 0;
+    std::uint64_t level0_offset = 0, level0_length = 0;
     for (int l = 0; l < levels; ++l) {
         const size_t at = kKtx2HeaderBytes + 24 * static_cast<size_t>(l);
         const std::uint64_t off = get64(b, at), len = get64(b, at + 8), ulen = get64(b, at + 16);
         const std::uint64_t want = 6 * face_bytes(f, w, l);
-        if (len != want || ulen != want)
-            return fail(ErrorCode::kBadFormat, name, "KTX2 level " + std::to_string(l) + " declares " + std::to_string(len) +
-                                                         " bytes (byte " + std::to_string(at + 8) + "); six faces of this size and format take " +
+        if (ulen != want || (!zstd && len != want) || (zstd && len == 0))
+            return fail(ErrorCode::kBadFormat, name, "KTX2 level " + std::to_string(l) + " declares " + std::to_string(len) + " / " +
+                                                         std::to_string(ulen) + " bytes (bytes " + std::to_string(at + 8) +
+                                                         ", " + std::to_string(at + 16) + "); six faces of this size and format take " +
                                                          std::to_string(want));
         if (off > size || len > size - off)
             return fail(ErrorCode::kTruncated, name, "KTX2 level " + std::to_string(l) + " (bytes " + std::to_string(off) + " + " +
@@ -281,20 +286,35 @@ Result<Image> read_ktx2_cube(std::span<const std::uint8_t> b, const std::string&
         if (off < index_end)
             return fail(ErrorCode::kBadFormat, name, "KTX2 level " + std::to_string(l) + " starts at byte " + std::to_string(off) +
                                                          ", inside the header and level index");
-        if (l == 0) level0_offset = off;
+        if (l == 0) level0_offset = off, level0_length = len;
         end = std::max(end, off + len);
     }
     if (end != size)
         return fail(ErrorCode::kTrailingBytes, name, std::to_string(size - end) + " trailing bytes after the KTX2 data (which ends at byte " +
                                                          std::to_string(end) + ")");
+    const std::uint64_t fb = face_bytes(f, w, 0);
+    const std::uint8_t* level0 = b.data() + level0_offset;
+    std::vector<std::uint8_t> inflated;
+    if (zstd) {
+        // Level 0 is one Zstandard frame whose content size must be the level's declared size
+        // (bounded by the pixel limit checked above) before the buffer is allocated.
+        const unsigned long long content = ZSTD_getFrameContentSize(level0, static_cast<size_t>(level0_length));
+        if (content != 6 * fb)
+            return fail(ErrorCode::kBadFormat, name, "KTX2 level 0 is not a Zstandard frame of " + std::to_string(6 * fb) +
+                                                         " bytes (supercompressionScheme 2)");
+        inflated.resize(static_cast<size_t>(6 * fb));
+        const size_t got = ZSTD_decompress(inflated.data(), inflated.size(), level0, static_cast<size_t>(level0_length));
+        if (ZSTD_isError(got) || got != inflated.size())
+            return fail(ErrorCode::kBadFormat, name, std::string("KTX2 level 0: Zstandard data is corrupt (") +
+                                                         (ZSTD_isError(got) ? ZSTD_getErrorName(got) : "short") + ")");
+        level0 = inflated.data();
+    }
     const int n = static_cast<int>(w);
     Image img = make_cube(n);
-    const std::uint64_t fb = face_bytes(f, w, 0);
-    for (int face = 0; face < 6; ++face)
-        decode_face(f, b.data() + level0_offset + static_cast<std::uint64_t>(face) * fb, n, face, img);
+    for (int face = 0; face < 6; ++face) decode_face(f, level0 + static_cast<std::uint64_t>(face) * fb, n, face, img);
     if (info) {
         info->format = "ktx2";
-        info->compression = "none";
+        info->compression = zstd ? "zstd" : "none";
         info->channels = f.channels;
         info->layout = "cube";
         info->part.clear();

@@ -5,11 +5,12 @@
 // lie inside the file and otherwise ignored).
 //
 // KTX2: faceCount 6, 2-D (pixelHeight > 0, pixelDepth 0), pixelWidth == pixelHeight, layerCount
-//   0 or 1, supercompressionScheme 0; vkFormat R16G16B16A16_SFLOAT (97), R16G16B16_SFLOAT (90),
+//   0 or 1, supercompressionScheme 0 (none) or 2 (Zstandard: level 0 is one frame whose content
+//   size is the level's uncompressedByteLength, checked before allocating); vkFormat R16G16B16A16_SFLOAT (97), R16G16B16_SFLOAT (90),
 //   R32G32B32A32_SFLOAT (109), R32G32B32_SFLOAT (106), E5B9G9R9_UFLOAT_PACK32 (123) or
 //   BC6H_UFLOAT_BLOCK (143, zhc's own decoder). Refused with kUnsupported (exit 5): other formats
 //   (BC6H_SFLOAT_BLOCK: zhc's BC6H decoder is unsigned only), faceCount 1 (a 2-D texture), cube
-//   arrays (layerCount > 1), 3-D textures, supercompression (BasisLZ, Zstandard, ZLIB).
+//   arrays (layerCount > 1), 3-D textures, supercompression BasisLZ (1) and ZLIB (3).
 // DDS: magic, DDS_HEADER (124 bytes), cube map with all six faces: legacy header (caps2
 //   DDSCAPS2_CUBEMAP and the six face flags) with FourCC 113 (D3DFMT_A16B16G16R16F) or 116
 //   (D3DFMT_A32B32G32R32F), or 'DX10' with DXGI_FORMAT R16G16B16A16_FLOAT (10), R32G32B32A32_FLOAT

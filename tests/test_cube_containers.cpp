@@ -15,6 +15,8 @@
 #include <cstring>
 #include <random>
 
+#include <zstd.h>
+
 #include "codec/bc6h.h"
 #include "codec/cubemap.h"
 #include "formats/envmap.h"
@@ -201,8 +203,10 @@ std::uint32_t vk_of(Fmt f) { return f == Fmt::kRgba16f ? 97 : f == Fmt::kRgba32f
 // KTX2: header, level index, a basic DFD-shaped block (not read by zhc), then the levels, smallest
 // first, each aligned to lcm(texel block size, 4). `levels` mip levels (box-filtered; the lower
 // levels are darker by `mip_scale` so that reading one instead of level 0 would show).
-std::vector<std::uint8_t> write_ktx2(const Image& cube, Fmt f, int levels = 1, float mip_scale = 1.0f) {
+// `zstd`: supercompressionScheme 2, each level one Zstandard frame (alignment 1).
+std::vector<std::uint8_t> write_ktx2(const Image& cube, Fmt f, int levels = 1, float mip_scale = 1.0f, bool zstd = false) {
     std::vector<std::vector<std::uint8_t>> data;
+    std::vector<std::uint64_t> raw_size;
     Image level = cube;
     for (int l = 0; l < levels; ++l) {
         std::vector<std::uint8_t> d;
@@ -211,10 +215,18 @@ std::vector<std::uint8_t> write_ktx2(const Image& cube, Fmt f, int levels = 1, f
             d.insert(d.end(), fb.begin(), fb.end());
         }
         data.push_back(d);
+        raw_size.push_back(d.size());
+        if (zstd) {
+            std::vector<std::uint8_t> z(ZSTD_compressBound(d.size()));
+            const size_t got = ZSTD_compress(z.data(), z.size(), d.data(), d.size(), 9);
+            EXPECT_FALSE(ZSTD_isError(got));
+            z.resize(got);
+            data.back() = z;
+        }
         level = half_cube(level);
         for (float& v : level.rgb) v *= mip_scale;
     }
-    const std::uint32_t align = f == Fmt::kBc6h ? 16 : f == Fmt::kRgba16f ? 8 : f == Fmt::kRgba32f ? 16 : 4;
+    const std::uint32_t align = zstd ? 1 : f == Fmt::kBc6h ? 16 : f == Fmt::kRgba16f ? 8 : f == Fmt::kRgba32f ? 16 : 4;
     const std::uint32_t dfd_len = 44;
     const std::uint64_t index_end = 80 + 24 * static_cast<std::uint64_t>(levels);
     std::vector<std::uint64_t> offset(static_cast<size_t>(levels));
@@ -233,7 +245,7 @@ std::vector<std::uint8_t> write_ktx2(const Image& cube, Fmt f, int levels = 1, f
     put32v(b, 0);  // layerCount
     put32v(b, 6);  // faceCount
     put32v(b, static_cast<std::uint32_t>(levels));
-    put32v(b, 0);  // supercompressionScheme
+    put32v(b, zstd ? 2 : 0);  // supercompressionScheme
     put32v(b, static_cast<std::uint32_t>(index_end));
     put32v(b, dfd_len);
     put32v(b, 0);
@@ -243,7 +255,7 @@ std::vector<std::uint8_t> write_ktx2(const Image& cube, Fmt f, int levels = 1, f
     for (int l = 0; l < levels; ++l) {
         put64v(b, offset[static_cast<size_t>(l)]);
         put64v(b, data[static_cast<size_t>(l)].size());
-        put64v(b, data[static_cast<size_t>(l)].size());
+        put64v(b, raw_size[static_cast<size_t>(l)]);
     }
     put32v(b, dfd_len);  // dfdTotalSize, then one basic descriptor block without samples' details
     put32v(b, 0);
@@ -420,6 +432,36 @@ TEST(CubeContainers, ConstantCubeHasOnlyL00) {
     }
 }
 
+TEST(CubeContainers, ZstdSupercompressedKtx2ReadsLikeTheRawOne) {
+    const Sh3Radiance a = test_sh();
+    const Image cube = render_cube(64, [&](Vec3 d) { return evaluate(a, d); });
+    for (Fmt f : {Fmt::kRgba16f, Fmt::kRgba32f, Fmt::kRgb9e5, Fmt::kBc6h}) {
+        SCOPED_TRACE(fmt_name(f));
+        EnvmapInfo info;
+        const auto raw = read(write_ktx2(cube, f, 3, 0.5f));
+        const auto z = read(write_ktx2(cube, f, 3, 0.5f, true), &info);
+        ASSERT_TRUE(raw && z) << (z ? "" : z.error().message);
+        EXPECT_EQ(raw->rgb, z->rgb);
+        EXPECT_EQ(info.compression, "zstd");
+    }
+    const auto small = write_ktx2(render_cube(4, [](Vec3) { return Rgb{1, 2, 3}; }), Fmt::kRgba16f, 3, 0.5f, true);
+    ASSERT_TRUE(read(small));
+    for (size_t len = 0; len < small.size(); ++len) {
+        auto r = read({small.begin(), small.begin() + static_cast<std::ptrdiff_t>(len)});
+        ASSERT_FALSE(r) << len;
+        EXPECT_TRUE(r.error().code == ErrorCode::kTruncated || r.error().code == ErrorCode::kBadFormat) << r.error().message;
+    }
+    // Every single-byte change is refused or read (never a crash; checked under the sanitizers).
+    for (size_t i = 0; i < small.size(); ++i) {
+        auto t = small;
+        t[i] ^= 0xA5;
+        auto r = read(t);
+        if (!r) {
+            EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
+        }
+    }
+}
+
 TEST(CubeContainers, MipChainsReadLevelZero) {
     // Lower levels scaled by 0.5 per level: reading any of them would change L00.
     const Sh3Radiance a = test_sh();
@@ -542,8 +584,16 @@ std::vector<Hostile> hostile_set() {
     test::put32(t, 32, 2);
     v.push_back({"array.ktx2", t, 5});
     t = ktx;
-    test::put32(t, 44, 2);
-    v.push_back({"zstd.ktx2", t, 5});
+    test::put32(t, 44, 2);  // says Zstandard, holds raw texels
+    v.push_back({"zstd_raw.ktx2", t, 4});
+    t = ktx;
+    test::put32(t, 44, 1);
+    v.push_back({"basislz.ktx2", t, 5});
+    const auto ktx_z = write_ktx2(cube, Fmt::kRgba16f, 2, 1.0f, true);
+    v.push_back({"good_zstd.ktx2", ktx_z, 0});
+    t = ktx_z;
+    t[t.size() - 3] ^= 0x55;  // level 0 is last in the file: damage its frame
+    v.push_back({"zstd_damaged.ktx2", t, 4});
     t = ktx;
     test::put32(t, 12, 144);
     test::put32(t, 16, 1);
