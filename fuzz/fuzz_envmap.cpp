@@ -1,5 +1,5 @@
 // Environment-map loading (OpenEXR through OpenEXR after zhc's header and chunk-table walk,
-// Radiance .hdr through zhc's own reader) from untrusted bytes; a successful load must be finite
+// Radiance .hdr and KTX2 / DDS cube maps through zhc's own readers) from untrusted bytes; a successful load must be finite
 // and in limits and project (lat-long or cube) to finite SH; an error is one non-empty line.
 #include <cmath>
 #include <cstdint>
