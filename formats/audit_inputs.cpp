@@ -63,7 +63,7 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         const Image ll = envmap_as_latlong(*img, std::max(512, 4 * img->width), std::max(256, 2 * img->width));
         in.map = downsample_for_audit({ll.rgb.data(), ll.width, ll.height});
         in.map_reference = integrate_irradiance(in.map.view(), dirs, options.threads);
-        in.description = std::string(img->layout == EnvmapLayout::kCubeOpenExr ? "cube " : "") + "environment map " + std::to_string(img->width) + "x" + std::to_string(img->height) +
+        in.description = std::string(img->layout != EnvmapLayout::kLatLong ? "cube " : "") + "environment map " + std::to_string(img->width) + "x" + std::to_string(img->height) +
                          ", reference: the map integrated at " + std::to_string(in.map.width) + "x" +
                          std::to_string(in.map.height);
         return in;

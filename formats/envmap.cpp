@@ -25,6 +25,7 @@
 #include <sstream>
 
 #include "codec/cubemap.h"
+#include "envmap_cube.h"
 #include "exr_memory.h"
 #include "file_io.h"
 
@@ -505,33 +506,19 @@ Result<Image> read_hdr(std::span<const std::uint8_t> bytes, const std::string& n
 Sh3Radiance project_envmap(const Image& image, int threads) {
     if (image.layout == EnvmapLayout::kCubeOpenExr)
         return project_cube_openexr(image.rgb.data(), image.width, static_cast<size_t>(image.width) * 3, threads);
+    if (image.layout == EnvmapLayout::kCubeVulkan)
+        return project_cube(kCubeLayoutVulkan, image.rgb.data(), image.width, static_cast<size_t>(image.width) * 3,
+                            threads);
     return project_latlong(image.rgb.data(), image.width, image.height, static_cast<size_t>(image.width) * 3, threads);
 }
 
 namespace {
-// Pixel of an OpenEXR cube map (face size n) seen in zhc direction d: the inverse of
-// cube_openexr_direction, rounded to the nearest pixel centre.
+// Pixel of a cube map seen in zhc direction d: the nearest pixel centre.
 const float* cube_pixel(const Image& cube, Vec3 d) {
-    const double x = d.y, y = d.z, z = d.x;  // OpenEXR frame
-    const double ax = std::fabs(x), ay = std::fabs(y), az = std::fabs(z);
-    int face;
-    double u, v;
-    if (ax >= ay && ax >= az) {
-        face = x > 0 ? 0 : 1;
-        u = (x > 0 ? z : -z) / ax;
-        v = -y / ax;
-    } else if (ay >= az) {
-        face = y > 0 ? 2 : 3;
-        u = x / ay;
-        v = (y > 0 ? -z : z) / ay;
-    } else {
-        face = z > 0 ? 4 : 5;
-        u = (z > 0 ? -x : x) / az;
-        v = -y / az;
-    }
-    const int n = cube.width;
-    auto index = [&](double t) { return std::clamp(static_cast<int>(std::lround((t + 1.0) * 0.5 * (n - 1))), 0, n - 1); };
-    return cube.row(face * n + index(v)) + 3 * static_cast<size_t>(index(u));
+    const CubeLayout& layout = cube.layout == EnvmapLayout::kCubeVulkan ? kCubeLayoutVulkan : kCubeLayoutOpenExr;
+    int face, col, row;
+    cube_nearest_pixel(layout, d, cube.width, &face, &col, &row);
+    return cube.row(face * cube.width + row) + 3 * static_cast<size_t>(col);
 }
 }  // namespace
 
@@ -556,14 +543,23 @@ Image envmap_as_latlong(const Image& image, int width, int height) {
     return out;
 }
 
-bool looks_like_envmap(std::span<const std::uint8_t> bytes) { return is_exr(bytes) || is_radiance(bytes); }
+bool looks_like_envmap(std::span<const std::uint8_t> bytes) {
+    return is_exr(bytes) || is_radiance(bytes) || ktx2_declares_cube(bytes) || dds_declares_cube(bytes);
+}
 
 Result<Image> read_envmap_memory(std::span<const std::uint8_t> bytes, const std::string& name,
                                  const EnvmapReadOptions& options, EnvmapInfo* info) {
     if (bytes.empty()) return make_error(ErrorCode::kTruncated, name + ": file is empty");
     if (is_exr(bytes)) return read_exr(bytes, name, options, info);
     if (is_radiance(bytes)) return read_hdr(bytes, name, options, info);
-    return make_error(ErrorCode::kBadFormat, name + ": not an OpenEXR or Radiance .hdr image (unknown magic bytes)");
+    if (is_ktx2(bytes) || is_dds(bytes)) {
+        auto img = is_ktx2(bytes) ? read_ktx2_cube(bytes, name, options, info) : read_dds_cube(bytes, name, options, info);
+        if (!img) return img.error();
+        if (Status s = check_finite(name, *img, options, info); !s) return s.error();
+        return img;
+    }
+    return make_error(ErrorCode::kBadFormat,
+                      name + ": not an OpenEXR, Radiance .hdr, KTX2 or DDS image (unknown magic bytes)");
 }
 
 Result<Image> read_envmap(const std::string& path, const EnvmapReadOptions& options, EnvmapInfo* info) {

@@ -9,7 +9,9 @@
 //
 // EXR files whose "envmap" attribute says cube (OpenEXR's cube layout, N x 6N, see
 // codec/cubemap.h) are read as cube maps: Image::layout tells the two apart, and
-// project_envmap projects either with exact per-pixel solid angles.
+// project_envmap projects either with exact per-pixel solid angles. KTX2 and DDS cube maps (the
+// containers game engines use for reflection/irradiance probes) are read in the graphics APIs'
+// cube layout (kCubeVulkan, codec/cubemap.h; formats/envmap_cube.h lists the variants).
 #pragma once
 
 #include <cstdint>
@@ -24,7 +26,8 @@ namespace zhc {
 
 enum class EnvmapLayout {
     kLatLong,     // docs/conventions.md
-    kCubeOpenExr  // OpenEXR's cube layout: width N, height 6N, faces +X -X +Y -Y +Z -Z (codec/cubemap.h)
+    kCubeOpenExr,  // OpenEXR's cube layout: width N, height 6N, faces +X -X +Y -Y +Z -Z (codec/cubemap.h)
+    kCubeVulkan    // KTX2 / DDS: width N, height 6N, faces +X -X +Y -Y +Z -Z of Vulkan's / D3D's table
 };
 
 // An owning RGB float image, interleaved, rows top to bottom.
@@ -52,18 +55,18 @@ struct EnvmapReadOptions {
 };
 
 struct EnvmapInfo {
-    std::string format;       // "openexr" or "radiance-hdr"
+    std::string format;       // "openexr", "radiance-hdr", "ktx2" or "dds"
     std::string compression;  // EXR compression name, "rle" or "flat" for .hdr
     std::string channels;     // e.g. "RGBA half"
     std::uint64_t replaced_non_finite = 0;
-    std::string layout = "lat-long";  // or "cube" (OpenEXR layout)
+    std::string layout = "lat-long";  // or "cube" (OpenEXR's or, for KTX2 / DDS, the APIs' layout)
     std::string part;                 // EXR: the part read ("#index" when it has no name)
 };
 
 // Reads an EXR (RGB or RGBA or Y or luminance/chroma Y RY BY, half/float/uint, any compression
 // OpenEXR supports, scanline or tiled, single- or multi-part, lat-long or cube) or a Radiance .hdr
-// (RGBE or XYZE, any of the eight orientations), detected by its magic bytes (not by the
-// extension). Bytes after the data are an error (kTrailingBytes). See docs/inputs.md.
+// (RGBE or XYZE, any of the eight orientations) or a KTX2 / DDS cube map (formats/envmap_cube.h),
+// detected by its magic bytes (not by the extension). Bytes after the data are an error (kTrailingBytes). See docs/inputs.md.
 Result<Image> read_envmap(const std::string& path, const EnvmapReadOptions& options = {},
                           EnvmapInfo* info = nullptr);
 // The same from bytes in memory; `name` is used in messages. Safe for untrusted input.
@@ -78,7 +81,8 @@ Sh3Radiance project_envmap(const Image& image, int threads = 1);
 // the cube (nearest pixel), for consumers that need lat-long pixels (the audit reference).
 Image envmap_as_latlong(const Image& image, int width, int height);
 
-// True when the bytes start like an EXR or a Radiance file.
+// True when the bytes start like an EXR or a Radiance file, or a KTX2 / DDS file whose header says
+// cube map (a 2-D KTX2 / DDS is a lightmap texture, not an environment map).
 bool looks_like_envmap(std::span<const std::uint8_t> bytes);
 
 // Writes a float RGB OpenEXR (ZIP compression), atomically.
