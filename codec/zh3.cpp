@@ -204,8 +204,12 @@ double channel_objective_vec(const Target& t, int k, Vec3 x, Vec3* grad) {
 // iterates for the same initial matrix. Initial inverse Hessian: h0 * I, or with `rescale` the
 // N&W Eq. 7.20 scaling s.y / y.y of the latest pair. Few function evaluations per iteration: the
 // full step is tried first and then shrunk by a safeguarded quadratic interpolation.
-template <int N, int M, class F>
-int lbfgs(F&& f, double* x, double* fx, int max_iterations, double gradient_tolerance, double h0, bool rescale) {
+//
+// `known(x)` ends the run early when x has reached (the basin of) a minimum already found by an
+// earlier start: it is checked before every iteration.
+template <int N, int M, class F, class K>
+int lbfgs(F&& f, K&& known, double* x, double* fx, int max_iterations, double gradient_tolerance, double h0,
+          bool rescale) {
     // Every constant below is either relative or, for the absolute ones (1e-300), meant for the
     // normalised problems the callers pass in (|target| in [1, 2), see normalised_target()).
     double g[N], gn[N], xn[N], p[N], q[N];
@@ -217,7 +221,7 @@ int lbfgs(F&& f, double* x, double* fx, int max_iterations, double gradient_tole
     for (; it < max_iterations; ++it) {
         double gg = 0;
         for (int i = 0; i < N; ++i) gg += g[i] * g[i];
-        if (!(std::sqrt(gg) > gradient_tolerance)) break;
+        if (!(std::sqrt(gg) > gradient_tolerance) || known(x)) break;
         // Two-loop recursion: p = -H g.
         for (int i = 0; i < N; ++i) q[i] = g[i];
         for (int j = 0; j < stored; ++j) {
@@ -488,7 +492,8 @@ Zh3 solve_luminance(const Sh3Radiance& sh, const CodecOptions& o, EncodeStats* s
             x[3 * k + 2] = g.z;
         }
         double e = 0;
-        iterations += lbfgs<9, 8>([&](const double* xx, double* gg) { return lum_objective_vec(tn, w, xx, gg); }, x,
+        iterations += lbfgs<9, 8>([&](const double* xx, double* gg) { return lum_objective_vec(tn, w, xx, gg); },
+                                  [](const double*) { return false; }, x,
                                   &e, o.solver_iterations, o.solver_tolerance * scale_n, 0.5, false);
         {
             // Re-inflate a luminance L1 the solve shrank towards zero (see min_length).
@@ -558,6 +563,19 @@ Zh3 solve_channel(const Sh3Radiance& sh, const CodecOptions& o, EncodeStats* sta
         // initial inverse Hessian by it (the axis has unit length).
         const double h0 = 1.0 / std::max(2.0 * (tn.t1sq[k] + 6.0 * tn.t2sq[k]), 1e-300);
         const int starts = std::min(count, kChannelStarts);
+        // Axes the earlier starts converged to: a later start that comes within ~1e-3 rad of one
+        // (as an axis: +-) is in that minimum's basin and stops there.
+        Vec3 found[kChannelStarts];
+        int found_count = 0;
+        auto known = [&](const double* xx) {
+            const Vec3 v{xx[0], xx[1], xx[2]};
+            const double vv = dot(v, v);
+            for (int j = 0; j < found_count; ++j) {
+                const double d = dot(v, found[j]);
+                if (d * d > (1.0 - 1e-6) * vv) return true;
+            }
+            return false;
+        };
         for (int c = 0; c < starts; ++c) {
             double x[3] = {cand[c].axis.x, cand[c].axis.y, cand[c].axis.z};
             double en = 0;
@@ -570,8 +588,9 @@ Zh3 solve_channel(const Sh3Radiance& sh, const CodecOptions& o, EncodeStats* sta
                     gg[2] = grad.z;
                     return v2;
                 },
-                x, &en, o.solver_iterations, o.solver_tolerance * scale_n2, h0, true);
+                known, x, &en, o.solver_iterations, o.solver_tolerance * scale_n2, h0, true);
             const Vec3 a = normalize_or({x[0], x[1], x[2]}, {0, 0, 1});
+            if (!known(x)) found[found_count++] = a;
             // L1 = projection of t1 on a, kept non-zero so the decoder recovers the axis.
             double p = dot(a, t.t1[k]);
             const double min_length = 1e-3 * scale;

@@ -518,6 +518,7 @@ TEST(Zh3Solve, ResultAndIterationsDoNotDependOnTheLightingsUnits) {
     for (const Sh3Radiance& p : probes)
         for (const ZonalAxisMode mode : {ZonalAxisMode::kLuminance, ZonalAxisMode::kPerChannel}) {
             EncodeStats st1;
+            if (std::getenv("ZHC_DBG_PROBE") && size_t(&p - probes.data()) != size_t(std::atoi(std::getenv("ZHC_DBG_PROBE")))) continue;
             const std::vector<double> v1 = solved_values(zh3_solve(p, mode, o, &st1));
             its[int(mode)] += st1.solver_iterations;
             double norm = 0;
@@ -531,6 +532,8 @@ TEST(Zh3Solve, ResultAndIterationsDoNotDependOnTheLightingsUnits) {
                 ++solves;
                 mismatched_iterations += st.solver_iterations != st1.solver_iterations;
                 mism[int(mode)] += st.solver_iterations != st1.solver_iterations;
+                if (std::getenv("ZHC_TEST_DEBUG") && st.solver_iterations != st1.solver_iterations)
+                    std::printf("probe %zu scale 1e%d: %d vs %d\n", size_t(&p - probes.data()), e, st.solver_iterations, st1.solver_iterations);
                 EXPECT_EQ(st.solver_iterations, st1.solver_iterations)
                     << "scale 1e" << e << (mode == ZonalAxisMode::kLuminance ? " lum" : " channel");
                 double d = 0;
