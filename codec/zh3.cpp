@@ -556,7 +556,11 @@ Zh3 solve_channel(const Sh3Radiance& sh, const CodecOptions& o, EncodeStats* sta
         double q[3][3];
         l2_quadratic_form(tn.t2[k], q);
         Vec3 e[3];
-        const int n = traceless_eigenvectors(q, e, tn.t1[k]);
+        // The first two are the eigenvectors of the largest and smallest eigenvalue, where |Y2(a).t2| is
+        // locally largest (local minima of the L2 part). The third (middle eigenvalue: a saddle, or
+        // the in-plane axis across the L1 for a repeated eigenvalue) is a stationary point where the
+        // solve would crawl for many iterations before rolling into one of the others' basins.
+        const int n = std::min(traceless_eigenvectors(q, e, tn.t1[k]), 2);
         for (int j = 0; j < n; ++j) add_candidate(cand, &count, e[j], profile(e[j]));
         sort_candidates(cand, count);
         // Curvature of E along the sphere is about 2 |t1|^2 + 12 (4 pi / 5) |h| |t2|: scale the
