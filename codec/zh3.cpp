@@ -384,7 +384,7 @@ void add_candidate(Candidate* list, int* count, Vec3 axis, double error) {
 
 // Best (lowest profile error) first.
 void sort_candidates(Candidate* list, int count) {
-    for (int i = 1; i < count; ++i)  // insertion sort: at most 7 entries
+    for (int i = 1; i < count; ++i)  // insertion sort: at most 13 entries
         for (int j = i; j > 0 && list[j].error < list[j - 1].error; --j) std::swap(list[j], list[j - 1]);
 }
 
@@ -454,7 +454,7 @@ Zh3 solve_luminance(const Sh3Radiance& sh, const CodecOptions& o, EncodeStats* s
     };
     // Start axes: the luminance L1 axis (the fit's) and the principal axes of the luminance L2
     // quadratic form (where a zonal L2 lobe fits best).
-    Candidate cand[4];
+    Candidate cand[13];
     int count = 0;
     if (has_zonal_axis(fit.linear, ZonalAxisMode::kLuminance, 0, lw)) add_candidate(cand, &count, fit_axis, f * f * fit_error);
     {
@@ -467,6 +467,13 @@ Zh3 solve_luminance(const Sh3Radiance& sh, const CodecOptions& o, EncodeStats* s
         Vec3 e[3];
         const int n = traceless_eigenvectors(q, e, u);
         for (int j = 0; j < n; ++j) add_candidate(cand, &count, e[j], profile(e[j]));
+        for (int k = 0; k < 3; ++k) {  // each channel's own L1 and L2 principal axes, ranked too
+            const double len = length(tn.t1[k]);
+            if (usable_length(len)) add_candidate(cand, &count, (1.0 / len) * tn.t1[k], profile((1.0 / len) * tn.t1[k]));
+            l2_quadratic_form(tn.t2[k], qk);
+            const int nk = std::min(traceless_eigenvectors(qk, e, tn.t1[k]), 2);
+            for (int j = 0; j < nk; ++j) add_candidate(cand, &count, e[j], profile(e[j]));
+        }
     }
     if (count == 0) return fit;
     sort_candidates(cand, count);
