@@ -19,11 +19,12 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Start axes (see solve_luminance / solve_channel). The shared-axis solve runs L-BFGS from the best
-// ranked start only: on the bench set (8 maps x 64 rotations + 512 random lightings) a second start
-// left its converged mean error unchanged (to 6 digits) at twice the cost, and a brute-force axis
-// search over 10,000 random probes finds nothing better (tests/test_zh3.cpp). The per-channel solve
-// runs from every distinct start (the channel's L1 axis and the principal axes of its L2 form): from
-// the best-ranked start alone it stopped in a poorer local minimum on about 1 random probe in 300.
+// ranked start only: a second start left its converged mean error on the bench set unchanged (to 6
+// digits) at 1.3-2x the cost and did not move its worst case against a brute-force axis search
+// (10,000 random lightings: mean 1.000006, worst 1.029, 3 probes above 0.1 %). The per-channel
+// solve runs from every distinct start (the channel's L1 axis and two principal axes of its L2
+// form): from the best-ranked start alone it stopped in a poorer local minimum on about 1 random
+// probe in 300; now never more than 0.1 % above the brute force on those 10,000 (tests/test_zh3.cpp).
 constexpr int kLumStarts = 1;
 constexpr int kChannelStarts = 4;
 // Relative step below which L-BFGS stops (|x_new - x| <= kStepTolerance |x|): the iteration cap is
@@ -452,8 +453,9 @@ Zh3 solve_luminance(const Sh3Radiance& sh, const CodecOptions& o, EncodeStats* s
         const double ua = dot(u, a);
         return (uu - ua * ua) / ww + l2_residual_sum(tn, a);
     };
-    // Start axes: the luminance L1 axis (the fit's) and the principal axes of the luminance L2
-    // quadratic form (where a zonal L2 lobe fits best).
+    // Start axes: the luminance L1 axis (the fit's), the principal axes of the luminance L2
+    // quadratic form (where a zonal L2 lobe fits best), and each channel's L1 axis and L2 principal
+    // axes (largest and smallest eigenvalue), all ranked by their profile error.
     Candidate cand[13];
     int count = 0;
     if (has_zonal_axis(fit.linear, ZonalAxisMode::kLuminance, 0, lw)) add_candidate(cand, &count, fit_axis, f * f * fit_error);
