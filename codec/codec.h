@@ -34,9 +34,10 @@ enum class L2Bound : std::uint8_t { kTight = 0, kLoose = 1 };
 // container stores the ones that change the meaning of stored bytes.
 struct CodecOptions {
     LuminanceWeights luminance;
-    // ZH3 axis solve (ZH3 paper Sec. 3.3): BFGS iterations and gradient-norm tolerance.
-    int solver_iterations = 32;
-    double solver_tolerance = 1e-7;
+    // ZH3 axis solve (ZH3 paper Sec. 3.3): L-BFGS iteration cap per start (a convergence guard; the
+    // solves stop on the relative gradient or step first) and the relative gradient tolerance.
+    int solver_iterations = 200;
+    double solver_tolerance = 1e-5;
     // Curve-fit hallucination, ZH3 paper Eq. 21: f20 = (a p^2 + b p) f0.
     double hallucinate_a = 0.6;
     double hallucinate_b = 0.08;

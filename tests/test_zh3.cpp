@@ -1,6 +1,9 @@
 // Properties of the ZH3 representations (codec/zh3.h, codec/zh3.cpp): fit, luminance axis, axis
 // solve, hallucination, ZH3 deringing — on analytic cases and on the eight real maps.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <random>
@@ -454,6 +457,210 @@ TEST(Zh3Solve, ReachesTheBestAxisFoundByExhaustiveSearch) {
         }
         EXPECT_LE(got, best + 1e-5 * (1 + best));
     }
+}
+
+// ---- scale invariance (issue 18, finding 1) -------------------------------------------------------
+
+Sh3Radiance scaled(const Sh3Radiance& in, double s) {
+    Sh3Radiance out;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) out[i][k] = static_cast<float>(s * in[i][k]);
+    return out;
+}
+
+// The stored floats of a ZH3 (nine L1 + three zonal; DC is copied and not solved).
+std::vector<double> solved_values(const Zh3& z) {
+    std::vector<double> v;
+    for (int i = 1; i < 4; ++i)
+        for (int k = 0; k < 3; ++k) v.push_back(z.linear[i][k]);
+    for (int k = 0; k < 3; ++k) v.push_back(z.zonal[k]);
+    return v;
+}
+
+std::vector<Sh3Radiance> scale_test_probes() {
+    Rng rng(40);
+    std::vector<Sh3Radiance> probes;
+    for (const RealMap& m : real_maps()) {
+        probes.push_back(m.sh);
+        for (int r = 0; r < 2; ++r) probes.push_back(rotate(m.sh, random_rotation(rng)));
+    }
+    for (int i = 0; i < 120; ++i) probes.push_back(random_lighting(rng));
+    return probes;
+}
+
+TEST(Zh3Solve, PowerOfTwoScalingGivesBitIdenticalSolves) {
+    // Normalising by a power of two is exact, so 2^n-scaled probes (far beyond the power-of-ten range
+    // below) must give exactly 2^n times the result with the same iterations.
+    for (const Sh3Radiance& p : scale_test_probes())
+        for (const ZonalAxisMode mode : {ZonalAxisMode::kLuminance, ZonalAxisMode::kPerChannel}) {
+            EncodeStats st1;
+            const Zh3 r1 = zh3_solve(p, mode, {}, &st1);
+            const std::vector<double> v1 = solved_values(r1);
+            for (const int n : {-60, -27, -1, 1, 33, 60}) {
+                const double s = std::ldexp(1.0, n);
+                EncodeStats st;
+                const std::vector<double> v = solved_values(zh3_solve(scaled(p, s), mode, {}, &st));
+                EXPECT_EQ(st.solver_iterations, st1.solver_iterations) << "2^" << n;
+                for (size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], s * v1[i]) << "2^" << n << " value " << i;
+            }
+        }
+}
+
+TEST(Zh3Solve, ResultAndIterationsDoNotDependOnTheLightingsUnits) {
+    // Scales 1e-8 .. 1e8: the solved coefficients are s times the scale-1 ones within 1e-6 of the
+    // result's norm, with identical iteration counts. (The scaled probe is rounded to float, so it is
+    // not exactly s times the original: this also checks that the solves are not fragile to that.)
+    const std::vector<Sh3Radiance> probes = scale_test_probes();
+    const CodecOptions o;
+    int mismatched_iterations = 0, solves = 0, mism[2] = {0, 0}, its[2] = {0, 0};
+    double worst = 0;
+    for (const Sh3Radiance& p : probes)
+        for (const ZonalAxisMode mode : {ZonalAxisMode::kLuminance, ZonalAxisMode::kPerChannel}) {
+            EncodeStats st1;
+            const std::vector<double> v1 = solved_values(zh3_solve(p, mode, o, &st1));
+            its[int(mode)] += st1.solver_iterations;
+            double norm = 0;
+            for (const double x : v1) norm += x * x;
+            norm = std::sqrt(norm);
+            for (int e = -8; e <= 8; ++e) {
+                if (e == 0) continue;
+                const double s = std::pow(10.0, e);
+                EncodeStats st;
+                const std::vector<double> v = solved_values(zh3_solve(scaled(p, s), mode, o, &st));
+                ++solves;
+                mismatched_iterations += st.solver_iterations != st1.solver_iterations;
+                mism[int(mode)] += st.solver_iterations != st1.solver_iterations;
+                EXPECT_EQ(st.solver_iterations, st1.solver_iterations)
+                    << "scale 1e" << e << (mode == ZonalAxisMode::kLuminance ? " lum" : " channel");
+                double d = 0;
+                for (size_t i = 0; i < v.size(); ++i) d += (v[i] / s - v1[i]) * (v[i] / s - v1[i]);
+                const double rel = std::sqrt(d) / norm;
+                worst = std::max(worst, rel);
+                EXPECT_LE(rel, 1e-6) << "scale 1e" << e;
+            }
+        }
+    std::printf("scale invariance: %d solves at scales 1e-8..1e8, %d with a different iteration count (lum %d, channel %d;"
+                " mean iterations lum %.2f channel %.2f), worst relative difference %.3g\n", solves, mismatched_iterations,
+                mism[0], mism[1], double(its[0]) / probes.size(), double(its[1]) / probes.size(), worst);
+}
+
+// ---- multi-start against a brute-force axis search (issue 18, finding 2) ---------------------------
+
+// Slow twin of an axis solve: the objective on a Fibonacci sphere of `dirs`, then a compass search
+// on the tangent plane from each of the best grid points that are at least 0.3 rad apart (as axes),
+// step halved down to 1e-10 rad. Returns the lowest value found.
+template <class F>
+double brute_force_axis_min(F&& objective, const std::vector<Vec3>& dirs) {
+    std::vector<std::pair<double, int>> values;
+    values.reserve(dirs.size());
+    for (size_t i = 0; i < dirs.size(); ++i) values.push_back({objective(dirs[i]), static_cast<int>(i)});
+    std::sort(values.begin(), values.end());
+    std::vector<Vec3> seeds;
+    for (const auto& [v, i] : values) {
+        if (seeds.size() >= 6) break;
+        bool far = true;
+        for (const Vec3 q : seeds) far = far && std::fabs(dot(q, dirs[i])) < std::cos(0.3);
+        if (far) seeds.push_back(dirs[i]);
+    }
+    double best = values.front().first;
+    const double spacing = std::sqrt(4 * kPi / dirs.size());
+    for (Vec3 a : seeds) {
+        double e = objective(a), h = spacing;
+        for (int evals = 0; h > 1e-10 && evals < 20000;) {
+            const Vec3 helper = std::fabs(a.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+            const Vec3 u = normalize_or(cross(a, helper), {0, 0, 1}), v = cross(a, u);
+            bool moved = false;
+            for (const Vec3 d : {u, -1.0 * u, v, -1.0 * v}) {
+                const Vec3 b = normalize_or(a + h * d, a);
+                const double eb = objective(b);
+                ++evals;
+                if (eb < e) {
+                    a = b;
+                    e = eb;
+                    moved = true;
+                    break;
+                }
+            }
+            if (!moved) h *= 0.5;
+        }
+        best = std::min(best, e);
+    }
+    return best;
+}
+
+// Eq. 11 of channel k alone, as decoded (zh3_eq11_error on the channel with the others zeroed).
+double channel_eq11(const Sh3Radiance& in, const Sh2Radiance& linear, int k) {
+    Sh3Radiance tk;
+    Sh2Radiance lk;
+    for (int i = 0; i < 9; ++i) tk[i][k] = in[i][k];
+    for (int i = 0; i < 4; ++i) lk[i][k] = linear[i][k];
+    return zh3_eq11_error(tk, lk, ZonalAxisMode::kPerChannel, {});
+}
+
+// Profile of the shared-axis objective: the best nine L1 coefficients for a fixed axis a (see
+// docs/zh3.md) evaluated through the public objective.
+double lum_profile(const Sh3Radiance& in, const LuminanceWeights& w, Vec3 a) {
+    const double wv[3] = {w.r, w.g, w.b}, ww = wv[0] * wv[0] + wv[1] * wv[1] + wv[2] * wv[2];
+    Vec3 u{};
+    for (int k = 0; k < 3; ++k) u = u + wv[k] * Vec3{-in[3][k] * 2 / 3.0, -in[1][k] * 2 / 3.0, in[2][k] * 2 / 3.0};
+    const Vec3 shift = (1.0 / ww) * (u - dot(u, a) * a);
+    double g[9];
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 t{-in[3][k] * 2 / 3.0, -in[1][k] * 2 / 3.0, in[2][k] * 2 / 3.0};
+        const Vec3 v = t - wv[k] * shift;
+        g[0 + k] = -v.y;
+        g[3 + k] = v.z;
+        g[6 + k] = -v.x;
+    }
+    return zh3_lum_objective(in, w, g, nullptr);
+}
+
+TEST(Zh3Solve, NeverMoreThanATenthOfAPercentAboveABruteForceAxisSearch) {
+    // Random lightings (several coloured lights + ambient). ZHC_ZH3_BRUTE_PROBES overrides the count
+    // (the notes give a 10,000-probe run); 2,000 keeps the sanitizer build quick.
+    int probes = 2000;
+    if (const char* env = std::getenv("ZHC_ZH3_BRUTE_PROBES")) probes = std::max(1, std::atoi(env));
+    const auto dirs = fibonacci_directions(3000);
+    const LuminanceWeights w;
+    Rng rng(41);
+    double sum_ratio[2] = {0, 0}, worst_ratio[2] = {0, 0};
+    int count[2] = {0, 0}, above[2] = {0, 0};
+    for (int trial = 0; trial < probes; ++trial) {
+        const Sh3Radiance in = random_lighting(rng);
+        EncodeStats st;
+        const Zh3 chan = zh3_solve(in, ZonalAxisMode::kPerChannel, {}, &st);
+        for (int k = 0; k < 3; ++k) {
+            const double got = channel_eq11(in, chan.linear, k);
+            const double brute =
+                brute_force_axis_min([&](Vec3 a) { return zh3_channel_objective(in, k, a, nullptr); }, dirs);
+            const double scale = double(in[0][k]) * in[0][k];
+            EXPECT_LE(got, 1.001 * brute + 1e-12 * scale) << "probe " << trial << " channel " << k;
+            if (brute > 1e-9 * scale) {
+                const double r = got / brute;
+                sum_ratio[1] += r;
+                worst_ratio[1] = std::max(worst_ratio[1], r);
+                above[1] += r > 1.001;
+                ++count[1];
+            }
+        }
+        const Zh3 lum = zh3_solve(in, ZonalAxisMode::kLuminance, {}, nullptr);
+        const double got = zh3_eq11_error(in, lum.linear, ZonalAxisMode::kLuminance, w);
+        const double brute = brute_force_axis_min([&](Vec3 a) { return lum_profile(in, w, a); }, dirs);
+        const double scale = double(in[0][1]) * in[0][1];
+        // Reported, not asserted: the shared-axis solve still runs from its best-ranked start only
+        // (see the notes: about 1 probe in 1,000 ends more than 0.1 % above the brute force).
+        if (brute > 1e-9 * scale) {
+            const double r = got / brute;
+            sum_ratio[0] += r;
+            worst_ratio[0] = std::max(worst_ratio[0], r);
+            above[0] += r > 1.001;
+            ++count[0];
+        }
+    }
+    std::printf("vs brute force (%d random lightings): lum mean ratio %.6f worst %.6f (%d > 1.001); per-channel mean"
+                " %.6f worst %.6f (%d of %d channels > 1.001)\n",
+                probes, sum_ratio[0] / std::max(count[0], 1), worst_ratio[0], above[0], sum_ratio[1] / std::max(count[1], 1),
+                worst_ratio[1], above[1], count[1]);
 }
 
 TEST(Zh3Solve, DegenerateZeroL1GivesFiniteOutputAndFindsTheZonalAxis) {
