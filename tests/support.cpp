@@ -1,5 +1,11 @@
 #include "support.h"
 
+#include <cmath>
+
+#include <algorithm>
+
+#include <cstdlib>
+
 #include <random>
 
 #include <sys/wait.h>
@@ -31,6 +37,15 @@ Image load_envmap(const std::string& path) {
 }
 
 std::string envmap_name(const std::string& path) { return fs::path(path).stem().string(); }
+
+long sample_count(long n) {
+    static const double scale = [] {
+        const char* v = std::getenv("ZHC_TEST_SAMPLE_SCALE");
+        const double s = v ? std::strtod(v, nullptr) : 1.0;
+        return (s > 0.0 && s <= 1.0) ? s : 1.0;
+    }();
+    return std::max(std::min(n, 1000L), static_cast<long>(std::llround(double(n) * scale)));
+}
 
 std::vector<Vec3> fibonacci_directions(int n) {
     std::vector<Vec3> out;

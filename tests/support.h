@@ -22,6 +22,13 @@ std::string envmap_name(const std::string& path);
 
 // n directions spread uniformly over the sphere (spherical Fibonacci lattice).
 std::vector<Vec3> fibonacci_directions(int n);
+
+// Sample counts of the large statistical comparisons (the runtime decoders against the codec on
+// 100,000 probes per encoding): n times ZHC_TEST_SAMPLE_SCALE from the environment (a number in
+// (0, 1]; default 1), at least min(n, 1000). scripts/sanitize.sh sets 0.1: the sanitizer pass looks
+// for memory errors and undefined behaviour on the same code paths, the Release pass (full
+// counts) for the statistics. Thresholds never change.
+long sample_count(long n);
 // Uniform random unit vector from two uniforms in [0, 1).
 Vec3 uniform_direction(double u1, double u2);
 

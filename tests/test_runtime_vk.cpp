@@ -401,7 +401,8 @@ TEST(RuntimeVkTable, EveryCodecHasAnHlslEncoding) {
 // >= 100,000 probes per encoding with the codec table's defaults: 30k lights, 20k random SH, 30k
 // sample maps under random rotations, 20k random bytes.
 TEST_F(RuntimeVk, EveryEncodingMatchesTheCodec) {
-    const std::size_t counts[4] = {30000, 20000, 30000, 20000};
+    const std::size_t counts[4] = {std::size_t(test::sample_count(30000)), std::size_t(test::sample_count(20000)),
+                                   std::size_t(test::sample_count(30000)), std::size_t(test::sample_count(20000))};
     std::printf("%-22s %8s %10s %12s %9s %9s\n", "encoding", "items", "err/epsT", "max|dE|/E", "nonfinite", "ill-cond");
     for (const Codec& codec : codecs()) {
         Stats st;
@@ -411,7 +412,7 @@ TEST_F(RuntimeVk, EveryEncodingMatchesTheCodec) {
         }
         std::printf("%-22s %8zu %10.3f %12.3g %9zu %9zu\n", std::string(codec.name).c_str(), st.items, st.max_rel,
                     st.max_rel_irr, st.nonfinite, st.ill_conditioned);
-        EXPECT_GE(st.items, 100000u);
+        EXPECT_GE(st.items, std::size_t(test::sample_count(100000)));
         EXPECT_EQ(st.failures, 0u) << st.failures << " items out of bound; first: " << st.first_failure;
         EXPECT_LE(st.ill_conditioned, st.items / 1000) << codec.name;
         results()[std::string(codec.name)] = st;
