@@ -16,8 +16,8 @@ export function glb(jsonObj, bin) {
   return Buffer.concat([header, c0, jsonBytes, c1, binPadded]);
 }
 
-// One triangle with a material.
-export function triangleScene() {
+// One triangle with a material: the glTF JSON and its binary chunk.
+export function triangleSceneParts() {
   const tri = Buffer.from(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]).buffer);
   const scene = {
     asset: { version: '2.0', generator: 'zhc tests/js' },
@@ -30,7 +30,13 @@ export function triangleScene() {
     bufferViews: [{ buffer: 0, byteOffset: 0, byteLength: tri.length, target: 34962 }],
     accessors: [{ bufferView: 0, componentType: 5126, count: 3, type: 'VEC3', min: [0, 0, 0], max: [1, 1, 0] }],
   };
-  return glb(scene, tri);
+  return { json: scene, bin: tri };
+}
+
+// The same as a GLB.
+export function triangleScene() {
+  const { json, bin } = triangleSceneParts();
+  return glb(json, bin);
 }
 
 // Deterministic LCG in [0, 1).

@@ -15,7 +15,7 @@ import { execFileSync } from 'node:child_process';
 import { register } from 'node:module';
 import validator from 'gltf-validator';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
-import { glb } from './fixtures.mjs';
+import { glb, triangleSceneParts } from './fixtures.mjs';
 
 // The plugin lives in runtime/web (issue 15); its bare 'three' import resolves to tests/js/node_modules.
 register('./three_resolver.mjs', import.meta.url);
@@ -36,18 +36,7 @@ const check = (ok, what) => {
 };
 
 // --- inputs -------------------------------------------------------------------------------
-const tri = Buffer.from(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]).buffer);
-const scene = {
-  asset: { version: '2.0', generator: 'zhc tests/js' },
-  scene: 0,
-  scenes: [{ nodes: [0] }],
-  nodes: [{ mesh: 0, name: 'tri' }],
-  meshes: [{ primitives: [{ attributes: { POSITION: 0 }, material: 0 }] }],
-  materials: [{ name: 'red', pbrMetallicRoughness: { baseColorFactor: [0.8, 0.1, 0.1, 1] } }],
-  buffers: [{ byteLength: tri.length }],
-  bufferViews: [{ buffer: 0, byteOffset: 0, byteLength: tri.length, target: 34962 }],
-  accessors: [{ bufferView: 0, componentType: 5126, count: 3, type: 'VEC3', min: [0, 0, 0], max: [1, 1, 0] }],
-};
+const { json: scene, bin: tri } = triangleSceneParts();
 fs.writeFileSync(path.join(work, 'scene.glb'), glb(scene, tri));
 
 // Deterministic, physically plausible probes: a sky-ish DC plus directional lobes.
