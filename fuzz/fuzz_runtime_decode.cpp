@@ -14,6 +14,7 @@
 #include "codec/quantize.h"
 #include "formats/probe_file.h"
 #include "zhc_runtime.h"
+#include "zhc_runtime_params.hpp"
 
 namespace {
 
@@ -69,17 +70,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (data[3] & 1) p.luminance = {data[3] / 255.0, 0.5, -0.25};
     const bool valid = bool(validate_quant_params(p, c.name));
     zhc_probe_format f;
-    if (zhc_probe_format_init(&f, std::string(c.name).c_str()) != ZHC_OK) std::abort();
-    f.bits = p.bits;
-    f.sqrt_encoding = p.sqrt_encoding;
-    f.l2_bound = int(p.l2_bound);
-    f.dc_format = int(p.dc_format);
-    f.zonal_mapping = int(p.zonal_mapping);
-    f.axis_mode = int(p.axis_mode);
-    f.kind = int(p.kind);
-    f.luminance[0] = p.luminance.r;
-    f.luminance[1] = p.luminance.g;
-    f.luminance[2] = p.luminance.b;
+    if (!runtime_format(c.name, p, &f)) std::abort();
     if ((zhc_probe_format_validate(&f) == ZHC_OK) != valid) std::abort();
     std::vector<std::uint8_t> stored(c.size_bytes, 0);
     std::memcpy(stored.data(), data + 4, std::min(size - 4, stored.size()));

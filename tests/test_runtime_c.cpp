@@ -27,6 +27,7 @@
 #include "formats/probe_file.h"
 #include "support.h"
 #include "zhc_runtime.h"
+#include "zhc_runtime_params.hpp"
 
 namespace zhc {
 namespace {
@@ -144,17 +145,7 @@ StorageParams random_params(std::mt19937_64& rng, std::string_view codec) {
 
 zhc_probe_format format_of(std::string_view codec, const StorageParams& p) {
     zhc_probe_format f;
-    EXPECT_EQ(zhc_probe_format_init(&f, std::string(codec).c_str()), ZHC_OK);
-    f.bits = p.bits;
-    f.sqrt_encoding = p.sqrt_encoding;
-    f.l2_bound = int(p.l2_bound);
-    f.dc_format = int(p.dc_format);
-    f.zonal_mapping = int(p.zonal_mapping);
-    f.axis_mode = int(p.axis_mode);
-    f.kind = int(p.kind);
-    f.luminance[0] = p.luminance.r;
-    f.luminance[1] = p.luminance.g;
-    f.luminance[2] = p.luminance.b;
+    EXPECT_TRUE(runtime_format(codec, p, &f)) << codec;
     return f;
 }
 

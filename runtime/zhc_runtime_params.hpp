@@ -1,0 +1,31 @@
+// zhc/runtime/zhc_runtime_params.hpp — C++ bridge for code that has zhc's own StorageParams
+// (codec/probe_set.h) and wants the matching zhc_probe_format of the C runtime (tests, fuzzers,
+// tools built with zhc's libraries). Not needed by engines, which fill the format from a .zhp
+// header or a glTF volume.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "codec/probe_set.h"
+#include "zhc_runtime.h"
+
+namespace zhc {
+
+// The runtime format of `codec` stored with `params`; false when the runtime does not know the name.
+inline bool runtime_format(std::string_view codec, const StorageParams& params, zhc_probe_format* f) {
+    if (zhc_probe_format_init(f, std::string(codec).c_str()) != ZHC_OK) return false;
+    f->bits = params.bits;
+    f->sqrt_encoding = params.sqrt_encoding;
+    f->l2_bound = int(params.l2_bound);
+    f->dc_format = int(params.dc_format);
+    f->zonal_mapping = int(params.zonal_mapping);
+    f->axis_mode = int(params.axis_mode);
+    f->kind = int(params.kind);
+    f->luminance[0] = params.luminance.r;
+    f->luminance[1] = params.luminance.g;
+    f->luminance[2] = params.luminance.b;
+    return true;
+}
+
+}  // namespace zhc
