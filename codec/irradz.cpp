@@ -276,6 +276,346 @@ IrradZ make(const Target& tg, double w, Vec3 d) {
     return p;
 }
 
+
+// ---- Newton solve (Solve::kNewton) ------------------------------------------------------------
+//
+// The colours collapse: sum_k |t_k - I_k m|_G^2 = C + S |m - u|_G^2 with S = sum_k I_k^2 and
+// u = sum_k I_k t_k / S, so per texel the fit is one 9-vector problem. The direction is held in
+// gnomonic coordinates q = (d_x, d_y) / d_z (theta <= 85 deg is the disk |q| <= tan 85) and
+// s = 1 - w_a. With R = sqrt(1 + |q|^2) the model is m = h + s (a(q) - h), where a = C(d) / d_z:
+//   a_0 = c0 R,  (a_1, a_2, a_3) = c1 (-q_y, 1, -q_x),  a_{4..8} = c2 Q_i(q_x, q_y, 1) / R
+// (c0 = pi Y00, c1 = (2 pi / 3) kY1, c2 = pi / 4; Q_i the quadratic forms of the l = 2 basis).
+// For fixed q the best s is closed form (clamped to [0, 1]); the reduced error psi(q) = min_s is
+// minimised by Newton with the analytic gradient and Hessian (docs/irradz.md).
+struct SparseGram {
+    // G_hemi's non-zero entries: the diagonal and the pairs (0,2), (1,5), (2,6), (3,7).
+    double d[9], g02, g15, g26, g37;
+};
+const SparseGram& sparse_gram() {
+    static const SparseGram s = [] {
+        const Mat9& g = tables().g_hemi;
+        SparseGram r{};
+        for (size_t i = 0; i < 9; ++i) r.d[i] = g[i * 10];
+        r.g02 = g[0 * 9 + 2];
+        r.g15 = g[1 * 9 + 5];
+        r.g26 = g[2 * 9 + 6];
+        r.g37 = g[3 * 9 + 7];
+        return r;
+    }();
+    return s;
+}
+inline Vec9 gmul(const SparseGram& g, const Vec9& v) {
+    return {g.d[0] * v[0] + g.g02 * v[2],
+            g.d[1] * v[1] + g.g15 * v[5],
+            g.d[2] * v[2] + g.g02 * v[0] + g.g26 * v[6],
+            g.d[3] * v[3] + g.g37 * v[7],
+            g.d[4] * v[4],
+            g.d[5] * v[5] + g.g15 * v[1],
+            g.d[6] * v[6] + g.g26 * v[2],
+            g.d[7] * v[7] + g.g37 * v[3],
+            g.d[8] * v[8]};
+}
+
+struct NewtonConst {
+    double c0, c1, c2;
+    double tan_max;  // tan(kMaxTheta): the disk |q| <= tan_max
+};
+const NewtonConst& newton_const() {
+    static const NewtonConst c{kPi * kY00, (2.0 * kPi / 3.0) * kY1, kPi / 4.0, std::tan(kMaxTheta)};
+    return c;
+}
+
+// The reduced problem of one texel: v = h - u, G v, v.G v.
+struct Reduced {
+    const Vec9* h;
+    Vec9 v, gv;
+    double vgv;
+    bool hhd;
+};
+
+// psi(q) and, if wanted, its gradient and (reduced) Hessian.
+struct PsiEval {
+    double psi = 0, s = 0;
+    double g[2] = {0, 0};
+    double hxx = 0, hxy = 0, hyy = 0;
+};
+
+inline Vec9 model_a(double qx, double qy, double r, double ir) {
+    const NewtonConst& c = newton_const();
+    return {c.c0 * r,
+            -c.c1 * qy,
+            c.c1,
+            -c.c1 * qx,
+            c.c2 * kY2 * qx * qy * ir,
+            -c.c2 * kY2 * qy * ir,
+            c.c2 * kY20 * (2 - qx * qx - qy * qy) * ir,
+            -c.c2 * kY2 * qx * ir,
+            c.c2 * kY22 * (qx * qx - qy * qy) * ir};
+}
+
+template <bool kDerivatives>
+PsiEval eval_psi(const Reduced& rd, double qx, double qy) {
+    const SparseGram& G = sparse_gram();
+    const NewtonConst& c = newton_const();
+    const double r2 = 1 + qx * qx + qy * qy, r = std::sqrt(r2), ir = 1 / r;
+    const Vec9 a = model_a(qx, qy, r, ir);
+    Vec9 b;
+    for (size_t i = 0; i < 9; ++i) b[i] = a[i] - (*rd.h)[i];
+    const Vec9 gb = gmul(G, b);
+    const double bgb = dot9(b, gb), bgv = dot9(gb, rd.v);
+    // s = 1 - w_a: the reference's w_a = num / den clamped (den = 0: w_a = 1).
+    const double s_free = bgb > 0 ? -bgv / bgb : 0.0;
+    const double s = std::clamp(s_free, 0.0, 1.0);
+    PsiEval e;
+    e.s = s;
+    e.psi = rd.vgv + 2 * s * bgv + s * s * bgb;
+    if constexpr (kDerivatives) {
+        if (s <= 0) return e;  // w_a = 1: psi does not depend on q here (flat)
+        Vec9 ge;  // G e, e = v + s b
+        for (size_t i = 0; i < 9; ++i) ge[i] = rd.gv[i] + s * gb[i];
+        // Q_i of the l = 2 basis and their derivatives (constants kY2, kY20, kY22 folded in).
+        const double q4 = kY2 * qx * qy, q5 = -kY2 * qy, q6 = kY20 * (2 - qx * qx - qy * qy), q7 = -kY2 * qx,
+                     q8 = kY22 * (qx * qx - qy * qy);
+        const double q4x = kY2 * qy, q4y = kY2 * qx, q5y = -kY2, q6x = -2 * kY20 * qx, q6y = -2 * kY20 * qy,
+                     q7x = -kY2, q8x = 2 * kY22 * qx, q8y = -2 * kY22 * qy;
+        const double ir3 = ir * ir * ir;
+        // da/dq_x, da/dq_y.
+        Vec9 ax{}, ay{};
+        ax[0] = c.c0 * qx * ir;
+        ay[0] = c.c0 * qy * ir;
+        ay[1] = -c.c1;
+        ax[3] = -c.c1;
+        const double qs[5] = {q4, q5, q6, q7, q8};
+        const double qxs[5] = {q4x, 0, q6x, q7x, q8x}, qys[5] = {q4y, q5y, q6y, 0, q8y};
+        for (size_t i = 0; i < 5; ++i) {
+            ax[4 + i] = c.c2 * (qxs[i] * ir - qs[i] * qx * ir3);
+            ay[4 + i] = c.c2 * (qys[i] * ir - qs[i] * qy * ir3);
+        }
+        const Vec9 gax = gmul(G, ax), gay = gmul(G, ay);
+        const double axe = dot9(ax, ge), aye = dot9(ay, ge);
+        e.g[0] = 2 * s * axe;
+        e.g[1] = 2 * s * aye;
+        // Second derivatives of a contracted with rho = G e: rho_0 c0 Hess(R) + c2 Hess(Qc / R),
+        // Qc = sum_{i>=4} rho_i Q_i.
+        const double* rho = ge.data();
+        const double qc = rho[4] * q4 + rho[5] * q5 + rho[6] * q6 + rho[7] * q7 + rho[8] * q8;
+        const double qcx = rho[4] * q4x + rho[6] * q6x + rho[7] * q7x + rho[8] * q8x;
+        const double qcy = rho[4] * q4y + rho[5] * q5y + rho[6] * q6y + rho[8] * q8y;
+        const double qcxx = -2 * kY20 * rho[6] + 2 * kY22 * rho[8], qcyy = -2 * kY20 * rho[6] - 2 * kY22 * rho[8],
+                     qcxy = kY2 * rho[4];
+        const double ir5 = ir3 * ir * ir;
+        const double rxx = (1 - qx * qx * ir * ir) * ir, ryy = (1 - qy * qy * ir * ir) * ir, rxy = -qx * qy * ir3;
+        const double sxx = qcxx * ir - 2 * qcx * qx * ir3 - qc * (ir3 - 3 * qx * qx * ir5);
+        const double syy = qcyy * ir - 2 * qcy * qy * ir3 - qc * (ir3 - 3 * qy * qy * ir5);
+        const double sxy = qcxy * ir - (qcx * qy + qcy * qx) * ir3 + qc * 3 * qx * qy * ir5;
+        const double tx = rho[0] * c.c0, t2 = c.c2;
+        e.hxx = 2 * s * s * dot9(ax, gax) + 2 * s * (tx * rxx + t2 * sxx);
+        e.hyy = 2 * s * s * dot9(ay, gay) + 2 * s * (tx * ryy + t2 * syy);
+        e.hxy = 2 * s * s * dot9(ax, gay) + 2 * s * (tx * rxy + t2 * sxy);
+        if (s_free < 1) {
+            // s interior: eliminate it (Schur complement of the (q, s) Hessian).
+            const double hxs = 2 * axe + 2 * s * dot9(gax, b), hys = 2 * aye + 2 * s * dot9(gay, b), hss = 2 * bgb;
+            e.hxx -= hxs * hxs / hss;
+            e.hyy -= hys * hys / hss;
+            e.hxy -= hxs * hys / hss;
+        }
+    }
+    return e;
+}
+
+// psi and its derivatives in stereographic coordinates p of d: d = (2p, 1 - |p|^2) / (1 + |p|^2),
+// q = 2p / (1 - |p|^2); theta <= 85 deg is the disk |p| <= tan(42.5 deg). q stretches the sphere
+// without bound near the horizon; p keeps Newton well conditioned over the whole range.
+// Chain rule: J = dq/dp = (2 / D) I + (4 / D^2) p p^T (D = 1 - |p|^2),
+// sum_i g_i d2q_i/dp_j dp_k = (4 / D^2) (g_j p_k + g_k p_j + delta_jk g.p) + (16 / D^3) (g.p) p_j p_k.
+template <bool kDerivatives>
+PsiEval eval_psi_p(const Reduced& rd, double px, double py) {
+    const double id = 1 / (1 - px * px - py * py);
+    PsiEval e = eval_psi<kDerivatives>(rd, 2 * px * id, 2 * py * id);
+    if constexpr (kDerivatives) {
+        if (e.s <= 0) return e;
+        const double id2 = id * id;
+        const double jxx = 2 * id + 4 * px * px * id2, jxy = 4 * px * py * id2, jyy = 2 * id + 4 * py * py * id2;
+        const double gx = e.g[0], gy = e.g[1], gp = gx * px + gy * py;
+        // H_p = J H_q J + the second-derivative term of q.
+        const double mxx = e.hxx * jxx + e.hxy * jxy, mxy = e.hxx * jxy + e.hxy * jyy;
+        const double myx = e.hxy * jxx + e.hyy * jxy, myy = e.hxy * jxy + e.hyy * jyy;
+        const double c3 = 16 * gp * id2 * id;
+        e.hxx = jxx * mxx + jxy * myx + 4 * id2 * (2 * gx * px + gp) + c3 * px * px;
+        e.hxy = jxx * mxy + jxy * myy + 4 * id2 * (gx * py + gy * px) + c3 * px * py;
+        e.hyy = jxy * mxy + jyy * myy + 4 * id2 * (2 * gy * py + gp) + c3 * py * py;
+        e.g[0] = jxx * gx + jxy * gy;
+        e.g[1] = jxy * gx + jyy * gy;
+    }
+    return e;
+}
+
+struct NewtonTables {
+    double p_max;                // tan(kMaxTheta / 2): the rim in p
+    std::array<double, 8> scan;  // tan(theta_j / 2), theta_j = kMaxTheta j / 7 (the reference's scan)
+};
+const NewtonTables& newton_tables() {
+    static const NewtonTables t = [] {
+        NewtonTables n{};
+        n.p_max = std::tan(kMaxTheta / 2);
+        for (size_t j = 0; j < 8; ++j) n.scan[j] = std::tan(kMaxTheta * double(j) / 14.0);
+        return n;
+    }();
+    return t;
+}
+
+// Start: match the model's L0 and L1 to u exactly (the linear-SH closed form of the reduced
+// problem). HHD: the L1 z component is fixed (c1), s q = beta = -(u_3, u_1) / c1 and
+// c0 sqrt(s^2 + |beta|^2) - 2 c0 s = u_0 - 2 c0. AHD: s = u_2 / c1. Returned in p.
+void newton_start(const Reduced& rd, double* px, double* py) {
+    const NewtonConst& c = newton_const();
+    Vec9 u;
+    for (size_t i = 0; i < 9; ++i) u[i] = (*rd.h)[i] - rd.v[i];
+    const double bx = -u[3] / c.c1, by = -u[1] / c.c1, b2 = bx * bx + by * by;
+    double s;
+    if (rd.hhd) {
+        const double kappa = (u[0] - 2 * c.c0) / c.c0;
+        s = (-2 * kappa + std::sqrt(kappa * kappa + 3 * b2)) / 3;
+    } else {
+        s = u[2] / c.c1;
+    }
+    s = std::clamp(std::isfinite(s) ? s : 1.0, 0.05, 1.0);
+    double qx = bx / s, qy = by / s;
+    if (!std::isfinite(qx) || !std::isfinite(qy)) qx = qy = 0;
+    // p = q / (1 + sqrt(1 + |q|^2)) (tan(theta / 2) from tan(theta)), clamped to the rim.
+    const double k = 1 / (1 + std::sqrt(1 + qx * qx + qy * qy));
+    *px = qx * k;
+    *py = qy * k;
+    const double len = std::hypot(*px, *py), pmax = newton_tables().p_max;
+    if (len > pmax) {
+        *px *= pmax / len;
+        *py *= pmax / len;
+    }
+}
+
+// Damped Newton on psi(p) inside the disk |p| <= p_max: the Hessian is shifted to positive definite
+// where it is not, and by a Levenberg-Marquardt term mu that grows when a step does not lower psi.
+// On the rim with the descent pointing outwards, the step runs along the rim (1-D Newton in arc
+// length, with the rim's curvature term).
+void newton_iterate(const Reduced& rd, double& px, double& py, int iterations) {
+    const double pmax = newton_tables().p_max;
+    PsiEval cur = eval_psi_p<true>(rd, px, py);
+    double mu = 0;
+    for (int it = 0; it < iterations; ++it) {
+        if (cur.s <= 0) break;  // w_a = 1: psi is flat here
+        const double hxx = cur.hxx, hyy = cur.hyy, hxy = cur.hxy;
+        const double tr = hxx + hyy, disc = std::sqrt((hxx - hyy) * (hxx - hyy) + 4 * hxy * hxy);
+        const double lmin = (tr - disc) / 2, lmax = std::max(std::abs((tr + disc) / 2), 1e-300);
+        const double shift = std::max(0.0, 1e-9 * lmax - lmin) + mu;
+        const double len = std::hypot(px, py);
+        double nx, ny;
+        if (len >= pmax * (1 - 1e-12) && cur.g[0] * px + cur.g[1] * py < 0) {
+            const double tx = -py / len, ty = px / len;
+            const double gt = cur.g[0] * tx + cur.g[1] * ty, gr = (cur.g[0] * px + cur.g[1] * py) / len;
+            const double ht = tx * tx * hxx + 2 * tx * ty * hxy + ty * ty * hyy - gr / len;
+            const double step = -gt / (std::max(ht, 1e-9 * lmax) + mu);
+            nx = px + step * tx;
+            ny = py + step * ty;
+            const double l = std::hypot(nx, ny);
+            nx *= pmax / l;
+            ny *= pmax / l;
+        } else {
+            const double axx = hxx + shift, ayy = hyy + shift, det = axx * ayy - hxy * hxy;
+            nx = px - (ayy * cur.g[0] - hxy * cur.g[1]) / det;
+            ny = py - (axx * cur.g[1] - hxy * cur.g[0]) / det;
+            const double l = std::hypot(nx, ny);
+            if (l > pmax) {
+                nx *= pmax / l;
+                ny *= pmax / l;
+            }
+        }
+        if (!std::isfinite(nx) || !std::isfinite(ny)) break;
+        const double moved = std::hypot(nx - px, ny - py);
+        const PsiEval next = eval_psi_p<false>(rd, nx, ny);
+        if (next.psi < cur.psi) {
+            px = nx;
+            py = ny;
+            mu *= 0.25;
+            if (moved <= 1e-10) break;
+            cur = eval_psi_p<true>(rd, px, py);
+        } else {
+            if (moved <= 1e-10) break;
+            mu = std::max(4 * mu, 1e-3 * lmax);
+        }
+    }
+}
+
+Reduced make_reduced(const Target& tg, Model model) {
+    const Tables& tb = tables();
+    const double s2 = tg.iz[0] * tg.iz[0] + tg.iz[1] * tg.iz[1] + tg.iz[2] * tg.iz[2];
+    Reduced rd;
+    rd.hhd = model == Model::kHhd;
+    rd.h = rd.hhd ? &tb.hemi : &tb.ambient;
+    for (size_t i = 0; i < 9; ++i) {
+        const double u = s2 > 0 ? (tg.iz[0] * tg.t[0][i] + tg.iz[1] * tg.t[1][i] + tg.iz[2] * tg.t[2][i]) / s2 : 0.0;
+        rd.v[i] = (*rd.h)[i] - u;
+    }
+    rd.gv = gmul(sparse_gram(), rd.v);
+    rd.vgv = dot9(rd.v, rd.gv);
+    return rd;
+}
+}  // namespace
+int kStartDirs = 1;
+ReducedError reduced_error(const Sh3Irradiance& target, Model model, double qx, double qy, const Rgb* sampled_iz) {
+    const Target tg = make_target(target, tables().g_hemi, sampled_iz);
+    const Reduced rd = make_reduced(tg, model);
+    const PsiEval e = eval_psi<true>(rd, qx, qy);
+    ReducedError r;
+    r.psi = e.psi;
+    r.s = e.s;
+    r.grad[0] = e.g[0];
+    r.grad[1] = e.g[1];
+    r.hess[0] = e.hxx;
+    r.hess[1] = e.hxy;
+    r.hess[2] = e.hyy;
+    return r;
+}
+void newton_debug(const Sh3Irradiance& target, Model model, double& qx, double& qy, int iterations) {
+    const Target tg = make_target(target, tables().g_hemi, nullptr);
+    const Reduced rd = make_reduced(tg, model);
+    const double k = 1 / (1 + std::sqrt(1 + qx * qx + qy * qy));
+    double px = qx * k, py = qy * k;
+    newton_iterate(rd, px, py, iterations);
+    const double id = 1 / (1 - px * px - py * py);
+    qx = 2 * px * id;
+    qy = 2 * py * id;
+}
+namespace {
+IrradZ fit_newton(const Target& tg, Model model, const EncodeOptions& options, double* error) {
+    const HemiEvaluator fit_at(tg, model);
+    const double s2 = tg.iz[0] * tg.iz[0] + tg.iz[1] * tg.iz[1] + tg.iz[2] * tg.iz[2];
+    Vec3 d{0, 0, 1};
+    if (s2 > 0) {
+        const Reduced rd = make_reduced(tg, model);
+        const NewtonTables& nt = newton_tables();
+        double px = 0, py = 0;
+        newton_start(rd, &px, &py);
+        // Also scan theta along the start's azimuth (the reference's 8 samples); the best start wins.
+        double best = eval_psi_p<false>(rd, px, py).psi;
+        const double len = std::hypot(px, py);
+        const double cx = len > 0 ? px / len : 1.0, cy = len > 0 ? py / len : 0.0;
+        for (int dir = 0; dir < kStartDirs; ++dir) {
+            const double ang = 2 * kPi * dir / kStartDirs;
+            const double ex = cx * std::cos(ang) - cy * std::sin(ang), ey = cx * std::sin(ang) + cy * std::cos(ang);
+            for (size_t j = (dir == 0 ? 0 : 1); j < 8; ++j) {
+                const double e = eval_psi_p<false>(rd, nt.scan[j] * ex, nt.scan[j] * ey).psi;
+                if (e < best) best = e, px = nt.scan[j] * ex, py = nt.scan[j] * ey;
+            }
+        }
+        newton_iterate(rd, px, py, options.newton_iterations);
+        const double r2 = px * px + py * py;
+        d = clamp_to_hemisphere(Vec3{2 * px, 2 * py, 1 - r2});
+    }
+    const Fit f = fit_at(d);
+    if (error) *error = f.err;
+    return make(tg, f.w, d);
+}
+
 }  // namespace
 
 Lighting to_lighting(const IrradZ& p) {
@@ -390,6 +730,11 @@ IrradZ encode(const Sh3Radiance& tangent_radiance, const EncodeOptions& options,
         const IrradZ p = make(tg, fit_direction(tg, d, options.model, tb.g_sphere).w, d);
         if (error) *error = sh_hemispherical_error(irr, p, options.model);
         return p;
+    }
+
+    if (options.solve == Solve::kNewton) {
+        const Target tg = make_target(irr, tb.g_hemi, sampled_iz);
+        return fit_newton(tg, options.model, options, error);
     }
 
     // Search (talk): the hemisphere term only adds to the z component of L1, so the azimuth of the
