@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <vector>
+#include <cstdio>
 
 namespace zhc::irradz {
 namespace {
@@ -493,55 +494,84 @@ void newton_start(const Reduced& rd, double* px, double* py) {
     }
 }
 
-// Damped Newton on psi(p) inside the disk |p| <= p_max: the Hessian is shifted to positive definite
-// where it is not, and by a Levenberg-Marquardt term mu that grows when a step does not lower psi.
-// On the rim with the descent pointing outwards, the step runs along the rim (1-D Newton in arc
-// length, with the rim's curvature term).
+// Damped Newton on psi(p) inside the disk |p| <= p_max. Where the Hessian is not positive definite
+// it is shifted until it is; a step that does not lower psi is halved (psi has kinks where s reaches
+// its bounds). On the rim with the descent pointing outwards, the step runs along the rim (1-D
+// Newton in arc length, with the rim's curvature term). A step shorter than 1e-6 (in p; about 2e-6
+// rad) is taken without checking and ends the solve: Newton converges quadratically, so the next
+// step would be of order 1e-12.
+}  // namespace
+long g_hist[130], g_fails; bool g_trace;
+namespace {
 void newton_iterate(const Reduced& rd, double& px, double& py, int iterations) {
     const double pmax = newton_tables().p_max;
+    struct H { int n = 0; ~H() { ++g_hist[std::min(n, 129)]; } } hh;
     PsiEval cur = eval_psi_p<true>(rd, px, py);
-    double mu = 0;
+    ++hh.n;
     for (int it = 0; it < iterations; ++it) {
         if (cur.s <= 0) break;  // w_a = 1: psi is flat here
         const double hxx = cur.hxx, hyy = cur.hyy, hxy = cur.hxy;
         const double tr = hxx + hyy, disc = std::sqrt((hxx - hyy) * (hxx - hyy) + 4 * hxy * hxy);
         const double lmin = (tr - disc) / 2, lmax = std::max(std::abs((tr + disc) / 2), 1e-300);
-        const double shift = std::max(0.0, 1e-9 * lmax - lmin) + mu;
         const double len = std::hypot(px, py);
-        double nx, ny;
-        if (len >= pmax * (1 - 1e-12) && cur.g[0] * px + cur.g[1] * py < 0) {
+        const bool rim = len >= pmax * (1 - 1e-12) && cur.g[0] * px + cur.g[1] * py < 0;
+        // The step: (dx, dy) in the disk, or an angle along the rim; at most kMaxStep long (a trust
+        // region: an indefinite Hessian's shifted step can be arbitrarily long).
+        constexpr double kMaxStep = 0.25;
+        double dx = 0, dy = 0, dalpha = 0;
+        if (rim) {
             const double tx = -py / len, ty = px / len;
             const double gt = cur.g[0] * tx + cur.g[1] * ty, gr = (cur.g[0] * px + cur.g[1] * py) / len;
             const double ht = tx * tx * hxx + 2 * tx * ty * hxy + ty * ty * hyy - gr / len;
-            const double step = -gt / (std::max(ht, 1e-9 * lmax) + mu);
-            nx = px + step * tx;
-            ny = py + step * ty;
-            const double l = std::hypot(nx, ny);
-            nx *= pmax / l;
-            ny *= pmax / l;
+            dalpha = std::clamp(-gt / std::max(ht, 1e-9 * lmax) / len, -kMaxStep / len, kMaxStep / len);
+            if (!std::isfinite(dalpha)) break;
         } else {
+            const double shift = std::max(0.0, 1e-9 * lmax - lmin);
             const double axx = hxx + shift, ayy = hyy + shift, det = axx * ayy - hxy * hxy;
-            nx = px - (ayy * cur.g[0] - hxy * cur.g[1]) / det;
-            ny = py - (axx * cur.g[1] - hxy * cur.g[0]) / det;
-            const double l = std::hypot(nx, ny);
-            if (l > pmax) {
-                nx *= pmax / l;
-                ny *= pmax / l;
-            }
+            dx = -(ayy * cur.g[0] - hxy * cur.g[1]) / det;
+            dy = -(axx * cur.g[1] - hxy * cur.g[0]) / det;
+            if (!std::isfinite(dx) || !std::isfinite(dy)) break;
+            const double l = std::hypot(dx, dy);
+            if (l > kMaxStep) dx *= kMaxStep / l, dy *= kMaxStep / l;
         }
-        if (!std::isfinite(nx) || !std::isfinite(ny)) break;
-        const double moved = std::hypot(nx - px, ny - py);
-        const PsiEval next = eval_psi_p<false>(rd, nx, ny);
-        if (next.psi < cur.psi) {
+        auto trial = [&](double t, double* nx, double* ny) {
+            if (rim) {
+                const double c = std::cos(t * dalpha), s = std::sin(t * dalpha);
+                *nx = c * px - s * py;
+                *ny = s * px + c * py;
+                return;
+            }
+            *nx = px + t * dx;
+            *ny = py + t * dy;
+            const double l = std::hypot(*nx, *ny);
+            if (l > pmax) {
+                *nx *= pmax / l;
+                *ny *= pmax / l;
+            }
+        };
+        double nx, ny;
+        if (std::hypot(dx, dy) + std::abs(dalpha) * len <= 1e-6) {
+            trial(1, &nx, &ny);
             px = nx;
             py = ny;
-            mu *= 0.25;
-            if (moved <= 1e-10) break;
-            cur = eval_psi_p<true>(rd, px, py);
-        } else {
-            if (moved <= 1e-10) break;
-            mu = std::max(4 * mu, 1e-3 * lmax);
+            break;
         }
+        bool accepted = false;
+        for (double t = 1; t > 1.0 / 64; t /= 2) {
+            trial(t, &nx, &ny);
+            const PsiEval next = eval_psi_p<true>(rd, nx, ny);
+            ++hh.n;
+            if (g_trace) std::fprintf(stderr, "  it %d p (%.6f %.6f) psi %.10g s %.5f g (%.3g %.3g) H (%.3g %.3g %.3g) t %g -> (%.6f %.6f) psi %.10g\n", it, px, py, cur.psi, cur.s, cur.g[0], cur.g[1], hxx, hxy, hyy, t, nx, ny, next.psi);
+            if (next.psi < cur.psi) {
+                px = nx;
+                py = ny;
+                cur = next;
+                accepted = true;
+                break;
+            }
+            ++g_fails;
+        }
+        if (!accepted) break;
     }
 }
 
