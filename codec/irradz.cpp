@@ -354,11 +354,12 @@ inline Vec9 model_a(double qx, double qy, double r, double ir) {
             c.c2 * kY22 * (qx * qx - qy * qy) * ir};
 }
 
+// r = sqrt(1 + |q|^2) = 1 / d_z and ir = 1 / r come from the caller (which has them without a
+// square root or with one division).
 template <bool kDerivatives>
-PsiEval eval_psi(const Reduced& rd, double qx, double qy) {
+PsiEval eval_psi(const Reduced& rd, double qx, double qy, double r, double ir) {
     const SparseGram& G = sparse_gram();
     const NewtonConst& c = newton_const();
-    const double r2 = 1 + qx * qx + qy * qy, r = std::sqrt(r2), ir = 1 / r;
     const Vec9 a = model_a(qx, qy, r, ir);
     Vec9 b;
     for (size_t i = 0; i < 9; ++i) b[i] = a[i] - (*rd.h)[i];
@@ -429,10 +430,12 @@ PsiEval eval_psi(const Reduced& rd, double qx, double qy) {
 // without bound near the horizon; p keeps Newton well conditioned over the whole range.
 // Chain rule: J = dq/dp = (2 / D) I + (4 / D^2) p p^T (D = 1 - |p|^2),
 // sum_i g_i d2q_i/dp_j dp_k = (4 / D^2) (g_j p_k + g_k p_j + delta_jk g.p) + (16 / D^3) (g.p) p_j p_k.
+// In p, with P = |p|^2: q = 2p / (1 - P), r = (1 + P) / (1 - P): one division, no square root.
 template <bool kDerivatives>
 PsiEval eval_psi_p(const Reduced& rd, double px, double py) {
-    const double id = 1 / (1 - px * px - py * py);
-    PsiEval e = eval_psi<kDerivatives>(rd, 2 * px * id, 2 * py * id);
+    const double pp = px * px + py * py, dm = 1 - pp, dp = 1 + pp, inv = 1 / (dm * dp);
+    const double id = dp * inv;  // 1 / (1 - P)
+    PsiEval e = eval_psi<kDerivatives>(rd, 2 * px * id, 2 * py * id, dp * dp * inv, dm * dm * inv);
     if constexpr (kDerivatives) {
         if (e.s <= 0) return e;
         const double id2 = id * id;
@@ -487,7 +490,7 @@ void newton_start(const Reduced& rd, double* px, double* py) {
     const double k = 1 / (1 + std::sqrt(1 + qx * qx + qy * qy));
     *px = qx * k;
     *py = qy * k;
-    const double len = std::hypot(*px, *py), pmax = newton_tables().p_max;
+    const double len = std::sqrt(*px * *px + *py * *py), pmax = newton_tables().p_max;
     if (len > pmax) {
         *px *= pmax / len;
         *py *= pmax / len;
@@ -513,7 +516,7 @@ void newton_iterate(const Reduced& rd, double& px, double& py, int iterations) {
         const double hxx = cur.hxx, hyy = cur.hyy, hxy = cur.hxy;
         const double tr = hxx + hyy, disc = std::sqrt((hxx - hyy) * (hxx - hyy) + 4 * hxy * hxy);
         const double lmin = (tr - disc) / 2, lmax = std::max(std::abs((tr + disc) / 2), 1e-300);
-        const double len = std::hypot(px, py);
+        const double len = std::sqrt(px * px + py * py);
         const bool rim = len >= pmax * (1 - 1e-12) && cur.g[0] * px + cur.g[1] * py < 0;
         // The step: (dx, dy) in the disk, or an angle along the rim; at most kMaxStep long (a trust
         // region: an indefinite Hessian's shifted step can be arbitrarily long).
@@ -531,7 +534,7 @@ void newton_iterate(const Reduced& rd, double& px, double& py, int iterations) {
             dx = -(ayy * cur.g[0] - hxy * cur.g[1]) / det;
             dy = -(axx * cur.g[1] - hxy * cur.g[0]) / det;
             if (!std::isfinite(dx) || !std::isfinite(dy)) break;
-            const double l = std::hypot(dx, dy);
+            const double l = std::sqrt(dx * dx + dy * dy);
             if (l > kMaxStep) dx *= kMaxStep / l, dy *= kMaxStep / l;
         }
         auto trial = [&](double t, double* nx, double* ny) {
@@ -543,14 +546,14 @@ void newton_iterate(const Reduced& rd, double& px, double& py, int iterations) {
             }
             *nx = px + t * dx;
             *ny = py + t * dy;
-            const double l = std::hypot(*nx, *ny);
+            const double l = std::sqrt(*nx * *nx + *ny * *ny);
             if (l > pmax) {
                 *nx *= pmax / l;
                 *ny *= pmax / l;
             }
         };
         double nx, ny;
-        if (std::hypot(dx, dy) + std::abs(dalpha) * len <= 1e-6) {
+        if (dx * dx + dy * dy + dalpha * dalpha * len * len <= 1e-12) {
             trial(1, &nx, &ny);
             px = nx;
             py = ny;
@@ -575,14 +578,30 @@ void newton_iterate(const Reduced& rd, double& px, double& py, int iterations) {
     }
 }
 
-Reduced make_reduced(const Target& tg, Model model) {
+// The texel as the Newton solve needs it: t_k and I_k only (no Gram products).
+struct Texel {
+    std::array<Vec9, 3> t{};
+    std::array<double, 3> iz{};
+};
+Texel make_texel(const Sh3Irradiance& irr, const Rgb* sampled_iz) {
     const Tables& tb = tables();
-    const double s2 = tg.iz[0] * tg.iz[0] + tg.iz[1] * tg.iz[1] + tg.iz[2] * tg.iz[2];
+    Texel x;
+    for (size_t k = 0; k < 3; ++k) {
+        for (size_t i = 0; i < 9; ++i) x.t[k][i] = irr[static_cast<int>(i)][static_cast<int>(k)];
+        // The same I_z as make_target (the reference).
+        x.iz[k] = std::max(0.0, sampled_iz ? double((*sampled_iz)[static_cast<int>(k)]) : dot9(x.t[k], tb.y_up));
+    }
+    return x;
+}
+
+Reduced make_reduced(const Texel& x, Model model) {
+    const Tables& tb = tables();
+    const double s2 = x.iz[0] * x.iz[0] + x.iz[1] * x.iz[1] + x.iz[2] * x.iz[2];
     Reduced rd;
     rd.hhd = model == Model::kHhd;
     rd.h = rd.hhd ? &tb.hemi : &tb.ambient;
     for (size_t i = 0; i < 9; ++i) {
-        const double u = s2 > 0 ? (tg.iz[0] * tg.t[0][i] + tg.iz[1] * tg.t[1][i] + tg.iz[2] * tg.t[2][i]) / s2 : 0.0;
+        const double u = s2 > 0 ? (x.iz[0] * x.t[0][i] + x.iz[1] * x.t[1][i] + x.iz[2] * x.t[2][i]) / s2 : 0.0;
         rd.v[i] = (*rd.h)[i] - u;
     }
     rd.gv = gmul(sparse_gram(), rd.v);
@@ -590,11 +609,11 @@ Reduced make_reduced(const Target& tg, Model model) {
     return rd;
 }
 }  // namespace
-int kStartDirs = 1;
+int kStartDirs = 1, kScanN = 2;
 ReducedError reduced_error(const Sh3Irradiance& target, Model model, double qx, double qy, const Rgb* sampled_iz) {
-    const Target tg = make_target(target, tables().g_hemi, sampled_iz);
-    const Reduced rd = make_reduced(tg, model);
-    const PsiEval e = eval_psi<true>(rd, qx, qy);
+    const Reduced rd = make_reduced(make_texel(target, sampled_iz), model);
+    const double rr = std::sqrt(1 + qx * qx + qy * qy);
+    const PsiEval e = eval_psi<true>(rd, qx, qy, rr, 1 / rr);
     ReducedError r;
     r.psi = e.psi;
     r.s = e.s;
@@ -606,8 +625,7 @@ ReducedError reduced_error(const Sh3Irradiance& target, Model model, double qx, 
     return r;
 }
 void newton_debug(const Sh3Irradiance& target, Model model, double& qx, double& qy, int iterations) {
-    const Target tg = make_target(target, tables().g_hemi, nullptr);
-    const Reduced rd = make_reduced(tg, model);
+    const Reduced rd = make_reduced(make_texel(target, nullptr), model);
     const double k = 1 / (1 + std::sqrt(1 + qx * qx + qy * qy));
     double px = qx * k, py = qy * k;
     newton_iterate(rd, px, py, iterations);
@@ -616,34 +634,48 @@ void newton_debug(const Sh3Irradiance& target, Model model, double& qx, double& 
     qy = 2 * py * id;
 }
 namespace {
-IrradZ fit_newton(const Target& tg, Model model, const EncodeOptions& options, double* error) {
-    const HemiEvaluator fit_at(tg, model);
-    const double s2 = tg.iz[0] * tg.iz[0] + tg.iz[1] * tg.iz[1] + tg.iz[2] * tg.iz[2];
+IrradZ fit_newton(const Sh3Irradiance& irr, Model model, const EncodeOptions& options, double* error,
+                  const Rgb* sampled_iz) {
+    const Texel x = make_texel(irr, sampled_iz);
+    const Reduced rd = make_reduced(x, model);
+    const double s2 = x.iz[0] * x.iz[0] + x.iz[1] * x.iz[1] + x.iz[2] * x.iz[2];
     Vec3 d{0, 0, 1};
     if (s2 > 0) {
-        const Reduced rd = make_reduced(tg, model);
-        const NewtonTables& nt = newton_tables();
         double px = 0, py = 0;
         newton_start(rd, &px, &py);
-        // Also scan theta along the start's azimuth (the reference's 8 samples); the best start wins.
+        // The best of three starts: the closed form, straight up (theta = 0) and the rim (theta = 85
+        // deg) at the closed form's azimuth (the ends of the reference's theta scan). A start where
+        // psi is flat (s = 0, w_a = 1) would stop Newton at once; theta = 0 avoids it.
         double best = eval_psi_p<false>(rd, px, py).psi;
-        const double len = std::hypot(px, py);
-        const double cx = len > 0 ? px / len : 1.0, cy = len > 0 ? py / len : 0.0;
-        for (int dir = 0; dir < kStartDirs; ++dir) {
-            const double ang = 2 * kPi * dir / kStartDirs;
-            const double ex = cx * std::cos(ang) - cy * std::sin(ang), ey = cx * std::sin(ang) + cy * std::cos(ang);
-            for (size_t j = (dir == 0 ? 0 : 1); j < 8; ++j) {
-                const double e = eval_psi_p<false>(rd, nt.scan[j] * ex, nt.scan[j] * ey).psi;
-                if (e < best) best = e, px = nt.scan[j] * ex, py = nt.scan[j] * ey;
-            }
-        }
+        const double len = std::sqrt(px * px + py * py), pmax = newton_tables().p_max;
+        const double rx = len > 0 ? px / len * pmax : pmax, ry = len > 0 ? py / len * pmax : 0.0;
+        const double e_up = eval_psi_p<false>(rd, 0, 0).psi, e_rim = eval_psi_p<false>(rd, rx, ry).psi;
+        if (e_up < best) best = e_up, px = 0, py = 0;
+        if (e_rim < best) px = rx, py = ry;
         newton_iterate(rd, px, py, options.newton_iterations);
         const double r2 = px * px + py * py;
         d = clamp_to_hemisphere(Vec3{2 * px, 2 * py, 1 - r2});
     }
-    const Fit f = fit_at(d);
-    if (error) *error = f.err;
-    return make(tg, f.w, d);
+    // w_a = 1 - s at the returned direction, and the error of the result, from the residuals
+    // r_k = t_k - I_k m (no cancellation): m = h + s (a - h).
+    const double qx = d.x / d.z, qy = d.y / d.z, r = std::sqrt(1 + qx * qx + qy * qy);
+    const Vec9 a = model_a(qx, qy, r, 1 / r);
+    const double s = s2 > 0 ? eval_psi<false>(rd, qx, qy, r, 1 / r).s : 0.0;
+    if (error) {
+        const SparseGram& g = sparse_gram();
+        double e = 0;
+        for (size_t k = 0; k < 3; ++k) {
+            Vec9 res;
+            for (size_t i = 0; i < 9; ++i) res[i] = x.t[k][i] - x.iz[k] * ((*rd.h)[i] + s * (a[i] - (*rd.h)[i]));
+            e += dot9(res, gmul(g, res));
+        }
+        *error = e;
+    }
+    IrradZ p;
+    p.i_z = Rgb{static_cast<float>(x.iz[0]), static_cast<float>(x.iz[1]), static_cast<float>(x.iz[2])};
+    p.w_a = 1 - s;
+    p.d = d;
+    return p;
 }
 
 }  // namespace
@@ -746,6 +778,7 @@ IrradZ solve_w_a(const Sh3Irradiance& target, Vec3 d, Model model, const std::ar
 IrradZ encode(const Sh3Radiance& tangent_radiance, const EncodeOptions& options, double* error,
               const Rgb* sampled_iz) {
     const Sh3Irradiance irr = to_irradiance(tangent_radiance);
+    if (options.solve == Solve::kNewton) return fit_newton(irr, options.model, options, error, sampled_iz);
     const Tables& tb = tables();
     // Optimal linear direction of the luminance L1 band (also the azimuth of the search plane).
     const LuminanceWeights& lw = options.luminance;
@@ -762,10 +795,6 @@ IrradZ encode(const Sh3Radiance& tangent_radiance, const EncodeOptions& options,
         return p;
     }
 
-    if (options.solve == Solve::kNewton) {
-        const Target tg = make_target(irr, tb.g_hemi, sampled_iz);
-        return fit_newton(tg, options.model, options, error);
-    }
 
     // Search (talk): the hemisphere term only adds to the z component of L1, so the azimuth of the
     // optimal linear direction is kept and theta is searched in [0, kMaxTheta]. A coarse scan of
