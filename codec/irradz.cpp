@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <vector>
-#include <cstdio>
 
 namespace zhc::irradz {
 namespace {
@@ -455,16 +454,10 @@ PsiEval eval_psi_p(const Reduced& rd, double px, double py) {
 }
 
 struct NewtonTables {
-    double p_max;                // tan(kMaxTheta / 2): the rim in p
-    std::array<double, 8> scan;  // tan(theta_j / 2), theta_j = kMaxTheta j / 7 (the reference's scan)
+    double p_max;  // tan(kMaxTheta / 2): the rim in p
 };
 const NewtonTables& newton_tables() {
-    static const NewtonTables t = [] {
-        NewtonTables n{};
-        n.p_max = std::tan(kMaxTheta / 2);
-        for (size_t j = 0; j < 8; ++j) n.scan[j] = std::tan(kMaxTheta * double(j) / 14.0);
-        return n;
-    }();
+    static const NewtonTables t{std::tan(kMaxTheta / 2)};
     return t;
 }
 
@@ -500,17 +493,12 @@ void newton_start(const Reduced& rd, double* px, double* py) {
 // Damped Newton on psi(p) inside the disk |p| <= p_max. Where the Hessian is not positive definite
 // it is shifted until it is; a step that does not lower psi is halved (psi has kinks where s reaches
 // its bounds). On the rim with the descent pointing outwards, the step runs along the rim (1-D
-// Newton in arc length, with the rim's curvature term). A step shorter than 1e-6 (in p; about 2e-6
-// rad) is taken without checking and ends the solve: Newton converges quadratically, so the next
-// step would be of order 1e-12.
-}  // namespace
-long g_hist[130], g_fails; bool g_trace;
-namespace {
-void newton_iterate(const Reduced& rd, double& px, double& py, int iterations) {
+// Newton in arc length, with the rim's curvature term). A step shorter than `tolerance` (in p; 1e-4
+// is about 2e-4 rad) is taken without checking and ends the solve: Newton converges quadratically,
+// so what remains after it is of order tolerance^2.
+void newton_iterate(const Reduced& rd, double& px, double& py, int iterations, double tolerance) {
     const double pmax = newton_tables().p_max;
-    struct H { int n = 0; ~H() { ++g_hist[std::min(n, 129)]; } } hh;
     PsiEval cur = eval_psi_p<true>(rd, px, py);
-    ++hh.n;
     for (int it = 0; it < iterations; ++it) {
         if (cur.s <= 0) break;  // w_a = 1: psi is flat here
         const double hxx = cur.hxx, hyy = cur.hyy, hxy = cur.hxy;
@@ -553,7 +541,7 @@ void newton_iterate(const Reduced& rd, double& px, double& py, int iterations) {
             }
         };
         double nx, ny;
-        if (dx * dx + dy * dy + dalpha * dalpha * len * len <= 1e-12) {
+        if (dx * dx + dy * dy + dalpha * dalpha * len * len <= tolerance * tolerance) {
             trial(1, &nx, &ny);
             px = nx;
             py = ny;
@@ -563,16 +551,13 @@ void newton_iterate(const Reduced& rd, double& px, double& py, int iterations) {
         for (double t = 1; t > 1.0 / 64; t /= 2) {
             trial(t, &nx, &ny);
             const PsiEval next = eval_psi_p<true>(rd, nx, ny);
-            ++hh.n;
-            if (g_trace) std::fprintf(stderr, "  it %d p (%.6f %.6f) psi %.10g s %.5f g (%.3g %.3g) H (%.3g %.3g %.3g) t %g -> (%.6f %.6f) psi %.10g\n", it, px, py, cur.psi, cur.s, cur.g[0], cur.g[1], hxx, hxy, hyy, t, nx, ny, next.psi);
-            if (next.psi < cur.psi) {
+                    if (next.psi < cur.psi) {
                 px = nx;
                 py = ny;
                 cur = next;
                 accepted = true;
                 break;
             }
-            ++g_fails;
         }
         if (!accepted) break;
     }
@@ -609,7 +594,6 @@ Reduced make_reduced(const Texel& x, Model model) {
     return rd;
 }
 }  // namespace
-int kStartDirs = 1, kScanN = 2;
 ReducedError reduced_error(const Sh3Irradiance& target, Model model, double qx, double qy, const Rgb* sampled_iz) {
     const Reduced rd = make_reduced(make_texel(target, sampled_iz), model);
     const double rr = std::sqrt(1 + qx * qx + qy * qy);
@@ -623,15 +607,6 @@ ReducedError reduced_error(const Sh3Irradiance& target, Model model, double qx, 
     r.hess[1] = e.hxy;
     r.hess[2] = e.hyy;
     return r;
-}
-void newton_debug(const Sh3Irradiance& target, Model model, double& qx, double& qy, int iterations) {
-    const Reduced rd = make_reduced(make_texel(target, nullptr), model);
-    const double k = 1 / (1 + std::sqrt(1 + qx * qx + qy * qy));
-    double px = qx * k, py = qy * k;
-    newton_iterate(rd, px, py, iterations);
-    const double id = 1 / (1 - px * px - py * py);
-    qx = 2 * px * id;
-    qy = 2 * py * id;
 }
 namespace {
 IrradZ fit_newton(const Sh3Irradiance& irr, Model model, const EncodeOptions& options, double* error,
@@ -652,7 +627,7 @@ IrradZ fit_newton(const Sh3Irradiance& irr, Model model, const EncodeOptions& op
         const double e_up = eval_psi_p<false>(rd, 0, 0).psi, e_rim = eval_psi_p<false>(rd, rx, ry).psi;
         if (e_up < best) best = e_up, px = 0, py = 0;
         if (e_rim < best) px = rx, py = ry;
-        newton_iterate(rd, px, py, options.newton_iterations);
+        newton_iterate(rd, px, py, options.newton_iterations, options.newton_tolerance);
         const double r2 = px * px + py * py;
         d = clamp_to_hemisphere(Vec3{2 * px, 2 * py, 1 - r2});
     }

@@ -69,6 +69,8 @@ struct EncodeOptions {
     Model model = Model::kHhd;
     Solve solve = Solve::kNewton;
     int newton_iterations = 12;   // Newton steps at most (each with a backtracking line search)
+    double newton_tolerance = 1e-4;  // a Newton step shorter than this (stereographic units, about
+                                     // 2e-4 rad) is taken without a check and ends the solve
     int scan_steps = 8;           // coarse theta samples before golden-section (bracketing)
     int golden_iterations = 16;   // golden-section steps (bracket shrinks by 0.618^16 ~ 5e-4)
     int azimuth_rounds = 1;       // phi-then-theta refinement rounds after the talk's theta search
