@@ -515,6 +515,8 @@ void newton_iterate(const Reduced& rd, double& px, double& py, int iterations, d
             const double gt = cur.g[0] * tx + cur.g[1] * ty, gr = (cur.g[0] * px + cur.g[1] * py) / len;
             const double ht = tx * tx * hxx + 2 * tx * ty * hxy + ty * ty * hyy - gr / len;
             dalpha = std::clamp(-gt / std::max(ht, 1e-9 * lmax) / len, -kMaxStep / len, kMaxStep / len);
+            // A saddle on the rim (symmetric targets): leave it along the rim.
+            if (ht < 0 && std::abs(gt) <= 1e-6 * -ht) dalpha = gt > 0 ? -kMaxStep / len : kMaxStep / len;
             if (!std::isfinite(dalpha)) break;
         } else {
             const double shift = std::max(0.0, 1e-9 * lmax - lmin);
@@ -522,6 +524,16 @@ void newton_iterate(const Reduced& rd, double& px, double& py, int iterations, d
             dx = -(ayy * cur.g[0] - hxy * cur.g[1]) / det;
             dy = -(axx * cur.g[1] - hxy * cur.g[0]) / det;
             if (!std::isfinite(dx) || !std::isfinite(dy)) break;
+            if (lmin < -1e-9 * lmax && std::abs(cur.g[0]) + std::abs(cur.g[1]) <= 1e-6 * -lmin) {
+                // A saddle (symmetric targets: zero L1, pure L2): leave along the eigenvector of
+                // the negative eigenvalue, downhill if the gradient tells, else towards +.
+                double vx = hxy, vy = lmin - hxx;
+                if (std::abs(vx) + std::abs(vy) < 1e-12 * lmax) vx = lmin - hyy, vy = hxy;
+                if (std::abs(vx) + std::abs(vy) < 1e-12 * lmax) vx = 1, vy = 0;
+                const double vl = std::sqrt(vx * vx + vy * vy), sg = vx * cur.g[0] + vy * cur.g[1] > 0 ? -1.0 : 1.0;
+                dx = sg * kMaxStep * vx / vl;
+                dy = sg * kMaxStep * vy / vl;
+            }
             const double l = std::sqrt(dx * dx + dy * dy);
             if (l > kMaxStep) dx *= kMaxStep / l, dy *= kMaxStep / l;
         }
@@ -618,15 +630,31 @@ IrradZ fit_newton(const Sh3Irradiance& irr, Model model, const EncodeOptions& op
     if (s2 > 0) {
         double px = 0, py = 0;
         newton_start(rd, &px, &py);
-        // The best of three starts: the closed form, straight up (theta = 0) and the rim (theta = 85
-        // deg) at the closed form's azimuth (the ends of the reference's theta scan). A start where
-        // psi is flat (s = 0, w_a = 1) would stop Newton at once; theta = 0 avoids it.
+        // The best of six starts: the closed form, straight up (theta = 0) and four points on the
+        // rim (theta = 85 deg) at the closed form's azimuth and +90, 180, 270 degrees from it (the
+        // reference scans theta from 0 to 85 deg). A start where psi is flat (s = 0, w_a = 1) would
+        // stop Newton at once; theta = 0 mostly avoids it, a ring of directions does the rest.
         double best = eval_psi_p<false>(rd, px, py).psi;
         const double len = std::sqrt(px * px + py * py), pmax = newton_tables().p_max;
         const double rx = len > 0 ? px / len * pmax : pmax, ry = len > 0 ? py / len * pmax : 0.0;
-        const double e_up = eval_psi_p<false>(rd, 0, 0).psi, e_rim = eval_psi_p<false>(rd, rx, ry).psi;
+        const double e_up = eval_psi_p<false>(rd, 0, 0).psi;
         if (e_up < best) best = e_up, px = 0, py = 0;
-        if (e_rim < best) px = rx, py = ry;
+        const double rims[4][2] = {{rx, ry}, {-ry, rx}, {-rx, -ry}, {ry, -rx}};
+        for (const auto& r : rims) {
+            const double e_rim = eval_psi_p<false>(rd, r[0], r[1]).psi;
+            if (e_rim < best) best = e_rim, px = r[0], py = r[1];
+        }
+        if (!(eval_psi_p<false>(rd, px, py).s > 0)) {
+            // All three starts where psi is flat (s = 0: the best w_a is 1 there, symmetric targets
+            // such as pure L2): a coarse ring of directions (theta 30, 60, 85 deg x 8 azimuths).
+            for (int i = 1; i <= 3; ++i)
+                for (int j = 0; j < 8; ++j) {
+                    const double r = std::tan((i < 3 ? i * kPi / 6 : kMaxTheta) / 2), ph = j * kPi / 4;
+                    const double x = r * std::cos(ph), y = r * std::sin(ph);
+                    const PsiEval e = eval_psi_p<false>(rd, x, y);
+                    if (e.psi < best && e.s > 0) best = e.psi, px = x, py = y;
+                }
+        }
         newton_iterate(rd, px, py, options.newton_iterations, options.newton_tolerance);
         const double r2 = px * px + py * py;
         d = clamp_to_hemisphere(Vec3{2 * px, 2 * py, 1 - r2});
