@@ -328,8 +328,8 @@ const NewtonConst& newton_const() {
 // The reduced problem of one texel: v = h - u, G v, v.G v.
 struct Reduced {
     const Vec9* h;
-    Vec9 v, gv;
-    double vgv;
+    Vec9 v, gv, gh;          // v = h - u, G v, G h
+    double vgv, hgv, hgh;    // v.G v, h.G v, h.G h
     bool hhd;
 };
 
@@ -360,10 +360,22 @@ PsiEval eval_psi(const Reduced& rd, double qx, double qy, double r, double ir) {
     const SparseGram& G = sparse_gram();
     const NewtonConst& c = newton_const();
     const Vec9 a = model_a(qx, qy, r, ir);
-    Vec9 b;
-    for (size_t i = 0; i < 9; ++i) b[i] = a[i] - (*rd.h)[i];
-    const Vec9 gb = gmul(G, b);
-    const double bgb = dot9(b, gb), bgv = dot9(gb, rd.v);
+    Vec9 b, gb;
+    double bgb, bgv;
+    if constexpr (kDerivatives) {
+        for (size_t i = 0; i < 9; ++i) b[i] = a[i] - (*rd.h)[i];
+        gb = gmul(G, b);
+        bgb = dot9(b, gb);
+        bgv = dot9(gb, rd.v);
+    } else {
+        // psi alone: b.G b = a.G a - 2 a.G h + h.G h and b.G v = a.G v - h.G v, a.G a over G's
+        // non-zero entries (the diagonal and the four pairs).
+        double aga = 0;
+        for (size_t i = 0; i < 9; ++i) aga += G.d[i] * a[i] * a[i];
+        aga += 2 * (G.g02 * a[0] * a[2] + G.g15 * a[1] * a[5] + G.g26 * a[2] * a[6] + G.g37 * a[3] * a[7]);
+        bgb = aga - 2 * dot9(a, rd.gh) + rd.hgh;
+        bgv = dot9(a, rd.gv) - rd.hgv;
+    }
     // s = 1 - w_a: the reference's w_a = num / den clamped (den = 0: w_a = 1).
     const double s_free = bgb > 0 ? -bgv / bgb : 0.0;
     const double s = std::clamp(s_free, 0.0, 1.0);
@@ -603,6 +615,9 @@ Reduced make_reduced(const Texel& x, Model model) {
     }
     rd.gv = gmul(sparse_gram(), rd.v);
     rd.vgv = dot9(rd.v, rd.gv);
+    rd.gh = gmul(sparse_gram(), *rd.h);
+    rd.hgv = dot9(*rd.h, rd.gv);
+    rd.hgh = dot9(*rd.h, rd.gh);
     return rd;
 }
 }  // namespace
@@ -630,21 +645,20 @@ IrradZ fit_newton(const Sh3Irradiance& irr, Model model, const EncodeOptions& op
     if (s2 > 0) {
         double px = 0, py = 0;
         newton_start(rd, &px, &py);
-        // The best of six starts: the closed form, straight up (theta = 0) and four points on the
-        // rim (theta = 85 deg) at the closed form's azimuth and +90, 180, 270 degrees from it (the
-        // reference scans theta from 0 to 85 deg). A start where psi is flat (s = 0, w_a = 1) would
+        // The best of four starts: the closed form, straight up (theta = 0) and the rim (theta = 85
+        // deg) at the closed form's azimuth and opposite it (the reference scans theta from 0 to 85
+        // deg; symmetric targets have their best direction on either side). A start where psi is flat (s = 0, w_a = 1) would
         // stop Newton at once; theta = 0 mostly avoids it, a ring of directions does the rest.
-        double best = eval_psi_p<false>(rd, px, py).psi;
+        const PsiEval e0 = eval_psi_p<false>(rd, px, py);
+        double best = e0.psi, best_s = e0.s;
         const double len = std::sqrt(px * px + py * py), pmax = newton_tables().p_max;
         const double rx = len > 0 ? px / len * pmax : pmax, ry = len > 0 ? py / len * pmax : 0.0;
-        const double e_up = eval_psi_p<false>(rd, 0, 0).psi;
-        if (e_up < best) best = e_up, px = 0, py = 0;
-        const double rims[4][2] = {{rx, ry}, {-ry, rx}, {-rx, -ry}, {ry, -rx}};
-        for (const auto& r : rims) {
-            const double e_rim = eval_psi_p<false>(rd, r[0], r[1]).psi;
-            if (e_rim < best) best = e_rim, px = r[0], py = r[1];
+        const double starts[3][2] = {{0, 0}, {rx, ry}, {-rx, -ry}};
+        for (const auto& st : starts) {
+            const PsiEval e = eval_psi_p<false>(rd, st[0], st[1]);
+            if (e.psi < best) best = e.psi, best_s = e.s, px = st[0], py = st[1];
         }
-        if (!(eval_psi_p<false>(rd, px, py).s > 0)) {
+        if (!(best_s > 0)) {
             // All three starts where psi is flat (s = 0: the best w_a is 1 there, symmetric targets
             // such as pure L2): a coarse ring of directions (theta 30, 60, 85 deg x 8 azimuths).
             for (int i = 1; i <= 3; ++i)
