@@ -212,7 +212,8 @@ TEST(IrradzEncode, LeastSquaresWaMatchesBruteForceScan) {
 TEST(IrradzEncode, RecoversAmbientPlusDirectionalExactly) {
     // HHD represents a constant hemisphere light plus a directional light exactly (talk).
     std::mt19937 rng(5);
-    for (int t = 0; t < 20; ++t) {
+    for (int t = 0; t < 40; ++t) {
+        const Solve solve = t % 2 ? Solve::kSearch : Solve::kNewton;  // the default and the reference
         const Vec3 d = upper_direction(rng, 1.35);
         const Rgb amb{0.3f, 0.5f, 0.8f};
         // Colours proportional so a single w_a can hold them (the IrradZ constraint).
@@ -224,6 +225,7 @@ TEST(IrradzEncode, RecoversAmbientPlusDirectionalExactly) {
         const Rgb iz{static_cast<float>(amb.r + dir.r / kPi * d.z), static_cast<float>(amb.g + dir.g / kPi * d.z),
                      static_cast<float>(amb.b + dir.b / kPi * d.z)};
         EncodeOptions o;
+        o.solve = solve;
         o.golden_iterations = 40;  // bracket 0.618^40 ~ 4e-9: the exactness test needs the precision
         const IrradZ p = encode(rad, o, &err_search, &iz);
         // I_z from the SH3 irradiance at the normal: not exact (SH3 truncation of the clamped
@@ -250,10 +252,12 @@ TEST(IrradzEncode, SearchErrorEqualsTheGeneralErrorOfItsResult) {
     const auto texels = real_texels();
     ASSERT_FALSE(texels.empty());
     int checked = 0;
+    for (const Solve solve : {Solve::kNewton, Solve::kSearch})
     for (const Model model : {Model::kHhd, Model::kAhd})
         for (size_t t = 0; t < texels.size(); ++t) {
             EncodeOptions o;
             o.model = model;
+            o.solve = solve;
             double e_search = -1;
             const IrradZ p = encode(texels[t], o, &e_search);
             const Sh3Irradiance irr = to_irradiance(texels[t]);
@@ -263,7 +267,7 @@ TEST(IrradzEncode, SearchErrorEqualsTheGeneralErrorOfItsResult) {
             EXPECT_NEAR(e_search, e_general, 1e-5 * e_general + 1e-9 * scale) << t;
             ++checked;
         }
-    EXPECT_EQ(checked, 2 * static_cast<int>(texels.size()));
+    EXPECT_EQ(checked, 4 * static_cast<int>(texels.size()));
 }
 
 TEST(IrradzEncode, GoldenSectionIsCloseToABruteForceDirectionGrid) {
@@ -271,12 +275,14 @@ TEST(IrradzEncode, GoldenSectionIsCloseToABruteForceDirectionGrid) {
     // w_a by the same least squares at every grid point.
     const auto texels = real_texels();
     ASSERT_FALSE(texels.empty());
-    double sum_search = 0, sum_grid = 0, sum_old = 0;
-    int worse = 0;
+    double sum_search = 0, sum_grid = 0, sum_old = 0, sum_newton = 0;
+    int worse = 0, worse_newton = 0;
     for (size_t t = 0; t < texels.size(); t += 3) {
         const Sh3Irradiance target = to_irradiance(texels[t]);
-        double e_search = 0, e_old = 0;
+        double e_search = 0, e_old = 0, e_newton = 0;
         EncodeOptions o;
+        encode(texels[t], o, &e_newton);
+        o.solve = Solve::kSearch;
         encode(texels[t], o, &e_search);
         o.solve = Solve::kOld;
         const IrradZ old = encode(texels[t], o, &e_old);
@@ -290,13 +296,19 @@ TEST(IrradzEncode, GoldenSectionIsCloseToABruteForceDirectionGrid) {
                 best = std::min(best, sh_hemispherical_error(target, q, Model::kHhd));
             }
         sum_search += e_search;
+        sum_newton += e_newton;
+        if (e_newton > 1.05 * best + 1e-9) ++worse_newton;
+        EXPECT_LE(e_newton, e_old * (1 + 1e-9) + 1e-12);
         sum_grid += best;
         sum_old += e_old;
         if (e_search > 1.05 * best + 1e-9) ++worse;
         EXPECT_LE(e_search, e_old * (1 + 1e-9) + 1e-12);
     }
-    std::printf("direction search, SH-space hemispherical error summed over texels: golden %.6g, 2D grid %.6g, old %.6g\n",
-                sum_search, sum_grid, sum_old);
+    std::printf("direction search, SH-space hemispherical error summed over texels: golden %.6g, newton %.6g, 2D grid %.6g, "
+                "old %.6g\n",
+                sum_search, sum_newton, sum_grid, sum_old);
+    EXPECT_LT(sum_newton, 1.05 * sum_grid);
+    EXPECT_LE(worse_newton, 2);
     EXPECT_LT(sum_search, 1.05 * sum_grid);
     EXPECT_LT(sum_search, sum_old);
     EXPECT_LE(worse, 2);
