@@ -575,7 +575,7 @@ void newton_iterate(const Reduced& rd, double& px, double& py, int iterations, d
         for (double t = 1; t > 1.0 / 64; t /= 2) {
             trial(t, &nx, &ny);
             const PsiEval next = eval_psi_p<true>(rd, nx, ny);
-                    if (next.psi < cur.psi) {
+            if (next.psi < cur.psi) {
                 px = nx;
                 py = ny;
                 cur = next;
