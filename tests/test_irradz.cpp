@@ -741,5 +741,36 @@ TEST(IrradzNewton, NonFiniteInputIsHandled) {
             }
 }
 
+TEST(IrradzNewton, RandomTargetsAgainstTheReference) {
+    // Rough random SH3 targets (coefficients down to -2, far from a physical lightmap): the total error
+    // and the share of texels where Newton ends in a worse local minimum than the search.
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(-2.0, 1.0);
+    for (const Model model : {Model::kHhd, Model::kAhd}) {
+        double sum_n = 0, sum_s = 0;
+        int worse = 0, better = 0;
+        const int n = 4000;
+        for (int t = 0; t < n; ++t) {
+            Sh3Radiance s;
+            for (int k = 0; k < 3; ++k) {
+                s[0][k] = static_cast<float>(3.0 + u(rng));
+                for (int i = 1; i < 9; ++i) s[i][k] = static_cast<float>(u(rng));
+            }
+            double e_n = 0, e_s = 0;
+            encode(s, newton::with(Solve::kNewton, model), &e_n);
+            encode(s, newton::with(Solve::kSearch, model), &e_s);
+            sum_n += e_n;
+            sum_s += e_s;
+            worse += e_n > e_s * (1 + 1e-3);
+            better += e_n < e_s * (1 - 1e-3);
+        }
+        std::printf("%s, %d random targets: error newton / search %.4f, newton better on %d, worse on %d\n",
+                    model == Model::kHhd ? "HHD" : "AHD", n, sum_n / sum_s, better, worse);
+        EXPECT_LT(sum_n, sum_s);
+        EXPECT_LT(worse, n / 100);
+        EXPECT_GT(better, 10 * worse);
+    }
+}
+
 }  // namespace
 }  // namespace zhc
