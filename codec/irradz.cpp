@@ -327,6 +327,8 @@ const NewtonConst& newton_const() {
 
 // The reduced problem of one texel: v = h - u, G v, v.G v.
 struct Reduced {
+    const SparseGram* g;     // sparse_gram() and newton_const(), fetched once per texel
+    const NewtonConst* c;
     const Vec9* h;
     Vec9 v, gv, gh;          // v = h - u, G v, G h
     double vgv, hgv, hgh;    // v.G v, h.G v, h.G h
@@ -340,8 +342,7 @@ struct PsiEval {
     double hxx = 0, hxy = 0, hyy = 0;
 };
 
-inline Vec9 model_a(double qx, double qy, double r, double ir) {
-    const NewtonConst& c = newton_const();
+inline Vec9 model_a(const NewtonConst& c, double qx, double qy, double r, double ir) {
     return {c.c0 * r,
             -c.c1 * qy,
             c.c1,
@@ -357,9 +358,9 @@ inline Vec9 model_a(double qx, double qy, double r, double ir) {
 // square root or with one division).
 template <bool kDerivatives>
 PsiEval eval_psi(const Reduced& rd, double qx, double qy, double r, double ir) {
-    const SparseGram& G = sparse_gram();
-    const NewtonConst& c = newton_const();
-    const Vec9 a = model_a(qx, qy, r, ir);
+    const SparseGram& G = *rd.g;
+    const NewtonConst& c = *rd.c;
+    const Vec9 a = model_a(c, qx, qy, r, ir);
     Vec9 b, gb;
     double bgb, bgv;
     if constexpr (kDerivatives) {
@@ -607,6 +608,8 @@ Reduced make_reduced(const Texel& x, Model model) {
     const Tables& tb = tables();
     const double s2 = x.iz[0] * x.iz[0] + x.iz[1] * x.iz[1] + x.iz[2] * x.iz[2];
     Reduced rd;
+    rd.g = &sparse_gram();
+    rd.c = &newton_const();
     rd.hhd = model == Model::kHhd;
     rd.h = rd.hhd ? &tb.hemi : &tb.ambient;
     for (size_t i = 0; i < 9; ++i) {
@@ -676,7 +679,7 @@ IrradZ fit_newton(const Sh3Irradiance& irr, Model model, const EncodeOptions& op
     // w_a = 1 - s at the returned direction, and the error of the result, from the residuals
     // r_k = t_k - I_k m (no cancellation): m = h + s (a - h).
     const double qx = d.x / d.z, qy = d.y / d.z, r = std::sqrt(1 + qx * qx + qy * qy);
-    const Vec9 a = model_a(qx, qy, r, 1 / r);
+    const Vec9 a = model_a(*rd.c, qx, qy, r, 1 / r);
     const double s = s2 > 0 ? eval_psi<false>(rd, qx, qy, r, 1 / r).s : 0.0;
     if (error) {
         const SparseGram& g = sparse_gram();
