@@ -24,7 +24,7 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 struct Options {
-    std::string input, output, quality = "default", solve = "search";
+    std::string input, output, quality = "default", solve = "newton";
     std::string container;  // encode: "" = ktx2; decode: "" = auto
     std::string part;       // synth: EXR part of the environment map
     int threads = 1, size = 256, stride = 17;
@@ -56,7 +56,7 @@ int run_encode(const Options& o) {
     auto lm = read_input(o);
     if (!lm) return report(lm.error());
     irradz::EncodeOptions eo;
-    eo.solve = o.solve == "old" ? irradz::Solve::kOld : irradz::Solve::kSearch;
+    eo.solve = o.solve == "old" ? irradz::Solve::kOld : (o.solve == "search" ? irradz::Solve::kSearch : irradz::Solve::kNewton);
     const auto t0 = Clock::now();
     const auto planes = lightmap::encode_planes(*lm, eo, o.threads);
     const double t_fit = since(t0);
@@ -195,7 +195,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     enc->add_option("-o,--output", o->output, "output prefix")->required();
     enc->add_option("--container", o->container, "ktx2 (default) | dds (DX10 header): PREFIX.{iz,d,wa}.ktx2 or .dds")
         ->check(CLI::IsMember({"ktx2", "dds"}));
-    enc->add_option("--solve", o->solve, "search (hemispherical Gram + golden section) | old")->check(CLI::IsMember({"search", "old"}));
+    enc->add_option("--solve", o->solve, "newton (hemispherical Gram, Newton on d) | search (the same by golden section: the reference) | old")->check(CLI::IsMember({"newton", "search", "old"}));
     quality(enc);
     CLI::App* dec = lm->add_subcommand("decode", "PREFIX.{iz,d,wa}.ktx2 or .dds -> IrradZ EXR (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)");
     dec->add_option("PREFIX", o->input, "prefix given to encode")->required();
