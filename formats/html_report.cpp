@@ -1,7 +1,6 @@
 #include "html_report.h"
 
 #include <stb_image.h>
-#include <stb_image_write.h>
 
 #include <algorithm>
 #include <climits>
@@ -76,16 +75,7 @@ std::string base64_encode(const std::vector<std::uint8_t>& bytes) {
 }
 
 std::vector<std::uint8_t> encode_png_rgb8(const std::vector<std::uint8_t>& rgb, int width, int height) {
-    std::vector<std::uint8_t> bytes;
-    if (width <= 0 || height <= 0 || width > (1 << 14) || height > (1 << 14) ||
-        rgb.size() != static_cast<size_t>(width) * height * 3)
-        return bytes;
-    auto sink = [](void* ctx, void* data, int size) {
-        auto* out = static_cast<std::vector<std::uint8_t>*>(ctx);
-        out->insert(out->end(), static_cast<std::uint8_t*>(data), static_cast<std::uint8_t*>(data) + size);
-    };
-    if (!stbi_write_png_to_func(sink, &bytes, width, height, 3, rgb.data(), width * 3)) bytes.clear();
-    return bytes;
+    return png_bytes_rgb8(rgb.data(), rgb.size(), width, height);
 }
 
 Result<DecodedImage> decode_image_rgb8(const std::vector<std::uint8_t>& bytes) {
@@ -178,30 +168,7 @@ double pixel_error(const Rgb& a, const Rgb& b, double mean) {
     return std::isfinite(e) ? e / mean : 1e30;
 }
 
-// The shared heat-map scale of one input: logarithmic over three decades, its top the 99th
-// percentile of the relative pixel error of the worst representation (the one whose 99th
-// percentile is largest).
-struct ErrorScale {
-    double top = 1e-6;  // relative error (of the mean reference irradiance) shown in the top colour
-    static constexpr double kDecades = 3;
-    double t(double e) const {
-        if (!(e > 0)) return 0;
-        return std::clamp((std::log10(e) - std::log10(top)) / kDecades + 1.0, 0.0, 1.0);
-    }
-    // Four colour bands per decade: readable as contours, and the pictures compress well.
-    static constexpr int kBands = 4 * static_cast<int>(kDecades);
-    static Rgb8 band_colour(double t) {
-        const int b = std::min(kBands - 1, static_cast<int>(t * kBands));
-        return false_colour((b + 0.5) / kBands);
-    }
-};
-
-std::string percent(double rel) {
-    const double p = rel * 100.0;
-    if (p >= 10) return num(p, "%.0f") + "%";
-    if (p >= 1) return num(p, "%.1f") + "%";
-    return num(p, "%.2g") + "%";
-}
+std::string percent(double rel) { return percent_text(rel); }
 
 std::string colour_bar_svg(const ErrorScale& s) {
     const int w = 360, bar_h = 14, n = ErrorScale::kBands;
@@ -277,18 +244,15 @@ void pictures_html(std::ostringstream& o, const SpherePictures& p) {
             ++count;
         }
     mean = std::max(count ? mean / count : 0.0, 1e-12);
-    // The shared error scale.
-    ErrorScale scale;
+    // The shared error scale: its top is the 99th percentile of the worst representation's error.
+    std::vector<std::vector<double>> errs;
     for (const auto& rec : p.representations) {
         if (rec.size() != n) continue;
-        std::vector<double> e;
+        errs.emplace_back();
         for (size_t i = 0; i < n; ++i)
-            if (p.inside[i]) e.push_back(pixel_error(rec[i], p.reference[i], mean));
-        if (e.empty()) continue;
-        const size_t k = std::min(e.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(e.size())));
-        std::nth_element(e.begin(), e.begin() + static_cast<std::ptrdiff_t>(k), e.end());
-        if (std::isfinite(e[k])) scale.top = std::max(scale.top, e[k]);
+            if (p.inside[i]) errs.back().push_back(pixel_error(rec[i], p.reference[i], mean));
     }
+    const ErrorScale scale = ErrorScale::from_percentile(std::move(errs));
     auto irradiance_uri = [&](const std::vector<Rgb>& img, size_t* negatives) {
         std::vector<std::uint8_t> px(n * 3);
         for (size_t i = 0; i < n; ++i) {

@@ -9,9 +9,10 @@
 namespace zhc {
 
 namespace {
+constexpr int kSmall = 17, kTitle = 24;  // text sizes in pixels (DejaVu Sans)
 std::string tick_label(double v) {
     char b[32];
-    if (v >= 1e4 || v < 1e-2) std::snprintf(b, sizeof b, "%.0E", v);
+    if (v >= 1e4 || v < 1e-2) std::snprintf(b, sizeof b, "%.0e", v);
     else std::snprintf(b, sizeof b, "%g", v);
     return b;
 }
@@ -50,18 +51,18 @@ Status write_scatter_png(const std::string& path, const ScatterPlot& plot) {
     for (double v : ticks(x0, x1, plot.log_x)) {
         const double x = left + ((plot.log_x ? std::log10(v) : v) - x0) / (x1 - x0) * pw;
         c.line(x, top, x, top + ph, grid);
-        c.text(static_cast<int>(x) - Canvas::text_width(tick_label(v), 2) / 2, top + ph + 10, tick_label(v), 2, ink);
+        c.text(static_cast<int>(x) - Canvas::text_width(tick_label(v), kSmall) / 2, top + ph + 8, tick_label(v), kSmall, ink);
     }
     for (double v : ticks(y0, y1, plot.log_y)) {
         const double y = top + ph - ((plot.log_y ? std::log10(v) : v) - y0) / (y1 - y0) * ph;
         c.line(left, y, left + pw, y, grid);
-        c.text(left - 8 - Canvas::text_width(tick_label(v), 2), static_cast<int>(y) - 5, tick_label(v), 2, ink);
+        c.text(left - 8 - Canvas::text_width(tick_label(v), kSmall), static_cast<int>(y) - kSmall / 2, tick_label(v), kSmall, ink);
     }
     c.line(left, top, left, top + ph, ink, 2);
     c.line(left, top + ph, left + pw, top + ph, ink, 2);
-    c.text(left, 18, plot.title, 3, ink);
-    c.text(left + pw / 2 - Canvas::text_width(plot.x_label, 2) / 2, H - 35, plot.x_label, 2, ink);
-    c.text(10, top - 22, plot.y_label, 2, ink);
+    c.text(left, 14, plot.title, kTitle, ink);
+    c.text(left + pw / 2 - Canvas::text_width(plot.x_label, kSmall) / 2, H - 38, plot.x_label, kSmall, ink);
+    c.text(10, top - 24, plot.y_label, kSmall, ink);
     // Frontier first (under the points).
     for (size_t i = 1; i < plot.frontier.size(); ++i) {
         const PlotPoint& a = plot.points[plot.frontier[i - 1]];
@@ -74,9 +75,10 @@ Status write_scatter_png(const std::string& path, const ScatterPlot& plot) {
         const PlotPoint& p = plot.points[i];
         const int x = static_cast<int>(std::lround(px(p.x))), y = static_cast<int>(std::lround(py(p.y)));
         c.fill_rect(x - 4, y - 4, 9, 9, on_front[i] ? front : dot);
-        c.text(x + 8, y - 12, p.label, 2, on_front[i] ? front : ink);
+        c.text(x + 8, y - kSmall, p.label, kSmall, on_front[i] ? front : ink);
     }
-    c.text(left + pw - 330, top + 8, "RED: PARETO FRONTIER", 2, front);
+    const std::string legend = "red: Pareto frontier";
+    c.text(left + pw - 12 - Canvas::text_width(legend, kSmall), top + 8, legend, kSmall, front);
     return write_png(path, c);
 }
 
