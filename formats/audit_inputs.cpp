@@ -139,7 +139,7 @@ Status write_audit_images(const std::string& dir, const AuditInput& input, const
 
     const int text_px = 17, title_px = 20, label_w = 170, pad = 8, title_h = 34, legend_h = 62;
     const int rows = 1 + static_cast<int>(codecs.size());
-    Canvas canvas(label_w + 2 * sw + 3 * pad, title_h + rows * (sh + pad) + legend_h, {32, 32, 36});
+    Canvas canvas(label_w + 2 * sw + 3 * pad + 28, title_h + rows * (sh + pad) + legend_h, {32, 32, 36});
     const Rgb8 white{235, 235, 235}, magenta{255, 0, 255};
     canvas.text(pad, 7, fs::path(input.path).filename().string() + ": irradiance (tone-mapped) | error / mean", title_px, white);
     auto draw_row = [&](int row, const std::string& label, const std::vector<Rgb>& rec, bool with_error) {
@@ -166,7 +166,7 @@ Status write_audit_images(const std::string& dir, const AuditInput& input, const
         canvas.fill_rect(x, ly + 12, 1, 5, white);
         const std::string t = percent_text(scale.top * std::pow(10.0, d - 3));
         const int w = Canvas::text_width(t, 14);
-        canvas.text(std::clamp(x - w / 2, bx - 20, bx + sw - w + 20), ly + 18, t, 14, white);
+        canvas.text(std::min(x - w / 2, canvas.width() - 2 - w), ly + 18, t, 14, white);
     }
     canvas.text(bx, ly + 36, "error / mean irradiance, log scale", 14, white);
     canvas.fill_rect(label_w + pad, ly, 12, 12, magenta);

@@ -133,11 +133,18 @@ SpherePictures render_sphere_pictures(const AuditInput& input, const std::vector
         for (size_t k = 0; k < where.size() && k < values.size(); ++k) out[where[k]] = values[k];
         return out;
     };
+    pics.latlong_width = std::min(size, 128) / 2 * 2;  // size >= 8
+    pics.latlong_height = pics.latlong_width / 2;
+    std::vector<Vec3> ll_dirs;
+    for (int y = 0; y < pics.latlong_height; ++y)
+        for (int x = 0; x < pics.latlong_width; ++x) ll_dirs.push_back(latlong_direction(x, y, pics.latlong_width, pics.latlong_height));
     if (input.kind == "envmap" && input.map.width > 0 && input.map.height > 0) {
         const LatLongImage coarse = downsample_for_audit(input.map.view(), 64, 32);
         pics.reference = scatter(integrate_irradiance(coarse.view(), dirs, 1));
+        pics.latlong_reference = integrate_irradiance(coarse.view(), ll_dirs, 1);
     } else {
         pics.reference = scatter(sh3_irradiance(input.probes[0], dirs));
+        pics.latlong_reference = sh3_irradiance(input.probes[0], ll_dirs);
     }
     for (const Codec* c : codecs) {
         if (!c) continue;
@@ -145,6 +152,7 @@ SpherePictures render_sphere_pictures(const AuditInput& input, const std::vector
         c->encode(input.probes[0], options, stored.data(), nullptr);
         pics.names.emplace_back(c->name);
         pics.representations.push_back(scatter(codec_irradiance(*c, stored.data(), options, dirs)));
+        pics.latlong_representations.push_back(codec_irradiance(*c, stored.data(), options, ll_dirs));
     }
     return pics;
 }
@@ -253,11 +261,15 @@ void pictures_html(std::ostringstream& o, const SpherePictures& p) {
             if (p.inside[i]) errs.back().push_back(pixel_error(rec[i], p.reference[i], mean));
     }
     const ErrorScale scale = ErrorScale::from_percentile(std::move(errs));
-    auto irradiance_uri = [&](const std::vector<Rgb>& img, size_t* negatives) {
-        std::vector<std::uint8_t> px(n * 3);
-        for (size_t i = 0; i < n; ++i) {
+    // Pictures: the sphere pair (pixels off the discs in the background colour) or the lat-long
+    // map (every pixel a normal). `inside` empty: every pixel is inside.
+    auto irradiance_uri = [&](const std::vector<Rgb>& img, int pw, int ph, const std::vector<std::uint8_t>& inside,
+                              size_t* negatives) {
+        const size_t m = static_cast<size_t>(pw) * ph;
+        std::vector<std::uint8_t> px(m * 3);
+        for (size_t i = 0; i < m && i < img.size(); ++i) {
             Rgb8 c = kOutside;
-            if (p.inside[i]) {
+            if (inside.empty() || inside[i]) {
                 const Rgb& v = img[i];
                 if (v.r < 0 || v.g < 0 || v.b < 0) {
                     c = kNegative;
@@ -270,39 +282,60 @@ void pictures_html(std::ostringstream& o, const SpherePictures& p) {
             px[i * 3 + 1] = c.g;
             px[i * 3 + 2] = c.b;
         }
-        return png_data_uri(px, w, h);
+        return png_data_uri(px, pw, ph);
     };
-    auto error_uri = [&](const std::vector<Rgb>& img) {
-        std::vector<std::uint8_t> px(n * 3);
-        for (size_t i = 0; i < n; ++i) {
-            const Rgb8 c = p.inside[i] ? ErrorScale::band_colour(scale.t(pixel_error(img[i], p.reference[i], mean))) : kOutside;
+    auto error_uri = [&](const std::vector<Rgb>& img, const std::vector<Rgb>& ref, int pw, int ph,
+                         const std::vector<std::uint8_t>& inside) {
+        const size_t m = static_cast<size_t>(pw) * ph;
+        std::vector<std::uint8_t> px(m * 3);
+        for (size_t i = 0; i < m && i < img.size() && i < ref.size(); ++i) {
+            const Rgb8 c = inside.empty() || inside[i] ? scale.colour(pixel_error(img[i], ref[i], mean)) : kOutside;
             px[i * 3] = c.r;
             px[i * 3 + 1] = c.g;
             px[i * 3 + 2] = c.b;
         }
-        return png_data_uri(px, w, h);
+        return png_data_uri(px, pw, ph);
     };
+    const int lw = p.latlong_width, lh = p.latlong_height;
+    const size_t ln = static_cast<size_t>(std::max(lw, 0)) * std::max(lh, 0);
+    const bool latlong = lw > 0 && lh > 0 && p.latlong_reference.size() == ln &&
+                         p.latlong_representations.size() == p.representations.size();
+    const std::vector<std::uint8_t> all_inside;
     o << "<p class=\"scale\">Lit spheres, seen from +X (left) and from &minus;X (right), +Z up: the pixel at "
          "normal n shows the irradiance E(n), exposed by the mean reference irradiance ("
       << num(mean) << ") and tone-mapped (Reinhard, sRGB); <span class=\"neg\">magenta</span> marks negative "
-         "irradiance. Error maps: max over channels of |E &minus; E<sub>ref</sub>| / mean reference, on one "
+         "irradiance."
+      << (latlong ? " Beside each pair, the same irradiance as a lat-long map of normals (+Z at the top, longitude "
+                    "from &minus;180&deg; at the left)."
+                  : "")
+      << " Error maps: max over channels of |E &minus; E<sub>ref</sub>| / mean reference, on one "
          "logarithmic scale shared by every representation of this input (three decades, four colour bands each; its top is the 99th "
-         "percentile of the worst representation's error, "
+         "percentile of the worst representation's error on the spheres, "
       << percent(scale.top) << "):</p>\n"
       << colour_bar_svg(scale) << "\n<div class=\"cards\">\n";
     size_t neg = 0;
-    o << "<figure class=\"card\"><figcaption>reference</figcaption>"
-      << img_tag(irradiance_uri(p.reference, &neg), w, h, "reference irradiance") << "</figure>\n";
+    o << "<figure class=\"card\"><figcaption>reference</figcaption><div class=\"pair\">"
+      << img_tag(irradiance_uri(p.reference, w, h, p.inside, &neg), w, h, "reference irradiance, lit spheres");
+    if (latlong) o << img_tag(irradiance_uri(p.latlong_reference, lw, lh, all_inside, &neg), lw, lh, "reference irradiance, lat-long");
+    o << "</div></figure>\n";
     for (size_t r = 0; r < p.representations.size() && r < p.names.size(); ++r) {
         if (p.representations[r].size() != n) continue;
-        size_t negatives = 0;
-        const std::string irr = irradiance_uri(p.representations[r], &negatives);
+        const bool ll = latlong && p.latlong_representations[r].size() == ln;
+        size_t negatives = 0, ll_negatives = 0;
+        const std::string irr = irradiance_uri(p.representations[r], w, h, p.inside, &negatives);
         double worst = 0;
         for (size_t i = 0; i < n; ++i)
             if (p.inside[i]) worst = std::max(worst, pixel_error(p.representations[r][i], p.reference[i], mean));
-        o << "<figure class=\"card\"><figcaption>" << html_escape(p.names[r]) << "</figcaption>"
-          << img_tag(irr, w, h, p.names[r] + " irradiance") << img_tag(error_uri(p.representations[r]), w, h, p.names[r] + " error")
-          << "<div class=\"small\">max error " << percent(worst);
+        o << "<figure class=\"card\"><figcaption>" << html_escape(p.names[r]) << "</figcaption><div class=\"pair\">"
+          << img_tag(irr, w, h, p.names[r] + " irradiance, lit spheres");
+        if (ll)
+            o << img_tag(irradiance_uri(p.latlong_representations[r], lw, lh, all_inside, &ll_negatives), lw, lh,
+                         p.names[r] + " irradiance, lat-long");
+        o << "</div><div class=\"pair\">" << img_tag(error_uri(p.representations[r], p.reference, w, h, p.inside), w, h, p.names[r] + " error, lit spheres");
+        if (ll)
+            o << img_tag(error_uri(p.latlong_representations[r], p.latlong_reference, lw, lh, all_inside), lw, lh,
+                         p.names[r] + " error, lat-long");
+        o << "</div><div class=\"small\">max error " << percent(worst);
         if (negatives) o << ", <span class=\"neg\">" << negatives << " negative px</span>";
         o << "</div></figure>\n";
     }
@@ -422,7 +455,7 @@ std::string html_report(const HtmlReport& r) {
          "caption{text-align:left;font-weight:bold;padding:.3em 0}\n"
          ".cards{display:flex;flex-wrap:wrap;gap:10px}\n"
          ".card{margin:0;padding:6px;background:#f2f2f4;border:1px solid #ddd;display:flex;flex-direction:column;gap:3px}\n"
-         ".card figcaption{font-family:monospace;font-weight:bold}.small{font-size:.8em}\n"
+         ".card figcaption{font-family:monospace;font-weight:bold}.small{font-size:.8em}.pair{display:flex;gap:4px;align-items:center}\n"
          ".neg{color:#c0c;font-weight:bold}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}\n"
          "dl.settings{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dl.settings dt{font-weight:bold}\n"
          "dl.settings dd{margin:0;font-family:monospace;word-break:break-all}\n"

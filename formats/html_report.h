@@ -40,6 +40,11 @@ struct SpherePictures {
     std::vector<Rgb> reference;                    // 2*size*size irradiance (0 outside)
     std::vector<std::string> names;                // per representation
     std::vector<std::vector<Rgb>> representations;  // per representation, 2*size*size
+    // The same irradiance as a lat-long map of normals (latlong_direction: +Z up at the top row,
+    // the same convention as the environment maps), latlong_width x latlong_height; 0: none.
+    int latlong_width = 0, latlong_height = 0;
+    std::vector<Rgb> latlong_reference;
+    std::vector<std::vector<Rgb>> latlong_representations;  // per representation
 };
 
 // The normal shown at pixel (x, y) of a 2*size x size sphere picture; false outside the discs.
@@ -47,7 +52,8 @@ bool sphere_pixel_normal(int x, int y, int size, Vec3* normal);
 
 // Evaluates the reference (an environment map: direct integration of the map box-downsampled to
 // 64x32; probes: probe 0's SH3 irradiance) and every codec's runtime irradiance of probe 0 at the
-// sphere pictures' normals. size is clamped to [8, 512].
+// sphere pictures' normals, and on a lat-long map of normals of size x size/2 pixels (below 128 x 64:
+// irradiance is smooth, and the report stays small). size is clamped to [8, 512].
 SpherePictures render_sphere_pictures(const AuditInput& input, const std::vector<const Codec*>& codecs,
                                       const CodecOptions& options, int size = 96);
 
