@@ -178,6 +178,8 @@ double pixel_error(const Rgb& a, const Rgb& b, double mean) {
 
 std::string percent(double rel) { return percent_text(rel); }
 
+}  // namespace
+
 std::string colour_bar_svg(const ErrorScale& s) {
     const int w = 360, bar_h = 14, n = ErrorScale::kBands;
     std::ostringstream o;
@@ -198,6 +200,8 @@ std::string colour_bar_svg(const ErrorScale& s) {
     o << "</svg>";
     return o.str();
 }
+
+namespace {
 
 const char* kColumns[] = {"representation", "bytes", "rmse", "relative rmse", "max abs", "min irradiance",
                           "negative fraction", "chroma error", "encode ns", "decode ns"};
@@ -441,12 +445,12 @@ std::string scatter_svg(const ScatterPlot& plot) {
     return o.str();
 }
 
-std::string html_report(const HtmlReport& r) {
+std::string html_page_begin(const std::string& title, const std::string& version) {
     std::ostringstream o;
     o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
          "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
          "<meta name=\"generator\" content=\"zhc "
-      << html_escape(r.version) << "\">\n<title>" << html_escape(r.title) << "</title>\n<style>\n"
+      << html_escape(version) << "\">\n<title>" << html_escape(title) << "</title>\n<style>\n"
          "body{font-family:system-ui,sans-serif;margin:1.5em;color:#222;background:#fff;max-width:1400px}\n"
          "h1{font-size:1.6em}h2{font-size:1.3em;margin-top:1.6em;border-bottom:1px solid #ccc}\n"
          "table{border-collapse:collapse;margin:.6em 0;font-size:.9em}\n"
@@ -460,6 +464,35 @@ std::string html_report(const HtmlReport& r) {
          "dl.settings{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dl.settings dt{font-weight:bold}\n"
          "dl.settings dd{margin:0;font-family:monospace;word-break:break-all}\n"
          "</style>\n</head>\n<body>\n";
+    return o.str();
+}
+
+std::string html_page_end() {
+    std::ostringstream o;
+    o << "<script>\n"
+         "(function(){\n"
+         "document.querySelectorAll('table.sortable').forEach(function(t){\n"
+         "  t.querySelectorAll('thead th').forEach(function(th,col){\n"
+         "    th.title='sort';th.addEventListener('click',function(){\n"
+         "      var tb=t.tBodies[0],rows=Array.prototype.slice.call(tb.rows),asc=th.dataset.dir!=='asc';\n"
+         "      t.querySelectorAll('thead th').forEach(function(h){delete h.dataset.dir;});th.dataset.dir=asc?'asc':'desc';\n"
+         "      rows.sort(function(a,b){var x=a.cells[col],y=b.cells[col];\n"
+         "        var p=x.dataset.v!==undefined?parseFloat(x.dataset.v):NaN,q=y.dataset.v!==undefined?parseFloat(y.dataset.v):NaN;\n"
+         "        var c=(isNaN(p)||isNaN(q))?x.textContent.localeCompare(y.textContent):p-q;return asc?c:-c;});\n"
+         "      rows.forEach(function(row){tb.appendChild(row);});});});});\n"
+         "window.addEventListener('load',function(){\n"
+         "  var imgs=document.images,ok=0;\n"
+         "  for(var i=0;i<imgs.length;i++)if(imgs[i].complete&&imgs[i].naturalWidth>0)ok++;\n"
+         "  document.body.dataset.imagesOk=ok+'/'+imgs.length;\n"
+         "});\n"
+         "})();\n"
+         "</script>\n</body>\n</html>\n";
+    return o.str();
+}
+
+std::string html_report(const HtmlReport& r) {
+    std::ostringstream o;
+    o << html_page_begin(r.title, r.version);
     o << "<h1>" << html_escape(r.title) << "</h1>\n<p>zhc " << html_escape(r.version) << ". " << html_escape(r.intro) << "</p>\n";
     // Settings.
     o << "<h2>Inputs and options</h2>\n<dl class=\"settings\">\n<dt>zhc version</dt><dd>" << html_escape(r.version) << "</dd>\n";
@@ -497,24 +530,7 @@ std::string html_report(const HtmlReport& r) {
         pictures_html(o, s.pictures);
         o << "</section>\n";
     }
-    o << "<script>\n"
-         "(function(){\n"
-         "document.querySelectorAll('table.sortable').forEach(function(t){\n"
-         "  t.querySelectorAll('thead th').forEach(function(th,col){\n"
-         "    th.title='sort';th.addEventListener('click',function(){\n"
-         "      var tb=t.tBodies[0],rows=Array.prototype.slice.call(tb.rows),asc=th.dataset.dir!=='asc';\n"
-         "      t.querySelectorAll('thead th').forEach(function(h){delete h.dataset.dir;});th.dataset.dir=asc?'asc':'desc';\n"
-         "      rows.sort(function(a,b){var x=a.cells[col],y=b.cells[col];\n"
-         "        var p=x.dataset.v!==undefined?parseFloat(x.dataset.v):NaN,q=y.dataset.v!==undefined?parseFloat(y.dataset.v):NaN;\n"
-         "        var c=(isNaN(p)||isNaN(q))?x.textContent.localeCompare(y.textContent):p-q;return asc?c:-c;});\n"
-         "      rows.forEach(function(row){tb.appendChild(row);});});});});\n"
-         "window.addEventListener('load',function(){\n"
-         "  var imgs=document.images,ok=0;\n"
-         "  for(var i=0;i<imgs.length;i++)if(imgs[i].complete&&imgs[i].naturalWidth>0)ok++;\n"
-         "  document.body.dataset.imagesOk=ok+'/'+imgs.length;\n"
-         "});\n"
-         "})();\n"
-         "</script>\n</body>\n</html>\n";
+    o << html_page_end();
     return o.str();
 }
 

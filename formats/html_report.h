@@ -17,6 +17,7 @@
 #include "codec/audit.h"
 #include "codec/status.h"
 #include "plot.h"
+#include "raster.h"
 
 namespace zhc {
 
@@ -82,6 +83,14 @@ struct HtmlReport {
 std::string html_report(const HtmlReport& report);
 // Writes it atomically.
 Status write_html_report(const std::string& path, const HtmlReport& report);
+
+// The page around a report's content: doctype, head with the inline style, <body>; and the inline
+// script (sortable tables, the images-decoded marker) with the closing tags. Shared by every kind
+// of report (formats/lightmap_report.h too).
+std::string html_page_begin(const std::string& title, const std::string& version);
+std::string html_page_end();
+// The heat-map colour bar as inline SVG, its decades labelled ("<= 0.052%" .. ">= 52%").
+std::string colour_bar_svg(const ErrorScale& scale);
 
 // Pieces, exposed for tests.
 std::string html_escape(const std::string& text);
