@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "codec/benchmark.h"
 #include "file_io.h"
 #include "raster.h"
 
@@ -206,13 +207,17 @@ namespace {
 const char* kColumns[] = {"representation", "bytes", "rmse", "relative rmse", "max abs", "min irradiance",
                           "negative fraction", "chroma error", "encode ns", "decode ns"};
 
-void table_html(std::ostringstream& o, const std::string& id, const std::string& caption, const std::vector<HtmlRow>& rows) {
+void table_html(std::ostringstream& o, const std::string& id, const std::string& caption, const std::vector<HtmlRow>& rows,
+                bool runtime_absent_column = false) {
     o << "<table class=\"sortable\"" << (id.empty() ? "" : " id=\"" + id + "\"") << ">\n";
     if (!caption.empty()) o << "<caption>" << html_escape(caption) << "</caption>\n";
     const bool eval = std::any_of(rows.begin(), rows.end(), [](const HtmlRow& r) { return r.eval_ns >= 0; });
     o << "<thead><tr>";
     for (const char* c : kColumns) o << "<th scope=\"col\">" << c << "</th>";
     if (eval) o << "<th scope=\"col\">eval ns/sample</th>";
+    const bool gpu = std::any_of(rows.begin(), rows.end(), [](const HtmlRow& r) { return r.spirv_instructions >= 0; });
+    if (gpu) o << "<th scope=\"col\">runtime cost: SPIR-V instructions</th><th scope=\"col\">runtime cost: GPU ns/eval</th>";
+    else if (runtime_absent_column) o << "<th scope=\"col\">runtime cost</th>";
     o << "</tr></thead>\n<tbody>\n";
     auto cell = [&](double v, const char* f) { o << "<td data-v=\"" << sort_key(v) << "\">" << num(v, f) << "</td>"; };
     auto time = [&](double v) {
@@ -238,6 +243,16 @@ void table_html(std::ostringstream& o, const std::string& id, const std::string&
         if (eval) {
             if (r.eval_ns < 0 || !std::isfinite(r.eval_ns)) o << "<td data-v=\"-1\">-</td>";
             else cell(r.eval_ns, "%.1f");
+        }
+        if (gpu) {
+            if (r.spirv_instructions < 0) o << "<td data-v=\"-1\">-</td><td data-v=\"-1\">-</td>";
+            else {
+                cell(r.spirv_instructions, "%.0f");
+                if (r.gpu_ns < 0 || !std::isfinite(r.gpu_ns)) o << "<td data-v=\"-1\">-</td>";
+                else cell(r.gpu_ns, "%.3g");
+            }
+        } else if (runtime_absent_column) {
+            o << "<td class=\"na\">not given</td>";
         }
         o << "</tr>\n";
     }
@@ -462,7 +477,7 @@ std::string html_page_begin(const std::string& title, const std::string& version
          ".card figcaption{font-family:monospace;font-weight:bold}.small{font-size:.8em}.pair{display:flex;gap:4px;align-items:center}\n"
          ".neg{color:#c0c;font-weight:bold}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}\n"
          "dl.settings{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dl.settings dt{font-weight:bold}\n"
-         "dl.settings dd{margin:0;font-family:monospace;word-break:break-all}\n"
+         "dl.settings dd{margin:0;font-family:monospace;word-break:break-all}td.na{color:#777;text-align:center}\n"
          "</style>\n</head>\n<body>\n";
     return o.str();
 }
@@ -490,6 +505,38 @@ std::string html_page_end() {
     return o.str();
 }
 
+void apply_runtime_cost(HtmlReport& report, const RuntimeCostTable* table, const std::string& path) {
+    if (!table) {
+        report.runtime_cost_absent =
+            "not given. It is the GPU cost of each encoding's irradiance evaluation (SPIR-V instructions and lavapipe ns per "
+            "evaluation), measured by build/bench/bench_runtime --json FILE; pass that file with --runtime-cost FILE.";
+        return;
+    }
+    report.runtime_cost_absent.clear();
+    report.settings.push_back({"runtime cost", path + " (" + table->device + ")"});
+    auto fill = [&](HtmlRow& row) {
+        auto it = table->by_name.find(row.name);
+        if (it == table->by_name.end()) return;
+        row.spirv_instructions = it->second.spirv_instructions;
+        row.gpu_ns = it->second.ns_per_eval;
+    };
+    for (HtmlRow& row : report.summary) fill(row);
+    for (HtmlInputSection& in : report.inputs)
+        for (HtmlRow& row : in.rows) fill(row);
+    ScatterPlot plot{"Error vs runtime cost", "SPIR-V instructions per irradiance evaluation (log scale)",
+                     "relative irradiance rmse (log scale)", {}, {}};
+    std::vector<double> cost, err;
+    for (const HtmlRow& row : report.summary)
+        if (row.spirv_instructions >= 0) {
+            plot.points.push_back({row.name, double(row.spirv_instructions), row.metrics.relative_rmse});
+            cost.push_back(row.spirv_instructions);
+            err.push_back(row.metrics.relative_rmse);
+        }
+    if (plot.points.empty()) return;
+    plot.frontier = pareto_frontier(cost, err);
+    report.plots.push_back(plot);
+}
+
 std::string html_report(const HtmlReport& r) {
     std::ostringstream o;
     o << html_page_begin(r.title, r.version);
@@ -500,7 +547,10 @@ std::string html_report(const HtmlReport& r) {
     o << "</dl>\n";
     // Summary.
     o << "<h2>Summary</h2>\n";
-    table_html(o, "summary", r.summary_caption, r.summary);
+    const bool absent = !r.runtime_cost_absent.empty();
+    table_html(o, "summary", r.summary_caption, r.summary, absent);
+    const bool any_gpu = std::any_of(r.summary.begin(), r.summary.end(), [](const HtmlRow& h) { return h.spirv_instructions >= 0; });
+    if (absent && !any_gpu) o << "<p class=\"small\" id=\"runtime-cost\">Runtime cost: " << html_escape(r.runtime_cost_absent) << "</p>\n";
     o << "<p class=\"small\">Click a column heading to sort (needs JavaScript; the page reads without it). "
          "Errors are of irradiance against the reference; relative rmse is rmse / mean reference irradiance; "
          "times are per probe.</p>\n";
@@ -526,7 +576,7 @@ std::string html_report(const HtmlReport& r) {
         const HtmlInputSection& s = r.inputs[i];
         o << "<section id=\"input-" << i << "\">\n<h2>" << html_escape(s.title) << "</h2>\n<p>" << html_escape(s.description)
           << "</p>\n";
-        if (!s.rows.empty()) table_html(o, "", "", s.rows);
+        if (!s.rows.empty()) table_html(o, "", "", s.rows, absent);
         pictures_html(o, s.pictures);
         o << "</section>\n";
     }

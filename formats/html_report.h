@@ -18,6 +18,7 @@
 #include "codec/status.h"
 #include "plot.h"
 #include "raster.h"
+#include "runtime_cost.h"
 
 namespace zhc {
 
@@ -30,6 +31,9 @@ struct HtmlRow {
     // false: only rmse and relative rmse are known (bench); the other metrics show as "-".
     bool all_metrics = true;
     double eval_ns = -1;  // per irradiance sample; the column appears when some row has it
+    // GPU runtime evaluation cost (bench_runtime --json, formats/runtime_cost.h); < 0: not known.
+    int spirv_instructions = -1;
+    double gpu_ns = -1;
 };
 
 // Lit spheres: orthographic views of a unit sphere whose pixel at normal n shows E(n). Two views,
@@ -77,7 +81,17 @@ struct HtmlReport {
     std::vector<std::string> gate_failures;  // which probes failed which gate; empty = passed
     std::vector<HtmlInputSection> inputs;
     std::vector<ScatterPlot> plots;  // drawn as SVG
+    // The runtime evaluation cost columns: shown when some row has a cost; otherwise, when this is
+    // non-empty, one "runtime cost" column whose cells say it was not given, and this note (how to
+    // give it) under the table.
+    std::string runtime_cost_absent;
 };
+
+// The runtime evaluation cost of every row (summary and inputs), by representation name, from
+// bench_runtime's table read from `path`: adds the cost columns, a "runtime cost" setting and an
+// error-vs-runtime-cost plot. table == nullptr: the report says the cost was not given (the
+// column's cells and a note naming the option).
+void apply_runtime_cost(HtmlReport& report, const RuntimeCostTable* table, const std::string& path);
 
 // The whole document. Deterministic: the same report gives the same bytes.
 std::string html_report(const HtmlReport& report);
