@@ -134,7 +134,7 @@ SpherePictures render_sphere_pictures(const AuditInput& input, const std::vector
         for (size_t k = 0; k < where.size() && k < values.size(); ++k) out[where[k]] = values[k];
         return out;
     };
-    pics.latlong_width = std::min(size, 128) / 2 * 2;  // size >= 8
+    pics.latlong_width = std::min(2 * size, 128);  // size >= 8
     pics.latlong_height = pics.latlong_width / 2;
     std::vector<Vec3> ll_dirs;
     for (int y = 0; y < pics.latlong_height; ++y)
