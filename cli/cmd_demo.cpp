@@ -227,7 +227,8 @@ int run(const Options& o) {
                       {"bake", rep.summary()},
                       {"directions", std::to_string(o.directions)},
                       {"timing", "not measured by the demo (zhc audit and zhc bench time encode and decode)"},
-                      {"command", "zhc demo -o " + o.dir + " --directions " + std::to_string(o.directions)}};
+                      {"command", "zhc demo -o " + o.dir + " --directions " + std::to_string(o.directions) +
+                                      (o.runtime_cost.empty() ? "" : " --runtime-cost " + o.runtime_cost)}};
         h.summary_caption = "All " + std::to_string(probes.size()) + " probes pooled";
         h.summary = html_rows;
         ScatterPlot plot{"Error vs bytes per probe", "bytes per probe (log scale)", "relative irradiance rmse (log scale)", {}, {}};
