@@ -19,7 +19,7 @@ std::string tick_label(double v) {
 }  // namespace
 
 Status write_scatter_png(const std::string& path, const ScatterPlot& plot) {
-    const int W = 1100, H = 720, left = 110, right = 40, top = 60, bottom = 80;
+    const int W = 1200, H = 720, left = 110, right = 290, top = 60, bottom = 80, row = 21;
     Canvas c(W, H, {255, 255, 255});
     const Rgb8 ink{30, 30, 30}, grid{225, 225, 225}, dot{40, 90, 200}, front{220, 60, 40};
     auto tx = [&](double v) { return plot.log_x ? std::log10(std::max(v, 1e-30)) : v; };
@@ -70,12 +70,32 @@ Status write_scatter_png(const std::string& path, const ScatterPlot& plot) {
         c.line(px(a.x), py(a.y), px(b.x), py(b.y), front, 3);
     }
     std::vector<bool> on_front(plot.points.size(), false);
-    for (size_t i : plot.frontier) on_front[i] = true;
-    for (size_t i = 0; i < plot.points.size(); ++i) {
-        const PlotPoint& p = plot.points[i];
+    for (size_t i : plot.frontier)
+        if (i < plot.points.size()) on_front[i] = true;
+    // Labels never overprint: each sits in a column right of the plot, in the order of its point's
+    // height, at least `row` pixels from the next, joined to its point by a leader line.
+    std::vector<size_t> order;
+    for (size_t i = 0; i < plot.points.size(); ++i)
+        if (std::isfinite(py(plot.points[i].y)) && std::isfinite(px(plot.points[i].x))) order.push_back(i);
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return py(plot.points[a].y) < py(plot.points[b].y); });
+    std::vector<double> ly(order.size());
+    for (size_t k = 0; k < order.size(); ++k) {
+        ly[k] = std::max(py(plot.points[order[k]].y), static_cast<double>(top));
+        if (k) ly[k] = std::max(ly[k], ly[k - 1] + row);
+    }
+    for (size_t k = order.size(); k-- > 0;)
+        ly[k] = std::min(ly[k], k + 1 < order.size() ? ly[k + 1] - row : static_cast<double>(H - 12));
+    const int lx = left + pw + 28;
+    for (size_t k = 0; k < order.size(); ++k) {
+        const bool f = on_front[order[k]];
+        c.line(px(plot.points[order[k]].x), py(plot.points[order[k]].y), lx - 4, ly[k], f ? Rgb8{240, 170, 160} : Rgb8{200, 200, 200});
+    }
+    for (size_t k = 0; k < order.size(); ++k) {
+        const PlotPoint& p = plot.points[order[k]];
+        const bool f = on_front[order[k]];
         const int x = static_cast<int>(std::lround(px(p.x))), y = static_cast<int>(std::lround(py(p.y)));
-        c.fill_rect(x - 4, y - 4, 9, 9, on_front[i] ? front : dot);
-        c.text(x + 8, y - kSmall, p.label, kSmall, on_front[i] ? front : ink);
+        c.fill_rect(x - 4, y - 4, 9, 9, f ? front : dot);
+        c.text(lx, static_cast<int>(std::lround(ly[k])) - kSmall / 2, p.label, kSmall, f ? front : ink);
     }
     const std::string legend = "red: Pareto frontier";
     c.text(left + pw - 12 - Canvas::text_width(legend, kSmall), top + 8, legend, kSmall, front);
