@@ -139,6 +139,10 @@ int run(const Options& o) {
             row.encode_ns = r.encode_ns.median;
             row.decode_ns = r.decode_ns.median;
             row.eval_ns = r.eval_ns.median;
+            if (const RuntimeCost* c = gpu_cost(r)) {
+                row.spirv_instructions = c->spirv_instructions;
+                row.gpu_ns = c->ns_per_eval;
+            }
             h.summary.push_back(row);
             by_bytes.points.push_back({row.name, double(row.bytes), r.mean_relative_rmse});
             by_time.points.push_back({row.name, r.encode_ns.median, r.mean_relative_rmse});
