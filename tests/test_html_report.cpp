@@ -352,6 +352,13 @@ TEST(HtmlReport, RuntimeCostColumns) {
     const std::string demo = slurp(demo_dir + "/report.html");
     EXPECT_NE(summary_table(demo).find(">123</td>"), std::string::npos);
     EXPECT_NE(d.out.find("gpu_ns"), std::string::npos);
+    // zhc bench's report shows the same columns.
+    const auto b = zhc::test::run_zhc({"bench", std::string(ZHC_ENVMAP_DIR) + "/city.exr", "--representations", "sh3,zh3_lum",
+                                       "--repeats", "1", "--directions", "64", "--no-plots", "--runtime-cost", cost, "--html",
+                                       dir + "/bench.html"});
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    const std::string bench = summary_table(slurp(dir + "/bench.html"));
+    EXPECT_NE(bench.find(">123</td><td data-v=\"2.5\">2.5</td>"), std::string::npos) << bench;
     // A cost file that is not bench_runtime's output is an error naming the file.
     {
         std::ofstream f(dir + "/bad.json");
