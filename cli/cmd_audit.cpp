@@ -348,7 +348,7 @@ int run(const Options& o) {
     }
     if (!o.html.empty()) {
         std::vector<double> eval_ns;  // CPU evaluation cost: cheap, measured only when timing is on
-        if (!o.no_timing)
+        if (!o.no_timing && !reports[0].input.probes.empty())
             for (const Codec* c : selected) eval_ns.push_back(eval_ns_per_sample(*c, reports[0].input.probes[0], dirs, copt));
         if (Status s = write_html_report(o.html, html_of(o, reports, aggregate, failures, gpu, eval_ns)); !s)
             return report_output(s.error());
