@@ -110,40 +110,24 @@ CropWindow worst_error_window(const std::vector<double>& error, int width, int h
     return win;
 }
 
-std::string lightmap_html_report(const LightmapHtml& p) {
-    std::ostringstream o;
-    o << html_page_begin(p.title, p.version);
-    o << "<h1>" << html_escape(p.title) << "</h1>\n<p>zhc " << html_escape(p.version) << ". " << html_escape(p.intro) << "</p>\n";
-    o << "<h2>Inputs and options</h2>\n<dl class=\"settings\">\n<dt>zhc version</dt><dd>" << html_escape(p.version) << "</dd>\n";
-    for (const auto& [k, v] : p.settings) o << "<dt>" << html_escape(k) << "</dt><dd>" << html_escape(v) << "</dd>\n";
-    o << "<dt>size</dt><dd>" << p.width << "x" << p.height << " texels</dd>\n</dl>\n";
-    o << "<h2>Summary</h2>\n<table class=\"sortable\" id=\"summary\">\n<caption>Hemispherical irradiance error against the "
-         "SH3 lightmap</caption>\n<thead><tr><th scope=\"col\">representation</th><th scope=\"col\">rmse</th>"
-         "<th scope=\"col\">relative rmse</th></tr></thead>\n<tbody>\n";
-    for (const LightmapHtmlRow& r : p.rows)
-        o << "<tr class=\"rep\"><th scope=\"row\">" << html_escape(r.name) << "</th><td data-v=\"" << num(r.rmse, "%.17g") << "\">"
-          << num(r.rmse, "%.6g") << "</td><td data-v=\"" << num(r.relative, "%.17g") << "\">" << percent_text(r.relative)
-          << "</td></tr>\n";
-    o << "</tbody></table>\n";
-    if (!p.metrics.empty()) {
-        o << "<table class=\"metrics\">\n<tbody>\n";
-        for (const auto& [k, v] : p.metrics) o << "<tr><th scope=\"row\">" << html_escape(k) << "</th><td>" << html_escape(v) << "</td></tr>\n";
-        o << "</tbody></table>\n";
-    }
+namespace {
+// One view of the lightmap (before, after, error): the overview and, with `crop`, the worst window.
+void view_html(std::ostringstream& o, const LightmapHtml& p, const std::vector<float>& before, const std::vector<float>& after,
+               const std::string& heading, const std::string& what, bool crop) {
     const int w = p.width, h = p.height;
     const size_t n = w > 0 && h > 0 ? static_cast<size_t>(w) * h : 0;
-    if (n > 0 && n <= (size_t(1) << 28) && p.before.size() == 3 * n && p.after.size() == 3 * n) {
+    if (n > 0 && n <= (size_t(1) << 28) && before.size() == 3 * n && after.size() == 3 * n) {
         double mean = 0;
         size_t count = 0;
         for (size_t i = 0; i < n; ++i) {
-            const double v = (double(p.before[3 * i]) + p.before[3 * i + 1] + p.before[3 * i + 2]) / 3.0;
+            const double v = (double(before[3 * i]) + before[3 * i + 1] + before[3 * i + 2]) / 3.0;
             if (std::isfinite(v)) mean += v, ++count;
         }
         mean = std::max(count ? mean / static_cast<double>(count) : 0.0, 1e-12);
         std::vector<double> err(n);
         for (size_t i = 0; i < n; ++i) {
             double e = 0;
-            for (int k = 0; k < 3; ++k) e = std::max(e, std::fabs(double(p.after[3 * i + k]) - p.before[3 * i + k]));
+            for (int k = 0; k < 3; ++k) e = std::max(e, std::fabs(double(after[3 * i + k]) - before[3 * i + k]));
             err[i] = std::isfinite(e) ? std::min(e / mean, kErrorCap) : kErrorCap;
         }
         const ErrorScale scale = ErrorScale::from_percentile({err});
@@ -165,7 +149,7 @@ std::string lightmap_html_report(const LightmapHtml& p) {
                 for (int y = by * f; y < std::min(h, (by + 1) * f); ++y)
                     for (int x = bx * f; x < std::min(w, (bx + 1) * f); ++x) {
                         const size_t i = static_cast<size_t>(y) * w + x;
-                        for (int k = 0; k < 3; ++k) sb[k] += p.before[3 * i + k], sa[k] += p.after[3 * i + k];
+                        for (int k = 0; k < 3; ++k) sb[k] += before[3 * i + k], sa[k] += after[3 * i + k];
                         emax = std::max(emax, err[i]);
                         ++cnt;
                     }
@@ -189,13 +173,13 @@ std::string lightmap_html_report(const LightmapHtml& p) {
         for (int y = 0; y < win.height; ++y)
             for (int x = 0; x < win.width; ++x) {
                 const size_t i = static_cast<size_t>(win.y + y) * w + (win.x + x);
-                cb.set(x, y, tone(p.before, i));
-                ca.set(x, y, tone(p.after, i));
+                cb.set(x, y, tone(before, i));
+                ca.set(x, y, tone(after, i));
                 ce.set(x, y, scale.colour(err[i]));
                 crop_worst = std::max(crop_worst, err[i]);
             }
         const int cu = enlargement(win.width, win.height, 256);
-        o << "<h2>Pictures</h2>\n<p class=\"scale\">Irradiance at each texel's normal (I<sub>z</sub>, linear RGB) "
+        o << "<h2>" << html_escape(heading) << "</h2>\n<p class=\"scale\">" << what << " "
           << html_escape(p.before_label) << " and " << html_escape(p.after_label)
           << ", exposed by the mean irradiance before (" << num(mean)
           << ") and tone-mapped (Reinhard, sRGB); <span class=\"neg\">magenta</span> marks negative values. Error: max over "
@@ -205,10 +189,11 @@ std::string lightmap_html_report(const LightmapHtml& p) {
           << colour_bar_svg(scale) << "\n";
         o << "<h3>Whole lightmap</h3>\n<p class=\"small\">" << w << "x" << h << " texels"
           << (f > 1 ? ", downsampled " + std::to_string(f) + "x (irradiance: block mean; error: block maximum)" : "")
-          << (ou > 1 ? ", shown " + std::to_string(ou) + "x" : "") << "; the outlined square is the crop below.</p>\n<div class=\"cards\">\n"
+          << (ou > 1 ? ", shown " + std::to_string(ou) + "x" : "") << "; the outlined square is the worst-error window.</p>\n<div class=\"cards\">\n"
           << "<figure class=\"card\"><figcaption>" << html_escape(p.before_label) << "</figcaption>" << img(obe, "overview " + p.before_label) << "</figure>\n"
           << "<figure class=\"card\"><figcaption>" << html_escape(p.after_label) << "</figcaption>" << img(oae, "overview " + p.after_label) << "</figure>\n"
           << "<figure class=\"card\"><figcaption>error</figcaption>" << img(oee, "overview error") << "</figure>\n</div>\n";
+        if (!crop) return;
         o << "<h3>Worst-error region</h3>\n<p class=\"small\" id=\"crop\">Texels (" << win.x << ", " << win.y << ") to ("
           << win.x + win.width - 1 << ", " << win.y + win.height - 1 << "), the " << win.width << "x" << win.height
           << " window with the largest summed error, at 1:1" << (cu > 1 ? " enlarged " + std::to_string(cu) + "x" : "")
@@ -217,6 +202,34 @@ std::string lightmap_html_report(const LightmapHtml& p) {
           << "<figure class=\"card\"><figcaption>" << html_escape(p.after_label) << "</figcaption>" << img(ca.enlarged(cu), "crop " + p.after_label) << "</figure>\n"
           << "<figure class=\"card\"><figcaption>error</figcaption>" << img(ce.enlarged(cu), "crop error") << "</figure>\n</div>\n";
     }
+}
+}  // namespace
+
+std::string lightmap_html_report(const LightmapHtml& p) {
+    std::ostringstream o;
+    o << html_page_begin(p.title, p.version);
+    o << "<h1>" << html_escape(p.title) << "</h1>\n<p>zhc " << html_escape(p.version) << ". " << html_escape(p.intro) << "</p>\n";
+    o << "<h2>Inputs and options</h2>\n<dl class=\"settings\">\n<dt>zhc version</dt><dd>" << html_escape(p.version) << "</dd>\n";
+    for (const auto& [k, v] : p.settings) o << "<dt>" << html_escape(k) << "</dt><dd>" << html_escape(v) << "</dd>\n";
+    o << "<dt>size</dt><dd>" << p.width << "x" << p.height << " texels</dd>\n</dl>\n";
+    o << "<h2>Summary</h2>\n<table class=\"sortable\" id=\"summary\">\n<caption>Hemispherical irradiance error against the "
+         "SH3 lightmap</caption>\n<thead><tr><th scope=\"col\">representation</th><th scope=\"col\">rmse</th>"
+         "<th scope=\"col\">relative rmse</th></tr></thead>\n<tbody>\n";
+    for (const LightmapHtmlRow& r : p.rows)
+        o << "<tr class=\"rep\"><th scope=\"row\">" << html_escape(r.name) << "</th><td data-v=\"" << num(r.rmse, "%.17g") << "\">"
+          << num(r.rmse, "%.6g") << "</td><td data-v=\"" << num(r.relative, "%.17g") << "\">" << percent_text(r.relative)
+          << "</td></tr>\n";
+    o << "</tbody></table>\n";
+    if (!p.metrics.empty()) {
+        o << "<table class=\"metrics\">\n<tbody>\n";
+        for (const auto& [k, v] : p.metrics) o << "<tr><th scope=\"row\">" << html_escape(k) << "</th><td>" << html_escape(v) << "</td></tr>\n";
+        o << "</tbody></table>\n";
+    }
+    const size_t texels = p.width > 0 && p.height > 0 ? static_cast<size_t>(p.width) * p.height : 0;
+    view_html(o, p, p.before, p.after, "Pictures: irradiance at the normal",
+              "Irradiance at each texel's normal (I<sub>z</sub>, linear RGB)", true);
+    if (!p.tilted_before.empty() && p.tilted_before.size() == 3 * texels && p.tilted_after.size() == 3 * texels)
+        view_html(o, p, p.tilted_before, p.tilted_after, "Pictures: " + p.tilted_label, html_escape(p.tilted_what), false);
     o << html_page_end();
     return o.str();
 }
@@ -240,6 +253,27 @@ LightmapHtml lightmap_audit_html(const std::string& version, std::vector<std::pa
         p.height = before.height;
         p.before = before.iz;
         p.after = after.iz;
+    }
+    if (p.width > 0 && before.width == after.width && before.height == after.height) {
+        const size_t n = static_cast<size_t>(before.width) * before.height;
+        if (before.iz.size() == 3 * n && before.wa.size() == n && before.d.size() == 2 * n && after.iz.size() == 3 * n &&
+            after.wa.size() == n && after.d.size() == 2 * n) {
+            const double s = std::sqrt(0.5);
+            const Vec3 tilted{s, 0, s};
+            p.tilted_before.resize(3 * n);
+            p.tilted_after.resize(3 * n);
+            for (size_t i = 0; i < n; ++i) {
+                const Rgb b = irradz::evaluate(before.texel(i), irradz::Model::kHhd, tilted);
+                const Rgb a = irradz::evaluate(after.texel(i), irradz::Model::kHhd, tilted);
+                for (int k = 0; k < 3; ++k) {
+                    p.tilted_before[3 * i + static_cast<size_t>(k)] = static_cast<float>(b[k]);
+                    p.tilted_after[3 * i + static_cast<size_t>(k)] = static_cast<float>(a[k]);
+                }
+            }
+            p.tilted_label = "irradiance for a normal tilted 45 degrees";
+            p.tilted_what = "Irradiance of the IrradZ (HHD) model for a normal tilted 45 degrees toward each texel's tangent +X, "
+                            "so that the direction d (BC5) and the weight w_a (BC4) take part (not only I_z),";
+        }
     }
     p.before_label = "before block compression (IrradZ fit)";
     p.after_label = "after BC6H + BC5 + BC4";

@@ -26,6 +26,10 @@ struct LightmapHtml {
     int width = 0, height = 0;
     std::vector<float> before, after;  // linear RGB, 3 per texel, row-major (width*height*3)
     std::string before_label = "before block compression", after_label = "after block compression";
+    // Optional second view (overview only): e.g. the irradiance for a normal tilted away from the
+    // surface normal, which also shows the d and w_a errors. Same layout as before/after.
+    std::vector<float> tilted_before, tilted_after;
+    std::string tilted_label, tilted_what;
     std::vector<LightmapHtmlRow> rows;                          // the summary table, one row each
     std::vector<std::pair<std::string, std::string>> metrics;  // further numbers (PSNR, angles)
 };
@@ -35,7 +39,8 @@ std::string lightmap_html_report(const LightmapHtml& page);
 Status write_lightmap_html_report(const std::string& path, const LightmapHtml& page);
 
 // The numbers and pictures of `zhc lightmap audit`: I_z of the IrradZ planes before (the fit)
-// and after block compression, the hemispherical error rows and per-texture PSNR of `audit`.
+// and after block compression, the irradiance (HHD model) for a normal tilted 45 degrees toward the
+// tangent +X, the hemispherical error rows and per-texture PSNR of `audit`.
 LightmapHtml lightmap_audit_html(const std::string& version, std::vector<std::pair<std::string, std::string>> settings,
                                  const lightmap::IrradzPlanes& before, const lightmap::IrradzPlanes& after,
                                  const lightmap::Audit& audit);

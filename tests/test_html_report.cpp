@@ -414,8 +414,9 @@ TEST(LightmapReport, AuditHtml) {
         const auto r = zhc::test::run_zhc({"lightmap", "audit", lm, "--threads", "2", "--quality", "fast", "--html", html});
         ASSERT_EQ(r.exit_code, 0) << r.err;
         const std::string doc = slurp(html);
-        // Overview and crop of: before, after, error.
-        check_self_contained(doc, 6);
+        // Overview and crop of I_z before, after, error; overview of the tilted-normal irradiance.
+        check_self_contained(doc, 9);
+        EXPECT_NE(doc.find("normal tilted 45 degrees"), std::string::npos);
         const std::vector<std::string> rows = row_names(summary_table(doc));
         ASSERT_EQ(rows.size(), 3u);
         EXPECT_EQ(rows[2], "search after BC6H + BC5 + BC4");
@@ -443,6 +444,6 @@ TEST(LightmapReport, AuditHtml) {
         const auto r2 = zhc::test::run_zhc({"lightmap", "audit", lm, "--threads", "2", "--quality", "fast", "--html", html + "2"});
         ASSERT_EQ(r2.exit_code, 0);
         EXPECT_EQ(slurp(html + "2"), doc);
-        if (size == 300) check_in_browser(html, dir, 3, 6);
+        if (size == 300) check_in_browser(html, dir, 3, 9);
     }
 }
