@@ -15,6 +15,7 @@
 #include "formats/file_io.h"
 #include "formats/ktx2.h"
 #include "formats/lightmap_exr.h"
+#include "formats/lightmap_report.h"
 
 namespace zhc::cli {
 namespace cmd_lightmap {  // one namespace per verb file: the CLI is a unity build
@@ -27,6 +28,7 @@ struct Options {
     std::string input, output, quality = "default", solve = "newton";
     std::string container;  // encode: "" = ktx2; decode: "" = auto
     std::string part;       // synth: EXR part of the environment map
+    std::string html;       // audit: also write the HTML report here
     int threads = 1, size = 256, stride = 17;
     bool json = false;
 };
@@ -140,6 +142,12 @@ int run_audit(const Options& o) {
     const double t_bc = since(t0);
     const auto after = lightmap::decompress(c);
     const auto a = lightmap::audit(*lm, search, old_way, after, static_cast<size_t>(o.stride));
+    if (!o.html.empty()) {  // formats/lightmap_report.h: pictures before/after block compression, error, tables
+        const auto page = lightmap_audit_html(ZHC_VERSION, {{"input", o.input}, {"quality", o.quality},
+                                              {"stride", std::to_string(o.stride)}, {"threads", std::to_string(o.threads)}}, search, after, a);
+        if (Status s = write_lightmap_html_report(o.html, page); !s) return report_output(s.error());
+        std::fprintf(stderr, "report: %s\n", o.html.c_str());
+    }
     if (o.json) {
         nlohmann::json j;
         j["input"] = o.input;
@@ -206,6 +214,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     aud->add_option("IN", o->input, "SH lightmap EXR")->required();
     aud->add_option("--stride", o->stride, "audit every N-th texel")->check(CLI::Range(1, 1 << 20));
     aud->add_flag("--json", o->json, "one JSON object");
+    aud->add_option("--html", o->html, "also write one self-contained HTML report (pictures before/after block compression, error map, tables)");
     quality(aud);
     CLI::App* syn = lm->add_subcommand("synth", "synthetic SH lightmap: a sphere lit by an environment map's SH3");
     syn->add_option("ENVMAP", o->input, "EXR (lat-long or cube) or .hdr environment map")->required();
