@@ -12,6 +12,7 @@
 
 #include "formats/audit_inputs.h"
 #include "cli.h"
+#include "json_output.h"
 #include "table.h"
 #include "codec/audit.h"
 #include "formats/file_io.h"
@@ -65,7 +66,7 @@ std::vector<std::string> row_of(const RepresentationResult& r) {
 }
 
 
-nlohmann::json metrics_json(const RepresentationResult& r) {
+nlohmann::ordered_json metrics_json(const RepresentationResult& r) {
     const ErrorMetrics& m = r.metrics;
     return {{"rmse", m.rmse},
             {"relative_rmse", m.relative_rmse},
@@ -73,7 +74,7 @@ nlohmann::json metrics_json(const RepresentationResult& r) {
             {"min_irradiance", m.min_irradiance},
             {"negative_fraction", m.negative_fraction},
             {"chromaticity_error", m.chromaticity_error},
-            {"size_bytes", r.codec->size_bytes},
+            {"bytes_per_probe", r.codec->size_bytes},
             {"encode_ns", r.encode_ns},
             {"decode_ns", r.decode_ns},
             {"clamped_ratios", r.stats.clamped_ratios},
@@ -242,26 +243,26 @@ int run(const Options& o) {
         }
 
     if (o.json) {
-        nlohmann::json j;
+        nlohmann::ordered_json j;
         j["directions"] = o.directions;
         j["reference"] = "environment maps: direct integration of the map (box-downsampled to >= 512x256); "
                          "probe files: the probes' SH3 irradiance";
-        j["files"] = nlohmann::json::array();
+        j["files"] = nlohmann::ordered_json::array();
         for (const FileReport& fr : reports) {
-            nlohmann::json f;
+            nlohmann::ordered_json f;
             f["path"] = fr.input.path;
             f["kind"] = fr.input.kind;
             f["probes"] = fr.input.probes.size();
-            nlohmann::json reps = nlohmann::json::object();
+            nlohmann::ordered_json reps = nlohmann::ordered_json::object();
             for (const RepresentationResult& r : fr.results) reps[std::string(r.codec->name)] = metrics_json(r);
             f["representations"] = reps;
             j["files"].push_back(f);
         }
-        nlohmann::json agg = nlohmann::json::object();
+        nlohmann::ordered_json agg = nlohmann::ordered_json::object();
         for (const RepresentationResult& r : aggregate) agg[std::string(r.codec->name)] = metrics_json(r);
         j["aggregate"] = {{"files", reports.size()}, {"representations", agg}};
         j["gates"] = {{"passed", failures.empty()}, {"failures", failures}};
-        std::cout << j.dump(2) << "\n";
+        print_json("audit", j);
     } else {
         for (const FileReport& fr : reports) {
             std::cout << fr.input.path << " (" << fr.input.description << ", " << o.directions << " directions)\n";

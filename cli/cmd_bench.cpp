@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli.h"
+#include "json_output.h"
 #include "codec/benchmark.h"
 #include "formats/audit_inputs.h"
 #include "formats/html_report.h"
@@ -67,14 +68,14 @@ int run(const Options& o) {
     const auto rows = benchmark_codecs(probes, dirs, selected, CodecOptions{}, o.repeats);
 
     if (o.json) {
-        nlohmann::json j;
+        nlohmann::ordered_json j;
         j["probes"] = probes.size();
         j["directions"] = o.directions;
         j["repeats"] = o.repeats;
         if (!o.runtime_cost.empty()) j["runtime_cost_device"] = gpu.device;
-        j["representations"] = nlohmann::json::array();
+        j["representations"] = nlohmann::ordered_json::array();
         for (const BenchRow& r : rows) {
-            auto spread = [](const Spread& s) { return nlohmann::json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
+            auto spread = [](const Spread& s) { return nlohmann::ordered_json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
             j["representations"].push_back({{"name", r.codec->name},
                                              {"bytes_per_probe", r.codec->size_bytes},
                                              {"mean_rmse", r.mean_rmse},
@@ -87,7 +88,7 @@ int run(const Options& o) {
                                                                {"gpu_ns_per_eval", c->ns_per_eval},
                                                                {"gpu_ratio_to_sh3", c->ratio_to_sh3}};
         }
-        std::cout << j.dump(2) << "\n";
+        print_json("bench", j);
     } else {
         std::printf("%zu probes, %d directions, medians of %d repeats [min-max], single thread\n", probes.size(),
                     o.directions, o.repeats);

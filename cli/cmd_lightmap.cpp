@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "json_output.h"
 #include "codec/lightmap.h"
 #include "formats/dds.h"
 #include "formats/envmap.h"
@@ -141,7 +142,7 @@ int run_audit(const Options& o) {
     const auto after = lightmap::decompress(c);
     const auto a = lightmap::audit(*lm, search, old_way, after, static_cast<size_t>(o.stride));
     if (o.json) {
-        nlohmann::json j;
+        nlohmann::ordered_json j;
         j["input"] = o.input;
         j["width"] = lm->width;
         j["height"] = lm->height;
@@ -153,7 +154,7 @@ int run_audit(const Options& o) {
         j["d_error_deg"] = {{"mean", a.d_mean_deg}, {"max", a.d_max_deg}};
         j["mtexel_per_s"] = {{"irradz_fit", texels / t_fit / 1e6}, {"block_compression", texels / t_bc / 1e6}};
         j["threads"] = o.threads;
-        std::cout << j.dump() << "\n";
+        print_json("lightmap audit", j);
         return kExitOk;
     }
     std::printf("%s: %dx%d texels, %zu audited (every %d-th), quality %s, %d thread(s)\n", o.input.c_str(), lm->width,

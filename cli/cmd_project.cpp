@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "cli.h"
+#include "json_output.h"
 #include "codec/sh.h"
 #include "formats/envmap.h"
 
@@ -39,7 +40,7 @@ int run(const Options& o) {
     const Sh3Radiance sh = project_envmap(*img, threads);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (o.json) {
-        nlohmann::json j;
+        nlohmann::ordered_json j;
         j["path"] = o.path;
         j["width"] = img->width;
         j["height"] = img->height;
@@ -47,11 +48,11 @@ int run(const Options& o) {
         j["layout"] = info.layout;
         j["kind"] = "radiance";
         j["basis"] = "zhc (ZH3 paper Eq. 4/5), index l(l+1)+m";
-        nlohmann::json rows = nlohmann::json::array();
+        nlohmann::ordered_json rows = nlohmann::ordered_json::array();
         for (int i = 0; i < 9; ++i) rows.push_back({sh[i].r, sh[i].g, sh[i].b});
         j["sh3"] = rows;
         j["replaced_non_finite"] = info.replaced_non_finite;
-        std::cout << j.dump() << "\n";
+        print_json("project", j);
     } else {
         std::printf("%s: %dx%d %s %s (%s, %s)\n", o.path.c_str(), img->width, img->height, info.format.c_str(),
                     info.layout.c_str(), info.channels.c_str(), info.compression.c_str());
