@@ -147,7 +147,7 @@ int run(const Options& o) {
     if (!files) return report(files.error());
     if (files->empty()) return report(make_error(ErrorCode::kInvalidArgument, "no audit inputs found"));
 
-    const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = resolve_threads(o.threads);
     const std::vector<Vec3> dirs = fibonacci_sphere(o.directions);
     const bool show_progress = o.progress || ::isatty(STDERR_FILENO);
     CodecOptions copt;
@@ -312,20 +312,19 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("audit", "Irradiance error, size and speed of every representation on your lighting");
     sub->add_option("INPUTS", o->inputs, "environment maps (.exr, .hdr), probe files, or folders of them")->required();
-    sub->add_option("--representations", o->representations, "comma-separated subset of the codec table (default: all)");
-    sub->add_flag("--json", o->json, "print one JSON object (files, aggregate, gates) on stdout");
+    add_representations_option(sub, o->representations, RepresentationCount::kList, "default: all");
+    add_json_flag(sub, o->json, "files, aggregate, gates");
     sub->add_option("--markdown", o->markdown, "also write the tables as Markdown to this file");
     sub->add_option("--html", o->html, "also write one self-contained HTML report (tables, gates, lit spheres, plots) to this file");
     sub->add_option("--images", o->images, "write irradiance/error PNGs per input into this folder");
     sub->add_option("--directions", o->directions, "number of Fibonacci-lattice directions")->check(CLI::Range(16, 1 << 20));
-    sub->add_option("--threads", o->threads, "worker threads (results do not depend on it)")->check(CLI::Range(0, 256));
+    add_threads_option(sub, o->threads, "results do not depend on it");
     sub->add_flag("--progress", o->progress, "report progress on stderr even when it is not a terminal");
     sub->add_flag("--no-timing", o->no_timing, "skip encode/decode timing (outputs become byte-identical across runs)");
     sub->add_option("--max-rmse", o->max_rmse, "gate: fail (exit 8) if any representation's RMSE exceeds this");
     sub->add_option("--max-relative-rmse", o->max_relative_rmse, "gate: fail (exit 8) if any relative RMSE exceeds this");
     sub->add_flag("--fail-on-negative", o->fail_on_negative, "gate: fail (exit 8) if any reconstruction goes negative");
-    sub->add_flag("--replace-non-finite", o->replace_non_finite, "replace NaN/Inf pixels by 0 instead of failing");
-    sub->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
+    add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     return [o] { return run(*o); };
 });
 

@@ -206,8 +206,8 @@ const VerbRegistration registration(50, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("bench", "Bytes, encode/decode/evaluation time and error of every representation, with Pareto plots");
     sub->add_option("MAPS", o->inputs, "environment maps or folders (default: the eight sample maps)");
-    sub->add_option("--representations", o->representations, "comma-separated subset of the codec table");
-    sub->add_flag("--json", o->json, "print one JSON object on stdout");
+    add_representations_option(sub, o->representations, RepresentationCount::kList, "default: all");
+    add_json_flag(sub, o->json);
     sub->add_option("--plots", o->plots, "folder for error_vs_encode_time.png and error_vs_bytes.png")->capture_default_str();
     sub->add_flag("--no-plots", o->no_plots, "do not write plots");
     sub->add_option("--html", o->html, "also write one self-contained HTML report (table, SVG plots) to this file");

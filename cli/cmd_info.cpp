@@ -198,7 +198,7 @@ const VerbRegistration registration(45, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("info", "Describe an environment map, .zhp probe container, JSON probe list or glTF asset");
     sub->add_option("FILE", o->path, "file to describe (type detected from its content)")->required();
-    sub->add_flag("--json", o->json, "print one JSON object");
+    add_json_flag(sub, o->json);
     return [o] { return run(*o); };
 });
 

@@ -189,7 +189,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     auto quality = [&](CLI::App* s) {
         s->add_option("--quality", o->quality, "block compression: fast | default | slow (exhaustive BC6H)")
             ->check(CLI::IsMember({"fast", "default", "slow"}));
-        s->add_option("--threads", o->threads, "worker threads (output identical for any count)")->check(CLI::Range(1, 256));
+        add_threads_option(s, o->threads, "output identical for any count");
     };
     CLI::App* enc = lm->add_subcommand("encode", "SH lightmap EXR -> PREFIX.iz.ktx2 (BC6H) + PREFIX.d.ktx2 (BC5) + PREFIX.wa.ktx2 (BC4), or .dds");
     enc->add_option("IN", o->input, "SH lightmap EXR (channels sh0.R .. sh8.B)")->required();
@@ -206,15 +206,16 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     CLI::App* aud = lm->add_subcommand("audit", "hemispherical error before/after block compression, PSNR per texture, speed");
     aud->add_option("IN", o->input, "SH lightmap EXR")->required();
     aud->add_option("--stride", o->stride, "audit every N-th texel")->check(CLI::Range(1, 1 << 20));
-    aud->add_flag("--json", o->json, "one JSON object");
+    add_json_flag(aud, o->json);
     quality(aud);
     CLI::App* syn = lm->add_subcommand("synth", "synthetic SH lightmap: a sphere lit by an environment map's SH3");
     syn->add_option("ENVMAP", o->input, "EXR (lat-long or cube) or .hdr environment map")->required();
-    syn->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
+    add_envmap_read_options(syn, nullptr, o->part);
     syn->add_option("-o,--output", o->output, "output SH lightmap EXR")->required();
     syn->add_option("--size", o->size, "width = height in texels")->check(CLI::Range(4, 4096));
-    syn->add_option("--threads", o->threads, "worker threads")->check(CLI::Range(1, 256));
+    add_threads_option(syn, o->threads, "output identical for any count");
     return [o, enc, dec, aud, syn] {
+        o->threads = resolve_threads(o->threads);  // 0 = all cores
         if (enc->parsed()) return run_encode(*o);
         if (dec->parsed()) return run_decode(*o);
         if (aud->parsed()) return run_audit(*o);

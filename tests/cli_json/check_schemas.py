@@ -94,8 +94,8 @@ def check(schema_name, command, args):
 
 W = lambda name: os.path.join(WORK, name)
 # Inputs: the map, a quantised container, a float container, a JSON probe list, a glTF, a lightmap.
-run("convert", ENVMAP, "-o", W("q16.zhp"), "--to", "zh3_q16")
-run("convert", ENVMAP, "-o", W("sh3.zhp"), "--to", "sh3", "--zstd", "3")
+run("convert", ENVMAP, "-o", W("q16.zhp"), "-r", "zh3_q16")
+run("convert", ENVMAP, "-o", W("sh3.zhp"), "-r", "sh3", "--zstd", "3")
 run("convert", ENVMAP, "-o", W("list.json"))
 run("lightmap", "synth", ENVMAP, "--size", "16", "-o", W("lm.exr"))
 with open(W("cost.json"), "w") as f:
