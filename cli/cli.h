@@ -29,6 +29,24 @@ int report(const Error& error);
 // For errors while writing outputs: prints the message and returns kExitOutputFailed.
 int report_output(const Error& error);
 
+// --- Shared option groups: every verb spells these the same way (README "Options"). -------------
+// The representation: `-r, --representations` in every verb that picks codec-table entries.
+// kList: a comma-separated subset (audit, bench; empty = all). kOne: exactly one name (convert,
+// bake, gltf embed). `old_spelling` ("--to", "--encoding") is that verb's earlier name, kept as
+// an alias. `what` completes the help text.
+enum class RepresentationCount { kOne, kList };
+CLI::Option* add_representations_option(CLI::App* app, std::string& names, RepresentationCount count,
+                                        const std::string& what, const std::string& old_spelling = "");
+// `--threads N`, N in 0..256, 0 = all cores (hardware_concurrency). Every verb that takes it gives
+// identical output for any count; the help shows the verb's default.
+CLI::Option* add_threads_option(CLI::App* app, int& threads, const std::string& what);
+// The worker count a --threads value means: 0 -> the machine's cores (at least 1).
+int resolve_threads(int threads);
+// `--json`: print one JSON object (cli/json_output.h: the versioned envelope) on stdout.
+CLI::Option* add_json_flag(CLI::App* app, bool& json, const std::string& what = "");
+// Environment-map reading: `--replace-non-finite` and `--part` (formats/envmap.h EnvmapReadOptions).
+void add_envmap_read_options(CLI::App* app, bool* replace_non_finite, std::string& part);
+
 // A verb: `setup` adds the subcommand and its options to the app and returns the function that
 // runs it after parsing. Verbs register themselves with a static VerbRegistration.
 using VerbSetup = std::function<std::function<int()>(CLI::App& app)>;

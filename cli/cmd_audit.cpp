@@ -13,6 +13,7 @@
 
 #include "formats/audit_inputs.h"
 #include "cli.h"
+#include "json_output.h"
 #include "table.h"
 #include "codec/audit.h"
 #include "formats/file_io.h"
@@ -98,7 +99,7 @@ std::vector<std::string> row_of(const RepresentationResult& r) {
 }
 
 
-nlohmann::json metrics_json(const RepresentationResult& r) {
+nlohmann::ordered_json metrics_json(const RepresentationResult& r) {
     const ErrorMetrics& m = r.metrics;
     return {{"rmse", m.rmse},
             {"relative_rmse", m.relative_rmse},
@@ -106,7 +107,7 @@ nlohmann::json metrics_json(const RepresentationResult& r) {
             {"min_irradiance", m.min_irradiance},
             {"negative_fraction", m.negative_fraction},
             {"chromaticity_error", m.chromaticity_error},
-            {"size_bytes", r.codec->size_bytes},
+            {"bytes_per_probe", r.codec->size_bytes},
             {"encode_ns", r.encode_ns},
             {"decode_ns", r.decode_ns},
             {"clamped_ratios", r.stats.clamped_ratios},
@@ -192,7 +193,7 @@ int run(const Options& o) {
     if (!files) return report(files.error());
     if (files->empty()) return report(make_error(ErrorCode::kInvalidArgument, "no audit inputs found"));
 
-    const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = resolve_threads(o.threads);
     const std::vector<Vec3> dirs = fibonacci_sphere(o.directions);
     const bool show_progress = o.progress || ::isatty(STDERR_FILENO);
     CodecOptions copt;
@@ -288,26 +289,26 @@ int run(const Options& o) {
         }
 
     if (o.json) {
-        nlohmann::json j;
+        nlohmann::ordered_json j;
         j["directions"] = o.directions;
         j["reference"] = "environment maps: direct integration of the map (box-downsampled to >= 512x256); "
                          "probe files: the probes' SH3 irradiance";
-        j["files"] = nlohmann::json::array();
+        j["files"] = nlohmann::ordered_json::array();
         for (const FileReport& fr : reports) {
-            nlohmann::json f;
+            nlohmann::ordered_json f;
             f["path"] = fr.input.path;
             f["kind"] = fr.input.kind;
             f["probes"] = fr.input.probes.size();
-            nlohmann::json reps = nlohmann::json::object();
+            nlohmann::ordered_json reps = nlohmann::ordered_json::object();
             for (const RepresentationResult& r : fr.results) reps[std::string(r.codec->name)] = metrics_json(r);
             f["representations"] = reps;
             j["files"].push_back(f);
         }
-        nlohmann::json agg = nlohmann::json::object();
+        nlohmann::ordered_json agg = nlohmann::ordered_json::object();
         for (const RepresentationResult& r : aggregate) agg[std::string(r.codec->name)] = metrics_json(r);
         j["aggregate"] = {{"files", reports.size()}, {"representations", agg}};
         j["gates"] = {{"passed", failures.empty()}, {"failures", failures}};
-        std::cout << j.dump(2) << "\n";
+        print_json("audit", j);
     } else {
         for (const FileReport& fr : reports) {
             std::cout << fr.input.path << " (" << fr.input.description << ", " << o.directions << " directions)\n";
@@ -365,8 +366,8 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("audit", "Irradiance error, size and speed of every representation on your lighting");
     sub->add_option("INPUTS", o->inputs, "environment maps (.exr, .hdr), probe files, or folders of them")->required();
-    sub->add_option("--representations", o->representations, "comma-separated subset of the codec table (default: all)");
-    sub->add_flag("--json", o->json, "print one JSON object (files, aggregate, gates) on stdout");
+    add_representations_option(sub, o->representations, RepresentationCount::kList, "default: all");
+    add_json_flag(sub, o->json, "files, aggregate, gates");
     sub->add_option("--markdown", o->markdown, "also write the tables as Markdown to this file");
     sub->add_option("--html", o->html, "also write one self-contained HTML report (tables, gates, lit spheres, plots) to this file");
     sub->add_option("--runtime-cost", o->runtime_cost,
@@ -374,14 +375,13 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
                     "columns (text, Markdown, HTML) and an error-vs-runtime-cost plot in the HTML report");
     sub->add_option("--images", o->images, "write irradiance/error PNGs per input into this folder");
     sub->add_option("--directions", o->directions, "number of Fibonacci-lattice directions")->check(CLI::Range(16, 1 << 20));
-    sub->add_option("--threads", o->threads, "worker threads (results do not depend on it)")->check(CLI::Range(0, 256));
+    add_threads_option(sub, o->threads, "results do not depend on it");
     sub->add_flag("--progress", o->progress, "report progress on stderr even when it is not a terminal");
     sub->add_flag("--no-timing", o->no_timing, "skip encode/decode timing (outputs become byte-identical across runs)");
     sub->add_option("--max-rmse", o->max_rmse, "gate: fail (exit 8) if any representation's RMSE exceeds this");
     sub->add_option("--max-relative-rmse", o->max_relative_rmse, "gate: fail (exit 8) if any relative RMSE exceeds this");
     sub->add_flag("--fail-on-negative", o->fail_on_negative, "gate: fail (exit 8) if any reconstruction goes negative");
-    sub->add_flag("--replace-non-finite", o->replace_non_finite, "replace NaN/Inf pixels by 0 instead of failing");
-    sub->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
+    add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     return [o] { return run(*o); };
 });
 

@@ -49,10 +49,10 @@ int run(const Options& o) {
     }
     const Codec* codec = find_codec(o.to);
     if (!codec) {
-        std::fprintf(stderr, "zhc: error: --to %s: unknown representation\n", o.to.c_str());
+        std::fprintf(stderr, "zhc: error: --representations %s: unknown representation\n", o.to.c_str());
         return kExitUsage;
     }
-    const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = resolve_threads(o.threads);
     SceneLoadOptions lo;
     lo.threads = threads;
     // A glTF input is read once: it is both the scene and, for -o .glb/.gltf, the host asset.
@@ -138,9 +138,8 @@ const VerbRegistration registration(15, [](CLI::App& app) -> std::function<int()
     CLI::App* sub = app.add_subcommand("bake", "Bake a scene (JSON, or glTF lights and meshes) into SH3 radiance probes");
     sub->add_option("SCENE", o->scene, "scene: JSON (docs/scene.md) or glTF .gltf/.glb (KHR_lights_punctual lights, meshes as occluders)")->required();
     sub->add_option("-o,--output", o->output, "output: .zhp (probe container), .json (float SH3 probe list), .glb/.gltf (probes embedded in glTF)")->required();
-    sub->add_option("--threads", o->threads, "worker threads (output identical for any count; 0 = all cores)")
-        ->check(CLI::Range(0, 256));
-    sub->add_option("--to", o->to, "stored representation of the .zhp (a codec table name; default sh3)");
+    add_threads_option(sub, o->threads, "output identical for any count");
+    add_representations_option(sub, o->to, RepresentationCount::kOne, "stored in the .zhp/glTF (default sh3)", "--to")->capture_default_str();
     sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")->check(CLI::Range(0, 22));
     sub->add_flag("--quiet", o->quiet, "do not print the effects report");
     return [o] { return run(*o); };

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli.h"
+#include "json_output.h"
 #include "codec/benchmark.h"
 #include "formats/audit_inputs.h"
 #include "formats/html_report.h"
@@ -67,14 +68,14 @@ int run(const Options& o) {
     const auto rows = benchmark_codecs(probes, dirs, selected, CodecOptions{}, o.repeats);
 
     if (o.json) {
-        nlohmann::json j;
+        nlohmann::ordered_json j;
         j["probes"] = probes.size();
         j["directions"] = o.directions;
         j["repeats"] = o.repeats;
         if (!o.runtime_cost.empty()) j["runtime_cost_device"] = gpu.device;
-        j["representations"] = nlohmann::json::array();
+        j["representations"] = nlohmann::ordered_json::array();
         for (const BenchRow& r : rows) {
-            auto spread = [](const Spread& s) { return nlohmann::json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
+            auto spread = [](const Spread& s) { return nlohmann::ordered_json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
             j["representations"].push_back({{"name", r.codec->name},
                                              {"bytes_per_probe", r.codec->size_bytes},
                                              {"mean_rmse", r.mean_rmse},
@@ -87,7 +88,7 @@ int run(const Options& o) {
                                                                {"gpu_ns_per_eval", c->ns_per_eval},
                                                                {"gpu_ratio_to_sh3", c->ratio_to_sh3}};
         }
-        std::cout << j.dump(2) << "\n";
+        print_json("bench", j);
     } else {
         std::printf("%zu probes, %d directions, medians of %d repeats [min-max], single thread\n", probes.size(),
                     o.directions, o.repeats);
@@ -209,8 +210,8 @@ const VerbRegistration registration(50, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("bench", "Bytes, encode/decode/evaluation time and error of every representation, with Pareto plots");
     sub->add_option("MAPS", o->inputs, "environment maps or folders (default: the eight sample maps)");
-    sub->add_option("--representations", o->representations, "comma-separated subset of the codec table");
-    sub->add_flag("--json", o->json, "print one JSON object on stdout");
+    add_representations_option(sub, o->representations, RepresentationCount::kList, "default: all");
+    add_json_flag(sub, o->json);
     sub->add_option("--plots", o->plots, "folder for error_vs_encode_time.png and error_vs_bytes.png")->capture_default_str();
     sub->add_flag("--no-plots", o->no_plots, "do not write plots");
     sub->add_option("--html", o->html, "also write one self-contained HTML report (table, SVG plots) to this file");

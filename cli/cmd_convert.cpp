@@ -67,7 +67,7 @@ Result<Loaded> load_input(const Options& o) {
         ro.part = o.part;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return img.error();
-        in.list.probes.push_back(project_envmap(*img, std::max(1, o.threads)));
+        in.list.probes.push_back(project_envmap(*img, resolve_threads(o.threads)));
         in.kind = "envmap";
     } else if (looks_like_json(*bytes)) {
         auto list = parse_probe_json(*bytes, o.input);
@@ -121,7 +121,7 @@ int run(const Options& o) {
     std::string rep = o.to;
     if (rep.empty() && ext == ".zhp") {
         if (!in->set) {
-            std::fprintf(stderr, "zhc: error: --to REPRESENTATION is required to write a .zhp from %s input\n",
+            std::fprintf(stderr, "zhc: error: -r/--representations NAME is required to write a .zhp from %s input\n",
                          in->kind.c_str());
             return kExitUsage;
         }
@@ -183,7 +183,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
         ->required();
     sub->add_option("-o,--output", o->output, "output file: .zhp (container) or .json (float SH3 probe list)")
         ->required();
-    sub->add_option("--to", o->to, "representation (a codec table name, e.g. zh3_q16, sh3_q28, sh2_q, sh3)");
+    add_representations_option(sub, o->to, RepresentationCount::kOne, "default: the input container's; JSON output: none (float SH3)", "--to");
     auto& f = o->storage_flags;
     f.push_back(sub->add_option("--bits", o->bits, "bits per quantised ratio (2..8, default 8)")->check(CLI::Range(2, 8)));
     f.push_back(sub->add_flag("--sqrt", o->sqrt, "sign-preserving square-root encoding of the ratios"));
@@ -200,10 +200,8 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
                               "store irradiance SH (irradiance-scaled bounds) instead of radiance"));
     sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")
         ->check(CLI::Range(0, 22));
-    sub->add_flag("--replace-non-finite", o->replace_non_finite, "env map input: replace NaN/Inf pixels by 0");
-    sub->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
-    sub->add_option("--threads", o->threads, "env map projection threads (result identical for any count)")
-        ->check(CLI::Range(1, 256));
+    add_envmap_read_options(sub, &o->replace_non_finite, o->part);
+    add_threads_option(sub, o->threads, "environment map projection; result identical for any count");
     return [o] { return run(*o); };
 });
 

@@ -60,7 +60,7 @@ int run(const Options& o) {
         if (!t) return report(t.error());
         gpu_table = std::move(*t);
     }
-    const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = resolve_threads(o.threads);
     std::error_code ec;
     fs::create_directories(o.dir, ec);
     if (ec) return report_output(make_error(ErrorCode::kIoError, o.dir + ": cannot create folder (" + ec.message() + ")"));
@@ -292,8 +292,7 @@ const VerbRegistration registration(10, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("demo", "Run the main job on the built-in default scene (no input files needed)");
     sub->add_option("-o,--output", o->dir, "output folder (default: zhc-demo in the current folder)");
-    sub->add_option("--threads", o->threads, "worker threads (outputs identical for any count; 0 = all cores)")
-        ->check(CLI::Range(0, 256));
+    add_threads_option(sub, o->threads, "outputs identical for any count");
     sub->add_option("--directions", o->directions, "audit directions per probe")->check(CLI::Range(16, 1 << 16));
     sub->add_option("--html", o->html, "where to write the HTML report (default: report.html in the output folder)");
     sub->add_option("--runtime-cost", o->runtime_cost,

@@ -30,7 +30,7 @@ struct Options {
     bool punctual = false;
     bool replace_non_finite = false;
     std::string part;
-    int threads = 0;
+    int threads = 1;
 };
 
 struct Probe {
@@ -113,8 +113,7 @@ int run(const Options& o) {
         ro.part = o.part;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return report(img.error());
-        const int threads = o.threads > 0 ? o.threads : 1;
-        probes.push_back({"", project_envmap(*img, threads)});
+        probes.push_back({"", project_envmap(*img, resolve_threads(o.threads))});
     } else {
         auto list = parse_probe_list(*bytes, o.input);
         if (!list) return report(list.error());
@@ -167,10 +166,8 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     sub->add_option("IN", o->input, "environment map (EXR/.hdr, KTX2/DDS cube map) or JSON probe list")->required();
     sub->add_option("-o,--output", o->output, "output JSON (written atomically)")->required();
     sub->add_flag("--punctual", o->punctual, "source is punctual lights: extra windowing 0.92 / 0.73 first");
-    sub->add_flag("--replace-non-finite", o->replace_non_finite, "map input: replace NaN/Inf pixels by 0");
-    sub->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
-    sub->add_option("--threads", o->threads, "map input: projection threads (same result for any count)")
-        ->check(CLI::Range(0, 256));
+    add_envmap_read_options(sub, &o->replace_non_finite, o->part);
+    add_threads_option(sub, o->threads, "environment map projection; same result for any count");
     return [o] { return run(*o); };
 });
 

@@ -149,7 +149,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     embed->add_option("SCENE", o->scene, "input scene (.gltf or .glb)")->required();
     embed->add_option("PROBES", o->probes, "probe set (.zhp container or JSON probe list)")->required();
     embed->add_option("-o,--output", o->output, "output: .glb (binary) or .gltf (JSON, data-URI buffers)")->required();
-    embed->add_option("--encoding", o->encoding, "store in this codec table representation (default: the input's; JSON: sh3)");
+    add_representations_option(embed, o->encoding, RepresentationCount::kOne, "stored in the glTF (default: the input's; JSON input: sh3)", "--encoding");
     embed->add_option("--sh-axes", o->sh_axes, "zhc (default, exact) or gltf (coefficients rotated into glTF axes)")
         ->check(CLI::IsMember({"zhc", "gltf"}));
     embed->add_flag("--draco", o->draco, "store positions + coefficients as a Draco point cloud (points layout, sh3/sh2)");

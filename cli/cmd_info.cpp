@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "cli.h"
+#include "json_output.h"
 #include "codec/probe_set.h"
 #include "formats/envmap.h"
 #include "formats/file_io.h"
@@ -89,7 +90,7 @@ bool is_gltf_json(const std::vector<std::uint8_t>& bytes) {
 
 void print_json_or_text(const nlohmann::ordered_json& j, bool as_json) {
     if (as_json) {
-        std::cout << j.dump() << "\n";
+        print_json("info", j);
         return;
     }
     for (auto it = j.begin(); it != j.end(); ++it) {
@@ -197,7 +198,7 @@ const VerbRegistration registration(45, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("info", "Describe an environment map, .zhp probe container, JSON probe list or glTF asset");
     sub->add_option("FILE", o->path, "file to describe (type detected from its content)")->required();
-    sub->add_flag("--json", o->json, "print one JSON object");
+    add_json_flag(sub, o->json);
     return [o] { return run(*o); };
 });
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "json_output.h"
 #include "codec/lightmap.h"
 #include "formats/dds.h"
 #include "formats/envmap.h"
@@ -149,7 +150,7 @@ int run_audit(const Options& o) {
         std::fprintf(stderr, "report: %s\n", o.html.c_str());
     }
     if (o.json) {
-        nlohmann::json j;
+        nlohmann::ordered_json j;
         j["input"] = o.input;
         j["width"] = lm->width;
         j["height"] = lm->height;
@@ -161,7 +162,7 @@ int run_audit(const Options& o) {
         j["d_error_deg"] = {{"mean", a.d_mean_deg}, {"max", a.d_max_deg}};
         j["mtexel_per_s"] = {{"irradz_fit", texels / t_fit / 1e6}, {"block_compression", texels / t_bc / 1e6}};
         j["threads"] = o.threads;
-        std::cout << j.dump() << "\n";
+        print_json("lightmap audit", j);
         return kExitOk;
     }
     std::printf("%s: %dx%d texels, %zu audited (every %d-th), quality %s, %d thread(s)\n", o.input.c_str(), lm->width,
@@ -196,7 +197,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     auto quality = [&](CLI::App* s) {
         s->add_option("--quality", o->quality, "block compression: fast | default | slow (exhaustive BC6H)")
             ->check(CLI::IsMember({"fast", "default", "slow"}));
-        s->add_option("--threads", o->threads, "worker threads (output identical for any count)")->check(CLI::Range(1, 256));
+        add_threads_option(s, o->threads, "output identical for any count");
     };
     CLI::App* enc = lm->add_subcommand("encode", "SH lightmap EXR -> PREFIX.iz.ktx2 (BC6H) + PREFIX.d.ktx2 (BC5) + PREFIX.wa.ktx2 (BC4), or .dds");
     enc->add_option("IN", o->input, "SH lightmap EXR (channels sh0.R .. sh8.B)")->required();
@@ -213,16 +214,17 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     CLI::App* aud = lm->add_subcommand("audit", "hemispherical error before/after block compression, PSNR per texture, speed");
     aud->add_option("IN", o->input, "SH lightmap EXR")->required();
     aud->add_option("--stride", o->stride, "audit every N-th texel")->check(CLI::Range(1, 1 << 20));
-    aud->add_flag("--json", o->json, "one JSON object");
+    add_json_flag(aud, o->json);
     aud->add_option("--html", o->html, "also write one self-contained HTML report (pictures before/after block compression, error map, tables)");
     quality(aud);
     CLI::App* syn = lm->add_subcommand("synth", "synthetic SH lightmap: a sphere lit by an environment map's SH3");
     syn->add_option("ENVMAP", o->input, "EXR (lat-long or cube) or .hdr environment map")->required();
-    syn->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
+    add_envmap_read_options(syn, nullptr, o->part);
     syn->add_option("-o,--output", o->output, "output SH lightmap EXR")->required();
     syn->add_option("--size", o->size, "width = height in texels")->check(CLI::Range(4, 4096));
-    syn->add_option("--threads", o->threads, "worker threads")->check(CLI::Range(1, 256));
+    add_threads_option(syn, o->threads, "output identical for any count");
     return [o, enc, dec, aud, syn] {
+        o->threads = resolve_threads(o->threads);  // 0 = all cores
         if (enc->parsed()) return run_encode(*o);
         if (dec->parsed()) return run_decode(*o);
         if (aud->parsed()) return run_audit(*o);

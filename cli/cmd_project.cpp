@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "cli.h"
+#include "json_output.h"
 #include "codec/sh.h"
 #include "formats/envmap.h"
 
@@ -18,7 +19,7 @@ struct Options {
     bool json = false;
     bool replace_non_finite = false;
     std::string part;
-    int threads = 0;
+    int threads = 1;
 };
 
 void print_sh3_table(const Sh3Radiance& sh) {
@@ -34,12 +35,12 @@ int run(const Options& o) {
     EnvmapInfo info;
     auto img = read_envmap(o.path, ro, &info);
     if (!img) return report(img.error());
-    const int threads = o.threads > 0 ? o.threads : 1;
+    const int threads = resolve_threads(o.threads);
     const auto t0 = std::chrono::steady_clock::now();
     const Sh3Radiance sh = project_envmap(*img, threads);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (o.json) {
-        nlohmann::json j;
+        nlohmann::ordered_json j;
         j["path"] = o.path;
         j["width"] = img->width;
         j["height"] = img->height;
@@ -47,11 +48,11 @@ int run(const Options& o) {
         j["layout"] = info.layout;
         j["kind"] = "radiance";
         j["basis"] = "zhc (ZH3 paper Eq. 4/5), index l(l+1)+m";
-        nlohmann::json rows = nlohmann::json::array();
+        nlohmann::ordered_json rows = nlohmann::ordered_json::array();
         for (int i = 0; i < 9; ++i) rows.push_back({sh[i].r, sh[i].g, sh[i].b});
         j["sh3"] = rows;
         j["replaced_non_finite"] = info.replaced_non_finite;
-        std::cout << j.dump() << "\n";
+        print_json("project", j);
     } else {
         std::printf("%s: %dx%d %s %s (%s, %s)\n", o.path.c_str(), img->width, img->height, info.format.c_str(),
                     info.layout.c_str(), info.channels.c_str(), info.compression.c_str());
@@ -65,10 +66,9 @@ const VerbRegistration registration(20, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("project", "Project an environment map (EXR lat-long or cube, or .hdr) to SH3 radiance");
     sub->add_option("ENVMAP", o->path, "OpenEXR or Radiance .hdr lat-long map")->required();
-    sub->add_flag("--json", o->json, "print one JSON object; key \"sh3\" holds 9 rows of [r, g, b]");
-    sub->add_flag("--replace-non-finite", o->replace_non_finite, "replace NaN/Inf pixels by 0 instead of failing");
-    sub->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
-    sub->add_option("--threads", o->threads, "worker threads (result is identical for any count)")->check(CLI::Range(0, 256));
+    add_json_flag(sub, o->json, "key \"sh3\" holds 9 rows of [r, g, b]");
+    add_envmap_read_options(sub, &o->replace_non_finite, o->part);
+    add_threads_option(sub, o->threads, "result identical for any count");
     return [o] { return run(*o); };
 });
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli.h"
@@ -46,6 +47,48 @@ int report(const Error& error) {
 int report_output(const Error& error) {
     std::fprintf(stderr, "zhc: error: %s\n", error.message.c_str());
     return kExitOutputFailed;
+}
+
+CLI::Option* add_representations_option(CLI::App* app, std::string& names, RepresentationCount count,
+                                        const std::string& what, const std::string& old_spelling) {
+    const bool one = count == RepresentationCount::kOne;
+    std::string spelling = "-r,--representations";
+    if (!old_spelling.empty()) spelling += "," + old_spelling;
+    std::string help = (one ? "one codec table representation (e.g. zh3_q16, sh3_q28, sh2_q, sh3)"
+                            : "comma-separated subset of the codec table") + (what.empty() ? "" : "; " + what);
+    if (!old_spelling.empty()) help += " (" + old_spelling + ": older spelling)";
+    CLI::Option* opt = app->add_option(spelling, names, help)->type_name(one ? "NAME" : "NAME,...");
+    if (one)
+        opt->check(CLI::Validator(
+            [](const std::string& v) -> std::string {
+                return v.find(',') == std::string::npos ? std::string() : "takes one representation, not a list";
+            },
+            "", "single name"));
+    return opt;
+}
+
+CLI::Option* add_threads_option(CLI::App* app, int& threads, const std::string& what) {
+    return app->add_option("--threads", threads,
+                           "worker threads, 0 = all cores (" + (what.empty() ? std::string("output identical for any count") : what) + ")")
+        ->check(CLI::Range(0, 256))
+        ->capture_default_str();
+}
+
+int resolve_threads(int threads) {
+    return threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+CLI::Option* add_json_flag(CLI::App* app, bool& json, const std::string& what) {
+    return app->add_flag("--json", json,
+                         "print one JSON object on stdout" + (what.empty() ? std::string() : " (" + what + ")") +
+                             ": {\"zhc\": version, \"command\": verb, ...}, schema docs/schema/");
+}
+
+void add_envmap_read_options(CLI::App* app, bool* replace_non_finite, std::string& part) {
+    if (replace_non_finite)
+        app->add_flag("--replace-non-finite", *replace_non_finite, "environment map input: replace NaN/Inf pixels by 0 instead of failing");
+    app->add_option("--part", part,
+                    "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
 }
 
 }  // namespace zhc::cli

@@ -6,18 +6,6 @@
 
 namespace zhc {
 
-std::vector<Vec3> fibonacci_sphere(int n) {
-    std::vector<Vec3> out;
-    out.reserve(static_cast<size_t>(std::max(n, 0)));
-    const double golden_angle = kPi * (3.0 - std::sqrt(5.0));
-    for (int i = 0; i < n; ++i) {
-        const double z = 1.0 - (2.0 * i + 1.0) / n;  // equal-area bands
-        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-        out.push_back({r * std::cos(golden_angle * i), r * std::sin(golden_angle * i), z});
-    }
-    return out;
-}
-
 LatLongImage downsample_for_audit(LatLongView map, int min_width, int min_height) {
     int f = 1;
     while (map.width % (2 * f) == 0 && map.height % (2 * f) == 0 && map.width / (2 * f) >= min_width &&

@@ -14,9 +14,6 @@
 
 namespace zhc {
 
-// n directions spread uniformly over the sphere (spherical Fibonacci lattice), deterministic.
-std::vector<Vec3> fibonacci_sphere(int n);
-
 // A lat-long RGB float image view (interleaved, rows top to bottom; see sh.h for orientation).
 struct LatLongView {
     const float* rgb = nullptr;

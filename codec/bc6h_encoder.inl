@@ -1,3 +1,30 @@
+// zhc/codec/bc6h_encoder.inl — the BC6H (unsigned, BC6H_UF16) block encoder. Included twice by
+// codec/bc6h.cpp: once for baseline x86-64 and once under an AVX2 target pragma, each copy in its
+// own namespace; both perform the same IEEE operations in the same order, so they write the same
+// bytes (docs/lightmap-formats.md "Two builds of the encoder, one output").
+//
+// Algorithm (docs/lightmap-formats.md "BC6H", with the quality levels' table):
+//  * Error: squared differences of half-float bit patterns (a piecewise-linear log2, the space BC6H
+//    interpolates in); inputs clamped to [0, 65504].
+//  * Per (mode, partition): endpoints = the subset's principal axis (power iteration on the
+//    covariance) spanning its extreme projections; quantize to the mode's precision (closed-form
+//    nearest level); anchor-index orientation and delta clamping; index selection (projection on
+//    the palette axis, or that plus an exact test of the two neighbours); least-squares endpoint
+//    refinement for the chosen indices (per subset and channel, 2x2 normal equations), repeated
+//    while the error drops. Principal-axis endpoints refined by least squares for fixed indices
+//    is the classic block-compression fit (I. Castano, "High Quality DXT Compression using CUDA",
+//    NVIDIA, 2007, for BC1; here per BC6H subset and mode).
+//  * Mode choice: the most precise mode whose delta range holds the endpoints (closed form, no
+//    trial of coarser modes); constant blocks directly in mode 14 (exact).
+//  * Partition choice: all 32 two-subset partitions scored at once by what a line cannot fit —
+//    per subset trace(C) - lambda_max(C) (3D, exhaustive) or the smaller eigenvalue in the plane
+//    of the block's two principal axes (2D, fast and default) — from subset moment sums computed
+//    as one masked product; the best few are then fitted. (zhc's own screening.)
+// Sources: the format — Microsoft, "BC6H Format" (Direct3D 11 texture block compression
+// documentation) and the Khronos Data Format Specification (BPTC float, BC6H); the decoder these
+// bytes are checked against is Mesa's llvmpipe (tests/test_mesa_bc.cpp). Written from those
+// descriptions, not from another encoder's code.
+
 // ---- encoder ---------------------------------------------------------------------------------
 
 struct Target {

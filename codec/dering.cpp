@@ -9,7 +9,6 @@
 #include <cmath>
 #include <limits>
 
-#include "audit.h"  // fibonacci_sphere
 #include "codec.h"
 
 namespace zhc {

@@ -74,7 +74,7 @@ std::array<double, 3> sh3_min_numeric(const Sh3Irradiance& irradiance, int sampl
 
 // Fraction of `directions` at which any channel of the irradiance is negative (0 when empty).
 double negative_fraction(const Sh3Irradiance& irradiance, std::span<const Vec3> directions);
-// Same on `count` spherical-Fibonacci directions (fibonacci_sphere of codec/audit.h).
+// Same on `count` spherical-Fibonacci directions (fibonacci_sphere of codec/sh.h).
 double negative_fraction(const Sh3Irradiance& irradiance, int count = 16384);
 
 // ---- windowing (Sec. 2.4, Table 1, Eq. 6) ---------------------------------------------------

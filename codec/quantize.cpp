@@ -250,7 +250,6 @@ float unpack_half(std::uint16_t bits) {
     return (bits & 0x8000u) ? -mag : mag;
 }
 
-int dc_format_bytes(DcFormat f) { return f == DcFormat::kHalf ? 6 : 4; }
 
 Rgb store_dc(const Rgb& dc, DcFormat f, std::uint8_t* out) {
     switch (f) {

@@ -120,8 +120,6 @@ Rgb unpack_rgb9e5(std::uint32_t bits);
 std::uint16_t pack_half(double v);
 float unpack_half(std::uint16_t bits);
 
-// Bytes a DC format needs: 4, 4, 6.
-int dc_format_bytes(DcFormat f);
 // Stores the DC triple at `out` (little-endian) and returns what the decoder will read back.
 Rgb store_dc(const Rgb& dc, DcFormat f, std::uint8_t* out);
 Rgb load_dc(const std::uint8_t* in, DcFormat f);

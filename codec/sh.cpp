@@ -127,6 +127,18 @@ Sh3Radiance project_samples(std::span<const WeightedSample> samples) {
     return out;
 }
 
+std::vector<Vec3> fibonacci_sphere(int n) {
+    std::vector<Vec3> out;
+    out.reserve(static_cast<size_t>(std::max(n, 0)));
+    const double golden_angle = kPi * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < n; ++i) {
+        const double z = 1.0 - (2.0 * i + 1.0) / n;  // equal-area bands
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        out.push_back({r * std::cos(golden_angle * i), r * std::sin(golden_angle * i), z});
+    }
+    return out;
+}
+
 Vec3 latlong_direction(double col, double row, int width, int height) {
     const double u = (col + 0.5) / width, v = (row + 0.5) / height;
     const double phi = kPi * (1.0 - 2.0 * u), theta = kPi * v;

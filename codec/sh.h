@@ -29,6 +29,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 namespace zhc {
 
@@ -165,6 +166,8 @@ struct WeightedSample {
 // SH3 projection of weighted direction samples: c_i = sum_k w_k L_k Y_i(d_k), in double.
 Sh3Radiance project_samples(std::span<const WeightedSample> samples);
 
+// n directions spread uniformly over the sphere (spherical Fibonacci lattice), deterministic.
+std::vector<Vec3> fibonacci_sphere(int n);
 // Direction of the centre of pixel (col, row) in a width x height latitude-longitude map.
 Vec3 latlong_direction(double col, double row, int width, int height);
 // Exact solid angle of row `row` of a lat-long map of the given size, per pixel:

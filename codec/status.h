@@ -24,8 +24,6 @@ enum class ErrorCode {
     kInternal,         // a bug in zhc
 };
 
-const char* error_code_name(ErrorCode code);
-
 struct Error {
     ErrorCode code = ErrorCode::kInternal;
     std::string message;  // one line: "<file>: <what is wrong> (<where>)"

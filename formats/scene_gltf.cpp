@@ -698,12 +698,6 @@ Result<Scene> parse_scene_gltf(std::span<const std::uint8_t> bytes, const std::s
     return s;
 }
 
-Result<Scene> read_scene_gltf_file(const std::string& path, const SceneLoadOptions& options, const GltfLimits& gltf_limits) {
-    auto bytes = read_file_bytes(path, gltf_limits.max_file_bytes);
-    if (!bytes) return bytes.error();
-    return parse_scene_gltf(*bytes, path, options, gltf_limits);
-}
-
 bool is_gltf_path(const std::string& path) {
     std::string ext = fs::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });

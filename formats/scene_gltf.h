@@ -47,8 +47,6 @@ namespace zhc {
 // `path` names the asset in messages and locates external buffers and the environment map.
 Result<Scene> parse_scene_gltf(std::span<const std::uint8_t> bytes, const std::string& path,
                                const SceneLoadOptions& options = {}, const GltfLimits& gltf_limits = {});
-Result<Scene> read_scene_gltf_file(const std::string& path, const SceneLoadOptions& options = {},
-                                   const GltfLimits& gltf_limits = {});
 
 // True for paths ending in .gltf or .glb (any case).
 bool is_gltf_path(const std::string& path);

@@ -4,7 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh --test
-bash scripts/build.sh -DZHC_REQUIRE_MESA_TEST=ON  # the Mesa decoder test must be built here
+bash scripts/build.sh -DZHC_REQUIRE_MESA_TEST=ON -DZHC_WARNINGS_AS_ERRORS=ON  # the Mesa decoder test must be built here; no warnings
 ctest --test-dir build --output-on-failure -j "$(nproc)"
 bash scripts/sanitize.sh
 bash scripts/fuzz.sh

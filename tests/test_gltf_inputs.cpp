@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "codec/scene.h"
+#include "formats/file_io.h"
 #include "formats/gltf_probes.h"
 #include "formats/probe_file.h"
 #include "formats/scene_gltf.h"
@@ -48,7 +49,10 @@ double max_coefficient(const std::vector<Sh3Radiance>& a) {
 }
 
 Scene scene_of(const std::string& file) {
-    auto s = read_scene_gltf_file(file);
+    auto bytes = read_file_bytes(file, GltfLimits{}.max_file_bytes);
+    EXPECT_TRUE(bytes.ok()) << (bytes.ok() ? "" : bytes.error().message);
+    if (!bytes.ok()) return Scene{};
+    auto s = parse_scene_gltf(*bytes, file);
     EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
     return s.ok() ? std::move(s).value() : Scene{};
 }

@@ -1,0 +1,141 @@
+#!/usr/bin/python3
+"""Every `zhc ... --json` output against its schema in docs/schema/ (issue 19).
+
+Usage: check_schemas.py ZHC SCHEMA_DIR ENVMAP WORK_DIR [GLTF_SCENE]
+
+Runs each verb that prints JSON on small real inputs (one sample environment map, a container
+converted from it, a JSON probe list, a glTF with the probes embedded, a 16x16 synthetic SH
+lightmap), checks the versioned envelope ("zhc" = `zhc --version`, "command" = the verb) and
+validates the object with Debian's python3-jsonschema. Then it shows each schema is strict: every
+key of every output, renamed, must make the object invalid (except the keys of maps whose keys are
+data, e.g. audit's "representations" keyed by codec name). Exit 0 when all of it holds.
+"""
+import json
+import os
+import subprocess
+import sys
+
+import jsonschema
+
+ZHC, SCHEMA_DIR, ENVMAP, WORK = sys.argv[1:5]
+GLTF_SCENE = sys.argv[5] if len(sys.argv) > 5 else None
+os.makedirs(WORK, exist_ok=True)
+failures = []
+checked = 0
+mutations = 0
+
+# Objects whose keys are names (codec table entries), not fields: renaming one stays valid.
+FREE_KEY_MAPS = {"representations"}
+
+
+def run(*args):
+    r = subprocess.run([ZHC, *args], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise SystemExit("zhc %s: exit %d\n%s" % (" ".join(args), r.returncode, r.stderr))
+    return r.stdout
+
+
+VERSION = run("--version").strip().split()[-1]
+
+
+def schema_for(name):
+    with open(os.path.join(SCHEMA_DIR, name + ".schema.json")) as f:
+        schema = json.load(f)
+    jsonschema.Draft202012Validator.check_schema(schema)
+    return jsonschema.Draft202012Validator(schema)
+
+
+def renamed_copies(value, path=()):
+    """Yields (path, copy of the root with one key renamed) for every object key under value."""
+    if isinstance(value, dict):
+        free = bool(path) and path[-1] in FREE_KEY_MAPS
+        for key in list(value):
+            if not free:
+                yield path + (key,), {(k + "_renamed" if k == key else k): v for k, v in value.items()}
+            for sub_path, sub in renamed_copies(value[key], path + (key,)):
+                copy = dict(value)
+                copy[key] = sub
+                yield sub_path, copy
+    elif isinstance(value, list):
+        for i, item in enumerate(value):
+            for sub_path, sub in renamed_copies(item, path + (i,)):
+                copy = list(value)
+                copy[i] = sub
+                yield sub_path, copy
+
+
+def check(schema_name, command, args):
+    global checked, mutations
+    label = "zhc " + " ".join(args)
+    try:
+        doc = json.loads(run(*args))
+    except json.JSONDecodeError as e:
+        failures.append("%s: not JSON (%s)" % (label, e))
+        return
+    if doc.get("zhc") != VERSION:
+        failures.append('%s: "zhc" is %r, expected %r' % (label, doc.get("zhc"), VERSION))
+    if doc.get("command") != command:
+        failures.append('%s: "command" is %r, expected %r' % (label, doc.get("command"), command))
+    if list(doc)[:2] != ["zhc", "command"]:
+        failures.append('%s: the envelope keys are not first: %s' % (label, list(doc)[:3]))
+    validator = schema_for(schema_name)
+    errors = sorted(validator.iter_errors(doc), key=lambda e: list(e.path))
+    for e in errors[:5]:
+        failures.append("%s: %s at %s" % (label, e.message, "/".join(map(str, e.path))))
+    checked += 1
+    if errors:
+        return
+    for path, copy in renamed_copies(doc):
+        mutations += 1
+        if validator.is_valid(copy):
+            failures.append("%s: schema %s still accepts the output with key %s renamed"
+                            % (label, schema_name, "/".join(map(str, path))))
+
+
+W = lambda name: os.path.join(WORK, name)
+# Inputs: the map, a quantised container, a float container, a JSON probe list, a glTF, a lightmap.
+run("convert", ENVMAP, "-o", W("q16.zhp"), "-r", "zh3_q16")
+run("convert", ENVMAP, "-o", W("sh3.zhp"), "-r", "sh3", "--zstd", "3")
+run("convert", ENVMAP, "-o", W("list.json"))
+run("lightmap", "synth", ENVMAP, "--size", "16", "-o", W("lm.exr"))
+with open(W("cost.json"), "w") as f:
+    json.dump({"device": "schema test", "rows": [
+        {"encoding": "sh3", "spirv_instructions": 120, "ns_per_eval": 2.5, "ratio_to_sh3": 1.0}]}, f)
+
+check("project", "project", ["project", ENVMAP, "--json"])
+check("info", "info", ["info", ENVMAP, "--json"])
+check("info", "info", ["info", W("q16.zhp"), "--json"])
+check("info", "info", ["info", W("sh3.zhp"), "--json"])
+check("info", "info", ["info", W("list.json"), "--json"])
+if GLTF_SCENE:
+    run("gltf", "embed", GLTF_SCENE, W("q16.zhp"), "-o", W("lit.glb"))
+    check("info", "info", ["info", W("lit.glb"), "--json"])
+check("audit", "audit", ["audit", ENVMAP, W("q16.zhp"), "--json", "--no-timing", "--directions", "64",
+                         "--representations", "sh3,zh3_q16"])
+check("bench", "bench", ["bench", ENVMAP, "--json", "--no-plots", "--repeats", "1", "--directions", "16",
+                         "--representations", "sh3,zh3_q16", "--runtime-cost", W("cost.json")])
+check("lightmap-audit", "lightmap audit", ["lightmap", "audit", W("lm.exr"), "--json", "--stride", "5"])
+
+# A failing gate still prints its JSON (exit 8): the gates object lists the failure.
+r = subprocess.run([ZHC, "audit", ENVMAP, "--json", "--no-timing", "--directions", "32", "--representations", "sh2",
+                    "--max-rmse", "0"], capture_output=True, text=True)
+if r.returncode != 8:
+    failures.append("audit --max-rmse 0: exit %d, expected 8" % r.returncode)
+else:
+    doc = json.loads(r.stdout)
+    if not schema_for("audit").is_valid(doc) or doc["gates"]["passed"] or not doc["gates"]["failures"]:
+        failures.append("audit --max-rmse 0: the JSON does not validate or does not report the failed gate")
+    checked += 1
+
+# Every schema in the folder named after a verb was used (a new verb's schema is tested here).
+verb_schemas = {"project", "info", "audit", "bench", "lightmap-audit"}
+on_disk = {n[:-len(".schema.json")] for n in os.listdir(SCHEMA_DIR) if n.endswith(".schema.json")}
+untested = on_disk - verb_schemas - {"ZHC_light_probes", "scene"}
+if untested:
+    failures.append("schemas without a case here: %s" % sorted(untested))
+
+for f in failures:
+    print("FAIL:", f)
+print("%d outputs validated, %d renamed-key copies rejected%s" % (checked, mutations - sum("renamed" in f for f in failures),
+                                                                 "" if not failures else ", %d failures" % len(failures)))
+sys.exit(1 if failures else 0)
