@@ -35,7 +35,12 @@ int band_rows(int width, int threads, int requested) {
     return std::max({4, by_size, 4 * std::clamp(threads, 1, 64)});
 }
 
-Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::string& prefix, const EncodeOptions& o) {
+Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::string& prefix, const EncodeOptions& o,
+                            bool* output_failed) {
+    auto out_error = [&](Error e) {
+        if (output_failed) *output_failed = true;
+        return e;
+    };
     LightmapStreamOptions so;
     so.threads = o.threads;
     auto src = ShLightmapSource::open(inputs, so);
@@ -52,10 +57,10 @@ Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::s
     std::uint64_t expected[3] = {};
     for (int f = 0; f < 3; ++f) {
         auto header = o.dds ? dds_header(kFormats[f], r.width, r.height) : ktx2_header(kFormats[f], r.width, r.height);
-        if (!header) return make_error(header.error().code, paths[static_cast<size_t>(f)] + ": " + header.error().message);
+        if (!header) return out_error(make_error(header.error().code, paths[static_cast<size_t>(f)] + ": " + header.error().message));
         if (f == 0)
-            if (Status s = out.open(paths); !s) return s.error();
-        if (Status s = out.write(static_cast<size_t>(f), header->data(), header->size()); !s) return s.error();
+            if (Status s = out.open(paths); !s) return out_error(s.error());
+        if (Status s = out.write(static_cast<size_t>(f), header->data(), header->size()); !s) return out_error(s.error());
         expected[f] = header->size() + ktx2_level_bytes(kFormats[f], r.width, r.height);
     }
     const int rows = band_rows(r.width, o.threads, o.band_rows);
@@ -74,7 +79,7 @@ Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::s
         t = Clock::now();
         const std::vector<std::uint8_t>* blocks[3] = {&c.bc6h, &c.bc5, &c.bc4};
         for (size_t f = 0; f < 3; ++f)
-            if (Status s = out.write(f, blocks[f]->data(), blocks[f]->size()); !s) return s.error();
+            if (Status s = out.write(f, blocks[f]->data(), blocks[f]->size()); !s) return out_error(s.error());
         r.timing.write += since(t);
         r.block_bytes += c.bc6h.size() + c.bc5.size() + c.bc4.size();
         if (o.progress) o.progress(static_cast<std::uint64_t>(y1), static_cast<std::uint64_t>(r.height));
@@ -84,13 +89,17 @@ Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::s
             return make_error(ErrorCode::kInternal, paths[f] + ": wrote " + std::to_string(out.written(f)) + " bytes, expected " +
                                                         std::to_string(expected[f]));
     const auto t = Clock::now();
-    if (Status s = out.commit(); !s) return s.error();
+    if (Status s = out.commit(); !s) return out_error(s.error());
     r.timing.write += since(t);
     return r;
 }
 
 Result<DecodeResult> decode(const std::string& prefix, bool dds, const std::string& output, int band_rows_requested,
-                            const ProgressFn& progress) {
+                            const ProgressFn& progress, bool* output_failed) {
+    auto out_error = [&](Error e) {
+        if (output_failed) *output_failed = true;
+        return e;
+    };
     const std::string ext = dds ? ".dds" : ".ktx2";
     BlockFileLayout layout[3];
     FileRangeReader readers[3];
@@ -114,7 +123,7 @@ Result<DecodeResult> decode(const std::string& prefix, bool dds, const std::stri
     r.width = layout[0].width;
     r.height = layout[0].height;
     auto writer = ExrBandWriter::open(output, r.width, r.height, irradz_channel_names(), false);
-    if (!writer) return writer.error();
+    if (!writer) return out_error(writer.error());
     const int rows = band_rows(r.width, 1, band_rows_requested);
     const std::uint64_t bw = static_cast<std::uint64_t>((r.width + 3) / 4);
     std::vector<float> texels;
@@ -140,10 +149,10 @@ Result<DecodeResult> decode(const std::string& prefix, bool dds, const std::stri
                                 static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z)};
             std::memcpy(&texels[t * 7], v, sizeof v);
         }
-        if (Status s = (*writer)->write_rows(texels.data(), c.height); !s) return s.error();
+        if (Status s = (*writer)->write_rows(texels.data(), c.height); !s) return out_error(s.error());
         if (progress) progress(static_cast<std::uint64_t>(y1), static_cast<std::uint64_t>(r.height));
     }
-    if (Status s = (*writer)->commit(); !s) return s.error();
+    if (Status s = (*writer)->commit(); !s) return out_error(s.error());
     return r;
 }
 

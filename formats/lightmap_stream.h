@@ -50,7 +50,9 @@ struct EncodeResult {
     Timing timing;
 };
 // inputs: see ShLightmapSource (one SH3 or linear-SH EXR, or 4 / 9 per-coefficient EXRs).
-Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::string& prefix, const EncodeOptions& options);
+// On failure, *output_failed (if given) tells an error writing the outputs from one on the input.
+Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::string& prefix, const EncodeOptions& options,
+                            bool* output_failed = nullptr);
 
 struct DecodeResult {
     int width = 0, height = 0;
@@ -58,7 +60,7 @@ struct DecodeResult {
 // PREFIX.{iz,d,wa}.{ktx2|dds} -> IrradZ EXR (write_irradz_exr's channels and bytes), block row band
 // by block row band.
 Result<DecodeResult> decode(const std::string& prefix, bool dds, const std::string& output, int band_rows_requested,
-                            const ProgressFn& progress);
+                            const ProgressFn& progress, bool* output_failed = nullptr);
 
 struct AuditOptions {
     bc6h::Quality bc6h_quality = bc6h::Quality::kDefault;
@@ -79,6 +81,6 @@ Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOpt
 // The synthetic sphere lightmap (lightmap::synthesize_sphere) written band by band; `half`: HALF
 // channels (half the file size) instead of FLOAT.
 Status synth(const Sh3Radiance& world, int size, const std::string& output, bool half, int threads, int band_rows_requested,
-             const ProgressFn& progress);
+             const ProgressFn& progress);  // every error is an output error
 
 }  // namespace zhc::lightmap_stream
