@@ -3,6 +3,7 @@
 
 #include <IlmThreadPool.h>
 #include <ImfChannelList.h>
+#include <half.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfIO.h>
@@ -375,6 +376,7 @@ public:
         height_ = h;
         channels_ = names.size();
         names_ = names;
+        half_ = half;
         tmp_ = temporary_path_for(path);
         try {
             Imf::Header header(w, h);
@@ -391,9 +393,18 @@ public:
             return make_error(ErrorCode::kInvalidArgument, path_ + ": rows beyond the image");
         try {
             Imf::FrameBuffer fb;
-            const size_t xs = channels_ * sizeof(float), ys = xs * static_cast<size_t>(width_);
-            char* base = reinterpret_cast<char*>(const_cast<float*>(data)) - static_cast<std::ptrdiff_t>(next_row_) * static_cast<std::ptrdiff_t>(ys);
-            for (size_t c = 0; c < channels_; ++c) fb.insert(names_[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+            // OpenEXR writes a channel only from a slice of its own type: HALF output converts here.
+            const size_t values = static_cast<size_t>(rows) * static_cast<size_t>(width_) * channels_;
+            if (half_) {
+                halves_.resize(values);
+                for (size_t i = 0; i < values; ++i) halves_[i] = Imath::half(data[i]);
+            }
+            const size_t bytes = half_ ? sizeof(Imath::half) : sizeof(float);
+            const size_t xs = channels_ * bytes, ys = xs * static_cast<size_t>(width_);
+            char* base = (half_ ? reinterpret_cast<char*>(halves_.data()) : reinterpret_cast<char*>(const_cast<float*>(data))) -
+                         static_cast<std::ptrdiff_t>(next_row_) * static_cast<std::ptrdiff_t>(ys);
+            for (size_t c = 0; c < channels_; ++c)
+                fb.insert(names_[c], Imf::Slice(half_ ? Imf::HALF : Imf::FLOAT, base + c * bytes, xs, ys));
             out_->setFrameBuffer(fb);
             out_->writePixels(rows);
             next_row_ += rows;
@@ -420,6 +431,8 @@ private:
     std::string path_, tmp_;
     std::vector<std::string> names_;
     std::unique_ptr<Imf::OutputFile> out_;
+    std::vector<Imath::half> halves_;
+    bool half_ = false;
     int width_ = 0, height_ = 0, next_row_ = 0;
     size_t channels_ = 0;
 };
