@@ -369,7 +369,7 @@ public:
             std::filesystem::remove(tmp_, ec);
         }
     }
-    Status open(const std::string& path, int w, int h, const std::vector<std::string>& names, bool half) {
+    Status open(const std::string& path, int w, int h, const std::vector<std::string>& names, bool half, int threads) {
         if (w <= 0 || h <= 0 || names.empty()) return make_error(ErrorCode::kInvalidArgument, path + ": empty image");
         path_ = path;
         width_ = w;
@@ -382,7 +382,10 @@ public:
             Imf::Header header(w, h);
             header.compression() = Imf::ZIP_COMPRESSION;
             for (const auto& n : names) header.channels().insert(n, Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
-            out_ = std::make_unique<Imf::OutputFile>(tmp_.c_str(), header);
+            threads = std::max(1, threads);
+            if (threads > 1 && IlmThread::ThreadPool::globalThreadPool().numThreads() < threads)
+                IlmThread::ThreadPool::globalThreadPool().setNumThreads(threads);
+            out_ = std::make_unique<Imf::OutputFile>(tmp_.c_str(), header, threads > 1 ? threads : 0);
         } catch (const std::exception& e) {
             return make_error(ErrorCode::kIoError, path + ": cannot write OpenEXR (" + e.what() + ")");
         }
@@ -447,9 +450,9 @@ Result<std::unique_ptr<ShLightmapSource>> ShLightmapSource::open(const std::vect
 }
 
 Result<std::unique_ptr<ExrBandWriter>> ExrBandWriter::open(const std::string& path, int width, int height,
-                                                           const std::vector<std::string>& names, bool half) {
+                                                           const std::vector<std::string>& names, bool half, int threads) {
     auto w = std::make_unique<ExrWriter>();
-    if (Status st = w->open(path, width, height, names, half); !st) return st.error();
+    if (Status st = w->open(path, width, height, names, half, threads); !st) return st.error();
     return std::unique_ptr<ExrBandWriter>(std::move(w));
 }
 

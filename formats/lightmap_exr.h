@@ -61,8 +61,9 @@ class ExrBandWriter {
 public:
     virtual ~ExrBandWriter() = default;
     // names: the channels, in the order of the floats of each texel in write_rows' data.
+    // threads > 1: OpenEXR compresses on that many threads (the same bytes).
     static Result<std::unique_ptr<ExrBandWriter>> open(const std::string& path, int width, int height,
-                                                       const std::vector<std::string>& names, bool half);
+                                                       const std::vector<std::string>& names, bool half, int threads = 1);
     // The next `rows` rows: rows * width * names.size() floats, interleaved per texel.
     virtual Status write_rows(const float* data, int rows) = 0;
     virtual Status commit() = 0;

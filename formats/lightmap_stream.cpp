@@ -189,7 +189,7 @@ Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOpt
 
 Status synth(const Sh3Radiance& world, int size, const std::string& output, bool half, int threads, int band_rows_requested,
              const ProgressFn& progress) {
-    auto writer = ExrBandWriter::open(output, size, size, sh_lightmap_channel_names(), half);
+    auto writer = ExrBandWriter::open(output, size, size, sh_lightmap_channel_names(), half, threads);
     if (!writer) return writer.error();
     const int rows = band_rows(size, threads, band_rows_requested);
     std::vector<float> data;

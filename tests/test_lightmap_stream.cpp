@@ -129,7 +129,7 @@ TEST(LightmapStream, DecodeAuditSynthMatchWholeImage) {
     // synth: the same file for any band height and thread count (square sizes only in the CLI).
     const auto square = lightmap::synthesize_sphere(world, 26, 26, 2);
     ASSERT_TRUE(write_sh_lightmap_exr(dir + "/sq_ref.exr", square).ok());
-    for (int rows : {4, 12, 0})
+    for (int rows : {4, 12, 0, 1000})
         for (int threads : {1, 3}) {
             ASSERT_TRUE(lightmap_stream::synth(world, 26, dir + "/sq.exr", false, threads, rows, {}).ok());
             EXPECT_EQ(test::read_bytes(dir + "/sq.exr"), test::read_bytes(dir + "/sq_ref.exr")) << rows << " " << threads;
