@@ -75,7 +75,8 @@ TEST(LightmapStream, EncodeBytesDoNotDependOnBandsOrThreads) {
     const std::string dir = test::fresh_dir("lightmap_stream_encode");
     const Sh3Radiance world = sample_world();
     // Heights that are and are not multiples of 4; a width that is not either.
-    for (const auto& [w, h] : {std::pair{37, 23}, std::pair{16, 30}, std::pair{9, 4}}) {
+    for (const auto& size : {std::pair{37, 23}, std::pair{16, 30}, std::pair{9, 4}}) {
+        const int w = size.first, h = size.second;
         const std::string exr = dir + "/lm" + std::to_string(w) + "x" + std::to_string(h) + ".exr";
         ASSERT_TRUE(write_sh_lightmap_exr(exr, lightmap::synthesize_sphere(world, w, h)).ok());
         for (bool dds : {false, true}) {
