@@ -28,7 +28,7 @@ struct Options {
     std::string input, output, quality = "default", solve = "search";
     std::string container;  // encode: "" = ktx2; decode: "" = auto
     std::string part;       // synth: EXR part of the environment map
-    int threads = 1, size = 256, stride = 17, band_rows = 0;
+    int threads = 1, size = 256, height = 0, stride = 17, band_rows = 0;
     bool json = false, half = false;
     ProgressFlags progress;
 };
@@ -166,11 +166,12 @@ int run_synth(const Options& o) {
     Progress progress("zhc lightmap synth", "rows", o.progress);
     lightmap_stream::ProgressFn fn;
     if (progress.enabled()) fn = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
-    const Status s = lightmap_stream::synth(world, o.size, o.output, o.half, o.threads, o.band_rows, fn);
+    const int height = o.height > 0 ? o.height : o.size;
+    const Status s = lightmap_stream::synth(world, o.size, height, o.output, o.half, o.threads, o.band_rows, fn);
     progress.finish();
     if (!s) return report_output(s.error());
     std::printf("%s -> %s: %dx%d SH lightmap of a sphere lit by the map's SH3 (channels sh0.R .. sh8.B)\n", o.input.c_str(),
-                o.output.c_str(), o.size, o.size);
+                o.output.c_str(), o.size, height);
     return kExitOk;
 }
 
@@ -216,7 +217,8 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     syn->add_option("ENVMAP", o->input, "EXR (lat-long or cube) or .hdr environment map")->required();
     syn->add_option("--part", o->part, "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
     syn->add_option("-o,--output", o->output, "output SH lightmap EXR")->required();
-    syn->add_option("--size", o->size, "width = height in texels")->check(CLI::Range(4, 16384));
+    syn->add_option("--size", o->size, "width (and height, unless --height) in texels")->check(CLI::Range(4, 16384));
+    syn->add_option("--height", o->height, "height in texels (default: --size)")->check(CLI::Range(4, 16384));
     syn->add_option("--threads", o->threads, "worker threads")->check(CLI::Range(1, 256));
     syn->add_flag("--half", o->half, "HALF channels (half the file size) instead of FLOAT");
     band(syn);

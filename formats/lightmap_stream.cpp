@@ -187,21 +187,21 @@ Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOpt
     return r;
 }
 
-Status synth(const Sh3Radiance& world, int size, const std::string& output, bool half, int threads, int band_rows_requested,
-             const ProgressFn& progress) {
-    auto writer = ExrBandWriter::open(output, size, size, sh_lightmap_channel_names(), half, threads);
+Status synth(const Sh3Radiance& world, int width, int height, const std::string& output, bool half, int threads,
+             int band_rows_requested, const ProgressFn& progress) {
+    auto writer = ExrBandWriter::open(output, width, height, sh_lightmap_channel_names(), half, threads);
     if (!writer) return writer.error();
-    const int rows = band_rows(size, threads, band_rows_requested);
+    const int rows = band_rows(width, threads, band_rows_requested);
     std::vector<float> data;
-    for (int y0 = 0; y0 < size; y0 += rows) {
-        const int y1 = std::min(size, y0 + rows);
-        const auto band = lightmap::synthesize_sphere_rows(world, size, size, y0, y1, threads);
+    for (int y0 = 0; y0 < height; y0 += rows) {
+        const int y1 = std::min(height, y0 + rows);
+        const auto band = lightmap::synthesize_sphere_rows(world, width, height, y0, y1, threads);
         data.resize(band.texels.size() * 27);
         for (size_t t = 0; t < band.texels.size(); ++t)
             for (int i = 0; i < 9; ++i)
                 for (int k = 0; k < 3; ++k) data[t * 27 + static_cast<size_t>(i * 3 + k)] = band.texels[t][i][k];
         if (Status s = (*writer)->write_rows(data.data(), y1 - y0); !s) return s;
-        if (progress) progress(static_cast<std::uint64_t>(y1), static_cast<std::uint64_t>(size));
+        if (progress) progress(static_cast<std::uint64_t>(y1), static_cast<std::uint64_t>(height));
     }
     return (*writer)->commit();
 }

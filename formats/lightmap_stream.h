@@ -78,9 +78,9 @@ struct AuditResult {
 // is taken on every stride-th texel (lightmap::audit's sampling), the PSNRs over every texel.
 Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOptions& options);
 
-// The synthetic sphere lightmap (lightmap::synthesize_sphere) written band by band; `half`: HALF
-// channels (half the file size) instead of FLOAT.
-Status synth(const Sh3Radiance& world, int size, const std::string& output, bool half, int threads, int band_rows_requested,
+// The synthetic sphere lightmap (lightmap::synthesize_sphere, width x height) written band by band;
+// `half`: HALF channels (half the file size) instead of FLOAT.
+Status synth(const Sh3Radiance& world, int width, int height, const std::string& output, bool half, int threads, int band_rows_requested,
              const ProgressFn& progress);  // every error is an output error
 
 }  // namespace zhc::lightmap_stream

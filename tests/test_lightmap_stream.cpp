@@ -127,20 +127,22 @@ TEST(LightmapStream, DecodeAuditSynthMatchWholeImage) {
     const auto lm = lightmap::synthesize_sphere(world, w, h);
     const std::string exr = dir + "/lm.exr";
     ASSERT_TRUE(write_sh_lightmap_exr(exr, lm).ok());
-    // synth: the same file for any band height and thread count (square sizes only in the CLI).
+    // synth: the same file for any band height and thread count.
     const auto square = lightmap::synthesize_sphere(world, 26, 26, 2);
     ASSERT_TRUE(write_sh_lightmap_exr(dir + "/sq_ref.exr", square).ok());
     for (int rows : {4, 12, 0, 1000})
         for (int threads : {1, 3}) {
-            ASSERT_TRUE(lightmap_stream::synth(world, 26, dir + "/sq.exr", false, threads, rows, {}).ok());
+            ASSERT_TRUE(lightmap_stream::synth(world, 26, 26, dir + "/sq.exr", false, threads, rows, {}).ok());
             EXPECT_EQ(test::read_bytes(dir + "/sq.exr"), test::read_bytes(dir + "/sq_ref.exr")) << rows << " " << threads;
         }
+    ASSERT_TRUE(lightmap_stream::synth(world, w, h, dir + "/rect.exr", false, 2, 8, {}).ok());
+    EXPECT_EQ(test::read_bytes(dir + "/rect.exr"), test::read_bytes(exr));
     // synthesize_sphere_rows is the band of synthesize_sphere.
     const auto band = lightmap::synthesize_sphere_rows(world, w, h, 8, 13, 2);
     ASSERT_EQ(band.height, 5);
     for (size_t t = 0; t < band.texels.size(); ++t) EXPECT_TRUE(band.texels[t] == lm.texels[8 * w + t]);
     // HALF output reads back within half precision.
-    ASSERT_TRUE(lightmap_stream::synth(world, 26, dir + "/half.exr", true, 1, 8, {}).ok());
+    ASSERT_TRUE(lightmap_stream::synth(world, 26, 26, dir + "/half.exr", true, 1, 8, {}).ok());
     auto half = read_sh_lightmap_exr(dir + "/half.exr");
     ASSERT_TRUE(half.ok());
     for (size_t t = 0; t < square.texels.size(); ++t)
