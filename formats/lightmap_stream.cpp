@@ -32,7 +32,7 @@ lightmap::IrradzPlanes fit_band(const lightmap::ShLightmap& band, Fit fit, int t
 int band_rows(int width, int threads, int requested) {
     if (requested > 0) return (std::min(requested, 1 << 20) + 3) / 4 * 4;
     const int by_size = (1 << 18) / std::max(1, width) / 4 * 4;
-    return std::max({4, by_size, 4 * std::clamp(threads, 1, 64)});
+    return std::max({4, by_size, 4 * std::clamp(threads, 1, 16)});
 }
 
 Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::string& prefix, const EncodeOptions& o,

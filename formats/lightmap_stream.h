@@ -28,7 +28,7 @@ enum class Fit {
 using ProgressFn = std::function<void(std::uint64_t done, std::uint64_t total)>;
 
 // Band height for an image `width` texels wide: `requested` rounded up to a multiple of 4 if > 0,
-// else about 2^18 texels per band (64 rows at 4096 wide), at least 4 rows per thread.
+// else about 2^18 texels per band (64 rows at 4096 wide), at least 4 rows per thread (up to 16 threads).
 int band_rows(int width, int threads, int requested);
 
 struct Timing {
