@@ -9,9 +9,12 @@
 #include <cstring>
 
 #include "file_io.h"
+#include "le_bytes.h"
 
 namespace zhc {
 namespace {
+using le::get32;
+using le::put32;
 
 constexpr std::uint32_t fourcc(char a, char b, char c, char d) {
     return static_cast<std::uint32_t>(static_cast<std::uint8_t>(a)) | (static_cast<std::uint32_t>(static_cast<std::uint8_t>(b)) << 8) |
@@ -83,14 +86,6 @@ std::string field_at(std::size_t at) {
     return std::string(f->name) + " at byte " + std::to_string(f->offset);
 }
 
-void put32(std::vector<std::uint8_t>& b, std::uint32_t v) {
-    for (int k = 0; k < 4; ++k) b.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
-}
-std::uint32_t get32(std::span<const std::uint8_t> b, std::size_t off) {
-    std::uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) v |= static_cast<std::uint32_t>(b[off + static_cast<size_t>(k)]) << (8 * k);
-    return v;
-}
 
 std::string fourcc_text(std::uint32_t v) {
     std::string s = "'";

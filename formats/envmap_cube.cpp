@@ -14,29 +14,18 @@
 
 #include "codec/bc6h.h"
 #include "codec/cubemap.h"
+#include "formats/le_bytes.h"
 
 namespace zhc {
 
 namespace {
+using le::get32;
+using le::get64;
+constexpr auto get16 = le::load16;
+constexpr auto getf32 = le::load_f32;
 
 constexpr std::uint8_t kKtx2Identifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
 
-std::uint32_t get32(std::span<const std::uint8_t> b, std::size_t off) {
-    std::uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) v |= static_cast<std::uint32_t>(b[off + static_cast<size_t>(k)]) << (8 * k);
-    return v;
-}
-std::uint64_t get64(std::span<const std::uint8_t> b, std::size_t off) {
-    return get32(b, off) | (static_cast<std::uint64_t>(get32(b, off + 4)) << 32);
-}
-std::uint16_t get16(const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
-float getf32(const std::uint8_t* p) {
-    std::uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) v |= static_cast<std::uint32_t>(p[k]) << (8 * k);
-    float f;
-    std::memcpy(&f, &v, 4);
-    return f;
-}
 
 Error fail(ErrorCode code, const std::string& name, const std::string& what) { return make_error(code, name + ": " + what); }
 

@@ -29,6 +29,7 @@
 #include <sstream>
 
 #include "formats/file_io.h"
+#include "formats/le_bytes.h"
 #include "formats/gltf_draco.h"
 #include "formats/json_depth.h"
 
@@ -37,6 +38,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
+using le::put32;
+constexpr auto le32 = le::load32;
 
 constexpr std::uint32_t kGlbMagic = 0x46546C67;     // "glTF"
 constexpr std::uint32_t kChunkJson = 0x4E4F534A;    // "JSON"
@@ -48,9 +51,6 @@ Error fail(ErrorCode code, const std::string& path, const std::string& what) {
     return make_error(code, path + ": " + what);
 }
 
-std::uint32_t le32(const std::uint8_t* p) {
-    return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
-}
 
 // ---- untrusted input: framing, URIs, sizes -------------------------------------------------
 
@@ -338,9 +338,6 @@ bool needs_draco_index_patch(const json& doc) {
     return false;
 }
 
-void put32(std::vector<std::uint8_t>& out, std::uint32_t v) {
-    for (int b = 0; b < 4; ++b) out.push_back(static_cast<std::uint8_t>(v >> (8 * b)));
-}
 
 // GLB 2.0: header, JSON chunk padded with spaces, optional BIN chunk padded with zeros.
 std::vector<std::uint8_t> make_glb(const std::string& json_text, std::span<const std::uint8_t> bin) {

@@ -4,9 +4,14 @@
 #include <cstring>
 
 #include "file_io.h"
+#include "le_bytes.h"
 
 namespace zhc {
 namespace {
+using le::get32;
+using le::get64;
+using le::put32;
+using le::put64;
 
 constexpr std::uint8_t kIdentifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
 constexpr std::size_t kHeaderBytes = 12 + 9 * 4;     // identifier + 9 u32 fields
@@ -19,20 +24,6 @@ constexpr std::uint32_t kModelBc4 = 131, kModelBc5 = 132, kModelBc6h = 133;
 constexpr std::uint32_t kPrimariesBt709 = 1, kTransferLinear = 1;
 constexpr std::uint32_t kQualifierFloat = 0x80;  // in the channelType|qualifiers byte
 
-void put32(std::vector<std::uint8_t>& b, std::uint32_t v) {
-    for (int k = 0; k < 4; ++k) b.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
-}
-void put64(std::vector<std::uint8_t>& b, std::uint64_t v) {
-    for (int k = 0; k < 8; ++k) b.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
-}
-std::uint32_t get32(std::span<const std::uint8_t> b, std::size_t off) {
-    std::uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) v |= static_cast<std::uint32_t>(b[off + static_cast<size_t>(k)]) << (8 * k);
-    return v;
-}
-std::uint64_t get64(std::span<const std::uint8_t> b, std::size_t off) {
-    return get32(b, off) | (static_cast<std::uint64_t>(get32(b, off + 4)) << 32);
-}
 
 // The DFD zhc writes (and the only one it accepts) for a format: dfdTotalSize + one basic block.
 std::vector<std::uint8_t> make_dfd(std::uint32_t vk_format) {

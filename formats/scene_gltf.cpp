@@ -11,11 +11,13 @@
 #include <new>
 
 #include "file_io.h"
+#include "formats/le_bytes.h"
 #include "formats/gltf_draco.h"
 #include "formats/gltf_meshopt.h"
 
 namespace zhc {
 namespace {
+constexpr auto le32 = le::load32;
 
 using json = nlohmann::json;
 namespace fs = std::filesystem;
@@ -53,9 +55,6 @@ Vec3 vector(const Mat4& a, Vec3 v) {
 }
 bool finite3(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-std::uint32_t le32(const std::uint8_t* p) {
-    return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
-}
 
 constexpr int kByte = 5120, kUbyte = 5121, kShort = 5122, kUshort = 5123, kUint = 5125, kFloat = 5126;
 

@@ -70,6 +70,14 @@ double max_abs_diff(const Sh3Radiance& a, const Sh3Radiance& b) {
         for (int k = 0; k < 3; ++k) m = std::max(m, std::fabs(double(a[i][k]) - b[i][k]));
     return m;
 }
+double sh_distance(const Sh3Radiance& a, const Sh3Radiance& b) {
+    double dc = 0, worst = 0;
+    for (int k = 0; k < 3; ++k) dc = std::max(dc, std::fabs(double(b[0][k])));
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) worst = std::max(worst, std::fabs(double(a[i][k]) - b[i][k]));
+    return worst / std::max(dc, 1e-30);
+}
+
 double max_abs(const Sh3Radiance& a) { return max_abs_diff(a, Sh3Radiance{}); }
 
 Sh3Radiance project_latlong_reference(const Image& img, int sub) {

@@ -38,6 +38,8 @@ Sh3Radiance project_latlong_reference(const Image& img, int sub = 1);
 // Largest coefficient difference (and largest coefficient) over the 27 numbers of SH3 radiance.
 double max_abs_diff(const Sh3Radiance& a, const Sh3Radiance& b);
 double max_abs(const Sh3Radiance& a);
+// Largest |a_i - b_i| over coefficients and channels, over the largest |L00| of b (the reference).
+double sh_distance(const Sh3Radiance& a, const Sh3Radiance& b);
 // Irradiance at n by direct integration of the map: (1/pi) sum L max(0, n.w) dw.
 Rgb integrate_irradiance(const Image& img, Vec3 n);
 // A box downsample that keeps total flux (solid-angle weighted), by integer factors.

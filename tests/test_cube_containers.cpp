@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <utility>
 
 #include <zstd.h>
 
@@ -72,14 +73,6 @@ Sh3Radiance test_sh() {
             a[i][k] = i == 0 ? 8.0f + 2.0f * k : (v >= 0 ? v + 0.05f : v - 0.05f);
         }
     return a;
-}
-
-double sh_distance(const Sh3Radiance& a, const Sh3Radiance& b) {
-    double dc = 0, worst = 0;
-    for (int k = 0; k < 3; ++k) dc = std::max(dc, std::fabs(double(b[0][k])));
-    for (int i = 0; i < 9; ++i)
-        for (int k = 0; k < 3; ++k) worst = std::max(worst, std::fabs(double(a[i][k]) - b[i][k]));
-    return worst / std::max(dc, 1e-30);
 }
 
 // A cube map (n x 6n, Vulkan layout) whose texel (col, row) of face f holds F(direction of the
@@ -383,7 +376,7 @@ TEST(CubeContainers, AnalyticShMapProjectsBackInEveryFormat) {
     const Sh3Radiance a = test_sh();
     const int n = 64;
     const Image cube = render_cube(n, [&](Vec3 d) { return evaluate(a, d); });
-    const double exact = sh_distance(project_envmap(cube), a);  // the quadrature alone
+    const double exact = test::sh_distance(project_envmap(cube), a);  // the quadrature alone
     std::printf("analytic SH3, N=64, float cube in memory: %.2e of |L00|\n", exact);
     EXPECT_LT(exact, 1e-4);
     for (const Case& c : kCases) {
@@ -396,7 +389,7 @@ TEST(CubeContainers, AnalyticShMapProjectsBackInEveryFormat) {
         ASSERT_EQ(img->height, 6 * n);
         EXPECT_EQ(info.format, c.container);
         EXPECT_EQ(info.layout, "cube");
-        const double d = sh_distance(project_envmap(*img), a);
+        const double d = test::sh_distance(project_envmap(*img), a);
         std::printf("%-4s %-8s %-6s: %.2e of |L00| (tolerance %.0e)\n", c.container, fmt_name(c.fmt), c.legacy ? "legacy" : "",
                     d, c.tol);
         EXPECT_LT(d, c.tol);
@@ -412,7 +405,7 @@ TEST(CubeContainers, AnalyticShMapProjectsBackInEveryFormat) {
     // can see orientation mistakes.
     Image wrong = cube;
     wrong.layout = EnvmapLayout::kCubeOpenExr;
-    EXPECT_GT(sh_distance(project_envmap(wrong), a), 0.01);
+    EXPECT_GT(test::sh_distance(project_envmap(wrong), a), 0.01);
 }
 
 TEST(CubeContainers, ConstantCubeHasOnlyL00) {
@@ -517,11 +510,11 @@ TEST(CubeContainers, SampleMapAsCubeProjectsLikeTheLatLong) {
             SCOPED_TRACE(std::string(c.container) + " " + fmt_name(c.fmt));
             auto img = read(write(c, fine));
             ASSERT_TRUE(img) << img.error().message;
-            const double d = sh_distance(project_envmap(*img), ref);
+            const double d = test::sh_distance(project_envmap(*img), ref);
             const bool bc = c.fmt == Fmt::kBc6h;
             std::printf("%-10s %-4s %-8s vs lat-long: %.4f of |L00| (vs the float cube: %.4f; brightest texel %.0f)\n",
                         test::envmap_name(path).c_str(), c.container, fmt_name(c.fmt), d,
-                        sh_distance(project_envmap(*img), float_cube), brightest);
+                        test::sh_distance(project_envmap(*img), float_cube), brightest);
             EXPECT_LT(d, bc ? 0.05 : 0.006);
             worst[bc] = std::max(worst[bc], d);
         }
@@ -568,80 +561,51 @@ std::vector<Hostile> hostile_set() {
     v.push_back({"good_legacy.dds", dds_legacy, 0});
     v.push_back({"truncated.ktx2", {ktx.begin(), ktx.end() - 1}, 4});
     v.push_back({"truncated.dds", {dds.begin(), dds.end() - 1}, 4});
-    auto t = ktx;
-    t.push_back(7);
-    v.push_back({"trailing.ktx2", t, 4});
-    t = dds;
-    t.push_back(7);
-    v.push_back({"trailing.dds", t, 4});
-    t = ktx;
-    test::put32(t, 36, 5);
-    v.push_back({"faces5.ktx2", t, 4});
-    t = ktx;
-    test::put32(t, 36, 1);
-    v.push_back({"faces1.ktx2", t, 5});  // a 2-D texture
-    t = ktx;
-    test::put32(t, 32, 2);
-    v.push_back({"array.ktx2", t, 5});
-    t = ktx;
-    test::put32(t, 44, 2);  // says Zstandard, holds raw texels
-    v.push_back({"zstd_raw.ktx2", t, 4});
-    t = ktx;
-    test::put32(t, 44, 1);
-    v.push_back({"basislz.ktx2", t, 5});
+    // One header field changed: {file name, base file, {byte offset, new 32-bit value}..., exit code}.
+    struct Patch {
+        const char* name;
+        const std::vector<std::uint8_t>* base;
+        std::vector<std::pair<std::size_t, std::uint32_t>> fields;
+        int exit_code;
+    };
+    constexpr std::uint32_t kAllButMinusZ = 0x200 | 0x400 | 0x800 | 0x1000 | 0x2000 | 0x4000;
+    const Patch patches[] = {
+        {"faces5.ktx2", &ktx, {{36, 5}}, 4},
+        {"faces1.ktx2", &ktx, {{36, 1}}, 5},  // a 2-D texture
+        {"array.ktx2", &ktx, {{32, 2}}, 5},
+        {"zstd_raw.ktx2", &ktx, {{44, 2}}, 4},  // says Zstandard, holds raw texels
+        {"basislz.ktx2", &ktx, {{44, 1}}, 5},
+        {"bc6h_sfloat.ktx2", &ktx, {{12, 144}, {16, 1}}, 5},
+        {"rgba8.ktx2", &ktx, {{12, 37}}, 5},  // R8G8B8A8_UNORM
+        {"huge.ktx2", &ktx, {{20, 60000}, {24, 60000}}, 6},
+        {"not_square.ktx2", &ktx, {{24, 4}}, 4},
+        {"level_length.ktx2", &ktx, {{80 + 8, 0xFFFFFFF0u}}, 4},  // level 0 byteLength
+        {"level_offset.ktx2", &ktx, {{80, 0xFFFFFFF0u}}, 4},      // level 0 offset beyond the file
+        {"levels.ktx2", &ktx, {{40, 40}}, 4},                     // levelCount
+        {"partial.dds", &dds, {{112, kAllButMinusZ}}, 5},         // no -Z
+        {"partial_legacy.dds", &dds_legacy, {{112, 0x200 | 0x400}}, 5},
+        {"flat_legacy.dds", &dds_legacy, {{112, 0}}, 5},
+        {"array.dds", &dds, {{140, 2}}, 5},
+        {"bc6h_sf16.dds", &dds, {{128, 96}}, 5},
+        {"huge.dds", &dds, {{12, 70000}, {16, 70000}}, 6},
+        {"mips.dds", &dds, {{28, 30}}, 4},
+        {"header_size.dds", &dds, {{4, 100}}, 4},
+    };
+    for (const Patch& p : patches) {
+        std::vector<std::uint8_t> t = *p.base;
+        for (const auto& [offset, value] : p.fields) test::put32(t, offset, value);
+        v.push_back({p.name, t, p.exit_code});
+    }
+    for (const auto* base : {&ktx, &dds}) {
+        std::vector<std::uint8_t> t = *base;
+        t.push_back(7);
+        v.push_back({base == &ktx ? "trailing.ktx2" : "trailing.dds", t, 4});
+    }
     const auto ktx_z = write_ktx2(cube, Fmt::kRgba16f, 2, 1.0f, true);
     v.push_back({"good_zstd.ktx2", ktx_z, 0});
-    t = ktx_z;
+    auto t = ktx_z;
     t[t.size() - 3] ^= 0x55;  // level 0 is last in the file: damage its frame
     v.push_back({"zstd_damaged.ktx2", t, 4});
-    t = ktx;
-    test::put32(t, 12, 144);
-    test::put32(t, 16, 1);
-    v.push_back({"bc6h_sfloat.ktx2", t, 5});
-    t = ktx;
-    test::put32(t, 12, 37);  // R8G8B8A8_UNORM
-    v.push_back({"rgba8.ktx2", t, 5});
-    t = ktx;
-    test::put32(t, 20, 60000);
-    test::put32(t, 24, 60000);
-    v.push_back({"huge.ktx2", t, 6});
-    t = ktx;
-    test::put32(t, 24, 4);
-    v.push_back({"not_square.ktx2", t, 4});
-    t = ktx;
-    test::put32(t, 80 + 8, 0xFFFFFFF0u);  // level 0 byteLength
-    v.push_back({"level_length.ktx2", t, 4});
-    t = ktx;
-    test::put32(t, 80, 0xFFFFFFF0u);  // level 0 offset beyond the file
-    v.push_back({"level_offset.ktx2", t, 4});
-    t = ktx;
-    test::put32(t, 40, 40);  // levelCount
-    v.push_back({"levels.ktx2", t, 4});
-    t = dds;
-    test::put32(t, 112, 0x200 | 0x400 | 0x800 | 0x1000 | 0x2000 | 0x4000);  // no -Z
-    v.push_back({"partial.dds", t, 5});
-    t = dds_legacy;
-    test::put32(t, 112, 0x200 | 0x400);
-    v.push_back({"partial_legacy.dds", t, 5});
-    t = dds_legacy;
-    test::put32(t, 112, 0);
-    v.push_back({"flat_legacy.dds", t, 5});
-    t = dds;
-    test::put32(t, 140, 2);
-    v.push_back({"array.dds", t, 5});
-    t = dds;
-    test::put32(t, 128, 96);
-    v.push_back({"bc6h_sf16.dds", t, 5});
-    t = dds;
-    test::put32(t, 12, 70000);
-    test::put32(t, 16, 70000);
-    v.push_back({"huge.dds", t, 6});
-    t = dds;
-    test::put32(t, 28, 30);
-    v.push_back({"mips.dds", t, 4});
-    t = dds;
-    test::put32(t, 4, 100);
-    v.push_back({"header_size.dds", t, 4});
     v.push_back({"header_only.dds", {dds.begin(), dds.begin() + 128}, 4});
     // zhc's own 2-D lightmap KTX2 / DDS are not environment maps.
     auto lm = encode_ktx2(test::sample_block_image(kVkFormatBc6hUfloat, 8, 8));
@@ -680,7 +644,7 @@ TEST(CubeContainers, CliProjectConvertAndAuditReadCubes) {
         Sh3Radiance s;
         for (int i = 0; i < 9; ++i)
             for (int k = 0; k < 3; ++k) s[i][k] = j["sh3"][static_cast<size_t>(i)][static_cast<size_t>(k)].get<float>();
-        EXPECT_LT(sh_distance(s, a), 3e-4);
+        EXPECT_LT(test::sh_distance(s, a), 3e-4);
         EXPECT_EQ(j["layout"], "cube");
         const auto au = test::run_zhc({"audit", dir + f, "--representations", "sh3", "--json"});
         ASSERT_EQ(au.exit_code, 0) << au.err;

@@ -52,15 +52,6 @@ namespace {
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128;
 }
 
-// Largest |a_i - b_i| over coefficients and channels, over |L00| of b (the reference).
-double sh_distance(const Sh3Radiance& a, const Sh3Radiance& b) {
-    double dc = 0, worst = 0;
-    for (int k = 0; k < 3; ++k) dc = std::max(dc, std::fabs(double(b[0][k])));
-    for (int i = 0; i < 9; ++i)
-        for (int k = 0; k < 3; ++k) worst = std::max(worst, std::fabs(double(a[i][k]) - b[i][k]));
-    return worst / std::max(dc, 1e-30);
-}
-
 Sh3Radiance parse_sh(const std::string& json_text) {
     const auto j = nlohmann::json::parse(json_text);
     Sh3Radiance s;
@@ -192,7 +183,7 @@ TEST(CubeMap, AnalyticShFunctionConvergesAsOneOverNSquared) {
         const int n = sizes[t];
         const std::string path = dir + "/analytic" + std::to_string(n) + ".exr";
         write_float_exr(path, n, 6 * n, render_cube(n, [&](Vec3 d) { return evaluate(a, d); }), true);
-        err[t] = sh_distance(cli_project(path), a);
+        err[t] = test::sh_distance(cli_project(path), a);
     }
     std::printf("analytic SH3 cube: error/|L00| %.3g at N=32, %.3g at N=128 (ratio %.1f)\n", err[0], err[1], err[0] / err[1]);
     EXPECT_LT(err[1], 1e-3);            // measured 2.7e-5
@@ -215,7 +206,7 @@ TEST(CubeMap, ResampledToLatLongForTheAuditReference) {
     cube.rgb = render_cube(n, [&](Vec3 d) { return evaluate(a, d); });
     const Image ll = envmap_as_latlong(cube, 256, 128);
     ASSERT_EQ(ll.layout, EnvmapLayout::kLatLong);
-    const double d = sh_distance(project_latlong(ll.rgb.data(), 256, 128, 256 * 3), a);
+    const double d = test::sh_distance(project_latlong(ll.rgb.data(), 256, 128, 256 * 3), a);
     std::printf("cube N=64 -> lat-long 256x128: SH3 error %.2e of |L00|\n", d);
     EXPECT_LT(d, 2e-3);
     const std::string dir = test::temp_dir("rw_cube_audit");
@@ -247,8 +238,8 @@ TEST(CubeMap, ExrenvmapCubeOfEachSampleMapProjectsLikeTheLatLong) {
         auto img = read_envmap(cube);
         ASSERT_TRUE(img) << img.error().message;
         ASSERT_EQ(img->layout, EnvmapLayout::kCubeOpenExr);
-        const double d = sh_distance(project_envmap(*img), ref);
-        const double wrong = sh_distance(project_latlong(img->rgb.data(), img->width, img->height, img->width * 3u), ref);
+        const double d = test::sh_distance(project_envmap(*img), ref);
+        const double wrong = test::sh_distance(project_latlong(img->rgb.data(), img->width, img->height, img->width * 3u), ref);
         std::printf("%-10s exrenvmap cube vs lat-long: %.4f of |L00| (read as lat-long: %.3f)\n",
                     test::envmap_name(path).c_str(), d, wrong);
         EXPECT_LT(d, 0.006);  // measured worst: night, 0.0045
@@ -268,7 +259,7 @@ TEST(CubeMap, ExrenvmapCubeOfEachSampleMapProjectsLikeTheLatLong) {
     ASSERT_EQ(sh_run(quote(ZHC_TOOL_EXRENVMAP) + " -l -w 1024 " + quote(dir + "/" + test::envmap_name(city) + "_cube.exr") +
                      " " + quote(back)),
               0);
-    EXPECT_LT(sh_distance(cli_project(back), cli_project(dir + "/" + test::envmap_name(city) + "_cube.exr")), 0.006);
+    EXPECT_LT(test::sh_distance(cli_project(back), cli_project(dir + "/" + test::envmap_name(city) + "_cube.exr")), 0.006);
 }
 #endif
 
@@ -353,16 +344,16 @@ TEST(LuminanceChroma, YcFilesProjectLikeTheirRgbSource) {
                 ASSERT_EQ(img->rgb[3 * i + 2], float(back[i].b)) << i;
             }
             const Sh3Radiance got = cli_project(yc_path);
-            const double d = sh_distance(got, ref);
+            const double d = test::sh_distance(got, ref);
             Sh3Radiance grey;
             for (int i = 0; i < 9; ++i) {
                 const double y = 0.2126 * ref[i].r + 0.7152 * ref[i].g + 0.0722 * ref[i].b;
                 grey[i] = Rgb{float(y), float(y), float(y)};
             }
             std::printf("YC %-6s (%s): SH3 vs RGB %.2e of |L00|; grey would be %.3f\n", c.name.c_str(),
-                        yc == Imf::WRITE_YC ? "Y RY BY" : "Y RY BY A", d, sh_distance(grey, ref));
+                        yc == Imf::WRITE_YC ? "Y RY BY" : "Y RY BY A", d, test::sh_distance(grey, ref));
             EXPECT_LT(d, c.threshold) << c.name;
-            EXPECT_GT(sh_distance(grey, ref), 0.1) << c.name;
+            EXPECT_GT(test::sh_distance(grey, ref), 0.1) << c.name;
         }
     }
 }
@@ -416,7 +407,7 @@ TEST(TrailingBytes, AfterEveryKindOfExrAndHdrAreExit4) {
     for (const std::string& path : good) {
         SCOPED_TRACE(path);
         const Sh3Radiance s = cli_project(path);
-        EXPECT_LT(sh_distance(s, ref), 0.01);  // .hdr: RGBE's 8-bit mantissa
+        EXPECT_LT(test::sh_distance(s, ref), 0.01);  // .hdr: RGBE's 8-bit mantissa
         const auto bytes = test::read_bytes(path);
         for (size_t n : {size_t(1), size_t(100)}) {
             const std::string bad = path + ".tail" + std::to_string(n);
@@ -586,12 +577,12 @@ TEST(MultiPart, FirstRgbPartIsReadAndPartChoosesAnother) {
     const Image a = test::render_latlong(32, 16, [](Vec3 d) { return Rgb{float(2 + d.z), 1.0f, 0.5f}; });
     const Image b = test::render_latlong(32, 16, [](Vec3 d) { return Rgb{0.5f, float(3 - d.x), 1.0f}; });
     const Sh3Radiance ref_a = project_latlong(a.rgb.data(), 32, 16, 96), ref_b = project_latlong(b.rgb.data(), 32, 16, 96);
-    ASSERT_GT(sh_distance(ref_a, ref_b), 0.1);
+    ASSERT_GT(test::sh_distance(ref_a, ref_b), 0.1);
     const std::string path = dir + "/api.exr";
     write_multipart(path, {{"depth", nullptr}, {"beauty", &a}, {"second", &b}});
-    EXPECT_LT(sh_distance(cli_project(path), ref_a), 1e-6);
-    EXPECT_LT(sh_distance(cli_project(path, {"--part", "second"}), ref_b), 1e-6);
-    EXPECT_LT(sh_distance(cli_project(path, {"--part", "2"}), ref_b), 1e-6);
+    EXPECT_LT(test::sh_distance(cli_project(path), ref_a), 1e-6);
+    EXPECT_LT(test::sh_distance(cli_project(path, {"--part", "second"}), ref_b), 1e-6);
+    EXPECT_LT(test::sh_distance(cli_project(path, {"--part", "2"}), ref_b), 1e-6);
     expect_one_line_error(test::run_zhc({"project", path, "--part", "nosuch"}), cli::kExitUsage, "--part nosuch");
     expect_one_line_error(test::run_zhc({"project", path, "--part", "depth"}), cli::kExitUnsupported, "--part depth");
     // Every verb that reads maps takes --part.
@@ -619,8 +610,8 @@ TEST(MultiPart, FirstRgbPartIsReadAndPartChoosesAnother) {
     ASSERT_EQ(sh_run(quote(ZHC_TOOL_EXRMULTIPART) + " -combine -i " + quote(dir + "/z.exr") + "::zdepth " + quote(dir + "/b.exr") +
                      "::rgb -o " + quote(combined)),
               0);
-    EXPECT_LT(sh_distance(cli_project(combined), ref_b), 1e-6);
-    EXPECT_LT(sh_distance(cli_project(combined, {"--part", "rgb"}), ref_b), 1e-6);
+    EXPECT_LT(test::sh_distance(cli_project(combined), ref_b), 1e-6);
+    EXPECT_LT(test::sh_distance(cli_project(combined, {"--part", "rgb"}), ref_b), 1e-6);
 #endif
 }
 
@@ -777,7 +768,7 @@ TEST(Radiance, ImageMagickHdrReadsLikeItsSource) {
     std::printf("ImageMagick .hdr: worst pixel error %.2f of its allowance (2^-7 relative + 2^-15)\n", worst);
     EXPECT_LT(worst, 1.0);
     const Sh3Radiance ref = project_latlong(src.rgb.data(), src.width, src.height, src.width * 3u);
-    EXPECT_LT(sh_distance(cli_project(dir + "/magick.hdr"), ref), 1.0 / 128);
+    EXPECT_LT(test::sh_distance(cli_project(dir + "/magick.hdr"), ref), 1.0 / 128);
 }
 #endif
 

@@ -1,0 +1,35 @@
+// Little-endian byte access shared by the container readers and writers (KTX2, DDS, GLB, cube
+// maps). Readers check bounds before calling these; the helpers themselves do not.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <vector>
+
+namespace zhc::le {
+
+inline std::uint16_t load16(const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
+inline std::uint32_t load32(const std::uint8_t* p) {
+    return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
+}
+inline float load_f32(const std::uint8_t* p) {
+    const std::uint32_t v = load32(p);
+    float f;
+    std::memcpy(&f, &v, 4);
+    return f;
+}
+inline std::uint32_t get32(std::span<const std::uint8_t> b, std::size_t off) { return load32(b.data() + off); }
+inline std::uint64_t get64(std::span<const std::uint8_t> b, std::size_t off) {
+    return get32(b, off) | (static_cast<std::uint64_t>(get32(b, off + 4)) << 32);
+}
+// Appends v to b.
+inline void put32(std::vector<std::uint8_t>& b, std::uint32_t v) {
+    for (int k = 0; k < 4; ++k) b.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
+}
+inline void put64(std::vector<std::uint8_t>& b, std::uint64_t v) {
+    for (int k = 0; k < 8; ++k) b.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
+}
+
+}  // namespace zhc::le
