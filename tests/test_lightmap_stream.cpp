@@ -407,6 +407,17 @@ TEST(LightmapStreamCli, ProgressGoesToStderrOnlyAndQuietSilences) {
     auto m = test::run_zhc({"lightmap", "encode", dir + "/linear.exr", "-o", dir + "/lin2", "--solve", "linear"});
     ASSERT_EQ(m.exit_code, 0) << m.err;
     EXPECT_EQ(read_set(dir + "/lin", false), read_set(dir + "/lin2", false));
+    // `zhc audit` over several files: the same progress helper ("files").
+    const auto maps = test::envmap_paths();
+    ASSERT_GE(maps.size(), 2u);
+    auto p1 = test::run_zhc({"audit", maps[0], maps[1], "--no-timing", "--directions", "64", "--progress"});
+    ASSERT_EQ(p1.exit_code, 0) << p1.err;
+    EXPECT_NE(p1.err.find("zhc audit: 50% (1/2 files)"), std::string::npos) << p1.err;
+    EXPECT_NE(p1.err.find("zhc audit: 100% (2/2 files)"), std::string::npos) << p1.err;
+    auto p2 = test::run_zhc({"audit", maps[0], maps[1], "--no-timing", "--directions", "64", "--quiet"});
+    ASSERT_EQ(p2.exit_code, 0) << p2.err;
+    EXPECT_EQ(p2.err, "");
+    EXPECT_EQ(p1.out, p2.out);
     // Usage errors: one line, exit 2.
     auto u = test::run_zhc({"lightmap", "encode", dir + "/a.exr", dir + "/a.exr", "-o", dir + "/z"});
     EXPECT_EQ(u.exit_code, 2);
