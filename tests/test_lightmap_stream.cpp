@@ -3,6 +3,7 @@
 // formats/ktx2.h, formats/dds.h) they replace in the CLI; linear-SH and per-coefficient inputs;
 // progress on stderr (cli/progress.h).
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <random>
 
@@ -117,6 +118,29 @@ TEST(LightmapStream, EncodeBytesDoNotDependOnBandsOrThreads) {
         o.threads = 2;
         ASSERT_TRUE(lightmap_stream::encode({exr}, dir + "/q", o).ok());
         EXPECT_EQ(read_set(dir + "/q", false), whole_image_files(exr, fit, false, bc6h::Quality::kDefault, bc45::Quality::kDefault));
+    }
+}
+
+TEST(LightmapStream, TiledInputGivesTheSameBytes) {
+    // A tiled copy (OpenEXR's exrmaketiled, from the openexr package in scripts/packages-test.txt)
+    // with 8x8 tiles, read in bands of 4 and 12 rows that cut through tile rows.
+    const std::string dir = test::fresh_dir("lightmap_stream_tiled");
+    ASSERT_TRUE(write_sh_lightmap_exr(dir + "/s.exr", lightmap::synthesize_sphere(sample_world(), 37, 23)).ok());
+    ASSERT_EQ(std::system(("exrmaketiled -t 8 8 '" + dir + "/s.exr' '" + dir + "/t.exr' > /dev/null 2>&1").c_str()), 0)
+        << "exrmaketiled (Debian package openexr) is needed";
+    const auto head = test::read_bytes(dir + "/t.exr");
+    ASSERT_GT(head.size(), 8u);
+    EXPECT_NE(head[5] & 0x02, 0) << "not a single-part tiled file";  // version flag 0x200
+    lightmap_stream::EncodeOptions o;
+    o.bc6h_quality = bc6h::Quality::kFast;
+    o.bc45_quality = bc45::Quality::kFast;
+    ASSERT_TRUE(lightmap_stream::encode({dir + "/s.exr"}, dir + "/s", o).ok());
+    for (int rows : {4, 12}) {
+        o.band_rows = rows;
+        o.threads = 2;
+        auto r = lightmap_stream::encode({dir + "/t.exr"}, dir + "/t", o);
+        ASSERT_TRUE(r.ok()) << r.error().message;
+        EXPECT_EQ(read_set(dir + "/t", false), read_set(dir + "/s", false)) << rows;
     }
 }
 
