@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -17,6 +18,7 @@
 #include "codec/audit.h"
 #include "formats/file_io.h"
 #include "formats/html_report.h"
+#include "formats/runtime_cost.h"
 #include "codec/benchmark.h"
 
 namespace zhc::cli {
@@ -40,6 +42,7 @@ struct Options {
     bool fail_on_negative = false;
     bool replace_non_finite = false;
     std::string part;
+    std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
 };
 
 struct FileReport {
@@ -58,6 +61,36 @@ std::string fmt(double v, const char* f = "%.4g") {
 std::vector<std::string> columns() {
     return {"representation", "bytes", "rmse", "rel_rmse", "max_abs", "min_irr", "neg_frac", "chroma", "enc_ns", "dec_ns"};
 }
+// --runtime-cost: two more columns (SPIR-V instructions, GPU ns/eval) looked up by the row's name.
+void add_cost_columns(std::vector<std::vector<std::string>>& rows, const RuntimeCostTable* gpu) {
+    if (!gpu || rows.empty()) return;
+    rows[0].push_back("spirv");
+    rows[0].push_back("gpu_ns");
+    for (size_t i = 1; i < rows.size(); ++i) {
+        auto it = gpu->by_name.find(rows[i][0]);
+        rows[i].push_back(it == gpu->by_name.end() ? "-" : std::to_string(it->second.spirv_instructions));
+        rows[i].push_back(it == gpu->by_name.end() ? "-" : fmt(it->second.ns_per_eval, "%.3g"));
+    }
+}
+
+// CPU time of one irradiance evaluation through the codec's runtime path (median of 5 batches over
+// the directions), on `hub`.
+double eval_ns_per_sample(const Codec& codec, const Sh3Radiance& hub, const std::vector<Vec3>& dirs, const CodecOptions& copt) {
+    std::vector<std::uint8_t> stored(codec.size_bytes);
+    codec.encode(hub, copt, stored.data(), nullptr);
+    std::vector<double> t;
+    volatile float sink = 0;
+    for (int b = 0; b < 5; ++b) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::vector<Rgb> e = codec_irradiance(codec, stored.data(), copt, dirs);
+        t.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() /
+                    static_cast<double>(std::max<size_t>(1, dirs.size())));
+        if (!e.empty()) sink = sink + e[0].r;
+    }
+    std::nth_element(t.begin(), t.begin() + 2, t.end());
+    return t[2];
+}
+
 std::vector<std::string> row_of(const RepresentationResult& r) {
     const ErrorMetrics& m = r.metrics;
     return {std::string(r.codec->name), std::to_string(r.codec->size_bytes), fmt(m.rmse), fmt(m.relative_rmse, "%.4f"),
@@ -92,7 +125,8 @@ HtmlRow html_row(const RepresentationResult& r, bool timed) {
 }
 
 HtmlReport html_of(const Options& o, const std::vector<FileReport>& reports,
-                   const std::vector<RepresentationResult>& aggregate, const std::vector<std::string>& failures) {
+                   const std::vector<RepresentationResult>& aggregate, const std::vector<std::string>& failures,
+                   const RuntimeCostTable* gpu, const std::vector<double>& eval_ns) {
     HtmlReport h;
     h.title = "zhc audit";
     h.version = ZHC_VERSION;
@@ -112,7 +146,11 @@ HtmlReport html_of(const Options& o, const std::vector<FileReport>& reports,
     h.summary_caption = reports.size() > 1 ? "Aggregate over " + std::to_string(reports.size()) +
                                                  " files (mean rmse, relative rmse, fractions and times; worst max abs and min irradiance)"
                                            : reports[0].input.path;
-    for (const RepresentationResult& r : aggregate) h.summary.push_back(html_row(r, timed));
+    for (size_t c = 0; c < aggregate.size(); ++c) {
+        h.summary.push_back(html_row(aggregate[c], timed));
+        if (c < eval_ns.size()) h.summary.back().eval_ns = eval_ns[c];
+    }
+    if (timed) h.settings.push_back({"eval ns/sample", "CPU, one irradiance evaluation through the runtime path, median of 5 batches over the directions, probe 0 of the first file"});
     h.gates_configured = o.max_rmse >= 0 || o.max_relative_rmse >= 0 || o.fail_on_negative;
     if (o.max_rmse >= 0) h.gates.push_back("rmse <= " + fmt(o.max_rmse) + " on every probe");
     if (o.max_relative_rmse >= 0) h.gates.push_back("relative rmse <= " + fmt(o.max_relative_rmse) + " on every probe");
@@ -136,6 +174,7 @@ HtmlReport html_of(const Options& o, const std::vector<FileReport>& reports,
         s.pictures = fr.pictures;
         h.inputs.push_back(std::move(s));
     }
+    apply_runtime_cost(h, gpu, o.runtime_cost);
     return h;
 }
 
@@ -143,6 +182,13 @@ int run(const Options& o) {
     auto chosen = select_codecs(o.representations);
     if (!chosen) return report(chosen.error());
     const std::vector<const Codec*>& selected = *chosen;
+    RuntimeCostTable gpu_table;
+    if (!o.runtime_cost.empty()) {
+        auto t = read_runtime_cost(o.runtime_cost);
+        if (!t) return report(t.error());
+        gpu_table = std::move(*t);
+    }
+    const RuntimeCostTable* gpu = o.runtime_cost.empty() ? nullptr : &gpu_table;
     auto files = expand_audit_inputs(o.inputs);
     if (!files) return report(files.error());
     if (files->empty()) return report(make_error(ErrorCode::kInvalidArgument, "no audit inputs found"));
@@ -268,6 +314,7 @@ int run(const Options& o) {
             std::cout << fr.input.path << " (" << fr.input.description << ", " << o.directions << " directions)\n";
             std::vector<std::vector<std::string>> rows{columns()};
             for (const RepresentationResult& r : fr.results) rows.push_back(row_of(r));
+            add_cost_columns(rows, gpu);
             print_table(std::cout, rows, false);
             std::cout << "\n";
         }
@@ -275,6 +322,7 @@ int run(const Options& o) {
             std::cout << "aggregate over " << reports.size() << " files (mean rmse, rel_rmse, fractions, times; worst max_abs, min_irr)\n";
             std::vector<std::vector<std::string>> rows{columns()};
             for (const RepresentationResult& r : aggregate) rows.push_back(row_of(r));
+            add_cost_columns(rows, gpu);
             print_table(std::cout, rows, false);
         }
     }
@@ -286,19 +334,25 @@ int run(const Options& o) {
             md << "## " << fr.input.path << "\n\n" << fr.input.description << "\n\n";
             std::vector<std::vector<std::string>> rows{columns()};
             for (const RepresentationResult& r : fr.results) rows.push_back(row_of(r));
+            add_cost_columns(rows, gpu);
             print_table(md, rows, true);
             md << "\n";
         }
         md << "## Aggregate over " << reports.size() << " files\n\n";
         std::vector<std::vector<std::string>> rows{columns()};
         for (const RepresentationResult& r : aggregate) rows.push_back(row_of(r));
+        add_cost_columns(rows, gpu);
         print_table(md, rows, true);
         const std::string text = md.str();
         if (Status s = write_file_atomic(o.markdown, std::vector<std::uint8_t>(text.begin(), text.end())); !s)
             return report_output(s.error());
     }
     if (!o.html.empty()) {
-        if (Status s = write_html_report(o.html, html_of(o, reports, aggregate, failures)); !s) return report_output(s.error());
+        std::vector<double> eval_ns;  // CPU evaluation cost: cheap, measured only when timing is on
+        if (!o.no_timing && !reports[0].input.probes.empty())
+            for (const Codec* c : selected) eval_ns.push_back(eval_ns_per_sample(*c, reports[0].input.probes[0], dirs, copt));
+        if (Status s = write_html_report(o.html, html_of(o, reports, aggregate, failures, gpu, eval_ns)); !s)
+            return report_output(s.error());
         std::fprintf(stderr, "report: %s\n", o.html.c_str());
     }
     if (!failures.empty()) {
@@ -316,6 +370,9 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     sub->add_flag("--json", o->json, "print one JSON object (files, aggregate, gates) on stdout");
     sub->add_option("--markdown", o->markdown, "also write the tables as Markdown to this file");
     sub->add_option("--html", o->html, "also write one self-contained HTML report (tables, gates, lit spheres, plots) to this file");
+    sub->add_option("--runtime-cost", o->runtime_cost,
+                    "GPU cost per encoding from build/bench/bench_runtime --json FILE: SPIR-V instructions and lavapipe ns/eval "
+                    "columns (text, Markdown, HTML) and an error-vs-runtime-cost plot in the HTML report");
     sub->add_option("--images", o->images, "write irradiance/error PNGs per input into this folder");
     sub->add_option("--directions", o->directions, "number of Fibonacci-lattice directions")->check(CLI::Range(16, 1 << 20));
     sub->add_option("--threads", o->threads, "worker threads (results do not depend on it)")->check(CLI::Range(0, 256));

@@ -139,6 +139,10 @@ int run(const Options& o) {
             row.encode_ns = r.encode_ns.median;
             row.decode_ns = r.decode_ns.median;
             row.eval_ns = r.eval_ns.median;
+            if (const RuntimeCost* c = gpu_cost(r)) {
+                row.spirv_instructions = c->spirv_instructions;
+                row.gpu_ns = c->ns_per_eval;
+            }
             h.summary.push_back(row);
             by_bytes.points.push_back({row.name, double(row.bytes), r.mean_relative_rmse});
             by_time.points.push_back({row.name, r.encode_ns.median, r.mean_relative_rmse});
@@ -164,8 +168,8 @@ int run(const Options& o) {
     if (!o.no_plots) {
         std::error_code ec;
         fs::create_directories(o.plots, ec);
-        ScatterPlot by_time{"ERROR VS ENCODE TIME", "ENCODE NS PER PROBE (LOG)", "MEAN RELATIVE IRRADIANCE RMSE (LOG)", {}, {}};
-        ScatterPlot by_bytes{"ERROR VS BYTES PER PROBE", "BYTES PER PROBE (LOG)", "MEAN RELATIVE IRRADIANCE RMSE (LOG)", {}, {}};
+        ScatterPlot by_time{"Error vs encode time", "encode time per probe, ns (log scale)", "mean relative irradiance rmse (log scale)", {}, {}};
+        ScatterPlot by_bytes{"Error vs bytes per probe", "bytes per probe (log scale)", "mean relative irradiance rmse (log scale)", {}, {}};
         std::vector<double> t, b, e;
         for (const BenchRow& r : rows) {
             by_time.points.push_back({std::string(r.codec->name), std::max(r.encode_ns.median, 0.1), r.mean_relative_rmse});
@@ -182,8 +186,8 @@ int run(const Options& o) {
         if (Status s = write_scatter_png(p2, by_bytes); !s) return report_output(s.error());
         std::fprintf(stderr, "plots: %s, %s\n", p1.c_str(), p2.c_str());
         // The ZH3 paper's argument: error against what the runtime pays per evaluation.
-        ScatterPlot by_runtime{"ERROR VS RUNTIME COST", "SPIR-V INSTRUCTIONS PER IRRADIANCE EVALUATION (LOG)",
-                               "MEAN RELATIVE IRRADIANCE RMSE (LOG)", {}, {}};
+        ScatterPlot by_runtime{"Error vs runtime cost", "SPIR-V instructions per irradiance evaluation (log scale)",
+                               "mean relative irradiance rmse (log scale)", {}, {}};
         std::vector<double> cost, err;
         for (const BenchRow& r : rows)
             if (const RuntimeCost* c = gpu_cost(r)) {

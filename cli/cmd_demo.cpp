@@ -21,6 +21,7 @@
 #include "formats/html_report.h"
 #include "codec/benchmark.h"
 #include "formats/probe_file.h"
+#include "formats/runtime_cost.h"
 #include "formats/scene_json.h"
 
 namespace zhc::cli {
@@ -35,6 +36,7 @@ struct Options {
     int threads = 0;
     int directions = 512;
     std::string html;  // default: DIR/report.html
+    std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
 };
 
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
@@ -52,6 +54,12 @@ Status write_text(const std::string& path, const std::string& text) {
 
 int run(const Options& o) {
     const auto t_all = Clock::now();
+    RuntimeCostTable gpu_table;
+    if (!o.runtime_cost.empty()) {
+        auto t = read_runtime_cost(o.runtime_cost);
+        if (!t) return report(t.error());
+        gpu_table = std::move(*t);
+    }
     const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     std::error_code ec;
     fs::create_directories(o.dir, ec);
@@ -132,6 +140,15 @@ int run(const Options& o) {
                         std::to_string(all[k]->size_bytes * probes.size()), fmt(m.rmse), fmt(m.relative_rmse, "%.4f"),
                         fmt(m.max_abs), fmt(m.min_irradiance), fmt(m.negative_fraction, "%.4f"),
                         fmt(m.chromaticity_error, "%.4f"), std::to_string(clamped)});
+        if (!o.runtime_cost.empty()) {  // --runtime-cost: SPIR-V instructions, GPU ns per evaluation
+            auto it = gpu_table.by_name.find(std::string(all[k]->name));
+            rows.back().push_back(it == gpu_table.by_name.end() ? "-" : std::to_string(it->second.spirv_instructions));
+            rows.back().push_back(it == gpu_table.by_name.end() ? "-" : fmt(it->second.ns_per_eval, "%.3g"));
+        }
+    }
+    if (!o.runtime_cost.empty()) {
+        rows[0].push_back("spirv");
+        rows[0].push_back("gpu_ns");
     }
     std::printf("\naudit: every representation on the %zu baked probes, irradiance at %d directions per probe\n"
                 "(reference: the baked SH3; %.0f ms)\n",
@@ -210,7 +227,8 @@ int run(const Options& o) {
                       {"bake", rep.summary()},
                       {"directions", std::to_string(o.directions)},
                       {"timing", "not measured by the demo (zhc audit and zhc bench time encode and decode)"},
-                      {"command", "zhc demo -o " + o.dir + " --directions " + std::to_string(o.directions)}};
+                      {"command", "zhc demo -o " + o.dir + " --directions " + std::to_string(o.directions) +
+                                      (o.runtime_cost.empty() ? "" : " --runtime-cost " + o.runtime_cost)}};
         h.summary_caption = "All " + std::to_string(probes.size()) + " probes pooled";
         h.summary = html_rows;
         ScatterPlot plot{"Error vs bytes per probe", "bytes per probe (log scale)", "relative irradiance rmse (log scale)", {}, {}};
@@ -244,6 +262,7 @@ int run(const Options& o) {
                 });
             for (auto& th : pool) th.join();
         }
+        apply_runtime_cost(h, o.runtime_cost.empty() ? nullptr : &gpu_table, o.runtime_cost);
         const std::string html_path = o.html.empty() ? path("report.html") : o.html;
         const std::string doc = html_report(h);
         if (Status s = write_text(html_path, doc); !s) return report_output(s.error());
@@ -277,6 +296,9 @@ const VerbRegistration registration(10, [](CLI::App& app) -> std::function<int()
         ->check(CLI::Range(0, 256));
     sub->add_option("--directions", o->directions, "audit directions per probe")->check(CLI::Range(16, 1 << 16));
     sub->add_option("--html", o->html, "where to write the HTML report (default: report.html in the output folder)");
+    sub->add_option("--runtime-cost", o->runtime_cost,
+                    "GPU cost per encoding from build/bench/bench_runtime --json FILE: SPIR-V instructions and lavapipe ns/eval "
+                    "in the audit table and the report (without it the report says the cost was not given)");
     return [o] { return run(*o); };
 });
 

@@ -16,6 +16,7 @@
 #include "formats/file_io.h"
 #include "formats/ktx2.h"
 #include "formats/lightmap_exr.h"
+#include "formats/lightmap_report.h"
 #include "formats/lightmap_stream.h"
 #include "progress.h"
 
@@ -25,9 +26,10 @@ namespace {
 
 struct Options {
     std::vector<std::string> inputs;
-    std::string input, output, quality = "default", solve = "search";
+    std::string input, output, quality = "default", solve = "newton";
     std::string container;  // encode: "" = ktx2; decode: "" = auto
     std::string part;       // synth: EXR part of the environment map
+    std::string html;       // audit: also write the HTML report here (whole-image path)
     int threads = 1, size = 256, height = 0, stride = 17, band_rows = 0;
     bool json = false, half = false;
     ProgressFlags progress;
@@ -67,7 +69,10 @@ std::string inputs_text(const std::vector<std::string>& files) {
 int run_encode(const Options& o) {
     const auto files = input_files(o.inputs);
     lightmap_stream::EncodeOptions eo;
-    eo.fit = o.solve == "old" ? lightmap_stream::Fit::kOld : (o.solve == "linear" ? lightmap_stream::Fit::kLinear : lightmap_stream::Fit::kSearch);
+    eo.fit = o.solve == "old"      ? lightmap_stream::Fit::kOld
+             : o.solve == "linear" ? lightmap_stream::Fit::kLinear
+             : o.solve == "search" ? lightmap_stream::Fit::kSearch
+                                   : lightmap_stream::Fit::kNewton;
     eo.bc6h_quality = bc6h_quality(o.quality);
     eo.bc45_quality = bc45_quality(o.quality);
     eo.threads = o.threads;
@@ -112,8 +117,34 @@ int run_decode(const Options& o) {
     return kExitOk;
 }
 
+// audit --html: the report needs the whole image's planes, so this path reads the whole lightmap
+// (one EXR, at most 4096 x 4096) as before streaming.
+int run_audit_html(const Options& o, const std::string& input) {
+    LightmapReadOptions ro;
+    ro.threads = o.threads;
+    auto lm = read_sh_lightmap_exr(input, ro);
+    if (!lm) return report(lm.error());
+    irradz::EncodeOptions eo;
+    const auto search = lightmap::encode_planes(*lm, eo, o.threads);
+    eo.solve = irradz::Solve::kOld;
+    const auto old_way = lightmap::encode_planes(*lm, eo, o.threads);
+    const auto c = lightmap::compress(search, bc6h_quality(o.quality), bc45_quality(o.quality), o.threads);
+    const auto after = lightmap::decompress(c);
+    const auto a = lightmap::audit(*lm, search, old_way, after, static_cast<size_t>(o.stride));
+    const auto page = lightmap_audit_html(ZHC_VERSION, {{"input", input}, {"quality", o.quality},
+                                          {"stride", std::to_string(o.stride)}, {"threads", std::to_string(o.threads)}}, search, after, a);
+    if (Status s = write_lightmap_html_report(o.html, page); !s) return report_output(s.error());
+    std::fprintf(stderr, "report: %s\n", o.html.c_str());
+    return kExitOk;
+}
+
 int run_audit(const Options& o) {
     const auto files = input_files(o.inputs);
+    if (!o.html.empty()) {
+        if (files.size() != 1)
+            return report(make_error(ErrorCode::kInvalidArgument, "lightmap audit --html takes one SH lightmap EXR"));
+        if (const int rc = run_audit_html(o, files[0]); rc != kExitOk) return rc;
+    }
     lightmap_stream::AuditOptions ao;
     ao.bc6h_quality = bc6h_quality(o.quality);
     ao.bc45_quality = bc45_quality(o.quality);
@@ -197,8 +228,10 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     enc->add_option("-o,--output", o->output, "output prefix")->required();
     enc->add_option("--container", o->container, "ktx2 (default) | dds (DX10 header): PREFIX.{iz,d,wa}.ktx2 or .dds")
         ->check(CLI::IsMember({"ktx2", "dds"}));
-    enc->add_option("--solve", o->solve, "search (hemispherical Gram + golden section) | old | linear (closed form from L0 + L1)")
-        ->check(CLI::IsMember({"search", "old", "linear"}));
+    enc->add_option("--solve", o->solve,
+                    "newton (hemispherical Gram, Newton on d) | search (the same by golden section: the reference) | old | "
+                    "linear (closed form from L0 + L1)")
+        ->check(CLI::IsMember({"newton", "search", "old", "linear"}));
     quality(enc);
     band(enc);
     CLI::App* dec = lm->add_subcommand("decode", "PREFIX.{iz,d,wa}.ktx2 or .dds -> IrradZ EXR (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)");
@@ -211,6 +244,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     aud->add_option("IN", o->inputs, "SH lightmap EXR(s), as for encode")->required();
     aud->add_option("--stride", o->stride, "audit every N-th texel")->check(CLI::Range(1, 1 << 20));
     aud->add_flag("--json", o->json, "one JSON object");
+    aud->add_option("--html", o->html, "also write one self-contained HTML report (pictures before/after block compression, error map, tables; reads the whole lightmap)");
     quality(aud);
     band(aud);
     CLI::App* syn = lm->add_subcommand("synth", "synthetic SH lightmap: a sphere lit by an environment map's SH3");

@@ -60,13 +60,17 @@ const std::array<double, 81>& hemisphere_gram();
 // ---- encoder -------------------------------------------------------------------------------
 
 enum class Solve {
+    kNewton,  // the same least squares, d by Newton on the analytic reduced error (default)
     kSearch,  // talk: w_a by least squares with the hemispherical Gram matrix, d by golden-section
     kOld,     // the old way: optimal linear direction + spherical Gram matrix (identity)
 };
 
 struct EncodeOptions {
     Model model = Model::kHhd;
-    Solve solve = Solve::kSearch;
+    Solve solve = Solve::kNewton;
+    int newton_iterations = 12;   // Newton steps at most (each with a backtracking line search)
+    double newton_tolerance = 1e-4;  // a Newton step shorter than this (stereographic units, about
+                                     // 2e-4 rad) is taken without a check and ends the solve
     int scan_steps = 8;           // coarse theta samples before golden-section (bracketing)
     int golden_iterations = 16;   // golden-section steps (bracket shrinks by 0.618^16 ~ 5e-4)
     int azimuth_rounds = 1;       // phi-then-theta refinement rounds after the talk's theta search
@@ -91,6 +95,17 @@ double hemispherical_mse(const Sh3Irradiance& target, const IrradZ& p, Model mod
 // baker sampled it directly (`sampled_iz`, the talk's "directly sample I_z in the bake").
 IrradZ encode(const Sh3Radiance& tangent_radiance, const EncodeOptions& options = {},
               double* error = nullptr, const Rgb* sampled_iz = nullptr);
+
+// The reduced error the Newton solve minimises, at the gnomonic direction q = (d_x, d_y) / d_z:
+// psi(q) = min over s = 1 - w_a in [0, 1] of |m - u|_G^2 (u the I_z-weighted colour average of the
+// target; the SH-space error is C + S psi, S = sum_k I_k^2), with its analytic gradient and Hessian
+// in q (hess: xx, xy, yy; the reduced Hessian, s eliminated where it is not clamped). Exposed for
+// the tests (finite differences, the general error).
+struct ReducedError {
+    double psi = 0, s = 0;
+    double grad[2] = {0, 0}, hess[3] = {0, 0, 0};
+};
+ReducedError reduced_error(const Sh3Irradiance& target, Model model, double qx, double qy, const Rgb* sampled_iz = nullptr);
 
 // For a fixed direction d: I_z from the target, w_a by least squares under Gram matrix `gram`
 // (hemisphere or identity), clamped to [0, 1]. Exposed for the tests (brute-force twin).

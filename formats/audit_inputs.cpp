@@ -1,6 +1,7 @@
 #include "audit_inputs.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -115,18 +116,35 @@ Status write_audit_images(const std::string& dir, const AuditInput& input, const
     }
     double mean = 0;
     for (const Rgb& c : ref) mean += (double(c.r) + c.g + c.b) / 3.0;
-    mean = std::max(mean / ref.size(), 1e-12);
+    mean = std::max(mean / static_cast<double>(ref.size()), 1e-12);
+    std::vector<std::vector<Rgb>> recs;
+    for (const Codec* codec : codecs) {
+        std::vector<std::uint8_t> stored(codec->size_bytes);
+        codec->encode(input.probes[0], options, stored.data(), nullptr);
+        recs.push_back(codec_irradiance(*codec, stored.data(), options, pixel_dirs));
+    }
+    // Relative error per pixel (max over channels of |E - E_ref| / mean reference), on one
+    // logarithmic scale shared by every representation (as in the HTML report).
+    auto error_of = [&](const std::vector<Rgb>& rec, size_t i) {
+        double err = 0;
+        for (int k = 0; k < 3; ++k) err = std::max(err, std::fabs(double(rec[i][k]) - ref[i][k]));
+        return std::isfinite(err) ? err / mean : 1e30;
+    };
+    std::vector<std::vector<double>> errors;
+    for (const auto& rec : recs) {
+        errors.emplace_back(rec.size());
+        for (size_t i = 0; i < rec.size(); ++i) errors.back()[i] = error_of(rec, i);
+    }
+    const ErrorScale scale = ErrorScale::from_percentile(errors);
 
-    const int scale = 2, label_w = 150, pad = 6, title_h = 30, legend_h = 34;
+    const int text_px = 17, title_px = 20, label_w = 170, pad = 8, title_h = 34, legend_h = 62;
     const int rows = 1 + static_cast<int>(codecs.size());
-    Canvas canvas(label_w + 2 * sw + 3 * pad, title_h + rows * (sh + pad) + legend_h, {32, 32, 36});
+    Canvas canvas(label_w + 2 * sw + 3 * pad + 28, title_h + rows * (sh + pad) + legend_h, {32, 32, 36});
     const Rgb8 white{235, 235, 235}, magenta{255, 0, 255};
-    canvas.text(pad, 8, fs::path(input.path).filename().string() + "  irradiance (tone-mapped)  |  abs error / mean",
-                scale, white);
-    const double error_full_scale = 0.25;  // error of 25 % of the mean irradiance saturates the ramp
-    auto draw_row = [&](int row, const std::string& label, const std::vector<Rgb>& rec) {
+    canvas.text(pad, 7, fs::path(input.path).filename().string() + ": irradiance (tone-mapped) | error / mean", title_px, white);
+    auto draw_row = [&](int row, const std::string& label, const std::vector<Rgb>& rec, bool with_error) {
         const int y0 = title_h + row * (sh + pad);
-        canvas.text(pad, y0 + sh / 2 - 5, label, scale, white);
+        canvas.text(pad, y0 + sh / 2 - text_px / 2, label, text_px, white);
         for (int y = 0; y < sh; ++y)
             for (int x = 0; x < sw; ++x) {
                 const size_t i = static_cast<size_t>(y) * sw + x;
@@ -135,25 +153,24 @@ Status write_audit_images(const std::string& dir, const AuditInput& input, const
                 Rgb8 p = negative ? magenta
                                   : Rgb8{tonemap_srgb8(c.r / mean), tonemap_srgb8(c.g / mean), tonemap_srgb8(c.b / mean)};
                 canvas.set(label_w + pad + x, y0 + y, p);
-                double err = 0;
-                for (int k = 0; k < 3; ++k) err = std::max(err, std::fabs(double(c[k]) - ref[i][k]));
-                canvas.set(label_w + 2 * pad + sw + x, y0 + y, negative ? magenta : false_colour(err / mean / error_full_scale));
+                if (with_error) canvas.set(label_w + 2 * pad + sw + x, y0 + y, negative ? magenta : scale.colour(error_of(rec, i)));
             }
     };
-    draw_row(0, "reference", ref);
-    for (size_t c = 0; c < codecs.size(); ++c) {
-        std::vector<std::uint8_t> stored(codecs[c]->size_bytes);
-        codecs[c]->encode(input.probes[0], options, stored.data(), nullptr);
-        draw_row(static_cast<int>(c) + 1, std::string(codecs[c]->name), codec_irradiance(*codecs[c], stored.data(), options, pixel_dirs));
+    draw_row(0, "reference", ref, false);
+    for (size_t c = 0; c < codecs.size(); ++c) draw_row(static_cast<int>(c) + 1, std::string(codecs[c]->name), recs[c], true);
+    // Legend: the error scale (three decades, four bands each) and the negative marker.
+    const int ly = canvas.height() - legend_h + 8, bx = label_w + 2 * pad + sw;
+    for (int x = 0; x < sw; ++x) canvas.fill_rect(bx + x, ly, 1, 12, ErrorScale::band_colour((x + 0.5) / sw));
+    for (int d = 0; d <= 3; ++d) {
+        const int x = bx + d * (sw - 1) / 3;
+        canvas.fill_rect(x, ly + 12, 1, 5, white);
+        const std::string t = percent_text(scale.top * std::pow(10.0, d - 3));
+        const int w = Canvas::text_width(t, 14);
+        canvas.text(std::min(x - w / 2, canvas.width() - 2 - w), ly + 18, t, 14, white);
     }
-    // Legend: the error ramp and the negative marker.
-    const int ly = canvas.height() - legend_h + 8;
-    for (int x = 0; x < sw; ++x)
-        canvas.fill_rect(label_w + 2 * pad + sw + x, ly, 1, 10, false_colour(double(x) / (sw - 1)));
-    canvas.text(label_w + 2 * pad + sw, ly + 14, "0", scale, white);
-    canvas.text(label_w + 2 * pad + 2 * sw - Canvas::text_width("25%", scale), ly + 14, "25%", scale, white);
-    canvas.fill_rect(label_w + pad, ly, 10, 10, magenta);
-    canvas.text(label_w + pad + 16, ly, "NEGATIVE", scale, white);
+    canvas.text(bx, ly + 36, "error / mean irradiance, log scale", 14, white);
+    canvas.fill_rect(label_w + pad, ly, 12, 12, magenta);
+    canvas.text(label_w + pad + 18, ly - 3, "negative", text_px, white);
     const std::string out = (fs::path(dir) / (fs::path(input.path).stem().string() + ".png")).string();
     return write_png(out, canvas);
 }

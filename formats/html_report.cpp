@@ -1,7 +1,6 @@
 #include "html_report.h"
 
 #include <stb_image.h>
-#include <stb_image_write.h>
 
 #include <algorithm>
 #include <climits>
@@ -10,6 +9,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "codec/benchmark.h"
 #include "file_io.h"
 #include "raster.h"
 
@@ -76,16 +76,7 @@ std::string base64_encode(const std::vector<std::uint8_t>& bytes) {
 }
 
 std::vector<std::uint8_t> encode_png_rgb8(const std::vector<std::uint8_t>& rgb, int width, int height) {
-    std::vector<std::uint8_t> bytes;
-    if (width <= 0 || height <= 0 || width > (1 << 14) || height > (1 << 14) ||
-        rgb.size() != static_cast<size_t>(width) * height * 3)
-        return bytes;
-    auto sink = [](void* ctx, void* data, int size) {
-        auto* out = static_cast<std::vector<std::uint8_t>*>(ctx);
-        out->insert(out->end(), static_cast<std::uint8_t*>(data), static_cast<std::uint8_t*>(data) + size);
-    };
-    if (!stbi_write_png_to_func(sink, &bytes, width, height, 3, rgb.data(), width * 3)) bytes.clear();
-    return bytes;
+    return png_bytes_rgb8(rgb.data(), rgb.size(), width, height);
 }
 
 Result<DecodedImage> decode_image_rgb8(const std::vector<std::uint8_t>& bytes) {
@@ -143,11 +134,18 @@ SpherePictures render_sphere_pictures(const AuditInput& input, const std::vector
         for (size_t k = 0; k < where.size() && k < values.size(); ++k) out[where[k]] = values[k];
         return out;
     };
+    pics.latlong_width = std::min(2 * size, 128);  // size >= 8
+    pics.latlong_height = pics.latlong_width / 2;
+    std::vector<Vec3> ll_dirs;
+    for (int y = 0; y < pics.latlong_height; ++y)
+        for (int x = 0; x < pics.latlong_width; ++x) ll_dirs.push_back(latlong_direction(x, y, pics.latlong_width, pics.latlong_height));
     if (input.kind == "envmap" && input.map.width > 0 && input.map.height > 0) {
         const LatLongImage coarse = downsample_for_audit(input.map.view(), 64, 32);
         pics.reference = scatter(integrate_irradiance(coarse.view(), dirs, 1));
+        pics.latlong_reference = integrate_irradiance(coarse.view(), ll_dirs, 1);
     } else {
         pics.reference = scatter(sh3_irradiance(input.probes[0], dirs));
+        pics.latlong_reference = sh3_irradiance(input.probes[0], ll_dirs);
     }
     for (const Codec* c : codecs) {
         if (!c) continue;
@@ -155,6 +153,7 @@ SpherePictures render_sphere_pictures(const AuditInput& input, const std::vector
         c->encode(input.probes[0], options, stored.data(), nullptr);
         pics.names.emplace_back(c->name);
         pics.representations.push_back(scatter(codec_irradiance(*c, stored.data(), options, dirs)));
+        pics.latlong_representations.push_back(codec_irradiance(*c, stored.data(), options, ll_dirs));
     }
     return pics;
 }
@@ -178,30 +177,9 @@ double pixel_error(const Rgb& a, const Rgb& b, double mean) {
     return std::isfinite(e) ? e / mean : 1e30;
 }
 
-// The shared heat-map scale of one input: logarithmic over three decades, its top the 99th
-// percentile of the relative pixel error of the worst representation (the one whose 99th
-// percentile is largest).
-struct ErrorScale {
-    double top = 1e-6;  // relative error (of the mean reference irradiance) shown in the top colour
-    static constexpr double kDecades = 3;
-    double t(double e) const {
-        if (!(e > 0)) return 0;
-        return std::clamp((std::log10(e) - std::log10(top)) / kDecades + 1.0, 0.0, 1.0);
-    }
-    // Four colour bands per decade: readable as contours, and the pictures compress well.
-    static constexpr int kBands = 4 * static_cast<int>(kDecades);
-    static Rgb8 band_colour(double t) {
-        const int b = std::min(kBands - 1, static_cast<int>(t * kBands));
-        return false_colour((b + 0.5) / kBands);
-    }
-};
+std::string percent(double rel) { return percent_text(rel); }
 
-std::string percent(double rel) {
-    const double p = rel * 100.0;
-    if (p >= 10) return num(p, "%.0f") + "%";
-    if (p >= 1) return num(p, "%.1f") + "%";
-    return num(p, "%.2g") + "%";
-}
+}  // namespace
 
 std::string colour_bar_svg(const ErrorScale& s) {
     const int w = 360, bar_h = 14, n = ErrorScale::kBands;
@@ -224,16 +202,22 @@ std::string colour_bar_svg(const ErrorScale& s) {
     return o.str();
 }
 
+namespace {
+
 const char* kColumns[] = {"representation", "bytes", "rmse", "relative rmse", "max abs", "min irradiance",
                           "negative fraction", "chroma error", "encode ns", "decode ns"};
 
-void table_html(std::ostringstream& o, const std::string& id, const std::string& caption, const std::vector<HtmlRow>& rows) {
+void table_html(std::ostringstream& o, const std::string& id, const std::string& caption, const std::vector<HtmlRow>& rows,
+                bool runtime_absent_column = false) {
     o << "<table class=\"sortable\"" << (id.empty() ? "" : " id=\"" + id + "\"") << ">\n";
     if (!caption.empty()) o << "<caption>" << html_escape(caption) << "</caption>\n";
     const bool eval = std::any_of(rows.begin(), rows.end(), [](const HtmlRow& r) { return r.eval_ns >= 0; });
     o << "<thead><tr>";
     for (const char* c : kColumns) o << "<th scope=\"col\">" << c << "</th>";
     if (eval) o << "<th scope=\"col\">eval ns/sample</th>";
+    const bool gpu = std::any_of(rows.begin(), rows.end(), [](const HtmlRow& r) { return r.spirv_instructions >= 0; });
+    if (gpu) o << "<th scope=\"col\">runtime cost: SPIR-V instructions</th><th scope=\"col\">runtime cost: GPU ns/eval</th>";
+    else if (runtime_absent_column) o << "<th scope=\"col\">runtime cost</th>";
     o << "</tr></thead>\n<tbody>\n";
     auto cell = [&](double v, const char* f) { o << "<td data-v=\"" << sort_key(v) << "\">" << num(v, f) << "</td>"; };
     auto time = [&](double v) {
@@ -260,6 +244,16 @@ void table_html(std::ostringstream& o, const std::string& id, const std::string&
             if (r.eval_ns < 0 || !std::isfinite(r.eval_ns)) o << "<td data-v=\"-1\">-</td>";
             else cell(r.eval_ns, "%.1f");
         }
+        if (gpu) {
+            if (r.spirv_instructions < 0) o << "<td data-v=\"-1\">-</td><td data-v=\"-1\">-</td>";
+            else {
+                cell(r.spirv_instructions, "%.0f");
+                if (r.gpu_ns < 0 || !std::isfinite(r.gpu_ns)) o << "<td data-v=\"-1\">-</td>";
+                else cell(r.gpu_ns, "%.3g");
+            }
+        } else if (runtime_absent_column) {
+            o << "<td class=\"na\">not given</td>";
+        }
         o << "</tr>\n";
     }
     o << "</tbody></table>\n";
@@ -277,23 +271,24 @@ void pictures_html(std::ostringstream& o, const SpherePictures& p) {
             ++count;
         }
     mean = std::max(count ? mean / count : 0.0, 1e-12);
-    // The shared error scale.
-    ErrorScale scale;
+    // The shared error scale: its top is the 99th percentile of the worst representation's error.
+    std::vector<std::vector<double>> errs;
     for (const auto& rec : p.representations) {
         if (rec.size() != n) continue;
-        std::vector<double> e;
+        errs.emplace_back();
         for (size_t i = 0; i < n; ++i)
-            if (p.inside[i]) e.push_back(pixel_error(rec[i], p.reference[i], mean));
-        if (e.empty()) continue;
-        const size_t k = std::min(e.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(e.size())));
-        std::nth_element(e.begin(), e.begin() + static_cast<std::ptrdiff_t>(k), e.end());
-        if (std::isfinite(e[k])) scale.top = std::max(scale.top, e[k]);
+            if (p.inside[i]) errs.back().push_back(pixel_error(rec[i], p.reference[i], mean));
     }
-    auto irradiance_uri = [&](const std::vector<Rgb>& img, size_t* negatives) {
-        std::vector<std::uint8_t> px(n * 3);
-        for (size_t i = 0; i < n; ++i) {
+    const ErrorScale scale = ErrorScale::from_percentile(std::move(errs));
+    // Pictures: the sphere pair (pixels off the discs in the background colour) or the lat-long
+    // map (every pixel a normal). `inside` empty: every pixel is inside.
+    auto irradiance_uri = [&](const std::vector<Rgb>& img, int pw, int ph, const std::vector<std::uint8_t>& inside,
+                              size_t* negatives) {
+        const size_t m = static_cast<size_t>(pw) * ph;
+        std::vector<std::uint8_t> px(m * 3);
+        for (size_t i = 0; i < m && i < img.size(); ++i) {
             Rgb8 c = kOutside;
-            if (p.inside[i]) {
+            if (inside.empty() || inside[i]) {
                 const Rgb& v = img[i];
                 if (v.r < 0 || v.g < 0 || v.b < 0) {
                     c = kNegative;
@@ -306,39 +301,60 @@ void pictures_html(std::ostringstream& o, const SpherePictures& p) {
             px[i * 3 + 1] = c.g;
             px[i * 3 + 2] = c.b;
         }
-        return png_data_uri(px, w, h);
+        return png_data_uri(px, pw, ph);
     };
-    auto error_uri = [&](const std::vector<Rgb>& img) {
-        std::vector<std::uint8_t> px(n * 3);
-        for (size_t i = 0; i < n; ++i) {
-            const Rgb8 c = p.inside[i] ? ErrorScale::band_colour(scale.t(pixel_error(img[i], p.reference[i], mean))) : kOutside;
+    auto error_uri = [&](const std::vector<Rgb>& img, const std::vector<Rgb>& ref, int pw, int ph,
+                         const std::vector<std::uint8_t>& inside) {
+        const size_t m = static_cast<size_t>(pw) * ph;
+        std::vector<std::uint8_t> px(m * 3);
+        for (size_t i = 0; i < m && i < img.size() && i < ref.size(); ++i) {
+            const Rgb8 c = inside.empty() || inside[i] ? scale.colour(pixel_error(img[i], ref[i], mean)) : kOutside;
             px[i * 3] = c.r;
             px[i * 3 + 1] = c.g;
             px[i * 3 + 2] = c.b;
         }
-        return png_data_uri(px, w, h);
+        return png_data_uri(px, pw, ph);
     };
+    const int lw = p.latlong_width, lh = p.latlong_height;
+    const size_t ln = static_cast<size_t>(std::max(lw, 0)) * std::max(lh, 0);
+    const bool latlong = lw > 0 && lh > 0 && p.latlong_reference.size() == ln &&
+                         p.latlong_representations.size() == p.representations.size();
+    const std::vector<std::uint8_t> all_inside;
     o << "<p class=\"scale\">Lit spheres, seen from +X (left) and from &minus;X (right), +Z up: the pixel at "
          "normal n shows the irradiance E(n), exposed by the mean reference irradiance ("
       << num(mean) << ") and tone-mapped (Reinhard, sRGB); <span class=\"neg\">magenta</span> marks negative "
-         "irradiance. Error maps: max over channels of |E &minus; E<sub>ref</sub>| / mean reference, on one "
+         "irradiance."
+      << (latlong ? " Beside each pair, the same irradiance as a lat-long map of normals (+Z at the top, longitude "
+                    "from &minus;180&deg; at the left)."
+                  : "")
+      << " Error maps: max over channels of |E &minus; E<sub>ref</sub>| / mean reference, on one "
          "logarithmic scale shared by every representation of this input (three decades, four colour bands each; its top is the 99th "
-         "percentile of the worst representation's error, "
+         "percentile of the worst representation's error on the spheres, "
       << percent(scale.top) << "):</p>\n"
       << colour_bar_svg(scale) << "\n<div class=\"cards\">\n";
     size_t neg = 0;
-    o << "<figure class=\"card\"><figcaption>reference</figcaption>"
-      << img_tag(irradiance_uri(p.reference, &neg), w, h, "reference irradiance") << "</figure>\n";
+    o << "<figure class=\"card\"><figcaption>reference</figcaption><div class=\"pair\">"
+      << img_tag(irradiance_uri(p.reference, w, h, p.inside, &neg), w, h, "reference irradiance, lit spheres");
+    if (latlong) o << img_tag(irradiance_uri(p.latlong_reference, lw, lh, all_inside, &neg), lw, lh, "reference irradiance, lat-long");
+    o << "</div></figure>\n";
     for (size_t r = 0; r < p.representations.size() && r < p.names.size(); ++r) {
         if (p.representations[r].size() != n) continue;
-        size_t negatives = 0;
-        const std::string irr = irradiance_uri(p.representations[r], &negatives);
+        const bool ll = latlong && p.latlong_representations[r].size() == ln;
+        size_t negatives = 0, ll_negatives = 0;
+        const std::string irr = irradiance_uri(p.representations[r], w, h, p.inside, &negatives);
         double worst = 0;
         for (size_t i = 0; i < n; ++i)
             if (p.inside[i]) worst = std::max(worst, pixel_error(p.representations[r][i], p.reference[i], mean));
-        o << "<figure class=\"card\"><figcaption>" << html_escape(p.names[r]) << "</figcaption>"
-          << img_tag(irr, w, h, p.names[r] + " irradiance") << img_tag(error_uri(p.representations[r]), w, h, p.names[r] + " error")
-          << "<div class=\"small\">max error " << percent(worst);
+        o << "<figure class=\"card\"><figcaption>" << html_escape(p.names[r]) << "</figcaption><div class=\"pair\">"
+          << img_tag(irr, w, h, p.names[r] + " irradiance, lit spheres");
+        if (ll)
+            o << img_tag(irradiance_uri(p.latlong_representations[r], lw, lh, all_inside, &ll_negatives), lw, lh,
+                         p.names[r] + " irradiance, lat-long");
+        o << "</div><div class=\"pair\">" << img_tag(error_uri(p.representations[r], p.reference, w, h, p.inside), w, h, p.names[r] + " error, lit spheres");
+        if (ll)
+            o << img_tag(error_uri(p.latlong_representations[r], p.latlong_reference, lw, lh, all_inside), lw, lh,
+                         p.names[r] + " error, lat-long");
+        o << "</div><div class=\"small\">max error " << percent(worst);
         if (negatives) o << ", <span class=\"neg\">" << negatives << " negative px</span>";
         o << "</div></figure>\n";
     }
@@ -444,12 +460,12 @@ std::string scatter_svg(const ScatterPlot& plot) {
     return o.str();
 }
 
-std::string html_report(const HtmlReport& r) {
+std::string html_page_begin(const std::string& title, const std::string& version) {
     std::ostringstream o;
     o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
          "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
          "<meta name=\"generator\" content=\"zhc "
-      << html_escape(r.version) << "\">\n<title>" << html_escape(r.title) << "</title>\n<style>\n"
+      << html_escape(version) << "\">\n<title>" << html_escape(title) << "</title>\n<style>\n"
          "body{font-family:system-ui,sans-serif;margin:1.5em;color:#222;background:#fff;max-width:1400px}\n"
          "h1{font-size:1.6em}h2{font-size:1.3em;margin-top:1.6em;border-bottom:1px solid #ccc}\n"
          "table{border-collapse:collapse;margin:.6em 0;font-size:.9em}\n"
@@ -458,11 +474,72 @@ std::string html_report(const HtmlReport& r) {
          "caption{text-align:left;font-weight:bold;padding:.3em 0}\n"
          ".cards{display:flex;flex-wrap:wrap;gap:10px}\n"
          ".card{margin:0;padding:6px;background:#f2f2f4;border:1px solid #ddd;display:flex;flex-direction:column;gap:3px}\n"
-         ".card figcaption{font-family:monospace;font-weight:bold}.small{font-size:.8em}\n"
+         ".card figcaption{font-family:monospace;font-weight:bold}.small{font-size:.8em}.pair{display:flex;gap:4px;align-items:center}\n"
          ".neg{color:#c0c;font-weight:bold}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}\n"
          "dl.settings{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dl.settings dt{font-weight:bold}\n"
-         "dl.settings dd{margin:0;font-family:monospace;word-break:break-all}\n"
+         "dl.settings dd{margin:0;font-family:monospace;word-break:break-all}td.na{color:#777;text-align:center}\n"
          "</style>\n</head>\n<body>\n";
+    return o.str();
+}
+
+std::string html_page_end() {
+    std::ostringstream o;
+    o << "<script>\n"
+         "(function(){\n"
+         "document.querySelectorAll('table.sortable').forEach(function(t){\n"
+         "  t.querySelectorAll('thead th').forEach(function(th,col){\n"
+         "    th.title='sort';th.addEventListener('click',function(){\n"
+         "      var tb=t.tBodies[0],rows=Array.prototype.slice.call(tb.rows),asc=th.dataset.dir!=='asc';\n"
+         "      t.querySelectorAll('thead th').forEach(function(h){delete h.dataset.dir;});th.dataset.dir=asc?'asc':'desc';\n"
+         "      rows.sort(function(a,b){var x=a.cells[col],y=b.cells[col];\n"
+         "        var p=x.dataset.v!==undefined?parseFloat(x.dataset.v):NaN,q=y.dataset.v!==undefined?parseFloat(y.dataset.v):NaN;\n"
+         "        var c=(isNaN(p)||isNaN(q))?x.textContent.localeCompare(y.textContent):p-q;return asc?c:-c;});\n"
+         "      rows.forEach(function(row){tb.appendChild(row);});});});});\n"
+         "window.addEventListener('load',function(){\n"
+         "  var imgs=document.images,ok=0;\n"
+         "  for(var i=0;i<imgs.length;i++)if(imgs[i].complete&&imgs[i].naturalWidth>0)ok++;\n"
+         "  document.body.dataset.imagesOk=ok+'/'+imgs.length;\n"
+         "});\n"
+         "})();\n"
+         "</script>\n</body>\n</html>\n";
+    return o.str();
+}
+
+void apply_runtime_cost(HtmlReport& report, const RuntimeCostTable* table, const std::string& path) {
+    if (!table) {
+        report.runtime_cost_absent =
+            "not given. It is the GPU cost of each encoding's irradiance evaluation (SPIR-V instructions and lavapipe ns per "
+            "evaluation), measured by build/bench/bench_runtime --json FILE; pass that file with --runtime-cost FILE.";
+        return;
+    }
+    report.runtime_cost_absent.clear();
+    report.settings.push_back({"runtime cost", path + " (" + table->device + ")"});
+    auto fill = [&](HtmlRow& row) {
+        auto it = table->by_name.find(row.name);
+        if (it == table->by_name.end()) return;
+        row.spirv_instructions = it->second.spirv_instructions;
+        row.gpu_ns = it->second.ns_per_eval;
+    };
+    for (HtmlRow& row : report.summary) fill(row);
+    for (HtmlInputSection& in : report.inputs)
+        for (HtmlRow& row : in.rows) fill(row);
+    ScatterPlot plot{"Error vs runtime cost", "SPIR-V instructions per irradiance evaluation (log scale)",
+                     "relative irradiance rmse (log scale)", {}, {}};
+    std::vector<double> cost, err;
+    for (const HtmlRow& row : report.summary)
+        if (row.spirv_instructions >= 0) {
+            plot.points.push_back({row.name, double(row.spirv_instructions), row.metrics.relative_rmse});
+            cost.push_back(row.spirv_instructions);
+            err.push_back(row.metrics.relative_rmse);
+        }
+    if (plot.points.empty()) return;
+    plot.frontier = pareto_frontier(cost, err);
+    report.plots.push_back(plot);
+}
+
+std::string html_report(const HtmlReport& r) {
+    std::ostringstream o;
+    o << html_page_begin(r.title, r.version);
     o << "<h1>" << html_escape(r.title) << "</h1>\n<p>zhc " << html_escape(r.version) << ". " << html_escape(r.intro) << "</p>\n";
     // Settings.
     o << "<h2>Inputs and options</h2>\n<dl class=\"settings\">\n<dt>zhc version</dt><dd>" << html_escape(r.version) << "</dd>\n";
@@ -470,7 +547,10 @@ std::string html_report(const HtmlReport& r) {
     o << "</dl>\n";
     // Summary.
     o << "<h2>Summary</h2>\n";
-    table_html(o, "summary", r.summary_caption, r.summary);
+    const bool absent = !r.runtime_cost_absent.empty();
+    table_html(o, "summary", r.summary_caption, r.summary, absent);
+    const bool any_gpu = std::any_of(r.summary.begin(), r.summary.end(), [](const HtmlRow& h) { return h.spirv_instructions >= 0; });
+    if (absent && !any_gpu) o << "<p class=\"small\" id=\"runtime-cost\">Runtime cost: " << html_escape(r.runtime_cost_absent) << "</p>\n";
     o << "<p class=\"small\">Click a column heading to sort (needs JavaScript; the page reads without it). "
          "Errors are of irradiance against the reference; relative rmse is rmse / mean reference irradiance; "
          "times are per probe.</p>\n";
@@ -496,28 +576,11 @@ std::string html_report(const HtmlReport& r) {
         const HtmlInputSection& s = r.inputs[i];
         o << "<section id=\"input-" << i << "\">\n<h2>" << html_escape(s.title) << "</h2>\n<p>" << html_escape(s.description)
           << "</p>\n";
-        if (!s.rows.empty()) table_html(o, "", "", s.rows);
+        if (!s.rows.empty()) table_html(o, "", "", s.rows, absent);
         pictures_html(o, s.pictures);
         o << "</section>\n";
     }
-    o << "<script>\n"
-         "(function(){\n"
-         "document.querySelectorAll('table.sortable').forEach(function(t){\n"
-         "  t.querySelectorAll('thead th').forEach(function(th,col){\n"
-         "    th.title='sort';th.addEventListener('click',function(){\n"
-         "      var tb=t.tBodies[0],rows=Array.prototype.slice.call(tb.rows),asc=th.dataset.dir!=='asc';\n"
-         "      t.querySelectorAll('thead th').forEach(function(h){delete h.dataset.dir;});th.dataset.dir=asc?'asc':'desc';\n"
-         "      rows.sort(function(a,b){var x=a.cells[col],y=b.cells[col];\n"
-         "        var p=x.dataset.v!==undefined?parseFloat(x.dataset.v):NaN,q=y.dataset.v!==undefined?parseFloat(y.dataset.v):NaN;\n"
-         "        var c=(isNaN(p)||isNaN(q))?x.textContent.localeCompare(y.textContent):p-q;return asc?c:-c;});\n"
-         "      rows.forEach(function(row){tb.appendChild(row);});});});});\n"
-         "window.addEventListener('load',function(){\n"
-         "  var imgs=document.images,ok=0;\n"
-         "  for(var i=0;i<imgs.length;i++)if(imgs[i].complete&&imgs[i].naturalWidth>0)ok++;\n"
-         "  document.body.dataset.imagesOk=ok+'/'+imgs.length;\n"
-         "});\n"
-         "})();\n"
-         "</script>\n</body>\n</html>\n";
+    o << html_page_end();
     return o.str();
 }
 

@@ -17,6 +17,8 @@
 #include "codec/audit.h"
 #include "codec/status.h"
 #include "plot.h"
+#include "raster.h"
+#include "runtime_cost.h"
 
 namespace zhc {
 
@@ -29,6 +31,9 @@ struct HtmlRow {
     // false: only rmse and relative rmse are known (bench); the other metrics show as "-".
     bool all_metrics = true;
     double eval_ns = -1;  // per irradiance sample; the column appears when some row has it
+    // GPU runtime evaluation cost (bench_runtime --json, formats/runtime_cost.h); < 0: not known.
+    int spirv_instructions = -1;
+    double gpu_ns = -1;
 };
 
 // Lit spheres: orthographic views of a unit sphere whose pixel at normal n shows E(n). Two views,
@@ -40,6 +45,11 @@ struct SpherePictures {
     std::vector<Rgb> reference;                    // 2*size*size irradiance (0 outside)
     std::vector<std::string> names;                // per representation
     std::vector<std::vector<Rgb>> representations;  // per representation, 2*size*size
+    // The same irradiance as a lat-long map of normals (latlong_direction: +Z up at the top row,
+    // the same convention as the environment maps), latlong_width x latlong_height; 0: none.
+    int latlong_width = 0, latlong_height = 0;
+    std::vector<Rgb> latlong_reference;
+    std::vector<std::vector<Rgb>> latlong_representations;  // per representation
 };
 
 // The normal shown at pixel (x, y) of a 2*size x size sphere picture; false outside the discs.
@@ -47,7 +57,8 @@ bool sphere_pixel_normal(int x, int y, int size, Vec3* normal);
 
 // Evaluates the reference (an environment map: direct integration of the map box-downsampled to
 // 64x32; probes: probe 0's SH3 irradiance) and every codec's runtime irradiance of probe 0 at the
-// sphere pictures' normals. size is clamped to [8, 512].
+// sphere pictures' normals, and on a lat-long map of normals of 2*size x size pixels, at most 128 x 64
+// (irradiance is smooth, and the report stays small). size is clamped to [8, 512].
 SpherePictures render_sphere_pictures(const AuditInput& input, const std::vector<const Codec*>& codecs,
                                       const CodecOptions& options, int size = 96);
 
@@ -70,12 +81,30 @@ struct HtmlReport {
     std::vector<std::string> gate_failures;  // which probes failed which gate; empty = passed
     std::vector<HtmlInputSection> inputs;
     std::vector<ScatterPlot> plots;  // drawn as SVG
+    // The runtime evaluation cost columns: shown when some row has a cost; otherwise, when this is
+    // non-empty, one "runtime cost" column whose cells say it was not given, and this note (how to
+    // give it) under the table.
+    std::string runtime_cost_absent;
 };
+
+// The runtime evaluation cost of every row (summary and inputs), by representation name, from
+// bench_runtime's table read from `path`: adds the cost columns, a "runtime cost" setting and an
+// error-vs-runtime-cost plot. table == nullptr: the report says the cost was not given (the
+// column's cells and a note naming the option).
+void apply_runtime_cost(HtmlReport& report, const RuntimeCostTable* table, const std::string& path);
 
 // The whole document. Deterministic: the same report gives the same bytes.
 std::string html_report(const HtmlReport& report);
 // Writes it atomically.
 Status write_html_report(const std::string& path, const HtmlReport& report);
+
+// The page around a report's content: doctype, head with the inline style, <body>; and the inline
+// script (sortable tables, the images-decoded marker) with the closing tags. Shared by every kind
+// of report (formats/lightmap_report.h too).
+std::string html_page_begin(const std::string& title, const std::string& version);
+std::string html_page_end();
+// The heat-map colour bar as inline SVG, its decades labelled ("<= 0.052%" .. ">= 52%").
+std::string colour_bar_svg(const ErrorScale& scale);
 
 // Pieces, exposed for tests.
 std::string html_escape(const std::string& text);

@@ -23,7 +23,7 @@ const char* const kSuffixes[3] = {".iz", ".d", ".wa"};
 lightmap::IrradzPlanes fit_band(const lightmap::ShLightmap& band, Fit fit, int threads) {
     if (fit == Fit::kLinear) return lightmap::encode_planes_linear_sh(band, threads);
     irradz::EncodeOptions eo;
-    eo.solve = fit == Fit::kOld ? irradz::Solve::kOld : irradz::Solve::kSearch;
+    eo.solve = fit == Fit::kOld ? irradz::Solve::kOld : (fit == Fit::kSearch ? irradz::Solve::kSearch : irradz::Solve::kNewton);
     return lightmap::encode_planes(band, eo, threads);
 }
 
@@ -174,7 +174,7 @@ Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOpt
         if (Status s = in.read_rows(y0, y1, band); !s) return s.error();
         r.timing.read += since(t);
         t = Clock::now();
-        const auto search = fit_band(band, Fit::kSearch, o.threads);
+        const auto search = fit_band(band, Fit::kNewton, o.threads);  // irradz::EncodeOptions' default, as lightmap audit
         r.timing.fit += since(t);
         const auto old_way = fit_band(band, Fit::kOld, o.threads);
         t = Clock::now();

@@ -19,6 +19,7 @@
 namespace zhc::lightmap_stream {
 
 enum class Fit {
+    kNewton,  // irradz::encode, Solve::kNewton (the default)
     kSearch,  // irradz::encode, Solve::kSearch
     kOld,     // irradz::encode, Solve::kOld
     kLinear,  // closed-form linear SH (lightmap::encode_planes_linear_sh)
@@ -36,7 +37,7 @@ struct Timing {
 };
 
 struct EncodeOptions {
-    Fit fit = Fit::kSearch;
+    Fit fit = Fit::kNewton;
     bc6h::Quality bc6h_quality = bc6h::Quality::kDefault;
     bc45::Quality bc45_quality = bc45::Quality::kDefault;
     int threads = 1;
@@ -74,7 +75,7 @@ struct AuditResult {
     lightmap::Audit audit;
     Timing timing;
 };
-// Every row is fitted (search and old way) and block-compressed; the hemispherical error integral
+// Every row is fitted (irradz's default solve and the old way) and block-compressed; the hemispherical error integral
 // is taken on every stride-th texel (lightmap::audit's sampling), the PSNRs over every texel.
 Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOptions& options);
 

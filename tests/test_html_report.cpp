@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +16,7 @@
 
 #include "codec/codec.h"
 #include "formats/html_report.h"
+#include "formats/lightmap_report.h"
 #include "support.h"
 
 namespace fs = std::filesystem;
@@ -70,19 +73,29 @@ void check_self_contained(const std::string& doc, size_t expected_images) {
     const std::regex script_src(R"(<script[^>]*\ssrc=)");
     EXPECT_FALSE(std::regex_search(doc, script_src));
     // Every image is an inlined PNG that decodes, and there are as many as expected.
-    const std::regex img(R"re(<img src="data:image/png;base64,([A-Za-z0-9+/=]+)" width="(\d+)" height="(\d+)")re");
+    // Parsed by hand: std::regex recurses per character and overflows the stack on a long data URI.
+    const std::string prefix = "<img src=\"data:image/png;base64,";
+    const size_t step = expected_images > 20 ? 9 : 1;  // decode every 9th of many (slow under sanitizers)
     size_t n = 0;
-    for (auto it = std::sregex_iterator(doc.begin(), doc.end(), img); it != std::sregex_iterator(); ++it, ++n) {
-        if (n % 9 != 0) continue;  // decode every 9th (all of them is slow under sanitizers)
-        const std::string b64 = (*it)[1].str();
+    for (size_t at = doc.find(prefix); at != std::string::npos; at = doc.find(prefix, at + 1), ++n) {
+        const size_t b64_begin = at + prefix.size();
+        const size_t b64_end = doc.find('"', b64_begin);
+        ASSERT_NE(b64_end, std::string::npos);
+        const std::regex size_attrs(R"re(^" width="(\d+)" height="(\d+)")re");
+        std::smatch m;
+        const std::string attrs = doc.substr(b64_end, 64);
+        ASSERT_TRUE(std::regex_search(attrs, m, size_attrs)) << attrs;
+        if (n % step != 0) continue;
         // Decode the base64 here (an independent decoder, not the writer's encoder run backwards).
         std::vector<std::uint8_t> bytes;
-        int val = 0, bits = -8;
-        for (char ch : b64) {
-            const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        std::uint32_t val = 0;
+        int bits = -8;
+        const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        for (size_t i = b64_begin; i < b64_end; ++i) {
+            const char ch = doc[i];
             const char* p = std::strchr(alphabet, ch);
             if (ch == '=' || !p) break;
-            val = (val << 6) + static_cast<int>(p - alphabet);
+            val = ((val << 6) | static_cast<std::uint32_t>(p - alphabet)) & 0xFFFFFFu;
             bits += 6;
             if (bits >= 0) {
                 bytes.push_back(static_cast<std::uint8_t>((val >> bits) & 0xFF));
@@ -91,8 +104,8 @@ void check_self_contained(const std::string& doc, size_t expected_images) {
         }
         auto decoded = decode_image_rgb8(bytes);
         ASSERT_TRUE(decoded.ok()) << "inline image " << n << " does not decode";
-        EXPECT_EQ(decoded->width, std::stoi((*it)[2].str()));
-        EXPECT_EQ(decoded->height, std::stoi((*it)[3].str()));
+        EXPECT_EQ(decoded->width, std::stoi(m[1].str()));
+        EXPECT_EQ(decoded->height, std::stoi(m[2].str()));
     }
     EXPECT_EQ(n, expected_images);
     EXPECT_EQ(count(doc, "<img "), expected_images);
@@ -235,8 +248,15 @@ TEST(HtmlReport, AuditOfTwoSampleMaps) {
     ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 8) << r.err;
     const std::string doc = slurp(html);
     const size_t reps = codecs().size();
-    // Per input: the reference and, per representation, irradiance and error.
-    check_self_contained(doc, 2 * (1 + 2 * reps));
+    // Per input: the reference and, per representation, irradiance and error, each as lit spheres
+    // and as a lat-long map (128x64).
+    check_self_contained(doc, 2 * 2 * (1 + 2 * reps));
+    EXPECT_EQ(count(doc, "width=\"128\" height=\"64\" alt="), 2 * (1 + 2 * reps));
+    EXPECT_EQ(count(doc, "width=\"192\" height=\"96\" alt="), 2 * (1 + 2 * reps));
+    // No --runtime-cost: the runtime cost column says it was not given, in every table, and how to give it.
+    EXPECT_EQ(count(doc, "<th scope=\"col\">runtime cost</th>"), 3u);
+    EXPECT_EQ(count(doc, "<td class=\"na\">not given</td>"), 3 * reps);
+    EXPECT_NE(doc.find("pass that file with --runtime-cost FILE"), std::string::npos);
     EXPECT_EQ(row_names(summary_table(doc)), codec_names());
     EXPECT_EQ(count(doc, "<tr class=\"rep\">"), 3 * reps);  // summary + one table per input
     EXPECT_NE(doc.find("city.exr"), std::string::npos);
@@ -255,7 +275,7 @@ TEST(HtmlReport, AuditOfTwoSampleMaps) {
                                         "--max-relative-rmse", "0.08", "--html", html2});
     EXPECT_EQ(r2.exit_code, r.exit_code);
     EXPECT_EQ(slurp(html2), doc);
-    check_in_browser(html, dir, reps, 2 * (1 + 2 * reps));
+    check_in_browser(html, dir, reps, 2 * 2 * (1 + 2 * reps));
 }
 
 TEST(HtmlReport, Demo) {
@@ -269,9 +289,11 @@ TEST(HtmlReport, Demo) {
     const size_t reps = codecs().size();
     const size_t inputs = count(doc, "<section id=\"input-");
     EXPECT_GE(inputs, 2u);
-    check_self_contained(doc, inputs * (1 + 2 * reps));
+    check_self_contained(doc, inputs * 2 * (1 + 2 * reps));
+    EXPECT_EQ(count(doc, "width=\"128\" height=\"64\" alt="), inputs * (1 + 2 * reps));
     EXPECT_EQ(row_names(summary_table(doc)), codec_names());
-    check_in_browser(html, dir, reps, inputs * (1 + 2 * reps));
+    EXPECT_EQ(count(doc, "<td class=\"na\">not given</td>"), (1 + inputs) * reps);
+    check_in_browser(html, dir, reps, inputs * 2 * (1 + 2 * reps));
 }
 
 TEST(HtmlReport, Bench) {
@@ -287,4 +309,141 @@ TEST(HtmlReport, Bench) {
     EXPECT_EQ(count(doc, "<svg class=\"plot\""), 2u);  // error vs bytes, error vs encode time
     EXPECT_EQ(count(doc, "red: Pareto frontier"), 2u);
     check_in_browser(html, dir, codecs().size(), 0);
+}
+
+TEST(HtmlReport, RuntimeCostColumns) {
+    // bench_runtime's JSON for three of the four representations audited.
+    const std::string dir = zhc::test::fresh_dir("html_report_cost");
+    const std::string cost = dir + "/cost.json", html = dir + "/audit.html", demo_dir = dir + "/demo";
+    {
+        std::ofstream f(cost);
+        f << R"({"benchmark":"runtime","device":"test device","rows":[)"
+             R"({"encoding":"sh3","spirv_instructions":123,"ns_per_eval":2.5,"ratio_to_sh3":1},)"
+             R"({"encoding":"zh3_q16","spirv_instructions":97,"ns_per_eval":1.25,"ratio_to_sh3":0.5},)"
+             R"({"encoding":"sh2","spirv_instructions":61,"ns_per_eval":0.75,"ratio_to_sh3":0.3}]})";
+    }
+    const auto r = zhc::test::run_zhc({"audit", std::string(ZHC_ENVMAP_DIR) + "/city.exr", "--representations", "sh3,sh2,zh3_lum,zh3_q16",
+                                       "--no-timing", "--directions", "256", "--runtime-cost", cost, "--html", html});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string doc = slurp(html);
+    const std::string table = summary_table(doc);
+    EXPECT_NE(table.find("runtime cost: SPIR-V instructions"), std::string::npos);
+    // Each row's cost is its own: the row text of sh3 has 123 and 2.5, zh3_lum (not in the file) dashes.
+    auto row = [&](const std::string& name) {
+        const size_t a = table.find("<th scope=\"row\">" + name + "</th>");
+        return a == std::string::npos ? std::string() : table.substr(a, table.find("</tr>", a) - a);
+    };
+    EXPECT_NE(row("sh3").find(">123</td><td data-v=\"2.5\">2.5</td>"), std::string::npos) << row("sh3");
+    EXPECT_NE(row("sh2").find(">61</td><td data-v=\"0.75\">0.75</td>"), std::string::npos) << row("sh2");
+    EXPECT_NE(row("zh3_q16").find(">97</td>"), std::string::npos);
+    const std::string lum = row("zh3_lum");
+    ASSERT_GT(lum.size(), 40u);
+    EXPECT_EQ(lum.substr(lum.size() - 44), "<td data-v=\"-1\">-</td><td data-v=\"-1\">-</td>") << lum;
+    EXPECT_EQ(doc.find("not given"), std::string::npos);
+    EXPECT_NE(doc.find("test device"), std::string::npos);
+    EXPECT_EQ(count(doc, "<svg class=\"plot\""), 2u);  // error vs bytes, error vs runtime cost
+    EXPECT_NE(doc.find("Error vs runtime cost"), std::string::npos);
+    // The text table has the columns too.
+    EXPECT_NE(r.out.find("spirv"), std::string::npos);
+    EXPECT_NE(r.out.find("gpu_ns"), std::string::npos);
+    // The demo takes the same option; its table and report show the cost.
+    const auto d = zhc::test::run_zhc({"demo", "-o", demo_dir, "--directions", "64", "--runtime-cost", cost});
+    ASSERT_EQ(d.exit_code, 0) << d.err;
+    const std::string demo = slurp(demo_dir + "/report.html");
+    EXPECT_NE(summary_table(demo).find(">123</td>"), std::string::npos);
+    EXPECT_NE(d.out.find("gpu_ns"), std::string::npos);
+    // zhc bench's report shows the same columns.
+    const auto b = zhc::test::run_zhc({"bench", std::string(ZHC_ENVMAP_DIR) + "/city.exr", "--representations", "sh3,zh3_lum",
+                                       "--repeats", "1", "--directions", "64", "--no-plots", "--runtime-cost", cost, "--html",
+                                       dir + "/bench.html"});
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    const std::string bench = summary_table(slurp(dir + "/bench.html"));
+    EXPECT_NE(bench.find(">123</td><td data-v=\"2.5\">2.5</td>"), std::string::npos) << bench;
+    // A cost file that is not bench_runtime's output is an error naming the file.
+    {
+        std::ofstream f(dir + "/bad.json");
+        f << R"({"rows":[{"encoding":"sh3"}]})";
+    }
+    const auto bad = zhc::test::run_zhc({"audit", std::string(ZHC_ENVMAP_DIR) + "/city.exr", "--representations", "sh3",
+                                         "--runtime-cost", dir + "/bad.json", "--html", dir + "/x.html"});
+    EXPECT_NE(bad.exit_code, 0);
+    EXPECT_NE(bad.err.find("bad.json"), std::string::npos) << bad.err;
+}
+
+TEST(LightmapReport, WorstErrorWindowMatchesBruteForce) {
+    // The sliding-window search against summing every window directly.
+    std::uint32_t state = 12345;
+    auto rnd = [&] { state = state * 1664525u + 1013904223u; return (state >> 8) / double(1u << 24); };
+    for (const auto& [w, h, size] : std::vector<std::array<int, 3>>{{37, 29, 8}, {20, 50, 16}, {13, 9, 64}, {64, 64, 64}, {1, 7, 3}}) {
+        std::vector<double> e(static_cast<size_t>(w) * h);
+        for (double& v : e) v = rnd() < 0.9 ? rnd() * 0.01 : rnd();
+        const CropWindow got = worst_error_window(e, w, h, size);
+        const int cw = std::min(size, w), ch = std::min(size, h);
+        EXPECT_EQ(got.width, cw);
+        EXPECT_EQ(got.height, ch);
+        double best = -1;
+        int bx = 0, by = 0;
+        for (int y = 0; y + ch <= h; ++y)
+            for (int x = 0; x + cw <= w; ++x) {
+                double s = 0;
+                for (int yy = y; yy < y + ch; ++yy)
+                    for (int xx = x; xx < x + cw; ++xx) s += e[static_cast<size_t>(yy) * w + xx];
+                if (s > best + 1e-9) best = s, bx = x, by = y;
+            }
+        EXPECT_EQ(got.x, bx) << w << "x" << h << " window " << size;
+        EXPECT_EQ(got.y, by) << w << "x" << h << " window " << size;
+    }
+    // A single hot texel: the window contains it. Non-finite errors count as the largest.
+    std::vector<double> e(100 * 80, 0.001);
+    e[static_cast<size_t>(70) * 100 + 90] = std::numeric_limits<double>::quiet_NaN();
+    const CropWindow hot = worst_error_window(e, 100, 80, 16);
+    EXPECT_TRUE(hot.x <= 90 && 90 < hot.x + 16 && hot.y <= 70 && 70 < hot.y + 16);
+    // Empty or mismatched: an empty window, no crash.
+    EXPECT_EQ(worst_error_window({}, 0, 0, 256).width, 0);
+    EXPECT_EQ(worst_error_window(e, 99, 80, 256).width, 0);
+}
+
+TEST(LightmapReport, AuditHtml) {
+    const std::string dir = zhc::test::fresh_dir("html_report_lightmap");
+    // 300x300: the 256x256 crop lies inside; a 48x48 lightmap is shown whole, enlarged.
+    for (const int size : {48, 300}) {
+        const std::string lm = dir + "/lm" + std::to_string(size) + ".exr", html = dir + "/lm" + std::to_string(size) + ".html";
+        const auto s = zhc::test::run_zhc({"lightmap", "synth", std::string(ZHC_ENVMAP_DIR) + "/city.exr", "-o", lm, "--size",
+                                           std::to_string(size), "--threads", "2"});
+        ASSERT_EQ(s.exit_code, 0) << s.err;
+        const auto r = zhc::test::run_zhc({"lightmap", "audit", lm, "--threads", "2", "--quality", "fast", "--html", html});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const std::string doc = slurp(html);
+        // Overview and crop of I_z before, after, error; overview of the tilted-normal irradiance.
+        check_self_contained(doc, 9);
+        EXPECT_NE(doc.find("normal tilted 45 degrees"), std::string::npos);
+        const std::vector<std::string> rows = row_names(summary_table(doc));
+        ASSERT_EQ(rows.size(), 3u);
+        EXPECT_EQ(rows[2], "search after BC6H + BC5 + BC4");
+        // The table's numbers are the command's: its text output prints the same rmse.
+        const std::regex after(R"(search after BC6H \+ BC5 \+ BC4\s+([0-9.e-]+))");
+        std::smatch m;
+        ASSERT_TRUE(std::regex_search(r.out, m, after)) << r.out;
+        std::string cell = ">";
+        cell += m[1].str();
+        cell += "</td>";
+        EXPECT_NE(summary_table(doc).find(cell), std::string::npos) << cell;
+        EXPECT_NE(doc.find("Worst-error region"), std::string::npos);
+        EXPECT_NE(doc.find("I_z BC6H PSNR"), std::string::npos);
+        EXPECT_NE(doc.find(lm), std::string::npos);  // the input, to reproduce
+        EXPECT_NE(doc.find("<svg class=\"bar\""), std::string::npos);  // the error scale
+        const std::string crop = size == 300 ? "the 256x256 window" : "the 48x48 window";
+        EXPECT_NE(doc.find(crop), std::string::npos);
+        // The crop pictures are readable: at least 256 pixels on a side (1:1, or enlarged).
+        const std::regex crop_img(R"re(width="(\d+)" height="(\d+)" alt="crop )re");
+        size_t crops = 0;
+        for (auto it = std::sregex_iterator(doc.begin(), doc.end(), crop_img); it != std::sregex_iterator(); ++it, ++crops)
+            EXPECT_GE(std::stoi((*it)[1].str()), 240);
+        EXPECT_EQ(crops, 3u);
+        // Deterministic.
+        const auto r2 = zhc::test::run_zhc({"lightmap", "audit", lm, "--threads", "2", "--quality", "fast", "--html", html + "2"});
+        ASSERT_EQ(r2.exit_code, 0);
+        EXPECT_EQ(slurp(html + "2"), doc);
+        if (size == 300) check_in_browser(html, dir, 3, 9);
+    }
 }
