@@ -14,6 +14,7 @@
 #include "formats/audit_inputs.h"
 #include "cli.h"
 #include "json_output.h"
+#include "progress.h"
 #include "table.h"
 #include "codec/audit.h"
 #include "formats/file_io.h"
@@ -36,7 +37,7 @@ struct Options {
     std::string html;
     int directions = 2048;
     int threads = 0;
-    bool progress = false;
+    ProgressFlags progress;
     bool no_timing = false;
     double max_rmse = -1, max_relative_rmse = -1;
     bool fail_on_negative = false;
@@ -195,7 +196,7 @@ int run(const Options& o) {
 
     const int threads = resolve_threads(o.threads);
     const std::vector<Vec3> dirs = fibonacci_sphere(o.directions);
-    const bool show_progress = o.progress || ::isatty(STDERR_FILENO);
+    Progress progress("zhc audit", "files", o.progress);
     CodecOptions copt;
     AuditLoadOptions lopt;
     lopt.threads = threads;
@@ -205,7 +206,6 @@ int run(const Options& o) {
     std::vector<FileReport> reports;
     for (size_t fi = 0; fi < files->size(); ++fi) {
         const std::string& path = (*files)[fi];
-        if (show_progress) std::fprintf(stderr, "[%zu/%zu] %s\n", fi + 1, files->size(), path.c_str());
         auto input = load_audit_input(path, dirs, lopt);
         if (!input) return report(input.error());
         FileReport fr;
@@ -249,6 +249,7 @@ int run(const Options& o) {
         }
         if (!o.html.empty()) fr.pictures = render_sphere_pictures(fr.input, selected, copt, 96);
         reports.push_back(std::move(fr));
+        progress.update(fi + 1, files->size());
     }
 
     // Aggregate over files: mean RMSE and relative RMSE, worst max_abs and minimum, mean fractions.
@@ -376,7 +377,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     sub->add_option("--images", o->images, "write irradiance/error PNGs per input into this folder");
     sub->add_option("--directions", o->directions, "number of Fibonacci-lattice directions")->check(CLI::Range(16, 1 << 20));
     add_threads_option(sub, o->threads, "results do not depend on it");
-    sub->add_flag("--progress", o->progress, "report progress on stderr even when it is not a terminal");
+    add_progress_flags(sub, o->progress);
     sub->add_flag("--no-timing", o->no_timing, "skip encode/decode timing (outputs become byte-identical across runs)");
     sub->add_option("--max-rmse", o->max_rmse, "gate: fail (exit 8) if any representation's RMSE exceeds this");
     sub->add_option("--max-relative-rmse", o->max_relative_rmse, "gate: fail (exit 8) if any relative RMSE exceeds this");

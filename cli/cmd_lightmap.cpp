@@ -1,6 +1,7 @@
 // zhc lightmap {encode, decode, audit, synth}: IrradZ directional lightmaps (docs/irradz.md,
-// docs/lightmap-formats.md). Input: an SH lightmap EXR (channels sh0.R .. sh8.B, tangent-frame SH3
-// radiance). Output: PREFIX.iz.ktx2 (BC6H_UFLOAT), PREFIX.d.ktx2 (BC5_UNORM), PREFIX.wa.ktx2
+// docs/lightmap-formats.md), streamed in bands of rows (formats/lightmap_stream.h). Input: an SH
+// lightmap EXR (channels sh0.R .. sh8.B, tangent-frame SH3 radiance; or linear SH sh0.R .. sh3.B;
+// or one EXR per coefficient). Output: PREFIX.iz.ktx2 (BC6H_UFLOAT), PREFIX.d.ktx2 (BC5_UNORM), PREFIX.wa.ktx2
 // (BC4_UNORM): 2.5 bytes per texel; with --container dds the same blocks in PREFIX.{iz,d,wa}.dds.
 #include <chrono>
 #include <cstdio>
@@ -17,21 +18,22 @@
 #include "formats/ktx2.h"
 #include "formats/lightmap_exr.h"
 #include "formats/lightmap_report.h"
+#include "formats/lightmap_stream.h"
+#include "progress.h"
 
 namespace zhc::cli {
 namespace cmd_lightmap {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
 struct Options {
+    std::vector<std::string> inputs;
     std::string input, output, quality = "default", solve = "newton";
     std::string container;  // encode: "" = ktx2; decode: "" = auto
     std::string part;       // synth: EXR part of the environment map
-    std::string html;       // audit: also write the HTML report here
-    int threads = 1, size = 256, stride = 17;
-    bool json = false;
+    std::string html;       // audit: also write the HTML report here (whole-image path)
+    int threads = 1, size = 256, height = 0, stride = 17, band_rows = 0;
+    bool json = false, half = false;
+    ProgressFlags progress;
 };
 
 bc6h::Quality bc6h_quality(const std::string& q) {
@@ -39,52 +41,56 @@ bc6h::Quality bc6h_quality(const std::string& q) {
 }
 bc45::Quality bc45_quality(const std::string& q) { return q == "fast" ? bc45::Quality::kFast : bc45::Quality::kDefault; }
 
-Ktx2Image ktx(std::uint32_t fmt, const lightmap::Compressed& c, const std::vector<std::uint8_t>& blocks) {
-    Ktx2Image k;
-    k.vk_format = fmt;
-    k.width = c.width;
-    k.height = c.height;
-    k.blocks = blocks;
-    return k;
+// The SH lightmap input(s): one EXR, several (one per coefficient), or one name with "{i}", which
+// stands for the coefficient index: the files for i = 0..8 if all nine exist, else i = 0..3.
+std::vector<std::string> input_files(const std::vector<std::string>& given) {
+    if (given.size() != 1) return given;
+    const std::string& pattern = given[0];
+    const auto at = pattern.find("{i}");
+    if (at == std::string::npos) return given;
+    auto name = [&](int i) { return pattern.substr(0, at) + std::to_string(i) + pattern.substr(at + 3); };
+    std::vector<std::string> files;
+    std::error_code ec;
+    int n = 9;
+    for (int i = 0; i < 9; ++i)
+        if (!std::filesystem::exists(name(i), ec)) {
+            n = 4;
+            break;
+        }
+    for (int i = 0; i < n; ++i) files.push_back(name(i));
+    return files;
 }
 
-// The SH lightmap, its EXR blocks decompressed on the verb's threads.
-Result<lightmap::ShLightmap> read_input(const Options& o) {
-    LightmapReadOptions ro;
-    ro.threads = o.threads;
-    return read_sh_lightmap_exr(o.input, ro);
+std::string inputs_text(const std::vector<std::string>& files) {
+    std::string s;
+    for (const auto& f : files) s += (s.empty() ? "" : " + ") + f;
+    return s;
 }
 
 int run_encode(const Options& o) {
-    auto lm = read_input(o);
-    if (!lm) return report(lm.error());
-    irradz::EncodeOptions eo;
-    eo.solve = o.solve == "old" ? irradz::Solve::kOld : (o.solve == "search" ? irradz::Solve::kSearch : irradz::Solve::kNewton);
-    const auto t0 = Clock::now();
-    const auto planes = lightmap::encode_planes(*lm, eo, o.threads);
-    const double t_fit = since(t0);
-    const auto t1 = Clock::now();
-    const auto c = lightmap::compress(planes, bc6h_quality(o.quality), bc45_quality(o.quality), o.threads);
-    const double t_bc = since(t1);
-    const bool dds = o.container == "dds";
-    const std::string ext = dds ? ".dds" : ".ktx2";
-    const std::pair<std::string, Ktx2Image> images[3] = {{o.output + ".iz" + ext, ktx(kVkFormatBc6hUfloat, c, c.bc6h)},
-                                                         {o.output + ".d" + ext, ktx(kVkFormatBc5Unorm, c, c.bc5)},
-                                                         {o.output + ".wa" + ext, ktx(kVkFormatBc4Unorm, c, c.bc4)}};
-    // All three files or none: encoded in memory first, then written as one unit.
-    std::vector<std::pair<std::string, std::vector<std::uint8_t>>> files;
-    for (const auto& [path, img] : images) {
-        auto bytes = dds ? encode_dds(img) : encode_ktx2(img);
-        if (!bytes) return report_output(make_error(bytes.error().code, path + ": " + bytes.error().message));
-        files.emplace_back(path, std::move(*bytes));
-    }
-    if (auto s = write_files_atomic(files); !s) return report_output(s.error());
-    const double texels = double(lm->width) * lm->height;
-    std::printf("%s: %dx%d texels -> %s.{iz,d,wa}%s (%zu bytes of blocks, %.3f bytes/texel)\n", o.input.c_str(),
-                lm->width, lm->height, o.output.c_str(), ext.c_str(), c.bc6h.size() + c.bc5.size() + c.bc4.size(),
-                double(c.bc6h.size() + c.bc5.size() + c.bc4.size()) / texels);
-    std::printf("IrradZ fit %.3f s (%.2f Mtexel/s), block compression (%s) %.3f s (%.2f Mtexel/s), %d thread(s)\n", t_fit,
-                texels / t_fit / 1e6, o.quality.c_str(), t_bc, texels / t_bc / 1e6, o.threads);
+    const auto files = input_files(o.inputs);
+    lightmap_stream::EncodeOptions eo;
+    eo.fit = o.solve == "old"      ? lightmap_stream::Fit::kOld
+             : o.solve == "linear" ? lightmap_stream::Fit::kLinear
+             : o.solve == "search" ? lightmap_stream::Fit::kSearch
+                                   : lightmap_stream::Fit::kNewton;
+    eo.bc6h_quality = bc6h_quality(o.quality);
+    eo.bc45_quality = bc45_quality(o.quality);
+    eo.threads = o.threads;
+    eo.band_rows = o.band_rows;
+    eo.dds = o.container == "dds";
+    Progress progress("zhc lightmap encode", "rows", o.progress);
+    if (progress.enabled()) eo.progress = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
+    bool output_failed = false;
+    auto r = lightmap_stream::encode(files, o.output, eo, &output_failed);
+    progress.finish();
+    if (!r) return output_failed ? report_output(r.error()) : report(r.error());
+    const std::string ext = eo.dds ? ".dds" : ".ktx2";
+    const double texels = double(r->width) * r->height;
+    std::printf("%s: %dx%d texels -> %s.{iz,d,wa}%s (%llu bytes of blocks, %.3f bytes/texel)\n", inputs_text(files).c_str(), r->width,
+                r->height, o.output.c_str(), ext.c_str(), static_cast<unsigned long long>(r->block_bytes), double(r->block_bytes) / texels);
+    std::printf("IrradZ fit %.3f s (%.2f Mtexel/s), block compression (%s) %.3f s (%.2f Mtexel/s), %d thread(s)\n", r->timing.fit,
+                texels / r->timing.fit / 1e6, o.quality.c_str(), r->timing.compress, texels / r->timing.compress / 1e6, o.threads);
     return kExitOk;
 }
 
@@ -100,60 +106,66 @@ int run_decode(const Options& o) {
     }
     const bool dds = container == "dds";
     const std::string ext = dds ? ".dds" : ".ktx2";
-    lightmap::Compressed c;
-    const std::pair<std::string, std::uint32_t> files[3] = {
-        {o.input + ".iz" + ext, kVkFormatBc6hUfloat}, {o.input + ".d" + ext, kVkFormatBc5Unorm}, {o.input + ".wa" + ext, kVkFormatBc4Unorm}};
-    for (int f = 0; f < 3; ++f) {
-        auto img = dds ? read_dds(files[f].first) : read_ktx2(files[f].first);
-        if (!img) return report(img.error());
-        if (img->vk_format != files[f].second)
-            return report(make_error(ErrorCode::kBadFormat,
-                                     files[f].first + (dds ? ": dxgiFormat " + std::to_string(dxgi_format_for_vk(img->vk_format)) +
-                                                                 ", expected " + std::to_string(dxgi_format_for_vk(files[f].second))
-                                                           : ": vkFormat " + std::to_string(img->vk_format) + ", expected " +
-                                                                 std::to_string(files[f].second))));
-        if (f == 0) {
-            c.width = img->width;
-            c.height = img->height;
-        } else if (img->width != c.width || img->height != c.height) {
-            return report(make_error(ErrorCode::kBadFormat, files[f].first + ": size " + std::to_string(img->width) + "x" +
-                                                                 std::to_string(img->height) + " differs from " + files[0].first));
-        }
-        (f == 0 ? c.bc6h : (f == 1 ? c.bc5 : c.bc4)) = std::move(img->blocks);
-    }
-    const auto planes = lightmap::decompress(c);
-    if (auto s = write_irradz_exr(o.output, planes); !s) return report_output(s.error());
-    std::printf("%s.{iz,d,wa}%s: %dx%d -> %s (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)\n", o.input.c_str(), ext.c_str(), c.width, c.height,
+    Progress progress("zhc lightmap decode", "rows", o.progress);
+    lightmap_stream::ProgressFn fn;
+    if (progress.enabled()) fn = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
+    bool output_failed = false;
+    auto r = lightmap_stream::decode(o.input, dds, o.output, o.band_rows, fn, &output_failed);
+    progress.finish();
+    if (!r) return output_failed ? report_output(r.error()) : report(r.error());
+    std::printf("%s.{iz,d,wa}%s: %dx%d -> %s (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)\n", o.input.c_str(), ext.c_str(), r->width, r->height,
                 o.output.c_str());
     return kExitOk;
 }
 
-int run_audit(const Options& o) {
-    auto lm = read_input(o);
+// audit --html: the report needs the whole image's planes, so this path reads the whole lightmap
+// (one EXR, at most 4096 x 4096) as before streaming.
+int run_audit_html(const Options& o, const std::string& input) {
+    LightmapReadOptions ro;
+    ro.threads = o.threads;
+    auto lm = read_sh_lightmap_exr(input, ro);
     if (!lm) return report(lm.error());
-    const double texels = double(lm->width) * lm->height;
     irradz::EncodeOptions eo;
-    auto t0 = Clock::now();
     const auto search = lightmap::encode_planes(*lm, eo, o.threads);
-    const double t_fit = since(t0);
     eo.solve = irradz::Solve::kOld;
     const auto old_way = lightmap::encode_planes(*lm, eo, o.threads);
-    t0 = Clock::now();
     const auto c = lightmap::compress(search, bc6h_quality(o.quality), bc45_quality(o.quality), o.threads);
-    const double t_bc = since(t0);
     const auto after = lightmap::decompress(c);
     const auto a = lightmap::audit(*lm, search, old_way, after, static_cast<size_t>(o.stride));
-    if (!o.html.empty()) {  // formats/lightmap_report.h: pictures before/after block compression, error, tables
-        const auto page = lightmap_audit_html(ZHC_VERSION, {{"input", o.input}, {"quality", o.quality},
-                                              {"stride", std::to_string(o.stride)}, {"threads", std::to_string(o.threads)}}, search, after, a);
-        if (Status s = write_lightmap_html_report(o.html, page); !s) return report_output(s.error());
-        std::fprintf(stderr, "report: %s\n", o.html.c_str());
+    const auto page = lightmap_audit_html(ZHC_VERSION, {{"input", input}, {"quality", o.quality},
+                                          {"stride", std::to_string(o.stride)}, {"threads", std::to_string(o.threads)}}, search, after, a);
+    if (Status s = write_lightmap_html_report(o.html, page); !s) return report_output(s.error());
+    std::fprintf(stderr, "report: %s\n", o.html.c_str());
+    return kExitOk;
+}
+
+int run_audit(const Options& o) {
+    const auto files = input_files(o.inputs);
+    if (!o.html.empty()) {
+        if (files.size() != 1)
+            return report(make_error(ErrorCode::kInvalidArgument, "lightmap audit --html takes one SH lightmap EXR"));
+        if (const int rc = run_audit_html(o, files[0]); rc != kExitOk) return rc;
     }
+    lightmap_stream::AuditOptions ao;
+    ao.bc6h_quality = bc6h_quality(o.quality);
+    ao.bc45_quality = bc45_quality(o.quality);
+    ao.threads = o.threads;
+    ao.band_rows = o.band_rows;
+    ao.stride = static_cast<size_t>(o.stride);
+    Progress progress("zhc lightmap audit", "rows", o.progress);
+    if (progress.enabled()) ao.progress = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
+    auto r = lightmap_stream::audit(files, ao);
+    progress.finish();
+    if (!r) return report(r.error());
+    const auto& a = r->audit;
+    const double texels = double(r->width) * r->height;
+    const double t_fit = r->timing.fit, t_bc = r->timing.compress;
+    const std::string input = inputs_text(files);
     if (o.json) {
         nlohmann::ordered_json j;
-        j["input"] = o.input;
-        j["width"] = lm->width;
-        j["height"] = lm->height;
+        j["input"] = input;
+        j["width"] = r->width;
+        j["height"] = r->height;
         j["quality"] = o.quality;
         j["texels_audited"] = a.texels_sampled;
         j["mean_irradiance_at_normal"] = a.mean_iz;
@@ -165,12 +177,12 @@ int run_audit(const Options& o) {
         print_json("lightmap audit", j);
         return kExitOk;
     }
-    std::printf("%s: %dx%d texels, %zu audited (every %d-th), quality %s, %d thread(s)\n", o.input.c_str(), lm->width,
-                lm->height, a.texels_sampled, o.stride, o.quality.c_str(), o.threads);
+    std::printf("%s: %dx%d texels, %zu audited (every %d-th), quality %s, %d thread(s)\n", input.c_str(), r->width, r->height,
+                a.texels_sampled, o.stride, o.quality.c_str(), o.threads);
     std::printf("hemispherical irradiance RMSE vs SH3 (mean irradiance at normal %.5g):\n", a.mean_iz);
     std::printf("  old way (optimal linear direction, spherical Gram)  %.6g  (%.2f%%)\n", a.rmse_old, 100 * a.rmse_old / a.mean_iz);
-    std::printf("  search (hemispherical Gram, golden-section d)       %.6g  (%.2f%%)\n", a.rmse_search, 100 * a.rmse_search / a.mean_iz);
-    std::printf("  search after BC6H + BC5 + BC4                       %.6g  (%.2f%%)\n", a.rmse_after_bc, 100 * a.rmse_after_bc / a.mean_iz);
+    std::printf("  fit (hemispherical Gram, Newton on d)               %.6g  (%.2f%%)\n", a.rmse_search, 100 * a.rmse_search / a.mean_iz);
+    std::printf("  fit after BC6H + BC5 + BC4                          %.6g  (%.2f%%)\n", a.rmse_after_bc, 100 * a.rmse_after_bc / a.mean_iz);
     std::printf("PSNR per texture: I_z BC6H %.2f dB (log2), w_a BC4 %.2f dB, d BC5 %.2f dB (angle mean %.3f deg, max %.2f deg)\n",
                 a.psnr_iz_log2, a.psnr_wa, a.psnr_d, a.d_mean_deg, a.d_max_deg);
     std::printf("speed: IrradZ fit %.2f Mtexel/s, block compression %.2f Mtexel/s\n", texels / t_fit / 1e6, texels / t_bc / 1e6);
@@ -183,10 +195,15 @@ int run_synth(const Options& o) {
     auto img = read_envmap(o.input, ro);
     if (!img) return report(img.error());
     const Sh3Radiance world = project_envmap(*img, o.threads);
-    const auto lm = lightmap::synthesize_sphere(world, o.size, o.size, o.threads);
-    if (auto s = write_sh_lightmap_exr(o.output, lm); !s) return report_output(s.error());
+    Progress progress("zhc lightmap synth", "rows", o.progress);
+    lightmap_stream::ProgressFn fn;
+    if (progress.enabled()) fn = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
+    const int height = o.height > 0 ? o.height : o.size;
+    const Status s = lightmap_stream::synth(world, o.size, height, o.output, o.half, o.threads, o.band_rows, fn);
+    progress.finish();
+    if (!s) return report_output(s.error());
     std::printf("%s -> %s: %dx%d SH lightmap of a sphere lit by the map's SH3 (channels sh0.R .. sh8.B)\n", o.input.c_str(),
-                o.output.c_str(), o.size, o.size);
+                o.output.c_str(), o.size, height);
     return kExitOk;
 }
 
@@ -199,30 +216,47 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
             ->check(CLI::IsMember({"fast", "default", "slow"}));
         add_threads_option(s, o->threads, "output identical for any count");
     };
+    auto band = [&](CLI::App* s) {
+        s->add_option("--band-rows", o->band_rows, "rows per streamed band (rounded up to a multiple of 4; default: about 2^18 texels; output identical for any value)")
+            ->check(CLI::Range(1, 1 << 20));
+        add_progress_flags(s, o->progress);
+    };
     CLI::App* enc = lm->add_subcommand("encode", "SH lightmap EXR -> PREFIX.iz.ktx2 (BC6H) + PREFIX.d.ktx2 (BC5) + PREFIX.wa.ktx2 (BC4), or .dds");
-    enc->add_option("IN", o->input, "SH lightmap EXR (channels sh0.R .. sh8.B)")->required();
+    enc->add_option("IN", o->inputs,
+                    "SH lightmap EXR (sh0.R .. sh8.B, or linear SH sh0.R .. sh3.B), or 4 / 9 EXRs one per coefficient "
+                    "(R, G, B), or one name with {i} for the coefficient index")
+        ->required();
     enc->add_option("-o,--output", o->output, "output prefix")->required();
     enc->add_option("--container", o->container, "ktx2 (default) | dds (DX10 header): PREFIX.{iz,d,wa}.ktx2 or .dds")
         ->check(CLI::IsMember({"ktx2", "dds"}));
-    enc->add_option("--solve", o->solve, "newton (hemispherical Gram, Newton on d) | search (the same by golden section: the reference) | old")->check(CLI::IsMember({"newton", "search", "old"}));
+    enc->add_option("--solve", o->solve,
+                    "newton (hemispherical Gram, Newton on d) | search (the same by golden section: the reference) | old | "
+                    "linear (closed form from L0 + L1)")
+        ->check(CLI::IsMember({"newton", "search", "old", "linear"}));
     quality(enc);
+    band(enc);
     CLI::App* dec = lm->add_subcommand("decode", "PREFIX.{iz,d,wa}.ktx2 or .dds -> IrradZ EXR (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)");
     dec->add_option("PREFIX", o->input, "prefix given to encode")->required();
     dec->add_option("--container", o->container, "auto (default: .ktx2 if PREFIX.iz.ktx2 exists, else .dds) | ktx2 | dds")
         ->check(CLI::IsMember({"auto", "ktx2", "dds"}));
     dec->add_option("-o,--output", o->output, "output EXR")->required();
+    band(dec);
     CLI::App* aud = lm->add_subcommand("audit", "hemispherical error before/after block compression, PSNR per texture, speed");
-    aud->add_option("IN", o->input, "SH lightmap EXR")->required();
+    aud->add_option("IN", o->inputs, "SH lightmap EXR(s), as for encode")->required();
     aud->add_option("--stride", o->stride, "audit every N-th texel")->check(CLI::Range(1, 1 << 20));
     add_json_flag(aud, o->json);
-    aud->add_option("--html", o->html, "also write one self-contained HTML report (pictures before/after block compression, error map, tables)");
+    aud->add_option("--html", o->html, "also write one self-contained HTML report (pictures before/after block compression, error map, tables; reads the whole lightmap)");
     quality(aud);
+    band(aud);
     CLI::App* syn = lm->add_subcommand("synth", "synthetic SH lightmap: a sphere lit by an environment map's SH3");
     syn->add_option("ENVMAP", o->input, "EXR (lat-long or cube) or .hdr environment map")->required();
     add_envmap_read_options(syn, nullptr, o->part);
     syn->add_option("-o,--output", o->output, "output SH lightmap EXR")->required();
-    syn->add_option("--size", o->size, "width = height in texels")->check(CLI::Range(4, 4096));
+    syn->add_option("--size", o->size, "width (and height, unless --height) in texels")->check(CLI::Range(4, 16384));
+    syn->add_option("--height", o->height, "height in texels (default: --size)")->check(CLI::Range(4, 16384));
     add_threads_option(syn, o->threads, "output identical for any count");
+    syn->add_flag("--half", o->half, "HALF channels (half the file size) instead of FLOAT");
+    band(syn);
     return [o, enc, dec, aud, syn] {
         o->threads = resolve_threads(o->threads);  // 0 = all cores
         if (enc->parsed()) return run_encode(*o);

@@ -45,13 +45,20 @@ irradz::IrradZ IrradzPlanes::texel(std::size_t i) const {
 }
 
 ShLightmap synthesize_sphere(const Sh3Radiance& world, int width, int height, int threads) {
+    return synthesize_sphere_rows(world, width, height, 0, height, threads);
+}
+
+ShLightmap synthesize_sphere_rows(const Sh3Radiance& world, int width, int height, int y_begin, int y_end, int threads) {
     ShLightmap lm;
+    y_begin = std::clamp(y_begin, 0, std::max(0, height));
+    y_end = std::clamp(y_end, y_begin, std::max(0, height));
     lm.width = width;
-    lm.height = height;
-    lm.texels.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
-    parallel_rows(height, threads, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
+    lm.height = y_end - y_begin;
+    lm.texels.resize(static_cast<size_t>(std::max(0, width)) * static_cast<size_t>(lm.height));
+    parallel_rows(lm.height, threads, [&](int r0, int r1) {
+        for (int r = r0; r < r1; ++r)
             for (int x = 0; x < width; ++x) {
+                const int y = y_begin + r;
                 // Octahedral map of the sphere: (u, v) in [-1, 1]^2 -> normal.
                 const double u = 2.0 * (x + 0.5) / width - 1, v = 2.0 * (y + 0.5) / height - 1;
                 Vec3 n{u, v, 1 - std::abs(u) - std::abs(v)};
@@ -62,7 +69,7 @@ ShLightmap synthesize_sphere(const Sh3Radiance& world, int width, int height, in
                 n = normalize_or(n, {0, 0, 1});
                 // The surface hides the lower hemisphere: a baker sees radiance over the visible
                 // hemisphere only, so window the rotated radiance by it (SH3 hemisphere multiply).
-                lm.texels[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)] =
+                lm.texels[static_cast<size_t>(r) * static_cast<size_t>(width) + static_cast<size_t>(x)] =
                     irradz::cap_multiply(rotate(world, transpose(frame_from_z(n))), 0.0);
             }
     });
@@ -81,6 +88,30 @@ IrradzPlanes encode_planes(const ShLightmap& lm, const irradz::EncodeOptions& op
         for (size_t i = static_cast<size_t>(y0) * static_cast<size_t>(lm.width);
              i < static_cast<size_t>(y1) * static_cast<size_t>(lm.width); ++i) {
             const irradz::IrradZ t = irradz::encode(lm.texels[i], options);
+            for (int k = 0; k < 3; ++k) p.iz[3 * i + static_cast<size_t>(k)] = t.i_z[k];
+            p.wa[i] = static_cast<float>(t.w_a);
+            const auto uv = encode_hemioct(t.d);
+            p.d[2 * i] = uv[0];
+            p.d[2 * i + 1] = uv[1];
+        }
+    });
+    return p;
+}
+
+IrradzPlanes encode_planes_linear_sh(const ShLightmap& lm, int threads) {
+    IrradzPlanes p;
+    p.width = lm.width;
+    p.height = lm.height;
+    const size_t n = lm.texels.size();
+    p.iz.resize(3 * n);
+    p.wa.resize(n);
+    p.d.resize(2 * n);
+    parallel_rows(lm.height, threads, [&](int y0, int y1) {
+        for (size_t i = static_cast<size_t>(y0) * static_cast<size_t>(lm.width);
+             i < static_cast<size_t>(y1) * static_cast<size_t>(lm.width); ++i) {
+            Sh2Radiance l;
+            for (int c = 0; c < 4; ++c) l[c] = lm.texels[i][c];
+            const irradz::IrradZ t = irradz::linear_sh_to_irradz(l);
             for (int k = 0; k < 3; ++k) p.iz[3 * i + static_cast<size_t>(k)] = t.i_z[k];
             p.wa[i] = static_cast<float>(t.w_a);
             const auto uv = encode_hemioct(t.d);
@@ -163,6 +194,55 @@ Audit audit(const ShLightmap& lm, const IrradzPlanes& search, const IrradzPlanes
     a.psnr_d = md > 0 ? 10 * std::log10(2 * m / md) : 999;
     a.d_mean_deg = ang / m;
     a.d_max_deg = amax;
+    return a;
+}
+
+void AuditAccumulator::add(const ShLightmap& lm, const IrradzPlanes& search, const IrradzPlanes& old_way,
+                           const IrradzPlanes& after_bc) {
+    // The texels audit() samples: global index next_, next_ + stride, ...
+    const size_t n = lm.texels.size();
+    for (; next_ < texels_ + n; next_ += stride_) {
+        const size_t i = next_ - texels_;
+        const Sh3Irradiance t = to_irradiance(lm.texels[i]);
+        s_ += irradz::hemispherical_mse(t, search.texel(i), irradz::Model::kHhd);
+        o_ += irradz::hemispherical_mse(t, old_way.texel(i), irradz::Model::kHhd);
+        b_ += irradz::hemispherical_mse(t, after_bc.texel(i), irradz::Model::kHhd);
+        const Rgb e = evaluate(t, {0, 0, 1});
+        iz_ += (e.r + e.g + e.b) / 3.0;
+        ++sampled_;
+    }
+    for (size_t i = 0; i < search.iz.size(); ++i) {
+        const double d = log2_clamped(search.iz[i]) - log2_clamped(after_bc.iz[i]);
+        mse_iz_ += d * d;
+    }
+    iz_values_ += search.iz.size();
+    for (size_t i = 0; i < search.wa.size(); ++i) {
+        mw_ += std::pow(double(search.wa[i]) - after_bc.wa[i], 2);
+        md_ += std::pow(double(search.d[2 * i]) - after_bc.d[2 * i], 2) + std::pow(double(search.d[2 * i + 1]) - after_bc.d[2 * i + 1], 2);
+        const double c = std::clamp(dot(decode_hemioct(search.d[2 * i], search.d[2 * i + 1]),
+                                        decode_hemioct(after_bc.d[2 * i], after_bc.d[2 * i + 1])), -1.0, 1.0);
+        const double deg = std::acos(c) * 180 / kPi;
+        ang_ += deg;
+        amax_ = std::max(amax_, deg);
+    }
+    texels_ += n;
+}
+
+Audit AuditAccumulator::result() const {
+    Audit a;
+    a.texels_sampled = sampled_;
+    const double n = static_cast<double>(std::max<size_t>(1, sampled_));
+    a.rmse_search = std::sqrt(s_ / n / 3);
+    a.rmse_old = std::sqrt(o_ / n / 3);
+    a.rmse_after_bc = std::sqrt(b_ / n / 3);
+    a.mean_iz = iz_ / n;
+    const double mse = mse_iz_ / static_cast<double>(std::max<size_t>(1, iz_values_));
+    a.psnr_iz_log2 = mse > 0 ? 10 * std::log10(30.0 * 30.0 / mse) : 999.0;
+    const double m = static_cast<double>(std::max<size_t>(1, texels_));
+    a.psnr_wa = mw_ > 0 ? 10 * std::log10(m / mw_) : 999;
+    a.psnr_d = md_ > 0 ? 10 * std::log10(2 * m / md_) : 999;
+    a.d_mean_deg = ang_ / m;
+    a.d_max_deg = amax_;
     return a;
 }
 

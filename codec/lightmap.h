@@ -25,6 +25,8 @@ struct ShLightmap {
 // rotated into its tangent frame (frame_from_z(normal)) and multiplied by the visible (upper)
 // hemisphere, projected back to SH3 (irradz::cap_multiply with cos_alpha = 0), as a baker would see it.
 ShLightmap synthesize_sphere(const Sh3Radiance& world, int width, int height, int threads = 1);
+// Rows [y0, y1) of synthesize_sphere(world, width, height) (a band of y1 - y0 rows; the same texels).
+ShLightmap synthesize_sphere_rows(const Sh3Radiance& world, int width, int height, int y0, int y1, int threads = 1);
 
 // The stored parameters as float planes (before or after block compression).
 struct IrradzPlanes {
@@ -42,6 +44,9 @@ std::array<float, 2> encode_hemioct(Vec3 d);
 Vec3 decode_hemioct(float u, float v);
 
 IrradzPlanes encode_planes(const ShLightmap& lm, const irradz::EncodeOptions& options, int threads = 1);
+// The closed-form linear SH -> IrradZ fit (irradz::linear_sh_to_irradz on each texel's L0 and L1;
+// L2 is ignored), for linear-SH lightmaps: no search, exact for IrradZ-valid HHD radiance.
+IrradzPlanes encode_planes_linear_sh(const ShLightmap& lm, int threads = 1);
 
 struct Compressed {
     int width = 0, height = 0;
@@ -65,6 +70,20 @@ struct Audit {
 // Every `stride`-th texel is audited (the per-texel error integral costs 512 model evaluations).
 Audit audit(const ShLightmap& lm, const IrradzPlanes& search, const IrradzPlanes& old_way, const IrradzPlanes& after_bc,
             std::size_t stride);
+
+// audit() over a lightmap given band by band (streaming): add() the bands in order (rows
+// top to bottom; each band's planes cover exactly its texels), then result(). The same sums in the
+// same order as audit() on the whole image, so the same numbers (tested).
+class AuditAccumulator {
+public:
+    explicit AuditAccumulator(std::size_t stride) : stride_(stride < 1 ? 1 : stride) {}
+    void add(const ShLightmap& band, const IrradzPlanes& search, const IrradzPlanes& old_way, const IrradzPlanes& after_bc);
+    Audit result() const;
+
+private:
+    std::size_t stride_, next_ = 0, sampled_ = 0, texels_ = 0, iz_values_ = 0;
+    double s_ = 0, o_ = 0, b_ = 0, iz_ = 0, mse_iz_ = 0, mw_ = 0, md_ = 0, ang_ = 0, amax_ = 0;
+};
 
 // log2-PSNR of HDR RGB values: l(v) = log2(max(v, 2^-14)) (v clamped to BC6H's [0, 65504]),
 // PSNR = 10 log10(30^2 / MSE_l): 30 = log2(65504) - (-14) rounded, the representable log range.

@@ -127,22 +127,31 @@ Result<std::vector<std::uint8_t>> encode_dds(const Ktx2Image& img) {
     const std::uint32_t dxgi = dxgi_format_for_vk(img.vk_format);
     if (dxgi == 0) return make_error(ErrorCode::kInvalidArgument, "dds: unsupported vkFormat " + std::to_string(img.vk_format));
     if (img.width <= 0 || img.height <= 0) return make_error(ErrorCode::kInvalidArgument, "dds: empty image");
-    const std::uint64_t level_bytes = static_cast<std::uint64_t>((img.width + 3) / 4) *
-                                      static_cast<std::uint64_t>((img.height + 3) / 4) * ktx2_block_bytes(img.vk_format);
-    if (img.blocks.size() != level_bytes)
+    if (img.blocks.size() != ktx2_level_bytes(img.vk_format, img.width, img.height))
         return make_error(ErrorCode::kInvalidArgument, "dds: block data does not match the image size");
+    auto out = dds_header(img.vk_format, img.width, img.height);
+    if (!out) return out;
+    out->insert(out->end(), img.blocks.begin(), img.blocks.end());
+    return out;
+}
+
+Result<std::vector<std::uint8_t>> dds_header(std::uint32_t vk_format, int width, int height) {
+    const std::uint32_t dxgi = dxgi_format_for_vk(vk_format);
+    if (dxgi == 0) return make_error(ErrorCode::kInvalidArgument, "dds: unsupported vkFormat " + std::to_string(vk_format));
+    if (width <= 0 || height <= 0) return make_error(ErrorCode::kInvalidArgument, "dds: empty image");
+    const std::uint64_t level_bytes = ktx2_level_bytes(vk_format, width, height);
     if (level_bytes > 0xFFFFFFFFu)
         return make_error(ErrorCode::kInvalidArgument, "dds: level larger than dwPitchOrLinearSize (32 bits) can state");
     std::vector<std::uint8_t> out;
-    out.reserve(kDdsDataOffset + img.blocks.size());
+    out.reserve(kDdsDataOffset);
     put32(out, kMagic);
     // DDS_HEADER. DDSD_MIPMAPCOUNT is left out (Microsoft: "required in a mipmapped texture"), but
     // dwMipMapCount still says 1, so readers that honour the count without the flag and readers that
     // read a missing flag as one level agree.
     put32(out, kHeaderSize);
     put32(out, kDdsdCaps | kDdsdHeight | kDdsdWidth | kDdsdPixelFormat | kDdsdLinearSize);
-    put32(out, static_cast<std::uint32_t>(img.height));
-    put32(out, static_cast<std::uint32_t>(img.width));
+    put32(out, static_cast<std::uint32_t>(height));
+    put32(out, static_cast<std::uint32_t>(width));
     put32(out, static_cast<std::uint32_t>(level_bytes));  // dwPitchOrLinearSize: the whole level (DDSD_LINEARSIZE)
     put32(out, 0);                                        // dwDepth
     put32(out, 1);                                        // dwMipMapCount
@@ -160,15 +169,18 @@ Result<std::vector<std::uint8_t>> encode_dds(const Ktx2Image& img) {
     put32(out, 0);                 // miscFlag: not a cube map
     put32(out, 1);                 // arraySize
     put32(out, kAlphaModeOpaque);  // miscFlags2: BC4/BC5/BC6H have no alpha; samplers return 1
-    out.insert(out.end(), img.blocks.begin(), img.blocks.end());
     return out;
 }
 
-Result<Ktx2Image> decode_dds(std::span<const std::uint8_t> b, const std::string& name, const DdsLimits& limits) {
-    if (b.size() < 4 || get32(b, 0) != kMagic) return bad(ErrorCode::kBadFormat, name, "not a DDS file (bad magic at byte 0)");
-    if (b.size() < kLegacyDataOffset)
-        return bad(ErrorCode::kTruncated, name, "header truncated: file ends at byte " + std::to_string(b.size()) +
-                                                    ", inside " + field_at(b.size()) + " (the header needs 128 bytes)");
+namespace {
+// decode_dds's checks on the first bytes `b` of a file of `size` bytes (b holds at least
+// min(size, 148) bytes): the image description without its blocks, and the data offset.
+Result<Ktx2Image> decode_dds_layout(std::span<const std::uint8_t> b, std::uint64_t size, const std::string& name,
+                                    const DdsLimits& limits, std::uint64_t* data_offset_out) {
+    if (size < 4 || b.size() < 4 || get32(b, 0) != kMagic) return bad(ErrorCode::kBadFormat, name, "not a DDS file (bad magic at byte 0)");
+    if (size < kLegacyDataOffset || b.size() < kLegacyDataOffset)
+        return bad(ErrorCode::kTruncated, name, "header truncated: file ends at byte " + std::to_string(size) +
+                                                    ", inside " + field_at(static_cast<size_t>(size)) + " (the header needs 128 bytes)");
     if (const std::uint32_t size = get32(b, 4); size != kHeaderSize)
         return bad(ErrorCode::kBadFormat, name, "dwSize " + std::to_string(size) + " (byte 4), must be 124");
     if (const std::uint32_t size = get32(b, 76); size != kPixelFormatSize)
@@ -180,9 +192,9 @@ Result<Ktx2Image> decode_dds(std::span<const std::uint8_t> b, const std::string&
     Ktx2Image img;
     std::size_t data_offset = kLegacyDataOffset;
     if (four == kFourCcDx10) {
-        if (b.size() < kDdsDataOffset)
-            return bad(ErrorCode::kTruncated, name, "DX10 header truncated: file ends at byte " + std::to_string(b.size()) +
-                                                        ", inside " + field_at(b.size()) + " (the header needs 148 bytes)");
+        if (size < kDdsDataOffset || b.size() < kDdsDataOffset)
+            return bad(ErrorCode::kTruncated, name, "DX10 header truncated: file ends at byte " + std::to_string(size) +
+                                                        ", inside " + field_at(static_cast<size_t>(size)) + " (the header needs 148 bytes)");
         data_offset = kDdsDataOffset;
         const std::uint32_t dxgi = get32(b, 128), dim = get32(b, 132), misc = get32(b, 136), array = get32(b, 140),
                             misc2 = get32(b, 144);
@@ -228,18 +240,40 @@ Result<Ktx2Image> decode_dds(std::span<const std::uint8_t> b, const std::string&
     if (pitch != 0 && pitch != expected)
         return bad(ErrorCode::kBadFormat, name, "dwPitchOrLinearSize " + std::to_string(pitch) + " (byte 20) but " + std::to_string(w) +
                                                     "x" + std::to_string(h) + " needs " + std::to_string(expected) + " (or 0)");
-    const std::uint64_t have = b.size() - data_offset;
+    const std::uint64_t have = size - data_offset;
     if (have < expected)
         return bad(ErrorCode::kTruncated, name, "file ends inside the block data (needs " + std::to_string(data_offset + expected) +
-                                                    " bytes, has " + std::to_string(b.size()) + ")");
+                                                    " bytes, has " + std::to_string(size) + ")");
     if (have > expected)
         return bad(ErrorCode::kTrailingBytes, name, std::to_string(have - expected) + " bytes after the block data (byte " +
                                                         std::to_string(data_offset + expected) + ")");
     img.width = static_cast<int>(w);
     img.height = static_cast<int>(h);
-    img.blocks.assign(b.begin() + static_cast<std::ptrdiff_t>(data_offset), b.end());
+    *data_offset_out = data_offset;
     return img;
 }
+}  // namespace
+
+Result<Ktx2Image> decode_dds(std::span<const std::uint8_t> b, const std::string& name, const DdsLimits& limits) {
+    std::uint64_t off = 0;
+    auto img = decode_dds_layout(b, b.size(), name, limits, &off);
+    if (!img) return img;
+    img->blocks.assign(b.begin() + static_cast<std::ptrdiff_t>(off), b.end());
+    return img;
+}
+
+Result<BlockFileLayout> read_dds_layout(const std::string& path, const DdsLimits& limits) {
+    auto prefix = read_file_prefix(path, kDdsDataOffset);
+    if (!prefix) return prefix.error();
+    BlockFileLayout l;
+    auto img = decode_dds_layout(prefix->bytes, prefix->file_size, path, limits, &l.data_offset);
+    if (!img) return img.error();
+    l.vk_format = img->vk_format;
+    l.width = img->width;
+    l.height = img->height;
+    return l;
+}
+
 
 Status write_dds(const std::string& path, const Ktx2Image& image) {
     auto bytes = encode_dds(image);

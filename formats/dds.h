@@ -43,6 +43,11 @@ struct DdsLimits {
 };
 
 Result<std::vector<std::uint8_t>> encode_dds(const Ktx2Image& image);
+// Streaming: the 148 bytes encode_dds writes before the blocks (every field depends only on the
+// format and the size); encode_dds = dds_header + the blocks.
+Result<std::vector<std::uint8_t>> dds_header(std::uint32_t vk_format, int width, int height);
+// See BlockFileLayout (ktx2.h).
+Result<BlockFileLayout> read_dds_layout(const std::string& path, const DdsLimits& limits = {});
 Result<Ktx2Image> decode_dds(std::span<const std::uint8_t> bytes, const std::string& name, const DdsLimits& limits = {});
 Status write_dds(const std::string& path, const Ktx2Image& image);
 Result<Ktx2Image> read_dds(const std::string& path, const DdsLimits& limits = {});

@@ -68,20 +68,18 @@ std::size_t ktx2_block_bytes(std::uint32_t vk_format) {
     }
 }
 
-Result<std::vector<std::uint8_t>> encode_ktx2(const Ktx2Image& img) {
-    const std::size_t bb = ktx2_block_bytes(img.vk_format);
-    if (bb == 0) return make_error(ErrorCode::kInvalidArgument, "ktx2: unsupported vkFormat " + std::to_string(img.vk_format));
-    if (img.width <= 0 || img.height <= 0) return make_error(ErrorCode::kInvalidArgument, "ktx2: empty image");
-    const std::size_t level_bytes = static_cast<size_t>((img.width + 3) / 4) * static_cast<size_t>((img.height + 3) / 4) * bb;
-    if (img.blocks.size() != level_bytes)
-        return make_error(ErrorCode::kInvalidArgument, "ktx2: block data does not match the image size");
-    const auto dfd = make_dfd(img.vk_format);
+Result<std::vector<std::uint8_t>> ktx2_header(std::uint32_t vk_format, int width, int height) {
+    const std::size_t bb = ktx2_block_bytes(vk_format);
+    if (bb == 0) return make_error(ErrorCode::kInvalidArgument, "ktx2: unsupported vkFormat " + std::to_string(vk_format));
+    if (width <= 0 || height <= 0) return make_error(ErrorCode::kInvalidArgument, "ktx2: empty image");
+    const std::size_t level_bytes = static_cast<size_t>((width + 3) / 4) * static_cast<size_t>((height + 3) / 4) * bb;
+    const auto dfd = make_dfd(vk_format);
     const std::size_t level_offset = align_up(kDfdStart + dfd.size(), bb);  // lcm(block bytes, 4) = block bytes
     std::vector<std::uint8_t> out(kIdentifier, kIdentifier + 12);
-    put32(out, img.vk_format);
+    put32(out, vk_format);
     put32(out, 1);  // typeSize: 1 for block-compressed formats
-    put32(out, static_cast<std::uint32_t>(img.width));
-    put32(out, static_cast<std::uint32_t>(img.height));
+    put32(out, static_cast<std::uint32_t>(width));
+    put32(out, static_cast<std::uint32_t>(height));
     put32(out, 0);  // pixelDepth
     put32(out, 0);  // layerCount
     put32(out, 1);  // faceCount
@@ -98,14 +96,32 @@ Result<std::vector<std::uint8_t>> encode_ktx2(const Ktx2Image& img) {
     put64(out, level_bytes);  // uncompressedByteLength (no supercompression)
     out.insert(out.end(), dfd.begin(), dfd.end());
     out.resize(level_offset, 0);
-    out.insert(out.end(), img.blocks.begin(), img.blocks.end());
     return out;
 }
 
-Result<Ktx2Image> decode_ktx2(std::span<const std::uint8_t> b, const std::string& name, const Ktx2Limits& limits) {
+Result<std::vector<std::uint8_t>> encode_ktx2(const Ktx2Image& img) {
+    auto out = ktx2_header(img.vk_format, img.width, img.height);
+    if (!out) return out;
+    if (img.blocks.size() != ktx2_level_bytes(img.vk_format, img.width, img.height))
+        return make_error(ErrorCode::kInvalidArgument, "ktx2: block data does not match the image size");
+    out->insert(out->end(), img.blocks.begin(), img.blocks.end());
+    return out;
+}
+
+std::uint64_t ktx2_level_bytes(std::uint32_t vk_format, int width, int height) {
+    if (width <= 0 || height <= 0) return 0;
+    return static_cast<std::uint64_t>((width + 3) / 4) * static_cast<std::uint64_t>((height + 3) / 4) * ktx2_block_bytes(vk_format);
+}
+
+namespace {
+// decode_ktx2's checks on the first bytes `b` of a file of `size` bytes (b holds at least
+// min(size, 104 + the DFD's length) bytes): the image description without its blocks, and the
+// byte offset of the level data.
+Result<Ktx2Image> decode_ktx2_layout(std::span<const std::uint8_t> b, std::uint64_t size, const std::string& name,
+                                     const Ktx2Limits& limits, std::uint64_t* data_offset) {
     if (b.size() < 12 || std::memcmp(b.data(), kIdentifier, 12) != 0)
         return bad(ErrorCode::kBadFormat, name, "not a KTX2 file (bad identifier at byte 0)");
-    if (b.size() < kDfdStart) return bad(ErrorCode::kTruncated, name, "header truncated (file ends before byte 104)");
+    if (size < kDfdStart || b.size() < kDfdStart) return bad(ErrorCode::kTruncated, name, "header truncated (file ends before byte 104)");
     Ktx2Image img;
     img.vk_format = get32(b, 12);
     const std::uint32_t type_size = get32(b, 16), w = get32(b, 20), h = get32(b, 24), depth = get32(b, 28),
@@ -130,7 +146,7 @@ Result<Ktx2Image> decode_ktx2(std::span<const std::uint8_t> b, const std::string
     const auto expected_dfd = make_dfd(img.vk_format);
     if (dfd_off != kDfdStart || dfd_len != expected_dfd.size())
         return bad(ErrorCode::kBadFormat, name, "data format descriptor not where/as long as expected (bytes 48-55)");
-    if (static_cast<std::uint64_t>(dfd_off) + dfd_len > b.size())
+    if (static_cast<std::uint64_t>(dfd_off) + dfd_len > size || static_cast<std::uint64_t>(dfd_off) + dfd_len > b.size())
         return bad(ErrorCode::kTruncated, name, "file ends inside the data format descriptor (byte " + std::to_string(dfd_off) + ")");
     if (std::memcmp(b.data() + dfd_off, expected_dfd.data(), expected_dfd.size()) != 0)
         return bad(ErrorCode::kBadFormat, name, "data format descriptor does not describe vkFormat " + std::to_string(img.vk_format) +
@@ -149,17 +165,39 @@ Result<Ktx2Image> decode_ktx2(std::span<const std::uint8_t> b, const std::string
                                                     std::to_string(expected) + " (bytes 88-103)");
     if (lvl_off % bb != 0 || lvl_off < dfd_off + dfd_len)
         return bad(ErrorCode::kBadFormat, name, "level 0 byteOffset " + std::to_string(lvl_off) + " misaligned or overlapping (byte 80)");
-    if (lvl_off > b.size() || b.size() - lvl_off < lvl_len)
+    if (lvl_off > size || size - lvl_off < lvl_len)
         return bad(ErrorCode::kTruncated, name, "file ends inside the level data (needs " + std::to_string(lvl_off + lvl_len) +
-                                                    " bytes, has " + std::to_string(b.size()) + ")");
-    if (b.size() != lvl_off + lvl_len)
-        return bad(ErrorCode::kTrailingBytes, name, std::to_string(b.size() - lvl_off - lvl_len) + " bytes after the level data (byte " +
+                                                    " bytes, has " + std::to_string(size) + ")");
+    if (size != lvl_off + lvl_len)
+        return bad(ErrorCode::kTrailingBytes, name, std::to_string(size - lvl_off - lvl_len) + " bytes after the level data (byte " +
                                                         std::to_string(lvl_off + lvl_len) + ")");
     img.width = static_cast<int>(w);
     img.height = static_cast<int>(h);
-    img.blocks.assign(b.begin() + static_cast<std::ptrdiff_t>(lvl_off), b.begin() + static_cast<std::ptrdiff_t>(lvl_off + lvl_len));
+    *data_offset = lvl_off;
     return img;
 }
+}  // namespace
+
+Result<Ktx2Image> decode_ktx2(std::span<const std::uint8_t> b, const std::string& name, const Ktx2Limits& limits) {
+    std::uint64_t off = 0;
+    auto img = decode_ktx2_layout(b, b.size(), name, limits, &off);
+    if (!img) return img;
+    img->blocks.assign(b.begin() + static_cast<std::ptrdiff_t>(off), b.end());
+    return img;
+}
+
+Result<BlockFileLayout> read_ktx2_layout(const std::string& path, const Ktx2Limits& limits) {
+    auto prefix = read_file_prefix(path, 1 << 16);
+    if (!prefix) return prefix.error();
+    BlockFileLayout l;
+    auto img = decode_ktx2_layout(prefix->bytes, prefix->file_size, path, limits, &l.data_offset);
+    if (!img) return img.error();
+    l.vk_format = img->vk_format;
+    l.width = img->width;
+    l.height = img->height;
+    return l;
+}
+
 
 Status write_ktx2(const std::string& path, const Ktx2Image& image) {
     auto bytes = encode_ktx2(image);

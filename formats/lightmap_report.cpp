@@ -279,8 +279,8 @@ LightmapHtml lightmap_audit_html(const std::string& version, std::vector<std::pa
     p.after_label = "after BC6H + BC5 + BC4";
     const double m = a.mean_iz > 0 ? a.mean_iz : 1;
     p.rows = {{"old way (optimal linear direction, spherical Gram)", a.rmse_old, a.rmse_old / m},
-              {"search (hemispherical Gram, golden-section d)", a.rmse_search, a.rmse_search / m},
-              {"search after BC6H + BC5 + BC4", a.rmse_after_bc, a.rmse_after_bc / m}};
+              {"fit (hemispherical Gram, Newton on d)", a.rmse_search, a.rmse_search / m},
+              {"fit after BC6H + BC5 + BC4", a.rmse_after_bc, a.rmse_after_bc / m}};
     p.metrics = {{"mean irradiance at the normal", num(a.mean_iz, "%.5g")},
                  {"I_z BC6H PSNR (log2 domain)", num(a.psnr_iz_log2, "%.2f") + " dB"},
                  {"w_a BC4 PSNR", num(a.psnr_wa, "%.2f") + " dB"},

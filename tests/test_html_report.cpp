@@ -419,9 +419,9 @@ TEST(LightmapReport, AuditHtml) {
         EXPECT_NE(doc.find("normal tilted 45 degrees"), std::string::npos);
         const std::vector<std::string> rows = row_names(summary_table(doc));
         ASSERT_EQ(rows.size(), 3u);
-        EXPECT_EQ(rows[2], "search after BC6H + BC5 + BC4");
+        EXPECT_EQ(rows[2], "fit after BC6H + BC5 + BC4");
         // The table's numbers are the command's: its text output prints the same rmse.
-        const std::regex after(R"(search after BC6H \+ BC5 \+ BC4\s+([0-9.e-]+))");
+        const std::regex after(R"(fit after BC6H \+ BC5 \+ BC4\s+([0-9.e-]+))");
         std::smatch m;
         ASSERT_TRUE(std::regex_search(r.out, m, after)) << r.out;
         std::string cell = ">";
