@@ -59,7 +59,8 @@ precision highp int;
 //   zh3_channel, zh3_solved_channel      ZHC_LAYOUT_ZH3_F32, axis per channel
 //   hall_{ambdir,sphere,curve}           ZHC_LAYOUT_SH2_F32 + hallucination, axis luminance
 //   hall_{ambdir,sphere,curve}_channel   ZHC_LAYOUT_SH2_F32 + hallucination, axis per channel
-//   zh3_q16, zh3_solved_q16, zh3_dering_q16  ZHC_LAYOUT_ZH3_Q16  (uvec4)
+//   zh3_q16, zh3_solved_q16, zh3_dering_q16  ZHC_LAYOUT_ZH3_Q16  (uvec4), axis from the header
+//   zh3_channel_q16, zh3_solved_channel_q16  ZHC_LAYOUT_ZH3_Q16, axis per channel (whatever the header says)
 //   sh3_q28                              ZHC_LAYOUT_SH3_Q28  (7 uints)
 //   sh2_q                                ZHC_LAYOUT_SH2_Q    (uvec4)
 //   hall_curve_q                         ZHC_LAYOUT_SH2_Q + ZHC_HALL_CURVE (axis from the header)

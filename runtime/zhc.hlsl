@@ -78,7 +78,9 @@
 #define ZHC_HALL_CURVE_Q 19u
 #define ZHC_ZH3_DERING 20u       // zh3_lum's 15 floats (whole-sphere deringing happens at encode)
 #define ZHC_ZH3_DERING_Q16 21u   // zh3_q16's 16 bytes
-#define ZHC_ENCODING_COUNT 22u
+#define ZHC_ZH3_CHANNEL_Q16 22u  // zh3_q16's 16 bytes, each channel's own axis (f.axisMode unused)
+#define ZHC_ZH3_SOLVED_CHANNEL_Q16 23u  // zh3_channel_q16's 16 bytes
+#define ZHC_ENCODING_COUNT 24u
 
 // Stored bytes per probe of each encoding (all multiples of 4).
 uint zhc_encoding_bytes(uint encoding)
@@ -421,7 +423,8 @@ float3 zhc_hallucinate(uint model, float3 c0, float3 c1m1, float3 c10, float3 c1
 uint zhc_axis_mode_of(uint encoding, ZhcFormat f)
 {
     if (encoding == ZHC_ZH3_CHANNEL || encoding == ZHC_ZH3_SOLVED_CHANNEL || encoding == ZHC_HALL_AMBDIR_CHANNEL ||
-        encoding == ZHC_HALL_SPHERE_CHANNEL || encoding == ZHC_HALL_CURVE_CHANNEL)
+        encoding == ZHC_HALL_SPHERE_CHANNEL || encoding == ZHC_HALL_CURVE_CHANNEL ||
+        encoding == ZHC_ZH3_CHANNEL_Q16 || encoding == ZHC_ZH3_SOLVED_CHANNEL_Q16)
         return ZHC_AXIS_PER_CHANNEL;
     if (encoding == ZHC_ZH3_DERING) return ZHC_AXIS_LUMINANCE;
     if (encoding >= ZHC_ZH3_Q16) return f.axisMode;  // quantised layouts: the container's axis mode
@@ -458,7 +461,7 @@ void zhc_zh3_floats(uint w[27], uint encoding, ZhcFormat f, out float3 c[4], out
 
 // ---- quantised layouts -----------------------------------------------------------------------------
 
-// zh3_q16 / zh3_solved_q16 (uint4): DC in word 0 (R11G11B10F or RGB9E5); word 1 + k holds channel
+// zh3_q16 / zh3_solved_q16 / zh3_channel_q16 ... (uint4): DC in word 0 (R11G11B10F or RGB9E5); word 1 + k holds channel
 // k's codes [L1-1, L10, L11, zonal] in bytes 0..3. Output: stored-domain DC + L1, f20, axes.
 void zhc_zh3_q16(uint4 p, ZhcFormat f, out float3 c[4], out float3 f20, out float3 a[3])
 {
@@ -471,7 +474,8 @@ void zhc_zh3_q16(uint4 p, ZhcFormat f, out float3 c[4], out float3 f20, out floa
                       zhc_decode_ratio(zhc_byte(p.w, j - 1u), m1)) * dc;
     f20 = float3(zhc_decode_ratio(zhc_byte(p.y, 3u), mz), zhc_decode_ratio(zhc_byte(p.z, 3u), mz),
                  zhc_decode_ratio(zhc_byte(p.w, 3u), mz)) * dc;
-    zhc_zonal_axes(c[1], c[2], c[3], f.axisMode, float3(f.lumR, f.lumG, f.lumB), a);
+    // f.axisMode, except for the entries that fix each channel's own axis (zh3_channel_q16, ...).
+    zhc_zonal_axes(c[1], c[2], c[3], zhc_axis_mode_of(f.encoding, f), float3(f.lumR, f.lumG, f.lumB), a);
 }
 
 // sh2_q / hall_curve_q (uint4): DC slot bytes 0..5; channel k's L1 codes at bytes 6 + 3k + j.
@@ -575,7 +579,8 @@ float3 zhc_irradiance_sh3_q28(uint w[7], ZhcFormat f, float3 n)
 
 float3 zhc_irradiance(uint w[27], ZhcFormat f, float3 n)
 {
-    if (f.encoding == ZHC_ZH3_Q16 || f.encoding == ZHC_ZH3_SOLVED_Q16 || f.encoding == ZHC_ZH3_DERING_Q16)
+    if (f.encoding == ZHC_ZH3_Q16 || f.encoding == ZHC_ZH3_SOLVED_Q16 || f.encoding == ZHC_ZH3_DERING_Q16 ||
+        f.encoding == ZHC_ZH3_CHANNEL_Q16 || f.encoding == ZHC_ZH3_SOLVED_CHANNEL_Q16)
         return zhc_irradiance_zh3_q16(uint4(w[0], w[1], w[2], w[3]), f, n);
     if (f.encoding == ZHC_SH2_Q) return zhc_irradiance_sh2_q(uint4(w[0], w[1], w[2], w[3]), f, n);
     if (f.encoding == ZHC_HALL_CURVE_Q) return zhc_irradiance_hall_curve_q(uint4(w[0], w[1], w[2], w[3]), f, n);
@@ -644,7 +649,9 @@ ZhcSH3 zhc_decode_sh3(uint w[27], ZhcFormat f)
 {
     uint e = f.encoding;
     uint4 p = uint4(w[0], w[1], w[2], w[3]);
-    if (e == ZHC_ZH3_Q16 || e == ZHC_ZH3_SOLVED_Q16 || e == ZHC_ZH3_DERING_Q16) return zhc_decode_zh3_q16(p, f);
+    if (e == ZHC_ZH3_Q16 || e == ZHC_ZH3_SOLVED_Q16 || e == ZHC_ZH3_DERING_Q16 || e == ZHC_ZH3_CHANNEL_Q16 ||
+        e == ZHC_ZH3_SOLVED_CHANNEL_Q16)
+        return zhc_decode_zh3_q16(p, f);
     if (e == ZHC_SH2_Q) return zhc_decode_sh2_q(p, f);
     if (e == ZHC_HALL_CURVE_Q) return zhc_decode_hall_curve_q(p, f);
     if (e == ZHC_SH3_Q28)

@@ -83,7 +83,9 @@ enum zhc_encoding {
     ZHC_ENC_HALL_CURVE_Q = 19,        /* sh2_q bytes, zonal hallucinated at decode (Eq. 21) */
     ZHC_ENC_ZH3_DERING = 20,          /* 15 floats: decoded as zh3_lum (deringing happens at encode) */
     ZHC_ENC_ZH3_DERING_Q16 = 21,      /* zh3_q16 bytes */
-    ZHC_ENC_COUNT = 22
+    ZHC_ENC_ZH3_CHANNEL_Q16 = 22,        /* zh3_q16 bytes, per-channel axes whatever axis_mode says */
+    ZHC_ENC_ZH3_SOLVED_CHANNEL_Q16 = 23, /* zh3_channel_q16 bytes */
+    ZHC_ENC_COUNT = 24
 };
 enum zhc_stored_kind { ZHC_KIND_RADIANCE = 0, ZHC_KIND_IRRADIANCE = 1 };
 enum zhc_dc_format { ZHC_DC_R11G11B10F = 0, ZHC_DC_RGB9E5 = 1, ZHC_DC_HALF = 2 };
@@ -128,7 +130,7 @@ static inline const char* zhc_encoding_name(int e) {
         "sh3", "sh2", "zh3_lum", "zh3_channel", "zh3_solved_lum", "zh3_solved_channel", "hall_ambdir",
         "hall_sphere", "hall_curve", "hall_ambdir_channel", "hall_sphere_channel", "hall_curve_channel",
         "zh3_lum_dering", "zh3_lum_dering_sphere", "sh3_dering", "zh3_q16", "zh3_solved_q16", "sh3_q28",
-        "sh2_q", "hall_curve_q", "zh3_dering", "zh3_dering_q16"};
+        "sh2_q", "hall_curve_q", "zh3_dering", "zh3_dering_q16", "zh3_channel_q16", "zh3_solved_channel_q16"};
     return (e >= 0 && e < ZHC_ENC_COUNT) ? names[e] : NULL;
 }
 
@@ -144,14 +146,19 @@ static inline int zhc_encoding_from_name(const char* name) {
 /* Stored bytes per probe of encoding e; 0 when e is out of range. */
 static inline size_t zhc_encoding_size(int e) {
     static const unsigned char sizes[ZHC_ENC_COUNT] = {108, 48, 60, 60, 60, 60, 48, 48, 48, 48,
-                                                       48,  48, 60, 60, 108, 16, 16, 28, 16, 16, 60, 16};
+                                                       48,  48, 60, 60, 108, 16, 16, 28, 16, 16, 60, 16, 16, 16};
     return (e >= 0 && e < ZHC_ENC_COUNT) ? sizes[e] : 0;
 }
 
 /* 1 for the packed (quantised) encodings zh3_q16, zh3_solved_q16, sh3_q28, sh2_q, hall_curve_q,
- * zh3_dering_q16. */
+ * zh3_dering_q16, zh3_channel_q16, zh3_solved_channel_q16. */
 static inline int zhc_encoding_is_packed(int e) {
-    return (e >= ZHC_ENC_ZH3_Q16 && e <= ZHC_ENC_HALL_CURVE_Q) || e == ZHC_ENC_ZH3_DERING_Q16;
+    return (e >= ZHC_ENC_ZH3_Q16 && e <= ZHC_ENC_HALL_CURVE_Q) || e == ZHC_ENC_ZH3_DERING_Q16 ||
+           e == ZHC_ENC_ZH3_CHANNEL_Q16 || e == ZHC_ENC_ZH3_SOLVED_CHANNEL_Q16;
+}
+/* 1 for the packed encodings in zh3_q16 bytes that fix each channel's own axis (f->axis_mode unused). */
+static inline int zhc__packed_per_channel(int e) {
+    return e == ZHC_ENC_ZH3_CHANNEL_Q16 || e == ZHC_ENC_ZH3_SOLVED_CHANNEL_Q16;
 }
 
 /* Defaults of `zhc convert --to ENCODING` (cli/cmd_convert.cpp, codec/quantize.h QuantParams):
@@ -230,7 +237,7 @@ static inline int zhc_probe_format_validate(const zhc_probe_format* f) {
         return ZHC_ERR_ARGUMENT;
     if (f->dc_format == ZHC_DC_HALF &&
         (f->encoding == ZHC_ENC_ZH3_Q16 || f->encoding == ZHC_ENC_ZH3_SOLVED_Q16 || f->encoding == ZHC_ENC_SH3_Q28 ||
-         f->encoding == ZHC_ENC_ZH3_DERING_Q16))
+         f->encoding == ZHC_ENC_ZH3_DERING_Q16 || zhc__packed_per_channel(f->encoding)))
         return ZHC_ERR_ARGUMENT;
     return ZHC_OK;
 }
@@ -520,7 +527,8 @@ static inline void zhc__decode_packed(const zhc_probe_format* f, const uint8_t* 
         const double s = sqrt(4.0 * ZHC__PI / 5.0);
         for (i = 0; i < 4; ++i)
             for (k = 0; k < 3; ++k) lin[i * 3 + k] = (float)zhc__f32_round(q[i][k]);
-        zhc__zh3_axes(lin, f->axis_mode == ZHC_AXIS_PER_CHANNEL, f->luminance, axes);
+        zhc__zh3_axes(lin, f->axis_mode == ZHC_AXIS_PER_CHANNEL || zhc__packed_per_channel(f->encoding), f->luminance,
+                      axes);
         for (k = 0; k < 3; ++k) {
             const double zq = zhc__ratio_decode(f, 6, 1, in[4 + 4 * k + 3]) * dc[k];
             zhc__sh3_basis(axes[k], y);
@@ -557,7 +565,8 @@ static inline int zhc__float_per_channel(int e) {
  *   zh3_*: L2_k = f20_k sqrt(4pi/5) Y2(a_k), a_k the zonal axis from the stored L1.
  *   hall_*: f20 hallucinated (zhc_hallucinate_zonal) then expanded as zh3.
  *   packed: DC decoded, c_i = ratio(code) DC (docs/quantization.md); zh3_q16 adds the zonal L2 on
- *     the axis of the dequantised L1 (f->axis_mode); hall_curve_q adds the Eq. 21 zonal L2 to the
+ *     the axis of the dequantised L1 (f->axis_mode; zh3_channel_q16, zh3_solved_channel_q16: always
+ *     each channel's own); hall_curve_q adds the Eq. 21 zonal L2 to the
  *     decoded sh2_q on f->axis_mode's axis.
  *   kind = irradiance: the stored band-scaled coefficients are turned back into radiance
  *     (float entries: c * (1 / s_l), rounded to float; packed: q / s_l, as zhc does).

@@ -175,6 +175,8 @@ const std::map<std::string, GlslEntry, std::less<>>& glsl_entries() {
         {"sh3_q28", {kSh3Q28, kHallNone, kAxisFromHeader}},
         {"sh2_q", {kSh2Q, kHallNone, kAxisFromHeader}},
         {"hall_curve_q", {kSh2Q, kHallCurve, kAxisFromHeader}},
+        {"zh3_channel_q16", {kZh3Q16, kHallNone, 1}},
+        {"zh3_solved_channel_q16", {kZh3Q16, kHallNone, 1}},
     };
     return m;
 }

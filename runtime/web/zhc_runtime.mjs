@@ -250,7 +250,7 @@ function hallucinateExpand(linear, model, axisMode, w) {
 // ---- packed layouts (decode_packed) ---------------------------------------------------------
 
 export const PACKED_LAYOUTS = Object.freeze({ zh3_q16: 'zh3_q16', zh3_solved_q16: 'zh3_q16', zh3_dering_q16: 'zh3_q16', sh3_q28: 'sh3_q28',
-  sh2_q: 'sh2_q', hall_curve_q: 'sh2_q' });
+  sh2_q: 'sh2_q', hall_curve_q: 'sh2_q', zh3_channel_q16: 'zh3_q16', zh3_solved_channel_q16: 'zh3_q16' });
 
 function ratioOffset(layout, k, i) {
   if (layout === 'zh3_q16') return 4 + 4 * k + (i - 1);
@@ -308,6 +308,7 @@ const zh3Float = (mode) => (b, o, p) => {
 };
 const hallFloat = (model, mode) => (b, o, p) => hallucinateExpand(loadFloats(b, o, 12), model, mode, p.luminanceWeights);
 const packed = (layout) => (b, o, p) => decodePacked(layout, b, o, p);
+const packedPerChannel = (b, o, p) => decodePacked('zh3_q16', b, o, { ...p, axisMode: 'channel' });
 
 // Every entry of zhc's codec table (codecs() in codec/codec_table.cpp): bytes per probe, whether
 // the entry is a packed (quantised) layout, and the decoder to radiance SH3 (before the `kind`
@@ -335,6 +336,10 @@ export const ENCODINGS = Object.freeze({
   sh3_q28: { bytes: 28, packed: true, decode: packed('sh3_q28') },
   sh2_q: { bytes: 16, packed: true, decode: packed('sh2_q') },
   hall_curve_q: { bytes: 16, packed: true, decode: (b, o, p) => hallucinateExpand(decodePacked('sh2_q', b, o, p), 'curve', p.axisMode, p.luminanceWeights) },
+  // zh3_q16 bytes with each channel's own axis, whatever params.axisMode says (`axisMode`: the
+  // entry's fixed axis, for code that builds params for a shader, e.g. the glTF plugin).
+  zh3_channel_q16: { bytes: 16, packed: true, axisMode: 'channel', decode: packedPerChannel },
+  zh3_solved_channel_q16: { bytes: 16, packed: true, axisMode: 'channel', decode: packedPerChannel },
 });
 
 export function encodingInfo(name) {
