@@ -38,12 +38,29 @@ double band_weight(StoredKind kind, int l) {
 }
 }  // namespace
 
-double channel_code_error(const ChannelCodeProblem& pr, const QuantParams& p, const std::array<std::uint8_t, 3>& l1,
-                          std::uint8_t* best_zonal) {
+namespace {
+// What one channel's search needs besides the problem: the coders (built once) and the decoded L1
+// ratio of each code, filled on first use (the three L1 indices share one interval).
+struct SearchContext {
+    RatioCoder l1, zonal;
+    std::array<double, 256> l1_value;
+    std::array<bool, 256> known{};
+    explicit SearchContext(const QuantParams& p) : l1(ratio_coder(1, p)), zonal(zonal_coder(p)) {}
+    double l1_ratio(std::uint8_t code) {
+        if (!known[code]) {
+            l1_value[code] = l1.decode(code);
+            known[code] = true;
+        }
+        return l1_value[code];
+    }
+};
+
+double code_error(const ChannelCodeProblem& pr, SearchContext& cx, const std::array<std::uint8_t, 3>& l1,
+                  std::uint8_t* best_zonal) {
     double l[3];
     double e1 = 0;
     for (int j = 0; j < 3; ++j) {
-        l[j] = ratio_coder(j + 1, p).decode(l1[static_cast<size_t>(j)]);
+        l[j] = cx.l1_ratio(l1[static_cast<size_t>(j)]);
         const double d = l[j] - pr.t1[static_cast<size_t>(j)];
         e1 += d * d;
     }
@@ -55,18 +72,25 @@ double channel_code_error(const ChannelCodeProblem& pr, const QuantParams& p, co
         pz += pr.t2[static_cast<size_t>(m)] * kSqrtFourPiOverFive * y[static_cast<size_t>(4 + m)];
         t2sq += pr.t2[static_cast<size_t>(m)] * pr.t2[static_cast<size_t>(m)];
     }
-    const RatioCoder zc = zonal_coder(p);
     bool clamped = false;
-    const std::uint8_t code = zc.encode(pz, &clamped);
-    const double zq = zc.decode(code);
+    const std::uint8_t code = cx.zonal.encode(pz, &clamped);
+    const double zq = cx.zonal.decode(code);
     if (best_zonal) *best_zonal = code;
     // |zq v - t2|^2 with |v| = 1; never below 0 in exact arithmetic.
     const double e2 = std::max(t2sq - 2.0 * zq * pz + zq * zq, 0.0);
     return pr.w1 * e1 + pr.w2 * e2;
 }
+}  // namespace
+
+double channel_code_error(const ChannelCodeProblem& pr, const QuantParams& p, const std::array<std::uint8_t, 3>& l1,
+                          std::uint8_t* best_zonal) {
+    SearchContext cx(p);
+    return code_error(pr, cx, l1, best_zonal);
+}
 
 ChannelCodes solve_channel_codes(const ChannelCodeProblem& pr, const QuantParams& p,
                                  const std::array<std::uint8_t, 3>* starts, int start_count, int* evaluations) {
+    SearchContext cx(p);
     const int top = 2 * quant_half_range(p.bits);
     int evals = 0;
     ChannelCodes best;
@@ -75,7 +99,7 @@ ChannelCodes solve_channel_codes(const ChannelCodeProblem& pr, const QuantParams
     for (int s = 0; s < start_count; ++s) {
         std::array<std::uint8_t, 3> c = starts[s];
         for (auto& v : c) v = static_cast<std::uint8_t>(std::min<int>(v, top));
-        double e = channel_code_error(pr, p, c, nullptr);
+        double e = code_error(pr, cx, c, nullptr);
         ++evals;
         // Steepest descent over the +-1 box; E strictly decreases, so it ends (the cap is a guard).
         for (int step = 0; step < 4 * top; ++step) {
@@ -90,7 +114,7 @@ ChannelCodes solve_channel_codes(const ChannelCodeProblem& pr, const QuantParams
                         const std::array<std::uint8_t, 3> cand = {static_cast<std::uint8_t>(n[0]),
                                                                   static_cast<std::uint8_t>(n[1]),
                                                                   static_cast<std::uint8_t>(n[2])};
-                        const double ce = channel_code_error(pr, p, cand, nullptr);
+                        const double ce = code_error(pr, cx, cand, nullptr);
                         ++evals;
                         if (ce < step_e) {
                             step_e = ce;
@@ -107,7 +131,7 @@ ChannelCodes solve_channel_codes(const ChannelCodeProblem& pr, const QuantParams
             best.l1 = c;
         }
     }
-    channel_code_error(pr, p, best.l1, &best.zonal);
+    code_error(pr, cx, best.l1, &best.zonal);
     if (evaluations) *evaluations += evals + 1;
     return best;
 }
@@ -158,7 +182,11 @@ void encode_solved(const Sh3Radiance& in, const QuantParams& params, const Codec
             finite = finite && std::isfinite(pr.t2[static_cast<size_t>(m)]);
         }
         if (!finite) continue;  // non-finite input: the fitted bytes (ratios stored as 0 / clamped)
-        const ChannelCodes c = solve_channel_codes(pr, p, starts, 2, nullptr);
+        // Descend from the better start only (the float solve's L1 is the continuous optimum; the
+        // fitted codes are the fallback when it rounds badly).
+        const double e0 = channel_code_error(pr, p, starts[0], nullptr);
+        const double e1 = channel_code_error(pr, p, starts[1], nullptr);
+        const ChannelCodes c = solve_channel_codes(pr, p, e1 < e0 ? &starts[1] : &starts[0], 1, nullptr);
         for (int j = 0; j < 3; ++j) out[code_offset(k, j)] = c.l1[static_cast<size_t>(j)];
         out[code_offset(k, 3)] = c.zonal;
     }
