@@ -1,5 +1,6 @@
 // The in-memory probe set (probe_set.h): encode/decode through the codec table.
 #include "probe_set.h"
+#include "zh3_hall.h"
 
 #include <cmath>
 
@@ -85,6 +86,8 @@ Status validate_probe_set(const ProbeSet& set) {
 
 void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radiance& hub, std::uint8_t* out,
                   EncodeStats* stats, const CodecOptions& base) {
+    if (hall_packed_entry(codec.name))
+        return hall_encode_packed(codec.name, hub, params, codec_options(params, base), out, stats);
     PackedLayout packed;
     if (packed_layout_from_name(codec.name, &packed)) {
         QuantEncodeControls controls;  // the table entry's encoder choices
@@ -100,6 +103,7 @@ void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radi
 }
 
 Sh3Radiance decode_probe(const Codec& codec, const StorageParams& params, const std::uint8_t* in) {
+    if (hall_packed_entry(codec.name)) return hall_decode_packed(codec.name, in, params, codec_options(params));
     PackedLayout packed;
     if (packed_layout_from_name(codec.name, &packed)) {
         const Sh3Radiance linear = decode_packed(packed, in, params);

@@ -305,7 +305,7 @@ std::size_t packed_size_bytes(PackedLayout layout) {
 bool packed_layout_from_name(std::string_view name, PackedLayout* out) {
     if (name == "zh3_q16" || name == "zh3_solved_q16" || name == "zh3_dering_q16") *out = PackedLayout::kZh3Q16;
     else if (name == "sh3_q28") *out = PackedLayout::kSh3Q28;
-    else if (name == "sh2_q" || name == "hall_curve_q") *out = PackedLayout::kSh2Q;
+    else if (name == "sh2_q" || name == "hall_curve_q" || name == "hall_solved_q16" || name == "hall_adaptive_q16") *out = PackedLayout::kSh2Q;
     else return false;
     return true;
 }
