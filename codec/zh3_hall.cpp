@@ -116,7 +116,7 @@ double solve_alpha_ratio(double gamma, double eta, double A, double B) {
             const double d = dP(x);
             double next = d > 0.0 ? x - px / d : 0.5 * (lo + hi);
             if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-            if (next == x || hi - lo <= 1e-15 * hi) {
+            if (std::fabs(next - x) <= 1e-14 * (x + 1e-3) || hi - lo <= 1e-15 * hi) {
                 x = next;
                 break;
             }
@@ -353,7 +353,7 @@ Vec3 solve_axis(const Problem& pr, const Vec3& fallback, int* iterations) {
     std::stable_sort(order, order + n, [&](int a, int b) { return err[a] < err[b]; });
     Vec3 best = cands[order[0]];
     double best_err = err[order[0]];
-    const int starts = std::min(n, 2);
+    const int starts = std::min(n, 1);
     for (int s = 0; s < starts; ++s) {
         Vec3 a = cands[order[s]];
         const double e = refine(pr, &a, 100, iterations);
@@ -443,7 +443,7 @@ Sh2Radiance hall_solve(const Sh3Radiance& target, double scale, ZonalAxisMode mo
 }
 
 double hall_scale_of_code(std::uint8_t code) {
-    return 0.25 * std::min<int>(code, kHallScaleCodeCount - 1);
+    return 0.5 * std::min<int>(code, kHallScaleCodeCount - 1);
 }
 
 // ---- packed entries ---------------------------------------------------------------------------

@@ -52,7 +52,8 @@ double hall_axis_profile(const Sh3Radiance& target, double scale, ZonalAxisMode 
 // ---- hall_adaptive_q16: the scale code in byte 15 of the sh2_q layout -------------------------
 
 inline constexpr int kHallScaleCodeCount = 8;  // codes 0..7; larger byte values decode as 7
-// s = code * 0.25 for codes 0..7 (0 = plain linear SH, 4 = the curve as fitted, 7 = 1.75x).
+// s = 0.5 * code for codes 0..7 (0 = plain linear SH, 2 = the curve as fitted, 7 = 3.5x); the set was
+// chosen by measurement (docs/zh3.md).
 double hall_scale_of_code(std::uint8_t code);
 
 // Probe-container hooks (codec/probe_set.cpp): the packed entries of this module encode/decode with
