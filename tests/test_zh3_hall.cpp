@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <random>
@@ -302,6 +303,263 @@ TEST(HallAudit, SyntheticInteriorsNeverWorseThanSh2) {
                 sum_curve / n, sum_solved / n, sum_adaptive / n, worst);
     EXPECT_LT(sum_solved, sum_curve);
     EXPECT_LE(sum_adaptive / n, 0.75);
+}
+
+// ---- solve properties -----------------------------------------------------------------------------
+
+TEST(HallSolve, NeverWorseThanStoringTheTargetL1AndDeterministic) {
+    Rng rng(23);
+    std::vector<Sh3Radiance> probes;
+    for (const Map& m : maps())
+        for (int r = 0; r < 4; ++r) probes.push_back(rotate(m.sh, rotation_axis_angle(rng.dir(), 2 * kPi * rng.u())));
+    for (int i = 0; i < 200; ++i) probes.push_back(synthetic_interior(rng));
+    int better = 0;
+    for (const Sh3Radiance& t : probes)
+        for (ZonalAxisMode mode : {ZonalAxisMode::kLuminance, ZonalAxisMode::kPerChannel})
+            for (double s : {0.5, 1.0, 3.5}) {
+                const Sh2Radiance a = hall_solve(t, s, mode, {}, nullptr);
+                EXPECT_TRUE(a == hall_solve(t, s, mode, {}, nullptr));
+                EXPECT_EQ(a[0], truncate_to_sh2(t)[0]);  // DC exact
+                const double e = decoded_error(t, a, s, mode), e0 = decoded_error(t, truncate_to_sh2(t), s, mode);
+                EXPECT_LE(e, e0);
+                better += e < 0.999 * e0;
+            }
+    EXPECT_GT(better, static_cast<int>(probes.size()));  // it usually helps (here: > 1 of 6 solves)
+}
+
+TEST(HallSolve, ScaleInvariant) {
+    Rng rng(29);
+    for (int i = 0; i < 40; ++i) {
+        const Sh3Radiance t = i < 8 ? maps()[static_cast<size_t>(i)].sh : synthetic_interior(rng);
+        for (ZonalAxisMode mode : {ZonalAxisMode::kLuminance, ZonalAxisMode::kPerChannel}) {
+            EncodeStats st0;
+            const Sh2Radiance a = hall_solve(t, 2.0, mode, {}, &st0);
+            // Powers of two: bit-identical (scaled) results and iterations.
+            for (int e : {-26, -13, -1, 1, 7, 26}) {
+                Sh3Radiance ts = t;
+                for (int j = 0; j < 9; ++j)
+                    for (int k = 0; k < 3; ++k) ts[j][k] = std::ldexp(t[j][k], e);
+                EncodeStats st;
+                const Sh2Radiance b = hall_solve(ts, 2.0, mode, {}, &st);
+                EXPECT_EQ(st.solver_iterations, st0.solver_iterations) << i << " " << e;
+                for (int j = 0; j < 4; ++j)
+                    for (int k = 0; k < 3; ++k) EXPECT_EQ(b[j][k], std::ldexp(a[j][k], e)) << i << " " << e;
+            }
+            // Any factor in 1e-8 .. 1e8: the same error relative to the probe's own.
+            const double e_a = decoded_error(t, a, 2.0, mode);
+            for (double f : {1e-8, 3.7e-5, 0.3, 7.0, 1e3, 1e8}) {
+                Sh3Radiance ts = t;
+                for (int j = 0; j < 9; ++j)
+                    for (int k = 0; k < 3; ++k) ts[j][k] = static_cast<float>(t[j][k] * f);
+                const double e_b = decoded_error(ts, hall_solve(ts, 2.0, mode, {}, nullptr), 2.0, mode) / (f * f);
+                EXPECT_NEAR(e_b, e_a, 1e-5 * e_a + 1e-12 * decoded_error(t, truncate_to_sh2(t), 2.0, mode)) << i << " " << f;
+            }
+        }
+    }
+}
+
+TEST(HallSolve, TotalOnDegenerateInput) {
+    const CodecOptions o;
+    Sh3Radiance zero;
+    EXPECT_TRUE(hall_solve(zero, 1.0, ZonalAxisMode::kLuminance, o, nullptr) == truncate_to_sh2(zero));
+    Sh3Radiance nan = maps()[0].sh;
+    nan[4][1] = NAN;
+    const Sh2Radiance r = hall_solve(nan, 1.0, ZonalAxisMode::kLuminance, o, nullptr);
+    EXPECT_TRUE(r == truncate_to_sh2(nan));
+    Sh3Radiance neg = maps()[1].sh;
+    neg[0][0] = -1.0f;  // a channel with a negative DC hallucinates nothing
+    const Sh2Radiance n2 = hall_solve(neg, 1.0, ZonalAxisMode::kPerChannel, o, nullptr);
+    for (int j = 0; j < 4; ++j)
+        for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::isfinite(n2[j][k]));
+    CodecOptions zero_w;
+    zero_w.luminance = {0, 0, 0};
+    EXPECT_TRUE(hall_solve(maps()[2].sh, 1.0, ZonalAxisMode::kLuminance, zero_w, nullptr) == truncate_to_sh2(maps()[2].sh));
+    // Every entry on hostile floats: finite-or-NaN out, no crash (the fuzzers go further).
+    for (const char* name : {"hall_solved", "hall_solved_q16", "hall_adaptive_q16"}) {
+        const Codec& c = *find_codec(name);
+        for (float v : {0.0f, 1e-40f, 1e30f, 3.4e38f, -1.0f, INFINITY, NAN}) {
+            Sh3Radiance t = maps()[3].sh;
+            t[2][0] = v;
+            t[6][2] = v;
+            std::vector<std::uint8_t> b(c.size_bytes);
+            c.encode(t, {}, b.data(), nullptr);
+            (void)c.decode(b.data(), {});
+        }
+    }
+}
+
+// ---- the hall_adaptive_q16 layout --------------------------------------------------------------
+
+// Bit-level reference of the layout as docs/quantization.md states it (default parameters: R11G11B10F
+// DC in bytes 0-3, bytes 4-5 zero, 8-bit L1 codes at 6 + 3k + j, interval +-sqrt 3, byte 15 = scale
+// code s = 0.5 min(code, 7)), decoded to SH3 radiance in double with its own arithmetic.
+double ref_ufloat(std::uint32_t v, int mbits) {
+    const std::uint32_t e = v >> mbits, m = v & ((1u << mbits) - 1);
+    if (e == 0) return std::ldexp(double(m), -14 - mbits);
+    if (e == 31) return m ? NAN : INFINITY;
+    return std::ldexp(1.0 + double(m) / double(1u << mbits), int(e) - 15);
+}
+std::array<double, 27> ref_decode_adaptive(const std::uint8_t* b) {
+    const std::uint32_t dcw = b[0] | b[1] << 8 | b[2] << 16 | std::uint32_t(b[3]) << 24;
+    const double dc[3] = {ref_ufloat(dcw & 0x7FF, 6), ref_ufloat((dcw >> 11) & 0x7FF, 6), ref_ufloat(dcw >> 22, 5)};
+    std::array<double, 27> sh{};
+    for (int k = 0; k < 3; ++k) {
+        sh[static_cast<size_t>(k)] = dc[k];
+        for (int j = 0; j < 3; ++j) {
+            const int code = std::min<int>(b[6 + 3 * k + j], 254);
+            sh[static_cast<size_t>((1 + j) * 3 + k)] = (code - 127) / 127.0 * std::sqrt(3.0) * dc[k];
+        }
+    }
+    const double s = 0.5 * std::min<int>(b[15], 7);
+    // Luminance axis: Rec. 709 weights on the L1 vectors v = (-L11, -L1-1, L10).
+    const double w[3] = {0.2126, 0.7152, 0.0722};
+    double ax[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k) {
+        ax[0] += w[k] * -sh[static_cast<size_t>(9 + k)];
+        ax[1] += w[k] * -sh[static_cast<size_t>(3 + k)];
+        ax[2] += w[k] * sh[static_cast<size_t>(6 + k)];
+    }
+    const double len = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+    const Vec3 a = len > 0 ? Vec3{ax[0] / len, ax[1] / len, ax[2] / len} : Vec3{0, 0, 1};
+    const auto y = sh3_basis(a);
+    for (int k = 0; k < 3; ++k) {
+        const double f0 = sh[static_cast<size_t>(k)];
+        const double f1 = std::fabs(-sh[static_cast<size_t>(9 + k)] * a.x - sh[static_cast<size_t>(3 + k)] * a.y + sh[static_cast<size_t>(6 + k)] * a.z);
+        const double p = f0 > 0 ? std::min(f1 / f0, std::sqrt(3.0)) : 0.0;
+        const double f20 = f0 > 0 ? s * (0.6 * p * p + 0.08 * p) * f0 : 0.0;
+        for (int m = 0; m < 5; ++m) sh[static_cast<size_t>((4 + m) * 3 + k)] = f20 * std::sqrt(4 * kPi / 5) * y[static_cast<size_t>(4 + m)];
+    }
+    return sh;
+}
+
+TEST(HallAdaptiveLayout, CodecDecodeEqualsTheBitLevelReference) {
+    const Codec& c = *find_codec("hall_adaptive_q16");
+    std::mt19937 gen(31);
+    Rng rng(37);
+    for (int i = 0; i < 3000; ++i) {
+        std::uint8_t b[16];
+        if (i < 1000) {
+            for (auto& x : b) x = static_cast<std::uint8_t>(gen());
+            // Keep each R11G11B10F exponent below 31 (Inf/NaN): clear its top bit (bits 10, 21, 31).
+            b[1] &= 0xFB;
+            b[2] &= 0xDF;
+            b[3] &= 0x7F;
+        } else {
+            c.encode(synthetic_interior(rng), {}, b, nullptr);
+            EXPECT_EQ(b[4], 0);
+            EXPECT_EQ(b[5], 0);
+            EXPECT_LE(b[15], 7);
+        }
+        const Sh3Radiance d = c.decode(b, {});
+        const auto r = ref_decode_adaptive(b);
+        double scale = 0;
+        for (double v : r) scale = std::max(scale, std::fabs(v));
+        for (int j = 0; j < 9; ++j)
+            for (int k = 0; k < 3; ++k)
+                EXPECT_NEAR(d[j][k], r[static_cast<size_t>(j * 3 + k)], 2e-6 * scale + 1e-30) << i << " " << j << " " << k;
+    }
+}
+
+TEST(HallAdaptiveLayout, EncoderPicksTheBestCandidateAndIsNeverWorseThanSh2Q) {
+    // Slow twin of the encoder's choice: every scale code with its solved L1, and plain sh2_q bytes,
+    // each encoded, decoded and measured; the encoder's bytes must give the least error.
+    const Codec& c = *find_codec("hall_adaptive_q16");
+    const Codec& sh2q = *find_codec("sh2_q");
+    Rng rng(41);
+    for (int i = 0; i < 60; ++i) {
+        const Sh3Radiance t = i < 8 ? maps()[static_cast<size_t>(i)].sh : synthetic_interior(rng);
+        std::uint8_t b[16];
+        c.encode(t, {}, b, nullptr);
+        const double chosen = irradiance_sq_error(t, c.decode(b, {}));
+        std::uint8_t q[16];
+        sh2q.encode(t, {}, q, nullptr);
+        EXPECT_EQ(q[15], 0);
+        EXPECT_LE(chosen, irradiance_sq_error(t, sh2q.decode(q, {})));
+        for (int code = 1; code < kHallScaleCodeCount; ++code) {
+            const double s = hall_scale_of_code(static_cast<std::uint8_t>(code));
+            const Sh2Radiance lin = hall_solve(t, s, ZonalAxisMode::kLuminance, {}, nullptr);
+            std::uint8_t cb[16];
+            encode_packed(PackedLayout::kSh2Q, extend_to_sh3(lin), QuantParams{}, cb, nullptr);
+            cb[15] = static_cast<std::uint8_t>(code);
+            EXPECT_LE(chosen, irradiance_sq_error(t, c.decode(cb, {}))) << i << " code " << code;
+        }
+    }
+}
+
+// Golden bytes of the hall entries on the literal probes of test_quantize.cpp's golden set (the
+// same four probes, literal floats), under the default and three non-default parameter sets
+// through the probe container path (encode_probe). ZHC_UPDATE_GOLDEN=1 rewrites them.
+std::vector<Sh3Radiance> golden_probes() {
+    const float p[4][9][3] = {
+        {{3.5f, 3.25f, 2.75f}, {0.5f, 0.375f, 0.25f}, {1.25f, 1.0f, 0.75f}, {-0.625f, -0.5f, -0.375f},
+         {0.125f, 0.1f, 0.05f}, {-0.25f, -0.2f, -0.15f}, {0.75f, 0.6f, 0.45f}, {0.3f, 0.2f, 0.1f},
+         {-0.0625f, -0.05f, -0.04f}},
+        {{1.0f, 2.0f, 4.0f}, {0.1f, 0.2f, 0.4f}, {-0.3f, -0.6f, -1.2f}, {0.2f, 0.4f, 0.8f},
+         {0.05f, 0.1f, 0.2f}, {0.02f, 0.04f, 0.08f}, {-0.4f, -0.8f, -1.6f}, {0.01f, 0.02f, 0.04f},
+         {0.3f, 0.6f, 1.2f}},
+        {{0.01f, 0.02f, 0.005f}, {0.005f, 0.0f, -0.002f}, {0.0f, 0.01f, 0.0f}, {-0.001f, 0.002f, 0.0f},
+         {0.0f, 0.0f, 0.0f}, {0.001f, -0.002f, 0.0005f}, {0.004f, 0.008f, 0.002f}, {0.0f, 0.0f, 0.0f},
+         {-0.002f, 0.001f, 0.0f}},
+        {{1.0f, 1.0f, 1.0f}, {3.0f, 0.0f, -3.0f}, {0.0f, 2.0f, 0.0f}, {0.0f, 0.0f, 1.0f},
+         {2.5f, -2.5f, 0.0f}, {0.0f, 0.0f, 0.0f}, {-1.5f, 2.5f, 0.0f}, {0.0f, 0.0f, 0.0f},
+         {0.0f, 0.0f, 0.0f}},
+    };
+    std::vector<Sh3Radiance> out(4);
+    for (int n = 0; n < 4; ++n)
+        for (int i = 0; i < 9; ++i)
+            for (int k = 0; k < 3; ++k) out[static_cast<size_t>(n)][i][k] = p[n][i][k];
+    return out;
+}
+
+TEST(HallAdaptiveLayout, GoldenBytes) {
+    const std::string dir = std::string(ZHC_TEST_DATA_DIR) + "/../golden";
+    std::vector<std::pair<const char*, QuantParams>> variants;
+    variants.push_back({"", QuantParams{}});
+    QuantParams half;
+    half.dc_format = DcFormat::kHalf;
+    half.sqrt_encoding = true;
+    variants.push_back({"_half_sqrt", half});
+    QuantParams irr;
+    irr.kind = StoredKind::kIrradiance;
+    irr.axis_mode = ZonalAxisMode::kPerChannel;
+    irr.bits = 6;
+    irr.dc_format = DcFormat::kRGB9E5;
+    variants.push_back({"_irradiance_channel_rgb9e5_6bit", irr});
+    for (const char* name : {"hall_solved_q16", "hall_adaptive_q16"})
+        for (const auto& [suffix, params] : variants) {
+            std::vector<std::uint8_t> all;
+            for (const Sh3Radiance& sh : golden_probes()) {
+                std::uint8_t b[16];
+                encode_probe(*find_codec(name), params, sh, b, nullptr);
+                all.insert(all.end(), b, b + 16);
+            }
+            const std::string path = dir + "/" + name + suffix + ".bin";
+            if (const char* u = std::getenv("ZHC_UPDATE_GOLDEN"); u && std::string(u) == "1") {
+                test::write_bytes(path, all);
+                continue;
+            }
+            EXPECT_EQ(test::read_bytes(path), all) << path;
+        }
+}
+
+TEST(HallSolve, Timing) {
+    // us per probe (thread CPU time would be better; wall time on a shared machine, minimum of 3).
+    Rng rng(43);
+    std::vector<Sh3Radiance> probes;
+    for (const Map& m : maps())
+        for (int r = 0; r < 16; ++r) probes.push_back(rotate(m.sh, rotation_axis_angle(rng.dir(), 2 * kPi * rng.u())));
+    for (int i = 0; i < 128; ++i) probes.push_back(synthetic_interior(rng));
+    for (const char* name : {"hall_curve", "hall_curve_q", "hall_solved", "hall_solved_q16", "hall_adaptive_q16", "zh3_solved_q16"}) {
+        const Codec& c = *find_codec(name);
+        std::vector<std::uint8_t> b(c.size_bytes);
+        double best = 1e300;
+        for (int rep = 0; rep < 3; ++rep) {
+            const auto t0 = std::chrono::steady_clock::now();
+            for (const Sh3Radiance& p : probes) c.encode(p, {}, b.data(), nullptr);
+            best = std::min(best, std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() / probes.size());
+        }
+        std::printf("%-18s encode %8.3f us/probe\n", name, best);
+    }
 }
 
 TEST(HallExperiment, DISABLED_BestScaleDistribution) {
