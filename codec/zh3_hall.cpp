@@ -238,7 +238,7 @@ double refine(const Problem& pr, Vec3* axis, int max_iterations, int* iterations
     int it = 0;
     for (; it < max_iterations; ++it) {
         const double gn = std::sqrt(g[0] * g[0] + g[1] * g[1]);
-        if (!(gn > 1e-9 * std::sqrt(fscale)) || !std::isfinite(f)) break;
+        if (!(gn > 1e-6 * std::sqrt(fscale)) || !std::isfinite(f)) break;
         double d[2] = {-(H[0][0] * g[0] + H[0][1] * g[1]), -(H[1][0] * g[0] + H[1][1] * g[1])};
         double slope = d[0] * g[0] + d[1] * g[1];
         if (!(slope < 0.0)) {
@@ -285,7 +285,7 @@ double refine(const Problem& pr, Vec3* axis, int max_iterations, int* iterations
                 for (int j = 0; j < 2; ++j)
                     H[i][j] += (1.0 + r * yHy) * r * s[i] * s[j] - r * (Hy[i] * s[j] + s[i] * Hy[j]);
         }
-        if (step <= 1e-12 * (1.0 + std::sqrt(x[0] * x[0] + x[1] * x[1])) || df <= 1e-15 * fscale) {
+        if (step <= 1e-12 * (1.0 + std::sqrt(x[0] * x[0] + x[1] * x[1])) || df <= 1e-12 * fscale) {
             ++it;
             break;
         }
@@ -321,8 +321,10 @@ double magnitude(const Sh3Radiance& t) {
     return std::sqrt(m);
 }
 
-// Best axis for the group in `pr` (candidates ranked by the profile, the best two refined).
-Vec3 solve_axis(const Problem& pr, const Vec3& fallback, int* iterations) {
+// Best axis for the group in `pr`: candidates ranked by the profile, the best one refined. With a
+// warm start (the axis solved for a neighbouring scale) the candidates are that axis and the target's
+// L1 axis only.
+Vec3 solve_axis(const Problem& pr, const Vec3& fallback, int* iterations, const Vec3* warm) {
     Vec3 cands[12];
     int n = 0;
     auto add = [&](Vec3 v) {
@@ -335,14 +337,17 @@ Vec3 solve_axis(const Problem& pr, const Vec3& fallback, int* iterations) {
         U = U + pr.w[k] * pr.u[k];
         for (int m = 0; m < 5; ++m) f2[m] += pr.w[k] * pr.t2[k][m];
     }
+    if (warm) add(*warm);
     add(U);
-    double q[3][3];
-    l2_form(f2, q);
-    Vec3 ev[3];
-    eigenvectors(q, ev);
-    for (const Vec3& e : ev) add(e);
-    if (pr.first != pr.last)
-        for (int k = pr.first; k <= pr.last; ++k) add(pr.u[k]);
+    if (!warm) {
+        double q[3][3];
+        l2_form(f2, q);
+        Vec3 ev[3];
+        eigenvectors(q, ev);
+        for (const Vec3& e : ev) add(e);
+        if (pr.first != pr.last)
+            for (int k = pr.first; k <= pr.last; ++k) add(pr.u[k]);
+    }
     if (n == 0) return fallback;
     double err[12];
     int order[12];
@@ -396,8 +401,11 @@ double hall_axis_profile(const Sh3Radiance& target, double scale, ZonalAxisMode 
     return profile(pr, normalize_or(axis, {0, 0, 1}), nullptr, nullptr);
 }
 
-Sh2Radiance hall_solve(const Sh3Radiance& target, double scale, ZonalAxisMode mode, const CodecOptions& o,
-                       EncodeStats* stats) {
+namespace {
+// hall_solve with optional warm-start axes (one per channel; all equal for the luminance axis),
+// updated to the solved axes.
+Sh2Radiance solve_impl(const Sh3Radiance& target, double scale, ZonalAxisMode mode, const CodecOptions& o,
+                       EncodeStats* stats, Vec3* warm, bool use_warm) {
     const Sh2Radiance plain = truncate_to_sh2(target);
     const double mag = magnitude(target);
     const double ww = o.luminance.r * o.luminance.r + o.luminance.g * o.luminance.g + o.luminance.b * o.luminance.b;
@@ -426,13 +434,17 @@ Sh2Radiance hall_solve(const Sh3Radiance& target, double scale, ZonalAxisMode mo
         }
     };
     if (mode == ZonalAxisMode::kLuminance) {
-        write_group(pr, solve_axis(pr, {0, 0, 1}, &iterations));
+        const Vec3 a = solve_axis(pr, {0, 0, 1}, &iterations, use_warm ? &warm[0] : nullptr);
+        write_group(pr, a);
+        if (warm) warm[0] = warm[1] = warm[2] = a;
     } else {
         for (int k = 0; k < 3; ++k) {
             Problem p = pr;
             p.first = p.last = k;
             p.w[k] = 1.0;
-            write_group(p, solve_axis(p, {0, 0, 1}, &iterations));
+            const Vec3 a = solve_axis(p, {0, 0, 1}, &iterations, use_warm ? &warm[k] : nullptr);
+            write_group(p, a);
+            if (warm) warm[k] = a;
         }
     }
     if (stats) stats->solver_iterations += iterations;
@@ -440,6 +452,12 @@ Sh2Radiance hall_solve(const Sh3Radiance& target, double scale, ZonalAxisMode mo
     const double e_out = irradiance_sq_error(target, hall_scaled_expand(out, scale, mode, o));
     const double e_plain = irradiance_sq_error(target, hall_scaled_expand(plain, scale, mode, o));
     return e_out < e_plain ? out : plain;
+}
+}  // namespace
+
+Sh2Radiance hall_solve(const Sh3Radiance& target, double scale, ZonalAxisMode mode, const CodecOptions& o,
+                       EncodeStats* stats) {
+    return solve_impl(target, scale, mode, o, stats, nullptr, false);
 }
 
 double hall_scale_of_code(std::uint8_t code) {
@@ -482,10 +500,13 @@ void encode_hall_packed(bool adaptive, const Sh3Radiance& hub, const QuantParams
     int iterations = 0;
     const int first = adaptive ? 1 : 0;
     const int last = adaptive ? kHallScaleCodeCount - 1 : 0;
+    // The scales are solved in increasing order, each starting from the previous scale's axes (the
+    // optimum moves little between neighbouring scales; the first is a full multi-candidate solve).
+    Vec3 warm[3];
     for (int code = first; code <= last; ++code) {
         const double s = adaptive ? hall_scale_of_code(static_cast<std::uint8_t>(code)) : 1.0;
         EncodeStats solve_stats;
-        const Sh2Radiance lin = hall_solve(hub, s, p.axis_mode, so, &solve_stats);
+        const Sh2Radiance lin = solve_impl(hub, s, p.axis_mode, so, &solve_stats, warm, code > first);
         iterations += solve_stats.solver_iterations;
         cand_stats = {};
         const double e = encode_candidate(adaptive, hub, lin, static_cast<std::uint8_t>(code), p, so, cand, &cand_stats);
