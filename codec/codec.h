@@ -88,6 +88,7 @@ std::span<const Codec> dering_codecs();     // sh3_dering, zh3_lum_dering (codec
 std::span<const Codec> zh3_window_codecs();  // zh3_dering, zh3_dering_q16 (codec/zh3_window.cpp)
 std::span<const Codec> quantized_codecs();  // zh3_q16, sh3_q28, sh2_q (codec/quantize.cpp)
 std::span<const Codec> zh3_channel_q16_codecs();  // zh3_channel_q16, zh3_solved_channel_q16 (codec/zh3_channel_q16.cpp)
+std::span<const Codec> hall_codecs();       // hall_solved, hall_solved_q16, hall_adaptive_q16 (codec/zh3_hall.cpp)
 
 // Little-endian float storage helpers shared by the float representations.
 void store_floats(std::span<const float> values, std::uint8_t* out);
