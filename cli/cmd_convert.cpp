@@ -194,7 +194,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     f.push_back(sub->add_option("--zonal-map", o->zonal_map,
                     "zonal L2 interval mapping: affine (default), zero (zero-preserving), symmetric (+-sqrt(5))")
         ->check(CLI::IsMember({"affine", "zero", "symmetric"})));
-    f.push_back(sub->add_option("--axis", o->axis, "zh3_q16/hall_curve_q zonal axis: luminance (default) or channel")
+    f.push_back(sub->add_option("--axis", o->axis, "zh3_q16/hall_curve_q zonal axis: luminance (default) or channel (*_channel_q16: always channel)")
         ->check(CLI::IsMember({"luminance", "channel"})));
     f.push_back(sub->add_flag("--irradiance", o->irradiance,
                               "store irradiance SH (irradiance-scaled bounds) instead of radiance"));

@@ -57,6 +57,8 @@ struct EncodeStats {
     int solver_iterations = 0;   // ZH3 axis solve: iterations used
 };
 
+struct PackedCodec;  // quantize.h
+
 struct Codec {
     std::string_view name;
     std::string_view summary;  // one line for `zhc --help` and the audit legend
@@ -66,6 +68,9 @@ struct Codec {
     Sh3Radiance (*decode)(const std::uint8_t* in, const CodecOptions& options);
     // Irradiance at unit normal n straight from the stored bytes (the runtime path).
     Rgb (*irradiance)(const std::uint8_t* in, const CodecOptions& options, Vec3 n);
+    // Quantised layouts only (null otherwise): the layout and the entry's encode/decode with every
+    // storage parameter (quantize.h), which the probe container uses instead of the two above.
+    const PackedCodec* packed = nullptr;
 };
 
 // The whole table, in a stable order (audit and benchmark rows follow it).
@@ -82,6 +87,8 @@ std::span<const Codec> zh3_codecs();        // ZH3 fits, solves, hallucination (
 std::span<const Codec> dering_codecs();     // sh3_dering, zh3_lum_dering (codec/dering.cpp)
 std::span<const Codec> zh3_window_codecs();  // zh3_dering, zh3_dering_q16 (codec/zh3_window.cpp)
 std::span<const Codec> quantized_codecs();  // zh3_q16, sh3_q28, sh2_q (codec/quantize.cpp)
+std::span<const Codec> zh3_channel_q16_codecs();  // zh3_channel_q16, zh3_solved_channel_q16 (codec/zh3_channel_q16.cpp)
+std::span<const Codec> hall_codecs();       // hall_solved, hall_solved_q16, hall_adaptive_q16 (codec/zh3_hall.cpp)
 
 // Little-endian float storage helpers shared by the float representations.
 void store_floats(std::span<const float> values, std::uint8_t* out);

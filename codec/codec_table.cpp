@@ -13,7 +13,8 @@ std::span<const Codec> codecs() {
     static const std::vector<Codec> table = [] {
         std::vector<Codec> all;
         // New entries go last: the runtime decoders (runtime/) number encodings by table order.
-        for (auto part : {core_codecs(), zh3_codecs(), dering_codecs(), quantized_codecs(), zh3_window_codecs()})
+        for (auto part : {core_codecs(), zh3_codecs(), dering_codecs(), quantized_codecs(), zh3_window_codecs(),
+                          zh3_channel_q16_codecs(), hall_codecs()})
             all.insert(all.end(), part.begin(), part.end());
         return all;
     }();

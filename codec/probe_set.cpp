@@ -85,13 +85,8 @@ Status validate_probe_set(const ProbeSet& set) {
 
 void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radiance& hub, std::uint8_t* out,
                   EncodeStats* stats, const CodecOptions& base) {
-    PackedLayout packed;
-    if (packed_layout_from_name(codec.name, &packed)) {
-        QuantEncodeControls controls;  // the table entry's encoder choices
-        controls.solve_axis = codec.name == "zh3_solved_q16";
-        controls.dering = codec.name == "zh3_dering_q16";
-        controls.solver = codec_options(params, base);
-        encode_packed(packed, hub, params, out, stats, controls);  // handles kind itself (scaled bounds)
+    if (codec.packed) {  // the entry's own encoder with every storage parameter (kind: scaled bounds)
+        codec.packed->encode(hub, params, codec_options(params, base), out, stats);
         return;
     }
     const CodecOptions o = codec_options(params, base);
@@ -100,11 +95,7 @@ void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radi
 }
 
 Sh3Radiance decode_probe(const Codec& codec, const StorageParams& params, const std::uint8_t* in) {
-    PackedLayout packed;
-    if (packed_layout_from_name(codec.name, &packed)) {
-        const Sh3Radiance linear = decode_packed(packed, in, params);
-        return hallucinates_at_decode(codec.name) ? hallucinate_curve(linear, params, codec_options(params)) : linear;
-    }
+    if (codec.packed) return codec.packed->decode(in, params, codec_options(params));
     const Sh3Radiance stored = codec.decode(in, codec_options(params));
     if (params.kind != StoredKind::kIrradiance) return stored;
     Sh3Irradiance e;

@@ -292,20 +292,10 @@ Rgb load_dc(const std::uint8_t* in, DcFormat f) {
 
 // ---- packed layouts ------------------------------------------------------------------------
 
-std::size_t packed_size_bytes(PackedLayout layout) {
-    switch (layout) {
-        case PackedLayout::kZh3Q16: return 16;
-        case PackedLayout::kSh3Q28: return 28;
-        case PackedLayout::kSh2Q: return 16;
-    }
-    return 0;
-}
-
 bool packed_layout_from_name(std::string_view name, PackedLayout* out) {
-    if (name == "zh3_q16" || name == "zh3_solved_q16" || name == "zh3_dering_q16") *out = PackedLayout::kZh3Q16;
-    else if (name == "sh3_q28") *out = PackedLayout::kSh3Q28;
-    else if (name == "sh2_q" || name == "hall_curve_q") *out = PackedLayout::kSh2Q;
-    else return false;
+    const Codec* c = find_codec(name);
+    if (!c || !c->packed) return false;
+    *out = c->packed->layout;
     return true;
 }
 
@@ -536,8 +526,6 @@ Sh3Radiance quantize_roundtrip(PackedLayout layout, const Sh3Radiance& hub, cons
     return hub_from_stored(q, params.kind);
 }
 
-bool hallucinates_at_decode(std::string_view name) { return name == "hall_curve_q"; }
-
 Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const QuantParams& params, const CodecOptions& options) {
     // ZH3 paper Sec. 3.4.3, Eq. 21 on the decoder's axis (luminance by default).
     const Zh3 z = zh3_hallucinate(truncate_to_sh2(linear_hub), Hallucination::kCurve, params.axis_mode, options);
@@ -548,44 +536,44 @@ Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const QuantParams& 
 
 namespace {
 template <PackedLayout L>
-void encode_entry(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
-    encode_packed(L, in, quant_params(o), out, stats);
+void encode_plain(const Sh3Radiance& in, const QuantParams& p, const CodecOptions&, std::uint8_t* out,
+                  EncodeStats* stats) {
+    encode_packed(L, in, p, out, stats);
 }
 template <PackedLayout L>
-Sh3Radiance decode_entry(const std::uint8_t* in, const CodecOptions& o) {
-    return decode_packed(L, in, quant_params(o));
-}
-template <PackedLayout L>
-Rgb irradiance_entry(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
-    return irradiance(decode_packed(L, in, quant_params(o)), n);
+Sh3Radiance decode_plain(const std::uint8_t* in, const QuantParams& p, const CodecOptions&) {
+    return decode_packed(L, in, p);
 }
 
-void encode_solved_q16(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
+void encode_solved_q16(const Sh3Radiance& in, const QuantParams& p, const CodecOptions& o, std::uint8_t* out,
+                       EncodeStats* stats) {
     QuantEncodeControls c;
     c.solve_axis = true;
     c.solver = o;
-    encode_packed(PackedLayout::kZh3Q16, in, quant_params(o), out, stats, c);
+    encode_packed(PackedLayout::kZh3Q16, in, p, out, stats, c);
 }
 
-Sh3Radiance decode_hall_curve(const std::uint8_t* in, const CodecOptions& o) {
-    const QuantParams p = quant_params(o);
+Sh3Radiance decode_hall_curve(const std::uint8_t* in, const QuantParams& p, const CodecOptions& o) {
     return hallucinate_curve(decode_packed(PackedLayout::kSh2Q, in, p), p, o);
 }
-Rgb irradiance_hall_curve(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
-    return irradiance(decode_hall_curve(in, o), n);
-}
+
+constexpr PackedCodec kZh3Q16{PackedLayout::kZh3Q16, encode_plain<PackedLayout::kZh3Q16>,
+                              decode_plain<PackedLayout::kZh3Q16>};
+constexpr PackedCodec kZh3SolvedQ16{PackedLayout::kZh3Q16, encode_solved_q16, decode_plain<PackedLayout::kZh3Q16>};
+constexpr PackedCodec kSh3Q28{PackedLayout::kSh3Q28, encode_plain<PackedLayout::kSh3Q28>,
+                              decode_plain<PackedLayout::kSh3Q28>};
+constexpr PackedCodec kSh2Q{PackedLayout::kSh2Q, encode_plain<PackedLayout::kSh2Q>, decode_plain<PackedLayout::kSh2Q>};
+constexpr PackedCodec kHallCurveQ{PackedLayout::kSh2Q, encode_plain<PackedLayout::kSh2Q>, decode_hall_curve};
 
 const Codec kQuantized[] = {
-    {"zh3_q16", "ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)", 16,
-     encode_entry<PackedLayout::kZh3Q16>, decode_entry<PackedLayout::kZh3Q16>, irradiance_entry<PackedLayout::kZh3Q16>},
-    {"zh3_solved_q16", "zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted", 16,
-     encode_solved_q16, decode_entry<PackedLayout::kZh3Q16>, irradiance_entry<PackedLayout::kZh3Q16>},
-    {"sh3_q28", "quadratic SH, 28 bytes: R11G11B10F DC + 24 8-bit ratios (tight L2 bound)", 28,
-     encode_entry<PackedLayout::kSh3Q28>, decode_entry<PackedLayout::kSh3Q28>, irradiance_entry<PackedLayout::kSh3Q28>},
-    {"sh2_q", "linear SH, 16 bytes: DC slot + 9 8-bit L1 ratios (padded; hallucination decodes from it)", 16,
-     encode_entry<PackedLayout::kSh2Q>, decode_entry<PackedLayout::kSh2Q>, irradiance_entry<PackedLayout::kSh2Q>},
-    {"hall_curve_q", "sh2_q bytes, zonal L2 hallucinated at decode by the Eq. 21 curve (luminance axis)", 16,
-     encode_entry<PackedLayout::kSh2Q>, decode_hall_curve, irradiance_hall_curve},
+    packed_codec<kZh3Q16>("zh3_q16", "ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)"),
+    packed_codec<kZh3SolvedQ16>("zh3_solved_q16",
+                                "zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted"),
+    packed_codec<kSh3Q28>("sh3_q28", "quadratic SH, 28 bytes: R11G11B10F DC + 24 8-bit ratios (tight L2 bound)"),
+    packed_codec<kSh2Q>("sh2_q",
+                        "linear SH, 16 bytes: DC slot + 9 8-bit L1 ratios (padded; hallucination decodes from it)"),
+    packed_codec<kHallCurveQ>("hall_curve_q",
+                              "sh2_q bytes, zonal L2 hallucinated at decode by the Eq. 21 curve (luminance axis)"),
 };
 }  // namespace
 

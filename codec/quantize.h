@@ -131,13 +131,14 @@ enum class PackedLayout : std::uint8_t {
     kSh3Q28 = 1,  // 28 bytes: DC (4) + per channel [L1-1 .. L22] (Listing 1's two words)
     kSh2Q = 2,    // 16 bytes: DC slot (6) + per channel [L1-1, L10, L11] + 1 zero byte
 };
-std::size_t packed_size_bytes(PackedLayout layout);
-// "zh3_q16", "zh3_solved_q16", "zh3_dering_q16" (zh3_q16 bytes), "sh3_q28", "sh2_q", "hall_curve_q" (sh2_q bytes)
-// -> layout; false for other names.
+constexpr std::size_t packed_size_bytes(PackedLayout layout) {
+    return layout == PackedLayout::kSh3Q28 ? 28 : 16;  // kZh3Q16, kSh2Q: 16
+}
+// The packed layout of a table entry (its Codec::packed); false for names that are not quantised
+// entries.
 bool packed_layout_from_name(std::string_view name, PackedLayout* out);
-// True for the entries whose decoder adds a hallucinated zonal L2 to the decoded linear SH
-// ("hall_curve_q": ZH3 paper Eq. 21 with options.hallucinate_a/b on params.axis_mode's axis).
-bool hallucinates_at_decode(std::string_view name);
+// The Eq. 21 hallucination of the entry "hall_curve_q": f20 = (a p^2 + b p) f0 with
+// options.hallucinate_a/b on params.axis_mode's axis, added to decoded linear SH.
 Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const QuantParams& params, const CodecOptions& options);
 
 // Quantisation controls that are not part of the stored format (they never change how bytes
@@ -175,5 +176,38 @@ Zh3 decode_zh3_q16(const std::uint8_t* in, const QuantParams& params);
 // (what the decoder would see if the DC were stored exactly). For error-budget studies.
 Sh3Radiance quantize_roundtrip(PackedLayout layout, const Sh3Radiance& hub, const QuantParams& params,
                                EncodeStats* stats, const QuantEncodeControls& controls = {});
+
+// ---- table entries that store a packed layout (Codec::packed) --------------------------------
+
+// What the probe container needs from a quantised table entry: its layout, and its encoder and
+// decoder with every storage parameter (the Codec functions only see CodecOptions, i.e. radiance,
+// the affine zonal mapping and the luminance axis). Everything entry-specific (which solve, which
+// axis, a hallucination at decode) lives in these two functions, never in a test of the name.
+struct PackedCodec {
+    PackedLayout layout;
+    void (*encode)(const Sh3Radiance& hub, const QuantParams& params, const CodecOptions& options, std::uint8_t* out,
+                   EncodeStats* stats);
+    Sh3Radiance (*decode)(const std::uint8_t* in, const QuantParams& params, const CodecOptions& options);
+};
+
+// The Codec functions of a packed entry P: its own functions with quant_params(options).
+template <const PackedCodec& P>
+void packed_entry_encode(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
+    P.encode(in, quant_params(o), o, out, stats);
+}
+template <const PackedCodec& P>
+Sh3Radiance packed_entry_decode(const std::uint8_t* in, const CodecOptions& o) {
+    return P.decode(in, quant_params(o), o);
+}
+template <const PackedCodec& P>
+Rgb packed_entry_irradiance(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
+    return irradiance(P.decode(in, quant_params(o), o), n);
+}
+// A whole Codec entry for P.
+template <const PackedCodec& P>
+constexpr Codec packed_codec(std::string_view name, std::string_view summary) {
+    return {name, summary, packed_size_bytes(P.layout), packed_entry_encode<P>, packed_entry_decode<P>,
+            packed_entry_irradiance<P>, &P};
+}
 
 }  // namespace zhc

@@ -194,21 +194,22 @@ Rgb irradiance_zh3_lum(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
     return zh3_lum_entry().irradiance(in, o, n);
 }
 
-void encode_dering_q16(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
+void encode_dering_q16(const Sh3Radiance& in, const QuantParams& p, const CodecOptions&, std::uint8_t* out,
+                       EncodeStats* stats) {
     QuantEncodeControls c;
     c.dering = true;
-    encode_packed(PackedLayout::kZh3Q16, in, quant_params(o), out, stats, c);
+    encode_packed(PackedLayout::kZh3Q16, in, p, out, stats, c);
 }
-Sh3Radiance decode_q16(const std::uint8_t* in, const CodecOptions& o) {
-    return decode_packed(PackedLayout::kZh3Q16, in, quant_params(o));
+Sh3Radiance decode_q16(const std::uint8_t* in, const QuantParams& p, const CodecOptions&) {
+    return decode_packed(PackedLayout::kZh3Q16, in, p);
 }
-Rgb irradiance_q16(const std::uint8_t* in, const CodecOptions& o, Vec3 n) { return irradiance(decode_q16(in, o), n); }
+constexpr PackedCodec kDeringQ16{PackedLayout::kZh3Q16, encode_dering_q16, decode_q16};
 
 const Codec kWindowCodecs[] = {
     {"zh3_dering", "zh3_lum with L1 and zonal windowed together: irradiance >= 0 on the whole sphere", kZh3Bytes,
      encode_zh3_dering, decode_zh3_lum, irradiance_zh3_lum},
-    {"zh3_dering_q16", "zh3_dering in zh3_q16 bytes; the decoded probe is checked and windowed further if needed", 16,
-     encode_dering_q16, decode_q16, irradiance_q16},
+    packed_codec<kDeringQ16>("zh3_dering_q16",
+                             "zh3_dering in zh3_q16 bytes; the decoded probe is checked and windowed further if needed"),
 };
 
 }  // namespace

@@ -59,10 +59,13 @@ precision highp int;
 //   zh3_channel, zh3_solved_channel      ZHC_LAYOUT_ZH3_F32, axis per channel
 //   hall_{ambdir,sphere,curve}           ZHC_LAYOUT_SH2_F32 + hallucination, axis luminance
 //   hall_{ambdir,sphere,curve}_channel   ZHC_LAYOUT_SH2_F32 + hallucination, axis per channel
-//   zh3_q16, zh3_solved_q16, zh3_dering_q16  ZHC_LAYOUT_ZH3_Q16  (uvec4)
+//   zh3_q16, zh3_solved_q16, zh3_dering_q16  ZHC_LAYOUT_ZH3_Q16  (uvec4), axis from the header
+//   zh3_channel_q16, zh3_solved_channel_q16  ZHC_LAYOUT_ZH3_Q16, axis per channel (whatever the header says)
 //   sh3_q28                              ZHC_LAYOUT_SH3_Q28  (7 uints)
 //   sh2_q                                ZHC_LAYOUT_SH2_Q    (uvec4)
-//   hall_curve_q                         ZHC_LAYOUT_SH2_Q + ZHC_HALL_CURVE (axis from the header)
+//   hall_curve_q, hall_solved_q16        ZHC_LAYOUT_SH2_Q + ZHC_HALL_CURVE (axis from the header)
+//   hall_solved                          ZHC_LAYOUT_SH2_F32 + ZHC_HALL_CURVE, axis luminance
+//   hall_adaptive_q16                    ZHC_LAYOUT_SH2_Q + ZHC_HALL_CURVE_ADAPTIVE (axis from the header)
 const uint ZHC_LAYOUT_SH3_F32 = 0u;
 const uint ZHC_LAYOUT_SH2_F32 = 1u;
 const uint ZHC_LAYOUT_ZH3_F32 = 2u;
@@ -75,6 +78,8 @@ const uint ZHC_HALL_NONE = 0u;
 const uint ZHC_HALL_AMBDIR = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
 const uint ZHC_HALL_SPHERE = 2u;  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
 const uint ZHC_HALL_CURVE = 3u;   // Eq. 21: f20 = (a p^2 + b p) f0
+// hall_adaptive_q16 (ZHC_LAYOUT_SH2_Q only): Eq. 21 with a, b times s = 0.5 min(byte 15, 7).
+const uint ZHC_HALL_CURVE_ADAPTIVE = 4u;
 
 // .zhp header enums (codec/quantize.h, same numeric values as the file).
 const uint ZHC_DC_R11G11B10F = 0u;
@@ -444,7 +449,17 @@ ZhcSh3 zhcDecodeSh3Q28(uint w[7], ZhcFormat f) { return zhcStoredToRadiance(zhcL
 
 // sh2_q and hall_curve_q (16 bytes). hall_curve_q hallucinates on the RADIANCE linear SH (codec
 // hallucinate_curve after decode_packed), whatever the stored kind. ~100 / ~200 flops.
+// hall_adaptive_q16's per-probe scale of the curve (byte 15), as plain Eq. 21 afterwards.
+ZhcFormat zhcHallAdaptive(uvec4 w, ZhcFormat f) {
+    if (f.hallucination == ZHC_HALL_CURVE_ADAPTIVE) {
+        f.curve *= 0.5 * float(min(w.w >> 24u, 7u));
+        f.hallucination = ZHC_HALL_CURVE;
+    }
+    return f;
+}
+
 ZhcSh3 zhcDecodeSh2Q(uvec4 w, ZhcFormat f) {
+    f = zhcHallAdaptive(w, f);
     ZhcSh3 s = zhcStoredToRadiance(zhcLoadSh2Q(w, f), f);
     if (f.hallucination != ZHC_HALL_NONE) {
         vec3 axis[3];
@@ -499,6 +514,7 @@ vec3 zhcIrradianceSh3Q28(uint w[7], ZhcFormat f, vec3 n) {
 }
 
 vec3 zhcIrradianceSh2Q(uvec4 w, ZhcFormat f, vec3 n) {
+    f = zhcHallAdaptive(w, f);
     ZhcSh3 s = zhcStoredToRadiance(zhcLoadSh2Q(w, f), f);
     vec3 zonal = vec3(0.0);
     vec3 axis[3];

@@ -16,7 +16,8 @@
 //   sh2, hall_*                         12 float words   DC + L1 as above
 //   zh3_lum/_channel/_solved_*/_dering* 15 float words   DC + L1 (12), then the zonal f20 per channel
 //   zh3_q16, zh3_solved_q16, sh2_q,
-//   hall_curve_q                        uint4            (docs/quantization.md)
+//   hall_curve_q, hall_solved_q16,
+//   hall_adaptive_q16                   uint4            (docs/quantization.md)
 //   sh3_q28                             seven uints
 // Byte b of a probe is bits 8 (b & 3) .. of word b >> 2.
 //
@@ -78,13 +79,19 @@
 #define ZHC_HALL_CURVE_Q 19u
 #define ZHC_ZH3_DERING 20u       // zh3_lum's 15 floats (whole-sphere deringing happens at encode)
 #define ZHC_ZH3_DERING_Q16 21u   // zh3_q16's 16 bytes
-#define ZHC_ENCODING_COUNT 22u
+#define ZHC_ZH3_CHANNEL_Q16 22u  // zh3_q16's 16 bytes, each channel's own axis (f.axisMode unused)
+#define ZHC_ZH3_SOLVED_CHANNEL_Q16 23u  // zh3_channel_q16's 16 bytes
+#define ZHC_HALL_SOLVED 24u      // hall_curve's 12 floats (the L1 is solved at encode: codec/zh3_hall.cpp)
+#define ZHC_HALL_SOLVED_Q16 25u  // hall_curve_q's 16 bytes
+#define ZHC_HALL_ADAPTIVE_Q16 26u  // sh2_q's 16 bytes, byte 15 = scale code: Eq. 21 times 0.5 min(code, 7)
+#define ZHC_ENCODING_COUNT 27u
 
 // Stored bytes per probe of each encoding (all multiples of 4).
 uint zhc_encoding_bytes(uint encoding)
 {
     if (encoding == ZHC_SH3 || encoding == ZHC_SH3_DERING) return 108u;
     if (encoding == ZHC_ZH3_DERING) return 60u;
+    if (encoding == ZHC_HALL_SOLVED) return 48u;
     if (encoding >= ZHC_ZH3_Q16) return encoding == ZHC_SH3_Q28 ? 28u : 16u;
     if (encoding == ZHC_SH2 || (encoding >= ZHC_HALL_AMBDIR && encoding <= ZHC_HALL_CURVE_CHANNEL)) return 48u;
     return 60u;  // the 15-float ZH3 layouts
@@ -421,9 +428,10 @@ float3 zhc_hallucinate(uint model, float3 c0, float3 c1m1, float3 c10, float3 c1
 uint zhc_axis_mode_of(uint encoding, ZhcFormat f)
 {
     if (encoding == ZHC_ZH3_CHANNEL || encoding == ZHC_ZH3_SOLVED_CHANNEL || encoding == ZHC_HALL_AMBDIR_CHANNEL ||
-        encoding == ZHC_HALL_SPHERE_CHANNEL || encoding == ZHC_HALL_CURVE_CHANNEL)
+        encoding == ZHC_HALL_SPHERE_CHANNEL || encoding == ZHC_HALL_CURVE_CHANNEL ||
+        encoding == ZHC_ZH3_CHANNEL_Q16 || encoding == ZHC_ZH3_SOLVED_CHANNEL_Q16)
         return ZHC_AXIS_PER_CHANNEL;
-    if (encoding == ZHC_ZH3_DERING) return ZHC_AXIS_LUMINANCE;
+    if (encoding == ZHC_ZH3_DERING || encoding == ZHC_HALL_SOLVED) return ZHC_AXIS_LUMINANCE;
     if (encoding >= ZHC_ZH3_Q16) return f.axisMode;  // quantised layouts: the container's axis mode
     return ZHC_AXIS_LUMINANCE;
 }
@@ -450,7 +458,7 @@ void zhc_zh3_floats(uint w[27], uint encoding, ZhcFormat f, out float3 c[4], out
     [unroll] for (uint i = 0u; i < 4u; ++i) c[i] = zhc_word3(w, i);
     float3 lum = float3(f.lumR, f.lumG, f.lumB);
     zhc_zonal_axes(c[1], c[2], c[3], zhc_axis_mode_of(encoding, f), lum, a);
-    if (encoding >= ZHC_HALL_AMBDIR && encoding <= ZHC_HALL_CURVE_CHANNEL)
+    if ((encoding >= ZHC_HALL_AMBDIR && encoding <= ZHC_HALL_CURVE_CHANNEL) || encoding == ZHC_HALL_SOLVED)
         f20 = zhc_hallucinate(zhc_hall_model_of(encoding), c[0], c[1], c[2], c[3], a, f);
     else
         f20 = zhc_word3(w, 4u);
@@ -458,7 +466,7 @@ void zhc_zh3_floats(uint w[27], uint encoding, ZhcFormat f, out float3 c[4], out
 
 // ---- quantised layouts -----------------------------------------------------------------------------
 
-// zh3_q16 / zh3_solved_q16 (uint4): DC in word 0 (R11G11B10F or RGB9E5); word 1 + k holds channel
+// zh3_q16 / zh3_solved_q16 / zh3_channel_q16 ... (uint4): DC in word 0 (R11G11B10F or RGB9E5); word 1 + k holds channel
 // k's codes [L1-1, L10, L11, zonal] in bytes 0..3. Output: stored-domain DC + L1, f20, axes.
 void zhc_zh3_q16(uint4 p, ZhcFormat f, out float3 c[4], out float3 f20, out float3 a[3])
 {
@@ -471,7 +479,8 @@ void zhc_zh3_q16(uint4 p, ZhcFormat f, out float3 c[4], out float3 f20, out floa
                       zhc_decode_ratio(zhc_byte(p.w, j - 1u), m1)) * dc;
     f20 = float3(zhc_decode_ratio(zhc_byte(p.y, 3u), mz), zhc_decode_ratio(zhc_byte(p.z, 3u), mz),
                  zhc_decode_ratio(zhc_byte(p.w, 3u), mz)) * dc;
-    zhc_zonal_axes(c[1], c[2], c[3], f.axisMode, float3(f.lumR, f.lumG, f.lumB), a);
+    // f.axisMode, except for the entries that fix each channel's own axis (zh3_channel_q16, ...).
+    zhc_zonal_axes(c[1], c[2], c[3], zhc_axis_mode_of(f.encoding, f), float3(f.lumR, f.lumG, f.lumB), a);
 }
 
 // sh2_q / hall_curve_q (uint4): DC slot bytes 0..5; channel k's L1 codes at bytes 6 + 3k + j.
@@ -551,12 +560,23 @@ float3 zhc_irradiance_sh2_q(uint4 p, ZhcFormat f, float3 n)
     return kZhcY00 * c[0] + (w1 * kZhcY1) * (-c[1] * n.y + c[2] * n.z - c[3] * n.x);
 }
 
-// hall_curve_q: sh2_q bytes, then (on the RADIANCE linear SH, as decode_probe does) the Eq. 21
-// curve along f.axisMode's axis.
+// hall_adaptive_q16: the curve's a and b times s = 0.5 min(byte 15, 7) (codec/zh3_hall.cpp); 1 for
+// hall_curve_q / hall_solved_q16.
+ZhcFormat zhc_hall_scaled(uint4 p, ZhcFormat f)
+{
+    float s = f.encoding == ZHC_HALL_ADAPTIVE_Q16 ? 0.5f * float(min(zhc_byte(p.w, 3u), 7u)) : 1.0f;
+    f.hallA *= s;
+    f.hallB *= s;
+    return f;
+}
+
+// hall_curve_q (and hall_solved_q16, hall_adaptive_q16): sh2_q bytes, then (on the RADIANCE linear
+// SH, as decode_probe does) the Eq. 21 curve along f.axisMode's axis.
 float3 zhc_irradiance_hall_curve_q(uint4 p, ZhcFormat f, float3 n)
 {
     float3 c[4], a[3];
     zhc_sh2_q(p, f, c);
+    f = zhc_hall_scaled(p, f);
     float s1 = f.kind == ZHC_KIND_IRRADIANCE ? 1.5f : 1.0f;  // stored -> radiance L1
     c[1] *= s1; c[2] *= s1; c[3] *= s1;
     zhc_zonal_axes(c[1], c[2], c[3], f.axisMode, float3(f.lumR, f.lumG, f.lumB), a);
@@ -575,10 +595,12 @@ float3 zhc_irradiance_sh3_q28(uint w[7], ZhcFormat f, float3 n)
 
 float3 zhc_irradiance(uint w[27], ZhcFormat f, float3 n)
 {
-    if (f.encoding == ZHC_ZH3_Q16 || f.encoding == ZHC_ZH3_SOLVED_Q16 || f.encoding == ZHC_ZH3_DERING_Q16)
+    if (f.encoding == ZHC_ZH3_Q16 || f.encoding == ZHC_ZH3_SOLVED_Q16 || f.encoding == ZHC_ZH3_DERING_Q16 ||
+        f.encoding == ZHC_ZH3_CHANNEL_Q16 || f.encoding == ZHC_ZH3_SOLVED_CHANNEL_Q16)
         return zhc_irradiance_zh3_q16(uint4(w[0], w[1], w[2], w[3]), f, n);
     if (f.encoding == ZHC_SH2_Q) return zhc_irradiance_sh2_q(uint4(w[0], w[1], w[2], w[3]), f, n);
-    if (f.encoding == ZHC_HALL_CURVE_Q) return zhc_irradiance_hall_curve_q(uint4(w[0], w[1], w[2], w[3]), f, n);
+    if (f.encoding == ZHC_HALL_CURVE_Q || f.encoding == ZHC_HALL_SOLVED_Q16 || f.encoding == ZHC_HALL_ADAPTIVE_Q16)
+        return zhc_irradiance_hall_curve_q(uint4(w[0], w[1], w[2], w[3]), f, n);
     if (f.encoding == ZHC_SH3_Q28)
     {
         uint q[7] = { w[0], w[1], w[2], w[3], w[4], w[5], w[6] };
@@ -619,6 +641,7 @@ ZhcSH3 zhc_decode_hall_curve_q(uint4 p, ZhcFormat f)
 {
     float3 c[4], a[3];
     zhc_sh2_q(p, f, c);
+    f = zhc_hall_scaled(p, f);
     float s1 = f.kind == ZHC_KIND_IRRADIANCE ? 1.5f : 1.0f;
     c[1] *= s1; c[2] *= s1; c[3] *= s1;
     zhc_zonal_axes(c[1], c[2], c[3], f.axisMode, float3(f.lumR, f.lumG, f.lumB), a);
@@ -644,9 +667,11 @@ ZhcSH3 zhc_decode_sh3(uint w[27], ZhcFormat f)
 {
     uint e = f.encoding;
     uint4 p = uint4(w[0], w[1], w[2], w[3]);
-    if (e == ZHC_ZH3_Q16 || e == ZHC_ZH3_SOLVED_Q16 || e == ZHC_ZH3_DERING_Q16) return zhc_decode_zh3_q16(p, f);
+    if (e == ZHC_ZH3_Q16 || e == ZHC_ZH3_SOLVED_Q16 || e == ZHC_ZH3_DERING_Q16 || e == ZHC_ZH3_CHANNEL_Q16 ||
+        e == ZHC_ZH3_SOLVED_CHANNEL_Q16)
+        return zhc_decode_zh3_q16(p, f);
     if (e == ZHC_SH2_Q) return zhc_decode_sh2_q(p, f);
-    if (e == ZHC_HALL_CURVE_Q) return zhc_decode_hall_curve_q(p, f);
+    if (e == ZHC_HALL_CURVE_Q || e == ZHC_HALL_SOLVED_Q16 || e == ZHC_HALL_ADAPTIVE_Q16) return zhc_decode_hall_curve_q(p, f);
     if (e == ZHC_SH3_Q28)
     {
         uint q[7] = { w[0], w[1], w[2], w[3], w[4], w[5], w[6] };

@@ -83,7 +83,12 @@ enum zhc_encoding {
     ZHC_ENC_HALL_CURVE_Q = 19,        /* sh2_q bytes, zonal hallucinated at decode (Eq. 21) */
     ZHC_ENC_ZH3_DERING = 20,          /* 15 floats: decoded as zh3_lum (deringing happens at encode) */
     ZHC_ENC_ZH3_DERING_Q16 = 21,      /* zh3_q16 bytes */
-    ZHC_ENC_COUNT = 22
+    ZHC_ENC_ZH3_CHANNEL_Q16 = 22,        /* zh3_q16 bytes, per-channel axes whatever axis_mode says */
+    ZHC_ENC_ZH3_SOLVED_CHANNEL_Q16 = 23, /* zh3_channel_q16 bytes */
+    ZHC_ENC_HALL_SOLVED = 24,         /* 12 floats: decoded as hall_curve (the L1 is solved at encode) */
+    ZHC_ENC_HALL_SOLVED_Q16 = 25,     /* sh2_q bytes: decoded as hall_curve_q */
+    ZHC_ENC_HALL_ADAPTIVE_Q16 = 26,   /* sh2_q bytes + byte 15 = scale code: f20 = (0.5 min(code, 7)) x Eq. 21 */
+    ZHC_ENC_COUNT = 27
 };
 enum zhc_stored_kind { ZHC_KIND_RADIANCE = 0, ZHC_KIND_IRRADIANCE = 1 };
 enum zhc_dc_format { ZHC_DC_R11G11B10F = 0, ZHC_DC_RGB9E5 = 1, ZHC_DC_HALF = 2 };
@@ -128,7 +133,8 @@ static inline const char* zhc_encoding_name(int e) {
         "sh3", "sh2", "zh3_lum", "zh3_channel", "zh3_solved_lum", "zh3_solved_channel", "hall_ambdir",
         "hall_sphere", "hall_curve", "hall_ambdir_channel", "hall_sphere_channel", "hall_curve_channel",
         "zh3_lum_dering", "zh3_lum_dering_sphere", "sh3_dering", "zh3_q16", "zh3_solved_q16", "sh3_q28",
-        "sh2_q", "hall_curve_q", "zh3_dering", "zh3_dering_q16"};
+        "sh2_q", "hall_curve_q", "zh3_dering", "zh3_dering_q16", "zh3_channel_q16", "zh3_solved_channel_q16",
+        "hall_solved", "hall_solved_q16", "hall_adaptive_q16"};
     return (e >= 0 && e < ZHC_ENC_COUNT) ? names[e] : NULL;
 }
 
@@ -144,14 +150,26 @@ static inline int zhc_encoding_from_name(const char* name) {
 /* Stored bytes per probe of encoding e; 0 when e is out of range. */
 static inline size_t zhc_encoding_size(int e) {
     static const unsigned char sizes[ZHC_ENC_COUNT] = {108, 48, 60, 60, 60, 60, 48, 48, 48, 48,
-                                                       48,  48, 60, 60, 108, 16, 16, 28, 16, 16, 60, 16};
+                                                       48,  48, 60, 60, 108, 16, 16, 28, 16, 16, 60, 16,
+                                                       16,  16, 48, 16, 16};
     return (e >= 0 && e < ZHC_ENC_COUNT) ? sizes[e] : 0;
 }
 
 /* 1 for the packed (quantised) encodings zh3_q16, zh3_solved_q16, sh3_q28, sh2_q, hall_curve_q,
- * zh3_dering_q16. */
+ * zh3_dering_q16, zh3_channel_q16, zh3_solved_channel_q16, hall_solved_q16, hall_adaptive_q16. */
 static inline int zhc_encoding_is_packed(int e) {
-    return (e >= ZHC_ENC_ZH3_Q16 && e <= ZHC_ENC_HALL_CURVE_Q) || e == ZHC_ENC_ZH3_DERING_Q16;
+    return (e >= ZHC_ENC_ZH3_Q16 && e <= ZHC_ENC_HALL_CURVE_Q) || e == ZHC_ENC_ZH3_DERING_Q16 ||
+           e == ZHC_ENC_ZH3_CHANNEL_Q16 || e == ZHC_ENC_ZH3_SOLVED_CHANNEL_Q16 || e == ZHC_ENC_HALL_SOLVED_Q16 ||
+           e == ZHC_ENC_HALL_ADAPTIVE_Q16;
+}
+/* 1 for the packed encodings in zh3_q16 bytes that fix each channel's own axis (f->axis_mode unused). */
+static inline int zhc__packed_per_channel(int e) {
+    return e == ZHC_ENC_ZH3_CHANNEL_Q16 || e == ZHC_ENC_ZH3_SOLVED_CHANNEL_Q16;
+}
+/* The packed encodings in sh2_q's 16-byte layout (6-byte DC slot; hallucinated except sh2_q). */
+static inline int zhc__sh2q_layout(int e) {
+    return e == ZHC_ENC_SH2_Q || e == ZHC_ENC_HALL_CURVE_Q || e == ZHC_ENC_HALL_SOLVED_Q16 ||
+           e == ZHC_ENC_HALL_ADAPTIVE_Q16;
 }
 
 /* Defaults of `zhc convert --to ENCODING` (cli/cmd_convert.cpp, codec/quantize.h QuantParams):
@@ -217,7 +235,7 @@ static inline int zhc_probe_format_set_gltf(zhc_probe_format* f, const char* key
 
 /* ZHC_OK when f is a format zhc's writer can produce (codec/quantize.cpp validate_quant_params):
  * known encoding, bits 2..8, enums in range, finite luminance weights and curve constants, half DC
- * only with sh2_q / hall_curve_q among the packed encodings. */
+ * only with the sh2_q layout (sh2_q, hall_curve_q, hall_solved_q16, hall_adaptive_q16) among the packed ones. */
 static inline int zhc_probe_format_validate(const zhc_probe_format* f) {
     if (!f || !zhc_encoding_name(f->encoding)) return ZHC_ERR_ARGUMENT;
     if (f->bits < 2 || f->bits > 8) return ZHC_ERR_ARGUMENT;
@@ -230,7 +248,7 @@ static inline int zhc_probe_format_validate(const zhc_probe_format* f) {
         return ZHC_ERR_ARGUMENT;
     if (f->dc_format == ZHC_DC_HALF &&
         (f->encoding == ZHC_ENC_ZH3_Q16 || f->encoding == ZHC_ENC_ZH3_SOLVED_Q16 || f->encoding == ZHC_ENC_SH3_Q28 ||
-         f->encoding == ZHC_ENC_ZH3_DERING_Q16))
+         f->encoding == ZHC_ENC_ZH3_DERING_Q16 || zhc__packed_per_channel(f->encoding)))
         return ZHC_ERR_ARGUMENT;
     return ZHC_OK;
 }
@@ -493,7 +511,7 @@ static inline void zhc__decode_packed(const zhc_probe_format* f, const uint8_t* 
     double q[9][3];
     float dc[3];
     int i, k, last;
-    const int layout = (f->encoding == ZHC_ENC_SH3_Q28) ? 1 : ((f->encoding == ZHC_ENC_SH2_Q || f->encoding == ZHC_ENC_HALL_CURVE_Q) ? 2 : 0);
+    const int layout = (f->encoding == ZHC_ENC_SH3_Q28) ? 1 : (zhc__sh2q_layout(f->encoding) ? 2 : 0);
     /* A 4-byte DC slot cannot hold half: there half means R11G11B10F (zhc never writes it). */
     const int dcf = (f->dc_format == ZHC_DC_HALF && layout != 2) ? ZHC_DC_R11G11B10F : f->dc_format;
     memset(q, 0, sizeof q);
@@ -520,7 +538,8 @@ static inline void zhc__decode_packed(const zhc_probe_format* f, const uint8_t* 
         const double s = sqrt(4.0 * ZHC__PI / 5.0);
         for (i = 0; i < 4; ++i)
             for (k = 0; k < 3; ++k) lin[i * 3 + k] = (float)zhc__f32_round(q[i][k]);
-        zhc__zh3_axes(lin, f->axis_mode == ZHC_AXIS_PER_CHANNEL, f->luminance, axes);
+        zhc__zh3_axes(lin, f->axis_mode == ZHC_AXIS_PER_CHANNEL || zhc__packed_per_channel(f->encoding), f->luminance,
+                      axes);
         for (k = 0; k < 3; ++k) {
             const double zq = zhc__ratio_decode(f, 6, 1, in[4 + 4 * k + 3]) * dc[k];
             zhc__sh3_basis(axes[k], y);
@@ -540,10 +559,12 @@ enum { ZHC__D_SH3, ZHC__D_SH2, ZHC__D_ZH3, ZHC__D_HALL, ZHC__D_PACKED };
 static inline int zhc__decoder(int e) {
     if (e == ZHC_ENC_SH3 || e == ZHC_ENC_SH3_DERING) return ZHC__D_SH3;
     if (e == ZHC_ENC_SH2) return ZHC__D_SH2;
-    if (e >= ZHC_ENC_HALL_AMBDIR && e <= ZHC_ENC_HALL_CURVE_CHANNEL) return ZHC__D_HALL;
+    if ((e >= ZHC_ENC_HALL_AMBDIR && e <= ZHC_ENC_HALL_CURVE_CHANNEL) || e == ZHC_ENC_HALL_SOLVED) return ZHC__D_HALL;
     if (zhc_encoding_is_packed(e)) return ZHC__D_PACKED;
     return ZHC__D_ZH3;
 }
+/* Hallucination model of the float hallucinated encodings (0 Eq. 14, 1 Eq. 20, 2 Eq. 21). */
+static inline int zhc__hall_model(int e) { return e == ZHC_ENC_HALL_SOLVED ? 2 : (e - ZHC_ENC_HALL_AMBDIR) % 3; }
 /* Per-channel axes for the float ZH3 / hallucinated encodings (their own mode, not f->axis_mode). */
 static inline int zhc__float_per_channel(int e) {
     return e == ZHC_ENC_ZH3_CHANNEL || e == ZHC_ENC_ZH3_SOLVED_CHANNEL ||
@@ -557,7 +578,8 @@ static inline int zhc__float_per_channel(int e) {
  *   zh3_*: L2_k = f20_k sqrt(4pi/5) Y2(a_k), a_k the zonal axis from the stored L1.
  *   hall_*: f20 hallucinated (zhc_hallucinate_zonal) then expanded as zh3.
  *   packed: DC decoded, c_i = ratio(code) DC (docs/quantization.md); zh3_q16 adds the zonal L2 on
- *     the axis of the dequantised L1 (f->axis_mode); hall_curve_q adds the Eq. 21 zonal L2 to the
+ *     the axis of the dequantised L1 (f->axis_mode; zh3_channel_q16, zh3_solved_channel_q16: always
+ *     each channel's own); hall_curve_q adds the Eq. 21 zonal L2 to the
  *     decoded sh2_q on f->axis_mode's axis.
  *   kind = irradiance: the stored band-scaled coefficients are turned back into radiance
  *     (float entries: c * (1 / s_l), rounded to float; packed: q / s_l, as zhc does).
@@ -583,17 +605,19 @@ static inline int zhc_decode_probe(const zhc_probe_format* f, const void* bytes,
         case ZHC__D_HALL:
             per_channel = zhc__float_per_channel(f->encoding);
             for (i = 0; i < 12; ++i) lin[i] = zhc__f32(in + 4 * i);
-            zhc__hallucinate(lin, (f->encoding - ZHC_ENC_HALL_AMBDIR) % 3, per_channel, f->luminance, f->hallucinate_a,
+            zhc__hallucinate(lin, zhc__hall_model(f->encoding), per_channel, f->luminance, f->hallucinate_a,
                              f->hallucinate_b, zonal);
             zhc__zh3_expand(lin, zonal, per_channel, f->luminance, radiance_sh3);
             break;
         default:
             zhc__decode_packed(f, in, radiance_sh3);
-            if (f->encoding == ZHC_ENC_HALL_CURVE_Q) {
-                /* ZH3 paper Sec. 3.4.3, Eq. 21 on the decoder's axis (quantize.cpp hallucinate_curve). */
+            if (zhc__sh2q_layout(f->encoding) && f->encoding != ZHC_ENC_SH2_Q) {
+                /* ZH3 paper Sec. 3.4.3, Eq. 21 on the decoder's axis (quantize.cpp hallucinate_curve);
+                 * hall_adaptive_q16 scales a and b by s = 0.5 min(byte 15, 7) (codec/zh3_hall.cpp). */
+                const double s = f->encoding == ZHC_ENC_HALL_ADAPTIVE_Q16 ? 0.5 * (in[15] < 7 ? in[15] : 7) : 1.0;
                 per_channel = f->axis_mode == ZHC_AXIS_PER_CHANNEL;
                 for (i = 0; i < 12; ++i) lin[i] = (float)zhc__f32_round(radiance_sh3[i]);
-                zhc__hallucinate(lin, 2, per_channel, f->luminance, f->hallucinate_a, f->hallucinate_b, zonal);
+                zhc__hallucinate(lin, 2, per_channel, f->luminance, s * f->hallucinate_a, s * f->hallucinate_b, zonal);
                 zhc__zh3_expand(lin, zonal, per_channel, f->luminance, radiance_sh3);
             }
             return ZHC_OK;
@@ -643,7 +667,7 @@ static inline void zhc_probe_irradiance_d(const zhc_probe_format* f, const void*
             break;
         default: /* hallucinated */
             for (i = 0; i < 12; ++i) lin[i] = zhc__f32(in + 4 * i);
-            zhc__hallucinate(lin, (f->encoding - ZHC_ENC_HALL_AMBDIR) % 3, per_channel, f->luminance, f->hallucinate_a,
+            zhc__hallucinate(lin, zhc__hall_model(f->encoding), per_channel, f->luminance, f->hallucinate_a,
                              f->hallucinate_b, zonal);
             break;
     }

@@ -142,7 +142,7 @@ std::string read_text(const char* path) {
 
 // GLSL constants (runtime/zhc.glsl).
 enum : std::uint32_t { kSh3F32 = 0, kSh2F32 = 1, kZh3F32 = 2, kZh3Q16 = 3, kSh3Q28 = 4, kSh2Q = 5 };
-enum : std::uint32_t { kHallNone = 0, kHallAmbdir = 1, kHallSphere = 2, kHallCurve = 3 };
+enum : std::uint32_t { kHallNone = 0, kHallAmbdir = 1, kHallSphere = 2, kHallCurve = 3, kHallCurveAdaptive = 4 };
 constexpr int kAxisFromHeader = -1;
 
 struct GlslEntry {
@@ -175,6 +175,11 @@ const std::map<std::string, GlslEntry, std::less<>>& glsl_entries() {
         {"sh3_q28", {kSh3Q28, kHallNone, kAxisFromHeader}},
         {"sh2_q", {kSh2Q, kHallNone, kAxisFromHeader}},
         {"hall_curve_q", {kSh2Q, kHallCurve, kAxisFromHeader}},
+        {"zh3_channel_q16", {kZh3Q16, kHallNone, 1}},
+        {"zh3_solved_channel_q16", {kZh3Q16, kHallNone, 1}},
+        {"hall_solved", {kSh2F32, kHallCurve, 0}},
+        {"hall_solved_q16", {kSh2Q, kHallCurve, kAxisFromHeader}},
+        {"hall_adaptive_q16", {kSh2Q, kHallCurveAdaptive, kAxisFromHeader}},
     };
     return m;
 }
@@ -295,6 +300,7 @@ Scale probe_scale(const GlslEntry& e, const StorageParams& p, const Sh3Radiance&
     if (e.hallucination == kHallAmbdir) g = 2 * std::sqrt(15.0) / 3;
     if (e.hallucination == kHallSphere) g = g_of(2 * std::sqrt(5.0) / 3, -std::sqrt(5.0 / 3));
     if (e.hallucination == kHallCurve) g = g_of(0.6, 0.08);
+    if (e.hallucination == kHallCurveAdaptive) g = g_of(3.5 * 0.6, 3.5 * 0.08);  // largest scale code
     // Hallucination in the irradiance domain (float hall_* with irradiance storage): the stored L1
     // is 2/3 of the radiance one and the zonal 1/4: the slope in radiance units is 8/3 G.
     if (p.kind == StoredKind::kIrradiance && e.family == kSh2F32) g *= 8.0 / 3.0;

@@ -201,7 +201,8 @@ bool is_packed(std::string_view name) {
 }
 bool lum_axis(std::string_view name, const StorageParams& p) {
     const bool channel = name.find("channel") != std::string_view::npos;
-    if (name == "zh3_q16" || name == "zh3_solved_q16" || name == "zh3_dering_q16" || name == "hall_curve_q")
+    if (name == "zh3_q16" || name == "zh3_solved_q16" || name == "zh3_dering_q16" || name == "hall_curve_q" ||
+        name == "hall_solved_q16" || name == "hall_adaptive_q16")
         return p.axis_mode == ZonalAxisMode::kLuminance;
     return !channel && (name.rfind("zh3", 0) == 0 || name.rfind("hall", 0) == 0);
 }

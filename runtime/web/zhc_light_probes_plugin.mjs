@@ -103,7 +103,7 @@ export function buildVolume(v, coefficientsArray, positionsArray) {
   const q = v.quantization ?? {};
   const params = makeParams({
     bits: q.bits ?? 8, sqrt: q.sqrt ?? false, l2Bound: q.l2Bound ?? 'tight', dcFormat: q.dcFormat ?? 'r11g11b10f',
-    zonalMapping: q.zonalMapping ?? 'affine', axisMode: q.axisMode ?? 'luminance', kind: v.kind ?? 'radiance',
+    zonalMapping: q.zonalMapping ?? 'affine', axisMode: enc.axisMode ?? q.axisMode ?? 'luminance', kind: v.kind ?? 'radiance',
     luminanceWeights: v.luminanceWeights ?? undefined,
   });
   const shAxes = v.shAxes ?? 'gltf';

@@ -236,13 +236,14 @@ export function hallucinateZonal(model, f0, f1Zonal, a = HALLUCINATE_CURVE_A, b 
   return (a * p * p + b * p) * f0;
 }
 // zh3_hallucinate then zh3_expand: linear (>= 12 float32 values) -> SH3 radiance.
-function hallucinateExpand(linear, model, axisMode, w) {
+// `scale` multiplies the curve's a and b (hall_adaptive_q16; codec/zh3_hall.cpp hall_scaled_expand).
+function hallucinateExpand(linear, model, axisMode, w, scale = 1) {
   const axes = zh3Axes(linear, axisMode, w);
   const zonal = [0, 0, 0];
   for (let k = 0; k < 3; k++) {
     const v = l1Vector(linear, k), a = axes[k];
     const f1 = v[0] * a[0] + v[1] * a[1] + v[2] * a[2];
-    zonal[k] = f32(hallucinateZonal(model, linear[k], f1));
+    zonal[k] = f32(hallucinateZonal(model, linear[k], f1, scale * HALLUCINATE_CURVE_A, scale * HALLUCINATE_CURVE_B));
   }
   return zh3Expand(linear.subarray ? linear.subarray(0, 12) : linear.slice(0, 12), zonal, axisMode, w);
 }
@@ -250,7 +251,8 @@ function hallucinateExpand(linear, model, axisMode, w) {
 // ---- packed layouts (decode_packed) ---------------------------------------------------------
 
 export const PACKED_LAYOUTS = Object.freeze({ zh3_q16: 'zh3_q16', zh3_solved_q16: 'zh3_q16', zh3_dering_q16: 'zh3_q16', sh3_q28: 'sh3_q28',
-  sh2_q: 'sh2_q', hall_curve_q: 'sh2_q' });
+  sh2_q: 'sh2_q', hall_curve_q: 'sh2_q', zh3_channel_q16: 'zh3_q16', zh3_solved_channel_q16: 'zh3_q16',
+  hall_solved_q16: 'sh2_q', hall_adaptive_q16: 'sh2_q' });
 
 function ratioOffset(layout, k, i) {
   if (layout === 'zh3_q16') return 4 + 4 * k + (i - 1);
@@ -308,6 +310,7 @@ const zh3Float = (mode) => (b, o, p) => {
 };
 const hallFloat = (model, mode) => (b, o, p) => hallucinateExpand(loadFloats(b, o, 12), model, mode, p.luminanceWeights);
 const packed = (layout) => (b, o, p) => decodePacked(layout, b, o, p);
+const packedPerChannel = (b, o, p) => decodePacked('zh3_q16', b, o, { ...p, axisMode: 'channel' });
 
 // Every entry of zhc's codec table (codecs() in codec/codec_table.cpp): bytes per probe, whether
 // the entry is a packed (quantised) layout, and the decoder to radiance SH3 (before the `kind`
@@ -335,6 +338,14 @@ export const ENCODINGS = Object.freeze({
   sh3_q28: { bytes: 28, packed: true, decode: packed('sh3_q28') },
   sh2_q: { bytes: 16, packed: true, decode: packed('sh2_q') },
   hall_curve_q: { bytes: 16, packed: true, decode: (b, o, p) => hallucinateExpand(decodePacked('sh2_q', b, o, p), 'curve', p.axisMode, p.luminanceWeights) },
+  // zh3_q16 bytes with each channel's own axis, whatever params.axisMode says (`axisMode`: the
+  // entry's fixed axis, for code that builds params for a shader, e.g. the glTF plugin).
+  zh3_channel_q16: { bytes: 16, packed: true, axisMode: 'channel', decode: packedPerChannel },
+  zh3_solved_channel_q16: { bytes: 16, packed: true, axisMode: 'channel', decode: packedPerChannel },
+  hall_solved: { bytes: 48, decode: hallFloat('curve', 'luminance') },
+  hall_solved_q16: { bytes: 16, packed: true, decode: (b, o, p) => hallucinateExpand(decodePacked('sh2_q', b, o, p), 'curve', p.axisMode, p.luminanceWeights) },
+  // byte 15: scale code, s = 0.5 min(code, 7) times the Eq. 21 curve (docs/quantization.md)
+  hall_adaptive_q16: { bytes: 16, packed: true, decode: (b, o, p) => hallucinateExpand(decodePacked('sh2_q', b, o, p), 'curve', p.axisMode, p.luminanceWeights, 0.5 * Math.min(b[o + 15], 7)) },
 });
 
 export function encodingInfo(name) {

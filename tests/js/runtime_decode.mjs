@@ -83,7 +83,7 @@ function compareWithJson(what, sh, jsonFile, quiet = false) {
 }
 
 const floatEncodings = ['sh3', 'sh2', 'zh3_lum', 'zh3_channel', 'zh3_solved_lum', 'zh3_solved_channel', 'hall_ambdir', 'hall_sphere',
-  'hall_curve', 'hall_ambdir_channel', 'hall_sphere_channel', 'hall_curve_channel', 'zh3_lum_dering', 'zh3_lum_dering_sphere', 'sh3_dering', 'zh3_dering'];
+  'hall_curve', 'hall_ambdir_channel', 'hall_sphere_channel', 'hall_curve_channel', 'zh3_lum_dering', 'zh3_lum_dering_sphere', 'sh3_dering', 'zh3_dering', 'hall_solved'];
 const cases = [];
 for (const e of floatEncodings) cases.push({ enc: e, flags: [] });
 for (const e of ['sh3', 'sh2', 'zh3_channel', 'hall_curve', 'hall_sphere_channel']) cases.push({ enc: e, flags: ['--irradiance'] });
@@ -101,9 +101,13 @@ for (const flags of [[], ['--bound', 'loose'], ['--sqrt', '--bits', '4'], ['--dc
 for (const flags of [[], ['--dc', 'half'], ['--dc', 'rgb9e5', '--bits', '7', '--sqrt'], ['--irradiance', '--dc', 'half', '--bits', '4']])
   cases.push({ enc: 'sh2_q', flags });
 for (const flags of [[], ['--axis', 'channel', '--dc', 'half'], ['--irradiance', '--sqrt']]) cases.push({ enc: 'hall_curve_q', flags });
+for (const enc of ['zh3_channel_q16', 'zh3_solved_channel_q16'])
+  for (const flags of [[], ['--bits', '5', '--sqrt', '--irradiance', '--dc', 'rgb9e5', '--zonal-map', 'zero']]) cases.push({ enc, flags });
+for (const enc of ['hall_solved_q16', 'hall_adaptive_q16'])
+  for (const flags of [[], ['--axis', 'channel', '--dc', 'half'], ['--irradiance', '--sqrt', '--bits', '6']]) cases.push({ enc, flags });
 
 let totalCoefficients = 0, totalCases = 0;
-const ENC_PACKED = new Set(['zh3_q16', 'zh3_solved_q16', 'zh3_dering_q16', 'sh3_q28', 'sh2_q', 'hall_curve_q']);
+const ENC_PACKED = new Set(Object.keys(runtime.ENCODINGS).filter((name) => runtime.ENCODINGS[name].packed));
 cases.forEach((c, idx) => {
   c.name = `c${idx}_${c.enc}`;
   run('convert', W('points.json'), '-o', W(`${c.name}.zhp`), '--to', c.enc, ...c.flags);

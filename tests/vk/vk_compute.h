@@ -72,7 +72,8 @@ inline constexpr const char* kHlslEncodings[] = {
     "sh3", "sh2", "zh3_lum", "zh3_channel", "zh3_solved_lum", "zh3_solved_channel", "hall_ambdir", "hall_sphere",
     "hall_curve", "hall_ambdir_channel", "hall_sphere_channel", "hall_curve_channel", "zh3_lum_dering",
     "zh3_lum_dering_sphere", "sh3_dering", "zh3_q16", "zh3_solved_q16", "sh3_q28", "sh2_q", "hall_curve_q",
-    "zh3_dering", "zh3_dering_q16",
+    "zh3_dering", "zh3_dering_q16", "zh3_channel_q16", "zh3_solved_channel_q16", "hall_solved", "hall_solved_q16",
+    "hall_adaptive_q16",
 };
 inline int hlsl_encoding(std::string_view name) {
     for (int i = 0; i < static_cast<int>(std::size(kHlslEncodings)); ++i)
