@@ -9,9 +9,10 @@
 //           on the I_z plane of a 16x16 synthetic lightmap lit by that map: log2-PSNR.
 //   bc5/bc4 every BC5/BC4 quality on the crop (tone-mapped R,G / luminance) and on the
 //           lightmap's d / w_a planes: PSNR (20 log10(1 / RMSE)).
-//   irradz  both IrradZ solves on the synthetic lightmap: hemispherical irradiance RMSE against
-//           its SH3 (lightmap::audit), hash of the planes; "search_bc" = search, then BC6H + BC5
-//           + BC4 at default quality (the `zhc lightmap encode` output).
+//   irradz  the three IrradZ solves (search, old, newton = the default) on the synthetic lightmap:
+//           hemispherical irradiance RMSE against its SH3 (lightmap::audit), hash of the planes;
+//           "search_bc" / "newton_bc" = that solve, then BC6H + BC5 + BC4 at default quality
+//           ("newton_bc" is the `zhc lightmap encode` output).
 //
 // A row fails when its size or hash changes, or its error leaves [value - tolerance, value +
 // tolerance] (absolute, stored in the file: 0.1% of the value when generated). A codec entry
@@ -236,6 +237,18 @@ std::vector<Row> compute_rows() {
         rows.push_back(make_row("irradz", "search_bc", lmname, c.bc6h.size() + c.bc5.size() + c.bc4.size(), "hemi_rmse",
                                 a.rmse_after_bc, hc.h));
         block_rows(lmname, search.iz, search.d, search.wa, rows);
+        // The default solve (Newton on d) and the default encoder output built on it.
+        eo.solve = irradz::Solve::kNewton;
+        const lightmap::IrradzPlanes newton = lightmap::encode_planes(lm, eo, 1);
+        const lightmap::Compressed cn = lightmap::compress(newton, bc6h::Quality::kDefault, bc45::Quality::kDefault, 1);
+        const lightmap::Audit an = lightmap::audit(lm, newton, old_way, lightmap::decompress(cn), 1);
+        rows.push_back(make_row("irradz", "newton", lmname, plane_bytes, "hemi_rmse", an.rmse_search, planes_hash(newton)));
+        Hash hn;
+        hn.bytes(cn.bc6h);
+        hn.bytes(cn.bc5);
+        hn.bytes(cn.bc4);
+        rows.push_back(make_row("irradz", "newton_bc", lmname, cn.bc6h.size() + cn.bc5.size() + cn.bc4.size(), "hemi_rmse",
+                                an.rmse_after_bc, hn.h));
     }
     return rows;
 }
@@ -319,7 +332,7 @@ TEST(Golden, TableCoversEveryPath) {
     EXPECT_EQ(per_kind["bc6h"], 4 * 2 * maps);
     EXPECT_EQ(per_kind["bc5"], 2 * 2 * maps);
     EXPECT_EQ(per_kind["bc4"], 2 * 2 * maps);
-    EXPECT_EQ(per_kind["irradz"], 3 * maps);
+    EXPECT_EQ(per_kind["irradz"], 5 * maps);
 }
 
 }  // namespace
