@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "cli.h"
+#include "progress.h"
 #include "codec/scene.h"
 #include "formats/file_io.h"
 #include "formats/gltf_probes.h"
@@ -25,7 +26,7 @@ struct Options {
     std::string to = "sh3";
     int threads = 0;
     int zstd = 0;
-    bool quiet = false;
+    ProgressFlags progress;  // --quiet also drops the effects report
 };
 
 void print_report(const BakeReport& r) {
@@ -68,9 +69,12 @@ int run(const Options& o) {
     BakeOptions bo;
     bo.threads = threads;
     BakeReport rep;
+    Progress progress("zhc bake", "probes", o.progress);
+    if (progress.enabled()) bo.progress = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
     auto probes = bake_scene(*scene, bo, &rep);
+    progress.finish();
     if (!probes) return report(probes.error());
-    if (!o.quiet) {
+    if (!o.progress.quiet) {
         print_report(rep);
         size_t triangles = 0;
         for (const Occluder& oc : scene->occluders) triangles += oc.kind == OccluderKind::kTriangle;
@@ -141,7 +145,8 @@ const VerbRegistration registration(15, [](CLI::App& app) -> std::function<int()
     add_threads_option(sub, o->threads, "output identical for any count");
     add_representations_option(sub, o->to, RepresentationCount::kOne, "stored in the .zhp/glTF (default sh3)", "--to")->capture_default_str();
     sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")->check(CLI::Range(0, 22));
-    sub->add_flag("--quiet", o->quiet, "do not print the effects report");
+    sub->add_flag("--progress", o->progress.force, "progress on stderr even when it is not a terminal (one line per 10 %)");
+    sub->add_flag("--quiet", o->progress.quiet, "do not print the effects report nor progress");
     return [o] { return run(*o); };
 });
 

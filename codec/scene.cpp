@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <mutex>
 #include <thread>
 
 namespace zhc {
@@ -500,6 +501,8 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
     std::vector<std::vector<std::uint64_t>> rays(static_cast<size_t>(threads),
                                                  std::vector<std::uint64_t>(effects.size(), 0));
     std::atomic<size_t> next{0};
+    std::mutex progress_mutex;
+    std::uint64_t probes_done = 0;
     auto worker = [&](int t) {
         std::vector<double> acc(kBlock * 27);
         for (size_t b = next++; b < blocks; b = next++) {
@@ -524,6 +527,11 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
                 for (int i = 0; i < 9; ++i)
                     for (int k = 0; k < 3; ++k)
                         out[p][i][k] = static_cast<float>(acc[(p - lo) * 27 + static_cast<size_t>(i * 3 + k)]);
+            if (options.progress) {
+                const std::lock_guard<std::mutex> lock(progress_mutex);
+                probes_done += hi - lo;
+                options.progress(probes_done, count);
+            }
         }
     };
     if (threads == 1) {

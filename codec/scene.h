@@ -34,6 +34,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -124,6 +125,9 @@ struct BakeReport {
 
 struct BakeOptions {
     int threads = 1;
+    // Called after each block of probes with (probes done, total), one call at a time (serialised
+    // across threads), done increasing; the baked bytes never depend on it.
+    std::function<void(std::uint64_t done, std::uint64_t total)> progress;
 };
 
 // Bakes every probe (validate_scene first; kInvalidValue on a bad scene).

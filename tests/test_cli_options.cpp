@@ -19,9 +19,9 @@ struct VerbOptions {
 const std::vector<VerbOptions>& table() {
     static const std::vector<VerbOptions> t = {
         {{"demo"}, {"--threads"}},
-        {{"bake"}, {"-r,--representations,--to", "--threads"}},
+        {{"bake"}, {"-r,--representations,--to", "--threads", "--progress", "--quiet"}},
         {{"project"}, {"--json", "--threads", "--replace-non-finite", "--part"}},
-        {{"audit"}, {"-r,--representations", "--json", "--threads", "--replace-non-finite", "--part"}},
+        {{"audit"}, {"-r,--representations", "--json", "--threads", "--replace-non-finite", "--part", "--progress", "--quiet"}},
         {{"convert"}, {"-r,--representations,--to", "--threads", "--replace-non-finite", "--part"}},
         {{"info"}, {"--json"}},
         {{"bench"}, {"-r,--representations", "--json"}},
@@ -29,10 +29,10 @@ const std::vector<VerbOptions>& table() {
         {{"gltf", "embed"}, {"-r,--representations,--encoding"}},
         {{"gltf", "extract"}, {}},
         {{"gltf", "eval"}, {}},
-        {{"lightmap", "encode"}, {"--threads"}},
-        {{"lightmap", "decode"}, {}},
-        {{"lightmap", "audit"}, {"--json", "--threads"}},
-        {{"lightmap", "synth"}, {"--threads", "--part"}},
+        {{"lightmap", "encode"}, {"--threads", "--progress", "--quiet"}},
+        {{"lightmap", "decode"}, {"--progress", "--quiet"}},
+        {{"lightmap", "audit"}, {"--json", "--threads", "--progress", "--quiet"}},
+        {{"lightmap", "synth"}, {"--threads", "--part", "--progress", "--quiet"}},
     };
     return t;
 }
@@ -77,7 +77,7 @@ TEST(SharedOptions, EveryVerbListsTheSharedNames) {
                 << "zhc " << joined(v.verb) << ": " << o << " outside the shared -r,--representations spelling";
             // Every shared option this verb takes is in its row (a new one must be added there).
             const bool shared = o.find("--representations") != std::string::npos || o == "--threads" || o == "--json" ||
-                                o == "--part" || o == "--replace-non-finite";
+                                o == "--part" || o == "--replace-non-finite" || o == "--progress" || o == "--quiet";
             if (shared) {
                 EXPECT_NE(std::find(v.names.begin(), v.names.end(), o), v.names.end())
                     << "zhc " << joined(v.verb) << " lists " << o << " but its row in the table does not";

@@ -468,6 +468,45 @@ TEST(SceneCli, BakeIsDeterministicAcrossThreadsAndReportsEffects) {
     EXPECT_EQ(set->layout.grid.counts, (std::array<std::uint32_t, 3>{20, 16, 8}));
 }
 
+// BakeOptions::progress: serialised calls, done increasing to the probe count, bytes unchanged;
+// the CLI prints it on stderr only with --progress and never with --quiet.
+TEST(SceneCli, BakeProgressIsMonotonicOnStderrAndChangesNothing) {
+    Scene big = default_scene();
+    big.probes.counts = {20, 16, 8};  // 2560 probes: three blocks of 1024
+    BakeOptions plain;
+    plain.threads = 2;
+    const auto reference = bake_scene(big, plain);
+    ASSERT_TRUE(reference.ok());
+    BakeOptions with = plain;
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> calls;
+    with.progress = [&](std::uint64_t done, std::uint64_t total) { calls.emplace_back(done, total); };
+    const auto baked = bake_scene(big, with);
+    ASSERT_TRUE(baked.ok());
+    EXPECT_EQ(*baked, *reference);
+    ASSERT_EQ(calls.size(), 3u);
+    for (std::size_t i = 0; i < calls.size(); ++i) {
+        EXPECT_EQ(calls[i].second, 2560u);
+        if (i) {
+            EXPECT_GT(calls[i].first, calls[i - 1].first);
+        }
+    }
+    EXPECT_EQ(calls.back().first, 2560u);
+
+    const std::string dir = test::temp_dir("scene_progress");
+    const std::string path = write_scene(dir, "scene.json", scene_json(big));
+    const auto quiet = test::run_zhc({"bake", path, "-o", dir + "/q.zhp", "--threads", "2", "--quiet"});
+    const auto shown = test::run_zhc({"bake", path, "-o", dir + "/p.zhp", "--threads", "2", "--progress"});
+    ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+    ASSERT_EQ(shown.exit_code, 0) << shown.err;
+    EXPECT_EQ(test::read_bytes(dir + "/q.zhp"), test::read_bytes(dir + "/p.zhp"));
+    EXPECT_EQ(quiet.err, "");
+    EXPECT_NE(shown.err.find("zhc bake: 100% (2560/2560 probes)"), std::string::npos) << shown.err;
+    EXPECT_EQ(shown.out.find('%'), std::string::npos) << shown.out;
+    const auto both = test::run_zhc({"bake", path, "-o", dir + "/b.zhp", "--progress", "--quiet"});
+    ASSERT_EQ(both.exit_code, 0) << both.err;
+    EXPECT_EQ(both.err, "");
+}
+
 TEST(SceneCli, ParserErrorsAreClearWithExitCodes) {
     const std::string dir = test::temp_dir("scene_err");
     struct Case {
