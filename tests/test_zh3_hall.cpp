@@ -22,15 +22,7 @@
 namespace zhc {
 namespace {
 
-struct Rng {
-    std::mt19937 gen;
-    explicit Rng(unsigned seed) : gen(seed) {}
-    double u() { return std::uniform_real_distribution<double>(0, 1)(gen); }
-    Vec3 dir() {
-        const double u1 = u();
-        return test::uniform_direction(u1, u());
-    }
-};
+using test::Rng;
 
 // Synthetic interior: a dim coloured ambient plus 2-5 coloured lights (deltas, spheres) from
 // different directions; non-negative lighting.
