@@ -46,6 +46,11 @@ struct Rng {
     }
 };
 
+// The four probes of the golden-bytes tests (test_quantize, test_zh3_hall), given as literal floats
+// (not computed with libm) so the golden inputs are bit-identical on every machine; the last one
+// is out of range (a negative lobe) to exercise clamping.
+std::vector<Sh3Radiance> golden_probes();
+
 // Slow, obviously-correct twin of project_latlong: evaluates all nine basis functions at the
 // centres of sub x sub sub-pixels of every pixel, times their exact solid angles.
 Sh3Radiance project_latlong_reference(const Image& img, int sub = 1);
