@@ -313,12 +313,7 @@ int main(int argc, char** argv) {
             }
             out << "    ]}" << (i + 1 < results.size() ? "," : "") << "\n";
         }
-        out << "  ]\n}\n";
-        if (!out) {
-            std::fprintf(stderr, "cannot write %s\n", json.c_str());
-            return 1;
-        }
-        std::printf("\nwrote %s\n", json.c_str());
+        if (!bench::finish_json(out, json)) return 1;
     }
     if (keep.empty()) fs::remove_all(dir);
     return 0;

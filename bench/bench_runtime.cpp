@@ -33,6 +33,7 @@
 
 #include "codec/codec.h"
 #include "vk_compute.h"
+#include "timing.h"
 
 namespace {
 
@@ -351,12 +352,7 @@ int main(int argc, char** argv) {
                           finite_or(r.ns_one), finite_or(r.ns_one / base_one), i + 1 < rows.size() ? "," : "");
             out << buf;
         }
-        out << "  ]\n}\n";
-        if (!out) {
-            std::fprintf(stderr, "cannot write %s\n", json.c_str());
-            return 1;
-        }
-        std::printf("\nwrote %s\n", json.c_str());
+        if (!bench::finish_json(out, json)) return 1;
     }
     if (keep.empty()) fs::remove_all(dir);
     return 0;

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <ostream>
+#include <string>
 #include <vector>
 
 namespace zhc::bench {
@@ -28,6 +31,18 @@ Timing time_repeats(int repeats, F&& fn) {
 template <class T>
 inline void keep(const T& value) {
     asm volatile("" : : "g"(&value) : "memory");
+}
+
+// Closes the JSON document written to `out` (the file `path`: an array in an object) and says where
+// it went; false, after a message on stderr, when the stream failed.
+inline bool finish_json(std::ostream& out, const std::string& path) {
+    out << "  ]\n}\n";
+    if (!out) {
+        std::fprintf(stderr, "cannot write %s\n", path.c_str());
+        return false;
+    }
+    std::printf("\nwrote %s\n", path.c_str());
+    return true;
 }
 
 }  // namespace zhc::bench

@@ -19,6 +19,40 @@ void parallel_rows(int rows, int threads, F&& f) {
 
 double log2_clamped(double v) { return std::log2(std::clamp(v, std::exp2(-14.0), 65504.0)); }
 
+// Adds the squared log2 errors of decoded against reference to mse.
+void add_log2_sq_errors(const float* reference, const float* decoded, std::size_t count, double& mse) {
+    for (size_t i = 0; i < count; ++i) {
+        const double d = log2_clamped(reference[i]) - log2_clamped(decoded[i]);
+        mse += d * d;
+    }
+}
+
+// Adds texel i's HHD errors of the three encodings to s, o, b and its I_z to iz.
+void add_texel_errors(const ShLightmap& lm, size_t i, const IrradzPlanes& search, const IrradzPlanes& old_way,
+                      const IrradzPlanes& after_bc, double& s, double& o, double& b, double& iz) {
+    const Sh3Irradiance t = to_irradiance(lm.texels[i]);
+    s += irradz::hemispherical_mse(t, search.texel(i), irradz::Model::kHhd);
+    o += irradz::hemispherical_mse(t, old_way.texel(i), irradz::Model::kHhd);
+    b += irradz::hemispherical_mse(t, after_bc.texel(i), irradz::Model::kHhd);
+    const Rgb e = evaluate(t, {0, 0, 1});
+    iz += (e.r + e.g + e.b) / 3.0;
+}
+
+// Adds the w_a and d plane errors of after_bc against search: squared errors to mw and md, the
+// angles between the directions (degrees) to ang and their maximum into amax.
+void add_wa_d_errors(const IrradzPlanes& search, const IrradzPlanes& after_bc, double& mw, double& md, double& ang,
+                     double& amax) {
+    for (size_t i = 0; i < search.wa.size(); ++i) {
+        mw += std::pow(double(search.wa[i]) - after_bc.wa[i], 2);
+        md += std::pow(double(search.d[2 * i]) - after_bc.d[2 * i], 2) + std::pow(double(search.d[2 * i + 1]) - after_bc.d[2 * i + 1], 2);
+        const double c = std::clamp(dot(decode_hemioct(search.d[2 * i], search.d[2 * i + 1]),
+                                        decode_hemioct(after_bc.d[2 * i], after_bc.d[2 * i + 1])), -1.0, 1.0);
+        const double deg = std::acos(c) * 180 / kPi;
+        ang += deg;
+        amax = std::max(amax, deg);
+    }
+}
+
 }  // namespace
 
 std::array<float, 2> encode_hemioct(Vec3 d) {
@@ -76,7 +110,11 @@ ShLightmap synthesize_sphere_rows(const Sh3Radiance& world, int width, int heigh
     return lm;
 }
 
-IrradzPlanes encode_planes(const ShLightmap& lm, const irradz::EncodeOptions& options, int threads) {
+namespace {
+
+// Fills the planes of lm, texel i from to_irradz(lm.texels[i]), rows split over threads.
+template <class ToIrradz>
+IrradzPlanes encode_planes_with(const ShLightmap& lm, int threads, ToIrradz&& to_irradz) {
     IrradzPlanes p;
     p.width = lm.width;
     p.height = lm.height;
@@ -87,7 +125,7 @@ IrradzPlanes encode_planes(const ShLightmap& lm, const irradz::EncodeOptions& op
     parallel_rows(lm.height, threads, [&](int y0, int y1) {
         for (size_t i = static_cast<size_t>(y0) * static_cast<size_t>(lm.width);
              i < static_cast<size_t>(y1) * static_cast<size_t>(lm.width); ++i) {
-            const irradz::IrradZ t = irradz::encode(lm.texels[i], options);
+            const irradz::IrradZ t = to_irradz(lm.texels[i]);
             for (int k = 0; k < 3; ++k) p.iz[3 * i + static_cast<size_t>(k)] = t.i_z[k];
             p.wa[i] = static_cast<float>(t.w_a);
             const auto uv = encode_hemioct(t.d);
@@ -98,28 +136,18 @@ IrradzPlanes encode_planes(const ShLightmap& lm, const irradz::EncodeOptions& op
     return p;
 }
 
+}  // namespace
+
+IrradzPlanes encode_planes(const ShLightmap& lm, const irradz::EncodeOptions& options, int threads) {
+    return encode_planes_with(lm, threads, [&](const auto& texel) { return irradz::encode(texel, options); });
+}
+
 IrradzPlanes encode_planes_linear_sh(const ShLightmap& lm, int threads) {
-    IrradzPlanes p;
-    p.width = lm.width;
-    p.height = lm.height;
-    const size_t n = lm.texels.size();
-    p.iz.resize(3 * n);
-    p.wa.resize(n);
-    p.d.resize(2 * n);
-    parallel_rows(lm.height, threads, [&](int y0, int y1) {
-        for (size_t i = static_cast<size_t>(y0) * static_cast<size_t>(lm.width);
-             i < static_cast<size_t>(y1) * static_cast<size_t>(lm.width); ++i) {
-            Sh2Radiance l;
-            for (int c = 0; c < 4; ++c) l[c] = lm.texels[i][c];
-            const irradz::IrradZ t = irradz::linear_sh_to_irradz(l);
-            for (int k = 0; k < 3; ++k) p.iz[3 * i + static_cast<size_t>(k)] = t.i_z[k];
-            p.wa[i] = static_cast<float>(t.w_a);
-            const auto uv = encode_hemioct(t.d);
-            p.d[2 * i] = uv[0];
-            p.d[2 * i + 1] = uv[1];
-        }
+    return encode_planes_with(lm, threads, [](const auto& texel) {
+        Sh2Radiance l;
+        for (int c = 0; c < 4; ++c) l[c] = texel[c];
+        return irradz::linear_sh_to_irradz(l);
     });
-    return p;
 }
 
 Compressed compress(const IrradzPlanes& p, bc6h::Quality q6, bc45::Quality q45, int threads) {
@@ -146,10 +174,7 @@ IrradzPlanes decompress(const Compressed& c) {
 
 double log2_psnr(const float* reference, const float* decoded, std::size_t count) {
     double mse = 0;
-    for (size_t i = 0; i < count; ++i) {
-        const double d = log2_clamped(reference[i]) - log2_clamped(decoded[i]);
-        mse += d * d;
-    }
+    add_log2_sq_errors(reference, decoded, count, mse);
     mse /= std::max<size_t>(1, count);
     return mse > 0 ? 10 * std::log10(30.0 * 30.0 / mse) : 999.0;
 }
@@ -165,12 +190,7 @@ Audit audit(const ShLightmap& lm, const IrradzPlanes& search, const IrradzPlanes
     stride = std::max<size_t>(1, stride);
     double s = 0, o = 0, b = 0, iz = 0;
     for (size_t i = 0; i < lm.texels.size(); i += stride) {
-        const Sh3Irradiance t = to_irradiance(lm.texels[i]);
-        s += irradz::hemispherical_mse(t, search.texel(i), irradz::Model::kHhd);
-        o += irradz::hemispherical_mse(t, old_way.texel(i), irradz::Model::kHhd);
-        b += irradz::hemispherical_mse(t, after_bc.texel(i), irradz::Model::kHhd);
-        const Rgb e = evaluate(t, {0, 0, 1});
-        iz += (e.r + e.g + e.b) / 3.0;
+        add_texel_errors(lm, i, search, old_way, after_bc, s, o, b, iz);
         ++a.texels_sampled;
     }
     const double n = static_cast<double>(std::max<size_t>(1, a.texels_sampled));
@@ -180,15 +200,7 @@ Audit audit(const ShLightmap& lm, const IrradzPlanes& search, const IrradzPlanes
     a.mean_iz = iz / n;
     a.psnr_iz_log2 = log2_psnr(search.iz.data(), after_bc.iz.data(), search.iz.size());
     double mw = 0, md = 0, ang = 0, amax = 0;
-    for (size_t i = 0; i < search.wa.size(); ++i) {
-        mw += std::pow(double(search.wa[i]) - after_bc.wa[i], 2);
-        md += std::pow(double(search.d[2 * i]) - after_bc.d[2 * i], 2) + std::pow(double(search.d[2 * i + 1]) - after_bc.d[2 * i + 1], 2);
-        const double c = std::clamp(dot(decode_hemioct(search.d[2 * i], search.d[2 * i + 1]),
-                                        decode_hemioct(after_bc.d[2 * i], after_bc.d[2 * i + 1])), -1.0, 1.0);
-        const double deg = std::acos(c) * 180 / kPi;
-        ang += deg;
-        amax = std::max(amax, deg);
-    }
+    add_wa_d_errors(search, after_bc, mw, md, ang, amax);
     const double m = static_cast<double>(std::max<size_t>(1, search.wa.size()));
     a.psnr_wa = mw > 0 ? 10 * std::log10(m / mw) : 999;
     a.psnr_d = md > 0 ? 10 * std::log10(2 * m / md) : 999;
@@ -202,29 +214,12 @@ void AuditAccumulator::add(const ShLightmap& lm, const IrradzPlanes& search, con
     // The texels audit() samples: global index next_, next_ + stride, ...
     const size_t n = lm.texels.size();
     for (; next_ < texels_ + n; next_ += stride_) {
-        const size_t i = next_ - texels_;
-        const Sh3Irradiance t = to_irradiance(lm.texels[i]);
-        s_ += irradz::hemispherical_mse(t, search.texel(i), irradz::Model::kHhd);
-        o_ += irradz::hemispherical_mse(t, old_way.texel(i), irradz::Model::kHhd);
-        b_ += irradz::hemispherical_mse(t, after_bc.texel(i), irradz::Model::kHhd);
-        const Rgb e = evaluate(t, {0, 0, 1});
-        iz_ += (e.r + e.g + e.b) / 3.0;
+        add_texel_errors(lm, next_ - texels_, search, old_way, after_bc, s_, o_, b_, iz_);
         ++sampled_;
     }
-    for (size_t i = 0; i < search.iz.size(); ++i) {
-        const double d = log2_clamped(search.iz[i]) - log2_clamped(after_bc.iz[i]);
-        mse_iz_ += d * d;
-    }
+    add_log2_sq_errors(search.iz.data(), after_bc.iz.data(), search.iz.size(), mse_iz_);
     iz_values_ += search.iz.size();
-    for (size_t i = 0; i < search.wa.size(); ++i) {
-        mw_ += std::pow(double(search.wa[i]) - after_bc.wa[i], 2);
-        md_ += std::pow(double(search.d[2 * i]) - after_bc.d[2 * i], 2) + std::pow(double(search.d[2 * i + 1]) - after_bc.d[2 * i + 1], 2);
-        const double c = std::clamp(dot(decode_hemioct(search.d[2 * i], search.d[2 * i + 1]),
-                                        decode_hemioct(after_bc.d[2 * i], after_bc.d[2 * i + 1])), -1.0, 1.0);
-        const double deg = std::acos(c) * 180 / kPi;
-        ang_ += deg;
-        amax_ = std::max(amax_, deg);
-    }
+    add_wa_d_errors(search, after_bc, mw_, md_, ang_, amax_);
     texels_ += n;
 }
 

@@ -14,6 +14,8 @@
 #include <cmath>
 #include <limits>
 
+#include "sh_l1.h"
+
 namespace zhc {
 namespace {
 
@@ -35,13 +37,8 @@ const double kFourPiOverFive = 4.0 * kPi / 5.0;
 const double kSqrtFourPiOverFive = std::sqrt(4.0 * kPi / 5.0);
 const double kSqrt3 = std::sqrt(3.0);
 
-Vec3 l1_vector(const Rgb* c, int k) { return {-double(c[3][k]), -double(c[1][k]), double(c[2][k])}; }
-// Inverse of l1_vector: writes (f1-1, f10, f11) of channel k.
-void set_l1(Rgb* c, int k, Vec3 v) {
-    c[1][k] = static_cast<float>(-v.y);
-    c[2][k] = static_cast<float>(v.z);
-    c[3][k] = static_cast<float>(-v.x);
-}
+using detail::l1_vector;
+using detail::set_l1;
 
 std::array<double, 5> y2(Vec3 a) {
     return {kY2 * a.x * a.y, -kY2 * a.y * a.z, kY20 * (3.0 * a.z * a.z - 1.0), -kY2 * a.x * a.z,

@@ -20,6 +20,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "sh_l1.h"
+
 namespace zhc {
 namespace {
 
@@ -28,12 +30,8 @@ const double kSqrtFourPiOverFive = std::sqrt(4.0 * kPi / 5.0);
 constexpr double kL1Weight = 4.0 / 9.0;   // (2/3)^2
 constexpr double kL2Weight = 1.0 / 16.0;  // (1/4)^2
 
-Vec3 l1_vector(const Rgb* c, int k) { return {-double(c[3][k]), -double(c[1][k]), double(c[2][k])}; }
-void set_l1(Rgb* c, int k, Vec3 v) {
-    c[1][k] = static_cast<float>(-v.y);
-    c[2][k] = static_cast<float>(v.z);
-    c[3][k] = static_cast<float>(-v.x);
-}
+using detail::l1_vector;
+using detail::set_l1;
 
 // q = sqrt(4 pi / 5) Y2(a): the unit L2 direction of a zonal function along a.
 std::array<double, 5> zonal_dir(Vec3 a) {

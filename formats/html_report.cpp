@@ -15,17 +15,17 @@
 
 namespace zhc {
 
-namespace {
-
-std::string num(double v, const char* f = "%.4g") {
+std::string html_number(double v, const char* format) {
     if (!std::isfinite(v)) return v != v ? "nan" : (v > 0 ? "inf" : "-inf");
     char b[64];
-    std::snprintf(b, sizeof b, f, v);
+    std::snprintf(b, sizeof b, format, v);
     return b;
 }
 
+namespace {
+
 // A number for sorting (data-v): plain, full precision.
-std::string sort_key(double v) { return num(v, "%.17g"); }
+std::string sort_key(double v) { return html_number(v, "%.17g"); }
 
 const Rgb8 kOutside{56, 56, 62}, kNegative{255, 0, 255};
 
@@ -219,7 +219,7 @@ void table_html(std::ostringstream& o, const std::string& id, const std::string&
     if (gpu) o << "<th scope=\"col\">runtime cost: SPIR-V instructions</th><th scope=\"col\">runtime cost: GPU ns/eval</th>";
     else if (runtime_absent_column) o << "<th scope=\"col\">runtime cost</th>";
     o << "</tr></thead>\n<tbody>\n";
-    auto cell = [&](double v, const char* f) { o << "<td data-v=\"" << sort_key(v) << "\">" << num(v, f) << "</td>"; };
+    auto cell = [&](double v, const char* f) { o << "<td data-v=\"" << sort_key(v) << "\">" << html_number(v, f) << "</td>"; };
     auto time = [&](double v) {
         if (v < 0 || !std::isfinite(v)) o << "<td data-v=\"-1\">-</td>";
         else cell(v, "%.0f");
@@ -322,7 +322,7 @@ void pictures_html(std::ostringstream& o, const SpherePictures& p) {
     const std::vector<std::uint8_t> all_inside;
     o << "<p class=\"scale\">Lit spheres, seen from +X (left) and from &minus;X (right), +Z up: the pixel at "
          "normal n shows the irradiance E(n), exposed by the mean reference irradiance ("
-      << num(mean) << ") and tone-mapped (Reinhard, sRGB); <span class=\"neg\">magenta</span> marks negative "
+      << html_number(mean) << ") and tone-mapped (Reinhard, sRGB); <span class=\"neg\">magenta</span> marks negative "
          "irradiance."
       << (latlong ? " Beside each pair, the same irradiance as a lat-long map of normals (+Z at the top, longitude "
                     "from &minus;180&deg; at the left)."
@@ -405,15 +405,15 @@ std::string scatter_svg(const ScatterPlot& plot) {
     };
     for (double v : ticks(x0, x1, plot.log_x)) {
         const double x = left + ((plot.log_x ? std::log10(v) : v) - x0) / (x1 - x0) * pw;
-        o << "<line x1=\"" << num(x) << "\" y1=\"" << top << "\" x2=\"" << num(x) << "\" y2=\"" << top + ph
-          << "\" stroke=\"#ddd\"/><text x=\"" << num(x) << "\" y=\"" << top + ph + 16
-          << "\" text-anchor=\"middle\" font-size=\"12\">" << num(v, "%g") << "</text>\n";
+        o << "<line x1=\"" << html_number(x) << "\" y1=\"" << top << "\" x2=\"" << html_number(x) << "\" y2=\"" << top + ph
+          << "\" stroke=\"#ddd\"/><text x=\"" << html_number(x) << "\" y=\"" << top + ph + 16
+          << "\" text-anchor=\"middle\" font-size=\"12\">" << html_number(v, "%g") << "</text>\n";
     }
     for (double v : ticks(y0, y1, plot.log_y)) {
         const double y = top + ph - ((plot.log_y ? std::log10(v) : v) - y0) / (y1 - y0) * ph;
-        o << "<line x1=\"" << left << "\" y1=\"" << num(y) << "\" x2=\"" << left + pw << "\" y2=\"" << num(y)
-          << "\" stroke=\"#ddd\"/><text x=\"" << left - 6 << "\" y=\"" << num(y + 4)
-          << "\" text-anchor=\"end\" font-size=\"12\">" << num(v, "%g") << "</text>\n";
+        o << "<line x1=\"" << left << "\" y1=\"" << html_number(y) << "\" x2=\"" << left + pw << "\" y2=\"" << html_number(y)
+          << "\" stroke=\"#ddd\"/><text x=\"" << left - 6 << "\" y=\"" << html_number(y + 4)
+          << "\" text-anchor=\"end\" font-size=\"12\">" << html_number(v, "%g") << "</text>\n";
     }
     o << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << pw << "\" height=\"" << ph
       << "\" fill=\"none\" stroke=\"#222\"/>\n";
@@ -427,7 +427,7 @@ std::string scatter_svg(const ScatterPlot& plot) {
     for (size_t i : plot.frontier) {
         if (i >= plot.points.size() || !std::isfinite(plot.points[i].x) || !std::isfinite(plot.points[i].y)) continue;
         on_front[i] = true;
-        path += (path.empty() ? "M" : " L") + num(px(plot.points[i].x)) + " " + num(py(plot.points[i].y));
+        path += (path.empty() ? "M" : " L") + html_number(px(plot.points[i].x)) + " " + html_number(py(plot.points[i].y));
     }
     if (!path.empty()) o << "<path d=\"" << path << "\" fill=\"none\" stroke=\"#d33\" stroke-width=\"2.5\"/>\n";
     // Labels in a column right of the plot, in the order of their points' heights, at least `row`
@@ -448,11 +448,11 @@ std::string scatter_svg(const ScatterPlot& plot) {
         const PlotPoint& p = plot.points[order[k]];
         const bool f = on_front[order[k]];
         const double x = px(p.x), y = py(p.y);
-        o << "<line x1=\"" << num(x) << "\" y1=\"" << num(y) << "\" x2=\"" << lx - 4 << "\" y2=\"" << num(ly[k])
+        o << "<line x1=\"" << html_number(x) << "\" y1=\"" << html_number(y) << "\" x2=\"" << lx - 4 << "\" y2=\"" << html_number(ly[k])
           << "\" stroke=\"" << (f ? "#e99" : "#bbb") << "\" stroke-width=\"0.8\"/>\n";
-        o << "<circle cx=\"" << num(x) << "\" cy=\"" << num(y) << "\" r=\"4\" fill=\"" << (f ? "#d33" : "#2a5bc8")
-          << "\"><title>" << html_escape(p.label) << ": " << num(p.x) << ", " << num(p.y) << "</title></circle>\n";
-        o << "<text x=\"" << lx << "\" y=\"" << num(ly[k] + 4) << "\" font-size=\"12\" fill=\"" << (f ? "#c22" : "#222")
+        o << "<circle cx=\"" << html_number(x) << "\" cy=\"" << html_number(y) << "\" r=\"4\" fill=\"" << (f ? "#d33" : "#2a5bc8")
+          << "\"><title>" << html_escape(p.label) << ": " << html_number(p.x) << ", " << html_number(p.y) << "</title></circle>\n";
+        o << "<text x=\"" << lx << "\" y=\"" << html_number(ly[k] + 4) << "\" font-size=\"12\" fill=\"" << (f ? "#c22" : "#222")
           << "\">" << html_escape(p.label) << (off_axis(p) ? " (0: drawn on the axis)" : "") << "</text>\n";
     }
     o << "<text x=\"" << left + 8 << "\" y=\"" << top + 16 << "\" font-size=\"12\" fill=\"#c22\">red: Pareto frontier</text>\n";

@@ -108,6 +108,8 @@ std::string colour_bar_svg(const ErrorScale& scale);
 
 // Pieces, exposed for tests.
 std::string html_escape(const std::string& text);
+// A number for a report: printf format ("%.4g" by default); nan, inf, -inf spelled out.
+std::string html_number(double v, const char* format = "%.4g");
 std::string base64_encode(const std::vector<std::uint8_t>& bytes);
 // RGB8 pixels (w*h*3) -> PNG bytes; empty on failure.
 std::vector<std::uint8_t> encode_png_rgb8(const std::vector<std::uint8_t>& rgb, int width, int height);

@@ -31,29 +31,37 @@ namespace {
 
 std::string sh_channel(int i, int k) { return "sh" + std::to_string(i) + "." + "RGB"[k]; }
 
+// The checks every input EXR passes before anything is decoded: the magic, a header within
+// max_texels, and every chunk inside the file with nothing after the last one. Fills *layout.
+Status check_exr_file(std::span<const std::uint8_t> b, const std::string& path, std::uint64_t max_texels,
+                      ExrLayout* layout) {
+    if (b.size() < 4 || !(b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01))
+        return make_error(ErrorCode::kBadFormat, path + ": not an OpenEXR file (bad magic at byte 0)");
+    auto check = [&](std::uint64_t w, std::uint64_t h) -> Status {
+        if (w * h > max_texels)
+            return make_error(ErrorCode::kTooLarge, path + ": " + std::to_string(w) + "x" + std::to_string(h) +
+                                                        " texels exceed the limit " + std::to_string(max_texels));
+        return Ok{};
+    };
+    if (Status s = validate_exr_header(b, path, check, layout); !s) return s;
+    auto end = exr_data_end(b, path, *layout);
+    if (!end) return end.error();
+    if (*end != b.size())
+        return make_error(ErrorCode::kTrailingBytes, path + ": " + std::to_string(b.size() - *end) +
+                                                         " trailing bytes after the OpenEXR data (which ends at byte " +
+                                                         std::to_string(*end) + ")");
+    return Ok{};
+}
+
 }  // namespace
 
 Result<lightmap::ShLightmap> read_sh_lightmap_exr(const std::string& path, const LightmapReadOptions& o) {
     auto bytes = read_file_bytes(path, o.max_file_bytes);
     if (!bytes) return bytes.error();
     const auto& b = *bytes;
-    if (b.size() < 4 || !(b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01))
-        return make_error(ErrorCode::kBadFormat, path + ": not an OpenEXR file (bad magic at byte 0)");
-    auto check = [&](std::uint64_t w, std::uint64_t h) -> Status {
-        if (w * h > o.max_texels)
-            return make_error(ErrorCode::kTooLarge, path + ": " + std::to_string(w) + "x" + std::to_string(h) +
-                                                        " texels exceed the limit " + std::to_string(o.max_texels));
-        return Ok{};
-    };
     ExrLayout layout;
-    if (Status s = validate_exr_header(b, path, check, &layout); !s) return s.error();
     // Every chunk inside the file before the texels are allocated; nothing after the last one.
-    auto end = exr_data_end(b, path, layout);
-    if (!end) return end.error();
-    if (*end != b.size())
-        return make_error(ErrorCode::kTrailingBytes, path + ": " + std::to_string(b.size() - *end) +
-                                                         " trailing bytes after the OpenEXR data (which ends at byte " +
-                                                         std::to_string(*end) + ")");
+    if (Status s = check_exr_file(b, path, o.max_texels, &layout); !s) return s.error();
     try {
         Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
         ExrMemoryStream stream(b, path);
@@ -239,22 +247,8 @@ public:
             in->path = path;
             if (Status s = in->file.open(path, o.max_file_bytes); !s) return s;
             const auto b = in->file.bytes();
-            if (b.size() < 4 || !(b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01))
-                return make_error(ErrorCode::kBadFormat, path + ": not an OpenEXR file (bad magic at byte 0)");
-            auto check = [&](std::uint64_t w, std::uint64_t h) -> Status {
-                if (w * h > o.max_texels)
-                    return make_error(ErrorCode::kTooLarge, path + ": " + std::to_string(w) + "x" + std::to_string(h) +
-                                                                " texels exceed the limit " + std::to_string(o.max_texels));
-                return Ok{};
-            };
             ExrLayout layout;
-            if (Status s = validate_exr_header(b, path, check, &layout); !s) return s;
-            auto end = exr_data_end(b, path, layout);
-            if (!end) return end.error();
-            if (*end != b.size())
-                return make_error(ErrorCode::kTrailingBytes, path + ": " + std::to_string(b.size() - *end) +
-                                                                 " trailing bytes after the OpenEXR data (which ends at byte " +
-                                                                 std::to_string(*end) + ")");
+            if (Status s = check_exr_file(b, path, o.max_texels, &layout); !s) return s;
             try {
                 Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
                 in->stream = std::make_unique<ExrMemoryStream>(b, path);

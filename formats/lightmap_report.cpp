@@ -13,13 +13,6 @@ namespace zhc {
 
 namespace {
 
-std::string num(double v, const char* f = "%.4g") {
-    if (!std::isfinite(v)) return v != v ? "nan" : (v > 0 ? "inf" : "-inf");
-    char b[64];
-    std::snprintf(b, sizeof b, f, v);
-    return b;
-}
-
 constexpr double kErrorCap = 1e6;  // a non-finite or absurd error counts as this (relative)
 const Rgb8 kNegative{255, 0, 255};
 
@@ -181,7 +174,7 @@ void view_html(std::ostringstream& o, const LightmapHtml& p, const std::vector<f
         const int cu = enlargement(win.width, win.height, 256);
         o << "<h2>" << html_escape(heading) << "</h2>\n<p class=\"scale\">" << what << " "
           << html_escape(p.before_label) << " and " << html_escape(p.after_label)
-          << ", exposed by the mean irradiance before (" << num(mean)
+          << ", exposed by the mean irradiance before (" << html_number(mean)
           << ") and tone-mapped (Reinhard, sRGB); <span class=\"neg\">magenta</span> marks negative values. Error: max over "
              "channels of |after &minus; before| / mean, on a logarithmic scale (three decades, four colour bands each) "
              "whose top is the 99th percentile of the error ("
@@ -216,8 +209,8 @@ std::string lightmap_html_report(const LightmapHtml& p) {
          "SH3 lightmap</caption>\n<thead><tr><th scope=\"col\">representation</th><th scope=\"col\">rmse</th>"
          "<th scope=\"col\">relative rmse</th></tr></thead>\n<tbody>\n";
     for (const LightmapHtmlRow& r : p.rows)
-        o << "<tr class=\"rep\"><th scope=\"row\">" << html_escape(r.name) << "</th><td data-v=\"" << num(r.rmse, "%.17g") << "\">"
-          << num(r.rmse, "%.6g") << "</td><td data-v=\"" << num(r.relative, "%.17g") << "\">" << percent_text(r.relative)
+        o << "<tr class=\"rep\"><th scope=\"row\">" << html_escape(r.name) << "</th><td data-v=\"" << html_number(r.rmse, "%.17g") << "\">"
+          << html_number(r.rmse, "%.6g") << "</td><td data-v=\"" << html_number(r.relative, "%.17g") << "\">" << percent_text(r.relative)
           << "</td></tr>\n";
     o << "</tbody></table>\n";
     if (!p.metrics.empty()) {
@@ -281,11 +274,11 @@ LightmapHtml lightmap_audit_html(const std::string& version, std::vector<std::pa
     p.rows = {{"old way (optimal linear direction, spherical Gram)", a.rmse_old, a.rmse_old / m},
               {"fit (hemispherical Gram, Newton on d)", a.rmse_search, a.rmse_search / m},
               {"fit after BC6H + BC5 + BC4", a.rmse_after_bc, a.rmse_after_bc / m}};
-    p.metrics = {{"mean irradiance at the normal", num(a.mean_iz, "%.5g")},
-                 {"I_z BC6H PSNR (log2 domain)", num(a.psnr_iz_log2, "%.2f") + " dB"},
-                 {"w_a BC4 PSNR", num(a.psnr_wa, "%.2f") + " dB"},
-                 {"d BC5 PSNR", num(a.psnr_d, "%.2f") + " dB"},
-                 {"d angle error after BC5", "mean " + num(a.d_mean_deg, "%.3f") + " deg, max " + num(a.d_max_deg, "%.2f") + " deg"}};
+    p.metrics = {{"mean irradiance at the normal", html_number(a.mean_iz, "%.5g")},
+                 {"I_z BC6H PSNR (log2 domain)", html_number(a.psnr_iz_log2, "%.2f") + " dB"},
+                 {"w_a BC4 PSNR", html_number(a.psnr_wa, "%.2f") + " dB"},
+                 {"d BC5 PSNR", html_number(a.psnr_d, "%.2f") + " dB"},
+                 {"d angle error after BC5", "mean " + html_number(a.d_mean_deg, "%.3f") + " deg, max " + html_number(a.d_max_deg, "%.2f") + " deg"}};
     return p;
 }
 

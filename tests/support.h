@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <random>
 #include <span>
 #include <string>
 #include <vector>
@@ -31,6 +32,24 @@ std::vector<Vec3> fibonacci_directions(int n);
 long sample_count(long n);
 // Uniform random unit vector from two uniforms in [0, 1).
 Vec3 uniform_direction(double u1, double u2);
+
+// Seeded draws for the randomised tests: u() uniform in [0, 1), dir() a uniform unit vector.
+struct Rng {
+    std::mt19937 gen;
+    explicit Rng(unsigned seed) : gen(seed) {}
+    double u() { return std::uniform_real_distribution<double>(0, 1)(gen); }
+    // Draws are sequenced in statements: the order of evaluation of function arguments differs
+    // between compilers (g++ right to left, clang left to right), and the inputs must not.
+    Vec3 dir() {
+        const double u1 = u();
+        return uniform_direction(u1, u());
+    }
+};
+
+// The four probes of the golden-bytes tests (test_quantize, test_zh3_hall), given as literal floats
+// (not computed with libm) so the golden inputs are bit-identical on every machine; the last one
+// is out of range (a negative lobe) to exercise clamping.
+std::vector<Sh3Radiance> golden_probes();
 
 // Slow, obviously-correct twin of project_latlong: evaluates all nine basis functions at the
 // centres of sub x sub sub-pixels of every pixel, times their exact solid angles.

@@ -394,31 +394,6 @@ TEST(PackedLayouts, DecodersAreTotalAndEncodingIsDeterministic) {
 
 // ---- golden bytes -----------------------------------------------------------------------------
 
-// Probes given as literal floats (not computed with libm) so the golden inputs are bit-identical
-// on every machine.
-std::vector<Sh3Radiance> golden_probes() {
-    const float p[4][9][3] = {
-        {{3.5f, 3.25f, 2.75f}, {0.5f, 0.375f, 0.25f}, {1.25f, 1.0f, 0.75f}, {-0.625f, -0.5f, -0.375f},
-         {0.125f, 0.1f, 0.05f}, {-0.25f, -0.2f, -0.15f}, {0.75f, 0.6f, 0.45f}, {0.3f, 0.2f, 0.1f},
-         {-0.0625f, -0.05f, -0.04f}},
-        {{1.0f, 2.0f, 4.0f}, {0.1f, 0.2f, 0.4f}, {-0.3f, -0.6f, -1.2f}, {0.2f, 0.4f, 0.8f},
-         {0.05f, 0.1f, 0.2f}, {0.02f, 0.04f, 0.08f}, {-0.4f, -0.8f, -1.6f}, {0.01f, 0.02f, 0.04f},
-         {0.3f, 0.6f, 1.2f}},
-        {{0.01f, 0.02f, 0.005f}, {0.005f, 0.0f, -0.002f}, {0.0f, 0.01f, 0.0f}, {-0.001f, 0.002f, 0.0f},
-         {0.0f, 0.0f, 0.0f}, {0.001f, -0.002f, 0.0005f}, {0.004f, 0.008f, 0.002f}, {0.0f, 0.0f, 0.0f},
-         {-0.002f, 0.001f, 0.0f}},
-        // Out of range (a negative lobe): exercises clamping.
-        {{1.0f, 1.0f, 1.0f}, {3.0f, 0.0f, -3.0f}, {0.0f, 2.0f, 0.0f}, {0.0f, 0.0f, 1.0f},
-         {2.5f, -2.5f, 0.0f}, {0.0f, 0.0f, 0.0f}, {-1.5f, 2.5f, 0.0f}, {0.0f, 0.0f, 0.0f},
-         {0.0f, 0.0f, 0.0f}},
-    };
-    std::vector<Sh3Radiance> out(4);
-    for (int n = 0; n < 4; ++n)
-        for (int i = 0; i < 9; ++i)
-            for (int k = 0; k < 3; ++k) out[static_cast<size_t>(n)][i][k] = p[n][i][k];
-    return out;
-}
-
 std::string golden_dir() { return (std::filesystem::path(__FILE__).parent_path() / "golden").string(); }
 
 // Compares with tests/golden/NAME; ZHC_UPDATE_GOLDEN=1 rewrites it instead (docs/quantization.md).
@@ -458,7 +433,7 @@ TEST(PackedLayouts, GoldenBytes) {
                                        {"sh2_q", PackedLayout::kSh2Q}})
         for (const Variant& v : variants) {
             std::vector<std::uint8_t> all;
-            for (const Sh3Radiance& sh : golden_probes()) {
+            for (const Sh3Radiance& sh : test::golden_probes()) {
                 std::uint8_t b[28];
                 encode_packed(layout, sh, v.params, b, nullptr);
                 all.insert(all.end(), b, b + packed_size_bytes(layout));

@@ -48,16 +48,8 @@ double coefficient_norm(const Sh3Radiance& a, int from = 0, int to = 9) { return
 
 // ---- inputs -----------------------------------------------------------------------------------
 
-struct Rng {
-    std::mt19937 gen;
-    explicit Rng(unsigned seed) : gen(seed) {}
-    double u() { return std::uniform_real_distribution<double>(0, 1)(gen); }
-    // Draws are sequenced in statements: the order of evaluation of function arguments differs
-    // between compilers (g++ right to left, clang left to right), and the inputs must not.
-    Vec3 dir() {
-        const double u1 = u();
-        return test::uniform_direction(u1, u());
-    }
+struct Rng : test::Rng {
+    using test::Rng::Rng;
     Rgb colour() { return {float(0.1 + u()), float(0.1 + u()), float(0.1 + u())}; }
 };
 

@@ -22,15 +22,7 @@
 namespace zhc {
 namespace {
 
-struct Rng {
-    std::mt19937 gen;
-    explicit Rng(unsigned seed) : gen(seed) {}
-    double u() { return std::uniform_real_distribution<double>(0, 1)(gen); }
-    Vec3 dir() {
-        const double u1 = u();
-        return test::uniform_direction(u1, u());
-    }
-};
+using test::Rng;
 
 // Synthetic interior: a dim coloured ambient plus 2-5 coloured lights (deltas, spheres) from
 // different directions; non-negative lighting.
@@ -489,28 +481,6 @@ TEST(HallAdaptiveLayout, EncoderPicksTheBestCandidateAndIsNeverWorseThanSh2Q) {
 // Golden bytes of the hall entries on the literal probes of test_quantize.cpp's golden set (the
 // same four probes, literal floats), under the default and three non-default parameter sets
 // through the probe container path (encode_probe). ZHC_UPDATE_GOLDEN=1 rewrites them.
-std::vector<Sh3Radiance> golden_probes() {
-    const float p[4][9][3] = {
-        {{3.5f, 3.25f, 2.75f}, {0.5f, 0.375f, 0.25f}, {1.25f, 1.0f, 0.75f}, {-0.625f, -0.5f, -0.375f},
-         {0.125f, 0.1f, 0.05f}, {-0.25f, -0.2f, -0.15f}, {0.75f, 0.6f, 0.45f}, {0.3f, 0.2f, 0.1f},
-         {-0.0625f, -0.05f, -0.04f}},
-        {{1.0f, 2.0f, 4.0f}, {0.1f, 0.2f, 0.4f}, {-0.3f, -0.6f, -1.2f}, {0.2f, 0.4f, 0.8f},
-         {0.05f, 0.1f, 0.2f}, {0.02f, 0.04f, 0.08f}, {-0.4f, -0.8f, -1.6f}, {0.01f, 0.02f, 0.04f},
-         {0.3f, 0.6f, 1.2f}},
-        {{0.01f, 0.02f, 0.005f}, {0.005f, 0.0f, -0.002f}, {0.0f, 0.01f, 0.0f}, {-0.001f, 0.002f, 0.0f},
-         {0.0f, 0.0f, 0.0f}, {0.001f, -0.002f, 0.0005f}, {0.004f, 0.008f, 0.002f}, {0.0f, 0.0f, 0.0f},
-         {-0.002f, 0.001f, 0.0f}},
-        {{1.0f, 1.0f, 1.0f}, {3.0f, 0.0f, -3.0f}, {0.0f, 2.0f, 0.0f}, {0.0f, 0.0f, 1.0f},
-         {2.5f, -2.5f, 0.0f}, {0.0f, 0.0f, 0.0f}, {-1.5f, 2.5f, 0.0f}, {0.0f, 0.0f, 0.0f},
-         {0.0f, 0.0f, 0.0f}},
-    };
-    std::vector<Sh3Radiance> out(4);
-    for (int n = 0; n < 4; ++n)
-        for (int i = 0; i < 9; ++i)
-            for (int k = 0; k < 3; ++k) out[static_cast<size_t>(n)][i][k] = p[n][i][k];
-    return out;
-}
-
 TEST(HallAdaptiveLayout, GoldenBytes) {
     const std::string dir = std::string(ZHC_TEST_DATA_DIR) + "/../golden";
     std::vector<std::pair<const char*, QuantParams>> variants;
@@ -528,7 +498,7 @@ TEST(HallAdaptiveLayout, GoldenBytes) {
     for (const char* name : {"hall_solved_q16", "hall_adaptive_q16"})
         for (const auto& [suffix, params] : variants) {
             std::vector<std::uint8_t> all;
-            for (const Sh3Radiance& sh : golden_probes()) {
+            for (const Sh3Radiance& sh : test::golden_probes()) {
                 std::uint8_t b[16];
                 encode_probe(*find_codec(name), params, sh, b, nullptr);
                 all.insert(all.end(), b, b + 16);

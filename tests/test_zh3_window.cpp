@@ -20,14 +20,8 @@
 namespace zhc {
 namespace {
 
-struct Rng {
-    std::mt19937 gen;
-    explicit Rng(unsigned seed) : gen(seed) {}
-    double u() { return std::uniform_real_distribution<double>(0, 1)(gen); }
-    Vec3 dir() {
-        const double u1 = u();
-        return test::uniform_direction(u1, u());
-    }
+struct Rng : test::Rng {
+    using test::Rng::Rng;
     Rgb colour() {
         const float r = float(0.1 + u()), g = float(0.1 + u());
         return {r, g, float(0.1 + u())};

@@ -1,0 +1,18 @@
+// zhc/codec/sh_l1.h — internal to codec/: the L1 band of one colour channel as a vector (shared by
+// zh3.cpp and zh3_hall.cpp).
+#pragma once
+
+#include "sh.h"
+
+namespace zhc::detail {
+
+// (x, y, z) of the L1 band of channel k: (-f11, -f1-1, f10) in the real-SH sign convention.
+inline Vec3 l1_vector(const Rgb* c, int k) { return {-double(c[3][k]), -double(c[1][k]), double(c[2][k])}; }
+// Inverse of l1_vector: writes (f1-1, f10, f11) of channel k.
+inline void set_l1(Rgb* c, int k, Vec3 v) {
+    c[1][k] = static_cast<float>(-v.y);
+    c[2][k] = static_cast<float>(v.z);
+    c[3][k] = static_cast<float>(-v.x);
+}
+
+}  // namespace zhc::detail
