@@ -230,12 +230,15 @@ std::vector<Row> compute_rows() {
         const std::uint64_t plane_bytes = 4 * (search.iz.size() + search.wa.size() + search.d.size());
         rows.push_back(make_row("irradz", "search", lmname, plane_bytes, "hemi_rmse", a.rmse_search, planes_hash(search)));
         rows.push_back(make_row("irradz", "old", lmname, plane_bytes, "hemi_rmse", a.rmse_old, planes_hash(old_way)));
-        Hash hc;
-        hc.bytes(c.bc6h);
-        hc.bytes(c.bc5);
-        hc.bytes(c.bc4);
-        rows.push_back(make_row("irradz", "search_bc", lmname, c.bc6h.size() + c.bc5.size() + c.bc4.size(), "hemi_rmse",
-                                a.rmse_after_bc, hc.h));
+        auto blocks_hash = [](const lightmap::Compressed& k) {
+            Hash h;
+            h.bytes(k.bc6h);
+            h.bytes(k.bc5);
+            h.bytes(k.bc4);
+            return h.h;
+        };
+        auto blocks_size = [](const lightmap::Compressed& k) { return k.bc6h.size() + k.bc5.size() + k.bc4.size(); };
+        rows.push_back(make_row("irradz", "search_bc", lmname, blocks_size(c), "hemi_rmse", a.rmse_after_bc, blocks_hash(c)));
         block_rows(lmname, search.iz, search.d, search.wa, rows);
         // The default solve (Newton on d) and the default encoder output built on it.
         eo.solve = irradz::Solve::kNewton;
@@ -243,12 +246,7 @@ std::vector<Row> compute_rows() {
         const lightmap::Compressed cn = lightmap::compress(newton, bc6h::Quality::kDefault, bc45::Quality::kDefault, 1);
         const lightmap::Audit an = lightmap::audit(lm, newton, old_way, lightmap::decompress(cn), 1);
         rows.push_back(make_row("irradz", "newton", lmname, plane_bytes, "hemi_rmse", an.rmse_search, planes_hash(newton)));
-        Hash hn;
-        hn.bytes(cn.bc6h);
-        hn.bytes(cn.bc5);
-        hn.bytes(cn.bc4);
-        rows.push_back(make_row("irradz", "newton_bc", lmname, cn.bc6h.size() + cn.bc5.size() + cn.bc4.size(), "hemi_rmse",
-                                an.rmse_after_bc, hn.h));
+        rows.push_back(make_row("irradz", "newton_bc", lmname, blocks_size(cn), "hemi_rmse", an.rmse_after_bc, blocks_hash(cn)));
     }
     return rows;
 }
