@@ -2,6 +2,9 @@
 // zh3.cpp and zh3_hall.cpp).
 #pragma once
 
+#include <cstdint>
+
+#include "codec.h"
 #include "sh.h"
 
 namespace zhc::detail {
@@ -13,6 +16,23 @@ inline void set_l1(Rgb* c, int k, Vec3 v) {
     c[1][k] = static_cast<float>(-v.y);
     c[2][k] = static_cast<float>(v.z);
     c[3][k] = static_cast<float>(-v.x);
+}
+
+// The 48-byte linear-SH layout (sh2, hall_*): DC + L1 of any SH order, 12 little-endian floats.
+template <class Sh>
+void store_linear(const Sh& s, std::uint8_t* out) {
+    float v[12];
+    for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 3; ++k) v[i * 3 + k] = s[i][k];
+    store_floats(v, out);
+}
+inline Sh2Radiance load_linear(const std::uint8_t* in) {
+    float v[12];
+    load_floats(in, v);
+    Sh2Radiance s;
+    for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 3; ++k) s[i][k] = v[i * 3 + k];
+    return s;
 }
 
 }  // namespace zhc::detail

@@ -39,6 +39,7 @@ const double kSqrt3 = std::sqrt(3.0);
 
 using detail::l1_vector;
 using detail::set_l1;
+using detail::load_linear;
 
 std::array<double, 5> y2(Vec3 a) {
     return {kY2 * a.x * a.y, -kY2 * a.y * a.z, kY20 * (3.0 * a.z * a.z - 1.0), -kY2 * a.x * a.z,
@@ -641,14 +642,6 @@ Zh3 load_zh3(const std::uint8_t* in) {
     for (int k = 0; k < 3; ++k) z.zonal[k] = v[12 + k];
     return z;
 }
-Sh2Radiance load_linear(const std::uint8_t* in) {
-    float v[kLinearFloats];
-    load_floats(in, v);
-    Sh2Radiance s;
-    for (int i = 0; i < 4; ++i)
-        for (int k = 0; k < 3; ++k) s[i][k] = v[i * 3 + k];
-    return s;
-}
 
 template <ZonalAxisMode Mode>
 void encode_fit(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats*) {
@@ -681,10 +674,7 @@ Rgb irradiance_zh3(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
 
 // Hallucinated: the stored bytes are exactly sh2's (DC + L1, 12 floats).
 void encode_linear(const Sh3Radiance& in, const CodecOptions&, std::uint8_t* out, EncodeStats*) {
-    float v[kLinearFloats];
-    for (int i = 0; i < 4; ++i)
-        for (int k = 0; k < 3; ++k) v[i * 3 + k] = in[i][k];
-    store_floats(v, out);
+    detail::store_linear(in, out);
 }
 template <Hallucination Model, ZonalAxisMode Mode>
 Sh3Radiance decode_hall(const std::uint8_t* in, const CodecOptions& o) {

@@ -523,22 +523,9 @@ void encode_hall_packed(bool adaptive, const Sh3Radiance& hub, const QuantParams
 // ---- codec table entries ------------------------------------------------------------------------
 
 namespace {
-constexpr std::size_t kLinearFloats = 12;
 
-void store_linear(const Sh2Radiance& s, std::uint8_t* out) {
-    float v[kLinearFloats];
-    for (int i = 0; i < 4; ++i)
-        for (int k = 0; k < 3; ++k) v[i * 3 + k] = s[i][k];
-    store_floats(v, out);
-}
-Sh2Radiance load_linear(const std::uint8_t* in) {
-    float v[kLinearFloats];
-    load_floats(in, v);
-    Sh2Radiance s;
-    for (int i = 0; i < 4; ++i)
-        for (int k = 0; k < 3; ++k) s[i][k] = v[i * 3 + k];
-    return s;
-}
+using detail::load_linear;
+using detail::store_linear;
 
 void encode_solved(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
     store_linear(hall_solve(in, 1.0, ZonalAxisMode::kLuminance, o, stats), out);
