@@ -1,4 +1,7 @@
-// zhc/formats/probes/gltf_probes.cpp — ZHC_light_probes (docs/gltf-extension.md) on top of tinygltf.
+// zhc/formats/probes/gltf_probes.cpp — ZHC_light_probes (docs/gltf-extension.md) on top of tinygltf:
+// loading an untrusted glTF 2.0 asset (shared by reading and embedding) and the zhc <-> glTF frames.
+// Reading the extension: gltf_probes_read.cpp; embedding: gltf_probes_write.cpp; what the three
+// share: gltf_probes_internal.h.
 //
 // tinygltf (Debian libtinygltf-dev, implementation in the shared library) parses and writes the
 // asset; everything untrusted is checked by us first: the GLB framing, every URI (no absolute
@@ -10,47 +13,29 @@
 // sees (their URIs are still checked). glTF 2.x only (asset.version / minVersion). Uri-less
 // meshopt fallback buffers load no bytes (formats/scene/scene_gltf.cpp decodes the compressed views). The extension itself is read from our own nlohmann parse of the same JSON, so every
 // index it holds is bound-checked against the arrays tinygltf loaded.
-#define TINYGLTF_NO_STB_IMAGE
-#define TINYGLTF_NO_STB_IMAGE_WRITE
-#define TINYGLTF_NO_EXTERNAL_IMAGE
-#include <tiny_gltf.h>
-
-#include "formats/probes/gltf_probes.h"
-
-#include <nlohmann/json.hpp>
+#include "formats/probes/gltf_probes_internal.h"
 
 #include <algorithm>
-#include <cctype>
-#include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <limits>
-#include <map>
-#include <sstream>
 
 #include "formats/io/file_io.h"
-#include "formats/io/le_bytes.h"
-#include "formats/probes/gltf_draco.h"
 #include "formats/io/json_depth.h"
 
 namespace zhc {
-namespace {
+namespace gltf_detail {
 
-namespace fs = std::filesystem;
-using json = nlohmann::ordered_json;
 using le::put32;
-constexpr auto le32 = le::load32;
 
 constexpr std::uint32_t kGlbMagic = 0x46546C67;     // "glTF"
 constexpr std::uint32_t kChunkJson = 0x4E4F534A;    // "JSON"
 constexpr std::uint32_t kChunkBin = 0x004E4942;     // "BIN\0"
-constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
-constexpr int kUbyte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
 
 Error fail(ErrorCode code, const std::string& path, const std::string& what) {
     return make_error(code, path + ": " + what);
 }
 
+namespace {
 
 // ---- untrusted input: framing, URIs, sizes -------------------------------------------------
 
@@ -135,6 +120,8 @@ std::string uri_problem(const std::string& uri) {
     return "";
 }
 
+}  // namespace
+
 // The path a relative URI names (percent escapes decoded; call after uri_problem accepted it).
 std::string uri_path(const std::string& uri) {
     std::string d;
@@ -148,6 +135,8 @@ std::string uri_path(const std::string& uri) {
     }
     return d;
 }
+
+namespace {
 
 Result<std::uint64_t> json_size(const json& j, const char* key, const std::string& path, const std::string& where) {
     if (!j.contains(key)) return fail(ErrorCode::kBadFormat, path, where + ": missing " + key);
@@ -249,6 +238,8 @@ struct FsGuard {
     ErrorCode code = ErrorCode::kBadFormat;
 };
 
+}  // namespace
+
 bool inside(const fs::path& base, const fs::path& p) {
     auto b = base.begin(), e = base.end();
     auto q = p.begin();
@@ -256,6 +247,8 @@ bool inside(const fs::path& base, const fs::path& p) {
         if (q == p.end() || *q != *b) return false;
     return true;
 }
+
+namespace {
 
 bool guard_resolve(FsGuard* g, const std::string& abs, fs::path* out) {
     std::error_code ec;
@@ -338,6 +331,7 @@ bool needs_draco_index_patch(const json& doc) {
     return false;
 }
 
+}  // namespace
 
 // GLB 2.0: header, JSON chunk padded with spaces, optional BIN chunk padded with zeros.
 std::vector<std::uint8_t> make_glb(const std::string& json_text, std::span<const std::uint8_t> bin) {
@@ -377,13 +371,6 @@ std::string base64(std::span<const std::uint8_t> b) {
 }
 
 std::string data_uri(std::span<const std::uint8_t> b) { return "data:application/octet-stream;base64," + base64(b); }
-
-struct Loaded {
-    json doc;
-    tinygltf::Model model;
-    bool binary = false;
-    std::vector<size_t> fallback_buffers;  // uri-less meshopt fallback buffers (no bytes loaded)
-};
 
 Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path, const GltfLimits& limits) {
     if (bytes.size() > limits.max_file_bytes)
@@ -526,258 +513,9 @@ std::vector<std::uint8_t> reorder_grid(const std::vector<std::uint8_t>& payload,
     return out;
 }
 
-const char* dc_name(DcFormat f) {
-    switch (f) {
-        case DcFormat::kR11G11B10F: return "r11g11b10f";
-        case DcFormat::kRGB9E5: return "rgb9e5";
-        case DcFormat::kHalf: return "half";
-    }
-    return "r11g11b10f";
-}
-const char* zonal_name(ZonalMapping m) {
-    switch (m) {
-        case ZonalMapping::kAffine: return "affine";
-        case ZonalMapping::kZeroPreserving: return "zero";
-        case ZonalMapping::kSymmetric: return "symmetric";
-    }
-    return "affine";
-}
+}  // namespace gltf_detail
 
-std::vector<std::uint8_t> float_bytes(const std::vector<std::array<float, 3>>& v) {
-    std::vector<std::uint8_t> out(v.size() * 12);
-    for (size_t i = 0; i < v.size(); ++i)
-        for (int k = 0; k < 3; ++k) {
-            std::uint32_t bits;
-            std::memcpy(&bits, &v[i][static_cast<size_t>(k)], 4);
-            for (int b = 0; b < 4; ++b) out[i * 12 + static_cast<size_t>(k) * 4 + static_cast<size_t>(b)] = static_cast<std::uint8_t>(bits >> (8 * b));
-        }
-    return out;
-}
-
-// ---- reading the extension ------------------------------------------------------------------
-
-struct VolumeReader {
-    const Loaded& in;
-    const std::string& path;
-    const GltfLimits& limits;
-    std::string where;
-
-    Error bad(ErrorCode code, const std::string& what) const { return fail(code, path, where + ": " + what); }
-
-    Result<std::uint64_t> index(const json& v, const char* key, std::size_t size, bool required = true) const {
-        if (!v.contains(key)) {
-            if (required) return bad(ErrorCode::kBadFormat, std::string("missing ") + key);
-            return std::numeric_limits<std::uint64_t>::max();
-        }
-        const json& x = v[key];
-        if (!x.is_number_integer() || x.get<std::int64_t>() < 0 || x.get<std::uint64_t>() >= size)
-            return bad(ErrorCode::kBadFormat, std::string(key) + " is not a valid index (0.." + std::to_string(size) + ")");
-        return x.get<std::uint64_t>();
-    }
-
-    Result<Vec3> vec3(const json& v, const char* key) const {
-        if (!v.contains(key) || !v[key].is_array() || v[key].size() != 3) return bad(ErrorCode::kBadFormat, std::string(key) + " is not [x, y, z]");
-        double c[3];
-        for (int k = 0; k < 3; ++k) {
-            const json& e = v[key][static_cast<size_t>(k)];
-            if (!e.is_number() || !std::isfinite(e.get<double>())) return bad(ErrorCode::kInvalidValue, std::string(key) + " holds a non-finite or non-number value");
-            c[k] = e.get<double>();
-        }
-        return Vec3{c[0], c[1], c[2]};
-    }
-
-    // The bytes of accessor `acc`, checked to be `count` tightly packed elements of the type.
-    Result<std::span<const std::uint8_t>> accessor_bytes(std::uint64_t acc, int component, int type, std::uint64_t count,
-                                                         const char* what) const {
-        const tinygltf::Model& m = in.model;
-        const tinygltf::Accessor& a = m.accessors[static_cast<size_t>(acc)];
-        const std::string an = std::string(what) + " accessor " + std::to_string(acc);
-        if (a.sparse.isSparse) return bad(ErrorCode::kUnsupported, an + " is sparse");
-        if (a.componentType != component || a.type != type)
-            return bad(ErrorCode::kBadFormat, an + " has the wrong component type / type");
-        if (a.count != count)
-            return bad(ErrorCode::kBadFormat, an + " has " + std::to_string(a.count) + " elements, expected " + std::to_string(count));
-        if (a.bufferView < 0 || static_cast<size_t>(a.bufferView) >= m.bufferViews.size())
-            return bad(ErrorCode::kBadFormat, an + ": bufferView index out of range");
-        const tinygltf::BufferView& v = m.bufferViews[static_cast<size_t>(a.bufferView)];
-        const std::uint64_t elem = static_cast<std::uint64_t>(tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(component))) *
-                                   static_cast<std::uint64_t>(tinygltf::GetNumComponentsInType(static_cast<uint32_t>(type)));
-        if (v.byteStride != 0 && v.byteStride != elem) return bad(ErrorCode::kUnsupported, an + ": interleaved bufferView");
-        if (v.buffer < 0 || static_cast<size_t>(v.buffer) >= m.buffers.size())
-            return bad(ErrorCode::kBadFormat, an + ": buffer index out of range");
-        const std::vector<unsigned char>& data = m.buffers[static_cast<size_t>(v.buffer)].data;
-        const std::uint64_t view_off = v.byteOffset, view_len = v.byteLength, acc_off = a.byteOffset;
-        if (count > limits.max_buffer_bytes / elem) return bad(ErrorCode::kTooLarge, an + " too large");
-        const std::uint64_t need = count * elem;
-        if (view_off > data.size() || view_len > data.size() - view_off)
-            return bad(ErrorCode::kBadFormat, an + ": bufferView range outside its buffer");
-        if (acc_off > view_len || need > view_len - acc_off)
-            return bad(ErrorCode::kBadFormat, an + ": elements run past the end of the bufferView");
-        return std::span<const std::uint8_t>(data.data() + view_off + acc_off, static_cast<size_t>(need));
-    }
-
-    Result<GltfProbeVolume> read(const json& v) const {
-        if (!v.is_object()) return bad(ErrorCode::kBadFormat, "not an object");
-        GltfProbeVolume out;
-        if (v.contains("name") && v["name"].is_string()) out.name = v["name"].get<std::string>();
-        if (!v.contains("encoding") || !v["encoding"].is_string()) return bad(ErrorCode::kBadFormat, "missing encoding");
-        ProbeSet& set = out.set;
-        set.representation = v["encoding"].get<std::string>();
-        const Codec* codec = set.codec();
-        if (!codec) return bad(ErrorCode::kUnsupported, "unknown encoding '" + set.representation + "'");
-        if (!v.contains("count") || !v["count"].is_number_unsigned() || v["count"].get<std::uint64_t>() == 0)
-            return bad(ErrorCode::kBadFormat, "count is not a positive integer");
-        set.count = v["count"].get<std::uint64_t>();
-        if (set.count > limits.max_probes) return bad(ErrorCode::kTooLarge, "count " + std::to_string(set.count) + " above the limit");
-        if (v.contains("kind")) {
-            const std::string k = v["kind"].is_string() ? v["kind"].get<std::string>() : "";
-            if (k == "irradiance") set.params.kind = StoredKind::kIrradiance;
-            else if (k != "radiance") return bad(ErrorCode::kUnsupported, "kind must be radiance or irradiance");
-        }
-        out.sh_axes = GltfShAxes::kGltf;
-        if (v.contains("shAxes")) {
-            const std::string a = v["shAxes"].is_string() ? v["shAxes"].get<std::string>() : "";
-            if (a == "zhc") out.sh_axes = GltfShAxes::kZhc;
-            else if (a != "gltf") return bad(ErrorCode::kUnsupported, "shAxes must be gltf or zhc");
-        }
-        if (v.contains("quantization")) {
-            const json& q = v["quantization"];
-            if (!q.is_object()) return bad(ErrorCode::kBadFormat, "quantization is not an object");
-            auto str = [&](const char* key, const char* def) {
-                return q.contains(key) && q[key].is_string() ? q[key].get<std::string>() : std::string(def);
-            };
-            if (q.contains("bits")) {
-                if (!q["bits"].is_number_integer()) return bad(ErrorCode::kBadFormat, "quantization.bits is not an integer");
-                const std::int64_t b = q["bits"].get<std::int64_t>();
-                if (b < kMinQuantBits || b > kMaxQuantBits) return bad(ErrorCode::kBadFormat, "quantization.bits out of range");
-                set.params.bits = static_cast<int>(b);
-            }
-            if (q.contains("sqrt")) {
-                if (!q["sqrt"].is_boolean()) return bad(ErrorCode::kBadFormat, "quantization.sqrt is not a boolean");
-                set.params.sqrt_encoding = q["sqrt"].get<bool>();
-            }
-            const std::string bound = str("l2Bound", "tight"), dc = str("dcFormat", "r11g11b10f"),
-                              zm = str("zonalMapping", "affine"), ax = str("axisMode", "luminance");
-            if (bound == "loose") set.params.l2_bound = L2Bound::kLoose;
-            else if (bound != "tight") return bad(ErrorCode::kUnsupported, "unknown l2Bound");
-            if (dc == "rgb9e5") set.params.dc_format = DcFormat::kRGB9E5;
-            else if (dc == "half") set.params.dc_format = DcFormat::kHalf;
-            else if (dc != "r11g11b10f") return bad(ErrorCode::kUnsupported, "unknown dcFormat");
-            if (zm == "zero") set.params.zonal_mapping = ZonalMapping::kZeroPreserving;
-            else if (zm == "symmetric") set.params.zonal_mapping = ZonalMapping::kSymmetric;
-            else if (zm != "affine") return bad(ErrorCode::kUnsupported, "unknown zonalMapping");
-            if (ax == "channel") set.params.axis_mode = ZonalAxisMode::kPerChannel;
-            else if (ax != "luminance") return bad(ErrorCode::kUnsupported, "unknown axisMode");
-        }
-        if (v.contains("luminanceWeights")) {
-            auto w = vec3(v, "luminanceWeights");
-            if (!w) return w.error();
-            set.params.luminance = {w->x, w->y, w->z};
-        }
-        auto pv = validate_quant_params(set.params, set.representation);
-        if (!pv) return bad(ErrorCode::kBadFormat, pv.error().message);
-
-        const std::string layout = v.contains("layout") && v["layout"].is_string() ? v["layout"].get<std::string>() : "";
-        const std::size_t size = codec->size_bytes;
-        const tinygltf::Model& m = in.model;
-        std::vector<std::array<float, 3>> gltf_positions;
-        if (v.contains("draco")) {
-            out.draco = true;
-            if (layout != "points") return bad(ErrorCode::kBadFormat, "draco needs layout points");
-            const json& d = v["draco"];
-            if (!d.is_object()) return bad(ErrorCode::kBadFormat, "draco is not an object");
-            auto view = index(d, "bufferView", m.bufferViews.size());
-            if (!view) return view.error();
-            const tinygltf::BufferView& bv = m.bufferViews[static_cast<size_t>(*view)];
-            if (bv.buffer < 0 || static_cast<size_t>(bv.buffer) >= m.buffers.size())
-                return bad(ErrorCode::kBadFormat, "draco bufferView: buffer index out of range");
-            const std::vector<unsigned char>& data = m.buffers[static_cast<size_t>(bv.buffer)].data;
-            if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
-                return bad(ErrorCode::kBadFormat, "draco bufferView range outside its buffer");
-            out.stored_bytes = bv.byteLength;
-            if (set.count > limits.max_buffer_bytes / size)
-                return bad(ErrorCode::kTooLarge, "Draco volume decodes to more than the buffer size limit");
-            if (!d.contains("attributes") || !d["attributes"].is_object()) return bad(ErrorCode::kBadFormat, "draco.attributes is not an object");
-            std::map<std::string, int> attrs;
-            for (auto a = d["attributes"].begin(); a != d["attributes"].end(); ++a) {
-                if (!a.value().is_number_unsigned() || a.value().get<std::uint64_t>() > 1000000)
-                    return bad(ErrorCode::kBadFormat, "draco.attributes." + a.key() + " is not a valid unique id");
-                attrs[a.key()] = a.value().get<int>();
-            }
-            auto decoded = decode_probe_point_cloud(std::span<const std::uint8_t>(data.data() + bv.byteOffset, bv.byteLength),
-                                                    set.representation, set.count, attrs, path + ": " + where);
-            if (!decoded) return decoded.error();
-            gltf_positions = std::move(decoded->positions);
-            set.payload = std::move(decoded->payload);
-        } else {
-            auto acc = index(v, "coefficients", m.accessors.size());
-            if (!acc) return acc.error();
-            Result<std::span<const std::uint8_t>> bytes =
-                is_float_vec3_encoding(set.representation)
-                    ? accessor_bytes(*acc, kFloat, TINYGLTF_TYPE_VEC3, set.count * (size / 12), "coefficients")
-                    : accessor_bytes(*acc, kUbyte, TINYGLTF_TYPE_SCALAR, set.count * size, "coefficients");
-            if (!bytes) return bytes.error();
-            set.payload.assign(bytes->begin(), bytes->end());
-            out.stored_bytes = bytes->size();
-            if (layout == "points") {
-                auto pacc = index(v, "positions", m.accessors.size());
-                if (!pacc) return pacc.error();
-                auto pb = accessor_bytes(*pacc, kFloat, TINYGLTF_TYPE_VEC3, set.count, "positions");
-                if (!pb) return pb.error();
-                gltf_positions.resize(set.count);
-                for (std::uint64_t i = 0; i < set.count; ++i)
-                    for (int k = 0; k < 3; ++k) {
-                        std::uint32_t bits = le32(pb->data() + i * 12 + static_cast<size_t>(k) * 4);
-                        std::memcpy(&gltf_positions[i][static_cast<size_t>(k)], &bits, 4);
-                    }
-                out.stored_bytes += pb->size();
-            }
-        }
-        if (layout == "grid") {
-            if (!v.contains("grid") || !v["grid"].is_object()) return bad(ErrorCode::kBadFormat, "layout grid without a grid object");
-            const json& g = v["grid"];
-            auto origin = vec3(g, "origin");
-            if (!origin) return origin.error();
-            auto spacing = vec3(g, "spacing");
-            if (!spacing) return spacing.error();
-            if (!g.contains("counts") || !g["counts"].is_array() || g["counts"].size() != 3) return bad(ErrorCode::kBadFormat, "grid.counts is not [nx, ny, nz]");
-            std::array<std::uint32_t, 3> gc{};
-            for (int k = 0; k < 3; ++k) {
-                const json& c = g["counts"][static_cast<size_t>(k)];
-                if (!c.is_number_unsigned() || c.get<std::uint64_t>() == 0 || c.get<std::uint64_t>() > 0xFFFFFFFFu)
-                    return bad(ErrorCode::kBadFormat, "grid.counts entries must be positive 32-bit integers");
-                gc[static_cast<size_t>(k)] = static_cast<std::uint32_t>(c.get<std::uint64_t>());
-            }
-            set.layout.kind = ProbeLayoutKind::kGrid;
-            set.layout.grid.origin = from_gltf(*origin);
-            set.layout.grid.spacing = from_gltf(*spacing);
-            set.layout.grid.counts = {gc[2], gc[0], gc[1]};  // glTF (y, z, x)_zhc
-            if (layout_probe_count(set.layout) != static_cast<std::int64_t>(set.count))
-                return bad(ErrorCode::kBadFormat, "grid counts do not multiply to count");
-            set.payload = reorder_grid(set.payload, size, set.layout.grid.counts, /*to_gltf_order=*/false);
-        } else if (layout == "points") {
-            set.layout.kind = ProbeLayoutKind::kPositions;
-            set.layout.positions.resize(gltf_positions.size());
-            for (size_t i = 0; i < gltf_positions.size(); ++i) {
-                for (float c : gltf_positions[i])
-                    if (!std::isfinite(c)) return bad(ErrorCode::kInvalidValue, "non-finite probe position " + std::to_string(i));
-                set.layout.positions[i] = from_gltf(gltf_positions[i]);
-            }
-        } else if (layout != "none") {
-            return bad(ErrorCode::kUnsupported, "layout must be grid, points or none");
-        }
-        auto valid = validate_probe_set(set);
-        if (!valid) return bad(ErrorCode::kBadFormat, valid.error().message);
-        if (out.sh_axes == GltfShAxes::kGltf) {
-            auto back = rotate_set(set, transpose(zhc_to_gltf_rotation()));
-            if (!back) return bad(ErrorCode::kBadFormat, back.error().message);
-            set = std::move(back).value();
-        }
-        return out;
-    }
-};
-
-}  // namespace
+using namespace gltf_detail;
 
 Mat3 zhc_to_gltf_rotation() {
     Mat3 r;
@@ -789,50 +527,6 @@ Mat3 zhc_to_gltf_rotation() {
 
 bool looks_like_glb(std::span<const std::uint8_t> bytes) { return bytes.size() >= 4 && le32(bytes.data()) == kGlbMagic; }
 
-Result<GltfSummary> read_gltf_probes(std::span<const std::uint8_t> bytes, const std::string& path, const GltfLimits& limits) {
-    auto loaded = load(bytes, path, limits);
-    if (!loaded) return loaded.error();
-    const Loaded& in = *loaded;
-    const tinygltf::Model& m = in.model;
-    GltfSummary s;
-    s.binary = in.binary;
-    s.generator = m.asset.generator;
-    s.meshes = m.meshes.size();
-    s.materials = m.materials.size();
-    s.nodes = m.nodes.size();
-    s.buffers = m.buffers.size();
-    s.accessors = m.accessors.size();
-    s.images = in.doc.contains("images") && in.doc["images"].is_array() ? in.doc["images"].size() : 0;
-    s.extensions_used = m.extensionsUsed;
-    s.extensions_required = m.extensionsRequired;
-    if (!in.doc.contains("extensions") || !in.doc["extensions"].is_object() || !in.doc["extensions"].contains(kGltfProbeExtension))
-        return s;
-    const json& ext = in.doc["extensions"][kGltfProbeExtension];
-    if (!ext.is_object() || !ext.contains("volumes") || !ext["volumes"].is_array())
-        return fail(ErrorCode::kBadFormat, path, std::string(kGltfProbeExtension) + ": volumes is not an array");
-    const json& vols = ext["volumes"];
-    for (size_t i = 0; i < vols.size(); ++i) {
-        VolumeReader r{in, path, limits, std::string(kGltfProbeExtension) + ".volumes[" + std::to_string(i) + "]"};
-        auto v = r.read(vols[i]);
-        if (!v) return v.error();
-        s.volumes.push_back(std::move(v).value());
-    }
-    if (in.doc.contains("nodes") && in.doc["nodes"].is_array()) {
-        const json& nodes = in.doc["nodes"];
-        for (size_t n = 0; n < nodes.size(); ++n) {
-            if (!nodes[n].is_object() || !nodes[n].contains("extensions") || !nodes[n]["extensions"].is_object() ||
-                !nodes[n]["extensions"].contains(kGltfProbeExtension))
-                continue;
-            const json& ne = nodes[n]["extensions"][kGltfProbeExtension];
-            if (!ne.is_object() || !ne.contains("volume") || !ne["volume"].is_number_unsigned() ||
-                ne["volume"].get<std::uint64_t>() >= s.volumes.size())
-                return fail(ErrorCode::kBadFormat, path, "nodes[" + std::to_string(n) + "]." + kGltfProbeExtension + ".volume is not a valid volume index");
-            s.volumes[ne["volume"].get<size_t>()].nodes.push_back(static_cast<int>(n));
-        }
-    }
-    return s;
-}
-
 Result<GltfRaw> load_gltf_raw(std::span<const std::uint8_t> bytes, const std::string& path, const GltfLimits& limits) {
     auto loaded = load(bytes, path, limits);
     if (!loaded) return loaded.error();
@@ -842,261 +536,6 @@ Result<GltfRaw> load_gltf_raw(std::span<const std::uint8_t> bytes, const std::st
     raw.buffers.reserve(loaded->model.buffers.size());
     for (tinygltf::Buffer& b : loaded->model.buffers) raw.buffers.push_back(std::move(b.data));
     return raw;
-}
-
-Result<GltfSummary> read_gltf_probes_file(const std::string& path, const GltfLimits& limits) {
-    auto bytes = read_file_bytes(path, limits.max_file_bytes);
-    if (!bytes) return bytes.error();
-    return read_gltf_probes(*bytes, path, limits);
-}
-
-namespace {
-
-// The MIME type of an image to embed: its mimeType, else from its first bytes.
-std::string image_mime(const json& image, const std::vector<std::uint8_t>& b) {
-    if (image.contains("mimeType") && image["mimeType"].is_string()) return image["mimeType"].get<std::string>();
-    auto starts = [&](std::initializer_list<int> m, size_t at = 0) {
-        if (b.size() < at + m.size()) return false;
-        size_t i = at;
-        for (int c : m)
-            if (b[i++] != c) return false;
-        return true;
-    };
-    if (starts({0x89, 'P', 'N', 'G'})) return "image/png";
-    if (starts({0xFF, 0xD8, 0xFF})) return "image/jpeg";
-    if (starts({'R', 'I', 'F', 'F'}) && starts({'W', 'E', 'B', 'P'}, 8)) return "image/webp";
-    if (starts({0xAB, 'K', 'T', 'X', ' ', '2', '0'})) return "image/ktx2";
-    return "";
-}
-
-// A relative URI for `rel` (a relative path): '/'-separated, percent-encoding all but RFC 3986
-// unreserved characters.
-std::string path_uri(const fs::path& rel) {
-    static const char* hex = "0123456789ABCDEF";
-    std::string out;
-    for (const char c : rel.generic_string()) {
-        const auto u = static_cast<unsigned char>(c);
-        if (std::isalnum(u) || c == '-' || c == '.' || c == '_' || c == '~' || c == '/') {
-            out.push_back(c);
-        } else {
-            out.push_back('%');
-            out.push_back(hex[u >> 4]);
-            out.push_back(hex[u & 15]);
-        }
-    }
-    return out;
-}
-
-// Images referenced by relative URIs, made to resolve from the output (GltfEmbedOptions::output_path).
-template <class AppendView>
-Status relocate_images(json& doc, const std::string& scene_path, const GltfEmbedOptions& options, const GltfLimits& limits,
-                       AppendView&& append_view) {
-    if (!doc.contains("images") || !doc["images"].is_array()) return Ok{};
-    std::error_code ec;
-    fs::path in_dir = fs::path(scene_path).parent_path();
-    if (in_dir.empty()) in_dir = ".";
-    fs::path out_dir = fs::absolute(fs::path(options.output_path), ec).parent_path();
-    const fs::path in_base = fs::weakly_canonical(in_dir, ec);
-    if (ec) return fail(ErrorCode::kIoError, scene_path, "cannot resolve the input's directory");
-    const fs::path out_base = fs::weakly_canonical(out_dir, ec);
-    if (ec) return fail(ErrorCode::kIoError, options.output_path, "cannot resolve the output's directory");
-    if (in_base == out_base) return Ok{};
-    std::uint64_t total = 0;
-    for (size_t i = 0; i < doc["images"].size(); ++i) {
-        json& image = doc["images"][i];
-        if (!image.is_object() || !image.contains("uri") || !image["uri"].is_string()) continue;
-        const std::string uri = image["uri"].get<std::string>();
-        if (uri.rfind("data:", 0) == 0) continue;
-        const std::string where = "images[" + std::to_string(i) + "].uri";
-        const fs::path file = fs::weakly_canonical(in_base / uri_path(uri), ec);
-        if (ec || !inside(in_base, file)) return fail(ErrorCode::kBadFormat, scene_path, "image '" + uri + "' resolves outside the input's directory (" + where + ")");
-        if (!fs::is_regular_file(file, ec))
-            return fail(ErrorCode::kIoError, scene_path, "referenced file '" + uri_path(uri) + "' not found in " + in_base.string() + " (" + where + ")");
-        if (inside(out_base, file)) {  // reachable from the output's folder without '..'
-            image["uri"] = path_uri(file.lexically_relative(out_base));
-            continue;
-        }
-        auto bytes = read_file_bytes(file.string(), limits.max_buffer_bytes);
-        if (!bytes) return bytes.error();
-        total += bytes->size();
-        if (total > limits.max_total_bytes) return fail(ErrorCode::kTooLarge, scene_path, "images to embed exceed the limit of " + std::to_string(limits.max_total_bytes) + " bytes");
-        const std::string mime = image_mime(image, *bytes);
-        if (mime.empty()) return fail(ErrorCode::kUnsupported, scene_path, "image '" + uri + "' has no mimeType and is not PNG, JPEG, WebP or KTX2: cannot embed it (" + where + ")");
-        image.erase("uri");
-        if (options.binary) {
-            image["bufferView"] = append_view(*bytes, "image " + std::to_string(i));
-            image["mimeType"] = mime;
-        } else {
-            image["uri"] = "data:" + mime + ";base64," + base64(*bytes);
-        }
-    }
-    return Ok{};
-}
-
-}  // namespace
-
-Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t> scene_bytes, const std::string& scene_path,
-                                                    const ProbeSet& input_set, const GltfEmbedOptions& options,
-                                                    const GltfLimits& limits) {
-    auto valid = validate_probe_set(input_set);
-    if (!valid) return valid.error();
-    if (options.draco && (input_set.layout.kind != ProbeLayoutKind::kPositions || !is_float_vec3_encoding(input_set.representation)))
-        return make_error(ErrorCode::kInvalidArgument, "--draco needs a probe set with explicit positions in a float encoding (sh3, sh2)");
-    auto loaded = load(scene_bytes, scene_path, limits);
-    if (!loaded) return loaded.error();
-    // The output is the input's own JSON (order and values kept by ordered_json) with our
-    // additions; tinygltf's model only supplies the bytes of each buffer.
-    json doc = loaded->doc;
-    const tinygltf::Model& m = loaded->model;
-    const Codec* codec = input_set.codec();
-    const std::size_t size = codec->size_bytes;
-
-    // The set as stored: SH axes, then glTF probe order and positions.
-    ProbeSet set = input_set;
-    if (options.sh_axes == GltfShAxes::kGltf) {
-        auto rotated = rotate_set(set, zhc_to_gltf_rotation());
-        if (!rotated) return rotated.error();
-        set = std::move(rotated).value();
-    }
-    json vol = json::object();
-    vol["name"] = options.name;
-    vol["encoding"] = set.representation;
-    vol["kind"] = set.params.kind == StoredKind::kIrradiance ? "irradiance" : "radiance";
-    vol["count"] = set.count;
-    vol["shAxes"] = options.sh_axes == GltfShAxes::kZhc ? "zhc" : "gltf";
-    PackedLayout packed;
-    if (packed_layout_from_name(set.representation, &packed)) {
-        const StorageParams& p = set.params;
-        vol["quantization"] = {{"bits", p.bits},
-                               {"sqrt", p.sqrt_encoding},
-                               {"l2Bound", p.l2_bound == L2Bound::kTight ? "tight" : "loose"},
-                               {"dcFormat", dc_name(p.dc_format)},
-                               {"zonalMapping", zonal_name(p.zonal_mapping)},
-                               {"axisMode", p.axis_mode == ZonalAxisMode::kLuminance ? "luminance" : "channel"}};
-    }
-    const LuminanceWeights defaults;
-    const LuminanceWeights& w = set.params.luminance;
-    if (w.r != defaults.r || w.g != defaults.g || w.b != defaults.b) vol["luminanceWeights"] = {w.r, w.g, w.b};
-
-    std::vector<std::uint8_t> payload = set.payload;
-    std::vector<std::array<float, 3>> positions;
-    switch (set.layout.kind) {
-        case ProbeLayoutKind::kGrid: {
-            const ProbeGrid& g = set.layout.grid;
-            const Vec3 o = to_gltf(g.origin), sp = to_gltf(g.spacing);
-            vol["layout"] = "grid";
-            vol["grid"] = {{"origin", {o.x, o.y, o.z}},
-                           {"spacing", {sp.x, sp.y, sp.z}},
-                           {"counts", {g.counts[1], g.counts[2], g.counts[0]}}};
-            payload = reorder_grid(payload, size, g.counts, /*to_gltf_order=*/true);
-            break;
-        }
-        case ProbeLayoutKind::kPositions:
-            vol["layout"] = "points";
-            positions.reserve(set.layout.positions.size());
-            for (const auto& p : set.layout.positions) positions.push_back(to_gltf(p));
-            break;
-        case ProbeLayoutKind::kNone: vol["layout"] = "none"; break;
-    }
-
-    // Buffers: GLB output keeps buffer 0 as the BIN chunk (its bytes stay a prefix) and appends
-    // there; .gltf output appends a new buffer. Every other buffer keeps its bytes; buffers that
-    // lived in a GLB chunk or an external file become data URIs so the output is self-contained.
-    if (!doc.contains("buffers")) doc["buffers"] = json::array();
-    if (!doc.contains("bufferViews")) doc["bufferViews"] = json::array();
-    if (!doc.contains("accessors")) doc["accessors"] = json::array();
-    json& buffers = doc["buffers"];
-    if (m.buffers.size() != buffers.size()) return fail(ErrorCode::kBadFormat, scene_path, "buffers could not all be loaded");
-    std::vector<std::uint8_t> target;  // the buffer we append to
-    std::size_t target_index = 0;
-    if (options.binary) {
-        if (buffers.empty()) buffers.push_back(json::object());
-        else target.assign(m.buffers[0].data.begin(), m.buffers[0].data.end());
-        target_index = 0;
-    } else {
-        target_index = buffers.size();
-        buffers.push_back(json{{"name", options.name}});
-    }
-    const auto& fallback = loaded->fallback_buffers;
-    if (options.binary && !fallback.empty() && fallback[0] == 0)
-        return fail(ErrorCode::kUnsupported, scene_path, "buffer 0 is a meshopt fallback buffer without bytes: embed into a .gltf output (buffers[0])");
-    for (std::size_t i = 0; i < m.buffers.size(); ++i) {
-        if (options.binary && i == 0) continue;
-        if (std::find(fallback.begin(), fallback.end(), i) != fallback.end()) continue;  // stays uri-less
-        json& b = buffers[i];
-        const bool data = b.contains("uri") && b["uri"].get<std::string>().rfind("data:", 0) == 0;
-        if (!data) b["uri"] = data_uri(m.buffers[i].data);
-    }
-    auto append_view = [&](const std::vector<std::uint8_t>& bytes, const std::string& name) {
-        while (target.size() % 8 != 0) target.push_back(0);
-        doc["bufferViews"].push_back(json{{"buffer", target_index}, {"byteOffset", target.size()}, {"byteLength", bytes.size()}, {"name", name}});
-        target.insert(target.end(), bytes.begin(), bytes.end());
-        return doc["bufferViews"].size() - 1;
-    };
-    auto add_accessor = [&](std::size_t view, int component, const char* type, std::size_t count, const std::string& name) {
-        doc["accessors"].push_back(json{{"bufferView", view}, {"componentType", component}, {"count", count}, {"type", type}, {"name", name}});
-        return doc["accessors"].size() - 1;
-    };
-    if (options.draco) {
-        auto encoded = encode_probe_point_cloud(positions, payload, set.representation, options.draco_bits);
-        if (!encoded) return encoded.error();
-        const std::size_t view = append_view(encoded->bytes, options.name + " draco");
-        json attrs = json::object();
-        for (const auto& [k, v] : encoded->attributes) attrs[k] = v;
-        vol["draco"] = {{"bufferView", view}, {"quantizationBits", options.draco_bits}, {"attributes", attrs}};
-    } else {
-        if (set.layout.kind == ProbeLayoutKind::kPositions) {
-            const std::size_t view = append_view(float_bytes(positions), options.name + " positions");
-            const std::size_t acc = add_accessor(view, kFloat, "VEC3", positions.size(), options.name + " positions");
-            std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-            for (const auto& p : positions)
-                for (size_t k = 0; k < 3; ++k) {
-                    lo[k] = std::min(lo[k], p[k]);
-                    hi[k] = std::max(hi[k], p[k]);
-                }
-            doc["accessors"][acc]["min"] = lo;
-            doc["accessors"][acc]["max"] = hi;
-            vol["positions"] = acc;
-        }
-        const std::size_t view = append_view(payload, options.name + " coefficients");
-        vol["coefficients"] = is_float_vec3_encoding(set.representation)
-                                  ? add_accessor(view, kFloat, "VEC3", set.count * (size / 12), options.name + " coefficients")
-                                  : add_accessor(view, kUbyte, "SCALAR", set.count * size, options.name + " coefficients");
-    }
-    if (!options.output_path.empty()) {
-        auto st = relocate_images(doc, scene_path, options, limits, append_view);
-        if (!st) return st.error();
-    }
-    while (target.size() % 4 != 0) target.push_back(0);
-    json& tb = buffers[target_index];
-    tb["byteLength"] = target.size();
-    if (options.binary) tb.erase("uri");
-    else tb["uri"] = data_uri(target);
-
-    // The extension object (volumes appended to any existing ones), extensionsUsed, the node.
-    if (!doc.contains("extensions") || !doc["extensions"].is_object()) doc["extensions"] = json::object();
-    json& ext = doc["extensions"][kGltfProbeExtension];
-    if (!ext.is_object()) ext = json::object();
-    if (!ext.contains("volumes") || !ext["volumes"].is_array()) ext["volumes"] = json::array();
-    const std::size_t volume_index = ext["volumes"].size();
-    ext["volumes"].push_back(vol);
-    if (!doc.contains("extensionsUsed") || !doc["extensionsUsed"].is_array()) doc["extensionsUsed"] = json::array();
-    json& used = doc["extensionsUsed"];
-    if (std::find(used.begin(), used.end(), json(kGltfProbeExtension)) == used.end()) used.push_back(kGltfProbeExtension);
-    if (options.add_node) {
-        if (!doc.contains("nodes") || !doc["nodes"].is_array()) doc["nodes"] = json::array();
-        doc["nodes"].push_back(json{{"name", options.name}, {"extensions", {{kGltfProbeExtension, {{"volume", volume_index}}}}}});
-        const std::size_t node = doc["nodes"].size() - 1;
-        if (doc.contains("scenes") && doc["scenes"].is_array())
-            for (json& scene : doc["scenes"]) {
-                if (!scene.is_object()) continue;
-                if (!scene.contains("nodes")) scene["nodes"] = json::array();
-                scene["nodes"].push_back(node);
-            }
-    }
-    if (options.binary) return make_glb(doc.dump(), target);
-    const std::string text = doc.dump(2) + "\n";
-    return std::vector<std::uint8_t>(text.begin(), text.end());
 }
 
 }  // namespace zhc

@@ -1,0 +1,77 @@
+// zhc/formats/probes/gltf_probes_internal.h — internal to formats/: what the three files of the
+// ZHC_light_probes implementation (docs/gltf-extension.md, glTF 2.0) share: the guarded tinygltf
+// load of an untrusted asset, GLB / data-URI writing, and the zhc <-> glTF frames.
+//   gltf_probes.cpp        untrusted input (GLB framing, URIs, sizes, file access), tinygltf load, frames
+//   gltf_probes_read.cpp   reading and validating the extension (volumes, accessors, Draco payloads)
+//   gltf_probes_write.cpp  embedding a probe set into an asset (buffers, accessors, images, GLB)
+#pragma once
+
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#include <tiny_gltf.h>
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "formats/io/le_bytes.h"
+#include "formats/probes/gltf_probes.h"
+
+namespace zhc::gltf_detail {
+
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+inline constexpr auto le32 = le::load32;
+
+inline constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
+inline constexpr int kUbyte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+
+// "<path>: <what>" as an error of `code`.
+Error fail(ErrorCode code, const std::string& path, const std::string& what);
+
+// The path a relative URI names (percent escapes decoded; call after the URI was accepted).
+std::string uri_path(const std::string& uri);
+// Whether `p` lies inside `base` (both canonical).
+bool inside(const fs::path& base, const fs::path& p);
+
+// GLB 2.0: header, JSON chunk padded with spaces, optional BIN chunk padded with zeros.
+std::vector<std::uint8_t> make_glb(const std::string& json_text, std::span<const std::uint8_t> bin);
+std::string base64(std::span<const std::uint8_t> b);
+std::string data_uri(std::span<const std::uint8_t> b);  // data:application/octet-stream;base64,...
+
+// An asset loaded from untrusted bytes: our own parse of its JSON and tinygltf's model (used for
+// buffer bytes only).
+struct Loaded {
+    json doc;
+    tinygltf::Model model;
+    bool binary = false;
+    std::vector<size_t> fallback_buffers;  // uri-less meshopt fallback buffers (no bytes loaded)
+};
+
+// Checks the framing, every URI and declared size, then loads the asset with tinygltf reading
+// only files inside the input's directory (see gltf_probes.cpp).
+Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path, const GltfLimits& limits);
+
+// Frames: (x, y, z)_glTF = (y, z, x)_zhc.
+std::array<float, 3> to_gltf(const std::array<float, 3>& p);
+std::array<float, 3> from_gltf(const std::array<float, 3>& p);
+Vec3 to_gltf(Vec3 v);
+Vec3 from_gltf(Vec3 v);
+
+// Whether the encoding's coefficients are stored as a VEC3 float accessor (else UNSIGNED_BYTE SCALAR).
+bool is_float_vec3_encoding(const std::string& name);
+
+// Re-encodes every probe after rotating it by r (decode -> rotate -> encode).
+Result<ProbeSet> rotate_set(const ProbeSet& set, const Mat3& r);
+
+// Grid probe order zhc (i fastest, zhc axes) <-> glTF (glTF x = zhc y fastest).
+std::vector<std::uint8_t> reorder_grid(const std::vector<std::uint8_t>& payload, std::size_t size,
+                                       const std::array<std::uint32_t, 3>& zc, bool to_gltf_order);
+
+}  // namespace zhc::gltf_detail

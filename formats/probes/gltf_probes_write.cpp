@@ -1,0 +1,297 @@
+// zhc/formats/probes/gltf_probes_write.cpp — embedding a probe set into a glTF 2.0 asset as the
+// ZHC_light_probes extension (docs/gltf-extension.md): the input's own JSON kept (order and values),
+// the probe data appended to the GLB binary buffer or a new data-URI buffer, accessors or a Draco
+// point cloud (gltf_draco.cpp), images the output could no longer reach relocated or embedded, and
+// the volume, extensionsUsed and a node added.
+#include "formats/probes/gltf_probes_internal.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+
+#include "formats/io/file_io.h"
+#include "formats/probes/gltf_draco.h"
+
+namespace zhc {
+using namespace gltf_detail;
+
+namespace {
+
+const char* dc_name(DcFormat f) {
+    switch (f) {
+        case DcFormat::kR11G11B10F: return "r11g11b10f";
+        case DcFormat::kRGB9E5: return "rgb9e5";
+        case DcFormat::kHalf: return "half";
+    }
+    return "r11g11b10f";
+}
+const char* zonal_name(ZonalMapping m) {
+    switch (m) {
+        case ZonalMapping::kAffine: return "affine";
+        case ZonalMapping::kZeroPreserving: return "zero";
+        case ZonalMapping::kSymmetric: return "symmetric";
+    }
+    return "affine";
+}
+
+std::vector<std::uint8_t> float_bytes(const std::vector<std::array<float, 3>>& v) {
+    std::vector<std::uint8_t> out(v.size() * 12);
+    for (size_t i = 0; i < v.size(); ++i)
+        for (int k = 0; k < 3; ++k) {
+            std::uint32_t bits;
+            std::memcpy(&bits, &v[i][static_cast<size_t>(k)], 4);
+            for (int b = 0; b < 4; ++b) out[i * 12 + static_cast<size_t>(k) * 4 + static_cast<size_t>(b)] = static_cast<std::uint8_t>(bits >> (8 * b));
+        }
+    return out;
+}
+
+
+// The MIME type of an image to embed: its mimeType, else from its first bytes.
+std::string image_mime(const json& image, const std::vector<std::uint8_t>& b) {
+    if (image.contains("mimeType") && image["mimeType"].is_string()) return image["mimeType"].get<std::string>();
+    auto starts = [&](std::initializer_list<int> m, size_t at = 0) {
+        if (b.size() < at + m.size()) return false;
+        size_t i = at;
+        for (int c : m)
+            if (b[i++] != c) return false;
+        return true;
+    };
+    if (starts({0x89, 'P', 'N', 'G'})) return "image/png";
+    if (starts({0xFF, 0xD8, 0xFF})) return "image/jpeg";
+    if (starts({'R', 'I', 'F', 'F'}) && starts({'W', 'E', 'B', 'P'}, 8)) return "image/webp";
+    if (starts({0xAB, 'K', 'T', 'X', ' ', '2', '0'})) return "image/ktx2";
+    return "";
+}
+
+// A relative URI for `rel` (a relative path): '/'-separated, percent-encoding all but RFC 3986
+// unreserved characters.
+std::string path_uri(const fs::path& rel) {
+    static const char* hex = "0123456789ABCDEF";
+    std::string out;
+    for (const char c : rel.generic_string()) {
+        const auto u = static_cast<unsigned char>(c);
+        if (std::isalnum(u) || c == '-' || c == '.' || c == '_' || c == '~' || c == '/') {
+            out.push_back(c);
+        } else {
+            out.push_back('%');
+            out.push_back(hex[u >> 4]);
+            out.push_back(hex[u & 15]);
+        }
+    }
+    return out;
+}
+
+// Images referenced by relative URIs, made to resolve from the output (GltfEmbedOptions::output_path).
+template <class AppendView>
+Status relocate_images(json& doc, const std::string& scene_path, const GltfEmbedOptions& options, const GltfLimits& limits,
+                       AppendView&& append_view) {
+    if (!doc.contains("images") || !doc["images"].is_array()) return Ok{};
+    std::error_code ec;
+    fs::path in_dir = fs::path(scene_path).parent_path();
+    if (in_dir.empty()) in_dir = ".";
+    fs::path out_dir = fs::absolute(fs::path(options.output_path), ec).parent_path();
+    const fs::path in_base = fs::weakly_canonical(in_dir, ec);
+    if (ec) return fail(ErrorCode::kIoError, scene_path, "cannot resolve the input's directory");
+    const fs::path out_base = fs::weakly_canonical(out_dir, ec);
+    if (ec) return fail(ErrorCode::kIoError, options.output_path, "cannot resolve the output's directory");
+    if (in_base == out_base) return Ok{};
+    std::uint64_t total = 0;
+    for (size_t i = 0; i < doc["images"].size(); ++i) {
+        json& image = doc["images"][i];
+        if (!image.is_object() || !image.contains("uri") || !image["uri"].is_string()) continue;
+        const std::string uri = image["uri"].get<std::string>();
+        if (uri.rfind("data:", 0) == 0) continue;
+        const std::string where = "images[" + std::to_string(i) + "].uri";
+        const fs::path file = fs::weakly_canonical(in_base / uri_path(uri), ec);
+        if (ec || !inside(in_base, file)) return fail(ErrorCode::kBadFormat, scene_path, "image '" + uri + "' resolves outside the input's directory (" + where + ")");
+        if (!fs::is_regular_file(file, ec))
+            return fail(ErrorCode::kIoError, scene_path, "referenced file '" + uri_path(uri) + "' not found in " + in_base.string() + " (" + where + ")");
+        if (inside(out_base, file)) {  // reachable from the output's folder without '..'
+            image["uri"] = path_uri(file.lexically_relative(out_base));
+            continue;
+        }
+        auto bytes = read_file_bytes(file.string(), limits.max_buffer_bytes);
+        if (!bytes) return bytes.error();
+        total += bytes->size();
+        if (total > limits.max_total_bytes) return fail(ErrorCode::kTooLarge, scene_path, "images to embed exceed the limit of " + std::to_string(limits.max_total_bytes) + " bytes");
+        const std::string mime = image_mime(image, *bytes);
+        if (mime.empty()) return fail(ErrorCode::kUnsupported, scene_path, "image '" + uri + "' has no mimeType and is not PNG, JPEG, WebP or KTX2: cannot embed it (" + where + ")");
+        image.erase("uri");
+        if (options.binary) {
+            image["bufferView"] = append_view(*bytes, "image " + std::to_string(i));
+            image["mimeType"] = mime;
+        } else {
+            image["uri"] = "data:" + mime + ";base64," + base64(*bytes);
+        }
+    }
+    return Ok{};
+}
+
+}  // namespace
+
+Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t> scene_bytes, const std::string& scene_path,
+                                                    const ProbeSet& input_set, const GltfEmbedOptions& options,
+                                                    const GltfLimits& limits) {
+    auto valid = validate_probe_set(input_set);
+    if (!valid) return valid.error();
+    if (options.draco && (input_set.layout.kind != ProbeLayoutKind::kPositions || !is_float_vec3_encoding(input_set.representation)))
+        return make_error(ErrorCode::kInvalidArgument, "--draco needs a probe set with explicit positions in a float encoding (sh3, sh2)");
+    auto loaded = load(scene_bytes, scene_path, limits);
+    if (!loaded) return loaded.error();
+    // The output is the input's own JSON (order and values kept by ordered_json) with our
+    // additions; tinygltf's model only supplies the bytes of each buffer.
+    json doc = loaded->doc;
+    const tinygltf::Model& m = loaded->model;
+    const Codec* codec = input_set.codec();
+    const std::size_t size = codec->size_bytes;
+
+    // The set as stored: SH axes, then glTF probe order and positions.
+    ProbeSet set = input_set;
+    if (options.sh_axes == GltfShAxes::kGltf) {
+        auto rotated = rotate_set(set, zhc_to_gltf_rotation());
+        if (!rotated) return rotated.error();
+        set = std::move(rotated).value();
+    }
+    json vol = json::object();
+    vol["name"] = options.name;
+    vol["encoding"] = set.representation;
+    vol["kind"] = set.params.kind == StoredKind::kIrradiance ? "irradiance" : "radiance";
+    vol["count"] = set.count;
+    vol["shAxes"] = options.sh_axes == GltfShAxes::kZhc ? "zhc" : "gltf";
+    PackedLayout packed;
+    if (packed_layout_from_name(set.representation, &packed)) {
+        const StorageParams& p = set.params;
+        vol["quantization"] = {{"bits", p.bits},
+                               {"sqrt", p.sqrt_encoding},
+                               {"l2Bound", p.l2_bound == L2Bound::kTight ? "tight" : "loose"},
+                               {"dcFormat", dc_name(p.dc_format)},
+                               {"zonalMapping", zonal_name(p.zonal_mapping)},
+                               {"axisMode", p.axis_mode == ZonalAxisMode::kLuminance ? "luminance" : "channel"}};
+    }
+    const LuminanceWeights defaults;
+    const LuminanceWeights& w = set.params.luminance;
+    if (w.r != defaults.r || w.g != defaults.g || w.b != defaults.b) vol["luminanceWeights"] = {w.r, w.g, w.b};
+
+    std::vector<std::uint8_t> payload = set.payload;
+    std::vector<std::array<float, 3>> positions;
+    switch (set.layout.kind) {
+        case ProbeLayoutKind::kGrid: {
+            const ProbeGrid& g = set.layout.grid;
+            const Vec3 o = to_gltf(g.origin), sp = to_gltf(g.spacing);
+            vol["layout"] = "grid";
+            vol["grid"] = {{"origin", {o.x, o.y, o.z}},
+                           {"spacing", {sp.x, sp.y, sp.z}},
+                           {"counts", {g.counts[1], g.counts[2], g.counts[0]}}};
+            payload = reorder_grid(payload, size, g.counts, /*to_gltf_order=*/true);
+            break;
+        }
+        case ProbeLayoutKind::kPositions:
+            vol["layout"] = "points";
+            positions.reserve(set.layout.positions.size());
+            for (const auto& p : set.layout.positions) positions.push_back(to_gltf(p));
+            break;
+        case ProbeLayoutKind::kNone: vol["layout"] = "none"; break;
+    }
+
+    // Buffers: GLB output keeps buffer 0 as the BIN chunk (its bytes stay a prefix) and appends
+    // there; .gltf output appends a new buffer. Every other buffer keeps its bytes; buffers that
+    // lived in a GLB chunk or an external file become data URIs so the output is self-contained.
+    if (!doc.contains("buffers")) doc["buffers"] = json::array();
+    if (!doc.contains("bufferViews")) doc["bufferViews"] = json::array();
+    if (!doc.contains("accessors")) doc["accessors"] = json::array();
+    json& buffers = doc["buffers"];
+    if (m.buffers.size() != buffers.size()) return fail(ErrorCode::kBadFormat, scene_path, "buffers could not all be loaded");
+    std::vector<std::uint8_t> target;  // the buffer we append to
+    std::size_t target_index = 0;
+    if (options.binary) {
+        if (buffers.empty()) buffers.push_back(json::object());
+        else target.assign(m.buffers[0].data.begin(), m.buffers[0].data.end());
+        target_index = 0;
+    } else {
+        target_index = buffers.size();
+        buffers.push_back(json{{"name", options.name}});
+    }
+    const auto& fallback = loaded->fallback_buffers;
+    if (options.binary && !fallback.empty() && fallback[0] == 0)
+        return fail(ErrorCode::kUnsupported, scene_path, "buffer 0 is a meshopt fallback buffer without bytes: embed into a .gltf output (buffers[0])");
+    for (std::size_t i = 0; i < m.buffers.size(); ++i) {
+        if (options.binary && i == 0) continue;
+        if (std::find(fallback.begin(), fallback.end(), i) != fallback.end()) continue;  // stays uri-less
+        json& b = buffers[i];
+        const bool data = b.contains("uri") && b["uri"].get<std::string>().rfind("data:", 0) == 0;
+        if (!data) b["uri"] = data_uri(m.buffers[i].data);
+    }
+    auto append_view = [&](const std::vector<std::uint8_t>& bytes, const std::string& name) {
+        while (target.size() % 8 != 0) target.push_back(0);
+        doc["bufferViews"].push_back(json{{"buffer", target_index}, {"byteOffset", target.size()}, {"byteLength", bytes.size()}, {"name", name}});
+        target.insert(target.end(), bytes.begin(), bytes.end());
+        return doc["bufferViews"].size() - 1;
+    };
+    auto add_accessor = [&](std::size_t view, int component, const char* type, std::size_t count, const std::string& name) {
+        doc["accessors"].push_back(json{{"bufferView", view}, {"componentType", component}, {"count", count}, {"type", type}, {"name", name}});
+        return doc["accessors"].size() - 1;
+    };
+    if (options.draco) {
+        auto encoded = encode_probe_point_cloud(positions, payload, set.representation, options.draco_bits);
+        if (!encoded) return encoded.error();
+        const std::size_t view = append_view(encoded->bytes, options.name + " draco");
+        json attrs = json::object();
+        for (const auto& [k, v] : encoded->attributes) attrs[k] = v;
+        vol["draco"] = {{"bufferView", view}, {"quantizationBits", options.draco_bits}, {"attributes", attrs}};
+    } else {
+        if (set.layout.kind == ProbeLayoutKind::kPositions) {
+            const std::size_t view = append_view(float_bytes(positions), options.name + " positions");
+            const std::size_t acc = add_accessor(view, kFloat, "VEC3", positions.size(), options.name + " positions");
+            std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+            for (const auto& p : positions)
+                for (size_t k = 0; k < 3; ++k) {
+                    lo[k] = std::min(lo[k], p[k]);
+                    hi[k] = std::max(hi[k], p[k]);
+                }
+            doc["accessors"][acc]["min"] = lo;
+            doc["accessors"][acc]["max"] = hi;
+            vol["positions"] = acc;
+        }
+        const std::size_t view = append_view(payload, options.name + " coefficients");
+        vol["coefficients"] = is_float_vec3_encoding(set.representation)
+                                  ? add_accessor(view, kFloat, "VEC3", set.count * (size / 12), options.name + " coefficients")
+                                  : add_accessor(view, kUbyte, "SCALAR", set.count * size, options.name + " coefficients");
+    }
+    if (!options.output_path.empty()) {
+        auto st = relocate_images(doc, scene_path, options, limits, append_view);
+        if (!st) return st.error();
+    }
+    while (target.size() % 4 != 0) target.push_back(0);
+    json& tb = buffers[target_index];
+    tb["byteLength"] = target.size();
+    if (options.binary) tb.erase("uri");
+    else tb["uri"] = data_uri(target);
+
+    // The extension object (volumes appended to any existing ones), extensionsUsed, the node.
+    if (!doc.contains("extensions") || !doc["extensions"].is_object()) doc["extensions"] = json::object();
+    json& ext = doc["extensions"][kGltfProbeExtension];
+    if (!ext.is_object()) ext = json::object();
+    if (!ext.contains("volumes") || !ext["volumes"].is_array()) ext["volumes"] = json::array();
+    const std::size_t volume_index = ext["volumes"].size();
+    ext["volumes"].push_back(vol);
+    if (!doc.contains("extensionsUsed") || !doc["extensionsUsed"].is_array()) doc["extensionsUsed"] = json::array();
+    json& used = doc["extensionsUsed"];
+    if (std::find(used.begin(), used.end(), json(kGltfProbeExtension)) == used.end()) used.push_back(kGltfProbeExtension);
+    if (options.add_node) {
+        if (!doc.contains("nodes") || !doc["nodes"].is_array()) doc["nodes"] = json::array();
+        doc["nodes"].push_back(json{{"name", options.name}, {"extensions", {{kGltfProbeExtension, {{"volume", volume_index}}}}}});
+        const std::size_t node = doc["nodes"].size() - 1;
+        if (doc.contains("scenes") && doc["scenes"].is_array())
+            for (json& scene : doc["scenes"]) {
+                if (!scene.is_object()) continue;
+                if (!scene.contains("nodes")) scene["nodes"] = json::array();
+                scene["nodes"].push_back(node);
+            }
+    }
+    if (options.binary) return make_glb(doc.dump(), target);
+    const std::string text = doc.dump(2) + "\n";
+    return std::vector<std::uint8_t>(text.begin(), text.end());
+}
+
+}  // namespace zhc
