@@ -1,0 +1,315 @@
+// zhc/formats/scene/scene_gltf_geometry.cpp — the mesh primitives of a glTF 2.0 scene as triangle
+// occluders (docs/scene.md "glTF input"): TRIANGLES / TRIANGLE_STRIP / TRIANGLE_FAN (glTF 2.0 spec
+// 3.7.2.1), accessors and buffer views bound-checked, POSITION as FLOAT or KHR_mesh_quantization
+// integers, EXT_/KHR_meshopt_compression buffer views (gltf_meshopt.cpp) and
+// KHR_draco_mesh_compression primitives (gltf_draco.cpp).
+#include "formats/scene/scene_gltf_reader.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include "formats/probes/gltf_draco.h"
+#include "formats/probes/gltf_meshopt.h"
+
+namespace zhc::scene_gltf_detail {
+
+// ---- meshes -------------------------------------------------------------------------------
+
+// The meshopt extension object of a bufferView (EXT_ or KHR_meshopt_compression), or null.
+const json* Reader::meshopt_ext(const json& v, std::string* name) const {
+    if (!v.contains("extensions") || !v["extensions"].is_object()) return nullptr;
+    for (const char* n : {"KHR_meshopt_compression", "EXT_meshopt_compression"})
+        if (v["extensions"].contains(n)) {
+            *name = n;
+            return &v["extensions"][n];
+        }
+    return nullptr;
+}
+
+// A compressed view decoded: sizes checked against the limits and against what the compressed
+// bytes can hold (every codec spends at least 1 bit per 16 output bytes... in practice the
+// bound below: 128 output bytes per input byte plus a 4 KiB tail) before anything is allocated.
+std::vector<std::uint8_t> Reader::decode_meshopt(const json& e, std::uint64_t v_len, const std::string& ep) {
+    if (!e.is_object()) fail(ErrorCode::kInvalidValue, ep, "must be an object");
+    const size_t bi = index(e.contains("buffer") ? e["buffer"] : json(), ep + ".buffer", raw_.buffers.size(), "buffers");
+    const std::uint64_t off = count_field(e, "byteOffset", ep, 0), len = count_field(e, "byteLength", ep, ~0ull);
+    const std::uint64_t stride = count_field(e, "byteStride", ep, ~0ull), n = count_field(e, "count", ep, ~0ull);
+    MeshoptView mv;
+    mv.count = n;
+    mv.stride = stride;
+    if (!e.contains("mode") || !e["mode"].is_string()) fail(ErrorCode::kInvalidValue, ep + ".mode", "missing or not a string");
+    const std::string mode = e["mode"].get<std::string>();
+    if (mode == "ATTRIBUTES") mv.mode = MeshoptMode::kAttributes;
+    else if (mode == "TRIANGLES") mv.mode = MeshoptMode::kTriangles;
+    else if (mode == "INDICES") mv.mode = MeshoptMode::kIndices;
+    else fail(ErrorCode::kUnsupported, ep + ".mode", "unknown meshopt mode \"" + mode + "\" (known: ATTRIBUTES, TRIANGLES, INDICES)");
+    if (e.contains("filter")) {
+        if (!e["filter"].is_string()) fail(ErrorCode::kInvalidValue, ep + ".filter", "must be a string");
+        const std::string f = e["filter"].get<std::string>();
+        if (f == "NONE") mv.filter = MeshoptFilter::kNone;
+        else if (f == "OCTAHEDRAL") mv.filter = MeshoptFilter::kOctahedral;
+        else if (f == "QUATERNION") mv.filter = MeshoptFilter::kQuaternion;
+        else if (f == "EXPONENTIAL") mv.filter = MeshoptFilter::kExponential;
+        else fail(ErrorCode::kUnsupported, ep + ".filter", "unknown meshopt filter \"" + f + "\" (known: NONE, OCTAHEDRAL, QUATERNION, EXPONENTIAL)");
+    }
+    if (const std::string why = meshopt_view_problem(mv); !why.empty()) fail(ErrorCode::kInvalidValue, ep, why);
+    if (n > gltf_limits_.max_buffer_bytes / stride)
+        fail(ErrorCode::kTooLarge, ep, "decoded size above the buffer limit of " + std::to_string(gltf_limits_.max_buffer_bytes) + " bytes");
+    const std::uint64_t size = n * stride;
+    if (size != v_len)
+        fail(ErrorCode::kInvalidValue, ep, "count x byteStride = " + std::to_string(size) + " differs from the bufferView's byteLength " + std::to_string(v_len));
+    const auto& buf = raw_.buffers[bi];
+    if (off > buf.size() || len > buf.size() - off)
+        fail(ErrorCode::kInvalidValue, ep, "byte range [" + std::to_string(off) + ", +" + std::to_string(len) + ") outside buffer " + std::to_string(bi) + " (" + std::to_string(buf.size()) + " bytes)");
+    if (size > len * 128 + 4096)
+        fail(ErrorCode::kInvalidValue, ep, std::to_string(len) + " compressed bytes cannot hold the " + std::to_string(size) + " bytes declared");
+    decoded_total_ += size;
+    if (decoded_total_ > gltf_limits_.max_total_bytes)
+        fail(ErrorCode::kTooLarge, ep, "decoded buffer views exceed the limit of " + std::to_string(gltf_limits_.max_total_bytes) + " bytes");
+    auto r = decode_meshopt_view(std::span<const std::uint8_t>(buf.data() + off, static_cast<size_t>(len)), mv, ep);
+    if (!r) throw Fail{make_error(r.error().code, path_ + ": " + r.error().message)};
+    return std::move(r).value();
+}
+
+// The bytes of bufferView `vi`: a range of its buffer, or the decoded bytes of a compressed view.
+std::span<const std::uint8_t> Reader::view_bytes(size_t vi, const std::string& vp) {
+    const json& v = array_of(doc_, "bufferViews")[vi];
+    if (!v.is_object()) fail(ErrorCode::kInvalidValue, vp, "must be an object");
+    const std::uint64_t v_len = count_field(v, "byteLength", vp, ~0ull);
+    std::string ext;
+    if (const json* mo = meshopt_ext(v, &ext)) {
+        auto it = decoded_.find(vi);
+        if (it == decoded_.end()) it = decoded_.emplace(vi, decode_meshopt(*mo, v_len, vp + ".extensions." + ext)).first;
+        return it->second;
+    }
+    const size_t bi = index(v.contains("buffer") ? v["buffer"] : json(), vp + ".buffer", raw_.buffers.size(), "buffers");
+    const std::uint64_t v_off = count_field(v, "byteOffset", vp, 0);
+    const auto& buf = raw_.buffers[bi];
+    if (v_off > buf.size() || v_len > buf.size() - v_off)
+        fail(ErrorCode::kInvalidValue, vp, "byte range [" + std::to_string(v_off) + ", +" + std::to_string(v_len) + ") outside buffer " + std::to_string(bi) + " (" + std::to_string(buf.size()) + " bytes)");
+    return {buf.data() + v_off, static_cast<size_t>(v_len)};
+}
+
+// The bytes of accessor `ai` (after its byteOffset) and the stride, bound-checked for `count`
+// elements of `elem` bytes.
+Reader::View Reader::accessor_view(size_t ai, std::uint64_t count, std::uint64_t elem, const std::string& ap) {
+    const json& acc = array_of(doc_, "accessors")[ai];
+    if (!acc.contains("bufferView")) fail(ErrorCode::kUnsupported, ap, "accessor without a bufferView (all zeros) is not read");
+    const json& views = array_of(doc_, "bufferViews");
+    const size_t vi = index(acc["bufferView"], ap + ".bufferView", views.size(), "bufferViews");
+    const std::string vp = at("bufferViews", vi);
+    const std::span<const std::uint8_t> bytes = view_bytes(vi, vp);
+    const json& v = views[vi];
+    const std::uint64_t v_len = bytes.size();
+    const std::uint64_t stride = v.contains("byteStride") ? count_field(v, "byteStride", vp, 0) : elem;
+    if (stride < elem || stride > 252) fail(ErrorCode::kInvalidValue, vp + ".byteStride", "must be in [" + std::to_string(elem) + ", 252]");
+    const std::uint64_t a_off = count_field(acc, "byteOffset", ap, 0);
+    // count >= 1 here; the last element ends at a_off + stride (count - 1) + elem.
+    if (a_off > v_len || (count - 1) > (v_len - a_off) / stride || (count - 1) * stride + elem > v_len - a_off)
+        fail(ErrorCode::kInvalidValue, ap, std::to_string(count) + " elements run past the end of " + vp);
+    return {bytes.data() + a_off, v_len - a_off, stride};
+}
+
+std::uint64_t Reader::count_field(const json& obj, const char* key, const std::string& where, std::uint64_t fallback) const {
+    if (!obj.contains(key)) {
+        if (fallback == ~0ull) fail(ErrorCode::kInvalidValue, where + "." + key, "missing required field");
+        return fallback;
+    }
+    return count(obj, key, where, true, 0);
+}
+
+const json& Reader::accessor(size_t ai, const std::string& ap) const {
+    const json& acc = array_of(doc_, "accessors")[ai];
+    if (!acc.is_object()) fail(ErrorCode::kInvalidValue, ap, "must be an object");
+    if (acc.contains("sparse")) fail(ErrorCode::kUnsupported, ap, "sparse accessors are not read as occluders");
+    return acc;
+}
+
+// POSITION values: FLOAT, or (KHR_mesh_quantization) BYTE/UNSIGNED_BYTE/SHORT/UNSIGNED_SHORT,
+// normalized or not (glTF 2.0 spec 3.11: signed c / (2^(n-1) - 1) clamped at -1, unsigned
+// c / (2^n - 1)); transformed by `world` into zhc axes and bound-checked for finiteness.
+std::vector<Vec3> Reader::read_positions(size_t pa, std::uint64_t nv, const Mat4& world) {
+    const std::string pap = at("accessors", pa);
+    const json& pacc = accessor(pa, pap);
+    if (!pacc.contains("type") || pacc["type"] != "VEC3") fail(ErrorCode::kInvalidValue, pap, "POSITION must be a VEC3 accessor");
+    const std::uint64_t ct = count(pacc, "componentType", pap, true, 0);
+    const bool normalized = pacc.contains("normalized") && pacc["normalized"].is_boolean() && pacc["normalized"].get<bool>();
+    const std::uint64_t csize = ct == kFloat ? 4 : ct == kByte || ct == kUbyte ? 1 : ct == kShort || ct == kUshort ? 2 : 0;
+    if (csize == 0) fail(ErrorCode::kUnsupported, pap + ".componentType", "POSITION must be FLOAT, BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT (got " + std::to_string(ct) + ")");
+    if (ct == kFloat && normalized) fail(ErrorCode::kInvalidValue, pap + ".normalized", "a FLOAT accessor cannot be normalized");
+    const View pv = accessor_view(pa, nv, 3 * csize, pap);
+    std::vector<Vec3> verts(nv);
+    for (std::uint64_t i = 0; i < nv; ++i) {
+        const std::uint8_t* e = pv.data + i * pv.stride;
+        double f[3];
+        for (int k = 0; k < 3; ++k) {
+            const std::uint8_t* c = e + csize * static_cast<std::uint64_t>(k);
+            switch (ct) {
+                case kFloat: {
+                    const std::uint32_t bits = le32(c);
+                    float x;
+                    std::memcpy(&x, &bits, 4);
+                    f[k] = x;
+                    break;
+                }
+                case kByte: f[k] = normalized ? std::max(static_cast<std::int8_t>(c[0]) / 127.0, -1.0) : static_cast<std::int8_t>(c[0]); break;
+                case kUbyte: f[k] = normalized ? c[0] / 255.0 : c[0]; break;
+                case kShort: {
+                    const auto v = static_cast<std::int16_t>(static_cast<std::uint16_t>(c[0] | c[1] << 8));
+                    f[k] = normalized ? std::max(v / 32767.0, -1.0) : v;
+                    break;
+                }
+                default: {
+                    const std::uint16_t v = static_cast<std::uint16_t>(c[0] | c[1] << 8);
+                    f[k] = normalized ? v / 65535.0 : v;
+                    break;
+                }
+            }
+        }
+        if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2]))
+            fail(ErrorCode::kInvalidValue, pap, "vertex " + std::to_string(i) + " is not finite");
+        verts[i] = transformed(world, {f[0], f[1], f[2]}, pap, i);
+    }
+    return verts;
+}
+
+Vec3 Reader::transformed(const Mat4& world, Vec3 p, const std::string& where, std::uint64_t i) {
+    const Vec3 v = from_gltf(point(world, p));
+    if (!finite3(v)) fail(ErrorCode::kInvalidValue, where, "transformed vertex " + std::to_string(i) + " is not finite");
+    for (int a = 0; a < 3; ++a) {
+        lo_[a] = std::min(lo_[a], v[a]);
+        hi_[a] = std::max(hi_[a], v[a]);
+    }
+    return v;
+}
+
+// Triangles of a TRIANGLES / TRIANGLE_STRIP / TRIANGLE_FAN element list (glTF 2.0 spec
+// 3.7.2.1): strip triangle i is (v_i, v_{i+1}, v_{i+2}) for even i and (v_{i+1}, v_i, v_{i+2})
+// for odd i (winding kept), fan triangle i is (v_{i+1}, v_{i+2}, v_0). Triangles that repeat an
+// index (the joins between strips) are dropped: they have no area.
+void Reader::add_triangles(const std::vector<Vec3>& verts, const std::vector<std::uint32_t>& idx, std::uint64_t mode) {
+    auto add = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+        if (mode != 4 && (a == b || b == c || a == c)) return;
+        occluders_.push_back(triangle_occluder(verts[a], verts[b], verts[c]));
+    };
+    const size_t n = idx.size();
+    if (mode == 4) {
+        for (size_t t = 0; t + 2 < n; t += 3) add(idx[t], idx[t + 1], idx[t + 2]);
+    } else if (mode == 5) {
+        for (size_t i = 0; i + 2 < n; ++i) {
+            if (i % 2 == 0) add(idx[i], idx[i + 1], idx[i + 2]);
+            else add(idx[i + 1], idx[i], idx[i + 2]);
+        }
+    } else {
+        for (size_t i = 0; i + 2 < n; ++i) add(idx[i + 1], idx[i + 2], idx[0]);
+    }
+}
+
+void Reader::count_triangles(std::uint64_t t, const std::string& pp) {
+    triangles_ += t;
+    if (triangles_ > options_.limits.max_triangles)
+        fail(ErrorCode::kTooLarge, pp, "mesh triangles (with instances) exceed the limit of " + std::to_string(options_.limits.max_triangles));
+}
+
+// KHR_draco_mesh_compression: the primitive's geometry from its Draco stream.
+void Reader::add_draco(const json& prim, const json& ext, const std::string& pp, std::uint64_t mode, const Mat4& world) {
+    const std::string ep = pp + ".extensions.KHR_draco_mesh_compression";
+    if (!ext.is_object()) fail(ErrorCode::kInvalidValue, ep, "must be an object");
+    if (mode != 4) fail(ErrorCode::kUnsupported, pp + ".mode", "Draco-compressed primitives are read as TRIANGLES only");
+    const size_t n_acc = array_of(doc_, "accessors").size();
+    const size_t pa = index(prim["attributes"]["POSITION"], pp + ".attributes.POSITION", n_acc, "accessors");
+    const std::uint64_t nv = count(accessor(pa, at("accessors", pa)), "count", at("accessors", pa), true, 0);
+    std::uint64_t ni = nv;
+    if (prim.contains("indices")) {
+        const size_t ia = index(prim["indices"], pp + ".indices", n_acc, "accessors");
+        ni = count(accessor(ia, at("accessors", ia)), "count", at("accessors", ia), true, 0);
+    }
+    if (ni % 3 != 0) fail(ErrorCode::kInvalidValue, pp, "TRIANGLES need a multiple of 3 indices (got " + std::to_string(ni) + ")");
+    count_triangles(ni / 3, pp);
+    if (nv > options_.limits.max_triangles * 3) fail(ErrorCode::kTooLarge, pp, std::to_string(nv) + " Draco points exceed 3 x the triangle limit");
+    if (!ext.contains("attributes") || !ext["attributes"].is_object() || !ext["attributes"].contains("POSITION") ||
+        !ext["attributes"]["POSITION"].is_number_integer())
+        fail(ErrorCode::kInvalidValue, ep + ".attributes.POSITION", "missing or not an integer");
+    const std::int64_t pid = ext["attributes"]["POSITION"].get<std::int64_t>();
+    if (pid < 0 || pid > std::numeric_limits<int>::max()) fail(ErrorCode::kInvalidValue, ep + ".attributes.POSITION", "not a Draco attribute id");
+    const json& views = array_of(doc_, "bufferViews");
+    const size_t vi = index(ext.contains("bufferView") ? ext["bufferView"] : json(), ep + ".bufferView", views.size(), "bufferViews");
+    const std::span<const std::uint8_t> bytes = view_bytes(vi, at("bufferViews", vi));
+    auto mesh = decode_draco_mesh(bytes, static_cast<int>(pid), nv, ni / 3, ep);
+    if (!mesh) throw Fail{make_error(mesh.error().code, path_ + ": " + mesh.error().message)};
+    std::vector<Vec3> verts(mesh->positions.size());
+    for (size_t i = 0; i < verts.size(); ++i) {
+        const auto& q = mesh->positions[i];
+        if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
+            fail(ErrorCode::kInvalidValue, ep, "Draco vertex " + std::to_string(i) + " is not finite");
+        verts[i] = transformed(world, {q[0], q[1], q[2]}, ep, i);
+    }
+    std::vector<std::uint32_t> idx;
+    idx.reserve(mesh->faces.size() * 3);
+    for (const auto& f : mesh->faces) idx.insert(idx.end(), f.begin(), f.end());
+    add_triangles(verts, idx, 4);
+}
+
+void Reader::add_mesh(size_t mi, const Mat4& world) {
+    const std::string mp = at("meshes", mi);
+    const json& mesh = array_of(doc_, "meshes")[mi];
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array())
+        fail(ErrorCode::kInvalidValue, mp + ".primitives", "missing or not an array");
+    const json& prims = mesh["primitives"];
+    const size_t n_acc = array_of(doc_, "accessors").size();
+    for (size_t pi = 0; pi < prims.size(); ++pi) {
+        const std::string pp = at(mp + ".primitives", pi);
+        const json& prim = prims[pi];
+        if (!prim.is_object()) fail(ErrorCode::kInvalidValue, pp, "must be an object");
+        const std::uint64_t mode = count(prim, "mode", pp, false, 4);
+        if (mode <= 3) continue;  // POINTS, LINES, LINE_LOOP, LINE_STRIP: no area, block nothing
+        if (mode > 6) fail(ErrorCode::kInvalidValue, pp + ".mode", "unknown primitive mode " + std::to_string(mode));
+        if (!prim.contains("attributes") || !prim["attributes"].is_object() || !prim["attributes"].contains("POSITION"))
+            fail(ErrorCode::kInvalidValue, pp + ".attributes.POSITION", "missing");
+        if (prim.contains("extensions") && prim["extensions"].is_object() && prim["extensions"].contains("KHR_draco_mesh_compression")) {
+            add_draco(prim, prim["extensions"]["KHR_draco_mesh_compression"], pp, mode, world);
+            continue;
+        }
+        const size_t pa = index(prim["attributes"]["POSITION"], pp + ".attributes.POSITION", n_acc, "accessors");
+        const std::string pap = at("accessors", pa);
+        const std::uint64_t nv = count(accessor(pa, pap), "count", pap, true, 0);
+        if (nv == 0) continue;
+        // Triangles of this primitive, checked against the limit before anything is decoded.
+        std::uint64_t ni = nv;
+        size_t ia = 0;
+        const bool indexed = prim.contains("indices");
+        if (indexed) {
+            ia = index(prim["indices"], pp + ".indices", n_acc, "accessors");
+            ni = count(accessor(ia, at("accessors", ia)), "count", at("accessors", ia), true, 0);
+        }
+        if (mode == 4 && ni % 3 != 0)
+            fail(ErrorCode::kInvalidValue, indexed ? at("accessors", ia) : pap,
+                 "TRIANGLES need a multiple of 3 " + std::string(indexed ? "indices" : "vertices") + " (got " + std::to_string(ni) + ")");
+        count_triangles(triangle_count(mode, ni), pp);
+        if (triangle_count(mode, ni) == 0) continue;
+        if (nv > options_.limits.max_triangles * 3) fail(ErrorCode::kTooLarge, pap, std::to_string(nv) + " vertices exceed 3 x the triangle limit");
+        const std::vector<Vec3> verts = read_positions(pa, nv, world);
+        std::vector<std::uint32_t> idx(ni);
+        if (indexed) {
+            const std::string iap = at("accessors", ia);
+            const json& iacc = array_of(doc_, "accessors")[ia];
+            if (!iacc.contains("type") || iacc["type"] != "SCALAR") fail(ErrorCode::kInvalidValue, iap, "indices must be a SCALAR accessor");
+            const std::uint64_t ct = count(iacc, "componentType", iap, true, 0);
+            const std::uint64_t size = ct == kUbyte ? 1 : ct == kUshort ? 2 : ct == kUint ? 4 : 0;
+            if (size == 0) fail(ErrorCode::kInvalidValue, iap + ".componentType", "indices must be UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT");
+            const View iv = accessor_view(ia, ni, size, iap);
+            for (std::uint64_t i = 0; i < ni; ++i) {
+                const std::uint8_t* e = iv.data + i * iv.stride;
+                const std::uint32_t v = size == 1 ? e[0] : size == 2 ? std::uint32_t(e[0] | e[1] << 8) : le32(e);
+                if (v >= nv) fail(ErrorCode::kInvalidValue, iap, "index " + std::to_string(i) + " = " + std::to_string(v) + " is not below the vertex count " + std::to_string(nv));
+                idx[i] = v;
+            }
+        } else {
+            for (std::uint64_t i = 0; i < ni; ++i) idx[i] = static_cast<std::uint32_t>(i);
+        }
+        add_triangles(verts, idx, mode);
+    }
+}
+
+}  // namespace zhc::scene_gltf_detail

@@ -1,0 +1,161 @@
+// zhc/formats/scene/scene_gltf_reader.h — internal to formats/: the glTF scene reader shared by
+// scene_gltf.cpp (node tree, default probes, the public entry points), scene_gltf_lights.cpp
+// (KHR_lights_punctual) and scene_gltf_geometry.cpp (mesh primitives as occluders: accessors,
+// KHR_mesh_quantization, EXT_/KHR_meshopt_compression, KHR_draco_mesh_compression). glTF 2.0;
+// the format as zhc reads it: formats/scene/scene_gltf.h, docs/scene.md.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "formats/io/le_bytes.h"
+#include "formats/probes/gltf_probes.h"
+#include "formats/scene/scene_gltf.h"
+
+namespace zhc::scene_gltf_detail {
+
+inline constexpr auto le32 = le::load32;
+
+using json = nlohmann::json;
+
+struct Fail {
+    Error error;
+};
+
+// glTF -> zhc axes: (x, y, z)_zhc = (z, x, y)_glTF (inverse of gltf_probes' to_gltf).
+inline Vec3 from_gltf(Vec3 v) { return {v.z, v.x, v.y}; }
+
+// Column-major 4x4 as glTF stores it: m[c * 4 + r].
+struct Mat4 {
+    std::array<double, 16> m{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    double at(int r, int c) const { return m[static_cast<size_t>(c * 4 + r)]; }
+};
+inline Mat4 mul(const Mat4& a, const Mat4& b) {
+    Mat4 o;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) {
+            double s = 0;
+            for (int k = 0; k < 4; ++k) s += a.at(r, k) * b.at(k, c);
+            o.m[static_cast<size_t>(c * 4 + r)] = s;
+        }
+    return o;
+}
+inline Vec3 point(const Mat4& a, Vec3 p) {
+    return {a.at(0, 0) * p.x + a.at(0, 1) * p.y + a.at(0, 2) * p.z + a.at(0, 3),
+            a.at(1, 0) * p.x + a.at(1, 1) * p.y + a.at(1, 2) * p.z + a.at(1, 3),
+            a.at(2, 0) * p.x + a.at(2, 1) * p.y + a.at(2, 2) * p.z + a.at(2, 3)};
+}
+inline Vec3 vector(const Mat4& a, Vec3 v) {
+    return {a.at(0, 0) * v.x + a.at(0, 1) * v.y + a.at(0, 2) * v.z, a.at(1, 0) * v.x + a.at(1, 1) * v.y + a.at(1, 2) * v.z,
+            a.at(2, 0) * v.x + a.at(2, 1) * v.y + a.at(2, 2) * v.z};
+}
+inline bool finite3(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+inline constexpr int kByte = 5120, kUbyte = 5121, kShort = 5122, kUshort = 5123, kUint = 5125, kFloat = 5126;
+
+struct LightDef {
+    LightKind kind = LightKind::kPoint;
+    std::string name;
+    Rgb color{1, 1, 1};
+    double intensity = 1;
+    double inner = 0, outer = kPi / 4;
+};
+
+class Reader {
+public:
+    Reader(std::string path, const json& doc, const GltfRaw& raw, const SceneLoadOptions& options, const GltfLimits& gltf_limits)
+        : path_(std::move(path)), doc_(doc), raw_(raw), options_(options), gltf_limits_(gltf_limits) {}
+
+    [[noreturn]] void fail(ErrorCode code, const std::string& where, const std::string& what) const {
+        throw Fail{make_error(code, path_ + ": " + (where.empty() ? "" : where + ": ") + what)};
+    }
+    static std::string at(const std::string& p, size_t i) { return p + "[" + std::to_string(i) + "]"; }
+
+    double number(const json& j, const std::string& where) const {
+        if (!j.is_number()) fail(ErrorCode::kInvalidValue, where, "must be a number (got " + std::string(j.type_name()) + ")");
+        const double v = j.get<double>();
+        if (!std::isfinite(v)) fail(ErrorCode::kInvalidValue, where, "must be finite");
+        return v;
+    }
+    // A non-negative integer index below `size`.
+    size_t index(const json& j, const std::string& where, size_t size, const char* what) const {
+        if (!j.is_number_unsigned() || j.get<std::uint64_t>() >= size)
+            fail(ErrorCode::kInvalidValue, where,
+                 std::string("must be an index into ") + what + " (0.." + std::to_string(size) + "), got " + j.dump());
+        return static_cast<size_t>(j.get<std::uint64_t>());
+    }
+    std::uint64_t count(const json& obj, const char* key, const std::string& where, bool required, std::uint64_t fallback) const {
+        if (!obj.contains(key)) {
+            if (required) fail(ErrorCode::kInvalidValue, where + "." + key, "missing required field");
+            return fallback;
+        }
+        const json& j = obj[key];
+        if (!j.is_number_unsigned()) fail(ErrorCode::kInvalidValue, where + "." + key, "must be a non-negative integer (got " + j.dump() + ")");
+        return j.get<std::uint64_t>();
+    }
+    const json& array_of(const json& obj, const char* key) const {
+        static const json empty = json::array();
+        if (!obj.is_object() || !obj.contains(key)) return empty;
+        if (!obj[key].is_array()) fail(ErrorCode::kInvalidValue, key, "must be an array");
+        return obj[key];
+    }
+    std::vector<double> numbers(const json& j, const std::string& where, size_t n) const {
+        if (!j.is_array() || j.size() != n) fail(ErrorCode::kInvalidValue, where, "must be an array of " + std::to_string(n) + " numbers");
+        std::vector<double> v(n);
+        for (size_t i = 0; i < n; ++i) v[i] = number(j[i], at(where, i));
+        return v;
+    }
+
+    struct View {
+        const std::uint8_t* data = nullptr;
+        std::uint64_t length = 0, stride = 0;
+    };
+    // Triangles a primitive of `mode` with n elements yields (an upper bound for strips/fans).
+    static std::uint64_t triangle_count(std::uint64_t mode, std::uint64_t n) { return mode == 4 ? n / 3 : n >= 3 ? n - 2 : 0; }
+
+    // node tree (scene_gltf.cpp)
+    Mat4 local_matrix(const json& n, const std::string& np) const;
+    void walk();
+
+    // KHR_lights_punctual (scene_gltf_lights.cpp)
+    void read_light_defs();
+    void add_light(size_t li, const Mat4& world, const std::string& where);
+
+    // mesh primitives as occluders (scene_gltf_geometry.cpp)
+    const json* meshopt_ext(const json& v, std::string* name) const;
+    std::vector<std::uint8_t> decode_meshopt(const json& e, std::uint64_t v_len, const std::string& ep);
+    std::span<const std::uint8_t> view_bytes(size_t vi, const std::string& vp);
+    View accessor_view(size_t ai, std::uint64_t count, std::uint64_t elem, const std::string& ap);
+    std::uint64_t count_field(const json& obj, const char* key, const std::string& where, std::uint64_t fallback) const;
+    const json& accessor(size_t ai, const std::string& ap) const;
+    std::vector<Vec3> read_positions(size_t pa, std::uint64_t nv, const Mat4& world);
+    Vec3 transformed(const Mat4& world, Vec3 p, const std::string& where, std::uint64_t i);
+    void add_triangles(const std::vector<Vec3>& verts, const std::vector<std::uint32_t>& idx, std::uint64_t mode);
+    void count_triangles(std::uint64_t t, const std::string& pp);
+    void add_draco(const json& prim, const json& ext, const std::string& pp, std::uint64_t mode, const Mat4& world);
+    void add_mesh(size_t mi, const Mat4& world);
+
+    std::vector<SceneLight> lights_;
+    std::vector<Occluder> occluders_;
+    double lo_[3] = {INFINITY, INFINITY, INFINITY}, hi_[3] = {-INFINITY, -INFINITY, -INFINITY};
+
+private:
+    std::string path_;
+    const json& doc_;
+    const GltfRaw& raw_;
+    const SceneLoadOptions& options_;
+    const GltfLimits& gltf_limits_;
+    std::vector<LightDef> defs_;
+    std::uint64_t triangles_ = 0;
+    std::map<size_t, std::vector<std::uint8_t>> decoded_;  // meshopt-compressed views, decoded once
+    std::uint64_t decoded_total_ = 0;
+};
+
+}  // namespace zhc::scene_gltf_detail
