@@ -11,7 +11,7 @@
 // missing one is kIoError naming it; tinygltf's extra search of the working directory always
 // finds nothing). Images are never read nor decoded: they are removed from the JSON tinygltf
 // sees (their URIs are still checked). glTF 2.x only (asset.version / minVersion). Uri-less
-// meshopt fallback buffers load no bytes (formats/scene/scene_gltf.cpp decodes the compressed views). The extension itself is read from our own nlohmann parse of the same JSON, so every
+// meshopt fallback buffers load no bytes (formats/scene/scene_gltf_geometry.cpp decodes the compressed views). The extension itself is read from our own nlohmann parse of the same JSON, so every
 // index it holds is bound-checked against the arrays tinygltf loaded.
 #include "formats/probes/gltf_probes_internal.h"
 
@@ -421,7 +421,7 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     // Two more changes for tinygltf's eyes only: images are dropped (never decoded nor needed;
     // their URIs were checked above, and a data: URI of any MIME type is data, not a path), and a
     // uri-less meshopt fallback buffer gets a 4-byte stand-in (its bytes are never read: every
-    // view of it is decoded from the compressed buffer, formats/scene/scene_gltf.cpp).
+    // view of it is decoded from the compressed buffer, formats/scene/scene_gltf_geometry.cpp).
     std::vector<std::uint8_t> patched_glb;
     std::string patched_text;
     std::vector<size_t> fallback_buffers;
