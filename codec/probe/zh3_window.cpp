@@ -194,13 +194,12 @@ Rgb irradiance_zh3_lum(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
     return zh3_lum_entry().irradiance(in, o, n);
 }
 
-void encode_dering_q16(const Sh3Radiance& in, const QuantParams& p, const CodecOptions&, std::uint8_t* out,
-                       EncodeStats* stats) {
+void encode_dering_q16(const Sh3Radiance& in, const CodecOptions& p, std::uint8_t* out, EncodeStats* stats) {
     QuantEncodeControls c;
     c.dering = true;
     encode_packed(PackedLayout::kZh3Q16, in, p, out, stats, c);
 }
-Sh3Radiance decode_q16(const std::uint8_t* in, const QuantParams& p, const CodecOptions&) {
+Sh3Radiance decode_q16(const std::uint8_t* in, const CodecOptions& p) {
     return decode_packed(PackedLayout::kZh3Q16, in, p);
 }
 constexpr PackedCodec kDeringQ16{PackedLayout::kZh3Q16, encode_dering_q16, decode_q16};
