@@ -18,14 +18,7 @@
 namespace zhc::irradz {
 namespace {
 
-using detail::clamp_to_hemisphere;
-using detail::clamped_cosine_sh;
-using detail::dot9;
-using detail::Mat9;
-using detail::mul;
-using detail::Tables;
-using detail::tables;
-using detail::Vec9;
+using namespace detail;  // irradz_internal.h
 
 // Gauss-Legendre nodes/weights on [-1, 1] (Newton on P_n); n = 10 integrates polynomials of degree
 // <= 19 exactly, far more than the degree-4 (Gram) and degree-3 (HLSH) integrands need.

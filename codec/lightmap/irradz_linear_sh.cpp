@@ -14,7 +14,7 @@
 
 namespace zhc::irradz {
 
-using detail::clamp_to_hemisphere;
+using namespace detail;  // irradz_internal.h
 
 Sh2Radiance hhd_to_linear_sh(const Lighting& l) {
     // Radiance: C_a over the hemisphere z >= 0 plus a delta of integral pi C_d along d.

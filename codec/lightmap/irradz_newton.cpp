@@ -16,12 +16,7 @@
 namespace zhc::irradz {
 namespace {
 
-using detail::clamp_to_hemisphere;
-using detail::dot9;
-using detail::Mat9;
-using detail::Tables;
-using detail::tables;
-using detail::Vec9;
+using namespace detail;  // irradz_internal.h
 
 // ---- Newton solve (Solve::kNewton) ------------------------------------------------------------
 //

@@ -17,15 +17,7 @@
 namespace zhc::irradz {
 namespace {
 
-using detail::clamp_to_hemisphere;
-using detail::clamped_cosine_sh;
-using detail::direction_from_angles;
-using detail::dot9;
-using detail::Mat9;
-using detail::mul;
-using detail::Tables;
-using detail::tables;
-using detail::Vec9;
+using namespace detail;  // irradz_internal.h
 
 struct Target {
     std::array<Vec9, 3> t{};   // SH3 irradiance per channel

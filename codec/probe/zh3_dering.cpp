@@ -15,9 +15,7 @@
 
 namespace zhc {
 
-using detail::Axes;
-using detail::kSqrt3;
-using detail::l1_vector;
+using namespace detail;  // zh3_internal.h and sh_l1.h
 
 // App. B, re-derived (docs/zh3.md). Along the zonal axis, irradiance / (Y00 f0) is
 //   g(z) = 1 + a z + b (3 z^2 - 1),  a = 2 f1 / (sqrt(3) f0),  b = sqrt(5) f20 / (8 f0)   (Eq. 23).

@@ -14,13 +14,7 @@
 namespace zhc {
 namespace {
 
-using detail::Axes;
-using detail::fit_zonal;
-using detail::kSqrtFourPiOverFive;
-using detail::l1_vector;
-using detail::luminance_l1;
-using detail::usable_length;
-using detail::y2;
+using namespace detail;  // zh3_internal.h and sh_l1.h
 
 // Axis source vector of channel k (not normalised).
 Vec3 axis_source(const Rgb* c, ZonalAxisMode mode, int k, const LuminanceWeights& w) {

@@ -13,9 +13,7 @@
 
 namespace zhc {
 
-using detail::Axes;
-using detail::kSqrt3;
-using detail::l1_vector;
+using namespace detail;  // zh3_internal.h and sh_l1.h
 
 double hallucinate_zonal(Hallucination model, double f0, double f1_zonal, double curve_a, double curve_b) {
     const double f1 = std::fabs(f1_zonal);

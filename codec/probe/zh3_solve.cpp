@@ -22,14 +22,7 @@
 namespace zhc {
 namespace {
 
-using detail::Axes;
-using detail::dot5;
-using detail::fit_zonal;
-using detail::l1_vector;
-using detail::lbfgs;
-using detail::set_l1;
-using detail::usable_length;
-using detail::y2;
+using namespace detail;  // zh3_internal.h, sh_l1.h and lbfgs.h
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Start axes (see solve_luminance / solve_channel). The shared-axis solve runs L-BFGS from the best
