@@ -11,8 +11,8 @@
 
 namespace zhc::detail {
 
-// Relative step below which L-BFGS stops (|x_new - x| <= kLbfgsStepTolerance |x|): the iteration cap is
-// a guard, not the usual stop.
+// Relative step below which L-BFGS stops (|x_new - x| <= kLbfgsStepTolerance |x|): the iteration
+// cap is a guard, not the usual stop.
 inline constexpr double kLbfgsStepTolerance = 1e-12;
 
 // ---- L-BFGS (Nocedal & Wright, Alg. 7.4/7.5) with a backtracking Armijo line search ----------
