@@ -1,6 +1,6 @@
 // Hallucinate-solve and the adaptive hallucination scale (codec/probe/zh3_hall.h; derivation in docs/zh3.md).
 //
-// Vector form as codec/probe/zh3.cpp: channel k's radiance L1 (f1-1, f10, f11) is v = (-f11, -f1-1, f10).
+// Vector form as codec/probe/zh3_internal.h: channel k's radiance L1 (f1-1, f10, f11) is v = (-f11, -f1-1, f10).
 // Error in irradiance SH (band scales 1, 2/3, 1/4), per channel, with u the target's L1 vector, T2
 // its radiance L2, q = sqrt(4 pi/5) Y2(a) (a unit 5-vector) and h = q . T2:
 //   e = (4/9) |v - u|^2 + (1/16) (f20^2 - 2 f20 h + |T2|^2),   f20 = G(|v . a| / f0) f0.

@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Vector form of channel k's L1 band: f1(d) = kY1 v . d (codec/probe/zh3.cpp uses the same).
+// Vector form of channel k's L1 band: f1(d) = kY1 v . d (codec/probe/zh3_internal.h uses the same).
 Vec3 l1_vector(const Sh2Radiance& s, int k) { return {-double(s[3][k]), -double(s[1][k]), double(s[2][k])}; }
 
 // Channel k's irradiance as a function of the angle theta to its zonal axis, at the worst azimuth:
