@@ -52,7 +52,7 @@ InputAudit audit_input(const AuditInput& input, const std::vector<Vec3>& directi
     std::vector<MetricsAccumulator> acc(nc);
     std::vector<double> enc(nc), dec(nc);
     std::vector<EncodeStats> stats(nc);
-    const size_t timed = std::min(probes, options.timed_probes);
+    const size_t timed = options.timing ? std::min(probes, options.timed_probes) : 0;
     // Pools one probe, in probe order (the accumulators' sums depend on the order).
     auto pool = [&](size_t p, const ProbeSlot& s) {
         for (size_t c = 0; c < nc; ++c) {
@@ -75,7 +75,7 @@ InputAudit audit_input(const AuditInput& input, const std::vector<Vec3>& directi
     // The timed probes one after another on this thread: nothing else competes with the clock.
     size_t p = 0;
     for (ProbeSlot s; p < timed; ++p) {
-        evaluate(p, options.timing, s);
+        evaluate(p, true, s);
         pool(p, s);
     }
     // The rest in blocks of 2 x threads probes evaluated in parallel, then pooled in order (the

@@ -47,6 +47,7 @@ struct AuditOptions {
     CodecOptions codec_options;
     bool timing = true;             // time encode/decode (audit_probe) on the first timed_probes probes
     std::size_t timed_probes = 8;   // a few probes, not all of a big grid; timed on the calling thread
+                                    // (times are means over them; 0 when timing is off)
     int threads = 1;                // untimed probes evaluated in parallel (clamped to 1..256)
     AuditGates gates;
 };
