@@ -1,10 +1,7 @@
 // zhc audit FILE|FOLDER... : every representation's irradiance error, size and speed per input.
-#include <unistd.h>
-
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -22,8 +19,6 @@
 namespace zhc::cli {
 namespace cmd_audit {  // one namespace per verb file: the CLI is a unity build
 namespace {
-
-namespace fs = std::filesystem;
 
 struct Options {
     std::vector<std::string> inputs;

@@ -2,8 +2,8 @@
 // every input, pooled per input and across inputs, timed, and checked against pass/fail gates.
 //
 // What `zhc audit` computes (the CLI only parses options, prints and maps to exit codes); reading
-// files and writing pictures is formats/report/audit_inputs.h. Results do not depend on the thread count:
-// probes are evaluated in parallel but pooled in probe order (MetricsAccumulator, audit.h).
+// files and writing pictures is formats/report/audit_inputs.h. Results do not depend on the
+// thread count: probes are evaluated in parallel but pooled in probe order (MetricsAccumulator).
 #pragma once
 
 #include <cstddef>
