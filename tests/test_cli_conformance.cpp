@@ -244,23 +244,27 @@ Generator file(std::function<Bytes(const std::string& dir)> make) {
 
 // A lightmap triplet (NAME.iz/.d/.wa.ktx2 or .dds) from the 8x8 lightmap, the .d file cut short
 // when `cut_d`.
-Generator triplet(const std::string& container, bool cut_d) {
-    return [container, cut_d](const std::string& dir, const std::string& name) {
+enum class TripletEdit { kNone, kCutD, kIzAsD };
+Generator triplet(const std::string& container, TripletEdit edit) {
+    return [container, edit](const std::string& dir, const std::string& name) {
         test::write_bytes(dir + "/.gen_lm.exr", lightmap_bytes(dir, false));
         run_ok({"lightmap", "encode", dir + "/.gen_lm.exr", "-o", dir + "/" + name, "--container", container, "--quality",
                 "fast", "--quiet"});
         fs::remove(dir + "/.gen_lm.exr");
         const std::string d = dir + "/" + name + ".d." + container;
-        if (cut_d) test::write_bytes(d, cut(test::read_bytes(d), 3));
+        if (edit == TripletEdit::kCutD) test::write_bytes(d, cut(test::read_bytes(d), 3));
+        if (edit == TripletEdit::kIzAsD) test::write_bytes(d, test::read_bytes(dir + "/" + name + ".iz." + container));
     };
 }
 
-void embed_probes(const std::string& dir, const std::string& name, bool cut_short) {
+enum class GlbEdit { kNone, kCut, kVersion3 };
+void embed_probes(const std::string& dir, const std::string& name, GlbEdit edit) {
     test::write_bytes(dir + "/.gen.zhp", probes_zhp());
     const std::string out = dir + "/" + name;
     run_ok({"gltf", "embed", std::string(ZHC_TEST_DATA_DIR) + "/gltf/gt_list.glb", dir + "/.gen.zhp", "-o", out});
     fs::remove(dir + "/.gen.zhp");
-    if (cut_short) test::write_bytes(out, cut(test::read_bytes(out), 10));
+    if (edit == GlbEdit::kCut) test::write_bytes(out, cut(test::read_bytes(out), 10));
+    if (edit == GlbEdit::kVersion3) test::write_bytes(out, patched32(test::read_bytes(out), 4, 3));  // GLB header version
 }
 
 const std::map<std::string, Generator>& generators() {
@@ -293,6 +297,10 @@ const std::map<std::string, Generator>& generators() {
              EXPECT_TRUE(write_hdr(d + "/" + n, small_map()));
              test::write_bytes(d + "/" + n, cut(test::read_bytes(d + "/" + n), 40));
          }},
+        {"tail.hdr", [](const std::string& d, const std::string& n) {
+             EXPECT_TRUE(write_hdr(d + "/" + n, small_map()));
+             test::write_bytes(d + "/" + n, with_tail(test::read_bytes(d + "/" + n)));
+         }},
         {"huge.hdr", file([](const std::string&) { return bytes_of("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 10000 +X 10000\n"); })},
         {"format.hdr", file([](const std::string&) { return bytes_of("#?RADIANCE\nFORMAT=32-bit_float\n\n-Y 2 +X 2\n"); })},
         // Cube maps.
@@ -300,6 +308,10 @@ const std::map<std::string, Generator>& generators() {
         {"cube.dds", file([](const std::string&) { return cube_dds(); })},
         {"cut_cube.ktx2", file([](const std::string&) { return cut(cube_ktx2(), 1); })},
         {"cut_cube.dds", file([](const std::string&) { return cut(cube_dds(), 1); })},
+        {"nan_cube.ktx2", file([](const std::string&) {  // the last texel's red is NaN
+             Bytes b = cube_ktx2();
+             return patched32(b, b.size() - 16, std::bit_cast<std::uint32_t>(std::nanf("")));
+         })},
         {"array_cube.ktx2", file([](const std::string&) { return patched32(cube_ktx2(), 32, 2); })},  // layerCount 2
         {"partial_cube.dds", file([](const std::string&) { return patched32(cube_dds(), 112, 0x200 | 0x400); })},
         {"huge_cube.ktx2", file([](const std::string&) { return patched32(patched32(cube_ktx2(), 20, 60000), 24, 60000); })},
@@ -315,7 +327,15 @@ const std::map<std::string, Generator>& generators() {
              return b;
          })},
         {"future.zhp", file([](const std::string&) { return zhp_header_edit(probes_zhp(), 8, {9, 0}); })},  // version 9
+        {"nan.zhp", file([](const std::string&) {  // probe 1's L00 red is NaN, both CRCs made to match
+             Bytes b = probes_zhp();
+             const size_t body = kProbeFileHeaderBytes + 4 * 12;  // after the four positions
+             test::put32(b, body + 108, std::bit_cast<std::uint32_t>(std::nanf("")));
+             const std::uint32_t body_crc = crc32(std::span<const std::uint8_t>(b.data() + kProbeFileHeaderBytes, b.size() - kProbeFileHeaderBytes));
+             return zhp_header_edit(b, 176, {std::uint8_t(body_crc), std::uint8_t(body_crc >> 8), std::uint8_t(body_crc >> 16), std::uint8_t(body_crc >> 24)});
+         })},
         {"huge.zhp", file([](const std::string&) { return zhp_header_edit(probes_zhp(), 56, {0, 0, 0, 0, 1}); })},  // 2^32 probes
+        {"garbage.bin", file([](const std::string&) { return bytes_of("these bytes are no format zhc knows\n"); })},
         {"deep.json", file([](const std::string&) { return bytes_of("{\"probes\":" + std::string(600, '[') + std::string(600, ']') + "}"); })},
         // Lightmaps.
         {"lm.exr", file([](const std::string& d) { return lightmap_bytes(d, false); })},
@@ -326,13 +346,16 @@ const std::map<std::string, Generator>& generators() {
              const size_t at = exr_attribute(b, "dataWindow", "box2i");
              return patched32(patched32(b, at + 8, 19999), at + 12, 19999);
          })},
-        {"lm", triplet("ktx2", false)},
-        {"lmdds", triplet("dds", false)},
-        {"cutlm", triplet("ktx2", true)},
-        {"cutlmdds", triplet("dds", true)},
+        {"lm", triplet("ktx2", TripletEdit::kNone)},
+        {"lmdds", triplet("dds", TripletEdit::kNone)},
+        {"cutlm", triplet("ktx2", TripletEdit::kCutD)},
+        {"cutlmdds", triplet("dds", TripletEdit::kCutD)},
+        {"swappedlm", triplet("ktx2", TripletEdit::kIzAsD)},  // BC6H where the BC5 direction belongs
+        {"swappedlmdds", triplet("dds", TripletEdit::kIzAsD)},
         // glTF: the four probes embedded into the corpus's plain triangle list.
-        {"lit.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, false); }},
-        {"cut.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, true); }},
+        {"lit.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, GlbEdit::kNone); }},
+        {"cut.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, GlbEdit::kCut); }},
+        {"v3.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, GlbEdit::kVersion3); }},
     };
     return g;
 }
