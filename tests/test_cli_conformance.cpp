@@ -211,12 +211,17 @@ ProbeList small_probe_list() {
     return l;
 }
 
-// probes.zhp: the four golden probes as float sh3 at listed positions.
-Bytes probes_zhp() {
+// probes.zhp: the four golden probes as float sh3 at listed positions (on a 4x1x1 grid: grid.zhp).
+Bytes probes_zhp(bool grid = false) {
     const ProbeList l = small_probe_list();
     ProbeSet s;
     s.representation = "sh3";
     s.layout = l.layout;
+    if (grid) {
+        s.layout = {};
+        s.layout.kind = ProbeLayoutKind::kGrid;
+        s.layout.grid.counts = {4, 1, 1};
+    }
     s.count = l.probes.size();
     for (const Sh3Radiance& p : l.probes)
         for (int i = 0; i < 9; ++i)
@@ -229,14 +234,6 @@ Bytes probes_zhp() {
     return b.ok() ? *b : Bytes{};
 }
 
-// A .zhp header field changed and the header CRC (bytes 180..183, over 0..179) made to match, so
-// the edit itself is what the reader sees (docs/zhp-container.md).
-Bytes zhp_header_edit(Bytes b, size_t offset, const std::vector<std::uint8_t>& value) {
-    std::copy(value.begin(), value.end(), b.begin() + static_cast<std::ptrdiff_t>(offset));
-    test::put32(b, 180, crc32(std::span<const std::uint8_t>(b.data(), 180)));
-    return b;
-}
-
 using Generator = std::function<void(const std::string& dir, const std::string& name)>;
 Generator file(std::function<Bytes(const std::string& dir)> make) {
     return [make](const std::string& dir, const std::string& name) { test::write_bytes(dir + "/" + name, make(dir)); };
@@ -244,7 +241,7 @@ Generator file(std::function<Bytes(const std::string& dir)> make) {
 
 // A lightmap triplet (NAME.iz/.d/.wa.ktx2 or .dds) from the 8x8 lightmap, the .d file cut short
 // when `cut_d`.
-enum class TripletEdit { kNone, kCutD, kIzAsD };
+enum class TripletEdit { kNone, kCutD, kIzAsD, kSignedIz };
 Generator triplet(const std::string& container, TripletEdit edit) {
     return [container, edit](const std::string& dir, const std::string& name) {
         test::write_bytes(dir + "/.gen_lm.exr", lightmap_bytes(dir, false));
@@ -254,6 +251,8 @@ Generator triplet(const std::string& container, TripletEdit edit) {
         const std::string d = dir + "/" + name + ".d." + container;
         if (edit == TripletEdit::kCutD) test::write_bytes(d, cut(test::read_bytes(d), 3));
         if (edit == TripletEdit::kIzAsD) test::write_bytes(d, test::read_bytes(dir + "/" + name + ".iz." + container));
+        const std::string iz = dir + "/" + name + ".iz." + container;
+        if (edit == TripletEdit::kSignedIz) test::write_bytes(iz, patched32(test::read_bytes(iz), 128, 96));  // DX10 dxgiFormat
     };
 }
 
@@ -319,6 +318,7 @@ const std::map<std::string, Generator>& generators() {
         // Probe containers and JSON probe lists.
         {"probes.json", file([](const std::string&) { return bytes_of(probe_json(small_probe_list())); })},
         {"probes.zhp", file([](const std::string&) { return probes_zhp(); })},
+        {"grid.zhp", file([](const std::string&) { return probes_zhp(true); })},
         {"cut.zhp", file([](const std::string&) { return cut(probes_zhp(), 3); })},
         {"tail.zhp", file([](const std::string&) { return with_tail(probes_zhp()); })},
         {"crc.zhp", file([](const std::string&) {  // a body byte changed: the body CRC no longer matches
@@ -326,15 +326,22 @@ const std::map<std::string, Generator>& generators() {
              b[b.size() - 5] ^= 4;
              return b;
          })},
-        {"future.zhp", file([](const std::string&) { return zhp_header_edit(probes_zhp(), 8, {9, 0}); })},  // version 9
+        {"future.zhp", file([](const std::string&) { return test::zhp_with_header_edit(probes_zhp(), 8, {9, 0}); })},  // version 9
         {"nan.zhp", file([](const std::string&) {  // probe 1's L00 red is NaN, both CRCs made to match
              Bytes b = probes_zhp();
              const size_t body = kProbeFileHeaderBytes + 4 * 12;  // after the four positions
              test::put32(b, body + 108, std::bit_cast<std::uint32_t>(std::nanf("")));
              const std::uint32_t body_crc = crc32(std::span<const std::uint8_t>(b.data() + kProbeFileHeaderBytes, b.size() - kProbeFileHeaderBytes));
-             return zhp_header_edit(b, 176, {std::uint8_t(body_crc), std::uint8_t(body_crc >> 8), std::uint8_t(body_crc >> 16), std::uint8_t(body_crc >> 24)});
+             return test::zhp_with_header_edit(b, 176, {std::uint8_t(body_crc), std::uint8_t(body_crc >> 8), std::uint8_t(body_crc >> 16), std::uint8_t(body_crc >> 24)});
          })},
-        {"huge.zhp", file([](const std::string&) { return zhp_header_edit(probes_zhp(), 56, {0, 0, 0, 0, 1}); })},  // 2^32 probes
+        {"huge.zhp", file([](const std::string&) { return test::zhp_with_header_edit(probes_zhp(), 56, {0, 0, 0, 0, 1}); })},  // 2^32 probes
+        // Outputs in the way: an existing file a failed run must leave alone; directories where an
+        // output (or the last of a lightmap triplet) must go, so that the write fails (exit 7).
+        {"existing.zhp", file([](const std::string&) { return Bytes{1, 2, 3}; })},
+        {"blocked.zhp", [](const std::string& d, const std::string& n) { fs::create_directories(d + "/" + n + "/inside"); }},
+        {"blocked", [](const std::string& d, const std::string& n) {
+             for (const char* c : {".wa.ktx2", ".wa.dds"}) fs::create_directories(d + "/" + n + c + "/inside");
+         }},
         {"garbage.bin", file([](const std::string&) { return bytes_of("these bytes are no format zhc knows\n"); })},
         {"deep.json", file([](const std::string&) { return bytes_of("{\"probes\":" + std::string(600, '[') + std::string(600, ']') + "}"); })},
         // Lightmaps.
@@ -352,6 +359,7 @@ const std::map<std::string, Generator>& generators() {
         {"cutlmdds", triplet("dds", TripletEdit::kCutD)},
         {"swappedlm", triplet("ktx2", TripletEdit::kIzAsD)},  // BC6H where the BC5 direction belongs
         {"swappedlmdds", triplet("dds", TripletEdit::kIzAsD)},
+        {"sf16lmdds", triplet("dds", TripletEdit::kSignedIz)},  // BC6H_SF16 where BC6H_UF16 belongs
         // glTF: the four probes embedded into the corpus's plain triangle list.
         {"lit.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, GlbEdit::kNone); }},
         {"cut.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, GlbEdit::kCut); }},
@@ -401,9 +409,13 @@ std::string unexpand(std::string s, const Paths& p) {
     return s;
 }
 
-std::set<std::string> listing(const std::string& dir) {
-    std::set<std::string> out;
-    for (const auto& e : fs::recursive_directory_iterator(dir)) out.insert(fs::relative(e.path(), dir).string());
+// Every path under `dir` with its bytes ("<dir>" for a folder): a failed run must leave it as it was.
+std::map<std::string, std::string> snapshot(const std::string& dir) {
+    std::map<std::string, std::string> out;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        const std::vector<std::uint8_t> b = e.is_directory() ? std::vector<std::uint8_t>{} : test::read_bytes(e.path().string());
+        out[fs::relative(e.path(), dir).string()] = e.is_directory() ? "<dir>" : std::string(b.begin(), b.end());
+    }
     return out;
 }
 
@@ -525,7 +537,7 @@ TEST_P(Conformance, Row) {
     SCOPED_TRACE("tests/conformance/cases.txt:" + std::to_string(c.line) + " " + c.id);
     std::vector<std::string> args;
     for (const std::string& t : c.command) args.push_back(expand(t, p));
-    const auto before = listing(p.tmp);
+    const auto before = snapshot(p.tmp);
     const auto r = test::run_zhc(args);
     const std::string err = unexpand(r.err, p), out = unexpand(r.out, p);
     EXPECT_EQ(r.exit_code, c.exit_code) << "stderr: " << err << "stdout: " << out.substr(0, 2000);
@@ -538,7 +550,11 @@ TEST_P(Conformance, Row) {
         if (c.exit_code < 7) {
             EXPECT_EQ(r.out, "") << "an input or usage error prints nothing on stdout";
         }
-        EXPECT_EQ(listing(p.tmp), before) << "a failed run left files behind (or removed one)";
+        const auto after = snapshot(p.tmp);
+        for (const auto& [path, bytes] : after)
+            EXPECT_TRUE(before.count(path)) << "a failed run left " << path << " behind";
+        for (const auto& [path, bytes] : before)
+            EXPECT_TRUE(after.count(path) && after.at(path) == bytes) << "a failed run removed or changed " << path;
     }
     for (const std::string& check : c.checks) {
         const std::string arg = check.size() > 4 ? check.substr(4) : "";
