@@ -1,9 +1,9 @@
-// Contracts every entry of the codec table must keep (codec/codec.h), checked by walking the
+// Contracts every entry of the codec table must keep (codec/probe/codec.h), checked by walking the
 // table: a new representation is covered here without writing a test for it.
 #include <random>
 #include <set>
 
-#include "codec/codec.h"
+#include "codec/probe/codec.h"
 #include "support.h"
 
 namespace zhc {

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "formats/file_io.h"
+#include "formats/io/file_io.h"
 #include "support.h"
 
 namespace zhc {
