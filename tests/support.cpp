@@ -1,6 +1,6 @@
 #include "support.h"
 
-#include "formats/probe_file.h"
+#include "formats/probes/probe_file.h"
 
 #include <cmath>
 

@@ -18,9 +18,9 @@
 #include <set>
 #include <sstream>
 
-#include "formats/envmap.h"
-#include "formats/lightmap_exr.h"
-#include "formats/probe_file.h"
+#include "formats/envmap/envmap.h"
+#include "formats/lightmap/lightmap_exr.h"
+#include "formats/probes/probe_file.h"
 #include "support.h"
 
 namespace zhc {
