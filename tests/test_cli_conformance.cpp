@@ -28,7 +28,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kConformanceDir = std::string(ZHC_TEST_DATA_DIR) + "/../conformance";
+const std::string kConformanceDir = std::filesystem::weakly_canonical(std::string(ZHC_TEST_DATA_DIR) + "/../conformance").string();
 
 // ---- the table -------------------------------------------------------------------------------
 
@@ -241,7 +241,7 @@ Generator file(std::function<Bytes(const std::string& dir)> make) {
 
 // A lightmap triplet (NAME.iz/.d/.wa.ktx2 or .dds) from the 8x8 lightmap, the .d file cut short
 // when `cut_d`.
-enum class TripletEdit { kNone, kCutD, kIzAsD, kSignedIz };
+enum class TripletEdit { kNone, kCutD, kIzAsD, kSignedIz, kHugeIz };
 Generator triplet(const std::string& container, TripletEdit edit) {
     return [container, edit](const std::string& dir, const std::string& name) {
         test::write_bytes(dir + "/.gen_lm.exr", lightmap_bytes(dir, false));
@@ -252,7 +252,11 @@ Generator triplet(const std::string& container, TripletEdit edit) {
         if (edit == TripletEdit::kCutD) test::write_bytes(d, cut(test::read_bytes(d), 3));
         if (edit == TripletEdit::kIzAsD) test::write_bytes(d, test::read_bytes(dir + "/" + name + ".iz." + container));
         const std::string iz = dir + "/" + name + ".iz." + container;
-        if (edit == TripletEdit::kSignedIz) test::write_bytes(iz, patched32(test::read_bytes(iz), 128, 96));  // DX10 dxgiFormat
+        const bool ktx2 = container == "ktx2";
+        if (edit == TripletEdit::kSignedIz)  // BC6H_SFLOAT: KTX2 vkFormat 144, DDS DX10 dxgiFormat 96
+            test::write_bytes(iz, patched32(test::read_bytes(iz), ktx2 ? 12 : 128, ktx2 ? 144 : 96));
+        if (edit == TripletEdit::kHugeIz)  // 60000 x 60000 texels: KTX2 pixelWidth/Height, DDS height/width
+            test::write_bytes(iz, patched32(patched32(test::read_bytes(iz), ktx2 ? 20 : 12, 60000), ktx2 ? 24 : 16, 60000));
     };
 }
 
@@ -359,7 +363,10 @@ const std::map<std::string, Generator>& generators() {
         {"cutlmdds", triplet("dds", TripletEdit::kCutD)},
         {"swappedlm", triplet("ktx2", TripletEdit::kIzAsD)},  // BC6H where the BC5 direction belongs
         {"swappedlmdds", triplet("dds", TripletEdit::kIzAsD)},
-        {"sf16lmdds", triplet("dds", TripletEdit::kSignedIz)},  // BC6H_SF16 where BC6H_UF16 belongs
+        {"sf16lmdds", triplet("dds", TripletEdit::kSignedIz)},  // signed BC6H where BC6H_UF16 belongs
+        {"sf16lm", triplet("ktx2", TripletEdit::kSignedIz)},
+        {"hugelm", triplet("ktx2", TripletEdit::kHugeIz)},
+        {"hugelmdds", triplet("dds", TripletEdit::kHugeIz)},
         // glTF: the four probes embedded into the corpus's plain triangle list.
         {"lit.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, GlbEdit::kNone); }},
         {"cut.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, GlbEdit::kCut); }},
