@@ -537,11 +537,8 @@ Status check_finite_probes(std::span<const Sh3Radiance> probes, const std::strin
 }
 
 Status write_probe_json(const std::string& path, const ProbeList& list) {
-    for (const Sh3Radiance& sh : list.probes)
-        for (int i = 0; i < 9; ++i)
-            for (int k = 0; k < 3; ++k)
-                if (!std::isfinite(sh[i][k]))
-                    return make_error(ErrorCode::kInvalidValue, path + ": a probe holds NaN/Inf; JSON cannot store it");
+    if (!check_finite_probes(list.probes, path))
+        return make_error(ErrorCode::kInvalidValue, path + ": a probe holds NaN/Inf; JSON cannot store it");
     const std::string text = probe_json(list);
     return write_file_atomic(path, std::vector<std::uint8_t>(text.begin(), text.end()));
 }
