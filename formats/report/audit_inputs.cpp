@@ -71,6 +71,7 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         if (!set) return set.error();
         auto hub = decode_probe_set(*set);
         if (!hub) return hub.error();
+        if (Status finite = check_finite_probes(*hub, path); !finite) return finite.error();
         in.kind = "probes";
         in.probes = std::move(hub).value();
         in.description = std::to_string(in.probes.size()) + " probes stored as " + set->representation +
@@ -85,8 +86,9 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         in.description = std::to_string(in.probes.size()) + " probes (JSON), reference: their SH3";
         return in;
     }
-    return make_error(ErrorCode::kUnsupported,
-                      path + ": not an environment map (.exr, .hdr), probe container (.zhp) or JSON probe list");
+    // The same code and words as convert and info for a file of no known format (exit 4).
+    return make_error(ErrorCode::kBadFormat,
+                      path + ": not an environment map (EXR/.hdr, KTX2/DDS cube map), .zhp probe file or JSON probe list");
 }
 
 Result<AuditedFiles> audit_files(const std::vector<std::string>& files, const std::vector<Vec3>& dirs,
