@@ -87,7 +87,7 @@ int run(const Options& o) {
         ProbeList list;
         list.probes = *probes;
         list.layout = layout;
-        if (o.to != "sh3") {
+        if (!codec->traits.exact) {  // a lossy entry: the JSON holds what it decodes to
             auto set = encode_probe_set(list.probes, o.to, StorageParams{}, layout);
             if (!set) return report(set.error());
             auto hub = decode_probe_set(*set);

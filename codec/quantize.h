@@ -203,11 +203,14 @@ template <const PackedCodec& P>
 Rgb packed_entry_irradiance(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
     return irradiance(P.decode(in, quant_params(o), o), n);
 }
-// A whole Codec entry for P.
+// A whole Codec entry for P; `zonal_axis` is its trait (codec.h CodecTraits).
 template <const PackedCodec& P>
-constexpr Codec packed_codec(std::string_view name, std::string_view summary) {
-    return {name, summary, packed_size_bytes(P.layout), packed_entry_encode<P>, packed_entry_decode<P>,
-            packed_entry_irradiance<P>, &P};
+constexpr Codec packed_codec(std::string_view name, std::string_view summary, ZonalAxis zonal_axis) {
+    return {name,          summary, packed_size_bytes(P.layout), packed_entry_encode<P>, packed_entry_decode<P>,
+            packed_entry_irradiance<P>, CodecTraits{.zonal_axis = zonal_axis}, &P};
 }
+
+// The codec table part of codec/quantize.cpp: zh3_q16, zh3_solved_q16, sh3_q28, sh2_q, hall_curve_q.
+std::span<const Codec> quantized_codecs();
 
 }  // namespace zhc

@@ -57,6 +57,8 @@
 #define ZHC_HLSL_INCLUDED
 
 // ---- encodings (the order of zhc::codecs()) -----------------------------------------------------
+// One "#define ZHC_<entry name in upper case> <index in the table>u" per codec table entry, new
+// entries appended; tests/test_runtime_vk.cpp and bench/bench_runtime.cpp read these lines.
 #define ZHC_SH3 0u
 #define ZHC_SH2 1u
 #define ZHC_ZH3_LUM 2u
