@@ -162,7 +162,7 @@ const std::map<std::string, GlslEntry, std::less<>>& glsl_entries() {
             std::istringstream in(line);
             std::vector<std::string> w;
             for (std::string word; in >> word;) w.push_back(word);
-            if (w.size() == 5 && w[0] == "const" && w[1] == "uint" && w[3] == "=" && w[4].size() > 2 &&
+            if (w.size() >= 5 && w[0] == "const" && w[1] == "uint" && w[3] == "=" && w[4].size() > 2 &&  // + a comment
                 w[4].substr(w[4].size() - 2) == "u;")
                 constants[w[2]] = static_cast<std::uint32_t>(std::stoul(w[4]));
             else if (w.size() == 5 && w[0] == "//" && w[2].rfind("ZHC_LAYOUT_", 0) == 0 && w[3].rfind("ZHC_HALL_", 0) == 0)
