@@ -14,8 +14,8 @@
 #include <cstdlib>
 #include <random>
 
-#include "codec/occluders.h"
-#include "codec/scene.h"
+#include "codec/bake/occluders.h"
+#include "codec/bake/scene.h"
 #include "timing.h"
 
 using namespace zhc;

@@ -31,10 +31,10 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "codec/bc45.h"
-#include "codec/bc6h.h"
-#include "codec/lightmap.h"
-#include "formats/envmap.h"
+#include "codec/lightmap/bc45.h"
+#include "codec/lightmap/bc6h.h"
+#include "codec/lightmap/lightmap.h"
+#include "formats/envmap/envmap.h"
 
 using namespace zhc;
 

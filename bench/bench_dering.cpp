@@ -1,4 +1,4 @@
-// Deringing speed (Sloan 2017, codec/dering.h): the conservative bound (with and without the
+// Deringing speed (Sloan 2017, codec/probe/dering.h): the conservative bound (with and without the
 // early out), the whole per-probe deringing search, and, as the baseline measured in the same run,
 // the numerical minimum (2048 Fibonacci samples + Newton refinement) a dense-sampling deringer
 // would need per evaluation. Accuracy next to time: the bound's mean gap below the true minimum.
@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "codec/dering.h"
+#include "codec/probe/dering.h"
 #include "timing.h"
 
 using namespace zhc;

@@ -36,11 +36,11 @@
 #include <string>
 #include <vector>
 
-#include "codec/lightmap.h"
-#include "formats/envmap.h"
-#include "formats/file_io.h"
-#include "formats/ktx2.h"
-#include "formats/lightmap_exr.h"
+#include "codec/lightmap/lightmap.h"
+#include "formats/envmap/envmap.h"
+#include "formats/io/file_io.h"
+#include "formats/lightmap/ktx2.h"
+#include "formats/lightmap/lightmap_exr.h"
 #include "timing.h"
 
 using namespace zhc;

@@ -7,8 +7,8 @@
 #include <thread>
 #include <vector>
 
-#include "codec/sh.h"
-#include "formats/envmap.h"
+#include "codec/sh/sh.h"
+#include "formats/envmap/envmap.h"
 #include "timing.h"
 
 using namespace zhc;

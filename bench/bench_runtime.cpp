@@ -31,7 +31,7 @@
 
 #include <unistd.h>
 
-#include "codec/codec.h"
+#include "codec/probe/codec.h"
 #include "vk_compute.h"
 #include "timing.h"
 

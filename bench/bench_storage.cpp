@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "codec/codec.h"
-#include "codec/sh.h"
+#include "codec/probe/codec.h"
+#include "codec/sh/sh.h"
 
 namespace {
 

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "codec/codec.h"
-#include "codec/zh3.h"
-#include "formats/envmap.h"
+#include "codec/probe/codec.h"
+#include "codec/probe/zh3.h"
+#include "formats/envmap/envmap.h"
 #include "timing.h"
 
 using namespace zhc;

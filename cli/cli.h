@@ -44,7 +44,7 @@ CLI::Option* add_threads_option(CLI::App* app, int& threads, const std::string& 
 int resolve_threads(int threads);
 // `--json`: print one JSON object (cli/json_output.h: the versioned envelope) on stdout.
 CLI::Option* add_json_flag(CLI::App* app, bool& json, const std::string& what = "");
-// Environment-map reading: `--replace-non-finite` and `--part` (formats/envmap.h EnvmapReadOptions).
+// Environment-map reading: `--replace-non-finite` and `--part` (formats/envmap/envmap.h EnvmapReadOptions).
 void add_envmap_read_options(CLI::App* app, bool* replace_non_finite, std::string& part);
 
 // A verb: `setup` adds the subcommand and its options to the app and returns the function that

@@ -11,16 +11,16 @@
 #include <sstream>
 #include <thread>
 
-#include "formats/audit_inputs.h"
+#include "formats/report/audit_inputs.h"
 #include "cli.h"
 #include "json_output.h"
 #include "progress.h"
 #include "table.h"
-#include "codec/audit.h"
-#include "formats/file_io.h"
-#include "formats/html_report.h"
-#include "formats/runtime_cost.h"
-#include "codec/benchmark.h"
+#include "codec/report/audit.h"
+#include "formats/io/file_io.h"
+#include "formats/report/html_report.h"
+#include "formats/report/runtime_cost.h"
+#include "codec/report/benchmark.h"
 
 namespace zhc::cli {
 namespace cmd_audit {  // one namespace per verb file: the CLI is a unity build

@@ -9,12 +9,12 @@
 
 #include "cli.h"
 #include "progress.h"
-#include "codec/scene.h"
-#include "formats/file_io.h"
-#include "formats/gltf_probes.h"
-#include "formats/probe_file.h"
-#include "formats/scene_gltf.h"
-#include "formats/scene_json.h"
+#include "codec/bake/scene.h"
+#include "formats/io/file_io.h"
+#include "formats/probes/gltf_probes.h"
+#include "formats/probes/probe_file.h"
+#include "formats/scene/scene_gltf.h"
+#include "formats/scene/scene_json.h"
 
 namespace zhc::cli {
 namespace cmd_bake {  // one namespace per verb file: the CLI is a unity build

@@ -8,11 +8,11 @@
 
 #include "cli.h"
 #include "json_output.h"
-#include "codec/benchmark.h"
-#include "formats/audit_inputs.h"
-#include "formats/html_report.h"
-#include "formats/plot.h"
-#include "formats/runtime_cost.h"
+#include "codec/report/benchmark.h"
+#include "formats/report/audit_inputs.h"
+#include "formats/report/html_report.h"
+#include "formats/report/plot.h"
+#include "formats/report/runtime_cost.h"
 
 namespace zhc::cli {
 namespace cmd_bench {  // one namespace per verb file: the CLI is a unity build

@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "cli.h"
-#include "codec/probe_set.h"
-#include "formats/envmap.h"
-#include "formats/file_io.h"
-#include "formats/probe_file.h"
+#include "codec/probe/probe_set.h"
+#include "formats/envmap/envmap.h"
+#include "formats/io/file_io.h"
+#include "formats/probes/probe_file.h"
 
 namespace zhc::cli {
 namespace cmd_convert {  // one namespace per verb file: the CLI is a unity build

@@ -1,7 +1,7 @@
 // zhc demo [-o DIR]: the main job on the built-in default scene (no input files).
 //
 // Bakes the default scene (gradient sky, sun, three coloured sphere lights, a roof and a sphere
-// occluder; codec/scene.h default_scene) into a probe grid, encodes it with every representation
+// occluder; codec/bake/scene.h default_scene) into a probe grid, encodes it with every representation
 // of the codec table, writes the probe containers, the scene, the audit table (reference: each
 // probe's baked SH3 irradiance) and pictures of a few probes, and prints where everything is.
 #include <algorithm>
@@ -13,16 +13,16 @@
 
 #include "cli.h"
 #include "table.h"
-#include "codec/audit.h"
-#include "codec/scene.h"
-#include "formats/audit_inputs.h"
-#include "formats/file_io.h"
-#include "formats/gltf_probes.h"
-#include "formats/html_report.h"
-#include "codec/benchmark.h"
-#include "formats/probe_file.h"
-#include "formats/runtime_cost.h"
-#include "formats/scene_json.h"
+#include "codec/report/audit.h"
+#include "codec/bake/scene.h"
+#include "formats/report/audit_inputs.h"
+#include "formats/io/file_io.h"
+#include "formats/probes/gltf_probes.h"
+#include "formats/report/html_report.h"
+#include "codec/report/benchmark.h"
+#include "formats/probes/probe_file.h"
+#include "formats/report/runtime_cost.h"
+#include "formats/scene/scene_json.h"
 
 namespace zhc::cli {
 namespace cmd_demo {  // one namespace per verb file: the CLI is a unity build

@@ -1,5 +1,5 @@
 // zhc dering IN -o OUT.json [--punctual]: window SH3 radiance so its irradiance is non-negative
-// (Sloan 2017; codec/dering.h). IN is a lat-long environment map (one probe: its SH3 projection)
+// (Sloan 2017; codec/probe/dering.h). IN is a lat-long environment map (one probe: its SH3 projection)
 // or a JSON probe list: {"sh3": 9x[r,g,b]} (what `zhc project --json` prints), {"probes": [...]},
 // or [...], each probe an object with "sh3" (and optional "name") or a bare 9x[r,g,b] array.
 #include <nlohmann/json.hpp>
@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "cli.h"
-#include "codec/dering.h"
-#include "codec/sh.h"
-#include "formats/envmap.h"
-#include "formats/file_io.h"
-#include "formats/json_depth.h"
+#include "codec/probe/dering.h"
+#include "codec/sh/sh.h"
+#include "formats/envmap/envmap.h"
+#include "formats/io/file_io.h"
+#include "formats/io/json_depth.h"
 
 namespace zhc::cli {
 namespace cmd_dering {  // one namespace per verb file: the CLI is a unity build

@@ -11,10 +11,10 @@
 #include <cstdio>
 
 #include "cli.h"
-#include "codec/probe_set.h"
-#include "formats/file_io.h"
-#include "formats/gltf_probes.h"
-#include "formats/probe_file.h"
+#include "codec/probe/probe_set.h"
+#include "formats/io/file_io.h"
+#include "formats/probes/gltf_probes.h"
+#include "formats/probes/probe_file.h"
 
 namespace zhc::cli {
 namespace cmd_gltf {  // one namespace per verb file: the CLI is a unity build

@@ -7,12 +7,12 @@
 
 #include "cli.h"
 #include "json_output.h"
-#include "codec/probe_set.h"
-#include "formats/envmap.h"
-#include "formats/file_io.h"
-#include "formats/gltf_probes.h"
-#include "formats/probe_file.h"
-#include "formats/json_depth.h"
+#include "codec/probe/probe_set.h"
+#include "formats/envmap/envmap.h"
+#include "formats/io/file_io.h"
+#include "formats/probes/gltf_probes.h"
+#include "formats/probes/probe_file.h"
+#include "formats/io/json_depth.h"
 
 namespace zhc::cli {
 namespace cmd_info {  // one namespace per verb file: the CLI is a unity build

@@ -1,5 +1,5 @@
 // zhc lightmap {encode, decode, audit, synth}: IrradZ directional lightmaps (docs/irradz.md,
-// docs/lightmap-formats.md), streamed in bands of rows (formats/lightmap_stream.h). Input: an SH
+// docs/lightmap-formats.md), streamed in bands of rows (formats/lightmap/lightmap_stream.h). Input: an SH
 // lightmap EXR (channels sh0.R .. sh8.B, tangent-frame SH3 radiance; or linear SH sh0.R .. sh3.B;
 // or one EXR per coefficient). Output: PREFIX.iz.ktx2 (BC6H_UFLOAT), PREFIX.d.ktx2 (BC5_UNORM), PREFIX.wa.ktx2
 // (BC4_UNORM): 2.5 bytes per texel; with --container dds the same blocks in PREFIX.{iz,d,wa}.dds.
@@ -11,14 +11,14 @@
 
 #include "cli.h"
 #include "json_output.h"
-#include "codec/lightmap.h"
-#include "formats/dds.h"
-#include "formats/envmap.h"
-#include "formats/file_io.h"
-#include "formats/ktx2.h"
-#include "formats/lightmap_exr.h"
-#include "formats/lightmap_report.h"
-#include "formats/lightmap_stream.h"
+#include "codec/lightmap/lightmap.h"
+#include "formats/lightmap/dds.h"
+#include "formats/envmap/envmap.h"
+#include "formats/io/file_io.h"
+#include "formats/lightmap/ktx2.h"
+#include "formats/lightmap/lightmap_exr.h"
+#include "formats/report/lightmap_report.h"
+#include "formats/lightmap/lightmap_stream.h"
 #include "progress.h"
 
 namespace zhc::cli {

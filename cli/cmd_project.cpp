@@ -7,8 +7,8 @@
 
 #include "cli.h"
 #include "json_output.h"
-#include "codec/sh.h"
-#include "formats/envmap.h"
+#include "codec/sh/sh.h"
+#include "formats/envmap/envmap.h"
 
 namespace zhc::cli {
 namespace cmd_project {  // one namespace per verb file: the CLI is a unity build

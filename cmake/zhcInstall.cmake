@@ -1,6 +1,6 @@
 # `cmake --install` puts zhc into a prefix as a library other projects build against:
 #   include/zhc/codec.h, include/zhc/formats.h      umbrella headers (#include <zhc/codec.h>)
-#   include/zhc/codec/*.h, include/zhc/formats/*.h  the public headers
+#   include/zhc/codec/*/*.h, include/zhc/formats/*/*.h  the public headers, by domain folder
 #   include/zhc/zhc_runtime.h                       the C99 runtime decoder (when runtime/ exists)
 #   lib/libzhc_codec.a, lib/libzhc_formats.a        static libraries
 #   lib/cmake/zhc/zhcConfig.cmake                   find_package(zhc): targets zhc::codec, zhc::formats
@@ -12,21 +12,24 @@ include(CMakePackageConfigHelpers)
 
 set(ZHC_CMAKE_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/zhc")
 
-# Public headers: every header of codec/ and formats/ except the internal ones that include a
-# third-party library's headers (the third-party libraries stay at the edge, DESIGN.md; e.g.
-# formats/exr_memory.h). The umbrella headers include them all, so a new header needs no edit here.
+# Public headers: every header of codec/ and formats/ except those whose first line says "internal to
+# codec/" and the internal ones that include a third-party library's headers (the third-party libraries stay at the edge, DESIGN.md; e.g.
+# formats/io/exr_memory.h). The umbrella headers include them all, so a new header needs no edit here.
 foreach(part codec formats)
-  file(GLOB _headers RELATIVE "${PROJECT_SOURCE_DIR}/${part}" CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/${part}/*.h")
+  file(GLOB_RECURSE _headers RELATIVE "${PROJECT_SOURCE_DIR}/${part}" CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/${part}/*.h")
   list(SORT _headers)
   set(_umbrella "// zhc/${part}.h — umbrella header of zhc_${part} (generated at configure time).\n#pragma once\n")
   foreach(h ${_headers})
     file(STRINGS "${PROJECT_SOURCE_DIR}/${part}/${h}" _third_party
          REGEX "^#include <(Imf|Iex|Imath|tiny_gltf|draco/|zstd|meshoptimizer|stb_|CLI/)")
-    if(_third_party)
+    # Headers whose first line says "internal to codec/" (or formats/) are implementation details.
+    file(STRINGS "${PROJECT_SOURCE_DIR}/${part}/${h}" _internal LIMIT_COUNT 1 REGEX "internal to (codec|formats)/")
+    if(_third_party OR _internal)
       continue()
     endif()
     string(APPEND _umbrella "#include \"${part}/${h}\"\n")
-    install(FILES "${PROJECT_SOURCE_DIR}/${part}/${h}" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/zhc/${part}")
+    get_filename_component(_sub "${h}" DIRECTORY)  # the domain folder (probe, lightmap, io, ...)
+    install(FILES "${PROJECT_SOURCE_DIR}/${part}/${h}" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/zhc/${part}/${_sub}")
   endforeach()
   file(GENERATE OUTPUT "${PROJECT_BINARY_DIR}/include/zhc/${part}.h" CONTENT "${_umbrella}")
   install(FILES "${PROJECT_BINARY_DIR}/include/zhc/${part}.h" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/zhc")

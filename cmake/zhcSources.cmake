@@ -2,13 +2,14 @@
 # that says what it compiles). zhc_check_sources_listed(DIR LISTED...) then fails the configure
 # step, naming the file, when DIR holds a .cpp the list lacks (a file added without listing it, or
 # a merge that brought one) or the list names a missing one. The glob here only checks the list;
-# it never decides what is compiled. (tests/, bench/ and fuzz/ keep their test_*/bench_*/fuzz_*
+# it never decides what is compiled. Sources live in domain subfolders (codec/probe/, formats/io/,
+# ...) and are listed with that relative path. (tests/, bench/ and fuzz/ keep their test_*/bench_*/fuzz_*
 # auto-registration.)
 function(zhc_check_sources_listed dir)
-  file(GLOB _present RELATIVE "${dir}" "${dir}/*.cpp")
+  file(GLOB_RECURSE _present RELATIVE "${dir}" "${dir}/*.cpp")
   set(_listed "")
   foreach(src ${ARGN})
-    get_filename_component(_name "${src}" NAME)
+    set(_name "${src}")  # relative to DIR, e.g. probe/zh3.cpp
     list(APPEND _listed "${_name}")
     if(NOT EXISTS "${dir}/${_name}")
       message(FATAL_ERROR "${dir}/${_name} is listed in ${dir}/CMakeLists.txt but does not exist")

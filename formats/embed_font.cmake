@@ -1,5 +1,5 @@
 # cmake -DIN=font.ttf -DOUT=embedded_font.cpp -P embed_font.cmake: writes the font's bytes as a C++
-# array (zhc::kEmbeddedFont, zhc::kEmbeddedFontSize) for formats/raster.cpp. Run at build time by
+# array (zhc::kEmbeddedFont, zhc::kEmbeddedFontSize) for formats/report/raster.cpp. Run at build time by
 # formats/pictures.cmake; the font itself is never committed.
 file(READ "${IN}" hex HEX)
 string(LENGTH "${hex}" n)

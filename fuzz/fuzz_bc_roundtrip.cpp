@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "codec/bc45.h"
-#include "codec/bc6h.h"
+#include "codec/lightmap/bc45.h"
+#include "codec/lightmap/bc6h.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     if (size < 1 + 16) return 0;

@@ -4,7 +4,7 @@
 #include <cstring>
 #include <vector>
 
-#include "codec/codec.h"
+#include "codec/probe/codec.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const auto table = zhc::codecs();

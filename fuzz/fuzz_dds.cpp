@@ -3,7 +3,7 @@
 // must also survive a write/read round trip with the same blocks.
 #include <cstdint>
 
-#include "formats/dds.h"
+#include "formats/lightmap/dds.h"
 #include "texture_checks.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

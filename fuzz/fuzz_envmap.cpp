@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "formats/envmap.h"
+#include "formats/envmap/envmap.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     zhc::EnvmapReadOptions o;

@@ -1,11 +1,11 @@
-// ZHC_light_probes reading (formats/gltf_probes.h) from untrusted GLB / glTF JSON bytes. Inputs
+// ZHC_light_probes reading (formats/probes/gltf_probes.h) from untrusted GLB / glTF JSON bytes. Inputs
 // live in a directory that does not exist, so any external URI fails (the URI checks and the
 // file-system guard are exercised without touching real files). A successful read gives valid sets;
 // embedding one back into the same asset and reading again gives the same bytes.
 #include <cstdint>
 #include <cstdlib>
 
-#include "formats/gltf_probes.h"
+#include "formats/probes/gltf_probes.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     zhc::GltfLimits limits;

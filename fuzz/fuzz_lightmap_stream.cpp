@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "formats/dds.h"
-#include "formats/ktx2.h"
-#include "formats/lightmap_exr.h"
+#include "formats/lightmap/dds.h"
+#include "formats/lightmap/ktx2.h"
+#include "formats/lightmap/lightmap_exr.h"
 
 namespace {
 

@@ -1,11 +1,11 @@
-// .zhp probe container parsing (formats/probe_file.h) from untrusted bytes. A successful parse must
+// .zhp probe container parsing (formats/probes/probe_file.h) from untrusted bytes. A successful parse must
 // give a valid set that decodes, and re-serialises to a file that parses to the same set.
 #include <cstdint>
 #include <cstdlib>
 #include <span>
 #include <vector>
 
-#include "formats/probe_file.h"
+#include "formats/probes/probe_file.h"
 
 namespace {
 int check(std::span<const std::uint8_t> bytes) {

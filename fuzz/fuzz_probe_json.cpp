@@ -1,10 +1,10 @@
-// JSON probe list parsing (formats/probe_file.h) from untrusted bytes. A successful parse must give
+// JSON probe list parsing (formats/probes/probe_file.h) from untrusted bytes. A successful parse must give
 // finite probes whose layout matches their count, and write back to JSON that parses identically.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 
-#include "formats/probe_file.h"
+#include "formats/probes/probe_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     zhc::ProbeJsonLimits limits;

@@ -9,10 +9,10 @@
 #include <cstring>
 #include <vector>
 
-#include "codec/codec.h"
-#include "codec/probe_set.h"
-#include "codec/quantize.h"
-#include "formats/probe_file.h"
+#include "codec/probe/codec.h"
+#include "codec/probe/probe_set.h"
+#include "codec/probe/quantize.h"
+#include "formats/probes/probe_file.h"
 #include "zhc_runtime.h"
 #include "zhc_runtime_params.hpp"
 

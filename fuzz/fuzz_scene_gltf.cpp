@@ -1,4 +1,4 @@
-// glTF scene reading (formats/scene_gltf.h: KHR_lights_punctual, meshes as occluders, node tree,
+// glTF scene reading (formats/scene/scene_gltf.h: KHR_lights_punctual, meshes as occluders, node tree,
 // extras.zhc) from untrusted GLB / glTF JSON bytes. The input lives in a directory that does not
 // exist, so external buffers and environment maps fail without touching real files. A successful
 // read is a valid scene: it bakes to exactly one probe per position with finite coefficients, and
@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <cstdlib>
 
-#include "codec/occluders.h"
-#include "codec/scene.h"
-#include "formats/scene_gltf.h"
+#include "codec/bake/occluders.h"
+#include "codec/bake/scene.h"
+#include "formats/scene/scene_gltf.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     zhc::GltfLimits glimits;

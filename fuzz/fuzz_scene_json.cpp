@@ -1,11 +1,11 @@
-// Scene description parsing (formats/scene_json.h) and baking (codec/scene.h) from untrusted
+// Scene description parsing (formats/scene/scene_json.h) and baking (codec/bake/scene.h) from untrusted
 // bytes. A successful parse must bake without crashing to exactly one probe per position, and
 // write back to JSON that parses to a scene with the same probe count and lights.
 #include <cstdint>
 #include <cstdlib>
 
-#include "codec/scene.h"
-#include "formats/scene_json.h"
+#include "codec/bake/scene.h"
+#include "formats/scene/scene_json.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     zhc::SceneLoadOptions options;

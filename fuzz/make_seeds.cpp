@@ -7,14 +7,14 @@
 #include <string>
 #include <vector>
 
-#include "codec/codec.h"
-#include "codec/sky.h"
-#include "formats/envmap.h"
-#include "formats/file_io.h"
-#include "formats/dds.h"
-#include "formats/ktx2.h"
-#include "codec/bc6h.h"
-#include "codec/bc45.h"
+#include "codec/probe/codec.h"
+#include "codec/bake/sky.h"
+#include "formats/envmap/envmap.h"
+#include "formats/io/file_io.h"
+#include "formats/lightmap/dds.h"
+#include "formats/lightmap/ktx2.h"
+#include "codec/lightmap/bc6h.h"
+#include "codec/lightmap/bc45.h"
 
 using namespace zhc;
 

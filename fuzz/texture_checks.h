@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "codec/bc45.h"
-#include "codec/bc6h.h"
-#include "formats/ktx2.h"
+#include "codec/lightmap/bc45.h"
+#include "codec/lightmap/bc6h.h"
+#include "formats/lightmap/ktx2.h"
 
 namespace zhc::fuzz {
 

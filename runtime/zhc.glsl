@@ -2,8 +2,8 @@
 // IrradZ lightmap (issue 15). An include file: no #version line; prepend "#version 450" (desktop)
 // or "#version 310 es" (GLSL ES 3.10), compute or fragment stage. No extensions are used.
 //
-// Source of truth: the C++ codec (codec/quantize.cpp, codec/zh3.cpp, codec/core_codecs.cpp,
-// codec/dering.cpp, codec/probe_set.cpp, codec/irradz.cpp, codec/lightmap.cpp). Every function
+// Source of truth: the C++ codec (codec/probe/quantize.cpp, codec/probe/zh3.cpp, codec/probe/core_codecs.cpp,
+// codec/probe/dering.cpp, codec/probe/probe_set.cpp, codec/lightmap/irradz.cpp, codec/lightmap/lightmap.cpp). Every function
 // here computes what the codec computes, in float instead of double; tests/test_runtime_gl.cpp
 // runs this file on Mesa llvmpipe and compares with the codec on >= 100,000 probes per encoding.
 //
@@ -99,7 +99,7 @@ const uint ZHC_HALL_CURVE = 3u;   // Eq. 21: f20 = (a p^2 + b p) f0
 // hall_adaptive_q16 (ZHC_LAYOUT_SH2_Q only): Eq. 21 with a, b times s = 0.5 min(byte 15, 7).
 const uint ZHC_HALL_CURVE_ADAPTIVE = 4u;
 
-// .zhp header enums (codec/quantize.h, same numeric values as the file).
+// .zhp header enums (codec/probe/quantize.h, same numeric values as the file).
 const uint ZHC_DC_R11G11B10F = 0u;
 const uint ZHC_DC_RGB9E5 = 1u;
 const uint ZHC_DC_HALF = 2u;  // sh2_q / hall_curve_q only (6-byte slot); elsewhere read as R11G11B10F
@@ -144,7 +144,7 @@ const float ZHC_Y22 = 0.54627421529603959;   // sqrt(15 / 16pi)
 const float ZHC_SQRT3 = 1.7320508075688772;
 const float ZHC_SQRT5 = 2.2360679774997897;
 const float ZHC_SQRT15 = 3.8729833462074169;
-// cos / sin of 85 degrees: IrradZ keeps its direction at d_z >= cos(85 deg) (codec/irradz.h).
+// cos / sin of 85 degrees: IrradZ keeps its direction at d_z >= cos(85 deg) (codec/lightmap/irradz.h).
 const float ZHC_IRRADZ_MIN_DZ = 0.087155742747658166;
 const float ZHC_IRRADZ_MAX_SIN = 0.99619469809174555;
 
@@ -231,7 +231,7 @@ ZhcSh3 zhcZeroSh3() {
     return s;
 }
 
-// ---- ZH3: zonal axes, expansion, evaluation (ZH3 paper Sec. 3, codec/zh3.cpp) ----------------------
+// ---- ZH3: zonal axes, expansion, evaluation (ZH3 paper Sec. 3, codec/probe/zh3.cpp) ----------------------
 
 // The L1 band of channel k as a vector: v = (-f11, -f1-1, f10), f1(d) = Y1 v.d.
 vec3 zhcL1Vector(ZhcSh3 s, int k) { return vec3(-s.c[3][k], -s.c[1][k], s.c[2][k]); }
@@ -574,7 +574,7 @@ vec3 zhcIrradiance(uint w[27], ZhcFormat f, vec3 n) {
     return vec3(0.0);
 }
 
-// ---- IrradZ lightmaps (codec/irradz.h, codec/lightmap.cpp, docs/irradz.md) --------------------------
+// ---- IrradZ lightmaps (codec/lightmap/irradz.h, codec/lightmap/lightmap.cpp, docs/irradz.md) --------------------------
 
 const uint ZHC_IRRADZ_HHD = 0u;  // E(n) = C_a (1 + n_z) / 2 + C_d max(0, n.d)  (hemisphere + direction)
 const uint ZHC_IRRADZ_AHD = 1u;  // E(n) = C_a + C_d max(0, n.d)                (ambient + direction)

@@ -1,8 +1,8 @@
 // zhc/runtime/zhc.hlsl — shader-side decoders and evaluators for zhc's stored probes and IrradZ
 // lightmaps (HLSL, shader model 5.0+ / 6.x; also compiles with glslang's HLSL front end to SPIR-V).
 //
-// Source of truth: the C++ codec (codec/quantize.cpp, codec/zh3.cpp, codec/core_codecs.cpp,
-// codec/dering.cpp, codec/probe_set.cpp decode_probe, codec/irradz.h, codec/lightmap.cpp). Every
+// Source of truth: the C++ codec (codec/probe/quantize.cpp, codec/probe/zh3.cpp, codec/probe/core_codecs.cpp,
+// codec/probe/dering.cpp, codec/probe/probe_set.cpp decode_probe, codec/lightmap/irradz.h, codec/lightmap/lightmap.cpp). Every
 // function here computes what its C++ twin computes, in float instead of double;
 // tests/test_runtime_vk.cpp runs them on Vulkan (Mesa lavapipe) against the C++ codec.
 //
@@ -83,7 +83,7 @@
 #define ZHC_ZH3_DERING_Q16 21u   // zh3_q16's 16 bytes
 #define ZHC_ZH3_CHANNEL_Q16 22u  // zh3_q16's 16 bytes, each channel's own axis (f.axisMode unused)
 #define ZHC_ZH3_SOLVED_CHANNEL_Q16 23u  // zh3_channel_q16's 16 bytes
-#define ZHC_HALL_SOLVED 24u      // hall_curve's 12 floats (the L1 is solved at encode: codec/zh3_hall.cpp)
+#define ZHC_HALL_SOLVED 24u      // hall_curve's 12 floats (the L1 is solved at encode: codec/probe/zh3_hall.cpp)
 #define ZHC_HALL_SOLVED_Q16 25u  // hall_curve_q's 16 bytes
 #define ZHC_HALL_ADAPTIVE_Q16 26u  // sh2_q's 16 bytes, byte 15 = scale code: Eq. 21 times 0.5 min(code, 7)
 #define ZHC_ENCODING_COUNT 27u
@@ -99,7 +99,7 @@ uint zhc_encoding_bytes(uint encoding)
     return 60u;  // the 15-float ZH3 layouts
 }
 
-// ---- format (what the probe container's header stores; codec/quantize.h QuantParams) ----------
+// ---- format (what the probe container's header stores; codec/probe/quantize.h QuantParams) ----------
 #define ZHC_DC_R11G11B10F 0u
 #define ZHC_DC_RGB9E5 1u
 #define ZHC_DC_HALF 2u
@@ -299,7 +299,7 @@ float3 zhc_load_dc(uint w0, uint w1, uint dcFormat, bool sixByteSlot)
     return zhc_unpack_r11g11b10f(w0);
 }
 
-// ---- ratio decoding (codec/quantize.cpp RatioCoder::decode) ----------------------------------------
+// ---- ratio decoding (codec/probe/quantize.cpp RatioCoder::decode) ----------------------------------------
 
 // Byte b (0..31) of a probe given as words.
 uint zhc_byte(uint w, uint b) { return (w >> (8u * (b & 3u))) & 0xFFu; }
@@ -399,7 +399,7 @@ void zhc_expand_zonal(inout ZhcSH3 sh, float3 f20, float3 a[3])
     [unroll] for (int m = 0; m < 5; ++m) sh.c[4 + m] = f20 * float3(v0[m], v1[m], v2[m]);
 }
 
-// ---- hallucination (ZH3 paper Sec. 3.4, Listing 1; codec/zh3.cpp hallucinate_zonal) ---------------
+// ---- hallucination (ZH3 paper Sec. 3.4, Listing 1; codec/probe/zh3.cpp hallucinate_zonal) ---------------
 #define ZHC_HALL_MODEL_AMBDIR 0u   // Eq. 14: f20 = sqrt(15)/3 |f1|
 #define ZHC_HALL_MODEL_SPHERE 1u   // Eq. 20: f20 = (2 sqrt5/3 p^2 - sqrt(5/3) p) f0
 #define ZHC_HALL_MODEL_CURVE 2u    // Eq. 21: f20 = (a p^2 + b p) f0
@@ -562,7 +562,7 @@ float3 zhc_irradiance_sh2_q(uint4 p, ZhcFormat f, float3 n)
     return kZhcY00 * c[0] + (w1 * kZhcY1) * (-c[1] * n.y + c[2] * n.z - c[3] * n.x);
 }
 
-// hall_adaptive_q16: the curve's a and b times s = 0.5 min(byte 15, 7) (codec/zh3_hall.cpp); 1 for
+// hall_adaptive_q16: the curve's a and b times s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall.cpp); 1 for
 // hall_curve_q / hall_solved_q16.
 ZhcFormat zhc_hall_scaled(uint4 p, ZhcFormat f)
 {
@@ -682,7 +682,7 @@ ZhcSH3 zhc_decode_sh3(uint w[27], ZhcFormat f)
     return zhc_decode_floats(w, f);
 }
 
-// ---- IrradZ lightmaps (codec/irradz.h, Roughton SIGGRAPH 2024 Advances) ------------------------------
+// ---- IrradZ lightmaps (codec/lightmap/irradz.h, Roughton SIGGRAPH 2024 Advances) ------------------------------
 //
 // Three textures per lightmap: BC6H I_z (rgb irradiance at the surface normal), BC4 w_a, BC5 d
 // (hemi-octahedral). Pass the SAMPLED (decoded, filtered) values; everything is in the tangent frame
@@ -694,7 +694,7 @@ ZhcSH3 zhc_decode_sh3(uint w[27], ZhcFormat f)
 static const float kZhcIrradzMinDz = 0.08715574274765817f;  // cos 85 deg: d is kept above the horizon
 static const float kZhcIrradzMaxSin = 0.99619469809174553f; // sin 85 deg
 
-// BC5 (u, v) in [0, 1]^2 -> unit direction in the upper hemisphere (codec/lightmap.cpp decode_hemioct).
+// BC5 (u, v) in [0, 1]^2 -> unit direction in the upper hemisphere (codec/lightmap/lightmap.cpp decode_hemioct).
 float3 zhc_decode_hemioct(float2 uv)
 {
     float2 ab = 2.0f * saturate(uv) - 1.0f;

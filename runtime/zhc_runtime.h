@@ -59,7 +59,7 @@ extern "C" {
 
 /* ---- enums --------------------------------------------------------------------------------- */
 
-/* Every codec table entry (codec/codec_table.cpp `codecs()`, same order). Bytes per probe in (). */
+/* Every codec table entry (codec/probe/codec_table.cpp `codecs()`, same order). Bytes per probe in (). */
 enum zhc_encoding {
     ZHC_ENC_SH3 = 0,                  /* 27 floats (108): the hub */
     ZHC_ENC_SH2 = 1,                  /* 12 floats (48): DC + L1, L2 = 0 */
@@ -97,7 +97,7 @@ enum zhc_zonal_mapping { ZHC_ZONAL_AFFINE = 0, ZHC_ZONAL_ZERO_PRESERVING = 1, ZH
 enum zhc_axis_mode { ZHC_AXIS_LUMINANCE = 0, ZHC_AXIS_PER_CHANNEL = 1 };
 enum zhc_irradz_model { ZHC_IRRADZ_HHD = 0, ZHC_IRRADZ_AHD = 1 };
 
-/* Error codes; the .zhp ones mirror zhc's reader (formats/probe_file.h). */
+/* Error codes; the .zhp ones mirror zhc's reader (formats/probes/probe_file.h). */
 enum zhc_error {
     ZHC_OK = 0,
     ZHC_ERR_ARGUMENT = 1,       /* unknown encoding name, invalid zhc_probe_format, null pointer */
@@ -172,7 +172,7 @@ static inline int zhc__sh2q_layout(int e) {
            e == ZHC_ENC_HALL_ADAPTIVE_Q16;
 }
 
-/* Defaults of `zhc convert --to ENCODING` (cli/cmd_convert.cpp, codec/quantize.h QuantParams):
+/* Defaults of `zhc convert --to ENCODING` (cli/cmd_convert.cpp, codec/probe/quantize.h QuantParams):
  * 8 bits, no sqrt, tight bound, R11G11B10F DC, affine zonal mapping, luminance axis, radiance,
  * Rec. 709 weights (0.2126, 0.7152, 0.0722), Eq. 21 a = 0.6, b = 0.08.
  * Returns ZHC_OK, or ZHC_ERR_ARGUMENT for an unknown name (f then holds the defaults with
@@ -233,7 +233,7 @@ static inline int zhc_probe_format_set_gltf(zhc_probe_format* f, const char* key
     return ZHC_ERR_UNSUPPORTED;
 }
 
-/* ZHC_OK when f is a format zhc's writer can produce (codec/quantize.cpp validate_quant_params):
+/* ZHC_OK when f is a format zhc's writer can produce (codec/probe/quantize.cpp validate_quant_params):
  * known encoding, bits 2..8, enums in range, finite luminance weights and curve constants, half DC
  * only with the sh2_q layout (sh2_q, hall_curve_q, hall_solved_q16, hall_adaptive_q16) among the packed ones. */
 static inline int zhc_probe_format_validate(const zhc_probe_format* f) {
@@ -259,7 +259,7 @@ static inline size_t zhc_probe_size(const zhc_probe_format* f) { return f ? zhc_
 /* ---- internal helpers (zhc__ prefix: not part of the API) ---------------------------------- */
 
 #define ZHC__PI 3.14159265358979323846
-/* Basis constants (ZH3 paper Eq. 4/5), computed exactly as codec/sh.h does (sqrt is correctly
+/* Basis constants (ZH3 paper Eq. 4/5), computed exactly as codec/sh/sh.h does (sqrt is correctly
  * rounded, so these are the same doubles everywhere). */
 #define ZHC__Y00 (1.0 / (2.0 * sqrt(ZHC__PI)))
 #define ZHC__Y1 sqrt(3.0 / (4.0 * ZHC__PI))
@@ -301,7 +301,7 @@ static inline double zhc__f64(const uint8_t* p) {
     return v;
 }
 
-/* The nine SH3 basis functions at unit direction d (codec/sh.h sh3_basis). */
+/* The nine SH3 basis functions at unit direction d (codec/sh/sh.h sh3_basis). */
 static inline void zhc__sh3_basis(const double d[3], double y[9]) {
     const double x = d[0], yy = d[1], z = d[2];
     y[0] = ZHC__Y00;
@@ -335,7 +335,7 @@ static inline void zhc__normalize_or_z(const double a[3], double out[3]) {
 
 /* Irradiance at unit normal n of SH radiance with `count` (4 or 9) coefficients, sh[i*3+k]:
  * E(n) = sum_i s_l c_i Y_i(n), s_l = 1, 2/3, 1/4, the scaled coefficients rounded to float first
- * (codec/sh.cpp irradiance = evaluate(to_irradiance(L), n)). */
+ * (codec/sh/sh.cpp irradiance = evaluate(to_irradiance(L), n)). */
 static inline void zhc__sh_irradiance(const float* sh, int count, const double n[3], float rgb[3]) {
     double y[9], acc[3] = {0.0, 0.0, 0.0};
     int i, k;
@@ -352,7 +352,7 @@ static inline void zhc_sh3_irradiance(const float sh3[27], const double n[3], fl
     zhc__sh_irradiance(sh3, 9, n, rgb);
 }
 
-/* ---- ZH3 (codec/zh3.cpp) ------------------------------------------------------------------- */
+/* ---- ZH3 (codec/probe/zh3.cpp) ------------------------------------------------------------------- */
 
 /* Zonal axes of the three channels from the linear SH lin[12] (DC, L1-1, L10, L11 x RGB):
  * luminance mode: normalize(sum_k w_k v_k), per-channel: normalize(v_k), with the L1 vector
@@ -423,7 +423,7 @@ static inline double zhc_hallucinate_zonal(int model, double f0, double f1, doub
     return (a * p * p + b * p) * f0;
 }
 
-/* Hallucinated zonal coefficients of the three channels (codec/zh3.cpp zh3_hallucinate). */
+/* Hallucinated zonal coefficients of the three channels (codec/probe/zh3.cpp zh3_hallucinate). */
 static inline void zhc__hallucinate(const float lin[12], int model, int per_channel, const double w[3], double a,
                                     double b, float zonal[3]) {
     double axes[3][3];
@@ -436,7 +436,7 @@ static inline void zhc__hallucinate(const float lin[12], int model, int per_chan
     }
 }
 
-/* ---- DC formats (codec/quantize.cpp) ------------------------------------------------------- */
+/* ---- DC formats (codec/probe/quantize.cpp) ------------------------------------------------------- */
 
 /* Unsigned float with a 5-bit exponent (bias 15) and mbits mantissa bits; exponent 31 is
  * +Inf (mantissa 0) or NaN, as the hardware formats. */
@@ -468,7 +468,7 @@ static inline float zhc_unpack_half(uint16_t bits) {
     return (bits & 0x8000u) ? -mag : mag;
 }
 
-/* ---- the ratio quantiser (codec/quantize.cpp RatioCoder::decode) --------------------------- */
+/* ---- the ratio quantiser (codec/probe/quantize.cpp RatioCoder::decode) --------------------------- */
 
 /* Interval [lo, hi] of c_i / c_0 (ZH3 App. A; W&S Sec. 3) for SH index i (1..8), or of the ZH3
  * zonal coefficient (zonal_coef = 1): L1 +-sqrt(3); L2 zonal [-sqrt(5)/2, sqrt(5)]; L2 non-zonal
@@ -506,7 +506,7 @@ static inline double zhc__ratio_decode(const zhc_probe_format* f, int i, int zon
 }
 
 /* Packed layouts -> the stored-domain coefficients q[i][k] (double) of the layout, then divided by
- * the band scale (irradiance kind) and rounded to float: codec/quantize.cpp decode_packed. */
+ * the band scale (irradiance kind) and rounded to float: codec/probe/quantize.cpp decode_packed. */
 static inline void zhc__decode_packed(const zhc_probe_format* f, const uint8_t* in, float out[27]) {
     double q[9][3];
     float dc[3];
@@ -613,7 +613,7 @@ static inline int zhc_decode_probe(const zhc_probe_format* f, const void* bytes,
             zhc__decode_packed(f, in, radiance_sh3);
             if (zhc__sh2q_layout(f->encoding) && f->encoding != ZHC_ENC_SH2_Q) {
                 /* ZH3 paper Sec. 3.4.3, Eq. 21 on the decoder's axis (quantize.cpp hallucinate_curve);
-                 * hall_adaptive_q16 scales a and b by s = 0.5 min(byte 15, 7) (codec/zh3_hall.cpp). */
+                 * hall_adaptive_q16 scales a and b by s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall.cpp). */
                 const double s = f->encoding == ZHC_ENC_HALL_ADAPTIVE_Q16 ? 0.5 * (in[15] < 7 ? in[15] : 7) : 1.0;
                 per_channel = f->axis_mode == ZHC_AXIS_PER_CHANNEL;
                 for (i = 0; i < 12; ++i) lin[i] = (float)zhc__f32_round(radiance_sh3[i]);
@@ -623,7 +623,7 @@ static inline int zhc_decode_probe(const zhc_probe_format* f, const void* bytes,
             return ZHC_OK;
     }
     if (f->kind == ZHC_KIND_IRRADIANCE) {
-        /* codec/sh.h to_radiance: inverse band scales 1, 1 / (2/3), 1 / (1/4). */
+        /* codec/sh/sh.h to_radiance: inverse band scales 1, 1 / (2/3), 1 / (1/4). */
         for (i = 0; i < 9; ++i) {
             const double s = i == 0 ? 1.0 / 1.0 : (i < 4 ? 1.0 / ZHC__BAND1 : 1.0 / ZHC__BAND2);
             for (k = 0; k < 3; ++k) radiance_sh3[i * 3 + k] = (float)(zhc__f32_round(radiance_sh3[i * 3 + k]) * s);
@@ -717,7 +717,7 @@ static inline uint32_t zhc_crc32(uint32_t crc, const void* data, size_t size) {
 }
 
 /* The header of a .zhp file: `header` holds `size` bytes (the whole file or at least its first
- * 184). Checks, in zhc's reader order (formats/probe_file.cpp): magic (a short prefix of it:
+ * 184). Checks, in zhc's reader order (formats/probes/probe_file.cpp): magic (a short prefix of it:
  * TRUNCATED, else BAD_FORMAT), version 1 (UNSUPPORTED), 184 bytes present (TRUNCATED), header CRC-32
  * (CHECKSUM), header size 184, reserved bytes zero (BAD_FORMAT), enum ranges of kind, DC format, L2
  * bound, zonal mapping, axis mode, compression, layout (UNSUPPORTED), sqrt 0/1 and bits 2..8
@@ -859,13 +859,13 @@ static inline int zhc_probe_format_from_zhp(zhc_probe_format* f, const void* hea
     return zhc_zhp_parse_header(f, NULL, header, size);
 }
 
-/* ---- IrradZ lightmaps (codec/irradz.h, codec/lightmap.h, docs/irradz.md) ------------------- */
+/* ---- IrradZ lightmaps (codec/lightmap/irradz.h, codec/lightmap/lightmap.h, docs/irradz.md) ------------------- */
 
 /* Directions are kept at most 85 degrees from the normal (d_z >= cos 85deg) so that
  * C_d = (1 - w_a) I_z / d_z stays bounded. */
 #define ZHC_IRRADZ_MAX_THETA (85.0 * ZHC__PI / 180.0)
 
-/* BC5 hemi-octahedral direction decode (codec/lightmap.cpp decode_hemioct): (u, v) in [0, 1]^2
+/* BC5 hemi-octahedral direction decode (codec/lightmap/lightmap.cpp decode_hemioct): (u, v) in [0, 1]^2
  * (clamped; NaN gives +Z), a = 2u - 1, b = 2v - 1, p = ((a + b)/2, (a - b)/2),
  * d = normalize(p.x, p.y, max(0, 1 - |p.x| - |p.y|)). Always a unit vector with d_z >= 0. */
 static inline void zhc_decode_hemioct(float u, float v, double d[3]) {
@@ -878,7 +878,7 @@ static inline void zhc_decode_hemioct(float u, float v, double d[3]) {
 }
 
 /* Irradiance at the tangent-space unit normal n (surface normal +Z) of an IrradZ texel
- * (I_z rgb, w_a, unit direction d), codec/irradz.cpp evaluate(IrradZ):
+ * (I_z rgb, w_a, unit direction d), codec/lightmap/irradz.cpp evaluate(IrradZ):
  *   d clamped to theta <= 85 deg (azimuth kept), w = clamp(w_a, 0, 1),
  *   C_a = w I_z, C_d = (1 - w) I_z / d_z (both rounded to float),
  *   HHD (model 0, default): E(n) = C_a (1 + n_z) / 2 + C_d max(0, n.d)
@@ -920,7 +920,7 @@ static inline void zhc_hlsh_evaluate(const float i_z[3], const float c_a[3], con
         rgb[k] = (float)(i_z[k] * m[2] + c_a[k] * (1 - m[2]) + c_x[k] * m[0] + c_y[k] * m[1]);
 }
 
-/* Frame around unit z (codec/sh.cpp frame_from_z), row-major 3x3 whose third column is z. */
+/* Frame around unit z (codec/sh/sh.cpp frame_from_z), row-major 3x3 whose third column is z. */
 static inline void zhc_frame_from_z(const double z_axis[3], double frame[9]) {
     double z[3], hx[3], x[3], y[3];
     zhc__normalize_or_z(z_axis, z);
@@ -960,7 +960,7 @@ typedef struct zhc_hlsh_tables {
     double p_one_minus_z[9], p_x[9], p_y[9], y_up[9];
 } zhc_hlsh_tables;
 
-/* Gauss-Legendre rule of 10 nodes on [-1, 1] (Newton on P_10; codec/irradz.cpp). */
+/* Gauss-Legendre rule of 10 nodes on [-1, 1] (Newton on P_10; codec/lightmap/irradz.cpp). */
 static inline void zhc__gauss_legendre10(double x[10], double w[10]) {
     const int n = 10;
     int i, it, k;
@@ -997,7 +997,7 @@ static inline double zhc__cap_node(const double glx[10], const double glw[10], d
 }
 
 /* Fills t for cones of half-angle alpha (cos_alpha clamped to [-1, 1]); ~30k flops, once per cone
- * angle. Equals zhc's tables (codec/irradz.cpp cap_gram, Tables) bit for bit with the same libm. */
+ * angle. Equals zhc's tables (codec/lightmap/irradz.cpp cap_gram, Tables) bit for bit with the same libm. */
 static inline void zhc_hlsh_tables_init(zhc_hlsh_tables* t, double cos_alpha) {
     double glx[10], glw[10], dir[3], y[9], up[3] = {0.0, 0.0, 1.0};
     const double c = zhc__clamp(cos_alpha, -1.0, 1.0);
@@ -1024,7 +1024,7 @@ static inline void zhc_hlsh_tables_init(zhc_hlsh_tables* t, double cos_alpha) {
     zhc__sh3_basis(up, t->y_up);
 }
 
-/* Rotates SH3 radiance by R (row-major): g(d) = f(R^T d) (codec/sh.cpp rotate: L1 as a vector,
+/* Rotates SH3 radiance by R (row-major): g(d) = f(R^T d) (codec/sh/sh.cpp rotate: L1 as a vector,
  * L2 as the traceless quadratic form Q -> R Q R^T). */
 static inline void zhc_sh3_rotate(const float in[27], const double r[9], float out[27]) {
     int k, i, j, l;
@@ -1067,7 +1067,7 @@ static inline void zhc_sh3_rotate(const float in[27], const double r[9], float o
     }
 }
 
-/* HLSH hemisphere / cone multiply of a probe (codec/irradz.cpp hlsh_multiply): world SH3 radiance
+/* HLSH hemisphere / cone multiply of a probe (codec/lightmap/irradz.cpp hlsh_multiply): world SH3 radiance
  * sh3[27], the normal's frame (row-major, third column = n, e.g. zhc_frame_from_z) and the tables
  * of the cone (zhc_hlsh_tables_init(t, cos_alpha); cos_alpha = 0 is the hemisphere):
  *   L_t = rotate(L, frame^T) (tangent frame), O = G_cap L_t (SH3 product with the cap),

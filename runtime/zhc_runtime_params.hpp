@@ -1,5 +1,5 @@
 // zhc/runtime/zhc_runtime_params.hpp — C++ bridge for code that has zhc's own StorageParams
-// (codec/probe_set.h) and wants the matching zhc_probe_format of the C runtime (tests, fuzzers,
+// (codec/probe/probe_set.h) and wants the matching zhc_probe_format of the C runtime (tests, fuzzers,
 // tools built with zhc's libraries). Not needed by engines, which fill the format from a .zhp
 // header or a glTF volume.
 #pragma once
@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "codec/probe_set.h"
+#include "codec/probe/probe_set.h"
 #include "zhc_runtime.h"
 
 namespace zhc {

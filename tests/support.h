@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "codec/sh.h"
-#include "formats/envmap.h"
-#include "formats/ktx2.h"
+#include "codec/sh/sh.h"
+#include "formats/envmap/envmap.h"
+#include "formats/lightmap/ktx2.h"
 
 namespace zhc::test {
 

@@ -5,8 +5,8 @@
 #include <filesystem>
 
 #include "cli/cli.h"
-#include "codec/audit.h"
-#include "codec/benchmark.h"
+#include "codec/report/audit.h"
+#include "codec/report/benchmark.h"
 #include "support.h"
 
 namespace zhc {
@@ -198,8 +198,8 @@ TEST(BenchCli, RuntimeCostFileAddsGpuCostAndPlot) {
 }  // namespace
 }  // namespace zhc
 
-#include "codec/probe_set.h"
-#include "formats/probe_file.h"
+#include "codec/probe/probe_set.h"
+#include "formats/probes/probe_file.h"
 
 namespace zhc {
 namespace {

@@ -1,10 +1,10 @@
-// BC4 / BC5 (codec/bc45.h): decoder against the format's palette formula, totality, and the
+// BC4 / BC5 (codec/lightmap/bc45.h): decoder against the format's palette formula, totality, and the
 // encoder against a brute-force optimum (every endpoint pair, best indices).
 #include <cstdio>
 #include <cstring>
 #include <random>
 
-#include "codec/bc45.h"
+#include "codec/lightmap/bc45.h"
 #include "support.h"
 
 namespace zhc {

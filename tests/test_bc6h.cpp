@@ -1,4 +1,4 @@
-// BC6H unsigned (codec/bc6h.h): half conversion, decoder totality, layout, encoder quality.
+// BC6H unsigned (codec/lightmap/bc6h.h): half conversion, decoder totality, layout, encoder quality.
 // The bit-exactness against an independent decoder (Mesa) is tests/test_mesa_bc.cpp.
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <cstring>
 #include <random>
 
-#include "codec/bc6h.h"
+#include "codec/lightmap/bc6h.h"
 #include "support.h"
 
 namespace zhc {
@@ -262,7 +262,7 @@ TEST(Bc6hImage, ThreadCountDoesNotChangeBytesAndEdgesReplicate) {
     EXPECT_LT(worst, 400);  // within a few hundred half ULPs (~log2 error < 0.4) everywhere
 }
 
-// The encoder's baseline and AVX2 twins (codec/bc6h.cpp) must write the same bytes: crops of every
+// The encoder's baseline and AVX2 twins (codec/lightmap/bc6h.cpp) must write the same bytes: crops of every
 // real map, from the detailed middle rows, at every quality.
 TEST(Bc6hIsa, BaselineAndAvx2WriteTheSameBytesOnRealMaps) {
     if (!isa_supported(Isa::kAvx2)) GTEST_SKIP() << "this CPU has no AVX2: only the baseline encoder runs here";

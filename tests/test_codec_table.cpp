@@ -1,9 +1,9 @@
-// Contracts every entry of the codec table must keep (codec/codec.h), checked by walking the
+// Contracts every entry of the codec table must keep (codec/probe/codec.h), checked by walking the
 // table: a new representation is covered here without writing a test for it.
 #include <random>
 #include <set>
 
-#include "codec/codec.h"
+#include "codec/probe/codec.h"
 #include "support.h"
 
 namespace zhc {
@@ -120,7 +120,7 @@ TEST(CodecTable, DcIsPreservedByEveryFloatRepresentation) {
     }
 }
 
-// CodecTraits (codec/codec.h) are facts about the entry's functions; code outside the entries
+// CodecTraits (codec/probe/codec.h) are facts about the entry's functions; code outside the entries
 // relies on them instead of names, so each is checked here against encode/decode.
 TEST(CodecTable, ExactTraitHoldsAndOnlyWhereClaimed) {
     const CodecOptions o;

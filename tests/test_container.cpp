@@ -1,14 +1,14 @@
-// The probe set (codec/probe_set.h), the .zhp container and the JSON probe list
-// (formats/probe_file.h), and the convert/info verbs: round trips, strict decoding (every
+// The probe set (codec/probe/probe_set.h), the .zhp container and the JSON probe list
+// (formats/probes/probe_file.h), and the convert/info verbs: round trips, strict decoding (every
 // truncation, every bit flip, trailing bytes, limits, unknown versions), golden container bytes,
 // determinism, and CLI behaviour including error paths and atomic outputs.
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "codec/probe_set.h"
-#include "formats/file_io.h"
-#include "formats/probe_file.h"
+#include "codec/probe/probe_set.h"
+#include "formats/io/file_io.h"
+#include "formats/probes/probe_file.h"
 #include "support.h"
 
 namespace zhc {
@@ -273,7 +273,7 @@ TEST(ProbeFile, RandomBytesNeverCrash) {
 
 // ---- golden container bytes ---------------------------------------------------------------------
 
-std::string golden_dir() { return (fs::path(__FILE__).parent_path() / "golden").string(); }
+std::string golden_dir() { return std::string(ZHC_GOLDEN_DIR); }
 
 void expect_golden(const std::string& name, const std::vector<std::uint8_t>& bytes) {
     const std::string path = golden_dir() + "/" + name;

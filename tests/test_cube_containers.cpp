@@ -1,4 +1,4 @@
-// KTX2 and DDS environment cube maps (formats/envmap_cube.h): the Vulkan / D3D face table,
+// KTX2 and DDS environment cube maps (formats/envmap/envmap_cube.h): the Vulkan / D3D face table,
 // analytic SH3 maps in every pixel format, consistency with the lat-long sample maps, mip chains,
 // and hostile variants through the CLI (README exit codes).
 //
@@ -18,11 +18,11 @@
 
 #include <zstd.h>
 
-#include "codec/bc6h.h"
-#include "codec/cubemap.h"
-#include "formats/envmap.h"
-#include "formats/envmap_cube.h"
-#include "formats/ktx2.h"
+#include "codec/lightmap/bc6h.h"
+#include "codec/sh/cubemap.h"
+#include "formats/envmap/envmap.h"
+#include "formats/envmap/envmap_cube.h"
+#include "formats/lightmap/ktx2.h"
 #include "support.h"
 
 namespace zhc {

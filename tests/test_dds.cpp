@@ -1,4 +1,4 @@
-// DDS writer and strict reader (formats/dds.h) and `zhc lightmap encode/decode --container dds`.
+// DDS writer and strict reader (formats/lightmap/dds.h) and `zhc lightmap encode/decode --container dds`.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -7,10 +7,10 @@
 #include <new>
 #include <random>
 
-#include "codec/lightmap.h"
-#include "formats/dds.h"
-#include "formats/file_io.h"
-#include "formats/ktx2.h"
+#include "codec/lightmap/lightmap.h"
+#include "formats/lightmap/dds.h"
+#include "formats/io/file_io.h"
+#include "formats/lightmap/ktx2.h"
 #include "support.h"
 
 // The largest single allocation while g_watch_allocations is set (global operator new is replaced

@@ -1,4 +1,4 @@
-// Deringing (codec/dering.h, Sloan 2017): the conservative minimum against dense sampling, the
+// Deringing (codec/probe/dering.h, Sloan 2017): the conservative minimum against dense sampling, the
 // window table, the bisection's minimality, non-negativity after deringing on analytic and real
 // lighting, the sh3_dering codec entry and the `zhc dering` verb.
 #include <algorithm>
@@ -9,8 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "codec/codec.h"
-#include "codec/dering.h"
+#include "codec/probe/codec.h"
+#include "codec/probe/dering.h"
 #include "support.h"
 
 namespace zhc {

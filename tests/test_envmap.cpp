@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "cli/cli.h"
-#include "formats/file_io.h"
+#include "formats/io/file_io.h"
 #include "support.h"
 
 namespace zhc {

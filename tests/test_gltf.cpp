@@ -1,4 +1,4 @@
-// ZHC_light_probes (formats/gltf_probes.h, docs/gltf-extension.md): embed -> extract round trips
+// ZHC_light_probes (formats/probes/gltf_probes.h, docs/gltf-extension.md): embed -> extract round trips
 // (float lossless, quantised bit-exact, grid/points/none, radiance/irradiance), preservation of the
 // scene's other content (mesh, material, unknown extensions, a Draco-compressed mesh; buffer bytes
 // byte-for-byte), the frame conversion (positions and SH checked against dense direction
@@ -21,11 +21,11 @@
 #include <random>
 #include <sstream>
 
-#include "codec/probe_set.h"
-#include "formats/envmap.h"
-#include "formats/file_io.h"
-#include "formats/gltf_probes.h"
-#include "formats/probe_file.h"
+#include "codec/probe/probe_set.h"
+#include "formats/envmap/envmap.h"
+#include "formats/io/file_io.h"
+#include "formats/probes/gltf_probes.h"
+#include "formats/probes/probe_file.h"
 #include "support.h"
 
 namespace zhc {

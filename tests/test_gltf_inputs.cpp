@@ -11,11 +11,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "codec/scene.h"
-#include "formats/file_io.h"
-#include "formats/gltf_probes.h"
-#include "formats/probe_file.h"
-#include "formats/scene_gltf.h"
+#include "codec/bake/scene.h"
+#include "formats/io/file_io.h"
+#include "formats/probes/gltf_probes.h"
+#include "formats/probes/probe_file.h"
+#include "formats/scene/scene_gltf.h"
 #include "support.h"
 
 namespace zhc {

@@ -22,7 +22,7 @@
 // added and removed row; review that diff, then commit the table).
 //
 // Fixed inputs (no ZHC_TEST_SAMPLE_SCALE): the same hashes in the Release and sanitizer builds,
-// and with g++ and clang (the "same bytes on every machine" contract, codec/codec.h).
+// and with g++ and clang (the "same bytes on every machine" contract, codec/probe/codec.h).
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -33,18 +33,18 @@
 #include <map>
 #include <sstream>
 
-#include "codec/audit.h"
-#include "codec/bc45.h"
-#include "codec/bc6h.h"
-#include "codec/codec.h"
-#include "codec/lightmap.h"
-#include "formats/audit_inputs.h"
+#include "codec/report/audit.h"
+#include "codec/lightmap/bc45.h"
+#include "codec/lightmap/bc6h.h"
+#include "codec/probe/codec.h"
+#include "codec/lightmap/lightmap.h"
+#include "formats/report/audit_inputs.h"
 #include "support.h"
 
 namespace zhc {
 namespace {
 
-const char* const kTablePath = ZHC_TEST_DATA_DIR "/../golden/metrics.tsv";
+const char* const kTablePath = ZHC_GOLDEN_DIR "/metrics.tsv";
 constexpr int kDirections = 128;
 constexpr int kCrop = 16;         // crop and lightmap: 16x16 texels = 16 blocks
 constexpr int kCropX = 248, kCropY = 96;  // in the 512x256 audit downsample: above the horizon, centre

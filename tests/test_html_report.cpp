@@ -14,9 +14,9 @@
 #include <set>
 #include <sstream>
 
-#include "codec/codec.h"
-#include "formats/html_report.h"
-#include "formats/lightmap_report.h"
+#include "codec/probe/codec.h"
+#include "formats/report/html_report.h"
+#include "formats/report/lightmap_report.h"
 #include "support.h"
 
 namespace fs = std::filesystem;

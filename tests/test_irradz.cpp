@@ -1,10 +1,10 @@
-// IrradZ / HHD / AHD lightmap maths (codec/irradz.h) against brute-force twins: dense sphere and
+// IrradZ / HHD / AHD lightmap maths (codec/lightmap/irradz.h) against brute-force twins: dense sphere and
 // hemisphere sampling, grid searches, direct integration. Derivations: docs/irradz.md.
 #include <cstdio>
 #include <limits>
 #include <random>
 
-#include "codec/irradz.h"
+#include "codec/lightmap/irradz.h"
 #include "support.h"
 
 namespace zhc {
@@ -526,7 +526,7 @@ std::vector<std::vector<Sh3Radiance>> sample_lightmaps(int size) {
     for (const auto& path : test::envmap_paths()) {
         const Image img = test::load_envmap(path);
         const Sh3Radiance world = project_latlong(img.rgb.data(), img.width, img.height, static_cast<size_t>(img.width) * 3, 2);
-        // synthesize_sphere (codec/lightmap.h) without the dependency: octahedral normals, windowed.
+        // synthesize_sphere (codec/lightmap/lightmap.h) without the dependency: octahedral normals, windowed.
         std::vector<Sh3Radiance> texels;
         for (int y = 0; y < size; ++y)
             for (int x = 0; x < size; ++x) {

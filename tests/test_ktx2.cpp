@@ -1,8 +1,8 @@
-// KTX2 writer and strict reader (formats/ktx2.h).
+// KTX2 writer and strict reader (formats/lightmap/ktx2.h).
 #include <random>
 
-#include "codec/bc6h.h"
-#include "formats/ktx2.h"
+#include "codec/lightmap/bc6h.h"
+#include "formats/lightmap/ktx2.h"
 #include "support.h"
 
 namespace zhc {

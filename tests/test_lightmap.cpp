@@ -1,12 +1,12 @@
-// IrradZ lightmap textures (codec/lightmap.h), SH lightmap EXR I/O (formats/lightmap_exr.h) and
+// IrradZ lightmap textures (codec/lightmap/lightmap.h), SH lightmap EXR I/O (formats/lightmap/lightmap_exr.h) and
 // the `zhc lightmap` verbs.
 #include <cstdio>
 #include <filesystem>
 #include <random>
 
-#include "codec/lightmap.h"
-#include "formats/ktx2.h"
-#include "formats/lightmap_exr.h"
+#include "codec/lightmap/lightmap.h"
+#include "formats/lightmap/ktx2.h"
+#include "formats/lightmap/lightmap_exr.h"
 #include "support.h"
 
 namespace zhc {

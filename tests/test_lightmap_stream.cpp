@@ -1,18 +1,18 @@
-// Streaming lightmap pipeline (formats/lightmap_stream.h): the band-by-band encode / decode /
-// audit / synth against the whole-image functions (codec/lightmap.h, formats/lightmap_exr.h,
-// formats/ktx2.h, formats/dds.h) they replace in the CLI; linear-SH and per-coefficient inputs;
+// Streaming lightmap pipeline (formats/lightmap/lightmap_stream.h): the band-by-band encode / decode /
+// audit / synth against the whole-image functions (codec/lightmap/lightmap.h, formats/lightmap/lightmap_exr.h,
+// formats/lightmap/ktx2.h, formats/lightmap/dds.h) they replace in the CLI; linear-SH and per-coefficient inputs;
 // progress on stderr (cli/progress.h).
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <random>
 
-#include "codec/lightmap.h"
-#include "formats/dds.h"
-#include "formats/envmap.h"
-#include "formats/ktx2.h"
-#include "formats/lightmap_exr.h"
-#include "formats/lightmap_stream.h"
+#include "codec/lightmap/lightmap.h"
+#include "formats/lightmap/dds.h"
+#include "formats/envmap/envmap.h"
+#include "formats/lightmap/ktx2.h"
+#include "formats/lightmap/lightmap_exr.h"
+#include "formats/lightmap/lightmap_stream.h"
 #include "support.h"
 
 namespace zhc {

@@ -12,8 +12,8 @@
 #include <cstring>
 #include <random>
 
-#include "codec/bc45.h"
-#include "codec/bc6h.h"
+#include "codec/lightmap/bc45.h"
+#include "codec/lightmap/bc6h.h"
 #include "support.h"
 
 namespace zhc {

@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <set>
 
-#include "formats/html_report.h"
-#include "formats/raster.h"
+#include "formats/report/html_report.h"
+#include "formats/report/raster.h"
 #include "support.h"
 
 namespace fs = std::filesystem;

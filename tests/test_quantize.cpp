@@ -1,4 +1,4 @@
-// Ratio-bound quantisation (codec/quantize.h): bounds re-derived numerically, DC formats against
+// Ratio-bound quantisation (codec/probe/quantize.h): bounds re-derived numerically, DC formats against
 // brute-force nearest search, the scalar quantiser's error bound, the packed layouts' bit
 // positions and golden bytes, totality and determinism, and the acceptance tables on the eight
 // real maps (irradiance RMSE, tight vs loose bound, sqrt, zonal mapping, DC vs ratio budget).
@@ -10,9 +10,9 @@
 #include <map>
 #include <random>
 
-#include "codec/codec.h"
-#include "codec/quantize.h"
-#include "codec/zh3.h"
+#include "codec/probe/codec.h"
+#include "codec/probe/quantize.h"
+#include "codec/probe/zh3.h"
 #include "support.h"
 
 namespace zhc {
@@ -394,7 +394,7 @@ TEST(PackedLayouts, DecodersAreTotalAndEncodingIsDeterministic) {
 
 // ---- golden bytes -----------------------------------------------------------------------------
 
-std::string golden_dir() { return (std::filesystem::path(__FILE__).parent_path() / "golden").string(); }
+std::string golden_dir() { return std::string(ZHC_GOLDEN_DIR); }
 
 // Compares with tests/golden/NAME; ZHC_UPDATE_GOLDEN=1 rewrites it instead (docs/quantization.md).
 void expect_golden(const std::string& name, const std::vector<std::uint8_t>& bytes) {

@@ -28,9 +28,9 @@
 #include <random>
 
 #include "cli/cli.h"
-#include "codec/cubemap.h"
-#include "formats/envmap.h"
-#include "formats/json_depth.h"
+#include "codec/sh/cubemap.h"
+#include "formats/envmap/envmap.h"
+#include "formats/io/json_depth.h"
 #include "support.h"
 
 namespace zhc {

@@ -1,7 +1,7 @@
 // runtime/zhc_runtime.h (the C consuming side of every probe encoding) against the codec itself:
 // every codec table entry, >= 100,000 encoded probes and >= 100,000 arbitrary byte strings each,
 // default and non-default storage parameters; IrradZ / HLSH / hemi-octahedral functions; .zhp
-// header parsing against formats/probe_file (every bit flip, every truncation, random mutations).
+// header parsing against formats/probes/probe_file (every bit flip, every truncation, random mutations).
 //
 // Bit equality is the claim: floats are compared by bit pattern, except that any NaN equals any
 // NaN (payloads of NaNs produced by arithmetic are not part of the contract). The largest ulp
@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "codec/codec.h"
-#include "codec/irradz.h"
-#include "codec/lightmap.h"
-#include "codec/probe_set.h"
-#include "codec/quantize.h"
-#include "formats/probe_file.h"
+#include "codec/probe/codec.h"
+#include "codec/lightmap/irradz.h"
+#include "codec/lightmap/lightmap.h"
+#include "codec/probe/probe_set.h"
+#include "codec/probe/quantize.h"
+#include "formats/probes/probe_file.h"
 #include "support.h"
 #include "zhc_runtime.h"
 #include "zhc_runtime_params.hpp"
@@ -252,7 +252,7 @@ TEST(RuntimeC, EveryCodecTableEntryIsKnownWithItsSizeInOrder) {
 }
 
 TEST(RuntimeC, GltfQuantizationStringsMapToTheStorageParams) {
-    // The strings of docs/gltf-extension.md and formats/gltf_probes.cpp, and the enum values the
+    // The strings of docs/gltf-extension.md and formats/probes/gltf_probes.cpp, and the enum values the
     // codec gives them (QuantParams).
     struct Case {
         const char* key;

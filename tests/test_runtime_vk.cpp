@@ -37,12 +37,12 @@
 #include <string>
 #include <vector>
 
-#include "codec/codec.h"
-#include "codec/irradz.h"
-#include "codec/lightmap.h"
-#include "codec/probe_set.h"
-#include "codec/quantize.h"
-#include "codec/zh3.h"
+#include "codec/probe/codec.h"
+#include "codec/lightmap/irradz.h"
+#include "codec/lightmap/lightmap.h"
+#include "codec/probe/probe_set.h"
+#include "codec/probe/quantize.h"
+#include "codec/probe/zh3.h"
 #include "support.h"
 #include "vk_compute.h"
 

@@ -1,4 +1,4 @@
-// Scene baking (codec/scene.h, codec/occluders.h), the scene JSON (formats/scene_json.h) and the
+// Scene baking (codec/bake/scene.h, codec/bake/occluders.h), the scene JSON (formats/scene/scene_json.h) and the
 // bake/demo verbs: closed forms against their slow twins (dense sphere sampling), inverse square,
 // environment-only == `zhc project`, occluders removing exactly the shadowed light, the effects
 // report, determinism across thread counts, and the parser's errors and exit codes.
@@ -7,11 +7,11 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "codec/occluders.h"
-#include "codec/scene.h"
-#include "codec/zh3.h"
-#include "formats/probe_file.h"
-#include "formats/scene_json.h"
+#include "codec/bake/occluders.h"
+#include "codec/bake/scene.h"
+#include "codec/probe/zh3.h"
+#include "formats/probes/probe_file.h"
+#include "formats/scene/scene_json.h"
 #include "support.h"
 
 namespace zhc {

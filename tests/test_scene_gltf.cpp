@@ -1,4 +1,4 @@
-// glTF scene input (formats/scene_gltf.h) and `zhc bake -o OUT.glb|.gltf`: glTF files written by
+// glTF scene input (formats/scene/scene_gltf.h) and `zhc bake -o OUT.glb|.gltf`: glTF files written by
 // the test (JSON + a base64 buffer) against the same scene written as zhc JSON (the twin), spot
 // cones, directional lights, mesh occluders with node transforms, strict errors, and the embedded
 // probes equal to the .zhp output.
@@ -7,11 +7,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "codec/scene.h"
-#include "formats/gltf_probes.h"
-#include "formats/probe_file.h"
-#include "formats/scene_gltf.h"
-#include "formats/scene_json.h"
+#include "codec/bake/scene.h"
+#include "formats/probes/gltf_probes.h"
+#include "formats/probes/probe_file.h"
+#include "formats/scene/scene_gltf.h"
+#include "formats/scene/scene_json.h"
 #include "support.h"
 
 namespace zhc {

@@ -1,4 +1,4 @@
-// Triangle-mesh occluders (codec/occluders.h) and mesh scenes (formats/scene_json.h "mesh"):
+// Triangle-mesh occluders (codec/bake/occluders.h) and mesh scenes (formats/scene/scene_json.h "mesh"):
 // Moller-Trumbore against a slow twin (plane intersection + edge functions), the BVH against a
 // brute-force loop over every triangle, seams without leaks, and a quad of two triangles removing
 // exactly the light it hides.
@@ -7,9 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "codec/occluders.h"
-#include "codec/scene.h"
-#include "formats/scene_json.h"
+#include "codec/bake/occluders.h"
+#include "codec/bake/scene.h"
+#include "formats/scene/scene_json.h"
 #include "support.h"
 
 namespace zhc {

@@ -1,7 +1,7 @@
-// Properties of the SH core (codec/sh.h): basis, projection, evaluation, rotation, closed forms.
+// Properties of the SH core (codec/sh/sh.h): basis, projection, evaluation, rotation, closed forms.
 #include <random>
 
-#include "codec/sky.h"
+#include "codec/bake/sky.h"
 #include "support.h"
 
 namespace zhc {

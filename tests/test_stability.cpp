@@ -3,8 +3,8 @@
 #include <cfloat>
 #include <random>
 
-#include "codec/audit.h"
-#include "codec/codec.h"
+#include "codec/report/audit.h"
+#include "codec/probe/codec.h"
 #include "support.h"
 
 namespace zhc {

@@ -1,4 +1,4 @@
-// Properties of the ZH3 representations (codec/zh3.h, codec/zh3.cpp): fit, luminance axis, axis
+// Properties of the ZH3 representations (codec/probe/zh3.h, codec/probe/zh3.cpp): fit, luminance axis, axis
 // solve, hallucination, ZH3 deringing — on analytic cases and on the eight real maps.
 #include <algorithm>
 #include <cmath>
@@ -9,8 +9,8 @@
 #include <random>
 #include <vector>
 
-#include "codec/codec.h"
-#include "codec/zh3.h"
+#include "codec/probe/codec.h"
+#include "codec/probe/zh3.h"
 #include "support.h"
 
 namespace zhc {

@@ -1,4 +1,4 @@
-// zh3_channel_q16 and zh3_solved_channel_q16 (codec/zh3_channel_q16.h): the code search against a
+// zh3_channel_q16 and zh3_solved_channel_q16 (codec/probe/zh3_channel_q16.h): the code search against a
 // brute-force twin over the stored code grid (decoded by the real decoder), the byte layout by a
 // hand decoder written from docs/quantization.md, golden bytes, the container's axis mode not
 // applying, scale invariance, determinism, bad input, and the audit ratios to SH2 on the maps.
@@ -11,11 +11,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "codec/codec.h"
-#include "codec/probe_set.h"
-#include "codec/quantize.h"
-#include "codec/zh3.h"
-#include "codec/zh3_channel_q16.h"
+#include "codec/probe/codec.h"
+#include "codec/probe/probe_set.h"
+#include "codec/probe/quantize.h"
+#include "codec/probe/zh3.h"
+#include "codec/probe/zh3_channel_q16.h"
 #include "support.h"
 
 namespace zhc {
@@ -250,7 +250,7 @@ std::vector<Sh3Radiance> golden_probes() {
 }
 
 TEST(Zh3ChannelQ16, GoldenBytes) {
-    const std::string dir = (std::filesystem::path(__FILE__).parent_path() / "golden").string();
+    const std::string dir = std::string(ZHC_GOLDEN_DIR);
     StorageParams other;
     other.bits = 6;
     other.sqrt_encoding = true;

@@ -1,5 +1,5 @@
 // Hallucinate-solve (hall_solved, hall_solved_q16) and the adaptive hallucination scale
-// (hall_adaptive_q16): codec/zh3_hall.h, issue 18 items 3-4.
+// (hall_adaptive_q16): codec/probe/zh3_hall.h, issue 18 items 3-4.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,12 +11,12 @@
 #include <map>
 #include <random>
 
-#include "codec/audit.h"
-#include "codec/codec.h"
-#include "codec/probe_set.h"
-#include "codec/quantize.h"
-#include "codec/zh3.h"
-#include "codec/zh3_hall.h"
+#include "codec/report/audit.h"
+#include "codec/probe/codec.h"
+#include "codec/probe/probe_set.h"
+#include "codec/probe/quantize.h"
+#include "codec/probe/zh3.h"
+#include "codec/probe/zh3_hall.h"
 #include "tests/support.h"
 
 namespace zhc {

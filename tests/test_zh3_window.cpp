@@ -1,4 +1,4 @@
-// Whole-sphere ZH3 deringing (codec/zh3_window.h): the certified profile minimum against dense
+// Whole-sphere ZH3 deringing (codec/probe/zh3_window.h): the certified profile minimum against dense
 // sampling, non-negative decoded irradiance for zh3_dering and zh3_dering_q16 on random lighting,
 // the sample maps under rotations and the demo's baked probes, minimality of the window, and no
 // change where no deringing is needed.
@@ -10,11 +10,11 @@
 #include <random>
 #include <vector>
 
-#include "codec/dering.h"
-#include "codec/probe_set.h"
-#include "codec/quantize.h"
-#include "codec/scene.h"
-#include "codec/zh3_window.h"
+#include "codec/probe/dering.h"
+#include "codec/probe/probe_set.h"
+#include "codec/probe/quantize.h"
+#include "codec/bake/scene.h"
+#include "codec/probe/zh3_window.h"
 #include "support.h"
 
 namespace zhc {

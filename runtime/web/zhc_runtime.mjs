@@ -1,5 +1,5 @@
 // zhc runtime for the web: decoders for every probe encoding zhc stores (the codec table of
-// codec/codec.h, the packed layouts of docs/quantization.md) to the hub, float SH3 radiance, and
+// codec/probe/codec.h, the packed layouts of docs/quantization.md) to the hub, float SH3 radiance, and
 // irradiance at a normal. No dependencies, no build step: an ES module for browsers and Node.
 //
 // Output convention: an SH3 probe is a Float32Array(27), element i * 3 + k = coefficient i
@@ -9,7 +9,7 @@
 // order and rounding to float32 (Math.fround) exactly where the C++ code stores a float. JavaScript
 // numbers are IEEE doubles with round-to-nearest, Math.sqrt is correctly rounded, and the codec is
 // compiled with -ffp-contract=off (no FMA), so `decodeProbe` returns the SAME float32 values as
-// zhc's decode_probe (codec/probe_set.cpp) for every encoding and parameter set, and `irradiance`
+// zhc's decode_probe (codec/probe/probe_set.cpp) for every encoding and parameter set, and `irradiance`
 // the same float32 values as zhc's irradiance(hub, n) (what `zhc gltf eval` prints). Powers of two
 // are built from exponent bits (ldexp), never with Math.pow. The functions that are NOT bit exact
 // are marked "(not bit exact)" with their bound: rotateZhcToGltf / rotateGltfToZhc (the two L2
@@ -19,9 +19,9 @@
 // Bad input: every decoder accepts ANY bytes (garbage in gives finite-or-NaN numbers out) and
 // never throws; the parsers (parseZhp, volume parsing in the plugin) throw Error on malformed data.
 
-export const PI = 3.14159265358979323846;  // == Math.PI (kPi of codec/sh.h)
+export const PI = 3.14159265358979323846;  // == Math.PI (kPi of codec/sh/sh.h)
 
-// ---- basis constants (codec/sh.h) -----------------------------------------------------------
+// ---- basis constants (codec/sh/sh.h) -----------------------------------------------------------
 export const kY00 = 1.0 / (2.0 * Math.sqrt(PI));
 export const kY1 = Math.sqrt(3.0 / (4.0 * PI));
 export const kY2 = Math.sqrt(15.0 / (4.0 * PI));
@@ -50,13 +50,13 @@ function ldexp(x, e) { return x * pow2(e); }
 
 // ---- SH helpers -----------------------------------------------------------------------------
 
-// The nine SH3 basis functions at a unit direction, exactly sh3_basis (codec/sh.h).
+// The nine SH3 basis functions at a unit direction, exactly sh3_basis (codec/sh/sh.h).
 export function shBasis(x, y, z) {
   return [kY00, -kY1 * y, kY1 * z, -kY1 * x, kY2 * x * y, -kY2 * y * z, kY20 * (3.0 * z * z - 1.0),
     -kY2 * x * z, kY22 * (x * x - y * y)];
 }
 
-// normalize_or (codec/sh.cpp): (1 / |a|) a, or `fallback` when |a| is 0 or not finite.
+// normalize_or (codec/sh/sh.cpp): (1 / |a|) a, or `fallback` when |a| is 0 or not finite.
 export function normalizeOr(a, fallback = [0, 0, 1]) {
   const len = Math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
   if (!(len > 0.0) || !Number.isFinite(len)) return [fallback[0], fallback[1], fallback[2]];
@@ -91,10 +91,10 @@ export function toRadiance(sh) {
 }
 
 // Irradiance at unit normal n (in the SH's axes) from SH3 radiance: irradiance(Sh3Radiance, n) of
-// codec/sh.cpp, float32 RGB. E is normalised: constant radiance 1 gives 1 (docs/conventions.md).
+// codec/sh/sh.cpp, float32 RGB. E is normalised: constant radiance 1 gives 1 (docs/conventions.md).
 export function irradiance(sh, n) { return evaluate(toIrradiance(sh), n); }
 
-// ---- quantiser (codec/quantize.cpp) ---------------------------------------------------------
+// ---- quantiser (codec/probe/quantize.cpp) ---------------------------------------------------------
 
 const kL1Bound = Math.sqrt(3.0);
 const kL2ZonalLo = -Math.sqrt(5.0) / 2.0;
@@ -102,7 +102,7 @@ const kL2ZonalHi = Math.sqrt(5.0);
 const kL2TightBound = Math.sqrt(15.0) / 2.0;
 const kL2LooseBound = Math.sqrt(5.0);
 
-// Quantisation parameters (QuantParams of codec/quantize.h) with their glTF spellings.
+// Quantisation parameters (QuantParams of codec/probe/quantize.h) with their glTF spellings.
 export const DEFAULT_PARAMS = Object.freeze({
   bits: 8, sqrt: false, l2Bound: 'tight', dcFormat: 'r11g11b10f', kind: 'radiance',
   zonalMapping: 'affine', axisMode: 'luminance', luminanceWeights: DEFAULT_LUMINANCE,
@@ -189,7 +189,7 @@ function loadDc(b, o, format, slotBytes) {
   return unpackR11G11B10F(u32(b, o));
 }
 
-// ---- ZH3 axes (codec/zh3.cpp) ---------------------------------------------------------------
+// ---- ZH3 axes (codec/probe/zh3.cpp) ---------------------------------------------------------------
 
 // L1 band of channel k in vector form (-f11, -f1-1, f10); c = float coefficients, index i*3+k.
 function l1Vector(c, k) { return [-c[9 + k], -c[3 + k], c[6 + k]]; }
@@ -236,7 +236,7 @@ export function hallucinateZonal(model, f0, f1Zonal, a = HALLUCINATE_CURVE_A, b 
   return (a * p * p + b * p) * f0;
 }
 // zh3_hallucinate then zh3_expand: linear (>= 12 float32 values) -> SH3 radiance.
-// `scale` multiplies the curve's a and b (hall_adaptive_q16; codec/zh3_hall.cpp hall_scaled_expand).
+// `scale` multiplies the curve's a and b (hall_adaptive_q16; codec/probe/zh3_hall.cpp hall_scaled_expand).
 function hallucinateExpand(linear, model, axisMode, w, scale = 1) {
   const axes = zh3Axes(linear, axisMode, w);
   const zonal = [0, 0, 0];
@@ -312,7 +312,7 @@ const hallFloat = (model, mode) => (b, o, p) => hallucinateExpand(loadFloats(b, 
 const packed = (layout) => (b, o, p) => decodePacked(layout, b, o, p);
 const packedPerChannel = (b, o, p) => decodePacked('zh3_q16', b, o, { ...p, axisMode: 'channel' });
 
-// Every entry of zhc's codec table (codecs() in codec/codec_table.cpp): bytes per probe, whether
+// Every entry of zhc's codec table (codecs() in codec/probe/codec_table.cpp): bytes per probe, whether
 // the entry is a packed (quantised) layout, and the decoder to radiance SH3 (before the `kind`
 // handling of decodeProbe).
 export const ENCODINGS = Object.freeze({
@@ -355,7 +355,7 @@ export function encodingInfo(name) {
 }
 
 // Probe bytes (b[o .. o + bytes)) -> SH3 radiance, Float32Array(27): decode_probe of
-// codec/probe_set.cpp. `params` from makeParams (kind 'irradiance': the packed layouts use the
+// codec/probe/probe_set.cpp. `params` from makeParams (kind 'irradiance': the packed layouts use the
 // irradiance intervals, the float ones store band-scaled coefficients; both return radiance).
 export function decodeProbe(encoding, bytes, offset = 0, params = DEFAULT_PARAMS) {
   const e = encodingInfo(encoding);

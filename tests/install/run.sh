@@ -9,7 +9,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 prefix="$work/prefix"
 cmake --install "$build" --prefix "$prefix" >/dev/null
-for f in include/zhc/codec.h include/zhc/formats.h include/zhc/codec/codec.h include/zhc/formats/probe_file.h \
+for f in include/zhc/codec.h include/zhc/formats.h include/zhc/codec/probe/codec.h include/zhc/formats/probes/probe_file.h \
          lib/cmake/zhc/zhcConfig.cmake lib/cmake/zhc/zhcConfigVersion.cmake bin/zhc; do
   [ -e "$prefix/$f" ] || { echo "install: $f missing from the prefix" >&2; exit 1; }
 done

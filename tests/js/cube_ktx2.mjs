@@ -19,7 +19,7 @@ if (!zhc || !work) {
 }
 fs.mkdirSync(work, { recursive: true });
 
-// zhc's SH3 basis (codec/sh.h): order 00, 1-1, 10, 11, 2-2, 2-1, 20, 21, 22.
+// zhc's SH3 basis (codec/sh/sh.h): order 00, 1-1, 10, 11, 2-2, 2-1, 20, 21, 22.
 const Y00 = 1 / (2 * Math.sqrt(Math.PI)), Y1 = Math.sqrt(3 / (4 * Math.PI)), Y2 = Math.sqrt(15 / (4 * Math.PI));
 const Y20 = Math.sqrt(5 / (16 * Math.PI)), Y22 = Math.sqrt(15 / (16 * Math.PI));
 const basis = ([x, y, z]) => [Y00, -Y1 * y, Y1 * z, -Y1 * x, Y2 * x * y, -Y2 * y * z, Y20 * (3 * z * z - 1), -Y2 * x * z,

@@ -1,0 +1,242 @@
+#include "codec/bake/occluders.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace zhc {
+namespace {
+
+void bounds_of(const Occluder& o, double lo[3], double hi[3]) {
+    for (int a = 0; a < 3; ++a) {
+        if (o.kind == OccluderKind::kSphere) {
+            lo[a] = o.center[a] - o.radius;
+            hi[a] = o.center[a] + o.radius;
+        } else if (o.kind == OccluderKind::kTriangle) {
+            lo[a] = std::min({o.v0[a], o.v1[a], o.v2[a]});
+            hi[a] = std::max({o.v0[a], o.v1[a], o.v2[a]});
+        } else {
+            lo[a] = o.min[a];
+            hi[a] = o.max[a];
+        }
+    }
+}
+
+// Slab test: the parameter interval where the ray is inside [lo, hi], clipped to (t0, t1).
+// Division by a zero direction component gives +-inf, which the min/max handle; a NaN (0 * inf
+// when the origin lies on a slab plane) is avoided by testing the origin against the slab.
+bool slab(const double lo[3], const double hi[3], Vec3 o, Vec3 d, double t0, double t1, double* enter) {
+    for (int a = 0; a < 3; ++a) {
+        const double da = d[a], oa = o[a];
+        if (da == 0.0) {
+            if (oa < lo[a] || oa > hi[a]) return false;
+            continue;
+        }
+        const double inv = 1.0 / da;
+        double ta = (lo[a] - oa) * inv, tb = (hi[a] - oa) * inv;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        if (t0 > t1) return false;
+    }
+    if (enter) *enter = t0;
+    return true;
+}
+
+// Moller-Trumbore (1997): solve o + t d = v0 + u e1 + v e2 by Cramer's rule with
+// det = e1 . (d x e2). Policy in occluders.h: det == 0 (parallel, or a degenerate triangle) misses;
+// inclusive barycentric bounds widened by 1e-10; t in the open interval (t_min, t_max); both faces.
+bool ray_hits_triangle(const Occluder& tri, Vec3 o, Vec3 d, double t_min, double t_max) {
+    const Vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+    const Vec3 p = cross(d, e2);
+    const double det = dot(e1, p);
+    if (det == 0.0 || !std::isfinite(det)) return false;
+    const double inv = 1.0 / det;
+    const Vec3 s = o - tri.v0;
+    // Barycentric tolerance: Moller-Trumbore computes u, v per triangle, so on a shared edge the
+    // two neighbours can both reject by a few ulps (not watertight). Growing every triangle by a
+    // relative 1e-10 of its edges closes such cracks (rounding errors are ~1e-15 for well-posed
+    // rays) while moving its boundary by far less than any scene feature.
+    constexpr double kBary = 1e-10;
+    const double u = dot(s, p) * inv;
+    if (u < -kBary || u > 1.0 + kBary) return false;
+    const Vec3 q = cross(s, e1);
+    const double v = dot(d, q) * inv;
+    if (v < -kBary || u + v > 1.0 + kBary) return false;
+    const double t = dot(e2, q) * inv;
+    return t > t_min && t < t_max;
+}
+
+}  // namespace
+
+Occluder triangle_occluder(Vec3 a, Vec3 b, Vec3 c) {
+    Occluder o;
+    o.kind = OccluderKind::kTriangle;
+    o.v0 = a;
+    o.v1 = b;
+    o.v2 = c;
+    return o;
+}
+
+std::vector<Occluder> uv_sphere_triangles(Vec3 c, double r, int n_lat, int n_lon) {
+    std::vector<Occluder> out;
+    auto at = [&](int i, int j) {
+        const double th = kPi * i / n_lat, ph = 2 * kPi * j / n_lon;
+        return c + r * Vec3{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
+    };
+    for (int i = 0; i < n_lat; ++i)
+        for (int j = 0; j < n_lon; ++j) {
+            const Vec3 a = at(i, j), b = at(i + 1, j), cc = at(i + 1, j + 1), d = at(i, j + 1);
+            if (i != n_lat - 1) out.push_back(triangle_occluder(a, b, cc));
+            if (i != 0) out.push_back(triangle_occluder(a, cc, d));
+        }
+    return out;
+}
+
+bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
+    if (occ.kind == OccluderKind::kTriangle) return ray_hits_triangle(occ, o, d, t_min, t_max);
+    if (occ.kind == OccluderKind::kSphere) {
+        // |o + t d - c|^2 = r^2 with |d| = 1: t^2 + 2 b t + c = 0, b = d.(o - c), c = |o - c|^2 - r^2.
+        const Vec3 oc = o - occ.center;
+        const double b = dot(d, oc), c = dot(oc, oc) - occ.radius * occ.radius;
+        if (c <= 0.0) return true;  // origin inside (or on) the sphere
+        const double disc = b * b - c;
+        if (disc < 0.0) return false;
+        const double s = std::sqrt(disc);
+        const double t_near = -b - s, t_far = -b + s;
+        // Any t of [t_near, t_far] inside (t_min, t_max)?
+        return t_far > t_min && t_near < t_max;
+    }
+    double lo[3] = {occ.min.x, occ.min.y, occ.min.z}, hi[3] = {occ.max.x, occ.max.y, occ.max.z};
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) inside = inside && o[a] >= lo[a] && o[a] <= hi[a];
+    if (inside) return true;
+    double enter = 0;
+    // Open interval: the box must be entered strictly after t_min and before t_max.
+    if (!slab(lo, hi, o, d, t_min, t_max, &enter)) return false;
+    return enter < t_max;
+}
+
+OccluderBvh::OccluderBvh(std::vector<Occluder> occluders) {
+    if (occluders.empty()) return;
+    // Boxes and centroids once; the build permutes indices, then the primitives are stored in
+    // leaf order (each leaf a contiguous range).
+    std::vector<Bounds> bounds(occluders.size());
+    for (size_t i = 0; i < occluders.size(); ++i) {
+        bounds_of(occluders[i], bounds[i].lo, bounds[i].hi);
+        for (int a = 0; a < 3; ++a) bounds[i].centroid[a] = 0.5 * (bounds[i].lo[a] + bounds[i].hi[a]);
+    }
+    std::vector<std::uint32_t> order(occluders.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+    nodes_.reserve(occluders.size() + 1);  // leaves of 2..4 primitives: < n nodes
+    build(order, bounds, 0, static_cast<std::uint32_t>(order.size()), 0);
+    prims_.reserve(occluders.size());
+    for (std::uint32_t i : order) prims_.push_back(occluders[i]);
+}
+
+std::uint32_t OccluderBvh::build(std::vector<std::uint32_t>& order, const std::vector<Bounds>& bounds,
+                                 std::uint32_t first, std::uint32_t count, int depth) {
+    const std::uint32_t index = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.push_back({});
+    Node n;
+    double clo[3], chi[3];  // centroid bounds
+    for (int a = 0; a < 3; ++a) {
+        n.lo[a] = clo[a] = std::numeric_limits<double>::infinity();
+        n.hi[a] = chi[a] = -std::numeric_limits<double>::infinity();
+    }
+    for (std::uint32_t i = first; i < first + count; ++i) {
+        const Bounds& b = bounds[order[i]];
+        for (int a = 0; a < 3; ++a) {
+            n.lo[a] = std::min(n.lo[a], b.lo[a]);
+            n.hi[a] = std::max(n.hi[a], b.hi[a]);
+            clo[a] = std::min(clo[a], b.centroid[a]);
+            chi[a] = std::max(chi[a], b.centroid[a]);
+        }
+    }
+    // Conservative node boxes: widened by a relative 1e-9 so rounding in the slab test never
+    // rejects a ray that grazes a box face where a primitive's own (widened) test would hit, e.g.
+    // a ray through the rim of a flat mesh whose box has zero thickness.
+    for (int a = 0; a < 3; ++a) {
+        const double pad = 1e-9 * std::max({n.hi[a] - n.lo[a], std::abs(n.lo[a]), std::abs(n.hi[a]), 1e-300});
+        n.lo[a] -= pad;
+        n.hi[a] += pad;
+    }
+    // Depth cap: median splits halve the count, so depth <= log2(n) + 1 < 40 for any n < 2^32;
+    // the cap only guards the traversal stack.
+    if (count <= 4 || depth > 40) {
+        n.first = first;
+        n.count = count;
+        nodes_[index] = n;
+        return index;
+    }
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+        if (chi[a] - clo[a] > chi[axis] - clo[axis]) axis = a;
+    const std::uint32_t mid = first + count / 2;
+    // Median split by centroid, ties broken by the primitive's index: a strict total order, so the
+    // partition (and the whole tree) is the same for the same input on every run.
+    std::nth_element(order.begin() + first, order.begin() + mid, order.begin() + first + count,
+                     [&bounds, axis](std::uint32_t a, std::uint32_t b) {
+                         const double ca = bounds[a].centroid[axis], cb = bounds[b].centroid[axis];
+                         return ca < cb || (ca == cb && a < b);
+                     });
+    n.count = 0;
+    n.axis = static_cast<std::uint8_t>(axis);
+    n.left = build(order, bounds, first, mid - first, depth + 1);
+    n.right = build(order, bounds, mid, first + count - mid, depth + 1);
+    nodes_[index] = n;
+    return index;
+}
+
+bool OccluderBvh::occluded(Vec3 o, Vec3 d, double t_min, double t_max) const {
+    if (nodes_.empty()) return false;
+    // Per-ray constants of the slab test (ZERO direction components handled by the origin test).
+    const double org[3] = {o.x, o.y, o.z}, dir[3] = {d.x, d.y, d.z};
+    double inv[3];
+    for (int a = 0; a < 3; ++a) inv[a] = dir[a] != 0.0 ? 1.0 / dir[a] : 0.0;
+    auto node_hit = [&](const Node& n) {
+        double t0 = t_min, t1 = t_max;
+        for (int a = 0; a < 3; ++a) {
+            if (dir[a] == 0.0) {
+                if (org[a] < n.lo[a] || org[a] > n.hi[a]) return false;
+                continue;
+            }
+            double ta = (n.lo[a] - org[a]) * inv[a], tb = (n.hi[a] - org[a]) * inv[a];
+            if (ta > tb) std::swap(ta, tb);
+            t0 = ta > t0 ? ta : t0;
+            t1 = tb < t1 ? tb : t1;
+            if (t0 > t1) return false;
+        }
+        return true;
+    };
+    std::uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const Node& n = nodes_[stack[--top]];
+        // A node is entered when the clipped ray overlaps its box (this includes an origin inside
+        // it: then t0 <= t_min <= t1).
+        if (!node_hit(n)) {
+            bool inside = true;
+            for (int a = 0; a < 3; ++a) inside = inside && org[a] >= n.lo[a] && org[a] <= n.hi[a];
+            if (!inside) continue;
+        }
+        if (n.count > 0) {
+            for (std::uint32_t i = n.first; i < n.first + n.count; ++i)
+                if (ray_hits(prims_[i], o, d, t_min, t_max)) return true;
+        } else if (top + 2 <= 128) {
+            // Nearer child (along the ray on the split axis) popped first: an any-hit query stops
+            // sooner when the closer half blocks.
+            if (dir[n.axis] < 0) {
+                stack[top++] = n.left;
+                stack[top++] = n.right;
+            } else {
+                stack[top++] = n.right;
+                stack[top++] = n.left;
+            }
+        }
+    }
+    return false;
+}
+
+}  // namespace zhc

@@ -1,0 +1,143 @@
+// zhc/codec/bake/scene.h — a lighting scene and its bake into SH3 radiance probes (no I/O).
+//
+// zhc is not a renderer: a bake evaluates exactly the effects the scene lists, each in closed form
+// where one exists (docs/scene.md), and reports what it simulated and how long each took.
+//
+//  * environment: an SH3 radiance projection (formats/scene_json does the projection once),
+//    scaled by `intensity` and rotated about +Z by `rotation_rad` (codec/sh/sh.h rotate);
+//  * sky: constant radiance, or the sky/ground gradient of codec/bake/sky.h;
+//  * directional light (a sun): a cone of angular radius sigma, ZH3 paper Eq. 15 (a delta for
+//    sigma = 0); `irradiance` is zhc's normalised irradiance on a surface facing it (E = L sin^2 sigma);
+//  * point light: radiance arriving from the light integrates to intensity / d^2 (a delta);
+//  * spot light: a point light times the cone attenuation
+//        a = smoothstep(cos outer, cos inner, dot(spot direction, unit(probe - light)))
+//    with smoothstep(e0, e1, x) = t^2 (3 - 2t), t = clamp((x - e0) / (e1 - e0), 0, 1)
+//    (a hard step when inner == outer);
+//  * sphere light of radius r and constant radiance at distance d: a cone of half-angle
+//    asin(r / d) towards its centre; a probe inside the sphere (d <= r) sees that radiance over
+//    the whole sphere (L00 only);
+//  * hemisphere light: constant radiance over the hemisphere around `direction` (Eq. 15, pi/2).
+//
+// Occluders (spheres, axis-aligned boxes, triangles of meshes) only matter for lights with
+// `shadows` on. Then:
+//  * point, spot and zero-radius directional lights: one shadow ray (to the light / to infinity);
+//  * cone lights (sun with a radius, sphere lights, hemisphere lights): a fixed set of
+//    `shadow_samples` equal-solid-angle directions inside the cone (a spherical-Fibonacci spiral
+//    over the cap). The occluded samples' projection (each weighted by cone solid angle / N) is
+//    subtracted from the closed form; all samples visible -> the closed form exactly; all blocked
+//    -> exactly zero.
+// The environment and the sky are never shadowed (they are not lights).
+//
+// Determinism: every probe is computed by itself with the effects in scene order, summed in
+// double, so the result is the same bytes whatever the thread count.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "codec/bake/occluders.h"
+#include "codec/probe/probe_set.h"
+#include "codec/sh/sh.h"
+#include "codec/bake/sky.h"
+#include "codec/status.h"
+
+namespace zhc {
+
+struct SceneEnvironment {
+    Sh3Radiance projected;     // the map's SH3 radiance as read (before intensity and rotation)
+    double intensity = 1.0;
+    double rotation_rad = 0;   // about +Z, right-hand rule
+    std::string source;        // for reports (the map's path)
+};
+
+enum class SkyKind : std::uint8_t { kConstant, kGradient };
+struct SceneSky {
+    SkyKind kind = SkyKind::kGradient;
+    Rgb radiance{1, 1, 1};  // kConstant
+    GradientSky gradient;   // kGradient
+};
+
+enum class LightKind : std::uint8_t { kDirectional, kPoint, kSpot, kSphere, kHemisphere };
+const char* light_kind_name(LightKind kind);
+
+struct SceneLight {
+    LightKind kind = LightKind::kPoint;
+    std::string name;
+    Vec3 position;                   // point, spot
+    Vec3 center;                     // sphere
+    Vec3 direction{0, 0, 1};         // directional: towards the light; spot: where it points;
+                                     // hemisphere: the hemisphere's axis
+    Rgb color{1, 1, 1};              // directional: irradiance; point/spot: intensity; sphere/hemisphere: radiance
+    double angular_radius_rad = 0;   // directional
+    double radius = 0;               // sphere
+    double inner_angle_rad = 0;      // spot (half-angles)
+    double outer_angle_rad = 0;
+    bool shadows = false;
+    int shadow_samples = 64;         // cone lights with shadows
+};
+
+enum class ProbePlacementKind : std::uint8_t { kGrid, kPositions };
+struct ProbePlacement {
+    ProbePlacementKind kind = ProbePlacementKind::kGrid;
+    Vec3 min, max;                              // kGrid: bounds; probes at the corners and in between
+    std::array<std::uint32_t, 3> counts{1, 1, 1};
+    std::vector<Vec3> positions;                // kPositions
+};
+
+struct Scene {
+    ProbePlacement probes;
+    std::optional<SceneEnvironment> environment;
+    std::optional<SceneSky> sky;
+    std::vector<SceneLight> lights;
+    std::vector<Occluder> occluders;
+};
+
+// The built-in default scene of `zhc demo`: the default gradient sky and sun (codec/bake/sky.h), three
+// coloured sphere lights, a box occluder under the sun and a sphere occluder, 8 x 8 x 4 probes.
+Scene default_scene();
+
+// Probe positions in index order (grid: x fastest, then y, then z) and the container layout.
+std::vector<Vec3> probe_positions(const ProbePlacement& placement);
+ProbeLayout probe_layout(const ProbePlacement& placement);
+// Checks counts, finiteness, angles, radii; kInvalidValue naming the field.
+Status validate_scene(const Scene& scene);
+
+// One simulated effect, in scene order.
+struct BakeEffect {
+    std::string name;      // "sky", "environment", "sun 'key'", "sphere 'lamp'", ...
+    std::string method;    // "closed form" or "closed form, shadowed: N rays"
+    std::uint64_t rays = 0;
+    double milliseconds = 0;
+};
+struct BakeReport {
+    std::vector<BakeEffect> effects;
+    std::uint64_t probes = 0;
+    std::uint64_t rays = 0;
+    double occluder_build_ms = 0;
+    double total_ms = 0;
+    // "sky (closed form): 0.3 ms; sun 'key' (closed form, shadowed: 4096 rays): 1.2 ms"
+    std::string summary() const;
+};
+
+struct BakeOptions {
+    int threads = 1;
+    // Called after each block of probes with (probes done, total), one call at a time (serialised
+    // across threads), done increasing; the baked bytes never depend on it.
+    std::function<void(std::uint64_t done, std::uint64_t total)> progress;
+};
+
+// Bakes every probe (validate_scene first; kInvalidValue on a bad scene).
+Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOptions& options = {},
+                                            BakeReport* report = nullptr);
+
+// One light's radiance SH at probe position p, closed form, no shadows (the building block,
+// exposed for tests and benchmarks): accumulates into acc (27 doubles, coefficient-major RGB).
+void add_light_closed_form(const SceneLight& light, Vec3 p, double acc[27]);
+// The equal-solid-angle sample directions of a cone (unit, around `axis`), deterministic.
+std::vector<Vec3> cone_sample_directions(Vec3 axis, double sigma, int count);
+
+}  // namespace zhc

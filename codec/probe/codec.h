@@ -1,0 +1,117 @@
+// zhc/codec/probe/codec.h — the one codec table (DESIGN.md "A hub representation").
+//
+// Every representation zhc knows is one `Codec` entry: a name, a fixed stored size per probe,
+// encode from the hub (float SH3 radiance), decode to the hub, and irradiance evaluation.
+// Conversion A -> B is A.decode then B.encode. The CLI, the audit, the benchmark and the fuzzers
+// walk `codecs()`, so a new entry shows up everywhere without further wiring.
+//
+// Contracts, for every entry:
+//  * encode writes exactly size_bytes bytes; it never reads or writes anything else.
+//  * decode and irradiance accept ANY size_bytes bytes (safe for untrusted input): they never
+//    crash or trap; garbage in gives finite-or-NaN numbers out, never undefined behaviour.
+//  * the stored bytes are little-endian and the same on every machine; encode is deterministic.
+//  * L0 (DC) round-trips exactly for the float representations.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "codec/status.h"
+
+#include "codec/sh/sh.h"
+
+namespace zhc {
+
+// How the DC term of a quantised layout is stored (ZH3 paper App. A.1).
+enum class DcFormat : std::uint8_t { kR11G11B10F = 0, kRGB9E5 = 1, kHalf = 2 };
+// Bound used for the non-zonal L2 ratios (Wiederien & Sloan: sqrt(15)/2 is tight).
+enum class L2Bound : std::uint8_t { kTight = 0, kLoose = 1 };
+
+// Options shared by the whole table. Each codec reads the ones that concern it; the probe
+// container stores the ones that change the meaning of stored bytes.
+struct CodecOptions {
+    LuminanceWeights luminance;
+    // ZH3 axis solve (ZH3 paper Sec. 3.3): L-BFGS iteration cap per start (a convergence guard; the
+    // solves stop on the relative gradient or step first) and the relative gradient tolerance.
+    int solver_iterations = 200;
+    double solver_tolerance = 1e-5;
+    // Curve-fit hallucination, ZH3 paper Eq. 21: f20 = (a p^2 + b p) f0.
+    double hallucinate_a = 0.6;
+    double hallucinate_b = 0.08;
+    // Quantised layouts (ZH3 paper App. A.1; Wiederien & Sloan).
+    int bits = 8;
+    bool sqrt_encoding = false;
+    L2Bound l2_bound = L2Bound::kTight;
+    DcFormat dc_format = DcFormat::kR11G11B10F;
+    // Deringing (Sloan 2017): treat the source as punctual lights (extra windowing).
+    bool dering_punctual = false;
+};
+
+// What an encode noticed; all counters are per call and optional to read.
+struct EncodeStats {
+    int clamped_ratios = 0;      // quantiser: ratios outside their bound interval, clamped
+    bool dering_clamped = false; // ZH3 App. B clamp or SH3 windowing changed the coefficients
+    int solver_iterations = 0;   // ZH3 axis solve: iterations used
+};
+
+struct PackedCodec;  // quantize.h
+
+// Along which axis the decoder expands the zonal L2 term of a probe (ZH3 paper Sec. 3.1/3.2).
+enum class ZonalAxis : std::uint8_t {
+    kNone = 0,        // no zonal term: the L2 band is stored whole or dropped (sh3, sh2, sh3_q28, sh2_q)
+    kLuminance = 1,   // one axis shared by R, G, B: the luminance-weighted L1 direction
+    kPerChannel = 2,  // each channel's own L1 direction
+    kFromParams = 3,  // the storage parameters' axis mode (quantised layouts; the container stores it)
+};
+
+// What code outside an entry may ask about it instead of testing its name. Each field is a fact
+// about the entry's bytes or decoder; tests check every one of them against the entry's functions
+// (tests/test_codec_table.cpp; zonal_axis against the GLSL and HLSL runtimes).
+struct CodecTraits {
+    // decode(encode(x)) == x bit for bit for every finite hub (the entry stores the hub itself: sh3).
+    // The first exact entry is the baseline of size and speed comparisons, and a round trip through
+    // an exact entry may be skipped.
+    bool exact = false;
+    // 0: the bytes are opaque to containers. 2 or 3: they are the hub's first float_bands^2
+    // coefficients as little-endian floats, [coefficient][R, G, B], read back unchanged, so a
+    // container may store them as float RGB triples (glTF VEC3 accessor, Draco attributes per
+    // band): sh3 3, sh2 2. (sh3_dering has that byte layout too but keeps 0: its glTF files have
+    // always stored a byte array, and they stay the same.)
+    int float_bands = 0;
+    ZonalAxis zonal_axis = ZonalAxis::kNone;
+};
+
+struct Codec {
+    std::string_view name;
+    std::string_view summary;  // one line for `zhc --help` and the audit legend
+    std::size_t size_bytes;    // stored bytes per probe
+    void (*encode)(const Sh3Radiance& in, const CodecOptions& options, std::uint8_t* out,
+                   EncodeStats* stats);
+    Sh3Radiance (*decode)(const std::uint8_t* in, const CodecOptions& options);
+    // Irradiance at unit normal n straight from the stored bytes (the runtime path).
+    Rgb (*irradiance)(const std::uint8_t* in, const CodecOptions& options, Vec3 n);
+    CodecTraits traits = {};
+    // Quantised layouts only (null otherwise): the layout and the entry's encode/decode with every
+    // storage parameter (quantize.h), which the probe container uses instead of the two above.
+    const PackedCodec* packed = nullptr;
+};
+
+// The whole table, in a stable order (audit and benchmark rows follow it).
+std::span<const Codec> codecs();
+// nullptr when no entry has that name.
+const Codec* find_codec(std::string_view name);
+// A comma-separated list of names ("sh3,zh3_lum") -> entries in that order; empty -> the whole
+// table. An unknown name is kInvalidArgument naming it and listing the known ones.
+Result<std::vector<const Codec*>> select_codecs(std::string_view comma_separated_names);
+
+// The table is made of parts, one per codec module (`std::span<const Codec> PART()` defined next to
+// the module's entries); codec/probe/codec_table.cpp lists them, one line each.
+
+// Little-endian float storage helpers shared by the float representations.
+void store_floats(std::span<const float> values, std::uint8_t* out);
+void load_floats(const std::uint8_t* in, std::span<float> values);
+
+}  // namespace zhc

@@ -1,0 +1,158 @@
+// The in-memory probe set (probe_set.h): encode/decode through the codec table.
+#include "codec/probe/probe_set.h"
+
+#include <cmath>
+
+namespace zhc {
+
+CodecOptions codec_options(const StorageParams& p, const CodecOptions& base) {
+    CodecOptions o = base;
+    o.luminance = p.luminance;
+    o.bits = p.bits;
+    o.sqrt_encoding = p.sqrt_encoding;
+    o.l2_bound = p.l2_bound;
+    o.dc_format = p.dc_format;
+    return o;
+}
+
+std::int64_t layout_probe_count(const ProbeLayout& layout) {
+    switch (layout.kind) {
+        case ProbeLayoutKind::kNone: return -1;
+        case ProbeLayoutKind::kPositions: return static_cast<std::int64_t>(layout.positions.size());
+        case ProbeLayoutKind::kGrid: {
+            // Three 32-bit factors: the product of two fits in 64 bits; check the third.
+            const unsigned __int128 n = static_cast<unsigned __int128>(layout.grid.counts[0]) * layout.grid.counts[1] *
+                                        layout.grid.counts[2];
+            if (n > static_cast<unsigned __int128>(INT64_MAX)) return -2;
+            return static_cast<std::int64_t>(n);
+        }
+    }
+    return -1;
+}
+
+namespace {
+bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+Status validate_layout(const ProbeLayout& layout, std::uint64_t count) {
+    switch (layout.kind) {
+        case ProbeLayoutKind::kNone: return Ok{};
+        case ProbeLayoutKind::kGrid: {
+            const std::int64_t n = layout_probe_count(layout);
+            if (n < 0 || static_cast<std::uint64_t>(n) != count)
+                return make_error(ErrorCode::kInvalidArgument, "grid counts " + std::to_string(layout.grid.counts[0]) +
+                                                                   "x" + std::to_string(layout.grid.counts[1]) + "x" +
+                                                                   std::to_string(layout.grid.counts[2]) +
+                                                                   " do not match the probe count " +
+                                                                   std::to_string(count));
+            if (!finite(layout.grid.origin) || !finite(layout.grid.spacing))
+                return make_error(ErrorCode::kInvalidArgument, "grid origin/spacing must be finite");
+            return Ok{};
+        }
+        case ProbeLayoutKind::kPositions: {
+            if (layout.positions.size() != count)
+                return make_error(ErrorCode::kInvalidArgument, std::to_string(layout.positions.size()) +
+                                                                   " positions for " + std::to_string(count) +
+                                                                   " probes");
+            for (size_t i = 0; i < layout.positions.size(); ++i)
+                for (float c : layout.positions[i])
+                    if (!std::isfinite(c))
+                        return make_error(ErrorCode::kInvalidArgument,
+                                          "position of probe " + std::to_string(i) + " is not finite");
+            return Ok{};
+        }
+    }
+    return make_error(ErrorCode::kInvalidArgument, "unknown layout kind");
+}
+
+Sh3Radiance as_radiance_type(const Sh3Irradiance& e) {
+    Sh3Radiance out;
+    out.c = e.c;
+    return out;
+}
+}  // namespace
+
+Status validate_probe_set(const ProbeSet& set) {
+    const Codec* codec = set.codec();
+    if (!codec) return make_error(ErrorCode::kInvalidArgument, "unknown representation '" + set.representation + "'");
+    if (Status st = validate_quant_params(set.params, set.representation); !st) return st;
+    // Overflow-safe: count <= payload.size() / size_bytes is necessary for equality.
+    if (set.count > set.payload.size() / codec->size_bytes || set.payload.size() != set.count * codec->size_bytes)
+        return make_error(ErrorCode::kInvalidArgument, "payload holds " + std::to_string(set.payload.size()) +
+                                                           " bytes, expected " + std::to_string(set.count) + " x " +
+                                                           std::to_string(codec->size_bytes));
+    return validate_layout(set.layout, set.count);
+}
+
+void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radiance& hub, std::uint8_t* out,
+                  EncodeStats* stats, const CodecOptions& base) {
+    if (codec.packed) {  // the entry's own encoder with every storage parameter (kind: scaled bounds)
+        codec.packed->encode(hub, params, codec_options(params, base), out, stats);
+        return;
+    }
+    const CodecOptions o = codec_options(params, base);
+    if (params.kind == StoredKind::kIrradiance) codec.encode(as_radiance_type(to_irradiance(hub)), o, out, stats);
+    else codec.encode(hub, o, out, stats);
+}
+
+Sh3Radiance decode_probe(const Codec& codec, const StorageParams& params, const std::uint8_t* in) {
+    if (codec.packed) return codec.packed->decode(in, params, codec_options(params));
+    const Sh3Radiance stored = codec.decode(in, codec_options(params));
+    if (params.kind != StoredKind::kIrradiance) return stored;
+    Sh3Irradiance e;
+    e.c = stored.c;
+    return to_radiance(e);
+}
+
+Result<ProbeSet> encode_probe_set(std::span<const Sh3Radiance> hub, std::string_view representation,
+                                  const StorageParams& params, ProbeLayout layout, EncodeStats* stats,
+                                  const CodecOptions& base) {
+    const Codec* codec = find_codec(representation);
+    if (!codec) return make_error(ErrorCode::kInvalidArgument, "unknown representation '" + std::string(representation) + "'");
+    if (Status st = validate_quant_params(params, representation); !st) return st.error();
+    if (Status st = validate_layout(layout, hub.size()); !st) return st.error();
+    ProbeSet set;
+    set.representation = std::string(representation);
+    set.params = params;
+    set.layout = std::move(layout);
+    set.count = hub.size();
+    set.payload.resize(hub.size() * codec->size_bytes);
+    for (size_t i = 0; i < hub.size(); ++i)
+        encode_probe(*codec, params, hub[i], set.payload.data() + i * codec->size_bytes, stats, base);
+    return set;
+}
+
+Result<std::vector<Sh3Radiance>> decode_probe_set(const ProbeSet& set) {
+    if (Status st = validate_probe_set(set); !st) return st.error();
+    const Codec& codec = *set.codec();
+    std::vector<Sh3Radiance> out(set.count);
+    for (size_t i = 0; i < out.size(); ++i)
+        out[i] = decode_probe(codec, set.params, set.payload.data() + i * codec.size_bytes);
+    return out;
+}
+
+Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view representation, const StorageParams& params,
+                                   EncodeStats* stats, const CodecOptions& base) {
+    auto hub = decode_probe_set(set);
+    if (!hub) return hub.error();
+    return encode_probe_set(*hub, representation, params, set.layout, stats, base);
+}
+
+Vec3 probe_position(const ProbeSet& set, std::uint64_t i) {
+    switch (set.layout.kind) {
+        case ProbeLayoutKind::kGrid: {
+            const ProbeGrid& g = set.layout.grid;
+            const std::uint64_t nx = g.counts[0], ny = g.counts[1];
+            const double x = static_cast<double>(i % nx), y = static_cast<double>((i / nx) % ny),
+                         z = static_cast<double>(i / (nx * ny));
+            return {g.origin.x + x * g.spacing.x, g.origin.y + y * g.spacing.y, g.origin.z + z * g.spacing.z};
+        }
+        case ProbeLayoutKind::kPositions: {
+            const auto& p = set.layout.positions[i];
+            return {p[0], p[1], p[2]};
+        }
+        case ProbeLayoutKind::kNone: break;
+    }
+    return {};
+}
+
+}  // namespace zhc

@@ -1,0 +1,97 @@
+// zhc/codec/probe/probe_set.h — a set of light probes in one stored representation, in memory.
+//
+// A ProbeSet is what a game ships for a volume of probes: one representation from the codec
+// table (codec.h), the parameters that give its bytes their meaning, where the probes are, and
+// the payload: probe i occupies bytes [i * size_bytes, (i + 1) * size_bytes). It is the in-memory
+// form of the .zhp container (formats/probes/probe_file.h, docs/zhp-container.md) and what other
+// consumers (glTF embedding, scene baking) build on. No I/O here.
+//
+// Invariants of a valid set (validate_probe_set checks them all):
+//  * `representation` names a codec table entry; payload.size() == count * its size_bytes;
+//  * `params` pass validate_quant_params for that representation;
+//  * layout kGrid: counts multiply to `count`, origin and spacing finite;
+//    layout kPositions: positions.size() == count, all finite; layout kNone: nothing.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "codec/probe/codec.h"
+#include "codec/probe/quantize.h"
+#include "codec/sh/sh.h"
+#include "codec/status.h"
+
+namespace zhc {
+
+enum class ProbeLayoutKind : std::uint8_t {
+    kNone = 0,       // probes without positions (e.g. one probe from an environment map)
+    kGrid = 1,       // regular grid: probe (x, y, z) at origin + (x sx, y sy, z sz), x fastest
+    kPositions = 2,  // one explicit position per probe
+};
+
+struct ProbeGrid {
+    Vec3 origin;
+    Vec3 spacing{1, 1, 1};
+    std::array<std::uint32_t, 3> counts{0, 0, 0};  // probe index = x + nx (y + ny z)
+};
+
+struct ProbeLayout {
+    ProbeLayoutKind kind = ProbeLayoutKind::kNone;
+    ProbeGrid grid;                               // kGrid only
+    std::vector<std::array<float, 3>> positions;  // kPositions only: one per probe
+};
+
+// Everything that changes how a payload decodes, as stored in a .zhp header. For the quantised
+// layouts these are all of QuantParams; the float representations read only the luminance
+// weights (ZH3 axes) and `kind` (see below).
+using StorageParams = QuantParams;
+
+struct ProbeSet {
+    std::string representation = "sh3";  // codec table name
+    StorageParams params;
+    ProbeLayout layout;
+    std::uint64_t count = 0;
+    std::vector<std::uint8_t> payload;  // count * size_bytes, probe-major
+
+    // nullptr when `representation` is not in the table.
+    const Codec* codec() const { return find_codec(representation); }
+};
+
+// Options for the codec table entries that match `params` (bits, sqrt, bound, DC format,
+// luminance weights), on top of `base` (solver iterations and other encode-only knobs).
+CodecOptions codec_options(const StorageParams& params, const CodecOptions& base = {});
+
+// Checks every invariant above; kInvalidArgument naming the first broken one.
+Status validate_probe_set(const ProbeSet& set);
+
+// Probe i's stored bytes -> hub, and hub -> stored bytes. With params.kind == kIrradiance the
+// payload holds irradiance SH: the quantised layouts then use the irradiance-scaled ratio bounds
+// (App. A.1) and the other representations store the band-scaled coefficients as they would a
+// radiance function (every representation in the table is linear per band, so this is exact
+// up to rounding). `out` must have codec->size_bytes bytes.
+void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radiance& hub, std::uint8_t* out,
+                  EncodeStats* stats, const CodecOptions& base = {});
+Sh3Radiance decode_probe(const Codec& codec, const StorageParams& params, const std::uint8_t* in);
+
+// Builds a set from hub probes. Fails (kInvalidArgument) for an unknown representation, bad
+// params, or a layout that does not match hub.size(). Deterministic.
+Result<ProbeSet> encode_probe_set(std::span<const Sh3Radiance> hub, std::string_view representation,
+                                  const StorageParams& params, ProbeLayout layout, EncodeStats* stats = nullptr,
+                                  const CodecOptions& base = {});
+// Decodes every probe to the hub. Fails only for an invalid set.
+Result<std::vector<Sh3Radiance>> decode_probe_set(const ProbeSet& set);
+// Decode then re-encode into another representation/params; the layout is kept.
+Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view representation, const StorageParams& params,
+                                   EncodeStats* stats = nullptr, const CodecOptions& base = {});
+
+// World position of probe i (origin for kNone). Precondition: i < count, valid set.
+Vec3 probe_position(const ProbeSet& set, std::uint64_t i);
+// Number of probes a layout describes (grid product, positions size), or -1 for kNone (any).
+// Overflow-checked: returns -2 when the grid product does not fit in 64 bits.
+std::int64_t layout_probe_count(const ProbeLayout& layout);
+
+}  // namespace zhc

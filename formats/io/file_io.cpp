@@ -1,0 +1,232 @@
+#include "formats/io/file_io.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+
+namespace zhc {
+
+namespace fs = std::filesystem;
+
+Result<std::vector<std::uint8_t>> read_file_bytes(const std::string& path, std::uint64_t max_bytes) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (ec || !fs::exists(st)) return make_error(ErrorCode::kIoError, path + ": no such file");
+    if (fs::is_directory(st)) return make_error(ErrorCode::kIoError, path + ": is a directory, not a file");
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return make_error(ErrorCode::kIoError, path + ": cannot open (" + std::strerror(errno) + ")");
+    std::vector<std::uint8_t> bytes;
+    // Read in chunks: works for pipes and special files whose size is unknown, and never
+    // allocates more than max_bytes + one chunk.
+    std::uint8_t chunk[1 << 16];
+    for (;;) {
+        const size_t n = std::fread(chunk, 1, sizeof chunk, f);
+        if (n > 0) {
+            if (bytes.size() + n > max_bytes) {
+                std::fclose(f);
+                return make_error(ErrorCode::kTooLarge, path + ": file larger than the limit of " +
+                                                            std::to_string(max_bytes) + " bytes");
+            }
+            bytes.insert(bytes.end(), chunk, chunk + n);
+        }
+        if (n < sizeof chunk) break;
+    }
+    const bool failed = std::ferror(f) != 0;
+    std::fclose(f);
+    if (failed) return make_error(ErrorCode::kIoError, path + ": read error");
+    return bytes;
+}
+
+Result<FilePrefix> read_file_prefix(const std::string& path, std::size_t max_bytes) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (ec || !fs::exists(st)) return make_error(ErrorCode::kIoError, path + ": no such file");
+    if (fs::is_directory(st)) return make_error(ErrorCode::kIoError, path + ": is a directory, not a file");
+    if (!fs::is_regular_file(st)) return make_error(ErrorCode::kIoError, path + ": not a regular file");
+    FilePrefix p;
+    p.file_size = fs::file_size(path, ec);
+    if (ec) return make_error(ErrorCode::kIoError, path + ": cannot read its size (" + ec.message() + ")");
+    FileRangeReader r;
+    if (Status s = r.open(path); !s) return s.error();
+    p.bytes.resize(static_cast<size_t>(std::min<std::uint64_t>(p.file_size, max_bytes)));
+    if (Status s = r.read(0, p.bytes.data(), p.bytes.size()); !s) return s.error();
+    return p;
+}
+
+FileRangeReader::~FileRangeReader() {
+    if (f_) std::fclose(f_);
+}
+
+Status FileRangeReader::open(const std::string& path) {
+    if (f_) std::fclose(f_);
+    path_ = path;
+    f_ = std::fopen(path.c_str(), "rb");
+    if (!f_) return make_error(ErrorCode::kIoError, path + ": cannot open (" + std::strerror(errno) + ")");
+    return Ok{};
+}
+
+Status FileRangeReader::read(std::uint64_t offset, std::uint8_t* out, std::size_t size) {
+    if (!f_) return make_error(ErrorCode::kInternal, path_ + ": not open");
+    if (size == 0) return Ok{};
+    if (offset > static_cast<std::uint64_t>(std::numeric_limits<off_t>::max()) ||
+        ::fseeko(f_, static_cast<off_t>(offset), SEEK_SET) != 0)
+        return make_error(ErrorCode::kIoError, path_ + ": cannot seek to byte " + std::to_string(offset));
+    const size_t n = std::fread(out, 1, size, f_);
+    if (n != size) {
+        if (std::ferror(f_)) return make_error(ErrorCode::kIoError, path_ + ": read error");
+        return make_error(ErrorCode::kTruncated, path_ + ": file ends at byte " + std::to_string(offset + n) + ", expected " +
+                                                     std::to_string(offset + size) + " (changed while being read?)");
+    }
+    return Ok{};
+}
+
+namespace {
+std::string temporary_name_for(const std::string& path) {
+    std::random_device rd;
+    char suffix[32];
+    std::snprintf(suffix, sizeof suffix, ".tmp-%d-%08x", static_cast<int>(::getpid()), rd());
+    return path + suffix;
+}
+}  // namespace
+
+Status write_via_temporary(const std::string& path, const std::function<Status(const std::string&)>& writer) {
+    const std::string tmp = temporary_name_for(path);
+    Status st = writer(tmp);
+    std::error_code ec;
+    if (!st) {
+        fs::remove(tmp, ec);
+        return st;
+    }
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        return make_error(ErrorCode::kIoError, path + ": cannot write (" + ec.message() + ")");
+    }
+    return Ok{};
+}
+
+namespace {
+// Writes `bytes` to the temporary file `tmp` (messages name `path`, the file the user asked for).
+// On failure `tmp` may exist; the caller removes it.
+Status write_temporary(const std::string& tmp, const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) return make_error(ErrorCode::kIoError, path + ": cannot create (" + std::strerror(errno) + ")");
+    const bool ok = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    const bool flushed = std::fflush(f) == 0;
+    const bool closed = std::fclose(f) == 0;
+    if (!ok || !flushed || !closed) return make_error(ErrorCode::kIoError, path + ": write failed");
+    return Ok{};
+}
+}  // namespace
+
+Status write_file_atomic(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    return write_via_temporary(path, [&](const std::string& tmp) { return write_temporary(tmp, path, bytes); });
+}
+
+AtomicFileSet::~AtomicFileSet() { discard(); }
+
+void AtomicFileSet::discard() {
+    for (std::FILE* f : files_)
+        if (f) std::fclose(f);
+    files_.clear();
+    std::error_code ec;
+    for (const auto& t : temps_) fs::remove(t, ec);
+    temps_.clear();
+    paths_.clear();
+    written_.clear();
+}
+
+Status AtomicFileSet::open(const std::vector<std::string>& paths) {
+    discard();
+    for (const auto& path : paths) {
+        temps_.push_back(temporary_name_for(path));
+        paths_.push_back(path);
+        written_.push_back(0);
+        std::FILE* f = std::fopen(temps_.back().c_str(), "wb");
+        if (!f) {
+            const Error e = make_error(ErrorCode::kIoError, path + ": cannot create (" + std::strerror(errno) + ")");
+            temps_.pop_back();  // never created
+            discard();
+            return e;
+        }
+        files_.push_back(f);
+    }
+    return Ok{};
+}
+
+Status AtomicFileSet::write(std::size_t file, const std::uint8_t* data, std::size_t size) {
+    if (file >= files_.size() || !files_[file]) return make_error(ErrorCode::kInternal, "AtomicFileSet: write to a file not open");
+    if (size > 0 && std::fwrite(data, 1, size, files_[file]) != size) {
+        const Error e = make_error(ErrorCode::kIoError, paths_[file] + ": write failed");
+        discard();
+        return e;
+    }
+    written_[file] += size;
+    return Ok{};
+}
+
+Status AtomicFileSet::commit() {
+    for (size_t i = 0; i < files_.size(); ++i) {
+        const bool flushed = std::fflush(files_[i]) == 0;
+        const bool closed = std::fclose(files_[i]) == 0;
+        files_[i] = nullptr;
+        if (!flushed || !closed) {
+            const Error e = make_error(ErrorCode::kIoError, paths_[i] + ": write failed");
+            discard();
+            return e;
+        }
+    }
+    std::error_code ec;
+    // A directory in the way would only show at the rename; look first so that the common case
+    // fails before anything is replaced.
+    for (const auto& path : paths_)
+        if (fs::is_directory(path, ec)) {
+            const Error e = make_error(ErrorCode::kIoError, path + ": is a directory");
+            discard();
+            return e;
+        }
+    std::vector<std::string> renamed;
+    for (size_t i = 0; i < paths_.size(); ++i) {
+        std::error_code rec;
+        fs::rename(temps_[i], paths_[i], rec);
+        if (rec) {
+            const Error e = make_error(ErrorCode::kIoError, paths_[i] + ": cannot write (" + rec.message() + ")");
+            for (const auto& p : renamed) fs::remove(p, ec);
+            discard();  // removes the temporaries not renamed yet (and tries the renamed names: gone)
+            return e;
+        }
+        renamed.push_back(paths_[i]);
+    }
+    files_.clear();
+    temps_.clear();
+    paths_.clear();
+    written_.clear();
+    return Ok{};
+}
+
+Status write_files_atomic(const std::vector<std::pair<std::string, std::vector<std::uint8_t>>>& files) {
+    std::vector<std::string> paths;
+    for (const auto& f : files) paths.push_back(f.first);
+    AtomicFileSet set;
+    if (Status s = set.open(paths); !s) return s;
+    for (size_t i = 0; i < files.size(); ++i)
+        if (Status s = set.write(i, files[i].second.data(), files[i].second.size()); !s) return s;
+    return set.commit();
+}
+
+std::string temporary_path_for(const std::string& path) { return temporary_name_for(path); }
+
+std::string file_extension(const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    return ext;
+}
+
+}  // namespace zhc

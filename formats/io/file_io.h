@@ -1,0 +1,86 @@
+// zhc/formats/io/file_io.h — bounded file reads and atomic file writes.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "codec/status.h"
+
+namespace zhc {
+
+// Whole file into memory; fails with kTooLarge (before allocating) when it exceeds max_bytes.
+Result<std::vector<std::uint8_t>> read_file_bytes(const std::string& path, std::uint64_t max_bytes);
+
+// The first min(size, max_bytes) bytes of a regular file, and its size (streaming readers check
+// a header first and read the rest piece by piece). Not for pipes: fails kIoError.
+struct FilePrefix {
+    std::vector<std::uint8_t> bytes;
+    std::uint64_t file_size = 0;
+};
+Result<FilePrefix> read_file_prefix(const std::string& path, std::size_t max_bytes);
+
+// Reads byte ranges of a file (streaming readers). Errors name the file; a range past the end is
+// kTruncated (the file changed after its header was checked).
+class FileRangeReader {
+public:
+    FileRangeReader() = default;
+    FileRangeReader(const FileRangeReader&) = delete;
+    FileRangeReader& operator=(const FileRangeReader&) = delete;
+    ~FileRangeReader();
+    Status open(const std::string& path);
+    Status read(std::uint64_t offset, std::uint8_t* out, std::size_t size);
+
+private:
+    std::string path_;
+    std::FILE* f_ = nullptr;
+};
+
+// Writes `bytes` to `path` atomically: a temporary file in the same folder, flushed, then renamed
+// over `path`. On failure `path` is untouched and no temporary file is left behind.
+Status write_file_atomic(const std::string& path, const std::vector<std::uint8_t>& bytes);
+
+// Writes several files as one unit: every file goes to a temporary name first; only when all of
+// them are written are they renamed over their paths. If any write fails, no path is touched and
+// no temporary file is left behind. If a rename fails (e.g. a directory of that name), the files
+// already renamed in this call are removed again, so the set is never left half new.
+Status write_files_atomic(const std::vector<std::pair<std::string, std::vector<std::uint8_t>>>& files);
+
+// Several files written piece by piece (streaming) and published as one unit, like
+// write_files_atomic: open() creates a temporary file per path; write() appends to one of them;
+// commit() flushes and closes them and renames them over their paths (all or none, with the same
+// roll-back as write_files_atomic). Until commit() succeeds no path is touched; the destructor (or
+// a failed write/commit) removes every temporary file.
+class AtomicFileSet {
+public:
+    AtomicFileSet() = default;
+    AtomicFileSet(const AtomicFileSet&) = delete;
+    AtomicFileSet& operator=(const AtomicFileSet&) = delete;
+    ~AtomicFileSet();
+    Status open(const std::vector<std::string>& paths);
+    Status write(std::size_t file, const std::uint8_t* data, std::size_t size);
+    Status commit();
+    // Bytes written so far to `file`.
+    std::uint64_t written(std::size_t file) const { return file < written_.size() ? written_[file] : 0; }
+
+private:
+    void discard();
+    std::vector<std::string> paths_, temps_;
+    std::vector<std::FILE*> files_;
+    std::vector<std::uint64_t> written_;
+};
+
+// For libraries that write to a file name themselves: `writer` writes to the temporary name it
+// is given; on success that file is renamed over `path`, on failure it is removed.
+Status write_via_temporary(const std::string& path, const std::function<Status(const std::string&)>& writer);
+
+// A fresh temporary name next to `path` (the one write_via_temporary and AtomicFileSet use).
+std::string temporary_path_for(const std::string& path);
+
+// Lower-case extension including the dot ("" when none): "a/b.EXR" -> ".exr".
+std::string file_extension(const std::string& path);
+
+}  // namespace zhc

@@ -1,0 +1,215 @@
+// zhc/formats/lightmap/ktx2.cpp — KTX 2.0 writer and strict reader (see ktx2.h).
+#include "formats/lightmap/ktx2.h"
+
+#include <cstring>
+
+#include "formats/io/file_io.h"
+#include "formats/io/le_bytes.h"
+
+namespace zhc {
+namespace {
+using le::get32;
+using le::get64;
+using le::put32;
+using le::put64;
+
+constexpr std::uint8_t kIdentifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
+constexpr std::size_t kHeaderBytes = 12 + 9 * 4;     // identifier + 9 u32 fields
+constexpr std::size_t kIndexBytes = 4 * 4 + 2 * 8;   // dfd/kvd offsets+lengths, sgd offset+length
+constexpr std::size_t kLevelIndexBytes = 3 * 8;      // one level
+constexpr std::size_t kDfdStart = kHeaderBytes + kIndexBytes + kLevelIndexBytes;  // 104
+
+// Khronos Data Format: colour models and sample layout for the three formats.
+constexpr std::uint32_t kModelBc4 = 131, kModelBc5 = 132, kModelBc6h = 133;
+constexpr std::uint32_t kPrimariesBt709 = 1, kTransferLinear = 1;
+constexpr std::uint32_t kQualifierFloat = 0x80;  // in the channelType|qualifiers byte
+
+
+// The DFD zhc writes (and the only one it accepts) for a format: dfdTotalSize + one basic block.
+std::vector<std::uint8_t> make_dfd(std::uint32_t vk_format) {
+    const bool bc5 = vk_format == kVkFormatBc5Unorm, bc6 = vk_format == kVkFormatBc6hUfloat;
+    const std::uint32_t samples = bc5 ? 2 : 1;
+    const std::uint32_t block_size = 24 + 16 * samples;
+    const std::uint32_t bytes = static_cast<std::uint32_t>(ktx2_block_bytes(vk_format));
+    std::vector<std::uint8_t> d;
+    put32(d, 4 + block_size);                     // dfdTotalSize
+    put32(d, 0);                                  // vendorId 0 (Khronos), descriptorType 0 (basic)
+    put32(d, 2u | (block_size << 16));            // versionNumber 2 (KDF 1.3), descriptorBlockSize
+    const std::uint32_t model = bc6 ? kModelBc6h : (bc5 ? kModelBc5 : kModelBc4);
+    put32(d, model | (kPrimariesBt709 << 8) | (kTransferLinear << 16));  // flags 0 (straight alpha)
+    put32(d, 3u | (3u << 8));                     // texelBlockDimension 4x4x1x1 (stored minus one)
+    put32(d, bytes);                              // bytesPlane0
+    put32(d, 0);                                  // bytesPlane4..7
+    for (std::uint32_t s = 0; s < samples; ++s) {
+        const std::uint32_t bit_length = (bc5 || !bc6) ? 63 : 127;  // stored minus one
+        const std::uint32_t channel = s | (bc6 ? kQualifierFloat : 0);
+        put32(d, (s * 64) | (bit_length << 16) | (channel << 24));  // bitOffset, bitLength, channel
+        put32(d, 0);                                                // samplePosition 0,0,0,0
+        put32(d, 0);                                                // sampleLower: 0 (0.0f / 0)
+        put32(d, bc6 ? 0x3F800000u : 0xFFFFFFFFu);                  // sampleUpper: 1.0f / max
+    }
+    return d;
+}
+
+std::size_t align_up(std::size_t v, std::size_t a) { return (v + a - 1) / a * a; }
+
+Error bad(ErrorCode code, const std::string& name, const std::string& what) {
+    return make_error(code, name + ": " + what);
+}
+
+}  // namespace
+
+std::size_t ktx2_block_bytes(std::uint32_t vk_format) {
+    switch (vk_format) {
+        case kVkFormatBc4Unorm: return 8;
+        case kVkFormatBc5Unorm:
+        case kVkFormatBc6hUfloat: return 16;
+        default: return 0;
+    }
+}
+
+Result<std::vector<std::uint8_t>> ktx2_header(std::uint32_t vk_format, int width, int height) {
+    const std::size_t bb = ktx2_block_bytes(vk_format);
+    if (bb == 0) return make_error(ErrorCode::kInvalidArgument, "ktx2: unsupported vkFormat " + std::to_string(vk_format));
+    if (width <= 0 || height <= 0) return make_error(ErrorCode::kInvalidArgument, "ktx2: empty image");
+    const std::size_t level_bytes = static_cast<size_t>((width + 3) / 4) * static_cast<size_t>((height + 3) / 4) * bb;
+    const auto dfd = make_dfd(vk_format);
+    const std::size_t level_offset = align_up(kDfdStart + dfd.size(), bb);  // lcm(block bytes, 4) = block bytes
+    std::vector<std::uint8_t> out(kIdentifier, kIdentifier + 12);
+    put32(out, vk_format);
+    put32(out, 1);  // typeSize: 1 for block-compressed formats
+    put32(out, static_cast<std::uint32_t>(width));
+    put32(out, static_cast<std::uint32_t>(height));
+    put32(out, 0);  // pixelDepth
+    put32(out, 0);  // layerCount
+    put32(out, 1);  // faceCount
+    put32(out, 1);  // levelCount
+    put32(out, 0);  // supercompressionScheme: none
+    put32(out, static_cast<std::uint32_t>(kDfdStart));
+    put32(out, static_cast<std::uint32_t>(dfd.size()));
+    put32(out, 0);  // kvdByteOffset
+    put32(out, 0);  // kvdByteLength
+    put64(out, 0);  // sgdByteOffset
+    put64(out, 0);  // sgdByteLength
+    put64(out, level_offset);
+    put64(out, level_bytes);
+    put64(out, level_bytes);  // uncompressedByteLength (no supercompression)
+    out.insert(out.end(), dfd.begin(), dfd.end());
+    out.resize(level_offset, 0);
+    return out;
+}
+
+Result<std::vector<std::uint8_t>> encode_ktx2(const Ktx2Image& img) {
+    auto out = ktx2_header(img.vk_format, img.width, img.height);
+    if (!out) return out;
+    if (img.blocks.size() != ktx2_level_bytes(img.vk_format, img.width, img.height))
+        return make_error(ErrorCode::kInvalidArgument, "ktx2: block data does not match the image size");
+    out->insert(out->end(), img.blocks.begin(), img.blocks.end());
+    return out;
+}
+
+std::uint64_t ktx2_level_bytes(std::uint32_t vk_format, int width, int height) {
+    if (width <= 0 || height <= 0) return 0;
+    return static_cast<std::uint64_t>((width + 3) / 4) * static_cast<std::uint64_t>((height + 3) / 4) * ktx2_block_bytes(vk_format);
+}
+
+namespace {
+// decode_ktx2's checks on the first bytes `b` of a file of `size` bytes (b holds at least
+// min(size, 104 + the DFD's length) bytes): the image description without its blocks, and the
+// byte offset of the level data.
+Result<Ktx2Image> decode_ktx2_layout(std::span<const std::uint8_t> b, std::uint64_t size, const std::string& name,
+                                     const Ktx2Limits& limits, std::uint64_t* data_offset) {
+    if (b.size() < 12 || std::memcmp(b.data(), kIdentifier, 12) != 0)
+        return bad(ErrorCode::kBadFormat, name, "not a KTX2 file (bad identifier at byte 0)");
+    if (size < kDfdStart || b.size() < kDfdStart) return bad(ErrorCode::kTruncated, name, "header truncated (file ends before byte 104)");
+    Ktx2Image img;
+    img.vk_format = get32(b, 12);
+    const std::uint32_t type_size = get32(b, 16), w = get32(b, 20), h = get32(b, 24), depth = get32(b, 28),
+                        layers = get32(b, 32), faces = get32(b, 36), levels = get32(b, 40), scheme = get32(b, 44);
+    const std::size_t bb = ktx2_block_bytes(img.vk_format);
+    if (bb == 0)
+        return bad(ErrorCode::kUnsupported, name, "unsupported vkFormat " + std::to_string(img.vk_format) +
+                                                      " (byte 12; zhc reads 139 BC4, 141 BC5, 143 BC6H_UFLOAT)");
+    if (type_size != 1) return bad(ErrorCode::kBadFormat, name, "typeSize must be 1 for block formats (byte 16)");
+    if (w == 0 || h == 0) return bad(ErrorCode::kBadFormat, name, "zero pixelWidth/pixelHeight (bytes 20-27)");
+    if (w > static_cast<std::uint32_t>(limits.max_dimension) || h > static_cast<std::uint32_t>(limits.max_dimension))
+        return bad(ErrorCode::kTooLarge, name, std::to_string(w) + "x" + std::to_string(h) + " exceeds the limit " +
+                                                   std::to_string(limits.max_dimension) + " (bytes 20-27)");
+    if (depth != 0 || layers != 0 || faces != 1)
+        return bad(ErrorCode::kUnsupported, name, "only single 2-D images are supported (pixelDepth 0, layerCount 0, faceCount 1; bytes 28-39)");
+    if (levels != 1) return bad(ErrorCode::kUnsupported, name, "levelCount " + std::to_string(levels) + " (byte 40): zhc reads exactly one mip level");
+    if (scheme != 0) return bad(ErrorCode::kUnsupported, name, "supercompressionScheme " + std::to_string(scheme) + " (byte 44): only 0 (none)");
+    const std::uint32_t dfd_off = get32(b, 48), dfd_len = get32(b, 52), kvd_off = get32(b, 56), kvd_len = get32(b, 60);
+    const std::uint64_t sgd_off = get64(b, 64), sgd_len = get64(b, 72);
+    const std::uint64_t lvl_off = get64(b, 80), lvl_len = get64(b, 88), lvl_ulen = get64(b, 96);
+    if (sgd_off != 0 || sgd_len != 0) return bad(ErrorCode::kBadFormat, name, "supercompression global data without a scheme (bytes 64-79)");
+    const auto expected_dfd = make_dfd(img.vk_format);
+    if (dfd_off != kDfdStart || dfd_len != expected_dfd.size())
+        return bad(ErrorCode::kBadFormat, name, "data format descriptor not where/as long as expected (bytes 48-55)");
+    if (static_cast<std::uint64_t>(dfd_off) + dfd_len > size || static_cast<std::uint64_t>(dfd_off) + dfd_len > b.size())
+        return bad(ErrorCode::kTruncated, name, "file ends inside the data format descriptor (byte " + std::to_string(dfd_off) + ")");
+    if (std::memcmp(b.data() + dfd_off, expected_dfd.data(), expected_dfd.size()) != 0)
+        return bad(ErrorCode::kBadFormat, name, "data format descriptor does not describe vkFormat " + std::to_string(img.vk_format) +
+                                                    " (byte " + std::to_string(dfd_off) + ")");
+    if (kvd_len != 0) {
+        // Key/value data is allowed (and ignored) if it lies between the DFD and the level data.
+        if (kvd_off < dfd_off + dfd_len || static_cast<std::uint64_t>(kvd_off) + kvd_len > lvl_off)
+            return bad(ErrorCode::kBadFormat, name, "key/value data outside its place (bytes 56-63)");
+    } else if (kvd_off != 0) {
+        return bad(ErrorCode::kBadFormat, name, "kvdByteOffset without kvdByteLength (byte 56)");
+    }
+    const std::uint64_t expected = static_cast<std::uint64_t>((w + 3) / 4) * ((h + 3) / 4) * bb;
+    if (lvl_len != expected || lvl_ulen != expected)
+        return bad(ErrorCode::kBadFormat, name, "level 0 byteLength " + std::to_string(lvl_len) + " but " +
+                                                    std::to_string(w) + "x" + std::to_string(h) + " needs " +
+                                                    std::to_string(expected) + " (bytes 88-103)");
+    if (lvl_off % bb != 0 || lvl_off < dfd_off + dfd_len)
+        return bad(ErrorCode::kBadFormat, name, "level 0 byteOffset " + std::to_string(lvl_off) + " misaligned or overlapping (byte 80)");
+    if (lvl_off > size || size - lvl_off < lvl_len)
+        return bad(ErrorCode::kTruncated, name, "file ends inside the level data (needs " + std::to_string(lvl_off + lvl_len) +
+                                                    " bytes, has " + std::to_string(size) + ")");
+    if (size != lvl_off + lvl_len)
+        return bad(ErrorCode::kTrailingBytes, name, std::to_string(size - lvl_off - lvl_len) + " bytes after the level data (byte " +
+                                                        std::to_string(lvl_off + lvl_len) + ")");
+    img.width = static_cast<int>(w);
+    img.height = static_cast<int>(h);
+    *data_offset = lvl_off;
+    return img;
+}
+}  // namespace
+
+Result<Ktx2Image> decode_ktx2(std::span<const std::uint8_t> b, const std::string& name, const Ktx2Limits& limits) {
+    std::uint64_t off = 0;
+    auto img = decode_ktx2_layout(b, b.size(), name, limits, &off);
+    if (!img) return img;
+    img->blocks.assign(b.begin() + static_cast<std::ptrdiff_t>(off), b.end());
+    return img;
+}
+
+Result<BlockFileLayout> read_ktx2_layout(const std::string& path, const Ktx2Limits& limits) {
+    auto prefix = read_file_prefix(path, 1 << 16);
+    if (!prefix) return prefix.error();
+    BlockFileLayout l;
+    auto img = decode_ktx2_layout(prefix->bytes, prefix->file_size, path, limits, &l.data_offset);
+    if (!img) return img.error();
+    l.vk_format = img->vk_format;
+    l.width = img->width;
+    l.height = img->height;
+    return l;
+}
+
+
+Status write_ktx2(const std::string& path, const Ktx2Image& image) {
+    auto bytes = encode_ktx2(image);
+    if (!bytes) return make_error(bytes.error().code, path + ": " + bytes.error().message);
+    return write_file_atomic(path, *bytes);
+}
+
+Result<Ktx2Image> read_ktx2(const std::string& path, const Ktx2Limits& limits) {
+    const std::uint64_t dim = static_cast<std::uint64_t>(limits.max_dimension);
+    auto bytes = read_file_bytes(path, 4096 + (dim + 3) / 4 * ((dim + 3) / 4) * 16);
+    if (!bytes) return bytes.error();
+    return decode_ktx2(*bytes, path, limits);
+}
+
+}  // namespace zhc

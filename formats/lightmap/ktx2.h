@@ -1,0 +1,57 @@
+// zhc/formats/lightmap/ktx2.h — KTX 2.0 files for zhc's block-compressed lightmap textures.
+//
+// Writes and reads exactly one kind of KTX2: a single 2-D image (no array layers, one face, one mip
+// level, no supercompression) in VK_FORMAT_BC6H_UFLOAT_BLOCK (143), VK_FORMAT_BC5_UNORM_BLOCK (141)
+// or VK_FORMAT_BC4_UNORM_BLOCK (139), with a Basic Data Format Descriptor (docs/lightmap-formats.md).
+// The reader is strict and safe for untrusted bytes: sizes are checked against limits before
+// anything is allocated, and each kind of problem has its own error code and message.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "codec/status.h"
+
+namespace zhc {
+
+inline constexpr std::uint32_t kVkFormatBc4Unorm = 139;
+inline constexpr std::uint32_t kVkFormatBc5Unorm = 141;
+inline constexpr std::uint32_t kVkFormatBc6hUfloat = 143;
+
+struct Ktx2Image {
+    std::uint32_t vk_format = 0;
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> blocks;  // ceil(w/4) * ceil(h/4) blocks, row-major
+};
+
+// Bytes per 4x4 block of a supported format; 0 if unsupported.
+std::size_t ktx2_block_bytes(std::uint32_t vk_format);
+
+struct Ktx2Limits {
+    int max_dimension = 16384;
+};
+
+Result<std::vector<std::uint8_t>> encode_ktx2(const Ktx2Image& image);
+// Streaming: everything encode_ktx2 writes before the blocks (every header field depends only on
+// the format and the size: one level, no supercompression), and the level's byte length (0 for an
+// unsupported format or an empty size). encode_ktx2 = ktx2_header + the blocks.
+Result<std::vector<std::uint8_t>> ktx2_header(std::uint32_t vk_format, int width, int height);
+std::uint64_t ktx2_level_bytes(std::uint32_t vk_format, int width, int height);
+
+// A block file's description without its blocks (streaming reads): the format, the size and the
+// byte offset of the level data, which runs to the end of the file (ceil(w/4) * ceil(h/4) blocks,
+// row-major). read_ktx2_layout / read_dds_layout make every check decode_ktx2 / decode_dds make,
+// from the file's first bytes and its size, without reading the blocks.
+struct BlockFileLayout {
+    std::uint32_t vk_format = 0;
+    int width = 0, height = 0;
+    std::uint64_t data_offset = 0;
+};
+Result<BlockFileLayout> read_ktx2_layout(const std::string& path, const Ktx2Limits& limits = {});
+Result<Ktx2Image> decode_ktx2(std::span<const std::uint8_t> bytes, const std::string& name, const Ktx2Limits& limits = {});
+Status write_ktx2(const std::string& path, const Ktx2Image& image);
+Result<Ktx2Image> read_ktx2(const std::string& path, const Ktx2Limits& limits = {});
+
+}  // namespace zhc

@@ -1,0 +1,87 @@
+// zhc/formats/lightmap/lightmap_stream.h — the lightmap verbs as streaming pipelines in bounded memory
+// (docs/lightmap-formats.md, "Streaming"): the SH lightmap EXR is read in bands of rows (a multiple
+// of 4, whole rows of 4x4 blocks), each band is fitted and block-compressed, and its blocks are
+// appended to the KTX2/DDS level data in temporary files renamed at the end (all three or none).
+// Peak memory is a few bands, whatever the image size. The bytes written do not depend on the band
+// height or the thread count: each 4x4 block depends only on its own texels (the last band holds the
+// image's partial bottom block row, whose missing rows repeat the last row as in the whole-image
+// encoder), and every per-texel fit is independent of the others.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "codec/lightmap/lightmap.h"
+#include "codec/status.h"
+
+namespace zhc::lightmap_stream {
+
+enum class Fit {
+    kNewton,  // irradz::encode, Solve::kNewton (the default)
+    kSearch,  // irradz::encode, Solve::kSearch
+    kOld,     // irradz::encode, Solve::kOld
+    kLinear,  // closed-form linear SH (lightmap::encode_planes_linear_sh)
+};
+
+// Called after each band with the rows done so far and the total.
+using ProgressFn = std::function<void(std::uint64_t done, std::uint64_t total)>;
+
+// Band height for an image `width` texels wide: `requested` rounded up to a multiple of 4 if > 0,
+// else about 2^18 texels per band (64 rows at 4096 wide), at least 4 rows per thread (up to 16 threads).
+int band_rows(int width, int threads, int requested);
+
+struct Timing {
+    double read = 0, fit = 0, compress = 0, write = 0;  // seconds
+};
+
+struct EncodeOptions {
+    Fit fit = Fit::kNewton;
+    bc6h::Quality bc6h_quality = bc6h::Quality::kDefault;
+    bc45::Quality bc45_quality = bc45::Quality::kDefault;
+    int threads = 1;
+    int band_rows = 0;  // 0: automatic (see band_rows())
+    bool dds = false;   // PREFIX.{iz,d,wa}.dds instead of .ktx2
+    ProgressFn progress;
+};
+struct EncodeResult {
+    int width = 0, height = 0, coefficients = 9;
+    std::uint64_t block_bytes = 0;  // the three levels together
+    Timing timing;
+};
+// inputs: see ShLightmapSource (one SH3 or linear-SH EXR, or 4 / 9 per-coefficient EXRs).
+// On failure, *output_failed (if given) tells an error writing the outputs from one on the input.
+Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::string& prefix, const EncodeOptions& options,
+                            bool* output_failed = nullptr);
+
+struct DecodeResult {
+    int width = 0, height = 0;
+};
+// PREFIX.{iz,d,wa}.{ktx2|dds} -> IrradZ EXR (write_irradz_exr's channels and bytes), block row band
+// by block row band.
+Result<DecodeResult> decode(const std::string& prefix, bool dds, const std::string& output, int band_rows_requested,
+                            const ProgressFn& progress, bool* output_failed = nullptr);
+
+struct AuditOptions {
+    bc6h::Quality bc6h_quality = bc6h::Quality::kDefault;
+    bc45::Quality bc45_quality = bc45::Quality::kDefault;
+    int threads = 1, band_rows = 0;
+    std::size_t stride = 17;
+    ProgressFn progress;
+};
+struct AuditResult {
+    int width = 0, height = 0;
+    lightmap::Audit audit;
+    Timing timing;
+};
+// Every row is fitted (irradz's default solve and the old way) and block-compressed; the hemispherical error integral
+// is taken on every stride-th texel (lightmap::audit's sampling), the PSNRs over every texel.
+Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOptions& options);
+
+// The synthetic sphere lightmap (lightmap::synthesize_sphere, width x height) written band by band;
+// `half`: HALF channels (half the file size) instead of FLOAT.
+Status synth(const Sh3Radiance& world, int width, int height, const std::string& output, bool half, int threads, int band_rows_requested,
+             const ProgressFn& progress);  // every error is an output error
+
+}  // namespace zhc::lightmap_stream
