@@ -337,8 +337,8 @@ int main(int argc, char** argv) {
     std::printf("ns/eval: one evaluation per invocation on %u distinct probes (fetch from memory);\n"
                 "cached: %u evaluations per invocation on 64 probes (overhead amortised, fetch from cache)\n\n",
                 kProbes, kCachedLoop);
-    std::printf("%-22s %6s %8s %11s %10s %8s %14s %8s\n", "encoding", "bytes", "SPIR-V", "SPIR-V-skel", "ns/eval", base_name.c_str(),
-                "ns/eval cached", base_name.c_str());
+    std::printf("%-22s %6s %8s %11s %10s %8s %14s %8s\n", "encoding", "bytes", "SPIR-V", "SPIR-V-skel", "ns/eval",
+                base_name.c_str(), "ns/eval cached", base_name.c_str());
     for (const Row& r : rows)
         std::printf("%-22s %6.1f %8d %11d %10.2f %8.2f %14.2f %8.2f\n", r.name.c_str(), r.bytes, r.instructions,
                     r.eval_instructions, r.ns, r.ns / base, r.ns_one, r.ns_one / base_one);
