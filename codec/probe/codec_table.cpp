@@ -20,7 +20,8 @@
     X(quantized_codecs)        \
     X(zh3_window_codecs)       \
     X(zh3_channel_q16_codecs)  \
-    X(hall_codecs)
+    X(hall_codecs)             \
+    /* a new module's line goes here, last */
 
 namespace zhc {
 
