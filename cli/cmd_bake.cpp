@@ -87,7 +87,7 @@ int run(const Options& o) {
         ProbeList list;
         list.probes = *probes;
         list.layout = layout;
-        if (o.to != "sh3") {
+        if (!codec->traits.exact) {  // a lossy entry: the JSON holds what it decodes to
             auto hub = round_trip_probes(list.probes, o.to, StorageParams{}, layout);
             if (!hub) return report(hub.error());
             list.probes = std::move(hub).value();

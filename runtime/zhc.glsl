@@ -51,21 +51,39 @@ precision highp int;
 
 // ---- format description ------------------------------------------------------------------------
 
-// Layout families (how the words are laid out). Codec table name -> layout, hallucination, axis:
-//   sh3, sh3_dering                      ZHC_LAYOUT_SH3_F32  (27 words)
-//   sh2                                  ZHC_LAYOUT_SH2_F32  (12 words)
-//   zh3_lum, zh3_solved_lum, zh3_lum_dering, zh3_lum_dering_sphere, zh3_dering
-//                                        ZHC_LAYOUT_ZH3_F32  (15 words), axis luminance
-//   zh3_channel, zh3_solved_channel      ZHC_LAYOUT_ZH3_F32, axis per channel
-//   hall_{ambdir,sphere,curve}           ZHC_LAYOUT_SH2_F32 + hallucination, axis luminance
-//   hall_{ambdir,sphere,curve}_channel   ZHC_LAYOUT_SH2_F32 + hallucination, axis per channel
-//   zh3_q16, zh3_solved_q16, zh3_dering_q16  ZHC_LAYOUT_ZH3_Q16  (uvec4), axis from the header
-//   zh3_channel_q16, zh3_solved_channel_q16  ZHC_LAYOUT_ZH3_Q16, axis per channel (whatever the header says)
-//   sh3_q28                              ZHC_LAYOUT_SH3_Q28  (7 uints)
-//   sh2_q                                ZHC_LAYOUT_SH2_Q    (uvec4)
-//   hall_curve_q, hall_solved_q16        ZHC_LAYOUT_SH2_Q + ZHC_HALL_CURVE (axis from the header)
-//   hall_solved                          ZHC_LAYOUT_SH2_F32 + ZHC_HALL_CURVE, axis luminance
-//   hall_adaptive_q16                    ZHC_LAYOUT_SH2_Q + ZHC_HALL_CURVE_ADAPTIVE (axis from the header)
+// Every codec table entry (zhc::codecs(), same order): its layout family (how the words are laid
+// out), the zonal L2 hallucinated at decode, and the zonal axis: luminance / channel = fixed by the
+// entry (set axisMode to it), header = the .zhp header's axis mode, none = no zonal term. One line
+// per entry; tests/test_runtime_gl.cpp reads these lines (an entry missing here fails it).
+//   name                   family              hallucination            axis
+//   sh3                    ZHC_LAYOUT_SH3_F32  ZHC_HALL_NONE            none
+//   sh2                    ZHC_LAYOUT_SH2_F32  ZHC_HALL_NONE            none
+//   zh3_lum                ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
+//   zh3_channel            ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            channel
+//   zh3_solved_lum         ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
+//   zh3_solved_channel     ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            channel
+//   hall_ambdir            ZHC_LAYOUT_SH2_F32  ZHC_HALL_AMBDIR          luminance
+//   hall_sphere            ZHC_LAYOUT_SH2_F32  ZHC_HALL_SPHERE          luminance
+//   hall_curve             ZHC_LAYOUT_SH2_F32  ZHC_HALL_CURVE           luminance
+//   hall_ambdir_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_AMBDIR          channel
+//   hall_sphere_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_SPHERE          channel
+//   hall_curve_channel     ZHC_LAYOUT_SH2_F32  ZHC_HALL_CURVE           channel
+//   zh3_lum_dering         ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
+//   zh3_lum_dering_sphere  ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
+//   sh3_dering             ZHC_LAYOUT_SH3_F32  ZHC_HALL_NONE            none
+//   zh3_q16                ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            header
+//   zh3_solved_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            header
+//   sh3_q28                ZHC_LAYOUT_SH3_Q28  ZHC_HALL_NONE            none
+//   sh2_q                  ZHC_LAYOUT_SH2_Q    ZHC_HALL_NONE            none
+//   hall_curve_q           ZHC_LAYOUT_SH2_Q    ZHC_HALL_CURVE           header
+//   zh3_dering             ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
+//   zh3_dering_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            header
+//   zh3_channel_q16        ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            channel
+//   zh3_solved_channel_q16 ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            channel
+//   hall_solved            ZHC_LAYOUT_SH2_F32  ZHC_HALL_CURVE           luminance
+//   hall_solved_q16        ZHC_LAYOUT_SH2_Q    ZHC_HALL_CURVE           header
+//   hall_adaptive_q16      ZHC_LAYOUT_SH2_Q    ZHC_HALL_CURVE_ADAPTIVE  header
+// (sh3 27 words, sh2 12, the ZH3 floats 15, sh3_q28 seven uints, the other quantised layouts uvec4.)
 const uint ZHC_LAYOUT_SH3_F32 = 0u;
 const uint ZHC_LAYOUT_SH2_F32 = 1u;
 const uint ZHC_LAYOUT_ZH3_F32 = 2u;

@@ -57,6 +57,8 @@
 #define ZHC_HLSL_INCLUDED
 
 // ---- encodings (the order of zhc::codecs()) -----------------------------------------------------
+// One "#define ZHC_<entry name in upper case> <index in the table>u" per codec table entry, new
+// entries appended; tests/test_runtime_vk.cpp and bench/bench_runtime.cpp read these lines.
 #define ZHC_SH3 0u
 #define ZHC_SH2 1u
 #define ZHC_ZH3_LUM 2u
@@ -593,10 +595,16 @@ float3 zhc_irradiance_sh3_q28(uint w[7], ZhcFormat f, float3 n)
 
 // ---- any encoding from up to 27 words (f.encoding selects; the uber-path of the tests) -------------
 
+// The encodings stored in zh3_q16's 16 bytes (decoded by zhc_decode_zh3_q16).
+bool zhc_zh3_q16_bytes(uint e)
+{
+    return e == ZHC_ZH3_Q16 || e == ZHC_ZH3_SOLVED_Q16 || e == ZHC_ZH3_DERING_Q16 || e == ZHC_ZH3_CHANNEL_Q16 ||
+           e == ZHC_ZH3_SOLVED_CHANNEL_Q16;
+}
+
 float3 zhc_irradiance(uint w[27], ZhcFormat f, float3 n)
 {
-    if (f.encoding == ZHC_ZH3_Q16 || f.encoding == ZHC_ZH3_SOLVED_Q16 || f.encoding == ZHC_ZH3_DERING_Q16 ||
-        f.encoding == ZHC_ZH3_CHANNEL_Q16 || f.encoding == ZHC_ZH3_SOLVED_CHANNEL_Q16)
+    if (zhc_zh3_q16_bytes(f.encoding))
         return zhc_irradiance_zh3_q16(uint4(w[0], w[1], w[2], w[3]), f, n);
     if (f.encoding == ZHC_SH2_Q) return zhc_irradiance_sh2_q(uint4(w[0], w[1], w[2], w[3]), f, n);
     if (f.encoding == ZHC_HALL_CURVE_Q || f.encoding == ZHC_HALL_SOLVED_Q16 || f.encoding == ZHC_HALL_ADAPTIVE_Q16)
@@ -667,9 +675,7 @@ ZhcSH3 zhc_decode_sh3(uint w[27], ZhcFormat f)
 {
     uint e = f.encoding;
     uint4 p = uint4(w[0], w[1], w[2], w[3]);
-    if (e == ZHC_ZH3_Q16 || e == ZHC_ZH3_SOLVED_Q16 || e == ZHC_ZH3_DERING_Q16 || e == ZHC_ZH3_CHANNEL_Q16 ||
-        e == ZHC_ZH3_SOLVED_CHANNEL_Q16)
-        return zhc_decode_zh3_q16(p, f);
+    if (zhc_zh3_q16_bytes(e)) return zhc_decode_zh3_q16(p, f);
     if (e == ZHC_SH2_Q) return zhc_decode_sh2_q(p, f);
     if (e == ZHC_HALL_CURVE_Q || e == ZHC_HALL_SOLVED_Q16 || e == ZHC_HALL_ADAPTIVE_Q16) return zhc_decode_hall_curve_q(p, f);
     if (e == ZHC_SH3_Q28)

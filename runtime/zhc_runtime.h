@@ -246,9 +246,8 @@ static inline int zhc_probe_format_validate(const zhc_probe_format* f) {
     if (!isfinite(f->luminance[0]) || !isfinite(f->luminance[1]) || !isfinite(f->luminance[2]) ||
         !isfinite(f->hallucinate_a) || !isfinite(f->hallucinate_b))
         return ZHC_ERR_ARGUMENT;
-    if (f->dc_format == ZHC_DC_HALF &&
-        (f->encoding == ZHC_ENC_ZH3_Q16 || f->encoding == ZHC_ENC_ZH3_SOLVED_Q16 || f->encoding == ZHC_ENC_SH3_Q28 ||
-         f->encoding == ZHC_ENC_ZH3_DERING_Q16 || zhc__packed_per_channel(f->encoding)))
+    /* Only the 6-byte DC slot of sh2_q's layout holds a half triple (the codec decides by layout too). */
+    if (f->dc_format == ZHC_DC_HALF && zhc_encoding_is_packed(f->encoding) && !zhc__sh2q_layout(f->encoding))
         return ZHC_ERR_ARGUMENT;
     return ZHC_OK;
 }

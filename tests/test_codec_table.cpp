@@ -109,7 +109,7 @@ TEST(CodecTable, DcIsPreservedByEveryFloatRepresentation) {
     // error bounds): the decoded DC equals the input's.
     const CodecOptions o;
     for (const Codec& c : codecs()) {
-        if (c.name.find("_q") != std::string_view::npos) continue;  // quantised layouts
+        if (c.packed) continue;  // quantised layouts
         SCOPED_TRACE(std::string(c.name));
         for (const Sh3Radiance& hub : sample_hubs()) {
             std::vector<std::uint8_t> s(c.size_bytes);
@@ -118,6 +118,62 @@ TEST(CodecTable, DcIsPreservedByEveryFloatRepresentation) {
             for (int k = 0; k < 3; ++k) EXPECT_EQ(d[0][k], hub[0][k]);
         }
     }
+}
+
+// CodecTraits (codec/probe/codec.h) are facts about the entry's functions; code outside the entries
+// relies on them instead of names, so each is checked here against encode/decode.
+TEST(CodecTable, ExactTraitHoldsAndOnlyWhereClaimed) {
+    const CodecOptions o;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-100.0f, 100.0f);
+    std::vector<Sh3Radiance> hubs = sample_hubs();
+    for (int t = 0; t < 50; ++t) {
+        Sh3Radiance h;
+        for (int i = 0; i < 9; ++i)
+            for (int k = 0; k < 3; ++k) h[i][k] = u(rng);
+        hubs.push_back(h);
+    }
+    int exact_entries = 0;
+    for (const Codec& c : codecs()) {
+        SCOPED_TRACE(std::string(c.name));
+        int differ = 0;
+        for (const Sh3Radiance& hub : hubs) {
+            std::vector<std::uint8_t> s(c.size_bytes);
+            c.encode(hub, o, s.data(), nullptr);
+            differ += !(c.decode(s.data(), o) == hub);
+        }
+        if (c.traits.exact) EXPECT_EQ(differ, 0) << "marked exact, but decode(encode(x)) != x";
+        else EXPECT_GT(differ, 0) << "gives every hub back: mark it exact";
+        exact_entries += c.traits.exact;
+    }
+    EXPECT_GE(exact_entries, 1) << "no exact entry: the benchmarks have no baseline";
+}
+
+TEST(CodecTable, FloatBandsTraitIsTheStoredLayout) {
+    const CodecOptions o;
+    int float_entries = 0;
+    for (const Codec& c : codecs()) {
+        const int bands = c.traits.float_bands;
+        if (bands == 0) continue;
+        SCOPED_TRACE(std::string(c.name));
+        ++float_entries;
+        ASSERT_TRUE(bands == 2 || bands == 3);
+        const std::size_t n = static_cast<std::size_t>(bands * bands);
+        ASSERT_EQ(c.size_bytes, n * 12);
+        for (const Sh3Radiance& hub : sample_hubs()) {
+            std::vector<float> values;
+            for (std::size_t i = 0; i < n; ++i)
+                for (int k = 0; k < 3; ++k) values.push_back(hub[i][k]);
+            std::vector<std::uint8_t> want(c.size_bytes), got(c.size_bytes);
+            store_floats(values, want.data());
+            c.encode(hub, o, got.data(), nullptr);
+            EXPECT_EQ(got, want);  // the first bands^2 coefficients as floats, [coefficient][channel]
+            const Sh3Radiance d = c.decode(got.data(), o);
+            for (std::size_t i = 0; i < 9; ++i)
+                for (int k = 0; k < 3; ++k) EXPECT_EQ(d[i][k], i < n ? hub[i][k] : 0.0f) << i << " " << k;
+        }
+    }
+    EXPECT_GE(float_entries, 1);
 }
 
 }  // namespace

@@ -140,48 +140,62 @@ std::string read_text(const char* path) {
 
 // ---- codec table -> GLSL format ----------------------------------------------------------------------
 
-// GLSL constants (runtime/zhc.glsl).
+// GLSL constants (runtime/zhc.glsl); checked against the file by glsl_entries().
 enum : std::uint32_t { kSh3F32 = 0, kSh2F32 = 1, kZh3F32 = 2, kZh3Q16 = 3, kSh3Q28 = 4, kSh2Q = 5 };
 enum : std::uint32_t { kHallNone = 0, kHallAmbdir = 1, kHallSphere = 2, kHallCurve = 3, kHallCurveAdaptive = 4 };
-constexpr int kAxisFromHeader = -1;
 
 struct GlslEntry {
     std::uint32_t family, hallucination;
-    int axis;  // 0 luminance, 1 per channel, kAxisFromHeader (the quantised layouts)
+    ZonalAxis axis;  // the table's axis column; must equal the codec entry's CodecTraits::zonal_axis
 };
 
-// Every codec table name the GLSL runtime knows. A table entry missing here fails the test.
+// runtime/zhc.glsl's table of the codec table's entries, its lines "//   NAME ZHC_LAYOUT_* ZHC_HALL_*
+// AXIS", with the values of the constants from its "const uint ZHC_... = Nu;" lines. The test takes
+// every entry's GLSL format from here; an entry missing from the file fails the test.
 const std::map<std::string, GlslEntry, std::less<>>& glsl_entries() {
-    static const std::map<std::string, GlslEntry, std::less<>> m = {
-        {"sh3", {kSh3F32, kHallNone, 0}},
-        {"sh3_dering", {kSh3F32, kHallNone, 0}},
-        {"sh2", {kSh2F32, kHallNone, 0}},
-        {"zh3_lum", {kZh3F32, kHallNone, 0}},
-        {"zh3_solved_lum", {kZh3F32, kHallNone, 0}},
-        {"zh3_lum_dering", {kZh3F32, kHallNone, 0}},
-        {"zh3_lum_dering_sphere", {kZh3F32, kHallNone, 0}},
-        {"zh3_dering", {kZh3F32, kHallNone, 0}},
-        {"zh3_channel", {kZh3F32, kHallNone, 1}},
-        {"zh3_solved_channel", {kZh3F32, kHallNone, 1}},
-        {"hall_ambdir", {kSh2F32, kHallAmbdir, 0}},
-        {"hall_sphere", {kSh2F32, kHallSphere, 0}},
-        {"hall_curve", {kSh2F32, kHallCurve, 0}},
-        {"hall_ambdir_channel", {kSh2F32, kHallAmbdir, 1}},
-        {"hall_sphere_channel", {kSh2F32, kHallSphere, 1}},
-        {"hall_curve_channel", {kSh2F32, kHallCurve, 1}},
-        {"zh3_q16", {kZh3Q16, kHallNone, kAxisFromHeader}},
-        {"zh3_solved_q16", {kZh3Q16, kHallNone, kAxisFromHeader}},
-        {"zh3_dering_q16", {kZh3Q16, kHallNone, kAxisFromHeader}},
-        {"sh3_q28", {kSh3Q28, kHallNone, kAxisFromHeader}},
-        {"sh2_q", {kSh2Q, kHallNone, kAxisFromHeader}},
-        {"hall_curve_q", {kSh2Q, kHallCurve, kAxisFromHeader}},
-        {"zh3_channel_q16", {kZh3Q16, kHallNone, 1}},
-        {"zh3_solved_channel_q16", {kZh3Q16, kHallNone, 1}},
-        {"hall_solved", {kSh2F32, kHallCurve, 0}},
-        {"hall_solved_q16", {kSh2Q, kHallCurve, kAxisFromHeader}},
-        {"hall_adaptive_q16", {kSh2Q, kHallCurveAdaptive, kAxisFromHeader}},
-    };
+    static const std::map<std::string, GlslEntry, std::less<>> m = [] {
+        const std::string text = read_text(ZHC_RUNTIME_GLSL_PATH);
+        std::map<std::string, std::uint32_t> constants;
+        std::vector<std::vector<std::string>> rows;  // the table lines, split into words
+        std::istringstream lines(text);
+        for (std::string line; std::getline(lines, line);) {
+            std::istringstream in(line);
+            std::vector<std::string> w;
+            for (std::string word; in >> word;) w.push_back(word);
+            if (w.size() >= 5 && w[0] == "const" && w[1] == "uint" && w[3] == "=" && w[4].size() > 2 &&  // + a comment
+                w[4].substr(w[4].size() - 2) == "u;")
+                constants[w[2]] = static_cast<std::uint32_t>(std::stoul(w[4]));
+            else if (w.size() == 5 && w[0] == "//" && w[2].rfind("ZHC_LAYOUT_", 0) == 0 && w[3].rfind("ZHC_HALL_", 0) == 0)
+                rows.push_back(w);
+        }
+        const std::map<std::string, ZonalAxis> axes = {{"none", ZonalAxis::kNone},
+                                                        {"luminance", ZonalAxis::kLuminance},
+                                                        {"channel", ZonalAxis::kPerChannel},
+                                                        {"header", ZonalAxis::kFromParams}};
+        std::map<std::string, GlslEntry, std::less<>> out;
+        for (const auto& w : rows) {
+            const bool known = constants.count(w[2]) && constants.count(w[3]) && axes.count(w[4]);
+            EXPECT_TRUE(known) << "runtime/zhc.glsl: unknown constant or axis in the table line of " << w[1];
+            if (known) out[w[1]] = GlslEntry{constants[w[2]], constants[w[3]], axes.at(w[4])};
+        }
+        // The test's own copies of the constants (its bounds depend on the family) must agree.
+        const std::pair<const char*, std::uint32_t> mine[] = {
+            {"ZHC_LAYOUT_SH3_F32", kSh3F32}, {"ZHC_LAYOUT_SH2_F32", kSh2F32},   {"ZHC_LAYOUT_ZH3_F32", kZh3F32},
+            {"ZHC_LAYOUT_ZH3_Q16", kZh3Q16}, {"ZHC_LAYOUT_SH3_Q28", kSh3Q28},   {"ZHC_LAYOUT_SH2_Q", kSh2Q},
+            {"ZHC_HALL_NONE", kHallNone},    {"ZHC_HALL_AMBDIR", kHallAmbdir},  {"ZHC_HALL_SPHERE", kHallSphere},
+            {"ZHC_HALL_CURVE", kHallCurve},  {"ZHC_HALL_CURVE_ADAPTIVE", kHallCurveAdaptive}};
+        for (const auto& [name, value] : mine)
+            EXPECT_TRUE(constants.count(name) && constants[name] == value) << name << " in runtime/zhc.glsl";
+        return out;
+    }();
     return m;
+}
+
+// The axis the shader is told (ZhcFormat.axisMode): the entry's fixed axis, else the header's.
+std::uint32_t axis_mode(const GlslEntry& e, const StorageParams& p) {
+    if (e.axis == ZonalAxis::kLuminance) return 0;
+    if (e.axis == ZonalAxis::kPerChannel) return 1;
+    return static_cast<std::uint32_t>(p.axis_mode);
 }
 
 bool is_quantised(std::uint32_t family) { return family >= kZh3Q16; }
@@ -266,7 +280,7 @@ Scale probe_scale(const GlslEntry& e, const StorageParams& p, const Sh3Radiance&
     }
     // Axis condition numbers.
     double kappa[3] = {1, 1, 1};
-    const int axis = e.axis == kAxisFromHeader ? static_cast<int>(p.axis_mode) : e.axis;
+    const std::uint32_t axis = axis_mode(e, p);
     auto vec = [&](int k) { return Vec3{-double(d[3][k]), -double(d[1][k]), double(d[2][k])}; };
     auto vmag = [&](int k) { return std::sqrt(m[1][k] * m[1][k] + m[2][k] * m[2][k] + m[3][k] * m[3][k]); };
     if (is_zonal(e)) {
@@ -522,6 +536,7 @@ void compare_every_codec(int kBatches, int kGarbageBatches, long min_valid) {
             continue;
         }
         const GlslEntry& e = it->second;
+        EXPECT_EQ(e.axis, codec.traits.zonal_axis) << codec.name << ": runtime/zhc.glsl's axis column";
         std::mt19937_64 rng(0x5EED0000u + codec.size_bytes * 131 + codec.name.size());
         std::uniform_real_distribution<double> u(0, 1);
         const std::size_t words = codec.size_bytes / 4;
@@ -561,7 +576,7 @@ void compare_every_codec(int kBatches, int kGarbageBatches, long min_valid) {
             un.b[0] = static_cast<std::uint32_t>(p.l2_bound);
             un.b[1] = static_cast<std::uint32_t>(p.dc_format);
             un.b[2] = static_cast<std::uint32_t>(p.zonal_mapping);
-            un.b[3] = e.axis == kAxisFromHeader ? static_cast<std::uint32_t>(p.axis_mode) : static_cast<std::uint32_t>(e.axis);
+            un.b[3] = axis_mode(e, p);
             un.kind = static_cast<std::uint32_t>(p.kind);
             un.lum[0] = static_cast<float>(p.luminance.r);
             un.lum[1] = static_cast<float>(p.luminance.g);

@@ -90,6 +90,31 @@ struct EncodeStats {
 
 struct PackedCodec;  // quantize.h
 
+// Along which axis the decoder expands the zonal L2 term of a probe (ZH3 paper Sec. 3.1/3.2).
+enum class ZonalAxis : std::uint8_t {
+    kNone = 0,        // no zonal term: the L2 band is stored whole or dropped (sh3, sh2, sh3_q28, sh2_q)
+    kLuminance = 1,   // one axis shared by R, G, B: the luminance-weighted L1 direction
+    kPerChannel = 2,  // each channel's own L1 direction
+    kFromParams = 3,  // the storage parameters' axis mode (quantised layouts; the container stores it)
+};
+
+// What code outside an entry may ask about it instead of testing its name. Each field is a fact
+// about the entry's bytes or decoder; tests check every one of them against the entry's functions
+// (tests/test_codec_table.cpp; zonal_axis against the GLSL and HLSL runtimes).
+struct CodecTraits {
+    // decode(encode(x)) == x bit for bit for every finite hub (the entry stores the hub itself: sh3).
+    // The first exact entry is the baseline of size and speed comparisons, and a round trip through
+    // an exact entry may be skipped.
+    bool exact = false;
+    // 0: the bytes are opaque to containers. 2 or 3: they are the hub's first float_bands^2
+    // coefficients as little-endian floats, [coefficient][R, G, B], read back unchanged, so a
+    // container may store them as float RGB triples (glTF VEC3 accessor, Draco attributes per
+    // band): sh3 3, sh2 2. (sh3_dering has that byte layout too but keeps 0: its glTF files have
+    // always stored a byte array, and they stay the same.)
+    int float_bands = 0;
+    ZonalAxis zonal_axis = ZonalAxis::kNone;
+};
+
 struct Codec {
     std::string_view name;
     std::string_view summary;  // one line for `zhc --help` and the audit legend
@@ -99,6 +124,7 @@ struct Codec {
     Sh3Radiance (*decode)(const std::uint8_t* in, const CodecOptions& options);
     // Irradiance at unit normal n straight from the stored bytes (the runtime path).
     Rgb (*irradiance)(const std::uint8_t* in, const CodecOptions& options, Vec3 n);
+    CodecTraits traits = {};
     // Quantised layouts only (null otherwise): the layout and the entry's encode/decode with every
     // storage parameter (quantize.h), which the probe container uses instead of the two above.
     const PackedCodec* packed = nullptr;
@@ -112,14 +138,8 @@ const Codec* find_codec(std::string_view name);
 // table. An unknown name is kInvalidArgument naming it and listing the known ones.
 Result<std::vector<const Codec*>> select_codecs(std::string_view comma_separated_names);
 
-// Parts of the table, one per codec module; codecs() concatenates them.
-std::span<const Codec> core_codecs();       // sh3, sh2 (codec/probe/core_codecs.cpp)
-std::span<const Codec> zh3_codecs();        // ZH3 fits, solves, hallucination (codec/probe/zh3.cpp)
-std::span<const Codec> dering_codecs();     // sh3_dering, zh3_lum_dering (codec/probe/dering.cpp)
-std::span<const Codec> zh3_window_codecs();  // zh3_dering, zh3_dering_q16 (codec/probe/zh3_window.cpp)
-std::span<const Codec> quantized_codecs();  // zh3_q16, sh3_q28, sh2_q (codec/probe/quantize.cpp)
-std::span<const Codec> zh3_channel_q16_codecs();  // zh3_channel_q16, zh3_solved_channel_q16 (codec/probe/zh3_channel_q16.cpp)
-std::span<const Codec> hall_codecs();       // hall_solved, hall_solved_q16, hall_adaptive_q16 (codec/probe/zh3_hall.cpp)
+// The table is made of parts, one per codec module (`std::span<const Codec> PART()` defined next to
+// the module's entries); codec/probe/codec_table.cpp lists them, one line each.
 
 // Little-endian float storage helpers shared by the float representations.
 void store_floats(std::span<const float> values, std::uint8_t* out);

@@ -5,17 +5,37 @@
 #include <vector>
 
 #include "codec/probe/codec.h"
-#include "codec/probe/zh3_window.h"
+
+// The parts of the table: one line per codec module, X(the module's part function), in table order.
+// The table's order is the runtime encoding ids (runtime/: zhc_runtime.h's enum, zhc.hlsl's
+// defines), so a new module's line goes last and no line ever moves or goes (the runtime tests
+// fail otherwise). This list is the only edit outside a new module's own files (plus its source
+// line in codec/CMakeLists.txt). Static self-registration would need no list, but objects of a
+// static library that nothing references are dropped by the linker, and the order would follow
+// the link order.
+#define ZHC_CODEC_PARTS(X)      \
+    X(core_codecs)             \
+    X(zh3_codecs)              \
+    X(dering_codecs)           \
+    X(quantized_codecs)        \
+    X(zh3_window_codecs)       \
+    X(zh3_channel_q16_codecs)  \
+    X(hall_codecs)             \
+    /* a new module's line goes here, last */
 
 namespace zhc {
+
+#define ZHC_DECLARE_PART(part) std::span<const Codec> part();
+ZHC_CODEC_PARTS(ZHC_DECLARE_PART)
+#undef ZHC_DECLARE_PART
 
 std::span<const Codec> codecs() {
     static const std::vector<Codec> table = [] {
         std::vector<Codec> all;
-        // New entries go last: the runtime decoders (runtime/) number encodings by table order.
-        for (auto part : {core_codecs(), zh3_codecs(), dering_codecs(), quantized_codecs(), zh3_window_codecs(),
-                          zh3_channel_q16_codecs(), hall_codecs()})
+#define ZHC_CALL_PART(part) part(),
+        for (std::span<const Codec> part : {ZHC_CODEC_PARTS(ZHC_CALL_PART)})
             all.insert(all.end(), part.begin(), part.end());
+#undef ZHC_CALL_PART
         return all;
     }();
     return table;

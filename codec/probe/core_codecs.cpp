@@ -29,9 +29,9 @@ Rgb irradiance_floats(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
 
 const Codec kCore[] = {
     {"sh3", "quadratic SH, 27 floats (the hub)", 27 * 4, encode_floats<9>, decode_floats<9>,
-     irradiance_floats<9>},
+     irradiance_floats<9>, {.exact = true, .float_bands = 3}},
     {"sh2", "linear SH, 12 floats (L2 band dropped)", 12 * 4, encode_floats<4>, decode_floats<4>,
-     irradiance_floats<4>},
+     irradiance_floats<4>, {.float_bands = 2}},
 };
 
 }  // namespace

@@ -550,15 +550,21 @@ constexpr PackedCodec kSh3Q28{PackedLayout::kSh3Q28, encode_plain<PackedLayout::
 constexpr PackedCodec kSh2Q{PackedLayout::kSh2Q, encode_plain<PackedLayout::kSh2Q>, decode_plain<PackedLayout::kSh2Q>};
 constexpr PackedCodec kHallCurveQ{PackedLayout::kSh2Q, encode_plain<PackedLayout::kSh2Q>, decode_hall_curve};
 
+constexpr auto kAxisFromParams = ZonalAxis::kFromParams;
 const Codec kQuantized[] = {
-    packed_codec<kZh3Q16>("zh3_q16", "ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)"),
+    packed_codec<kZh3Q16>("zh3_q16", "ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)",
+                          kAxisFromParams),
     packed_codec<kZh3SolvedQ16>("zh3_solved_q16",
-                                "zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted"),
-    packed_codec<kSh3Q28>("sh3_q28", "quadratic SH, 28 bytes: R11G11B10F DC + 24 8-bit ratios (tight L2 bound)"),
+                                "zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted",
+                                kAxisFromParams),
+    packed_codec<kSh3Q28>("sh3_q28", "quadratic SH, 28 bytes: R11G11B10F DC + 24 8-bit ratios (tight L2 bound)",
+                          ZonalAxis::kNone),
     packed_codec<kSh2Q>("sh2_q",
-                        "linear SH, 16 bytes: DC slot + 9 8-bit L1 ratios (padded; hallucination decodes from it)"),
+                        "linear SH, 16 bytes: DC slot + 9 8-bit L1 ratios (padded; hallucination decodes from it)",
+                        ZonalAxis::kNone),
     packed_codec<kHallCurveQ>("hall_curve_q",
-                              "sh2_q bytes, zonal L2 hallucinated at decode by the Eq. 21 curve (luminance axis)"),
+                              "sh2_q bytes, zonal L2 hallucinated at decode by the Eq. 21 curve (luminance axis)",
+                              kAxisFromParams),
 };
 }  // namespace
 

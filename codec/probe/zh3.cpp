@@ -85,31 +85,34 @@ constexpr auto kAmbDir = Hallucination::kAmbientDirectional;
 constexpr auto kSphere = Hallucination::kSphere;
 constexpr auto kCurve = Hallucination::kCurve;
 
+constexpr CodecTraits kLumAxis{.zonal_axis = ZonalAxis::kLuminance};
+constexpr CodecTraits kChanAxis{.zonal_axis = ZonalAxis::kPerChannel};
+
 const Codec kZh3Codecs[] = {
     {"zh3_lum", "ZH3 fit (Eq. 9/10) on the luminance L1 axis, 15 floats", kZh3Floats * 4, encode_fit<kLum>,
-     decode_zh3<kLum>, irradiance_zh3<kLum>},
+     decode_zh3<kLum>, irradiance_zh3<kLum>, kLumAxis},
     {"zh3_channel", "ZH3 fit (Eq. 9/10) on each channel's L1 axis, 15 floats", kZh3Floats * 4, encode_fit<kChan>,
-     decode_zh3<kChan>, irradiance_zh3<kChan>},
+     decode_zh3<kChan>, irradiance_zh3<kChan>, kChanAxis},
     {"zh3_solved_lum", "ZH3, luminance axis solved by BFGS (Eq. 11), 15 floats", kZh3Floats * 4,
-     encode_solved<kLum>, decode_zh3<kLum>, irradiance_zh3<kLum>},
+     encode_solved<kLum>, decode_zh3<kLum>, irradiance_zh3<kLum>, kLumAxis},
     {"zh3_solved_channel", "ZH3, per-channel axes solved by BFGS (Eq. 11), 15 floats", kZh3Floats * 4,
-     encode_solved<kChan>, decode_zh3<kChan>, irradiance_zh3<kChan>},
+     encode_solved<kChan>, decode_zh3<kChan>, irradiance_zh3<kChan>, kChanAxis},
     {"hall_ambdir", "linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), luminance axis",
-     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kLum>, irradiance_hall<kAmbDir, kLum>},
+     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kLum>, irradiance_hall<kAmbDir, kLum>, kLumAxis},
     {"hall_sphere", "linear SH + zonal L2 hallucinated, sphere light (Eq. 20), luminance axis", kLinearFloats * 4,
-     encode_linear, decode_hall<kSphere, kLum>, irradiance_hall<kSphere, kLum>},
+     encode_linear, decode_hall<kSphere, kLum>, irradiance_hall<kSphere, kLum>, kLumAxis},
     {"hall_curve", "linear SH + zonal L2 hallucinated, curve fit (Eq. 21), luminance axis", kLinearFloats * 4,
-     encode_linear, decode_hall<kCurve, kLum>, irradiance_hall<kCurve, kLum>},
+     encode_linear, decode_hall<kCurve, kLum>, irradiance_hall<kCurve, kLum>, kLumAxis},
     {"hall_ambdir_channel", "linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), channel axes",
-     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kChan>, irradiance_hall<kAmbDir, kChan>},
+     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kChan>, irradiance_hall<kAmbDir, kChan>, kChanAxis},
     {"hall_sphere_channel", "linear SH + zonal L2 hallucinated, sphere light (Eq. 20), channel axes",
-     kLinearFloats * 4, encode_linear, decode_hall<kSphere, kChan>, irradiance_hall<kSphere, kChan>},
+     kLinearFloats * 4, encode_linear, decode_hall<kSphere, kChan>, irradiance_hall<kSphere, kChan>, kChanAxis},
     {"hall_curve_channel", "linear SH + zonal L2 hallucinated, curve fit (Eq. 21), channel axes",
-     kLinearFloats * 4, encode_linear, decode_hall<kCurve, kChan>, irradiance_hall<kCurve, kChan>},
+     kLinearFloats * 4, encode_linear, decode_hall<kCurve, kChan>, irradiance_hall<kCurve, kChan>, kChanAxis},
     {"zh3_lum_dering", "zh3_lum with the zonal L2 clamped for non-negative irradiance (App. B)",
-     kZh3Floats * 4, encode_lum_dering, decode_zh3<kLum>, irradiance_zh3<kLum>},
+     kZh3Floats * 4, encode_lum_dering, decode_zh3<kLum>, irradiance_zh3<kLum>, kLumAxis},
     {"zh3_lum_dering_sphere", "zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere",
-     kZh3Floats * 4, encode_lum_dering_sphere, decode_zh3<kLum>, irradiance_zh3<kLum>},
+     kZh3Floats * 4, encode_lum_dering_sphere, decode_zh3<kLum>, irradiance_zh3<kLum>, kLumAxis},
 };
 
 }  // namespace

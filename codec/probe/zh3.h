@@ -6,7 +6,7 @@
 // the stored L1 (the luminance L1's optimal linear direction, shared by all channels, or each
 // channel's own), so the decoder needs nothing else.
 //
-// Codec-table entries (codec/probe/zh3.cpp, zh3_codecs()): zh3_lum, zh3_channel, zh3_solved_lum,
+// Codec-table entries (codec/probe/zh3.cpp, zh3_codecs() below): zh3_lum, zh3_channel, zh3_solved_lum,
 // zh3_solved_channel, hall_{ambdir,sphere,curve}[_channel], zh3_lum_dering (App. B; issue 4's
 // name, defined here), zh3_lum_dering_sphere. Derivations and choices: docs/zh3.md.
 #pragma once
@@ -106,5 +106,8 @@ bool zh3_dering(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
 double zh3_dering_sphere_zonal(double f0, double f1_zonal, double f1_perp, double f20, bool* clamped);
 // Applies it to every channel of a ZH3 (axis from `mode`). Returns true when a coefficient changed.
 bool zh3_dering_sphere(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
+
+// The codec table part of this module (its entries in table order).
+std::span<const Codec> zh3_codecs();
 
 }  // namespace zhc

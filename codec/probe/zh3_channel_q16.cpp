@@ -197,10 +197,12 @@ constexpr PackedCodec kSolvedChannelQ16{PackedLayout::kZh3Q16, encode_solved, de
 
 const Codec kCodecs[] = {
     packed_codec<kChannelQ16>("zh3_channel_q16",
-                              "zh3_q16 bytes on per-channel axes (each from its decoded L1); zonal refitted"),
+                              "zh3_q16 bytes on per-channel axes (each from its decoded L1); zonal refitted",
+                              ZonalAxis::kPerChannel),
     packed_codec<kSolvedChannelQ16>(
         "zh3_solved_channel_q16",
-        "zh3_channel_q16 bytes; encoder searches the L1/zonal codes for the least decoded error (Eq. 11)"),
+        "zh3_channel_q16 bytes; encoder searches the L1/zonal codes for the least decoded error (Eq. 11)",
+        ZonalAxis::kPerChannel),
 };
 }  // namespace
 

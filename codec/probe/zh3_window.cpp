@@ -206,9 +206,10 @@ constexpr PackedCodec kDeringQ16{PackedLayout::kZh3Q16, encode_dering_q16, decod
 
 const Codec kWindowCodecs[] = {
     {"zh3_dering", "zh3_lum with L1 and zonal windowed together: irradiance >= 0 on the whole sphere", kZh3Bytes,
-     encode_zh3_dering, decode_zh3_lum, irradiance_zh3_lum},
+     encode_zh3_dering, decode_zh3_lum, irradiance_zh3_lum, {.zonal_axis = ZonalAxis::kLuminance}},
     packed_codec<kDeringQ16>("zh3_dering_q16",
-                             "zh3_dering in zh3_q16 bytes; the decoded probe is checked and windowed further if needed"),
+                             "zh3_dering in zh3_q16 bytes; the decoded probe is checked and windowed further if needed",
+                             ZonalAxis::kFromParams),
 };
 
 }  // namespace

@@ -8,6 +8,8 @@
 
 #include <cstring>
 
+#include "codec/probe/codec.h"
+
 namespace zhc {
 namespace {
 
@@ -19,10 +21,10 @@ struct Group {
 // Band groups of the float layouts: L0 = coefficient 0 (RGB), L1 = 1..3, L2 = 4..8.
 constexpr Group kSh3Groups[] = {{"L0", 0, 3}, {"L1", 3, 9}, {"L2", 12, 15}};
 
+// One attribute per band of an entry stored as float RGB triples (CodecTraits::float_bands), else 0.
 int groups_for(const std::string& representation) {
-    if (representation == "sh3") return 3;
-    if (representation == "sh2") return 2;
-    return 0;
+    const Codec* c = find_codec(representation);
+    return c ? c->traits.float_bands : 0;
 }
 
 }  // namespace
@@ -35,7 +37,7 @@ Result<DracoProbeCloud> encode_probe_point_cloud(const std::vector<std::array<fl
     if (quantization_bits < 0 || quantization_bits > 30)
         return make_error(ErrorCode::kInvalidArgument, "Draco quantisation bits must be 0 (lossless) or 1..30");
     const std::size_t n = positions.size();
-    const std::size_t floats_per_probe = ngroups == 3 ? 27 : 12;
+    const std::size_t floats_per_probe = 3 * static_cast<size_t>(ngroups * ngroups);  // 27 or 12
     if (n == 0 || payload.size() != n * floats_per_probe * 4)
         return make_error(ErrorCode::kInvalidArgument, "Draco payload: positions and payload sizes disagree");
     std::vector<float> values(n * floats_per_probe);
@@ -118,7 +120,7 @@ Result<DecodedProbeCloud> decode_probe_point_cloud(std::span<const std::uint8_t>
         if (!a || a->num_components() != components || a->data_type() != type) return nullptr;
         return a;
     };
-    const std::size_t floats_per_probe = ngroups == 3 ? 27 : 12;
+    const std::size_t floats_per_probe = 3 * static_cast<size_t>(ngroups * ngroups);  // 27 or 12
     const draco::PointAttribute* pos = attribute("POSITION", 3, draco::DT_FLOAT32);
     const draco::PointAttribute* idx = attribute("INDEX", 1, draco::DT_UINT32);
     if (!pos || !idx) return bad("POSITION (3 x f32) or INDEX (1 x u32) attribute missing or of the wrong type");

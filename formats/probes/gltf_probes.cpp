@@ -486,7 +486,11 @@ std::array<float, 3> from_gltf(const std::array<float, 3>& p) { return {p[2], p[
 Vec3 to_gltf(Vec3 v) { return {v.y, v.z, v.x}; }
 Vec3 from_gltf(Vec3 v) { return {v.z, v.x, v.y}; }
 
-bool is_float_vec3_encoding(const std::string& name) { return name == "sh3" || name == "sh2"; }
+// The entry's bytes are float RGB triples (CodecTraits::float_bands): a float VEC3 accessor.
+bool is_float_vec3_encoding(const std::string& name) {
+    const Codec* c = find_codec(name);
+    return c && c->traits.float_bands > 0;
+}
 
 // Re-encodes every probe after rotating it by r (decode -> rotate -> encode).
 Result<ProbeSet> rotate_set(const ProbeSet& set, const Mat3& r) {

@@ -76,29 +76,43 @@ function compareWithJson(what, sh, jsonFile, quiet = false) {
   return { bad, n, worstUlp, probes: doc.probes.length };
 }
 
-const floatEncodings = ['sh3', 'sh2', 'zh3_lum', 'zh3_channel', 'zh3_solved_lum', 'zh3_solved_channel', 'hall_ambdir', 'hall_sphere',
-  'hall_curve', 'hall_ambdir_channel', 'hall_sphere_channel', 'hall_curve_channel', 'zh3_lum_dering', 'zh3_lum_dering_sphere', 'sh3_dering', 'zh3_dering', 'hall_solved'];
+// The codec table as zhc reports it (`zhc audit --json` keys every entry by name, with its size):
+// runtime/web must decode every entry, with the same size, and know no other name.
+fs.writeFileSync(W('two.json'), JSON.stringify({ format: 'zhc-probes', version: 1, kind: 'radiance', layout: { type: 'positions' },
+  probes: probes.slice(0, 2).map((sh, i) => ({ position: [i, 0, 0], sh3: sh })) }));
+const table = JSON.parse(run('audit', W('two.json'), '--json', '--no-timing')).aggregate.representations;
+const tableNames = Object.keys(table);
+check(tableNames.length > 0, 'zhc audit lists the codec table');
+for (const name of tableNames)
+  check(Object.prototype.hasOwnProperty.call(runtime.ENCODINGS, name) && runtime.ENCODINGS[name].bytes === table[name].bytes_per_probe,
+    `codec table entry ${name} (${table[name].bytes_per_probe} bytes): runtime/web ENCODINGS has no entry of that size`);
+for (const name of Object.keys(runtime.ENCODINGS)) check(name in table, `runtime/web ENCODINGS.${name} is not a codec table entry`);
+
+// Every entry with the defaults, the float ones also as irradiance; then parameter sets chosen
+// for some of the quantised entries (an entry not named below still gets its defaults and one
+// combination of every quantisation flag).
 const cases = [];
-for (const e of floatEncodings) cases.push({ enc: e, flags: [] });
+for (const e of tableNames) cases.push({ enc: e, flags: [] });
 for (const e of ['sh3', 'sh2', 'zh3_channel', 'hall_curve', 'hall_sphere_channel']) cases.push({ enc: e, flags: ['--irradiance'] });
-for (const flags of [[], ['--bits', '5'], ['--bits', '2', '--sqrt'], ['--dc', 'rgb9e5'], ['--zonal-map', 'zero', '--sqrt'],
+for (const flags of [['--bits', '5'], ['--bits', '2', '--sqrt'], ['--dc', 'rgb9e5'], ['--zonal-map', 'zero', '--sqrt'],
   ['--zonal-map', 'symmetric', '--bits', '7'], ['--axis', 'channel'], ['--irradiance'],
   ['--irradiance', '--axis', 'channel', '--zonal-map', 'zero', '--bits', '6', '--dc', 'rgb9e5'], ['--bits', '3', '--sqrt', '--zonal-map', 'symmetric']])
   cases.push({ enc: 'zh3_q16', flags });
-cases.push({ enc: 'zh3_solved_q16', flags: [] });
 cases.push({ enc: 'zh3_solved_q16', flags: ['--bits', '6', '--axis', 'channel'] });
-cases.push({ enc: 'zh3_dering_q16', flags: [] });
 cases.push({ enc: 'zh3_dering_q16', flags: ['--bits', '5', '--sqrt', '--irradiance'] });
-for (const flags of [[], ['--bound', 'loose'], ['--sqrt', '--bits', '4'], ['--dc', 'rgb9e5', '--irradiance'], ['--zonal-map', 'zero'],
+for (const flags of [['--bound', 'loose'], ['--sqrt', '--bits', '4'], ['--dc', 'rgb9e5', '--irradiance'], ['--zonal-map', 'zero'],
   ['--zonal-map', 'symmetric', '--bits', '3', '--bound', 'loose', '--sqrt'], ['--irradiance', '--zonal-map', 'zero', '--sqrt', '--bits', '2']])
   cases.push({ enc: 'sh3_q28', flags });
-for (const flags of [[], ['--dc', 'half'], ['--dc', 'rgb9e5', '--bits', '7', '--sqrt'], ['--irradiance', '--dc', 'half', '--bits', '4']])
+for (const flags of [['--dc', 'half'], ['--dc', 'rgb9e5', '--bits', '7', '--sqrt'], ['--irradiance', '--dc', 'half', '--bits', '4']])
   cases.push({ enc: 'sh2_q', flags });
-for (const flags of [[], ['--axis', 'channel', '--dc', 'half'], ['--irradiance', '--sqrt']]) cases.push({ enc: 'hall_curve_q', flags });
+for (const flags of [['--axis', 'channel', '--dc', 'half'], ['--irradiance', '--sqrt']]) cases.push({ enc: 'hall_curve_q', flags });
 for (const enc of ['zh3_channel_q16', 'zh3_solved_channel_q16'])
-  for (const flags of [[], ['--bits', '5', '--sqrt', '--irradiance', '--dc', 'rgb9e5', '--zonal-map', 'zero']]) cases.push({ enc, flags });
+  cases.push({ enc, flags: ['--bits', '5', '--sqrt', '--irradiance', '--dc', 'rgb9e5', '--zonal-map', 'zero'] });
 for (const enc of ['hall_solved_q16', 'hall_adaptive_q16'])
-  for (const flags of [[], ['--axis', 'channel', '--dc', 'half'], ['--irradiance', '--sqrt', '--bits', '6']]) cases.push({ enc, flags });
+  for (const flags of [['--axis', 'channel', '--dc', 'half'], ['--irradiance', '--sqrt', '--bits', '6']]) cases.push({ enc, flags });
+for (const e of tableNames)
+  if (runtime.ENCODINGS[e]?.packed && cases.filter((c) => c.enc === e).length === 1)
+    cases.push({ enc: e, flags: ['--bits', '5', '--sqrt', '--irradiance', '--dc', 'rgb9e5', '--zonal-map', 'zero', '--axis', 'channel'] });
 
 let totalCoefficients = 0, totalCases = 0;
 const ENC_PACKED = new Set(Object.keys(runtime.ENCODINGS).filter((name) => runtime.ENCODINGS[name].packed));

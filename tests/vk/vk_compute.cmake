@@ -5,6 +5,8 @@ if(NOT TARGET zhc_vk_compute AND TARGET Vulkan::Vulkan)
   add_library(zhc_vk_compute STATIC "${CMAKE_CURRENT_LIST_DIR}/vk_compute.cpp")
   target_include_directories(zhc_vk_compute PUBLIC "${CMAKE_CURRENT_LIST_DIR}")
   target_link_libraries(zhc_vk_compute PUBLIC Vulkan::Vulkan PRIVATE zhc_warnings)
+  # hlsl_encoding() reads the encoding ids from the runtime's source.
+  target_compile_definitions(zhc_vk_compute PRIVATE ZHC_RUNTIME_HLSL_PATH="${CMAKE_CURRENT_LIST_DIR}/../../runtime/zhc.hlsl")
 endif()
 
 # Mesa's CPU Vulkan driver (lavapipe): its ICD manifest, forced by the test and the benchmark.

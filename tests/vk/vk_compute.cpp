@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <map>
+#include <sstream>
 
 namespace zhc::vk {
 namespace {
@@ -333,6 +335,44 @@ double Kernel::dispatch(std::uint32_t groups_x, std::string* error) {
         return -1;
     }
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+namespace {
+
+// The "#define ZHC_X Nu" lines of zhc.hlsl from "---- encodings" up to ZHC_ENCODING_COUNT.
+const std::map<std::string, int, std::less<>>& hlsl_defines() {
+    static const std::map<std::string, int, std::less<>> m = [] {
+        std::map<std::string, int, std::less<>> out;
+        std::ifstream in(ZHC_RUNTIME_HLSL_PATH);
+        bool section = false;
+        for (std::string line; std::getline(in, line);) {
+            if (line.find("---- encodings") != std::string::npos) section = true;
+            std::istringstream words(line);
+            std::string define, name, value;
+            if (!section || !(words >> define >> name >> value) || define != "#define" || value.size() < 2 ||
+                value.back() != 'u' || value.find_first_not_of("0123456789") != value.size() - 1)
+                continue;
+            out[name] = std::stoi(value);
+            if (name == "ZHC_ENCODING_COUNT") break;
+        }
+        return out;
+    }();
+    return m;
+}
+
+}  // namespace
+
+int hlsl_encoding(std::string_view name) {
+    std::string macro = "ZHC_";
+    for (char c : name) macro += static_cast<char>(c >= 'a' && c <= 'z' ? c - 'a' + 'A' : c);
+    if (macro == "ZHC_ENCODING_COUNT") return -1;
+    const auto it = hlsl_defines().find(macro);
+    return it == hlsl_defines().end() ? -1 : it->second;
+}
+
+int hlsl_encoding_count() {
+    const auto it = hlsl_defines().find("ZHC_ENCODING_COUNT");
+    return it == hlsl_defines().end() ? -1 : it->second;
 }
 
 }  // namespace zhc::vk

@@ -66,19 +66,11 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
-// zhc.hlsl's encoding ids (its ZHC_* macros) by codec name: the index in this list (the codec
-// table's order; new entries are appended). -1 for a name zhc.hlsl does not know.
-inline constexpr const char* kHlslEncodings[] = {
-    "sh3", "sh2", "zh3_lum", "zh3_channel", "zh3_solved_lum", "zh3_solved_channel", "hall_ambdir", "hall_sphere",
-    "hall_curve", "hall_ambdir_channel", "hall_sphere_channel", "hall_curve_channel", "zh3_lum_dering",
-    "zh3_lum_dering_sphere", "sh3_dering", "zh3_q16", "zh3_solved_q16", "sh3_q28", "sh2_q", "hall_curve_q",
-    "zh3_dering", "zh3_dering_q16", "zh3_channel_q16", "zh3_solved_channel_q16", "hall_solved", "hall_solved_q16",
-    "hall_adaptive_q16",
-};
-inline int hlsl_encoding(std::string_view name) {
-    for (int i = 0; i < static_cast<int>(std::size(kHlslEncodings)); ++i)
-        if (name == kHlslEncodings[i]) return i;
-    return -1;
-}
+// runtime/zhc.hlsl's encoding id of a codec table entry: its "#define ZHC_<NAME> <id>u" line in
+// the file's encodings section (NAME = the entry's name in upper case), read from the source tree
+// at the first call. -1 when the file has no such line (the entry has no HLSL decoder).
+int hlsl_encoding(std::string_view name);
+// The section's ZHC_ENCODING_COUNT; -1 when the file cannot be read.
+int hlsl_encoding_count();
 
 }  // namespace zhc::vk
