@@ -24,8 +24,8 @@
 #include "formats/envmap/envmap.h"
 #include "formats/envmap/envmap_cube.h"
 #include "formats/lightmap/ktx2.h"
-#include "support.h"
 #include "cube_helpers.h"
+#include "support.h"
 
 namespace zhc {
 namespace {

@@ -11,8 +11,8 @@
 
 #include "codec/probe/codec.h"
 #include "codec/probe/dering.h"
-#include "support.h"
 #include "dering_helpers.h"
+#include "support.h"
 
 namespace zhc {
 namespace {

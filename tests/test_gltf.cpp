@@ -5,14 +5,6 @@
 // sampling). The Draco point-cloud payload, hostile inputs and the CLI verbs are in
 // test_gltf_hostile.cpp (helpers: gltf_helpers.h); the real-client checks (glTF-Validator, three.js)
 // are the node tests in tests/js/.
-#define TINYGLTF_NO_STB_IMAGE
-#define TINYGLTF_NO_STB_IMAGE_WRITE
-#define TINYGLTF_NO_EXTERNAL_IMAGE
-#include <tiny_gltf.h>
-
-#include <draco/compression/encode.h>
-#include <draco/mesh/triangle_soup_mesh_builder.h>
-
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -27,8 +19,8 @@
 #include "formats/io/file_io.h"
 #include "formats/probes/gltf_probes.h"
 #include "formats/probes/probe_file.h"
-#include "support.h"
 #include "gltf_helpers.h"
+#include "support.h"
 
 namespace zhc {
 namespace {

@@ -1,14 +1,6 @@
 // ZHC_light_probes (formats/probes/gltf_probes.h): the Draco point-cloud payload (order, losslessness,
 // size, header checked before decoding), hostile inputs (URIs, sizes, indices, GLB framing) and the
 // CLI verbs embed/extract/eval/info (helpers: gltf_helpers.h).
-#define TINYGLTF_NO_STB_IMAGE
-#define TINYGLTF_NO_STB_IMAGE_WRITE
-#define TINYGLTF_NO_EXTERNAL_IMAGE
-#include <tiny_gltf.h>
-
-#include <draco/compression/encode.h>
-#include <draco/mesh/triangle_soup_mesh_builder.h>
-
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -23,8 +15,8 @@
 #include "formats/io/file_io.h"
 #include "formats/probes/gltf_probes.h"
 #include "formats/probes/probe_file.h"
-#include "support.h"
 #include "gltf_helpers.h"
+#include "support.h"
 
 namespace zhc {
 namespace {

@@ -6,8 +6,8 @@
 #include <random>
 
 #include "codec/lightmap/irradz.h"
-#include "support.h"
 #include "irradz_helpers.h"
+#include "support.h"
 
 namespace zhc {
 namespace {

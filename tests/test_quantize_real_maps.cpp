@@ -12,8 +12,8 @@
 #include "codec/probe/codec.h"
 #include "codec/probe/quantize.h"
 #include "codec/probe/zh3.h"
-#include "support.h"
 #include "quantize_helpers.h"
+#include "support.h"
 
 namespace zhc {
 namespace {

@@ -25,10 +25,10 @@
 #include "codec/probe/probe_set.h"
 #include "codec/probe/quantize.h"
 #include "formats/probes/probe_file.h"
+#include "runtime_c_helpers.h"
 #include "support.h"
 #include "zhc_runtime.h"
 #include "zhc_runtime_params.hpp"
-#include "runtime_c_helpers.h"
 
 namespace zhc {
 namespace {
