@@ -4,7 +4,7 @@
 // (Imf::InputFile into one float frame buffer, no checks, no conversion). Also the IrradZ fit's
 // Newton solve against the golden-section reference (Solve::kSearch, what the fit was before) on the
 // same texels, one after the other in this process: the ratio survives a noisy machine.
-//   bench_lightmap [--sizes 1024,2048,4096] [--map FILE.exr] [--quality fast|default]
+//   bench_lightmap [--sizes 1024,2048,4096] [--map FILE.exr] [--quality fast|default|slow]
 //                  [--ref-texels N] [--reps R] [--json FILE] [--keep DIR]
 // Every stage runs on one thread. Times: wall and this thread's CPU time (Mtexel/s from the CPU
 // time, which other processes on the shared cores do not inflate; the wall time is printed too).
@@ -228,7 +228,7 @@ int main(int argc, char** argv) {
         else if (a == "--keep" && has) keep = argv[++i];
         else {
             std::fprintf(stderr,
-                         "usage: %s [--sizes 1024,2048,4096] [--map FILE.exr] [--quality fast|default] [--ref-texels N] "
+                         "usage: %s [--sizes 1024,2048,4096] [--map FILE.exr] [--quality fast|default|slow] [--ref-texels N] "
                          "[--reps R] [--json FILE] [--keep DIR]\n",
                          argv[0]);
             return 2;
@@ -238,8 +238,13 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "--sizes: no size in [4, 16384]\n");
         return 2;
     }
-    const bc6h::Quality q6 = quality == "default" ? bc6h::Quality::kDefault : bc6h::Quality::kFast;
-    const bc45::Quality q45 = quality == "default" ? bc45::Quality::kDefault : bc45::Quality::kFast;
+    const lightmap::QualityPreset* preset = lightmap::find_quality_preset(quality);
+    if (!preset) {
+        std::fprintf(stderr, "--quality: unknown preset '%s' (the names of zhc lightmap encode --quality)\n", quality.c_str());
+        return 2;
+    }
+    const bc6h::Quality q6 = preset->bc6h;
+    const bc45::Quality q45 = preset->bc45;
     auto img = read_envmap(map);
     if (!img) {
         std::fprintf(stderr, "%s\n", img.error().message.c_str());

@@ -28,6 +28,9 @@ int exit_code_for(const Error& error);
 int report(const Error& error);
 // For errors while writing outputs: prints the message and returns kExitOutputFailed.
 int report_output(const Error& error);
+// For a failed write of an output file: a value the format cannot hold (kInvalidValue, e.g. NaN in
+// JSON) is the input's fault (report), anything else the output's (report_output).
+int report_write(const Error& error);
 
 // --- Shared option groups: every verb spells these the same way (README "Options"). -------------
 // The representation: `-r, --representations` in every verb that picks codec-table entries.

@@ -88,16 +88,11 @@ int run(const Options& o) {
         list.probes = *probes;
         list.layout = layout;
         if (o.to != "sh3") {
-            auto set = encode_probe_set(list.probes, o.to, StorageParams{}, layout);
-            if (!set) return report(set.error());
-            auto hub = decode_probe_set(*set);
+            auto hub = round_trip_probes(list.probes, o.to, StorageParams{}, layout);
             if (!hub) return report(hub.error());
             list.probes = std::move(hub).value();
         }
-        if (Status st = write_probe_json(o.output, list); !st) {
-            if (st.error().code == ErrorCode::kInvalidValue) return report(st.error());
-            return report_output(st.error());
-        }
+        if (Status st = write_probe_json(o.output, list); !st) return report_write(st.error());
         std::printf("%s: %zu probes as JSON float SH3 radiance\n", o.output.c_str(), list.probes.size());
         return kExitOk;
     }

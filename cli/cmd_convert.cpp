@@ -160,16 +160,11 @@ int run(const Options& o) {
     // JSON: float SH3; through the representation first when --to is given (a lossy preview).
     ProbeList list = in->list;
     if (!rep.empty()) {
-        auto set = encode_probe_set(list.probes, rep, *params, list.layout, &stats);
-        if (!set) return report(set.error());
-        auto hub = decode_probe_set(*set);
+        auto hub = round_trip_probes(list.probes, rep, *params, list.layout, &stats);
         if (!hub) return report(hub.error());
         list.probes = std::move(hub).value();
     }
-    if (Status st = write_probe_json(o.output, list); !st) {
-        if (st.error().code == ErrorCode::kInvalidValue) return report(st.error());
-        return report_output(st.error());
-    }
+    if (Status st = write_probe_json(o.output, list); !st) return report_write(st.error());
     std::printf("%s: %zu probes as JSON float SH3%s%s, clamped ratios: %d\n", o.output.c_str(), list.probes.size(),
                 rep.empty() ? "" : " via ", rep.c_str(), stats.clamped_ratios);
     return kExitOk;

@@ -36,10 +36,23 @@ struct Options {
     ProgressFlags progress;
 };
 
-bc6h::Quality bc6h_quality(const std::string& q) {
-    return q == "fast" ? bc6h::Quality::kFast : (q == "slow" ? bc6h::Quality::kExhaustive : bc6h::Quality::kDefault);
+// --quality and --solve take their names from the library's tables (CLI11 has checked the name).
+bc6h::Quality bc6h_quality(const std::string& q) { return lightmap::find_quality_preset(q)->bc6h; }
+bc45::Quality bc45_quality(const std::string& q) { return lightmap::find_quality_preset(q)->bc45; }
+
+// "a: summary; b: summary; ..." and the names, for an option's help and its check.
+template <class Table>
+std::string choices_help(const Table& table) {
+    std::string s;
+    for (const auto& e : table) s += (s.empty() ? "" : "; ") + std::string(e.name) + ": " + std::string(e.summary);
+    return s;
 }
-bc45::Quality bc45_quality(const std::string& q) { return q == "fast" ? bc45::Quality::kFast : bc45::Quality::kDefault; }
+template <class Table>
+std::vector<std::string> choice_names(const Table& table) {
+    std::vector<std::string> v;
+    for (const auto& e : table) v.emplace_back(e.name);
+    return v;
+}
 
 // The SH lightmap input(s): one EXR, several (one per coefficient), or one name with "{i}", which
 // stands for the coefficient index: the files for i = 0..8 if all nine exist, else i = 0..3.
@@ -70,10 +83,7 @@ std::string inputs_text(const std::vector<std::string>& files) {
 int run_encode(const Options& o) {
     const auto files = input_files(o.inputs);
     lightmap_stream::EncodeOptions eo;
-    eo.fit = o.solve == "old"      ? lightmap_stream::Fit::kOld
-             : o.solve == "linear" ? lightmap_stream::Fit::kLinear
-             : o.solve == "search" ? lightmap_stream::Fit::kSearch
-                                   : lightmap_stream::Fit::kNewton;
+    eo.fit = lightmap::find_fit(o.solve)->fit;
     eo.bc6h_quality = bc6h_quality(o.quality);
     eo.bc45_quality = bc45_quality(o.quality);
     eo.threads = o.threads;
@@ -212,8 +222,8 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     CLI::App* lm = app.add_subcommand("lightmap", "IrradZ directional lightmaps: encode/decode/audit/synth");
     lm->require_subcommand(1);
     auto quality = [&](CLI::App* s) {
-        s->add_option("--quality", o->quality, "block compression: fast | default | slow (exhaustive BC6H)")
-            ->check(CLI::IsMember({"fast", "default", "slow"}));
+        s->add_option("--quality", o->quality, "block compression: " + choices_help(lightmap::quality_presets()))
+            ->check(CLI::IsMember(choice_names(lightmap::quality_presets())));
         add_threads_option(s, o->threads, "output identical for any count");
     };
     auto band = [&](CLI::App* s) {
@@ -229,10 +239,8 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     enc->add_option("-o,--output", o->output, "output prefix")->required();
     enc->add_option("--container", o->container, "ktx2 (default) | dds (DX10 header): PREFIX.{iz,d,wa}.ktx2 or .dds")
         ->check(CLI::IsMember({"ktx2", "dds"}));
-    enc->add_option("--solve", o->solve,
-                    "newton (hemispherical Gram, Newton on d) | search (the same by golden section: the reference) | old | "
-                    "linear (closed form from L0 + L1)")
-        ->check(CLI::IsMember({"newton", "search", "old", "linear"}));
+    enc->add_option("--solve", o->solve, "IrradZ fit: " + choices_help(lightmap::fits()))
+        ->check(CLI::IsMember(choice_names(lightmap::fits())));
     quality(enc);
     band(enc);
     CLI::App* dec = lm->add_subcommand("decode", "PREFIX.{iz,d,wa}.ktx2 or .dds -> IrradZ EXR (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)");

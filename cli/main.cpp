@@ -49,6 +49,10 @@ int report_output(const Error& error) {
     return kExitOutputFailed;
 }
 
+int report_write(const Error& error) {
+    return error.code == ErrorCode::kInvalidValue ? report(error) : report_output(error);
+}
+
 CLI::Option* add_representations_option(CLI::App* app, std::string& names, RepresentationCount count,
                                         const std::string& what, const std::string& old_spelling) {
     const bool one = count == RepresentationCount::kOne;

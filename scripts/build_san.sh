@@ -2,7 +2,8 @@
 # Configures (once) and builds the sanitized tree build-san/: clang, AddressSanitizer +
 # UndefinedBehaviorSanitizer (any UBSan finding aborts), with the test suite, the CLI and the
 # libFuzzer targets in one build (one compile of the sources serves scripts/sanitize.sh and
-# scripts/fuzz.sh). -gline-tables-only keeps stack traces symbolised at a fraction of -g's cost.
+# scripts/fuzz.sh). Warnings are errors here too (clang's -Wall -Wextra, as g++'s in scripts/test.sh).
+# -gline-tables-only keeps stack traces symbolised at a fraction of -g's cost.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ ! -f build-san/build.ninja ]; then
@@ -10,7 +11,7 @@ if [ ! -f build-san/build.ninja ]; then
     -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
-    -DZHC_SANITIZE=ON -DZHC_BUILD_FUZZERS=ON -DZHC_REQUIRE_MESA_TEST=ON -DZHC_BUILD_TESTS=ON -DZHC_BUILD_BENCH=OFF >/dev/null
+    -DZHC_SANITIZE=ON -DZHC_BUILD_FUZZERS=ON -DZHC_REQUIRE_MESA_TEST=ON -DZHC_BUILD_TESTS=ON -DZHC_BUILD_BENCH=OFF -DZHC_WARNINGS_AS_ERRORS=ON >/dev/null
 fi
 # The build log is kept quiet but shown when the build fails (a failed build must never leave
 # stale binaries to be tested).

@@ -3,7 +3,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <random>
+#include <set>
+#include <string_view>
 
+#include "codec/bake/sky.h"
 #include "codec/lightmap/lightmap.h"
 #include "formats/lightmap/ktx2.h"
 #include "formats/lightmap/lightmap_exr.h"
@@ -98,6 +101,56 @@ TEST(LightmapExr, RoundTripAndErrors) {
     lm.texels[7][3].g = std::nanf("");
     ASSERT_TRUE(write_sh_lightmap_exr(dir + "/nan.exr", lm).ok());
     EXPECT_EQ(read_sh_lightmap_exr(dir + "/nan.exr").error().code, ErrorCode::kInvalidValue);
+}
+
+// The lightmap tables: unique names that find their own entry; each fit entry gives the planes of
+// the solve it names (computed here without the table), and every preset and fit is accepted by
+// the CLI under its table name (a 16x16 lightmap), an unknown name is a usage error.
+TEST(LightmapTables, FitsAndPresetsAreWhatTheirNamesSay) {
+    std::set<std::string_view> names;
+    for (const FitEntry& f : fits()) {
+        EXPECT_TRUE(names.insert(f.name).second) << f.name;
+        EXPECT_EQ(find_fit(f.name), &f);
+        EXPECT_FALSE(f.summary.empty());
+    }
+    EXPECT_EQ(find_fit("nope"), nullptr);
+    EXPECT_EQ(fits().front().fit, Fit::kNewton);  // the default comes first
+    names.clear();
+    for (const QualityPreset& q : quality_presets()) {
+        EXPECT_TRUE(names.insert(q.name).second) << q.name;
+        EXPECT_EQ(find_quality_preset(q.name), &q);
+    }
+    EXPECT_EQ(find_quality_preset("nope"), nullptr);
+    EXPECT_EQ(find_quality_preset("slow")->bc6h, bc6h::Quality::kExhaustive);
+    EXPECT_EQ(find_quality_preset("fast")->bc45, bc45::Quality::kFast);
+
+    const Sh3Radiance world = project_default_lighting();
+    const ShLightmap lm = synthesize_sphere(world, 8, 8, 1);
+    const std::pair<Fit, irradz::Solve> solves[] = {
+        {Fit::kNewton, irradz::Solve::kNewton}, {Fit::kSearch, irradz::Solve::kSearch}, {Fit::kOld, irradz::Solve::kOld}};
+    for (auto [fit, solve] : solves) {
+        irradz::EncodeOptions eo;
+        eo.solve = solve;
+        const IrradzPlanes direct = encode_planes(lm, eo, 1), table = fit_planes(lm, fit, 1);
+        EXPECT_EQ(direct.iz, table.iz);
+        EXPECT_EQ(direct.wa, table.wa);
+        EXPECT_EQ(direct.d, table.d);
+    }
+    EXPECT_EQ(fit_planes(lm, Fit::kLinear, 1).d, encode_planes_linear_sh(lm, 1).d);
+
+    const std::string dir = test::temp_dir("lightmap_tables");
+    auto r = test::run_zhc({"lightmap", "synth", test::envmap_paths().front(), "-o", dir + "/lm.exr", "--size", "16"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const QualityPreset& q : quality_presets()) {
+        r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/q", "--quality", std::string(q.name)});
+        EXPECT_EQ(r.exit_code, 0) << q.name << ": " << r.err;
+    }
+    for (const FitEntry& f : fits()) {
+        r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/f", "--solve", std::string(f.name), "--quality", "fast"});
+        EXPECT_EQ(r.exit_code, 0) << f.name << ": " << r.err;
+    }
+    r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/f", "--solve", "nope"});
+    EXPECT_EQ(r.exit_code, 2);
 }
 
 TEST(LightmapCli, EncodeDecodeAuditAndBadInput) {

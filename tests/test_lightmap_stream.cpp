@@ -33,16 +33,7 @@ std::vector<std::vector<std::uint8_t>> whole_image_files(const std::string& exr,
     auto lm = read_sh_lightmap_exr(exr);
     EXPECT_TRUE(lm.ok()) << lm.error().message;
     if (!lm) return {};
-    lightmap::IrradzPlanes planes;
-    if (fit == lightmap_stream::Fit::kLinear) {
-        planes = lightmap::encode_planes_linear_sh(*lm, 1);
-    } else {
-        irradz::EncodeOptions eo;
-        eo.solve = fit == lightmap_stream::Fit::kOld      ? irradz::Solve::kOld
-                   : fit == lightmap_stream::Fit::kSearch ? irradz::Solve::kSearch
-                                                          : irradz::Solve::kNewton;
-        planes = lightmap::encode_planes(*lm, eo, 1);
-    }
+    const lightmap::IrradzPlanes planes = lightmap::fit_planes(*lm, fit, 1);
     const auto c = lightmap::compress(planes, q6, q45, 1);
     std::vector<std::vector<std::uint8_t>> files;
     const std::pair<std::uint32_t, const std::vector<std::uint8_t>*> parts[3] = {

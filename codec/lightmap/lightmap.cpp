@@ -241,4 +241,44 @@ Audit AuditAccumulator::result() const {
     return a;
 }
 
+// ---- the lightmap tables ------------------------------------------------------------------
+
+namespace {
+constexpr FitEntry kFits[] = {
+    {"newton", "hemispherical Gram matrix, d by Newton on the analytic reduced error, the default", Fit::kNewton},
+    {"search", "the same least squares, d by golden-section search, the reference", Fit::kSearch},
+    {"old", "the old way: optimal linear direction, spherical Gram matrix", Fit::kOld},
+    {"linear", "closed form from L0 + L1 for linear-SH lightmaps, L2 ignored", Fit::kLinear},
+};
+constexpr QualityPreset kQualityPresets[] = {
+    {"fast", "BC6H fast, BC4/BC5 fast", bc6h::Quality::kFast, bc45::Quality::kFast},
+    {"default", "BC6H default, BC4/BC5 default", bc6h::Quality::kDefault, bc45::Quality::kDefault},
+    {"slow", "BC6H exhaustive over all modes and partitions, BC4/BC5 default", bc6h::Quality::kExhaustive,
+     bc45::Quality::kDefault},
+};
+}  // namespace
+
+std::span<const FitEntry> fits() { return kFits; }
+
+const FitEntry* find_fit(std::string_view name) {
+    for (const FitEntry& f : kFits)
+        if (f.name == name) return &f;
+    return nullptr;
+}
+
+IrradzPlanes fit_planes(const ShLightmap& lm, Fit fit, int threads) {
+    if (fit == Fit::kLinear) return encode_planes_linear_sh(lm, threads);
+    irradz::EncodeOptions eo;
+    eo.solve = fit == Fit::kOld ? irradz::Solve::kOld : (fit == Fit::kSearch ? irradz::Solve::kSearch : irradz::Solve::kNewton);
+    return encode_planes(lm, eo, threads);
+}
+
+std::span<const QualityPreset> quality_presets() { return kQualityPresets; }
+
+const QualityPreset* find_quality_preset(std::string_view name) {
+    for (const QualityPreset& q : kQualityPresets)
+        if (q.name == name) return &q;
+    return nullptr;
+}
+
 }  // namespace zhc::lightmap

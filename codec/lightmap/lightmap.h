@@ -5,6 +5,8 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
+#include <string_view>
 #include <vector>
 
 #include "codec/lightmap/bc45.h"
@@ -47,6 +49,34 @@ IrradzPlanes encode_planes(const ShLightmap& lm, const irradz::EncodeOptions& op
 // The closed-form linear SH -> IrradZ fit (irradz::linear_sh_to_irradz on each texel's L0 and L1;
 // L2 is ignored), for linear-SH lightmaps: no search, exact for IrradZ-valid HHD radiance.
 IrradzPlanes encode_planes_linear_sh(const ShLightmap& lm, int threads = 1);
+
+// The lightmap side's two tables (the probe side has codecs()): every IrradZ fit and every
+// block-compression preset by name, with a one-line summary. The CLI (--solve, --quality), the
+// streaming pipeline, bench_lightmap and the tests take names, help text and settings from here.
+enum class Fit {
+    kNewton,  // irradz Solve::kNewton (the default)
+    kSearch,  // irradz Solve::kSearch (golden-section reference)
+    kOld,     // irradz Solve::kOld (the talk's "old way")
+    kLinear,  // encode_planes_linear_sh (closed form from L0 + L1)
+};
+struct FitEntry {
+    std::string_view name;
+    std::string_view summary;
+    Fit fit;
+};
+std::span<const FitEntry> fits();  // newton (default), search, old, linear
+const FitEntry* find_fit(std::string_view name);  // nullptr when unknown
+// encode_planes with the fit's solve, or encode_planes_linear_sh for kLinear.
+IrradzPlanes fit_planes(const ShLightmap& lm, Fit fit, int threads = 1);
+
+struct QualityPreset {
+    std::string_view name;
+    std::string_view summary;
+    bc6h::Quality bc6h;  // I_z
+    bc45::Quality bc45;  // d and w_a
+};
+std::span<const QualityPreset> quality_presets();  // fast, default, slow
+const QualityPreset* find_quality_preset(std::string_view name);  // nullptr when unknown
 
 struct Compressed {
     int width = 0, height = 0;

@@ -130,6 +130,13 @@ Result<std::vector<Sh3Radiance>> decode_probe_set(const ProbeSet& set) {
     return out;
 }
 
+Result<std::vector<Sh3Radiance>> round_trip_probes(std::span<const Sh3Radiance> hub, std::string_view representation,
+                                                   const StorageParams& params, ProbeLayout layout, EncodeStats* stats) {
+    auto set = encode_probe_set(hub, representation, params, std::move(layout), stats);
+    if (!set) return set.error();
+    return decode_probe_set(*set);
+}
+
 Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view representation, const StorageParams& params,
                                    EncodeStats* stats, const CodecOptions& base) {
     auto hub = decode_probe_set(set);

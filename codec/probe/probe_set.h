@@ -84,6 +84,11 @@ Result<ProbeSet> encode_probe_set(std::span<const Sh3Radiance> hub, std::string_
                                   const CodecOptions& base = {});
 // Decodes every probe to the hub. Fails only for an invalid set.
 Result<std::vector<Sh3Radiance>> decode_probe_set(const ProbeSet& set);
+// What the runtime would see: encode the hub probes into a representation, then decode back to
+// the hub (a lossy preview, e.g. a JSON probe list "through" zh3_q16). Fails as encode_probe_set.
+Result<std::vector<Sh3Radiance>> round_trip_probes(std::span<const Sh3Radiance> hub, std::string_view representation,
+                                                   const StorageParams& params, ProbeLayout layout,
+                                                   EncodeStats* stats = nullptr);
 // Decode then re-encode into another representation/params; the layout is kept.
 Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view representation, const StorageParams& params,
                                    EncodeStats* stats = nullptr, const CodecOptions& base = {});

@@ -1,5 +1,7 @@
 #include "formats/io/exr_memory.h"
 
+#include "formats/io/le_bytes.h"
+
 #include <algorithm>
 #include <cstring>
 
@@ -11,12 +13,6 @@ namespace zhc {
 // zhc's limits first. Header layout: magic, version, then attributes "name\0type\0" int32 size,
 // value; a 0 byte ends a header; multi-part files (version bit 12) end the list with another 0.
 namespace {
-
-std::uint32_t load_u32(const std::uint8_t* p) {
-    std::uint32_t v;
-    std::memcpy(&v, p, 4);
-    return v;
-}
 
 // OpenEXR's typed attribute readers parse their own value and ignore the declared size: a fixed
 // type reads its fixed number of bytes, a channel list reads until its empty name, a preview reads
@@ -78,14 +74,14 @@ Status check_attribute_value(std::span<const std::uint8_t> v, const std::string&
     }
     if (raw_type == "preview") {
         if (v.size() < 8) return bad("is too short");
-        const std::uint64_t w = load_u32(v.data()), h = load_u32(v.data() + 4);
+        const std::uint64_t w = le::load32(v.data()), h = le::load32(v.data() + 4);
         return w * h * 4 + 8 == v.size() ? Status(Ok{}) : Status(bad("does not match its width x height"));
     }
     if (raw_type == "stringvector") {
         size_t p = 0;
         while (p < v.size()) {
             if (p + 4 > v.size()) return bad("ends inside a string length");
-            const std::uint32_t n = load_u32(v.data() + p);
+            const std::uint32_t n = le::load32(v.data() + p);
             p += 4;
             if (n > v.size() - p) return bad("has a string longer than the attribute");
             p += n;
@@ -163,8 +159,8 @@ Status validate_exr_header(std::span<const std::uint8_t> b, const std::string& n
             }
             if (attr == "tiles" && type == "tiledesc") {
                 pl.has_tiles = true;
-                pl.tile_x = load_u32(value);
-                pl.tile_y = load_u32(value + 4);
+                pl.tile_x = le::load32(value);
+                pl.tile_y = le::load32(value + 4);
                 pl.tile_mode = value[8];
             }
             if (attr == "dataWindow" && type == "box2i" && size == 16) {
@@ -198,12 +194,6 @@ Status validate_exr_header(std::span<const std::uint8_t> b, const std::string& n
 namespace zhc {
 
 namespace {
-
-std::uint64_t load_u64(const std::uint8_t* p) {
-    std::uint64_t v;
-    std::memcpy(&v, p, 8);
-    return v;
-}
 
 // Scanlines per chunk of each OpenEXR compression (ImfCompression.h order: none, rle, zips, zip,
 // piz, pxr24, b44, b44a, dwaa, dwab).
@@ -304,7 +294,7 @@ Result<std::uint64_t> exr_data_end(std::span<const std::uint8_t> b, const std::s
     for (size_t p = 0; p < parts.size(); ++p) {
         const std::string where = layout.multipart ? " of part " + std::to_string(p) : "";
         for (std::uint64_t k = 0; k < parts[p].count; ++k, entry += 8) {
-            const std::uint64_t at = load_u64(b.data() + entry);
+            const std::uint64_t at = le::load64(b.data() + entry);
             auto chunk_error = [&](ErrorCode code, const std::string& what) {
                 return make_error(code, name + ": OpenEXR chunk " + std::to_string(k) + where + " (offset " +
                                             std::to_string(at) + ") " + what);
@@ -324,7 +314,7 @@ Result<std::uint64_t> exr_data_end(std::span<const std::uint8_t> b, const std::s
             const std::uint64_t coords = parts[p].tiled ? 16 : 4;
             if (parts[p].deep) {
                 if (!need(coords + 24)) return chunk_error(ErrorCode::kTruncated, "lies beyond the end of the file");
-                const std::uint64_t table = load_u64(b.data() + q + coords), samples = load_u64(b.data() + q + coords + 8);
+                const std::uint64_t table = le::load64(b.data() + q + coords), samples = le::load64(b.data() + q + coords + 8);
                 q += coords + 24;
                 if (table > size || samples > size || !need(table + samples))
                     return chunk_error(ErrorCode::kTruncated, "ends beyond the end of the file");

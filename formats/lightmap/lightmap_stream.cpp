@@ -20,12 +20,6 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 constexpr std::uint32_t kFormats[3] = {kVkFormatBc6hUfloat, kVkFormatBc5Unorm, kVkFormatBc4Unorm};
 const char* const kSuffixes[3] = {".iz", ".d", ".wa"};
 
-lightmap::IrradzPlanes fit_band(const lightmap::ShLightmap& band, Fit fit, int threads) {
-    if (fit == Fit::kLinear) return lightmap::encode_planes_linear_sh(band, threads);
-    irradz::EncodeOptions eo;
-    eo.solve = fit == Fit::kOld ? irradz::Solve::kOld : (fit == Fit::kSearch ? irradz::Solve::kSearch : irradz::Solve::kNewton);
-    return lightmap::encode_planes(band, eo, threads);
-}
 
 }  // namespace
 
@@ -71,7 +65,7 @@ Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::s
         if (Status s = in.read_rows(y0, y1, band); !s) return s.error();
         r.timing.read += since(t);
         t = Clock::now();
-        const auto planes = fit_band(band, o.fit, o.threads);
+        const auto planes = lightmap::fit_planes(band, o.fit, o.threads);
         r.timing.fit += since(t);
         t = Clock::now();
         const auto c = lightmap::compress(planes, o.bc6h_quality, o.bc45_quality, o.threads);
@@ -174,9 +168,9 @@ Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOpt
         if (Status s = in.read_rows(y0, y1, band); !s) return s.error();
         r.timing.read += since(t);
         t = Clock::now();
-        const auto search = fit_band(band, Fit::kNewton, o.threads);  // irradz::EncodeOptions' default, as lightmap audit
+        const auto search = lightmap::fit_planes(band, Fit::kNewton, o.threads);  // irradz::EncodeOptions' default, as lightmap audit
         r.timing.fit += since(t);
-        const auto old_way = fit_band(band, Fit::kOld, o.threads);
+        const auto old_way = lightmap::fit_planes(band, Fit::kOld, o.threads);
         t = Clock::now();
         const auto c = lightmap::compress(search, o.bc6h_quality, o.bc45_quality, o.threads);
         r.timing.compress += since(t);

@@ -18,12 +18,7 @@
 
 namespace zhc::lightmap_stream {
 
-enum class Fit {
-    kNewton,  // irradz::encode, Solve::kNewton (the default)
-    kSearch,  // irradz::encode, Solve::kSearch
-    kOld,     // irradz::encode, Solve::kOld
-    kLinear,  // closed-form linear SH (lightmap::encode_planes_linear_sh)
-};
+using Fit = lightmap::Fit;  // the fits by name: lightmap::fits()
 
 // Called after each band with the rows done so far and the total.
 using ProgressFn = std::function<void(std::uint64_t done, std::uint64_t total)>;

@@ -1,6 +1,8 @@
 // The .zhp container and the JSON probe list (probe_file.h, docs/zhp-container.md).
 #include "formats/probes/probe_file.h"
 
+#include "formats/io/le_bytes.h"
+
 #include <zstd.h>
 
 #include <array>
@@ -73,37 +75,6 @@ enum : std::size_t {
 };
 static_assert(kOffHeaderCrc + 4 == kProbeFileHeaderBytes);
 
-void put(std::uint8_t* p, std::uint64_t v, int bytes) {
-    for (int b = 0; b < bytes; ++b) p[b] = static_cast<std::uint8_t>(v >> (8 * b));
-}
-std::uint64_t get(const std::uint8_t* p, int bytes) {
-    std::uint64_t v = 0;
-    for (int b = 0; b < bytes; ++b) v |= std::uint64_t(p[b]) << (8 * b);
-    return v;
-}
-void put_f64(std::uint8_t* p, double v) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &v, 8);
-    put(p, bits, 8);
-}
-double get_f64(const std::uint8_t* p) {
-    const std::uint64_t bits = get(p, 8);
-    double v;
-    std::memcpy(&v, &bits, 8);
-    return v;
-}
-void put_f32(std::uint8_t* p, float v) {
-    std::uint32_t bits;
-    std::memcpy(&bits, &v, 4);
-    put(p, bits, 4);
-}
-float get_f32(const std::uint8_t* p) {
-    const std::uint32_t bits = static_cast<std::uint32_t>(get(p, 4));
-    float v;
-    std::memcpy(&v, &bits, 4);
-    return v;
-}
-
 Error err(ErrorCode code, const std::string& name, const std::string& what) {
     return make_error(code, name + ": " + what);
 }
@@ -130,7 +101,7 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
     std::vector<std::uint8_t> body(positions_bytes(set) + set.payload.size());
     if (set.layout.kind == ProbeLayoutKind::kPositions)
         for (size_t i = 0; i < set.count; ++i)
-            for (int c = 0; c < 3; ++c) put_f32(body.data() + 12 * i + 4 * static_cast<size_t>(c), set.layout.positions[i][static_cast<size_t>(c)]);
+            for (size_t c = 0; c < 3; ++c) le::store_f32(body.data() + 12 * i + 4 * c, set.layout.positions[i][c]);
     if (!set.payload.empty()) std::memcpy(body.data() + positions_bytes(set), set.payload.data(), set.payload.size());
     const std::uint64_t raw_bytes = body.size();
     if (options.zstd_level > 0) {
@@ -144,8 +115,8 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
     std::vector<std::uint8_t> out(kProbeFileHeaderBytes + body.size(), 0);
     std::uint8_t* h = out.data();
     std::memcpy(h + kOffMagic, kMagic, sizeof kMagic);
-    put(h + kOffVersion, kProbeFileVersion, 2);
-    put(h + kOffHeaderBytes, kProbeFileHeaderBytes, 2);
+    le::store(h + kOffVersion, kProbeFileVersion, 2);
+    le::store(h + kOffHeaderBytes, kProbeFileHeaderBytes, 2);
     const StorageParams& p = set.params;
     h[kOffKind] = static_cast<std::uint8_t>(p.kind);
     h[kOffBits] = static_cast<std::uint8_t>(p.bits);
@@ -157,23 +128,23 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
     h[kOffCompression] = options.zstd_level > 0 ? 1 : 0;
     h[kOffLayoutKind] = static_cast<std::uint8_t>(set.layout.kind);
     std::memcpy(h + kOffName, set.representation.data(), set.representation.size());
-    put(h + kOffCount, set.count, 8);
-    put(h + kOffProbeBytes, set.codec()->size_bytes, 4);
-    put_f64(h + kOffLuminance, p.luminance.r);
-    put_f64(h + kOffLuminance + 8, p.luminance.g);
-    put_f64(h + kOffLuminance + 16, p.luminance.b);
+    le::store(h + kOffCount, set.count, 8);
+    le::store(h + kOffProbeBytes, set.codec()->size_bytes, 4);
+    le::store_f64(h + kOffLuminance, p.luminance.r);
+    le::store_f64(h + kOffLuminance + 8, p.luminance.g);
+    le::store_f64(h + kOffLuminance + 16, p.luminance.b);
     if (set.layout.kind == ProbeLayoutKind::kGrid) {
         const ProbeGrid& g = set.layout.grid;
         for (int c = 0; c < 3; ++c) {
-            put_f64(h + kOffOrigin + 8 * static_cast<size_t>(c), g.origin[c]);
-            put_f64(h + kOffSpacing + 8 * static_cast<size_t>(c), g.spacing[c]);
-            put(h + kOffCounts + 4 * static_cast<size_t>(c), g.counts[static_cast<size_t>(c)], 4);
+            le::store_f64(h + kOffOrigin + 8 * static_cast<size_t>(c), g.origin[c]);
+            le::store_f64(h + kOffSpacing + 8 * static_cast<size_t>(c), g.spacing[c]);
+            le::store(h + kOffCounts + 4 * static_cast<size_t>(c), g.counts[static_cast<size_t>(c)], 4);
         }
     }
-    put(h + kOffRawBody, raw_bytes, 8);
-    put(h + kOffStoredBody, body.size(), 8);
-    put(h + kOffBodyCrc, crc32(body), 4);
-    put(h + kOffHeaderCrc, crc32({h, kOffHeaderCrc}), 4);
+    le::store(h + kOffRawBody, raw_bytes, 8);
+    le::store(h + kOffStoredBody, body.size(), 8);
+    le::store(h + kOffBodyCrc, crc32(body), 4);
+    le::store(h + kOffHeaderCrc, crc32({h, kOffHeaderCrc}), 4);
     if (!body.empty()) std::memcpy(out.data() + kProbeFileHeaderBytes, body.data(), body.size());
     return out;
 }
@@ -192,7 +163,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
         return err(ErrorCode::kTruncated, name, "file ends inside the header (" + std::to_string(bytes.size()) +
                                                     " of " + std::to_string(kProbeFileHeaderBytes) + " bytes)");
     // 2. Version before anything version-specific (a newer file may have another header size).
-    const auto version = static_cast<std::uint16_t>(get(h + kOffVersion, 2));
+    const auto version = static_cast<std::uint16_t>(le::load(h + kOffVersion, 2));
     if (version != kProbeFileVersion)
         return err(ErrorCode::kUnsupported, name, ".zhp version " + std::to_string(version) +
                                                       " is not supported (this zhc reads version " +
@@ -201,15 +172,15 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
         return err(ErrorCode::kTruncated, name, "file ends inside the header (" + std::to_string(bytes.size()) +
                                                     " of " + std::to_string(kProbeFileHeaderBytes) + " bytes)");
     // 3. Header checksum before trusting any field.
-    const auto header_crc = static_cast<std::uint32_t>(get(h + kOffHeaderCrc, 4));
+    const auto header_crc = static_cast<std::uint32_t>(le::load(h + kOffHeaderCrc, 4));
     if (crc32({h, kOffHeaderCrc}) != header_crc)
         return err(ErrorCode::kChecksum, name, "header checksum mismatch (CRC-32 at byte 180)");
     // 4. Fields.
-    if (get(h + kOffHeaderBytes, 2) != kProbeFileHeaderBytes)
-        return err(ErrorCode::kBadFormat, name, "header size field is " + std::to_string(get(h + kOffHeaderBytes, 2)) +
+    if (le::load(h + kOffHeaderBytes, 2) != kProbeFileHeaderBytes)
+        return err(ErrorCode::kBadFormat, name, "header size field is " + std::to_string(le::load(h + kOffHeaderBytes, 2)) +
                                                     ", version 1 requires 184 (byte 10)");
-    if (h[kOffReserved0] | h[kOffReserved0 + 1] | h[kOffReserved0 + 2] || get(h + kOffReserved1, 4) ||
-        get(h + kOffReserved2, 4))
+    if (h[kOffReserved0] | h[kOffReserved0 + 1] | h[kOffReserved0 + 2] || le::load(h + kOffReserved1, 4) ||
+        le::load(h + kOffReserved2, 4))
         return err(ErrorCode::kBadFormat, name, "reserved header bytes are not zero (bytes 21-23, 68-71, 156-159)");
     auto enum_field = [&](std::size_t off, int max, const char* what) -> Status {
         if (h[off] > max)
@@ -241,7 +212,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
     }
     const Codec* codec = find_codec(rep);
     if (!codec) return err(ErrorCode::kUnsupported, name, "unknown representation '" + rep + "'");
-    const std::uint64_t probe_bytes = get(h + kOffProbeBytes, 4);
+    const std::uint64_t probe_bytes = le::load(h + kOffProbeBytes, 4);
     if (probe_bytes != codec->size_bytes)
         return err(ErrorCode::kBadFormat, name, "'" + rep + "' probes are " + std::to_string(codec->size_bytes) +
                                                     " bytes, header says " + std::to_string(probe_bytes) + " (byte 64)");
@@ -255,11 +226,11 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
     p.sqrt_encoding = h[kOffSqrt] != 0;
     p.zonal_mapping = static_cast<ZonalMapping>(h[kOffZonalMapping]);
     p.axis_mode = static_cast<ZonalAxisMode>(h[kOffAxisMode]);
-    p.luminance = {get_f64(h + kOffLuminance), get_f64(h + kOffLuminance + 8), get_f64(h + kOffLuminance + 16)};
+    p.luminance = {le::load_f64(h + kOffLuminance), le::load_f64(h + kOffLuminance + 8), le::load_f64(h + kOffLuminance + 16)};
     if (!std::isfinite(p.luminance.r) || !std::isfinite(p.luminance.g) || !std::isfinite(p.luminance.b))
         return err(ErrorCode::kInvalidValue, name, "luminance weights are not finite (bytes 72-95)");
     if (Status st = validate_quant_params(p, rep); !st) return err(ErrorCode::kBadFormat, name, st.error().message);
-    const std::uint64_t count = get(h + kOffCount, 8);
+    const std::uint64_t count = le::load(h + kOffCount, 8);
     if (count > limits.max_probes)
         return err(ErrorCode::kTooLarge, name, std::to_string(count) + " probes exceed the limit of " +
                                                    std::to_string(limits.max_probes) + " (byte 56)");
@@ -269,9 +240,9 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
     double grid_values[6];
     std::uint32_t counts[3];
     for (int c = 0; c < 3; ++c) {
-        grid_values[c] = get_f64(h + kOffOrigin + 8 * static_cast<size_t>(c));
-        grid_values[3 + c] = get_f64(h + kOffSpacing + 8 * static_cast<size_t>(c));
-        counts[c] = static_cast<std::uint32_t>(get(h + kOffCounts + 4 * static_cast<size_t>(c), 4));
+        grid_values[c] = le::load_f64(h + kOffOrigin + 8 * static_cast<size_t>(c));
+        grid_values[3 + c] = le::load_f64(h + kOffSpacing + 8 * static_cast<size_t>(c));
+        counts[c] = static_cast<std::uint32_t>(le::load(h + kOffCounts + 4 * static_cast<size_t>(c), 4));
     }
     if (layout_kind == ProbeLayoutKind::kGrid) {
         for (double v : grid_values)
@@ -294,7 +265,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
     // Body sizes: count <= 2^26 and size_bytes < 2^8 keep these products far from overflow.
     const std::uint64_t pos_bytes = layout_kind == ProbeLayoutKind::kPositions ? count * 12 : 0;
     const std::uint64_t raw_expected = pos_bytes + count * probe_bytes;
-    const std::uint64_t raw_bytes = get(h + kOffRawBody, 8);
+    const std::uint64_t raw_bytes = le::load(h + kOffRawBody, 8);
     if (raw_bytes != raw_expected)
         return err(ErrorCode::kBadFormat, name, "body size " + std::to_string(raw_bytes) + " does not match " +
                                                     std::to_string(count) + " probes (expected " +
@@ -303,7 +274,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
         return err(ErrorCode::kTooLarge, name, "body of " + std::to_string(raw_bytes) + " bytes exceeds the limit of " +
                                                    std::to_string(limits.max_body_bytes));
     const bool compressed = h[kOffCompression] == 1;
-    const std::uint64_t stored_bytes = get(h + kOffStoredBody, 8);
+    const std::uint64_t stored_bytes = le::load(h + kOffStoredBody, 8);
     if (!compressed && stored_bytes != raw_bytes)
         return err(ErrorCode::kBadFormat, name, "uncompressed body: stored size " + std::to_string(stored_bytes) +
                                                     " differs from body size " + std::to_string(raw_bytes));
@@ -319,7 +290,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
                                                         " unexpected bytes after the body (from byte " +
                                                         std::to_string(kProbeFileHeaderBytes + stored_bytes) + ")");
     const std::span<const std::uint8_t> stored = bytes.subspan(kProbeFileHeaderBytes);
-    const auto body_crc = static_cast<std::uint32_t>(get(h + kOffBodyCrc, 4));
+    const auto body_crc = static_cast<std::uint32_t>(le::load(h + kOffBodyCrc, 4));
     if (crc32(stored) != body_crc) return err(ErrorCode::kChecksum, name, "body checksum mismatch (CRC-32 at byte 176)");
     // 6. Body.
     std::vector<std::uint8_t> raw;
@@ -341,7 +312,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
         set.layout.positions.resize(count);
         for (size_t i = 0; i < count; ++i)
             for (int c = 0; c < 3; ++c) {
-                const float v = get_f32(body.data() + 12 * i + 4 * static_cast<size_t>(c));
+                const float v = le::load_f32(body.data() + 12 * i + 4 * static_cast<size_t>(c));
                 if (!std::isfinite(v))
                     return err(ErrorCode::kInvalidValue, name, "position of probe " + std::to_string(i) + " is not finite");
                 set.layout.positions[i][static_cast<size_t>(c)] = v;

@@ -118,6 +118,15 @@ vec3 zhcNormalizeOrZ(vec3 v) {
   return (len > 0.0 && !isinf(len)) ? v * (1.0 / len) : vec3(0.0, 0.0, 1.0);
 }
 
+// Zonal axis of channel k: its own L1 (per-channel entries) or the luminance-weighted L1 (the rest).
+vec3 zhcZonalAxis(vec3 v[3], int k) {
+#if ZHC_AXIS_CHANNEL
+  return zhcNormalizeOrZ(v[k]);
+#else
+  return zhcNormalizeOrZ(ZHC_LUMINANCE.r * v[0] + ZHC_LUMINANCE.g * v[1] + ZHC_LUMINANCE.b * v[2]);
+#endif
+}
+
 float zhcUnpackHalf(uint h) {
   float mag = zhcUnpackUfloat(h & 32767u, 10u);
   return (h & 32768u) != 0u ? -mag : mag;
@@ -189,13 +198,8 @@ vec3 zhcIrradianceHallCurveQ(uvec4 words, vec3 n) {
     v[k] = toRad1 * dc[k] * vec3(-zhcUnit(zhcByte(words, 6 + 3 * k + 2)), -zhcUnit(zhcByte(words, 6 + 3 * k)),
                                  zhcUnit(zhcByte(words, 6 + 3 * k + 1))) * ZHC_L1_HI;
   vec3 e;
-#if !ZHC_AXIS_CHANNEL
-  vec3 a = zhcNormalizeOrZ(ZHC_LUMINANCE.r * v[0] + ZHC_LUMINANCE.g * v[1] + ZHC_LUMINANCE.b * v[2]);
-#endif
   for (int k = 0; k < 3; ++k) {
-#if ZHC_AXIS_CHANNEL
-    vec3 a = zhcNormalizeOrZ(v[k]);
-#endif
+    vec3 a = zhcZonalAxis(v, k);
     float f0 = dc[k];
     float z20 = 0.0;
     if (f0 > 0.0 && !isinf(f0)) {
@@ -226,13 +230,8 @@ vec3 zhcIrradianceZh3Q16(uvec4 words, vec3 n) {
   const float s1 = 2.0 / 3.0, s2 = 0.25;
 #endif
   vec3 e;
-#if !ZHC_AXIS_CHANNEL
-  vec3 a = zhcNormalizeOrZ(ZHC_LUMINANCE.r * v[0] + ZHC_LUMINANCE.g * v[1] + ZHC_LUMINANCE.b * v[2]);
-#endif
   for (int k = 0; k < 3; ++k) {
-#if ZHC_AXIS_CHANNEL
-    vec3 a = zhcNormalizeOrZ(v[k]);
-#endif
+    vec3 a = zhcZonalAxis(v, k);
     float z = dot(a, n);
     e[k] = ZHC_Y00 * dc[k] + s1 * ZHC_Y1 * dot(v[k], n) + s2 * zq[k] * ZHC_Y20 * (3.0 * z * z - 1.0);
   }

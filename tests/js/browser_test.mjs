@@ -23,7 +23,7 @@ import http from 'node:http';
 import { execFile, execFileSync, spawn } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { promisify } from 'node:util';
-import { randomProbes, triangleScene, makeRand } from './fixtures.mjs';
+import { randomProbes, triangleScene, makeRand, checker } from './fixtures.mjs';
 
 const [zhc, workArg, chromiumArg] = process.argv.slice(2);
 if (!zhc || !workArg) {
@@ -36,13 +36,7 @@ fs.mkdirSync(work, { recursive: true });
 const here = path.dirname(fileURLToPath(import.meta.url));
 const repo = path.resolve(here, '..', '..');
 const W = (f) => path.join(work, f);
-let failures = 0;
-const check = (ok, what) => {
-  if (!ok) {
-    failures++;
-    console.log(`FAIL: ${what}`);
-  }
-};
+const { check, finish } = checker();
 
 // --- 1. inputs written by zhc ----------------------------------------------------------------
 fs.writeFileSync(W('scene.glb'), triangleScene());
@@ -201,5 +195,4 @@ for (const r of report.files ?? []) {
   check(r.threeCompared >= Math.min(16, r.count) * DZ && r.threeWorst < 2e-5, `${r.glb}: three.js LightProbe shading equals zhc's irradiance`);
   check(r.gpuPackedWorst < GPU_BOUND && r.gpuSh3Worst < GPU_BOUND && r.gpuVsJsWorst < GPU_BOUND, `${r.glb}: WebGL2 irradiance within ${GPU_BOUND} of the DC term`);
 }
-console.log(failures === 0 ? 'all runtime/web browser checks passed' : `${failures} runtime/web browser checks FAILED`);
-process.exit(failures === 0 ? 0 : 1);
+finish('runtime/web browser');

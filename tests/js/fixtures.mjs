@@ -87,3 +87,20 @@ export function randomProbes(count, seed) {
   }
   return probes;
 }
+
+// The checks of one test script: check(ok, what) prints "FAIL: what" and counts; finish(what)
+// prints the summary and exits 0 only when every check passed.
+export function checker() {
+  let failures = 0;
+  const check = (ok, what) => {
+    if (!ok) {
+      failures++;
+      console.log(`FAIL: ${what}`);
+    }
+  };
+  const finish = (what) => {
+    console.log(failures === 0 ? `all ${what} checks passed` : `${failures} ${what} checks FAILED`);
+    process.exit(failures === 0 ? 0 : 1);
+  };
+  return { check, finish };
+}

@@ -15,7 +15,7 @@ import { execFileSync } from 'node:child_process';
 import { register } from 'node:module';
 import validator from 'gltf-validator';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
-import { glb, triangleSceneParts } from './fixtures.mjs';
+import { glb, triangleSceneParts, checker } from './fixtures.mjs';
 
 // The plugin lives in runtime/web (issue 15); its bare 'three' import resolves to tests/js/node_modules.
 register('./three_resolver.mjs', import.meta.url);
@@ -27,13 +27,7 @@ if (!zhc || !work) {
   process.exit(2);
 }
 fs.mkdirSync(work, { recursive: true });
-let failures = 0;
-const check = (ok, what) => {
-  if (!ok) {
-    failures++;
-    console.log(`FAIL: ${what}`);
-  }
-};
+const { check, finish } = checker();
 
 // --- inputs -------------------------------------------------------------------------------
 const { json: scene, bin: tri } = triangleSceneParts();
@@ -158,5 +152,4 @@ for (const b of bakes) {
   }
 }
 
-console.log(failures === 0 ? 'all glTF client checks passed' : `${failures} glTF client checks FAILED`);
-process.exit(failures === 0 ? 0 : 1);
+finish('glTF client');

@@ -18,7 +18,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { register } from 'node:module';
-import { randomProbes, triangleScene, makeRand } from './fixtures.mjs';
+import { randomProbes, triangleScene, makeRand, checker } from './fixtures.mjs';
 
 register('./three_resolver.mjs', import.meta.url);
 const runtime = await import('../../runtime/web/zhc_runtime.mjs');
@@ -33,13 +33,7 @@ if (!zhc || !work) {
 }
 fs.mkdirSync(work, { recursive: true });
 const W = (f) => path.join(work, f);
-let failures = 0;
-const check = (ok, what) => {
-  if (!ok) {
-    failures++;
-    console.log(`FAIL: ${what}`);
-  }
-};
+const { check, finish } = checker();
 const run = (...args) => execFileSync(zhc, args, { maxBuffer: 1 << 28 }).toString();
 
 // --- inputs -----------------------------------------------------------------------------------
@@ -349,5 +343,4 @@ for (const c of cases.filter((c) => ['zh3_q16', 'hall_curve_q'].includes(c.enc) 
 }
 
 console.log(`${totalCases} decode cases, ${totalCoefficients} coefficients compared bit for bit; ${evalCount - evalBad}/${evalCount} irradiance evaluations equal zhc gltf eval`);
-console.log(failures === 0 ? 'all runtime/web decode checks passed' : `${failures} runtime/web decode checks FAILED`);
-process.exit(failures === 0 ? 0 : 1);
+finish('runtime/web decode');
