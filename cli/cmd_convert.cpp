@@ -57,6 +57,7 @@ Result<Loaded> load_input(const Options& o) {
         if (!set) return set.error();
         auto hub = decode_probe_set(*set);
         if (!hub) return make_error(ErrorCode::kBadFormat, o.input + ": " + hub.error().message);
+        if (Status finite = check_finite_probes(*hub, o.input); !finite) return finite.error();
         in.list.probes = std::move(hub).value();
         in.list.layout = set->layout;
         in.set = std::move(set).value();

@@ -13,7 +13,7 @@
 
 #include "cli.h"
 #include "table.h"
-#include "codec/report/audit.h"
+#include "codec/report/audit_run.h"
 #include "codec/bake/scene.h"
 #include "formats/report/audit_inputs.h"
 #include "formats/io/file_io.h"
@@ -106,35 +106,25 @@ int run(const Options& o) {
     for (const Codec& k : codecs()) all.push_back(&k);
     const std::vector<Vec3> dirs = fibonacci_sphere(o.directions);
     const CodecOptions copt;
-    // Probes split over threads in contiguous ranges; per-probe results kept and pooled in probe
-    // order afterwards, so the table does not depend on the thread count.
-    std::vector<std::vector<std::vector<Rgb>>> recon(probes.size());
-    std::vector<std::vector<Rgb>> refs(probes.size());
-    std::vector<std::vector<EncodeStats>> stats(probes.size());
-    {
-        std::vector<std::thread> pool;
-        const size_t per = (probes.size() + threads - 1) / threads;
-        for (int t = 0; t < threads; ++t)
-            pool.emplace_back([&, t] {
-                for (size_t p = t * per; p < std::min(probes.size(), (t + 1) * per); ++p) {
-                    refs[p] = sh3_irradiance(probes[p], dirs);
-                    auto res = audit_probe(probes[p], refs[p], dirs, all, copt, false, &recon[p]);
-                    for (const auto& r : res) stats[p].push_back(r.stats);
-                }
-            });
-        for (auto& th : pool) th.join();
-    }
+    // The baked grid as one audit input (reference: each probe's SH3); per-probe metrics kept for
+    // the pictured probes' tables.
+    AuditInput grid;
+    grid.path = "baked grid";
+    grid.kind = "probes";
+    grid.probes = probes;
+    AuditOptions aopt;
+    aopt.timing = false;
+    aopt.threads = threads;
+    std::vector<std::vector<ErrorMetrics>> probe_metrics(probes.size());
+    const InputAudit audit = audit_input(grid, dirs, all, aopt, [&](size_t p, const std::vector<RepresentationResult>& per_codec) {
+        for (const RepresentationResult& r : per_codec) probe_metrics[p].push_back(r.metrics);
+    });
     std::vector<std::vector<std::string>> rows{{"representation", "bytes", "grid_bytes", "rmse", "rel_rmse", "max_abs",
                                                 "min_irr", "neg_frac", "chroma", "clamped"}};
     std::vector<HtmlRow> html_rows;
     for (size_t k = 0; k < all.size(); ++k) {
-        MetricsAccumulator acc;
-        int clamped = 0;
-        for (size_t p = 0; p < probes.size(); ++p) {
-            acc.add(recon[p][k], refs[p]);
-            clamped += stats[p][k].clamped_ratios;
-        }
-        const ErrorMetrics m = acc.result();
+        const ErrorMetrics& m = audit.results[k].metrics;
+        const int clamped = audit.results[k].stats.clamped_ratios;
         html_rows.push_back({std::string(all[k]->name), all[k]->size_bytes, m, -1, -1});
         rows.push_back({std::string(all[k]->name), std::to_string(all[k]->size_bytes),
                         std::to_string(all[k]->size_bytes * probes.size()), fmt(m.rmse), fmt(m.relative_rmse, "%.4f"),
@@ -252,7 +242,7 @@ int run(const Options& o) {
                         s.title = role[p] + " probe " + std::to_string(p);
                         s.description = "at (" + fmt(pos.x, "%.2f") + ", " + fmt(pos.y, "%.2f") + ", " + fmt(pos.z, "%.2f") + ")";
                         for (size_t k = 0; k < all.size(); ++k)
-                            s.rows.push_back({std::string(all[k]->name), all[k]->size_bytes, compare_irradiance(recon[p][k], refs[p]), -1, -1});
+                            s.rows.push_back({std::string(all[k]->name), all[k]->size_bytes, probe_metrics[p][k], -1, -1});
                         AuditInput in;
                         in.path = "probe_" + std::to_string(p);
                         in.kind = "probes";

@@ -35,6 +35,9 @@ Result<ProbeSet> load_probes(const std::string& path, const std::string& encodin
     if (looks_like_probe_file(*bytes)) {
         auto set = parse_probe_set(*bytes, path);
         if (!set) return set.error();
+        auto hub = decode_probe_set(*set);
+        if (!hub) return hub.error();
+        if (Status finite = check_finite_probes(*hub, path); !finite) return finite.error();
         if (encoding.empty() || encoding == set->representation) return set;
         StorageParams params;
         params.kind = set->params.kind;

@@ -95,6 +95,23 @@ void add_envmap_read_options(CLI::App* app, bool* replace_non_finite, std::strin
                     "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
 }
 
+// CLI11 reports a verb it does not know as "A subcommand is required": name the word instead
+// ("unknown verb 'bogus'", "unknown verb 'gltf bogus'"). Empty when the verbs on the command line
+// are all known.
+std::string unknown_verb(const CLI::App& app, int argc, char** argv) {
+    const CLI::App* at = &app;
+    std::string path;
+    for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {
+        const auto subs = at->get_subcommands({});
+        if (subs.empty()) break;
+        const auto it = std::find_if(subs.begin(), subs.end(), [&](const CLI::App* s) { return s->check_name(argv[i]); });
+        path += (path.empty() ? "" : " ") + std::string(argv[i]);
+        if (it == subs.end()) return "unknown verb '" + path + "'";
+        at = *it;
+    }
+    return "";
+}
+
 }  // namespace zhc::cli
 
 int main(int argc, char** argv) {
@@ -120,7 +137,8 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         // One line (README "Exit codes"): CLI11's message with any line breaks folded, and the
         // pointer to --help on the same line.
-        std::string what = e.what();
+        std::string what = unknown_verb(app, argc, argv);
+        if (what.empty()) what = e.what();
         for (char& c : what)
             if (c == '\n' || c == '\r') c = ' ';
         while (!what.empty() && what.back() == ' ') what.pop_back();

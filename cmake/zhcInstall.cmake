@@ -34,7 +34,7 @@ foreach(part codec formats)
   file(GENERATE OUTPUT "${PROJECT_BINARY_DIR}/include/zhc/${part}.h" CONTENT "${_umbrella}")
   install(FILES "${PROJECT_BINARY_DIR}/include/zhc/${part}.h" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/zhc")
 endforeach()
-# bc6h_encoder.inl is compiled into the library, not an interface: not installed.
+# bc6h_encoder*.inl are compiled into the library, not an interface: not installed.
 
 install(TARGETS zhc_codec zhc_formats EXPORT zhcTargets
         ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"

@@ -352,7 +352,7 @@ static inline void zhc_sh3_irradiance(const float sh3[27], const double n[3], fl
     zhc__sh_irradiance(sh3, 9, n, rgb);
 }
 
-/* ---- ZH3 (codec/probe/zh3.cpp) ------------------------------------------------------------------- */
+/* ---- ZH3 (codec/probe/zh3_fit.cpp) --------------------------------------------------------------- */
 
 /* Zonal axes of the three channels from the linear SH lin[12] (DC, L1-1, L10, L11 x RGB):
  * luminance mode: normalize(sum_k w_k v_k), per-channel: normalize(v_k), with the L1 vector
@@ -423,7 +423,7 @@ static inline double zhc_hallucinate_zonal(int model, double f0, double f1, doub
     return (a * p * p + b * p) * f0;
 }
 
-/* Hallucinated zonal coefficients of the three channels (codec/probe/zh3.cpp zh3_hallucinate). */
+/* Hallucinated zonal coefficients of the three channels (codec/probe/zh3_hallucinate.cpp). */
 static inline void zhc__hallucinate(const float lin[12], int model, int per_channel, const double w[3], double a,
                                     double b, float zonal[3]) {
     double axes[3][3];

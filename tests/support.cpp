@@ -1,5 +1,7 @@
 #include "support.h"
 
+#include "formats/probes/probe_file.h"
+
 #include <cmath>
 
 #include <algorithm>
@@ -190,6 +192,14 @@ std::uint32_t get32(const std::vector<std::uint8_t>& b, std::size_t off) {
 }
 void put32(std::vector<std::uint8_t>& b, std::size_t off, std::uint32_t v) {
     for (int k = 0; k < 4; ++k) b[off + static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(v >> (8 * k));
+}
+
+std::vector<std::uint8_t> zhp_with_header_edit(std::vector<std::uint8_t> bytes, std::size_t offset,
+                                               std::initializer_list<std::uint8_t> values) {
+    std::size_t i = offset;
+    for (std::uint8_t v : values) bytes[i++] = v;
+    put32(bytes, 180, crc32({bytes.data(), 180}));
+    return bytes;
 }
 
 Ktx2Image sample_block_image(std::uint32_t vk_format, int w, int h) {

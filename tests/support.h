@@ -109,6 +109,11 @@ std::vector<std::uint8_t> read_bytes(const std::string& path);
 std::uint32_t get32(const std::vector<std::uint8_t>& b, std::size_t off);
 void put32(std::vector<std::uint8_t>& b, std::size_t off, std::uint32_t v);
 
+// A serialised .zhp with header bytes [offset, offset + values.size()) replaced and the header
+// CRC (bytes 180-183) recomputed, so the field checks (not the checksum) are what a reader meets.
+std::vector<std::uint8_t> zhp_with_header_edit(std::vector<std::uint8_t> bytes, std::size_t offset,
+                                               std::initializer_list<std::uint8_t> values);
+
 // A block-compressed image of the given vkFormat and size whose block bytes are a fixed pattern
 // (i * 37 + 11): for container round trips.
 Ktx2Image sample_block_image(std::uint32_t vk_format, int w, int h);

@@ -839,23 +839,7 @@ TEST(JsonDepth, EveryJsonReaderRefusesDeepNestingWithOneLine) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
-// ---- 8. usage errors ---------------------------------------------------------------------
-
-TEST(UsageErrors, AreOneLineAndExit2) {
-    const std::vector<std::vector<std::string>> runs = {{},
-                                                        {"nosuchverb"},
-                                                        {"project"},
-                                                        {"project", "x.exr", "--threads", "abc"},
-                                                        {"project", "x.exr", "--nosuchoption"},
-                                                        {"convert", "x.json"},
-                                                        {"lightmap"},
-                                                        {"audit", "x", "--representations"}};
-    for (const auto& args : runs) {
-        std::string what;
-        for (const auto& a : args) what += a + " ";
-        expect_one_line_error(test::run_zhc(args), cli::kExitUsage, what);
-    }
-}
+// ---- 8. usage errors: tests/conformance cli_usage_* ----------------------------------------------
 
 }  // namespace
 }  // namespace zhc

@@ -520,16 +520,7 @@ TEST(SceneCli, ParserErrorsAreClearWithExitCodes) {
          "probes.grid.max: missing required field"},
         {"wrong_type", R"({"version":1,"probes":{"positions":[[0,0,0]]},"lights":[{"type":"point","position":"here","intensity":1}]})",
          4, "lights[0].position: must be an array of 3 numbers"},
-        {"unknown_light", R"({"version":1,"probes":{"positions":[[0,0,0]]},"lights":[{"type":"laser"}]})", 5,
-         "lights[0].type: unknown light type \"laser\""},
-        {"negative_radius",
-         R"({"version":1,"probes":{"positions":[[0,0,0]]},"lights":[{"type":"sphere","center":[0,0,1],"radius":-1,"radiance":1}]})",
-         4, "lights[0].radius: must be > 0 (got -1)"},
-        {"huge_grid", R"({"version":1,"probes":{"grid":{"min":[0,0,0],"max":[1,1,1],"counts":[100000,100000,100000]}}})", 6,
-         "probes.grid.counts: grid holds more than the limit"},
         {"unknown_field", R"({"version":1,"probes":{"positions":[[0,0,0]]},"lihgts":[]})", 4, "lihgts: unknown field"},
-        {"not_json", R"({"version":1,)", 4, "not valid JSON"},
-        {"number_overflow", R"({"version":1,"probes":{"positions":[[0,0,1e999]]}})", 4, "not valid JSON"},
         {"bad_version", R"({"version":2,"probes":{"positions":[[0,0,0]]}})", 5, "version: unsupported scene version 2"},
         {"negative_colour", R"({"version":1,"probes":{"positions":[[0,0,0]]},"sky":{"type":"constant","radiance":[1,-1,1]}})", 4,
          "sky.radiance[1]: must be >= 0"},
@@ -538,8 +529,6 @@ TEST(SceneCli, ParserErrorsAreClearWithExitCodes) {
              "lights":[{"type":"hemisphere","direction":[0,0,1],"radiance":1,"shadows":true,"shadow_samples":4096}],
              "occluders":[{"type":"sphere","center":[0,0,9],"radius":1}]})",
          6, "shadow rays, above the limit"},
-        {"missing_map", R"({"version":1,"probes":{"positions":[[0,0,0]]},"environment":{"map":"nowhere.exr"}})", 3,
-         "environment.map"},
     };
     for (const Case& c : cases) {
         const std::string path = write_scene(dir, std::string(c.name) + ".json", c.text);
@@ -551,12 +540,8 @@ TEST(SceneCli, ParserErrorsAreClearWithExitCodes) {
         EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": one line: " << r.err;
         EXPECT_FALSE(fs::exists(out)) << c.name;
     }
-    const auto missing = test::run_zhc({"bake", dir + "/absent.json", "-o", dir + "/x.zhp"});
-    EXPECT_EQ(missing.exit_code, 3);
-    const std::string ok = write_scene(dir, "ok.json", R"({"version":1,"probes":{"positions":[[0,0,0]]}})");
-    EXPECT_EQ(test::run_zhc({"bake", ok, "-o", dir + "/x.txt"}).exit_code, 2);
-    EXPECT_EQ(test::run_zhc({"bake", ok, "-o", dir + "/x.zhp", "--to", "nope"}).exit_code, 2);
-    EXPECT_EQ(test::run_zhc({"bake", ok, "-o", dir + "/missing_dir/x.zhp"}).exit_code, 7);
+    // Missing, negative radius, unknown light, huge grid, cut and overflowing JSON, missing map;
+    // bad -o extension, unknown representation, unwritable output: tests/conformance scenejson_*.
 }
 
 TEST(SceneBake, DefaultSceneProbesAreOutsideLightsAndOccluders) {

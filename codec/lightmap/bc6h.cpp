@@ -367,13 +367,14 @@ void decode_block(const std::uint8_t in[16], std::uint16_t out[16][3]) {
 }
 
 // ---- encoder: compiled twice, for baseline x86-64 and for AVX2 ----------------------------------
-// bc6h_encoder.inl is the whole encoder; it is included once per instruction set, each time in its
-// own namespace with internal linkage, so no function compiled for AVX2 can be picked by the
-// linker for a baseline caller (the shared helpers above and the standard library's templates are
-// defined before the target pragma and keep the baseline target). The encoder's loops are written
-// to vectorise; AVX2 doubles their width. It uses no FMA (the target adds none, and the library is
-// built with -ffp-contract=off) and no reassociation, so both versions compute the same floats in
-// the same order and write the same bytes (tested on real maps for every quality).
+// bc6h_encoder.inl (with the two parts it includes) is the whole encoder; it is included once per
+// instruction set, each time in its own namespace with internal linkage, so no function compiled
+// for AVX2 can be picked by the linker for a baseline caller (the shared helpers above and the
+// standard library's templates are defined before the target pragma and keep the baseline
+// target). The encoder's loops are written to vectorise; AVX2 doubles their width. It uses no FMA
+// (the target adds none, and the library is built with -ffp-contract=off) and no reassociation, so
+// both versions compute the same floats in the same order and write the same bytes (tested on real
+// maps for every quality).
 // The encoder's 16-lane vector types never cross a function boundary (always inlined), so GCC's
 // note that passing them by value would change with AVX-512 does not apply (clang reads this
 // pragma too).

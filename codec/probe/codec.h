@@ -30,8 +30,36 @@ enum class DcFormat : std::uint8_t { kR11G11B10F = 0, kRGB9E5 = 1, kHalf = 2 };
 // Bound used for the non-zonal L2 ratios (Wiederien & Sloan: sqrt(15)/2 is tight).
 enum class L2Bound : std::uint8_t { kTight = 0, kLoose = 1 };
 
-// Options shared by the whole table. Each codec reads the ones that concern it; the probe
-// container stores the ones that change the meaning of stored bytes.
+// Whether stored SH are radiance or irradiance (band scales 1, 2/3, 1/4 applied). The ratio
+// intervals of irradiance are the radiance ones times the band scale (ZH3 paper App. A.1).
+enum class StoredKind : std::uint8_t { kRadiance = 0, kIrradiance = 1 };
+
+// How the asymmetric zonal interval [lo, hi] = [-sqrt(5)/2, sqrt(5)] is mapped to [-1, 1].
+enum class ZonalMapping : std::uint8_t {
+    // t = (2 r - (hi + lo)) / (hi - lo): the whole code range covers exactly the interval, so the
+    // step is 3/4 of the symmetric one; ratio 0 falls between codes.
+    kAffine = 0,
+    // t = r / hi for r >= 0, r / -lo for r < 0: ratio 0 stays at code 0 (what the square-root
+    // encoding wants, its precision is concentrated there); negative side has half the step.
+    kZeroPreserving = 1,
+    // t = r / sqrt(5): the symmetric interval of Listing 1 (Wiederien & Sloan), for comparison.
+    kSymmetric = 2,
+};
+
+// Which axis a ZH3 zonal coefficient lies on.
+enum class ZonalAxisMode : std::uint8_t {
+    kLuminance = 0,   // one axis from the luminance-weighted L1 (Sec. 3.2), default
+    kPerChannel = 1,  // each channel's own optimal linear direction (Sec. 3.1)
+};
+
+// The one parameter type of the table (issue 19): every entry's encode / decode / irradiance, the
+// quantiser (quantize.h, where it is also called QuantParams) and the probe container (probe_set.h,
+// StorageParams) take it. Two groups of fields:
+//  * storage parameters (luminance .. axis_mode below): they change what stored bytes mean, so the
+//    .zhp header and the glTF extension store them and decoders need them;
+//  * encoder controls (solver_*, hallucinate_*, dering_punctual): they only choose which bytes an
+//    encoder writes (hallucinate_a/b are also decoder constants of the hall_* entries, fixed at the
+//    defaults in files). Each entry reads the fields that concern it.
 struct CodecOptions {
     LuminanceWeights luminance;
     // ZH3 axis solve (ZH3 paper Sec. 3.3): L-BFGS iteration cap per start (a convergence guard; the
@@ -42,10 +70,13 @@ struct CodecOptions {
     double hallucinate_a = 0.6;
     double hallucinate_b = 0.08;
     // Quantised layouts (ZH3 paper App. A.1; Wiederien & Sloan).
-    int bits = 8;
-    bool sqrt_encoding = false;
+    int bits = 8;                 // 2..8 per ratio; codes use the low `bits` bits of a byte
+    bool sqrt_encoding = false;   // sign-preserving square root before rounding
     L2Bound l2_bound = L2Bound::kTight;
     DcFormat dc_format = DcFormat::kR11G11B10F;
+    StoredKind kind = StoredKind::kRadiance;
+    ZonalMapping zonal_mapping = ZonalMapping::kAffine;
+    ZonalAxisMode axis_mode = ZonalAxisMode::kLuminance;  // zh3_q16's stored axis (container field)
     // Deringing (Sloan 2017): treat the source as punctual lights (extra windowing).
     bool dering_punctual = false;
 };

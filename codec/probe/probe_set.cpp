@@ -6,12 +6,15 @@
 namespace zhc {
 
 CodecOptions codec_options(const StorageParams& p, const CodecOptions& base) {
-    CodecOptions o = base;
+    CodecOptions o = base;  // encoder controls
     o.luminance = p.luminance;
     o.bits = p.bits;
     o.sqrt_encoding = p.sqrt_encoding;
     o.l2_bound = p.l2_bound;
     o.dc_format = p.dc_format;
+    o.kind = p.kind;
+    o.zonal_mapping = p.zonal_mapping;
+    o.axis_mode = p.axis_mode;
     return o;
 }
 
@@ -85,19 +88,16 @@ Status validate_probe_set(const ProbeSet& set) {
 
 void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radiance& hub, std::uint8_t* out,
                   EncodeStats* stats, const CodecOptions& base) {
-    if (codec.packed) {  // the entry's own encoder with every storage parameter (kind: scaled bounds)
-        codec.packed->encode(hub, params, codec_options(params, base), out, stats);
-        return;
-    }
     const CodecOptions o = codec_options(params, base);
-    if (params.kind == StoredKind::kIrradiance) codec.encode(as_radiance_type(to_irradiance(hub)), o, out, stats);
-    else codec.encode(hub, o, out, stats);
+    // Packed entries read every storage parameter themselves (kind: scaled bounds); the float
+    // entries store what they are given, so irradiance is converted here.
+    if (codec.packed || params.kind != StoredKind::kIrradiance) codec.encode(hub, o, out, stats);
+    else codec.encode(as_radiance_type(to_irradiance(hub)), o, out, stats);
 }
 
 Sh3Radiance decode_probe(const Codec& codec, const StorageParams& params, const std::uint8_t* in) {
-    if (codec.packed) return codec.packed->decode(in, params, codec_options(params));
-    const Sh3Radiance stored = codec.decode(in, codec_options(params));
-    if (params.kind != StoredKind::kIrradiance) return stored;
+    const Sh3Radiance stored = codec.decode(in, params);
+    if (codec.packed || params.kind != StoredKind::kIrradiance) return stored;
     Sh3Irradiance e;
     e.c = stored.c;
     return to_radiance(e);

@@ -45,10 +45,11 @@ struct ProbeLayout {
     std::vector<std::array<float, 3>> positions;  // kPositions only: one per probe
 };
 
-// Everything that changes how a payload decodes, as stored in a .zhp header. For the quantised
-// layouts these are all of QuantParams; the float representations read only the luminance
-// weights (ZH3 axes) and `kind` (see below).
-using StorageParams = QuantParams;
+// Everything that changes how a payload decodes, as stored in a .zhp header: the storage fields
+// of CodecOptions (codec.h, the table's one parameter type; StorageParams is the same type). The
+// quantised layouts read all of them; the float representations read only the luminance weights
+// (ZH3 axes) and `kind` (see below).
+using StorageParams = CodecOptions;
 
 struct ProbeSet {
     std::string representation = "sh3";  // codec table name
@@ -61,8 +62,8 @@ struct ProbeSet {
     const Codec* codec() const { return find_codec(representation); }
 };
 
-// Options for the codec table entries that match `params` (bits, sqrt, bound, DC format,
-// luminance weights), on top of `base` (solver iterations and other encode-only knobs).
+// The storage fields of `params` (luminance .. axis_mode) over the encoder controls of `base`
+// (solver iterations and other encode-only knobs).
 CodecOptions codec_options(const StorageParams& params, const CodecOptions& base = {});
 
 // Checks every invariant above; kInvalidArgument naming the first broken one.

@@ -53,16 +53,6 @@ RatioInterval ratio_interval(int sh_index, StoredKind kind, L2Bound l2_bound) {
 
 // ---- parameters ----------------------------------------------------------------------------
 
-QuantParams quant_params(const CodecOptions& o) {
-    QuantParams p;
-    p.bits = o.bits;
-    p.sqrt_encoding = o.sqrt_encoding;
-    p.l2_bound = o.l2_bound;
-    p.dc_format = o.dc_format;
-    p.luminance = o.luminance;
-    return p;
-}
-
 Status validate_quant_params(const QuantParams& p, std::string_view layout_name) {
     if (p.bits < kMinQuantBits || p.bits > kMaxQuantBits)
         return make_error(ErrorCode::kInvalidArgument, "quantisation bits must be " + std::to_string(kMinQuantBits) +
@@ -389,10 +379,8 @@ void encode_impl(PackedLayout layout, const Sh3Radiance& hub, const QuantParams&
     Coeffs c = stored_coefficients(hub, p.kind);
     if (layout == PackedLayout::kZh3Q16 && controls.solve_axis) {
         // Replace the L1 by the solved one (same DC); L2 stays the target for the zonal refit.
-        CodecOptions so = controls.solver;
-        so.luminance = p.luminance;
         EncodeStats solve_stats;
-        const Zh3 z = zh3_solve(hub, p.axis_mode, so, &solve_stats);
+        const Zh3 z = zh3_solve(hub, p.axis_mode, p, &solve_stats);
         if (stats) stats->solver_iterations += solve_stats.solver_iterations;
         for (int i = 1; i < 4; ++i)
             for (int k = 0; k < 3; ++k)
@@ -526,9 +514,9 @@ Sh3Radiance quantize_roundtrip(PackedLayout layout, const Sh3Radiance& hub, cons
     return hub_from_stored(q, params.kind);
 }
 
-Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const QuantParams& params, const CodecOptions& options) {
+Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const CodecOptions& params) {
     // ZH3 paper Sec. 3.4.3, Eq. 21 on the decoder's axis (luminance by default).
-    const Zh3 z = zh3_hallucinate(truncate_to_sh2(linear_hub), Hallucination::kCurve, params.axis_mode, options);
+    const Zh3 z = zh3_hallucinate(truncate_to_sh2(linear_hub), Hallucination::kCurve, params.axis_mode, params);
     return zh3_expand(z, params.axis_mode, params.luminance);
 }
 
@@ -536,25 +524,22 @@ Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const QuantParams& 
 
 namespace {
 template <PackedLayout L>
-void encode_plain(const Sh3Radiance& in, const QuantParams& p, const CodecOptions&, std::uint8_t* out,
-                  EncodeStats* stats) {
+void encode_plain(const Sh3Radiance& in, const CodecOptions& p, std::uint8_t* out, EncodeStats* stats) {
     encode_packed(L, in, p, out, stats);
 }
 template <PackedLayout L>
-Sh3Radiance decode_plain(const std::uint8_t* in, const QuantParams& p, const CodecOptions&) {
+Sh3Radiance decode_plain(const std::uint8_t* in, const CodecOptions& p) {
     return decode_packed(L, in, p);
 }
 
-void encode_solved_q16(const Sh3Radiance& in, const QuantParams& p, const CodecOptions& o, std::uint8_t* out,
-                       EncodeStats* stats) {
+void encode_solved_q16(const Sh3Radiance& in, const CodecOptions& p, std::uint8_t* out, EncodeStats* stats) {
     QuantEncodeControls c;
-    c.solve_axis = true;
-    c.solver = o;
+    c.solve_axis = true;  // the solver's iterations and tolerance: p's encoder controls
     encode_packed(PackedLayout::kZh3Q16, in, p, out, stats, c);
 }
 
-Sh3Radiance decode_hall_curve(const std::uint8_t* in, const QuantParams& p, const CodecOptions& o) {
-    return hallucinate_curve(decode_packed(PackedLayout::kSh2Q, in, p), p, o);
+Sh3Radiance decode_hall_curve(const std::uint8_t* in, const CodecOptions& p) {
+    return hallucinate_curve(decode_packed(PackedLayout::kSh2Q, in, p), p);
 }
 
 constexpr PackedCodec kZh3Q16{PackedLayout::kZh3Q16, encode_plain<PackedLayout::kZh3Q16>,

@@ -30,21 +30,7 @@ namespace zhc {
 
 // ---- bound intervals -----------------------------------------------------------------------
 
-// Whether the stored SH are radiance or irradiance (band scales 1, 2/3, 1/4 applied). The ratio
-// intervals of irradiance are the radiance ones times the band scale (App. A.1).
-enum class StoredKind : std::uint8_t { kRadiance = 0, kIrradiance = 1 };
-
-// How the asymmetric zonal interval [lo, hi] = [-sqrt(5)/2, sqrt(5)] is mapped to [-1, 1].
-enum class ZonalMapping : std::uint8_t {
-    // t = (2 r - (hi + lo)) / (hi - lo): the whole code range covers exactly the interval, so the
-    // step is 3/4 of the symmetric one; ratio 0 falls between codes.
-    kAffine = 0,
-    // t = r / hi for r >= 0, r / -lo for r < 0: ratio 0 stays at code 0 (what the square-root
-    // encoding wants, its precision is concentrated there); negative side has half the step.
-    kZeroPreserving = 1,
-    // t = r / sqrt(5): the symmetric interval of Listing 1 (Wiederien & Sloan), for comparison.
-    kSymmetric = 2,
-};
+// StoredKind and ZonalMapping: codec/probe/codec.h (fields of CodecOptions).
 
 struct RatioInterval {
     double lo = -1, hi = 1;
@@ -58,23 +44,13 @@ RatioInterval zonal_l2_interval(StoredKind kind);
 
 // ---- the parameters a quantised layout depends on ------------------------------------------
 
-// Everything that changes the meaning of stored quantised bytes. The codec table entries use
-// quant_params(CodecOptions) (radiance, luminance axis, default zonal mapping); the probe container
-// stores all of these in its header, so non-default values round-trip through files.
-struct QuantParams {
-    int bits = 8;                    // 2..8 per ratio; codes use the low `bits` bits of a byte
-    bool sqrt_encoding = false;      // sign-preserving square root before rounding
-    L2Bound l2_bound = L2Bound::kTight;
-    DcFormat dc_format = DcFormat::kR11G11B10F;
-    StoredKind kind = StoredKind::kRadiance;
-    ZonalMapping zonal_mapping = ZonalMapping::kAffine;
-    ZonalAxisMode axis_mode = ZonalAxisMode::kLuminance;  // zh3_q16 only
-    LuminanceWeights luminance;                           // zh3_q16 luminance axis only
-};
+// The quantiser's parameters are CodecOptions (codec.h), the table's one parameter type; the
+// storage fields there (bits .. axis_mode) change the meaning of stored quantised bytes, and the
+// probe container stores all of them in its header, so non-default values round-trip through files.
+using QuantParams = CodecOptions;
 inline constexpr int kMinQuantBits = 2;
 inline constexpr int kMaxQuantBits = 8;
 
-QuantParams quant_params(const CodecOptions& options);
 // Checks the ranges and the combination with a layout (e.g. a half DC needs 6 bytes, which only
 // sh2_q has). `layout_name` may be any codec name; non-quantised names only get the range checks.
 Status validate_quant_params(const QuantParams& params, std::string_view layout_name);
@@ -138,8 +114,8 @@ constexpr std::size_t packed_size_bytes(PackedLayout layout) {
 // entries.
 bool packed_layout_from_name(std::string_view name, PackedLayout* out);
 // The Eq. 21 hallucination of the entry "hall_curve_q": f20 = (a p^2 + b p) f0 with
-// options.hallucinate_a/b on params.axis_mode's axis, added to decoded linear SH.
-Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const QuantParams& params, const CodecOptions& options);
+// params.hallucinate_a/b on params.axis_mode's axis, added to decoded linear SH.
+Sh3Radiance hallucinate_curve(const Sh3Radiance& linear_hub, const CodecOptions& params);
 
 // Quantisation controls that are not part of the stored format (they never change how bytes
 // decode, only which bytes the encoder picks). Defaults are what the codec table uses.
@@ -149,9 +125,9 @@ struct QuantEncodeControls {
     bool refit_zonal_after_l1 = true;
     // zh3_q16: take the L1 to quantise from the BFGS axis solve (zh3_solve, ZH3 paper Sec. 3.3,
     // Eq. 11) instead of the projection; the zonal is still refitted on the decoder's axis. The
-    // bytes decode with the ordinary zh3_q16 decoder (entry "zh3_solved_q16"). Slower encode.
+    // bytes decode with the ordinary zh3_q16 decoder (entry "zh3_solved_q16"). Slower encode; the
+    // solve's iterations and tolerance are the params' encoder controls.
     bool solve_axis = false;
-    CodecOptions solver;  // iterations, tolerance (luminance weights come from QuantParams)
     // zh3_q16: whole-sphere deringing (entry "zh3_dering_q16", codec/probe/zh3_window.h): the probe is
     // windowed, quantised, decoded, and windowed further while the DECODED irradiance has a
     // negative certified minimum anywhere on the sphere.
@@ -179,35 +155,24 @@ Sh3Radiance quantize_roundtrip(PackedLayout layout, const Sh3Radiance& hub, cons
 
 // ---- table entries that store a packed layout (Codec::packed) --------------------------------
 
-// What the probe container needs from a quantised table entry: its layout, and its encoder and
-// decoder with every storage parameter (the Codec functions only see CodecOptions, i.e. radiance,
-// the affine zonal mapping and the luminance axis). Everything entry-specific (which solve, which
-// axis, a hallucination at decode) lives in these two functions, never in a test of the name.
+// What the table, the container and the runtimes need from a quantised entry: its layout, and its
+// encoder and decoder, which take every parameter (storage and encoder controls) in the one
+// CodecOptions. Everything entry-specific (which solve, which axis, a hallucination at decode)
+// lives in these two functions, never in a test of the name.
 struct PackedCodec {
     PackedLayout layout;
-    void (*encode)(const Sh3Radiance& hub, const QuantParams& params, const CodecOptions& options, std::uint8_t* out,
-                   EncodeStats* stats);
-    Sh3Radiance (*decode)(const std::uint8_t* in, const QuantParams& params, const CodecOptions& options);
+    void (*encode)(const Sh3Radiance& hub, const CodecOptions& params, std::uint8_t* out, EncodeStats* stats);
+    Sh3Radiance (*decode)(const std::uint8_t* in, const CodecOptions& params);
 };
 
-// The Codec functions of a packed entry P: its own functions with quant_params(options).
-template <const PackedCodec& P>
-void packed_entry_encode(const Sh3Radiance& in, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
-    P.encode(in, quant_params(o), o, out, stats);
-}
-template <const PackedCodec& P>
-Sh3Radiance packed_entry_decode(const std::uint8_t* in, const CodecOptions& o) {
-    return P.decode(in, quant_params(o), o);
-}
+// A whole Codec entry for P: P's encode and decode, the irradiance of the decoded hub.
 template <const PackedCodec& P>
 Rgb packed_entry_irradiance(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
-    return irradiance(P.decode(in, quant_params(o), o), n);
+    return irradiance(P.decode(in, o), n);
 }
-// A whole Codec entry for P.
 template <const PackedCodec& P>
 constexpr Codec packed_codec(std::string_view name, std::string_view summary) {
-    return {name, summary, packed_size_bytes(P.layout), packed_entry_encode<P>, packed_entry_decode<P>,
-            packed_entry_irradiance<P>, &P};
+    return {name, summary, packed_size_bytes(P.layout), P.encode, P.decode, packed_entry_irradiance<P>, &P};
 }
 
 }  // namespace zhc

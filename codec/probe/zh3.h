@@ -16,10 +16,7 @@
 
 namespace zhc {
 
-enum class ZonalAxisMode : std::uint8_t {
-    kLuminance = 0,   // one axis from the luminance-weighted L1 (Sec. 3.2), default
-    kPerChannel = 1,  // each channel's own optimal linear direction (Sec. 3.1)
-};
+// ZonalAxisMode: codec/probe/codec.h.
 
 struct Zh3 {
     Sh2Radiance linear;  // DC and L1, radiance

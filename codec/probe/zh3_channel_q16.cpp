@@ -139,24 +139,20 @@ ChannelCodes solve_channel_codes(const ChannelCodeProblem& pr, const QuantParams
 namespace {
 
 // zh3_channel_q16: the zh3_q16 encoder with the per-channel axis (zonal refitted on the decoder's axis).
-void encode_fit(const Sh3Radiance& in, const QuantParams& p, const CodecOptions&, std::uint8_t* out,
-                EncodeStats* stats) {
+void encode_fit(const Sh3Radiance& in, const CodecOptions& p, std::uint8_t* out, EncodeStats* stats) {
     encode_packed(PackedLayout::kZh3Q16, in, per_channel(p), out, stats);
 }
 
 // zh3_solved_channel_q16: start from the fitted bytes; per channel, search the L1 codes from two
 // starts (the fitted codes and the quantised L1 of the float per-channel axis solve, zh3_solve)
 // for the lowest error of the decoded probe; the zonal code is the best for the final L1.
-void encode_solved(const Sh3Radiance& in, const QuantParams& params, const CodecOptions& o, std::uint8_t* out,
-                   EncodeStats* stats) {
-    const QuantParams p = per_channel(params);
+void encode_solved(const Sh3Radiance& in, const CodecOptions& params, std::uint8_t* out, EncodeStats* stats) {
+    const CodecOptions p = per_channel(params);
     EncodeStats fit_stats;
     encode_packed(PackedLayout::kZh3Q16, in, p, out, &fit_stats);
     if (stats) stats->clamped_ratios += fit_stats.clamped_ratios;
-    CodecOptions so = o;
-    so.luminance = p.luminance;
     EncodeStats solve_stats;
-    const Zh3 solved = zh3_solve(in, ZonalAxisMode::kPerChannel, so, &solve_stats);
+    const Zh3 solved = zh3_solve(in, ZonalAxisMode::kPerChannel, p, &solve_stats);
     if (stats) stats->solver_iterations += solve_stats.solver_iterations;
     const Rgb dc = load_dc(out, q16_dc_format(p.dc_format));
     const double s1 = p.kind == StoredKind::kIrradiance ? kIrradianceBandScale[1] : 1.0;
@@ -192,7 +188,7 @@ void encode_solved(const Sh3Radiance& in, const QuantParams& params, const Codec
     }
 }
 
-Sh3Radiance decode(const std::uint8_t* in, const QuantParams& p, const CodecOptions&) {
+Sh3Radiance decode(const std::uint8_t* in, const CodecOptions& p) {
     return decode_packed(PackedLayout::kZh3Q16, in, per_channel(p));
 }
 

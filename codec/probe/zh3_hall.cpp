@@ -1,6 +1,6 @@
 // Hallucinate-solve and the adaptive hallucination scale (codec/probe/zh3_hall.h; derivation in docs/zh3.md).
 //
-// Vector form as codec/probe/zh3.cpp: channel k's radiance L1 (f1-1, f10, f11) is v = (-f11, -f1-1, f10).
+// Vector form as codec/probe/zh3_internal.h: channel k's radiance L1 (f1-1, f10, f11) is v = (-f11, -f1-1, f10).
 // Error in irradiance SH (band scales 1, 2/3, 1/4), per channel, with u the target's L1 vector, T2
 // its radiance L2, q = sqrt(4 pi/5) Y2(a) (a unit 5-vector) and h = q . T2:
 //   e = (4/9) |v - u|^2 + (1/16) (f20^2 - 2 f20 h + |T2|^2),   f20 = G(|v . a| / f0) f0.
@@ -469,30 +469,28 @@ constexpr int kScaleByte = 15;
 
 Sh3Radiance with_target_dc(const Sh2Radiance& linear) { return extend_to_sh3(linear); }
 
-Sh3Radiance decode_packed_hall(bool adaptive, const std::uint8_t* in, const QuantParams& p, const CodecOptions& o) {
+Sh3Radiance decode_packed_hall(bool adaptive, const std::uint8_t* in, const CodecOptions& p) {
     const Sh3Radiance linear = decode_packed(PackedLayout::kSh2Q, in, p);
     const double s = adaptive ? hall_scale_of_code(in[kScaleByte]) : 1.0;
-    return hall_scaled_expand(truncate_to_sh2(linear), s, p.axis_mode, o);
+    return hall_scaled_expand(truncate_to_sh2(linear), s, p.axis_mode, p);
 }
 
 // Encodes the candidate linear SH with scale code `code` and returns the decoder's error.
 double encode_candidate(bool adaptive, const Sh3Radiance& target, const Sh2Radiance& linear, std::uint8_t code,
-                        const QuantParams& p, const CodecOptions& o, std::uint8_t* out, EncodeStats* stats) {
+                        const CodecOptions& p, std::uint8_t* out, EncodeStats* stats) {
     encode_packed(PackedLayout::kSh2Q, with_target_dc(linear), p, out, stats);
     if (adaptive) out[kScaleByte] = code;
-    return irradiance_sq_error(target, decode_packed_hall(adaptive, out, p, o));
+    return irradiance_sq_error(target, decode_packed_hall(adaptive, out, p));
 }
 
-void encode_hall_packed(bool adaptive, const Sh3Radiance& hub, const QuantParams& p, const CodecOptions& o,
-                        std::uint8_t* out, EncodeStats* stats) {
-    CodecOptions so = o;
-    so.luminance = p.luminance;
+void encode_hall_packed(bool adaptive, const Sh3Radiance& hub, const CodecOptions& p, std::uint8_t* out,
+                        EncodeStats* stats) {
     std::uint8_t best[16], cand[16];
     // Candidate 0: the target's own L1 (s = 0 for the adaptive layout: exactly sh2_q plus a zero
     // byte; s = 1 for hall_solved_q16: exactly hall_curve_q's bytes).
     EncodeStats best_stats, cand_stats;
     const Sh2Radiance plain = truncate_to_sh2(hub);
-    double best_err = encode_candidate(adaptive, hub, plain, 0, p, so, best, &best_stats);
+    double best_err = encode_candidate(adaptive, hub, plain, 0, p, best, &best_stats);
     int iterations = 0;
     const int first = adaptive ? 1 : 0;
     const int last = adaptive ? kHallScaleCodeCount - 1 : 0;
@@ -502,10 +500,10 @@ void encode_hall_packed(bool adaptive, const Sh3Radiance& hub, const QuantParams
     for (int code = first; code <= last; ++code) {
         const double s = adaptive ? hall_scale_of_code(static_cast<std::uint8_t>(code)) : 1.0;
         EncodeStats solve_stats;
-        const Sh2Radiance lin = solve_impl(hub, s, p.axis_mode, so, &solve_stats, warm, code > first);
+        const Sh2Radiance lin = solve_impl(hub, s, p.axis_mode, p, &solve_stats, warm, code > first);
         iterations += solve_stats.solver_iterations;
         cand_stats = {};
-        const double e = encode_candidate(adaptive, hub, lin, static_cast<std::uint8_t>(code), p, so, cand, &cand_stats);
+        const double e = encode_candidate(adaptive, hub, lin, static_cast<std::uint8_t>(code), p, cand, &cand_stats);
         if (e < best_err) {
             best_err = e;
             std::memcpy(best, cand, 16);
@@ -538,18 +536,14 @@ Rgb irradiance_solved(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
                           ZonalAxisMode::kLuminance, o.luminance, n);
 }
 
-// The packed entries' own encoder/decoder with every storage parameter (Codec::packed): the
-// probe container calls these directly, the Codec functions through quant_params(options).
+// The packed entries' encoder/decoder (Codec::packed), with every parameter in one CodecOptions.
 template <bool Adaptive>
-void encode_q(const Sh3Radiance& hub, const QuantParams& params, const CodecOptions& options, std::uint8_t* out,
-              EncodeStats* stats) {
-    encode_hall_packed(Adaptive, hub, params, options, out, stats);
+void encode_q(const Sh3Radiance& hub, const CodecOptions& params, std::uint8_t* out, EncodeStats* stats) {
+    encode_hall_packed(Adaptive, hub, params, out, stats);
 }
 template <bool Adaptive>
-Sh3Radiance decode_q(const std::uint8_t* in, const QuantParams& params, const CodecOptions& options) {
-    CodecOptions o = options;
-    o.luminance = params.luminance;
-    return decode_packed_hall(Adaptive, in, params, o);
+Sh3Radiance decode_q(const std::uint8_t* in, const CodecOptions& params) {
+    return decode_packed_hall(Adaptive, in, params);
 }
 
 constexpr PackedCodec kHallSolvedQ16{PackedLayout::kSh2Q, encode_q<false>, decode_q<false>};

@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Vector form of channel k's L1 band: f1(d) = kY1 v . d (codec/probe/zh3.cpp uses the same).
+// Vector form of channel k's L1 band: f1(d) = kY1 v . d (codec/probe/zh3_internal.h uses the same).
 Vec3 l1_vector(const Sh2Radiance& s, int k) { return {-double(s[3][k]), -double(s[1][k]), double(s[2][k])}; }
 
 // Channel k's irradiance as a function of the angle theta to its zonal axis, at the worst azimuth:
@@ -194,13 +194,12 @@ Rgb irradiance_zh3_lum(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
     return zh3_lum_entry().irradiance(in, o, n);
 }
 
-void encode_dering_q16(const Sh3Radiance& in, const QuantParams& p, const CodecOptions&, std::uint8_t* out,
-                       EncodeStats* stats) {
+void encode_dering_q16(const Sh3Radiance& in, const CodecOptions& p, std::uint8_t* out, EncodeStats* stats) {
     QuantEncodeControls c;
     c.dering = true;
     encode_packed(PackedLayout::kZh3Q16, in, p, out, stats, c);
 }
-Sh3Radiance decode_q16(const std::uint8_t* in, const QuantParams& p, const CodecOptions&) {
+Sh3Radiance decode_q16(const std::uint8_t* in, const CodecOptions& p) {
     return decode_packed(PackedLayout::kZh3Q16, in, p);
 }
 constexpr PackedCodec kDeringQ16{PackedLayout::kZh3Q16, encode_dering_q16, decode_q16};

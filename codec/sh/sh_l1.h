@@ -1,5 +1,5 @@
 // zhc/codec/sh/sh_l1.h — internal to codec/: the L1 band of one colour channel as a vector (shared by
-// zh3.cpp and zh3_hall.cpp).
+// the codec/probe/zh3*.cpp files).
 #pragma once
 
 #include <cstdint>

@@ -526,12 +526,19 @@ std::string probe_json(const ProbeList& list) {
     return doc.dump() + "\n";
 }
 
-Status write_probe_json(const std::string& path, const ProbeList& list) {
-    for (const Sh3Radiance& sh : list.probes)
+Status check_finite_probes(std::span<const Sh3Radiance> probes, const std::string& name) {
+    for (size_t n = 0; n < probes.size(); ++n)
         for (int i = 0; i < 9; ++i)
             for (int k = 0; k < 3; ++k)
-                if (!std::isfinite(sh[i][k]))
-                    return make_error(ErrorCode::kInvalidValue, path + ": a probe holds NaN/Inf; JSON cannot store it");
+                if (!std::isfinite(probes[n][i][k]))
+                    return make_error(ErrorCode::kInvalidValue, name + ": probe " + std::to_string(n) + " holds NaN/Inf (coefficient " +
+                                                                    std::to_string(i) + ", channel " + std::to_string(k) + ")");
+    return Ok{};
+}
+
+Status write_probe_json(const std::string& path, const ProbeList& list) {
+    if (!check_finite_probes(list.probes, path))
+        return make_error(ErrorCode::kInvalidValue, path + ": a probe holds NaN/Inf; JSON cannot store it");
     const std::string text = probe_json(list);
     return write_file_atomic(path, std::vector<std::uint8_t>(text.begin(), text.end()));
 }

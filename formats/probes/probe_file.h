@@ -69,6 +69,13 @@ Status write_probe_file(const std::string& path, const ProbeSet& set, const Prob
 Result<ProbeSet> read_probe_file(const std::string& path, const ProbeFileLimits& limits = {},
                                  ProbeFileInfo* info = nullptr);
 
+// ok when every coefficient of every probe is finite, else kInvalidValue naming `name` and the
+// first probe with NaN/Inf. A .zhp or glTF payload can hold them (float entries store any bits; a
+// half or R11G11B10F DC can encode Inf/NaN): the verbs that compute with probes (convert, audit,
+// gltf embed) refuse such input (exit 4) instead of encoding or averaging NaN; zhc info describes
+// it (non_finite_probes).
+Status check_finite_probes(std::span<const Sh3Radiance> probes, const std::string& name);
+
 // ---- JSON probe list -----------------------------------------------------------------------
 
 struct ProbeList {

@@ -15,11 +15,6 @@ namespace zhc {
 
 namespace fs = std::filesystem;
 
-std::vector<Rgb> AuditInput::reference_for(std::size_t probe, const std::vector<Vec3>& dirs) const {
-    if (kind == "envmap" && probe == 0 && map_reference.size() == dirs.size()) return map_reference;
-    return sh3_irradiance(probes[probe], dirs);
-}
-
 namespace {
 bool audit_extension(const std::string& ext) { return ext == ".exr" || ext == ".hdr" || ext == ".zhp" || ext == ".json"; }
 }  // namespace
@@ -76,6 +71,7 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         if (!set) return set.error();
         auto hub = decode_probe_set(*set);
         if (!hub) return hub.error();
+        if (Status finite = check_finite_probes(*hub, path); !finite) return finite.error();
         in.kind = "probes";
         in.probes = std::move(hub).value();
         in.description = std::to_string(in.probes.size()) + " probes stored as " + set->representation +
@@ -90,8 +86,27 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         in.description = std::to_string(in.probes.size()) + " probes (JSON), reference: their SH3";
         return in;
     }
-    return make_error(ErrorCode::kUnsupported,
-                      path + ": not an environment map (.exr, .hdr), probe container (.zhp) or JSON probe list");
+    // The same code and words as convert and info for a file of no known format (exit 4).
+    return make_error(ErrorCode::kBadFormat,
+                      path + ": not an environment map (EXR/.hdr, KTX2/DDS cube map), .zhp probe file or JSON probe list");
+}
+
+Result<AuditedFiles> audit_files(const std::vector<std::string>& files, const std::vector<Vec3>& dirs,
+                                 const std::vector<const Codec*>& codecs, const AuditOptions& options,
+                                 const AuditLoadOptions& load, const AuditFileHook& after_input) {
+    AuditedFiles out;
+    std::vector<InputAudit> audited;
+    for (size_t i = 0; i < files.size(); ++i) {
+        auto input = load_audit_input(files[i], dirs, load);
+        if (!input) return input.error();
+        audited.push_back(audit_input(*input, dirs, codecs, options));
+        if (after_input) {
+            if (Status s = after_input(*input, audited.back(), i); !s) return s.error();
+        }
+        out.inputs.push_back(std::move(input).value());
+    }
+    out.run = summarize_audit(std::move(audited));
+    return out;
 }
 
 Status write_audit_images(const std::string& dir, const AuditInput& input, const std::vector<Vec3>&,

@@ -1,10 +1,12 @@
 // zhc/formats/report/audit_inputs.h — what `zhc audit` reads and the pictures it writes.
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
-#include "codec/report/audit.h"
+#include "codec/report/audit_run.h"
 #include "codec/status.h"
 
 namespace zhc {
@@ -15,25 +17,26 @@ struct AuditLoadOptions {
     std::string part;  // EXR part (EnvmapReadOptions::part)
 };
 
-// One audited file: its probes (SH3 radiance hubs) and, for an environment map, the map itself
-// (downsampled) and the true irradiance at the audit directions.
-struct AuditInput {
-    std::string path;
-    std::string kind;         // "envmap" or "probes"
-    std::string description;  // one line for the report
-    std::vector<Sh3Radiance> probes;
-    LatLongImage map;                  // envmaps: the flux-preserving downsample used as reference
-    std::vector<Rgb> map_reference;    // envmaps: E(n) at the audit directions
-    // The reference irradiance of probe p at `dirs` (the map's for an envmap, else the probe's SH3).
-    std::vector<Rgb> reference_for(std::size_t probe, const std::vector<Vec3>& dirs) const;
-};
-
 // Files and folders -> the list of files to audit (folders: their .exr/.hdr/.zhp/.json files,
 // sorted by name, not recursive). Missing paths are an error.
 Result<std::vector<std::string>> expand_audit_inputs(const std::vector<std::string>& paths);
 
+// Reads one file as an AuditInput (codec/report/audit_run.h): an environment map (.exr, .hdr; its
+// reference integrated at `dirs`), a probe container or a JSON probe list.
 Result<AuditInput> load_audit_input(const std::string& path, const std::vector<Vec3>& dirs,
                                     const AuditLoadOptions& options);
+
+// The audit of files: each is loaded (load_audit_input) and audited (audit_input) in order; then
+// aggregated and gated (summarize_audit). `after_input` (if set) runs after each input's audit,
+// e.g. to write its pictures; a failure there stops the audit and is returned as is.
+struct AuditedFiles {
+    std::vector<AuditInput> inputs;  // as loaded, in file order
+    AuditRun run;                    // run.inputs[i] is the audit of inputs[i]
+};
+using AuditFileHook = std::function<Status(const AuditInput& input, const InputAudit& audit, std::size_t index)>;
+Result<AuditedFiles> audit_files(const std::vector<std::string>& files, const std::vector<Vec3>& dirs,
+                                 const std::vector<const Codec*>& codecs, const AuditOptions& options,
+                                 const AuditLoadOptions& load, const AuditFileHook& after_input = {});
 
 // Writes DIR/<input stem>.png: one row per reference/representation, each a lat-long irradiance
 // strip (tone-mapped, negative irradiance in magenta) beside a false-colour error strip, labelled.
