@@ -40,14 +40,16 @@ Image load_envmap(const std::string& path) {
 
 std::string envmap_name(const std::string& path) { return fs::path(path).stem().string(); }
 
-long sample_count(long n) {
+long scaled_count(long n, long at_least) {
     static const double scale = [] {
         const char* v = std::getenv("ZHC_TEST_SAMPLE_SCALE");
         const double s = v ? std::strtod(v, nullptr) : 1.0;
         return (s > 0.0 && s <= 1.0) ? s : 1.0;
     }();
-    return std::max(std::min(n, 1000L), static_cast<long>(std::llround(double(n) * scale)));
+    return std::min(n, std::max(at_least, static_cast<long>(std::llround(double(n) * scale))));
 }
+
+long sample_count(long n) { return scaled_count(n, std::min(n, 1000L)); }
 
 std::vector<Vec3> fibonacci_directions(int n) {
     std::vector<Vec3> out;

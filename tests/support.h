@@ -30,6 +30,11 @@ std::vector<Vec3> fibonacci_directions(int n);
 // for memory errors and undefined behaviour on the same code paths, the Release pass (full
 // counts) for the statistics. Thresholds never change.
 long sample_count(long n);
+// The same scale for the slow brute-force twins (exhaustive scans, dense sampling over many random
+// inputs) where the sanitizer pass needs the code paths, not the count: n times
+// ZHC_TEST_SAMPLE_SCALE, at least at_least, at most n. Without the variable (the Release pass) it is
+// n, so the Release pass asserts exactly what it did before; a test using it says so in a comment.
+long scaled_count(long n, long at_least);
 // Uniform random unit vector from two uniforms in [0, 1).
 Vec3 uniform_direction(double u1, double u2);
 
