@@ -88,7 +88,7 @@ int run(const Options& o) {
         list.probes = *probes;
         list.layout = layout;
         if (!codec->traits.exact) {  // a lossy entry: the JSON holds what it decodes to
-            auto hub = round_trip_probes(list.probes, o.to, StorageParams{}, layout);
+            auto hub = round_trip_probes(list.probes, o.to, CodecOptions{}, layout);
             if (!hub) return report(hub.error());
             list.probes = std::move(hub).value();
         }
@@ -96,7 +96,7 @@ int run(const Options& o) {
         std::printf("%s: %zu probes as JSON float SH3 radiance\n", o.output.c_str(), list.probes.size());
         return kExitOk;
     }
-    auto set = encode_probe_set(*probes, o.to, StorageParams{}, layout);
+    auto set = encode_probe_set(*probes, o.to, CodecOptions{}, layout);
     if (!set) return report(set.error());
     if (gltf_out) {
         // Into a copy of the input asset (everything of it kept, docs/gltf-extension.md), or into

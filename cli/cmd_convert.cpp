@@ -33,7 +33,7 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     int threads = 1;
-    std::vector<CLI::Option*> storage_flags;  // the options that set StorageParams
+    std::vector<CLI::Option*> storage_flags;  // the options that set CodecOptions
     bool any_storage_flag() const {
         for (const CLI::Option* opt : storage_flags)
             if (opt->count() > 0) return true;
@@ -82,8 +82,8 @@ Result<Loaded> load_input(const Options& o) {
     return in;
 }
 
-Result<StorageParams> params_from(const Options& o) {
-    StorageParams p;
+Result<CodecOptions> params_from(const Options& o) {
+    CodecOptions p;
     p.bits = o.bits;
     p.sqrt_encoding = o.sqrt;
     p.l2_bound = o.bound == "loose" ? L2Bound::kLoose : L2Bound::kTight;
@@ -95,7 +95,7 @@ Result<StorageParams> params_from(const Options& o) {
     return p;
 }
 
-bool same_params(const StorageParams& a, const StorageParams& b) {
+bool same_params(const CodecOptions& a, const CodecOptions& b) {
     return a.bits == b.bits && a.sqrt_encoding == b.sqrt_encoding && a.l2_bound == b.l2_bound &&
            a.dc_format == b.dc_format && a.kind == b.kind && a.zonal_mapping == b.zonal_mapping &&
            a.axis_mode == b.axis_mode && a.luminance.r == b.luminance.r && a.luminance.g == b.luminance.g &&

@@ -91,7 +91,7 @@ int run(const Options& o) {
     const ProbeLayout layout = probe_layout(scene.probes);
     ProbeSet q16_set;
     for (const char* rep_name : {"sh3", "zh3_q16"}) {
-        auto set = encode_probe_set(probes, rep_name, StorageParams{}, layout);
+        auto set = encode_probe_set(probes, rep_name, CodecOptions{}, layout);
         if (!set) return report(set.error());
         if (std::string(rep_name) == "zh3_q16") q16_set = *set;
         if (Status s = write_probe_file(path(std::string("probes_") + rep_name + ".zhp"), *set); !s)

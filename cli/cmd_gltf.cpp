@@ -39,14 +39,14 @@ Result<ProbeSet> load_probes(const std::string& path, const std::string& encodin
         if (!hub) return hub.error();
         if (Status finite = check_finite_probes(*hub, path); !finite) return finite.error();
         if (encoding.empty() || encoding == set->representation) return set;
-        StorageParams params;
+        CodecOptions params;
         params.kind = set->params.kind;
         return convert_probe_set(*set, encoding, params);
     }
     if (looks_like_json(*bytes)) {
         auto list = parse_probe_json(*bytes, path);
         if (!list) return list.error();
-        return encode_probe_set(list->probes, encoding.empty() ? "sh3" : encoding, StorageParams{}, list->layout);
+        return encode_probe_set(list->probes, encoding.empty() ? "sh3" : encoding, CodecOptions{}, list->layout);
     }
     return make_error(ErrorCode::kBadFormat, path + ": not a .zhp probe container or JSON probe list");
 }

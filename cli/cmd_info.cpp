@@ -110,7 +110,7 @@ int run(const Options& o) {
         auto set = parse_probe_set(*bytes, o.path, {}, &info);
         if (!set) return report(set.error());
         const Codec* codec = set->codec();
-        const StorageParams& p = set->params;
+        const CodecOptions& p = set->params;
         j["type"] = "zhp probe container";
         j["version"] = info.version;
         j["representation"] = set->representation;

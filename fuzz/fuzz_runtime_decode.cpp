@@ -59,7 +59,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const auto table = codecs();
     if (size < 4 || table.empty()) return 0;
     const Codec& c = table[data[0] % table.size()];
-    StorageParams p;
+    CodecOptions p;
     p.bits = 2 + data[1] % 7;
     p.sqrt_encoding = (data[1] >> 3) & 1;
     p.l2_bound = L2Bound((data[1] >> 4) & 1);
@@ -89,7 +89,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const Vec3 nd{n[0], n[1], n[2]};
     PackedLayout layout;
     const Rgb ref_e = (p.kind == StoredKind::kRadiance && !packed_layout_from_name(c.name, &layout))
-                          ? c.irradiance(stored.data(), codec_options(p), nd)
+                          ? c.irradiance(stored.data(), p, nd)
                           : irradiance(decode_probe(c, p, stored.data()), nd);
     for (int k = 0; k < 3; ++k)
         if (!same(e[k], ref_e[k])) std::abort();

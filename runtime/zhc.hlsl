@@ -99,7 +99,7 @@ uint zhc_encoding_bytes(uint encoding)
     return 60u;  // the 15-float ZH3 layouts
 }
 
-// ---- format (what the probe container's header stores; codec/probe/quantize.h QuantParams) ----------
+// ---- format (what the probe container's header stores; CodecOptions storage fields, codec/probe/codec.h) --------
 #define ZHC_DC_R11G11B10F 0u
 #define ZHC_DC_RGB9E5 1u
 #define ZHC_DC_HALF 2u
@@ -127,7 +127,7 @@ struct ZhcFormat
     float hallA, hallB;      // Eq. 21 curve, f20 = (a p^2 + b p) f0 (defaults 0.6, 0.08)
 };
 
-// The codec table's defaults (CodecOptions / QuantParams defaults) for an encoding.
+// The codec table's defaults (CodecOptions defaults) for an encoding.
 ZhcFormat zhc_default_format(uint encoding)
 {
     ZhcFormat f;

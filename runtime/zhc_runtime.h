@@ -172,7 +172,7 @@ static inline int zhc__sh2q_layout(int e) {
            e == ZHC_ENC_HALL_ADAPTIVE_Q16;
 }
 
-/* Defaults of `zhc convert --to ENCODING` (cli/cmd_convert.cpp, codec/probe/quantize.h QuantParams):
+/* Defaults of `zhc convert --to ENCODING` (cli/cmd_convert.cpp, codec/probe/quantize.h CodecOptions):
  * 8 bits, no sqrt, tight bound, R11G11B10F DC, affine zonal mapping, luminance axis, radiance,
  * Rec. 709 weights (0.2126, 0.7152, 0.0722), Eq. 21 a = 0.6, b = 0.08.
  * Returns ZHC_OK, or ZHC_ERR_ARGUMENT for an unknown name (f then holds the defaults with

@@ -1,4 +1,4 @@
-// zhc/runtime/zhc_runtime_params.hpp — C++ bridge for code that has zhc's own StorageParams
+// zhc/runtime/zhc_runtime_params.hpp — C++ bridge for code that has zhc's own CodecOptions
 // (codec/probe/probe_set.h) and wants the matching zhc_probe_format of the C runtime (tests, fuzzers,
 // tools built with zhc's libraries). Not needed by engines, which fill the format from a .zhp
 // header or a glTF volume.
@@ -13,7 +13,7 @@
 namespace zhc {
 
 // The runtime format of `codec` stored with `params`; false when the runtime does not know the name.
-inline bool runtime_format(std::string_view codec, const StorageParams& params, zhc_probe_format* f) {
+inline bool runtime_format(std::string_view codec, const CodecOptions& params, zhc_probe_format* f) {
     if (zhc_probe_format_init(f, std::string(codec).c_str()) != ZHC_OK) return false;
     f->bits = params.bits;
     f->sqrt_encoding = params.sqrt_encoding;

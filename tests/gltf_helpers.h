@@ -229,7 +229,7 @@ inline Sh3Radiance blended_probe(Vec3 p) {
     return scale(sh, 1.0 / total);
 }
 
-inline ProbeSet scattered_set(std::size_t n, const std::string& rep, const StorageParams& params = {}) {
+inline ProbeSet scattered_set(std::size_t n, const std::string& rep, const CodecOptions& params = {}) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-1.0f, 8.0f);
     ProbeLayout layout;
@@ -245,7 +245,7 @@ inline ProbeSet scattered_set(std::size_t n, const std::string& rep, const Stora
     return std::move(set).value();
 }
 
-inline ProbeSet grid_set(const std::string& rep, const StorageParams& params = {}) {
+inline ProbeSet grid_set(const std::string& rep, const CodecOptions& params = {}) {
     ProbeLayout layout;
     layout.kind = ProbeLayoutKind::kGrid;
     layout.grid.origin = {-1.5, 0.25, 3};
@@ -271,7 +271,7 @@ inline void expect_same_set(const ProbeSet& a, const ProbeSet& b) {
         EXPECT_EQ(a.layout.grid.origin[k], b.layout.grid.origin[k]);
         EXPECT_EQ(a.layout.grid.spacing[k], b.layout.grid.spacing[k]);
     }
-    const StorageParams &p = a.params, &q = b.params;
+    const CodecOptions &p = a.params, &q = b.params;
     EXPECT_EQ(p.kind, q.kind);
     EXPECT_EQ(p.luminance.r, q.luminance.r);
     EXPECT_EQ(p.luminance.g, q.luminance.g);

@@ -119,9 +119,9 @@ inline Sh3Radiance random_probe(std::mt19937_64& rng, std::uint64_t i) {
 }
 
 // Random storage parameters valid for `codec` (validate_quant_params).
-inline StorageParams random_params(std::mt19937_64& rng, std::string_view codec) {
+inline CodecOptions random_params(std::mt19937_64& rng, std::string_view codec) {
     std::uniform_real_distribution<double> u(0, 1);
-    StorageParams p;
+    CodecOptions p;
     p.bits = 2 + int(rng() % 7);
     p.sqrt_encoding = rng() % 2;
     p.l2_bound = L2Bound(rng() % 2);

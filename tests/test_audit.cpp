@@ -193,7 +193,7 @@ TEST(AuditCli, AuditsProbeContainersAndNamesFailingProbes) {
     std::vector<Sh3Radiance> hubs;
     for (int i = 0; i < 3; ++i)
         hubs.push_back(project_cone(normalize_or({double(i), 1, 2}, {0, 0, 1}), 0.4, {2, 1, 1}) + project_constant({0.2f, 0.2f, 0.2f}));
-    auto set = encode_probe_set(hubs, "sh3", StorageParams{}, ProbeLayout{});
+    auto set = encode_probe_set(hubs, "sh3", CodecOptions{}, ProbeLayout{});
     ASSERT_TRUE(set) << set.error().message;
     const std::string path = test::temp_dir("audit_probes") + "/three.zhp";
     ASSERT_TRUE(write_probe_file(path, *set));

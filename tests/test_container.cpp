@@ -93,7 +93,7 @@ TEST(ProbeSet, EncodeDecodeConvertAndPositions) {
     EXPECT_EQ(q->payload, direct->payload);
     EXPECT_EQ(q->layout.grid.counts, set->layout.grid.counts);
     // Irradiance-stored sets decode back to the same radiance hub (float reps: up to rounding).
-    StorageParams irr;
+    CodecOptions irr;
     irr.kind = StoredKind::kIrradiance;
     auto e = encode_probe_set(hub, "sh3", irr, {});
     auto eb = decode_probe_set(*e);
@@ -113,7 +113,7 @@ TEST(ProbeSet, ValidationNamesTheBrokenInvariant) {
     const auto hub = grid_probes(3, 1, 1);
     EXPECT_EQ(encode_probe_set(hub, "nope", {}, {}).error().code, ErrorCode::kInvalidArgument);
     EXPECT_FALSE(encode_probe_set(hub, "sh3", {}, grid_layout(2, 1, 1)).ok());  // 2 != 3
-    StorageParams half;
+    CodecOptions half;
     half.dc_format = DcFormat::kHalf;
     EXPECT_FALSE(encode_probe_set(hub, "zh3_q16", half, {}).ok());
     EXPECT_TRUE(encode_probe_set(hub, "sh2_q", half, {}).ok());
@@ -151,7 +151,7 @@ TEST(ProbeFile, RoundTripsEveryLayoutRepresentationAndCompression) {
                 EXPECT_EQ(*serialize_probe_set(*back, wo), *bytes);
             }
     // Non-default parameters round-trip through the header.
-    StorageParams p;
+    CodecOptions p;
     p.bits = 5;
     p.sqrt_encoding = true;
     p.l2_bound = L2Bound::kLoose;

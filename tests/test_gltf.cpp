@@ -55,21 +55,21 @@ TEST(GltfProbes, FloatSh3LosslessEveryLayoutBothContainers) {
 
 TEST(GltfProbes, QuantisedBitExact) {
     const Bytes scene = write_model(make_scene(false), true);
-    StorageParams odd;
+    CodecOptions odd;
     odd.bits = 6;
     odd.sqrt_encoding = true;
     odd.zonal_mapping = ZonalMapping::kZeroPreserving;
     odd.l2_bound = L2Bound::kLoose;
     odd.dc_format = DcFormat::kRGB9E5;
     odd.luminance = {0.3, 0.59, 0.11};
-    StorageParams irr;
+    CodecOptions irr;
     irr.kind = StoredKind::kIrradiance;
-    StorageParams chan;
+    CodecOptions chan;
     chan.axis_mode = ZonalAxisMode::kPerChannel;
     int checked = 0;
     for (const Codec& c : codecs()) {
         const std::string rep(c.name);
-        for (const StorageParams& p : {StorageParams{}, odd, irr, chan}) {
+        for (const CodecOptions& p : {CodecOptions{}, odd, irr, chan}) {
             if (!validate_quant_params(p, rep)) continue;
             for (const ProbeSet& set : {scattered_set(64, rep, p), grid_set(rep, p)}) {
                 const GltfProbeVolume v = round_trip(scene, set);

@@ -181,7 +181,7 @@ TEST(QuantScalar, EveryCodeRoundTripsAndErrorIsWithinHalfAStep) {
         for (bool sq : {false, true})
             for (ZonalMapping zm : {ZonalMapping::kAffine, ZonalMapping::kZeroPreserving, ZonalMapping::kSymmetric})
                 for (int i = 1; i < 9; ++i) {
-                    QuantParams p;
+                    CodecOptions p;
                     p.bits = bits;
                     p.sqrt_encoding = sq;
                     p.zonal_mapping = zm;
@@ -211,7 +211,7 @@ TEST(QuantScalar, EveryCodeRoundTripsAndErrorIsWithinHalfAStep) {
 }
 
 TEST(QuantScalar, OutOfRangeAndNonFiniteRatiosAreClampedAndCounted) {
-    QuantParams p;
+    CodecOptions p;
     const RatioCoder c = ratio_coder(1, p);
     bool clamped = false;
     EXPECT_EQ(c.decode(c.encode(5.0, &clamped)), std::sqrt(3.0));
@@ -277,7 +277,7 @@ TEST(PackedLayouts, BytesAreWhereTheSpecSaysZh3Q16AndSh2Q) {
 }
 
 TEST(PackedLayouts, HalfDcOnlyInSh2QAndEveryCodecEntryIsPresent) {
-    QuantParams p;
+    CodecOptions p;
     p.dc_format = DcFormat::kHalf;
     EXPECT_TRUE(validate_quant_params(p, "sh2_q").ok());
     EXPECT_FALSE(validate_quant_params(p, "zh3_q16").ok());
@@ -397,19 +397,19 @@ void expect_golden(const std::string& name, const std::vector<std::uint8_t>& byt
 TEST(PackedLayouts, GoldenBytes) {
     struct Variant {
         const char* suffix;
-        QuantParams params;
+        CodecOptions params;
     };
     std::vector<Variant> variants;
-    variants.push_back({"", QuantParams{}});
-    QuantParams sq;
+    variants.push_back({"", CodecOptions{}});
+    CodecOptions sq;
     sq.sqrt_encoding = true;
     variants.push_back({"_sqrt", sq});
-    QuantParams loose;
+    CodecOptions loose;
     loose.l2_bound = L2Bound::kLoose;
     loose.dc_format = DcFormat::kRGB9E5;
     loose.bits = 6;
     variants.push_back({"_loose_rgb9e5_6bit", loose});
-    QuantParams irr;
+    CodecOptions irr;
     irr.kind = StoredKind::kIrradiance;
     irr.zonal_mapping = ZonalMapping::kZeroPreserving;
     irr.axis_mode = ZonalAxisMode::kPerChannel;

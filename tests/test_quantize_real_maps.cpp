@@ -85,7 +85,7 @@ TEST(QuantRealMaps, EveryCoefficientIsWithinHalfAStepOfItsIntervalTimesDc) {
             for (int bits : {8, 5})
                 for (bool sq : {false, true})
                     for (PackedLayout L : {PackedLayout::kSh3Q28, PackedLayout::kSh2Q, PackedLayout::kZh3Q16}) {
-                        QuantParams p;
+                        CodecOptions p;
                         p.bits = bits;
                         p.sqrt_encoding = sq;
                         std::uint8_t b[28];
@@ -115,7 +115,7 @@ TEST(QuantRealMaps, EveryCoefficientIsWithinHalfAStepOfItsIntervalTimesDc) {
 
 struct Config {
     std::string name;
-    QuantParams params;
+    CodecOptions params;
     QuantEncodeControls controls;
 };
 
@@ -127,7 +127,7 @@ TEST(QuantRealMaps, QuantisationErrorTableOverRotatedMaps) {
     std::mt19937 rng(2024);
     for (const Sh3Radiance& sh : maps)
         for (int r = 0; r < 32; ++r) probes.push_back(rotate(sh, random_rotation(rng)));
-    auto rel_rmse = [&](PackedLayout L, const QuantParams& p, const QuantEncodeControls& c, int* clamps) {
+    auto rel_rmse = [&](PackedLayout L, const CodecOptions& p, const QuantEncodeControls& c, int* clamps) {
         double num = 0, den = 0;
         EncodeStats st;
         for (const Sh3Radiance& sh : probes) {
@@ -150,7 +150,7 @@ TEST(QuantRealMaps, QuantisationErrorTableOverRotatedMaps) {
                 std::printf("%-10s %-6s %-10s |", bound == L2Bound::kTight ? "tight" : "loose", sq ? "yes" : "no", zname);
                 int clamps = 0;
                 for (int dc = 0; dc < 4; ++dc) {
-                    QuantParams p;
+                    CodecOptions p;
                     p.l2_bound = bound;
                     p.sqrt_encoding = sq;
                     p.zonal_mapping = zm;
@@ -203,7 +203,7 @@ TEST(QuantRealMaps, QuantisationErrorTableOverRotatedMaps) {
     for (int bits : {8, 6, 5, 4})
         for (bool sq : {false, true}) {
             double num[2] = {0, 0}, den = 0;
-            QuantParams p;
+            CodecOptions p;
             p.bits = bits;
             p.sqrt_encoding = sq;
             for (const Sh3Radiance& sh : probes) {
@@ -242,7 +242,7 @@ TEST(QuantRealMaps, QuantisationErrorTableOverRotatedMaps) {
         std::printf("\nother normalisations (sh3_q28, R11G11B10F DC, affine zonal): per-probe mean | pointwise relative\n");
         for (L2Bound bound : {L2Bound::kTight, L2Bound::kLoose})
             for (bool sq : {false, true}) {
-                QuantParams p;
+                CodecOptions p;
                 p.l2_bound = bound;
                 p.sqrt_encoding = sq;
                 double per_probe = 0, pw_num = 0;

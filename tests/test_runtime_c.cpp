@@ -35,7 +35,7 @@ namespace {
 
 using namespace runtime_c_test;
 
-zhc_probe_format format_of(std::string_view codec, const StorageParams& p) {
+zhc_probe_format format_of(std::string_view codec, const CodecOptions& p) {
     zhc_probe_format f;
     EXPECT_TRUE(runtime_format(codec, p, &f)) << codec;
     return f;
@@ -50,10 +50,10 @@ Vec3 random_float_normal(std::mt19937_64& rng) {
 
 // What the codec says the irradiance of stored bytes is, for these params (see zhc_runtime.h):
 // the table entry's runtime path for radiance float entries, else the irradiance of the decoded hub.
-Rgb codec_irradiance(const Codec& c, const StorageParams& p, const std::uint8_t* bytes, Vec3 n) {
+Rgb codec_irradiance(const Codec& c, const CodecOptions& p, const std::uint8_t* bytes, Vec3 n) {
     PackedLayout layout;
     if (p.kind == StoredKind::kRadiance && !packed_layout_from_name(c.name, &layout))
-        return c.irradiance(bytes, codec_options(p), n);
+        return c.irradiance(bytes, p, n);
     return irradiance(decode_probe(c, p, bytes), n);
 }
 
@@ -62,7 +62,7 @@ struct EntryStats {
     std::uint64_t probes = 0, random_bytes = 0, nan_outputs = 0;
 };
 
-void compare_probe(const Codec& c, const StorageParams& p, const std::uint8_t* bytes, std::mt19937_64& rng,
+void compare_probe(const Codec& c, const CodecOptions& p, const std::uint8_t* bytes, std::mt19937_64& rng,
                    MaxUlp& dec, MaxUlp& irr, EntryStats& st, MaxUlp* table_dec = nullptr, MaxUlp* table_irr = nullptr) {
     const zhc_probe_format f = format_of(c.name, p);
     float rt[27];
@@ -105,8 +105,8 @@ TEST(RuntimeC, EveryCodecTableEntryIsKnownWithItsSizeInOrder) {
         EXPECT_EQ(zhc_encoding_is_packed(int(e)) != 0, packed_layout_from_name(name, &layout)) << name;
         zhc_probe_format f;
         ASSERT_EQ(zhc_probe_format_init(&f, name.c_str()), ZHC_OK);
-        // The defaults are zhc convert's (QuantParams) and the codec's curve constants.
-        const StorageParams d;
+        // The defaults are zhc convert's (CodecOptions) and the codec's curve constants.
+        const CodecOptions d;
         const CodecOptions o;
         EXPECT_EQ(f.bits, d.bits);
         EXPECT_EQ(f.sqrt_encoding, int(d.sqrt_encoding));
@@ -123,7 +123,7 @@ TEST(RuntimeC, EveryCodecTableEntryIsKnownWithItsSizeInOrder) {
         EXPECT_EQ(zhc_probe_size(&f), table[e].size_bytes);
         // The same validity rule as the codec's.
         for (int dc = 0; dc < 3; ++dc) {
-            StorageParams p;
+            CodecOptions p;
             p.dc_format = DcFormat(dc);
             f.dc_format = dc;
             EXPECT_EQ(zhc_probe_format_validate(&f) == ZHC_OK, bool(validate_quant_params(p, name))) << name << dc;
@@ -145,7 +145,7 @@ TEST(RuntimeC, EveryCodecTableEntryIsKnownWithItsSizeInOrder) {
 
 TEST(RuntimeC, GltfQuantizationStringsMapToTheStorageParams) {
     // The strings of docs/gltf-extension.md and formats/probes/gltf_probes.cpp, and the enum values the
-    // codec gives them (QuantParams).
+    // codec gives them (CodecOptions).
     struct Case {
         const char* key;
         const char* value;
@@ -214,7 +214,7 @@ TEST_P(RuntimeCEntry, DecodeAndIrradianceEqualTheCodecBitForBit) {
     // Default parameters: the table entry itself (encode with default options).
     for (int i = 0; i < kProbes; ++i) {
         const Sh3Radiance hub = random_probe(rng, std::uint64_t(i));
-        const StorageParams p;
+        const CodecOptions p;
         encode_probe(*c, p, hub, bytes.data(), nullptr);
         compare_probe(*c, p, bytes.data(), rng, st.decode_default, st.irr_default, st, &st.decode_table, &st.irr_table);
         ++st.probes;
@@ -223,7 +223,7 @@ TEST_P(RuntimeCEntry, DecodeAndIrradianceEqualTheCodecBitForBit) {
     // Non-default parameters (bits 2..8, sqrt, bound, DC format, zonal mapping, axis, kind, weights).
     for (int i = 0; i < kProbes; ++i) {
         const Sh3Radiance hub = random_probe(rng, std::uint64_t(i));
-        const StorageParams p = random_params(rng, c->name);
+        const CodecOptions p = random_params(rng, c->name);
         encode_probe(*c, p, hub, bytes.data(), nullptr);
         compare_probe(*c, p, bytes.data(), rng, st.decode_params, st.irr_params, st);
         ++st.probes;
@@ -235,7 +235,7 @@ TEST_P(RuntimeCEntry, DecodeAndIrradianceEqualTheCodecBitForBit) {
         if (rng() % 4 == 0)
             for (size_t j = 0; j + 4 <= bytes.size(); j += 4)
                 if (rng() % 3 == 0) bytes[j + 3] = std::uint8_t((rng() % 2) ? 0x7F : 0xFF), bytes[j + 2] |= 0x80;
-        const StorageParams p = (i % 2) ? random_params(rng, c->name) : StorageParams{};
+        const CodecOptions p = (i % 2) ? random_params(rng, c->name) : CodecOptions{};
         compare_probe(*c, p, bytes.data(), rng, st.bytes_decode, st.bytes_irr, st);
         ++st.random_bytes;
         if (HasFatalFailure()) return;

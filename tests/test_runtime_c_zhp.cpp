@@ -59,7 +59,7 @@ void expect_agreement(const std::vector<std::uint8_t>& file, const std::string& 
     }
     if (ref) {
         ASSERT_EQ(rt, ZHC_OK) << what;
-        const StorageParams& p = ref->params;
+        const CodecOptions& p = ref->params;
         EXPECT_EQ(f.encoding, zhc_encoding_from_name(ref->representation.c_str())) << what;
         EXPECT_EQ(f.bits, p.bits);
         EXPECT_EQ(f.sqrt_encoding, int(p.sqrt_encoding));
@@ -93,7 +93,7 @@ std::vector<std::vector<std::uint8_t>> sample_files() {
     std::vector<std::vector<std::uint8_t>> files;
     for (const Codec& c : codecs()) {
         for (int variant = 0; variant < 3; ++variant) {
-            const StorageParams p = variant == 0 ? StorageParams{} : random_params(rng, c.name);
+            const CodecOptions p = variant == 0 ? CodecOptions{} : random_params(rng, c.name);
             std::vector<Sh3Radiance> hub;
             ProbeLayout layout;
             const int n = variant == 2 ? 0 : 6;
@@ -142,7 +142,7 @@ TEST(RuntimeC, ZhpFilesFromZhcsWriterParseToTheSameParamsAndPayload) {
     }
     // zstd bodies: the header parses, the body is out of scope (distinct error).
     std::vector<Sh3Radiance> hub(5, project_constant({1, 2, 3}));
-    auto set = encode_probe_set(hub, "zh3_q16", StorageParams{}, ProbeLayout{});
+    auto set = encode_probe_set(hub, "zh3_q16", CodecOptions{}, ProbeLayout{});
     ASSERT_TRUE(bool(set));
     ProbeFileWriteOptions wo;
     wo.zstd_level = 3;

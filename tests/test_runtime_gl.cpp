@@ -192,7 +192,7 @@ const std::map<std::string, GlslEntry, std::less<>>& glsl_entries() {
 }
 
 // The axis the shader is told (ZhcFormat.axisMode): the entry's fixed axis, else the header's.
-std::uint32_t axis_mode(const GlslEntry& e, const StorageParams& p) {
+std::uint32_t axis_mode(const GlslEntry& e, const CodecOptions& p) {
     if (e.axis == ZonalAxis::kLuminance) return 0;
     if (e.axis == ZonalAxis::kPerChannel) return 1;
     return static_cast<std::uint32_t>(p.axis_mode);
@@ -266,7 +266,7 @@ struct Scale {
     bool defined = true;   // false: ill-conditioned axis (kappa infinite), not compared
 };
 
-Scale probe_scale(const GlslEntry& e, const StorageParams& p, const Sh3Radiance& d) {
+Scale probe_scale(const GlslEntry& e, const CodecOptions& p, const Sh3Radiance& d) {
     Scale s;
     const bool quant = is_quantised(e.family);
     const double w[3] = {p.luminance.r, p.luminance.g, p.luminance.b};
@@ -376,8 +376,8 @@ void check_value(Tally& t, double* max_seen, double ref, float gpu, double scale
 }
 
 // Parameter sets for batch b of an encoding.
-StorageParams batch_params(const GlslEntry& e, std::string_view name, int b, std::mt19937_64& rng) {
-    StorageParams p;
+CodecOptions batch_params(const GlslEntry& e, std::string_view name, int b, std::mt19937_64& rng) {
+    CodecOptions p;
     if (b == 0) return p;  // the defaults (Codec::irradiance is the reference)
     std::uniform_real_distribution<double> u(0, 1);
     if (b % 4 == 3) p.luminance = {0.05 + u(rng), 0.05 + u(rng), 0.05 + u(rng)};
@@ -396,8 +396,8 @@ StorageParams batch_params(const GlslEntry& e, std::string_view name, int b, std
     return p;
 }
 
-bool default_irradiance_path(const StorageParams& p) {
-    const StorageParams d;
+bool default_irradiance_path(const CodecOptions& p) {
+    const CodecOptions d;
     return p.kind == StoredKind::kRadiance && p.zonal_mapping == d.zonal_mapping && p.axis_mode == d.axis_mode;
 }
 
@@ -545,7 +545,7 @@ void compare_every_codec(int kBatches, int kGarbageBatches, long min_valid) {
         long valid = 0, garbage = 0;
         for (int b = 0; b < kBatches + kGarbageBatches; ++b) {
             const bool is_garbage = b >= kBatches;
-            const StorageParams p = batch_params(e, codec.name, is_garbage ? b - kBatches + 1 : b, rng);
+            const CodecOptions p = batch_params(e, codec.name, is_garbage ? b - kBatches + 1 : b, rng);
             std::vector<std::uint8_t> bytes(kBatchSize * codec.size_bytes);
             std::vector<float> normals(kBatchSize * 3);
             for (int i = 0; i < kBatchSize; ++i) {
@@ -581,7 +581,7 @@ void compare_every_codec(int kBatches, int kGarbageBatches, long min_valid) {
             un.lum[0] = static_cast<float>(p.luminance.r);
             un.lum[1] = static_cast<float>(p.luminance.g);
             un.lum[2] = static_cast<float>(p.luminance.b);
-            const CodecOptions o = codec_options(p);
+            const CodecOptions o = p;
             un.curve[0] = static_cast<float>(o.hallucinate_a);
             un.curve[1] = static_cast<float>(o.hallucinate_b);
             const std::vector<float> gpu = Fixture::run(un, w, normals, kBatchSize);

@@ -200,7 +200,7 @@ bool is_packed(std::string_view name) {
     return packed_layout_from_name(name, &layout);
 }
 // Whether the decoded zonal term uses the luminance axis (CodecTraits::zonal_axis).
-bool lum_axis(const Codec& codec, const StorageParams& p) {
+bool lum_axis(const Codec& codec, const CodecOptions& p) {
     switch (codec.traits.zonal_axis) {
         case ZonalAxis::kLuminance: return true;
         case ZonalAxis::kFromParams: return p.axis_mode == ZonalAxisMode::kLuminance;
@@ -209,8 +209,8 @@ bool lum_axis(const Codec& codec, const StorageParams& p) {
     }
     return false;
 }
-bool is_default(const StorageParams& p) {
-    const StorageParams d;
+bool is_default(const CodecOptions& p) {
+    const CodecOptions d;
     return p.bits == d.bits && p.sqrt_encoding == d.sqrt_encoding && p.l2_bound == d.l2_bound &&
            p.dc_format == d.dc_format && p.kind == d.kind && p.zonal_mapping == d.zonal_mapping &&
            p.axis_mode == d.axis_mode && p.luminance.r == d.luminance.r && p.luminance.g == d.luminance.g &&
@@ -229,7 +229,7 @@ struct Stats {
 
 struct Case {
     std::string label;
-    StorageParams params;
+    CodecOptions params;
     std::vector<std::uint8_t> bytes;  // count * size
     std::vector<float> normals;       // count * 4
     std::size_t count = 0;
@@ -237,11 +237,11 @@ struct Case {
 };
 
 // Compares one item; returns false (with a message) on a bound violation.
-bool compare_item(const Codec& codec, const StorageParams& p, const std::uint8_t* bytes, Vec3 n, const float* gpu,
+bool compare_item(const Codec& codec, const CodecOptions& p, const std::uint8_t* bytes, Vec3 n, const float* gpu,
                   bool encoded, Stats* st, std::string* msg) {
     const Sh3Radiance d = decode_probe(codec, p, bytes);
     Rgb e;
-    if (is_default(p)) e = codec.irradiance(bytes, codec_options(p), n);
+    if (is_default(p)) e = codec.irradiance(bytes, p, n);
     else e = irradiance(d, n);
     // Per-channel scale T_k.
     const bool packed = is_packed(codec.name);
@@ -316,7 +316,7 @@ bool compare_item(const Codec& codec, const StorageParams& p, const std::uint8_t
 void run_case(const Codec& codec, const Case& c, Stats* st) {
     const int id = hlsl_encoding(codec.name);
     ASSERT_GE(id, 0);
-    const StorageParams& p = c.params;
+    const CodecOptions& p = c.params;
     std::uint32_t params[16] = {static_cast<std::uint32_t>(id),
                                 static_cast<std::uint32_t>(p.bits),
                                 p.sqrt_encoding ? 1u : 0u,
@@ -356,7 +356,7 @@ void add_normal(std::mt19937_64& rng, std::vector<float>* normals) {
 
 // `count` probes of one source, encoded with `p` (sources: 0 lights, 1 random SH, 2 envmaps,
 // 3 random bytes).
-Case make_case(const Codec& codec, const StorageParams& p, int source, std::size_t count, std::uint64_t seed) {
+Case make_case(const Codec& codec, const CodecOptions& p, int source, std::size_t count, std::uint64_t seed) {
     static const char* const kSources[] = {"lights", "random SH", "envmaps", "random bytes"};
     Case c;
     c.label = std::string(codec.name) + " / " + kSources[source];
@@ -415,7 +415,7 @@ TEST_F(RuntimeVk, EveryEncodingMatchesTheCodec) {
     for (const Codec& codec : codecs()) {
         Stats st;
         for (int source = 0; source < 4; ++source) {
-            const Case c = make_case(codec, StorageParams{}, source, counts[source], 1000u * static_cast<unsigned>(source) + 17u);
+            const Case c = make_case(codec, CodecOptions{}, source, counts[source], 1000u * static_cast<unsigned>(source) + 17u);
             run_case(codec, c, &st);
         }
         std::printf("%-22s %8zu %10.3f %12.3g %9zu %9zu\n", std::string(codec.name).c_str(), st.items, st.max_rel,
@@ -431,11 +431,11 @@ TEST_F(RuntimeVk, EveryEncodingMatchesTheCodec) {
 // zonal mapping, axis mode, stored kind, luminance weights; every quantised layout, and the stored
 // kind / luminance weights for the float layouts too.
 TEST_F(RuntimeVk, EveryFormatMatchesTheCodec) {
-    std::vector<StorageParams> variants;
+    std::vector<CodecOptions> variants;
     std::mt19937_64 rng(99);
     for (int bits = 2; bits <= 8; ++bits)
         for (int sq = 0; sq < 2; ++sq) {
-            StorageParams p;
+            CodecOptions p;
             p.bits = bits;
             p.sqrt_encoding = sq != 0;
             p.l2_bound = static_cast<L2Bound>(rng() % 2);
@@ -449,7 +449,7 @@ TEST_F(RuntimeVk, EveryFormatMatchesTheCodec) {
     for (int dc = 0; dc < 3; ++dc)
         for (int zm = 0; zm < 3; ++zm)
             for (int kind = 0; kind < 2; ++kind) {
-                StorageParams p;
+                CodecOptions p;
                 p.dc_format = static_cast<DcFormat>(dc);
                 p.zonal_mapping = static_cast<ZonalMapping>(zm);
                 p.kind = static_cast<StoredKind>(kind);
@@ -461,7 +461,7 @@ TEST_F(RuntimeVk, EveryFormatMatchesTheCodec) {
     for (const Codec& codec : codecs()) {
         Stats st;
         int v = 0;
-        for (StorageParams p : variants) {
+        for (CodecOptions p : variants) {
             ++v;
             if (!is_packed(codec.name) && (p.bits != 8 || p.sqrt_encoding)) continue;  // only kind / weights apply
             if (!validate_quant_params(p, codec.name)) p.dc_format = DcFormat::kRGB9E5;  // half needs sh2_q's slot

@@ -75,7 +75,7 @@ double channel_error(const Sh3Radiance& decoded, const Sh3Radiance& target, int 
     return e;
 }
 
-std::array<std::uint8_t, 16> encode(const Codec& c, const Sh3Radiance& sh, const StorageParams& p = StorageParams{}) {
+std::array<std::uint8_t, 16> encode(const Codec& c, const Sh3Radiance& sh, const CodecOptions& p = CodecOptions{}) {
     std::array<std::uint8_t, 16> b{};
     encode_probe(c, p, sh, b.data(), nullptr);
     return b;
@@ -84,7 +84,7 @@ std::array<std::uint8_t, 16> encode(const Codec& c, const Sh3Radiance& sh, const
 // Brute force over channel k's stored codes: every L1 code triple within +-r of `centre`'s and every
 // zonal code, each decoded by the real decoder. Returns the lowest channel error found.
 double brute_force_channel(const std::array<std::uint8_t, 16>& bytes, const std::array<std::uint8_t, 16>& centre,
-                           int k, int r, const Sh3Radiance& target, const StorageParams& p) {
+                           int k, int r, const Sh3Radiance& target, const CodecOptions& p) {
     const int top = 2 * quant_half_range(p.bits);
     std::array<std::uint8_t, 16> b = bytes;
     double best = INFINITY;
@@ -108,7 +108,7 @@ double brute_force_channel(const std::array<std::uint8_t, 16>& bytes, const std:
 // Slow twin of the search: brute force over the stored code grid around the result and around
 // the fitted codes, for the default parameters and a non-default set (5 bits, sqrt, irradiance
 // storage, zero-preserving zonal mapping, RGB9E5 DC).
-void check_against_brute_force(const StorageParams& p, int probes_from_maps, int random_probes, int* better,
+void check_against_brute_force(const CodecOptions& p, int probes_from_maps, int random_probes, int* better,
                                int* channels) {
     Rng rng(5);
     std::vector<Sh3Radiance> probes;
@@ -135,10 +135,10 @@ void check_against_brute_force(const StorageParams& p, int probes_from_maps, int
 
 TEST(Zh3ChannelQ16, SolvedCodesAreTheBestOfABruteForceSearchAroundThemAndAroundTheFit) {
     int better = 0, channels = 0;
-    check_against_brute_force(StorageParams{}, 4, 6, &better, &channels);
+    check_against_brute_force(CodecOptions{}, 4, 6, &better, &channels);
     std::printf("defaults: solved better than fitted on %d of %d channels\n", better, channels);
     EXPECT_GT(better, channels / 2);
-    StorageParams other;
+    CodecOptions other;
     other.bits = 5;
     other.sqrt_encoding = true;
     other.kind = StoredKind::kIrradiance;
@@ -165,7 +165,7 @@ TEST(Zh3ChannelQ16, SearchErrorIsTheDecodersError) {
             for (int j = 0; j < 3; ++j) pr.t1[size_t(j)] = sh[j + 1][k] / double(dc[k]);
             for (int m = 0; m < 5; ++m) pr.t2[size_t(m)] = sh[4 + m][k] / double(dc[k]);
             std::uint8_t zonal = 0;
-            const double e = channel_code_error(pr, QuantParams{}, {b[size_t(4 + 4 * k)], b[size_t(5 + 4 * k)], b[size_t(6 + 4 * k)]}, &zonal);
+            const double e = channel_code_error(pr, CodecOptions{}, {b[size_t(4 + 4 * k)], b[size_t(5 + 4 * k)], b[size_t(6 + 4 * k)]}, &zonal);
             EXPECT_EQ(zonal, b[size_t(7 + 4 * k)]);
             const double measured = channel_error(d, sh, k);
             EXPECT_NEAR(e * double(dc[k]) * double(dc[k]), measured, 1e-5 * measured + 1e-9 * double(dc[k]) * double(dc[k]));
@@ -216,7 +216,7 @@ TEST(Zh3ChannelQ16, ContainerAxisModeDoesNotApplyButMattersForZh3Q16) {
     int differs = 0;
     for (int t = 0; t < 50; ++t) {
         const Sh3Radiance sh = random_lighting(rng);
-        StorageParams lum, chan;
+        CodecOptions lum, chan;
         chan.axis_mode = ZonalAxisMode::kPerChannel;
         const auto b = encode(solved(), sh, lum);
         EXPECT_EQ(b, encode(solved(), sh, chan));
@@ -251,14 +251,14 @@ std::vector<Sh3Radiance> golden_probes() {
 
 TEST(Zh3ChannelQ16, GoldenBytes) {
     const std::string dir = std::string(ZHC_GOLDEN_DIR);
-    StorageParams other;
+    CodecOptions other;
     other.bits = 6;
     other.sqrt_encoding = true;
     other.dc_format = DcFormat::kRGB9E5;
     other.kind = StoredKind::kIrradiance;
     other.zonal_mapping = ZonalMapping::kZeroPreserving;
     for (const Codec* c : {&fitted(), &solved()})
-        for (const auto& [suffix, params] : {std::pair{std::string(""), StorageParams{}}, {std::string("_6bit_sqrt_rgb9e5_irradiance_zero"), other}}) {
+        for (const auto& [suffix, params] : {std::pair{std::string(""), CodecOptions{}}, {std::string("_6bit_sqrt_rgb9e5_irradiance_zero"), other}}) {
             std::vector<std::uint8_t> all;
             for (const Sh3Radiance& sh : golden_probes()) {
                 const auto b = encode(*c, sh, params);
@@ -293,10 +293,10 @@ TEST(Zh3ChannelQ16, CodeSearchIsScaleInvariant) {
             for (int m = 0; m < 5; ++m) pr.t2[size_t(m)] = double(sh[4 + m][k]) * s / dc;
             bool clamped = false;
             std::array<std::uint8_t, 3> start;
-            for (int j = 0; j < 3; ++j) start[size_t(j)] = ratio_coder(j + 1, QuantParams{}).encode(pr.t1[size_t(j)], &clamped);
+            for (int j = 0; j < 3; ++j) start[size_t(j)] = ratio_coder(j + 1, CodecOptions{}).encode(pr.t1[size_t(j)], &clamped);
             int evals = 0;
-            const ChannelCodes c = solve_channel_codes(pr, QuantParams{}, &start, 1, &evals);
-            const double e = channel_code_error(pr, QuantParams{}, c.l1, nullptr);
+            const ChannelCodes c = solve_channel_codes(pr, CodecOptions{}, &start, 1, &evals);
+            const double e = channel_code_error(pr, CodecOptions{}, c.l1, nullptr);
             if (e10 == -8) {
                 ref = c;
                 ref_e = e;

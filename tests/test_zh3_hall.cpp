@@ -471,7 +471,7 @@ TEST(HallAdaptiveLayout, EncoderPicksTheBestCandidateAndIsNeverWorseThanSh2Q) {
             const double s = hall_scale_of_code(static_cast<std::uint8_t>(code));
             const Sh2Radiance lin = hall_solve(t, s, ZonalAxisMode::kLuminance, {}, nullptr);
             std::uint8_t cb[16];
-            encode_packed(PackedLayout::kSh2Q, extend_to_sh3(lin), QuantParams{}, cb, nullptr);
+            encode_packed(PackedLayout::kSh2Q, extend_to_sh3(lin), CodecOptions{}, cb, nullptr);
             cb[15] = static_cast<std::uint8_t>(code);
             EXPECT_LE(chosen, irradiance_sq_error(t, c.decode(cb, {}))) << i << " code " << code;
         }
@@ -483,13 +483,13 @@ TEST(HallAdaptiveLayout, EncoderPicksTheBestCandidateAndIsNeverWorseThanSh2Q) {
 // through the probe container path (encode_probe). ZHC_UPDATE_GOLDEN=1 rewrites them.
 TEST(HallAdaptiveLayout, GoldenBytes) {
     const std::string dir = std::string(ZHC_TEST_DATA_DIR) + "/../golden";
-    std::vector<std::pair<const char*, QuantParams>> variants;
-    variants.push_back({"", QuantParams{}});
-    QuantParams half;
+    std::vector<std::pair<const char*, CodecOptions>> variants;
+    variants.push_back({"", CodecOptions{}});
+    CodecOptions half;
     half.dc_format = DcFormat::kHalf;
     half.sqrt_encoding = true;
     variants.push_back({"_half_sqrt", half});
-    QuantParams irr;
+    CodecOptions irr;
     irr.kind = StoredKind::kIrradiance;
     irr.axis_mode = ZonalAxisMode::kPerChannel;
     irr.bits = 6;

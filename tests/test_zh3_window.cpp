@@ -233,7 +233,7 @@ TEST(Zh3Window, Q16WithOtherStorageParameters) {
     Rng rng(44);
     const Codec* c = find_codec("zh3_dering_q16");
     for (int variant = 0; variant < 4; ++variant) {
-        StorageParams sp;
+        CodecOptions sp;
         sp.bits = 4 + variant;
         sp.sqrt_encoding = variant % 2 == 1;
         sp.dc_format = variant == 2 ? DcFormat::kRGB9E5 : DcFormat::kR11G11B10F;

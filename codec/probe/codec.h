@@ -52,9 +52,8 @@ enum class ZonalAxisMode : std::uint8_t {
     kPerChannel = 1,  // each channel's own optimal linear direction (Sec. 3.1)
 };
 
-// The one parameter type of the table (issue 19): every entry's encode / decode / irradiance, the
-// quantiser (quantize.h, where it is also called QuantParams) and the probe container (probe_set.h,
-// StorageParams) take it. Two groups of fields:
+// The one parameter type (issue 19): every entry's encode / decode / irradiance, the quantiser
+// (quantize.h) and the probe container (probe_set.h, ProbeSet::params) take it. Two groups of fields:
 //  * storage parameters (luminance .. axis_mode below): they change what stored bytes mean, so the
 //    .zhp header and the glTF extension store them and decoders need them;
 //  * encoder controls (solver_*, hallucinate_*, dering_punctual): they only choose which bytes an

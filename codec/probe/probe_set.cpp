@@ -5,19 +5,6 @@
 
 namespace zhc {
 
-CodecOptions codec_options(const StorageParams& p, const CodecOptions& base) {
-    CodecOptions o = base;  // encoder controls
-    o.luminance = p.luminance;
-    o.bits = p.bits;
-    o.sqrt_encoding = p.sqrt_encoding;
-    o.l2_bound = p.l2_bound;
-    o.dc_format = p.dc_format;
-    o.kind = p.kind;
-    o.zonal_mapping = p.zonal_mapping;
-    o.axis_mode = p.axis_mode;
-    return o;
-}
-
 std::int64_t layout_probe_count(const ProbeLayout& layout) {
     switch (layout.kind) {
         case ProbeLayoutKind::kNone: return -1;
@@ -86,16 +73,16 @@ Status validate_probe_set(const ProbeSet& set) {
     return validate_layout(set.layout, set.count);
 }
 
-void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radiance& hub, std::uint8_t* out,
-                  EncodeStats* stats, const CodecOptions& base) {
-    const CodecOptions o = codec_options(params, base);
+void encode_probe(const Codec& codec, const CodecOptions& params, const Sh3Radiance& hub, std::uint8_t* out,
+                  EncodeStats* stats) {
+    const CodecOptions& o = params;
     // Packed entries read every storage parameter themselves (kind: scaled bounds); the float
     // entries store what they are given, so irradiance is converted here.
     if (codec.packed || params.kind != StoredKind::kIrradiance) codec.encode(hub, o, out, stats);
     else codec.encode(as_radiance_type(to_irradiance(hub)), o, out, stats);
 }
 
-Sh3Radiance decode_probe(const Codec& codec, const StorageParams& params, const std::uint8_t* in) {
+Sh3Radiance decode_probe(const Codec& codec, const CodecOptions& params, const std::uint8_t* in) {
     const Sh3Radiance stored = codec.decode(in, params);
     if (codec.packed || params.kind != StoredKind::kIrradiance) return stored;
     Sh3Irradiance e;
@@ -104,8 +91,7 @@ Sh3Radiance decode_probe(const Codec& codec, const StorageParams& params, const 
 }
 
 Result<ProbeSet> encode_probe_set(std::span<const Sh3Radiance> hub, std::string_view representation,
-                                  const StorageParams& params, ProbeLayout layout, EncodeStats* stats,
-                                  const CodecOptions& base) {
+                                  const CodecOptions& params, ProbeLayout layout, EncodeStats* stats) {
     const Codec* codec = find_codec(representation);
     if (!codec) return make_error(ErrorCode::kInvalidArgument, "unknown representation '" + std::string(representation) + "'");
     if (Status st = validate_quant_params(params, representation); !st) return st.error();
@@ -117,7 +103,7 @@ Result<ProbeSet> encode_probe_set(std::span<const Sh3Radiance> hub, std::string_
     set.count = hub.size();
     set.payload.resize(hub.size() * codec->size_bytes);
     for (size_t i = 0; i < hub.size(); ++i)
-        encode_probe(*codec, params, hub[i], set.payload.data() + i * codec->size_bytes, stats, base);
+        encode_probe(*codec, params, hub[i], set.payload.data() + i * codec->size_bytes, stats);
     return set;
 }
 
@@ -131,17 +117,17 @@ Result<std::vector<Sh3Radiance>> decode_probe_set(const ProbeSet& set) {
 }
 
 Result<std::vector<Sh3Radiance>> round_trip_probes(std::span<const Sh3Radiance> hub, std::string_view representation,
-                                                   const StorageParams& params, ProbeLayout layout, EncodeStats* stats) {
+                                                   const CodecOptions& params, ProbeLayout layout, EncodeStats* stats) {
     auto set = encode_probe_set(hub, representation, params, std::move(layout), stats);
     if (!set) return set.error();
     return decode_probe_set(*set);
 }
 
-Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view representation, const StorageParams& params,
-                                   EncodeStats* stats, const CodecOptions& base) {
+Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view representation, const CodecOptions& params,
+                                   EncodeStats* stats) {
     auto hub = decode_probe_set(set);
     if (!hub) return hub.error();
-    return encode_probe_set(*hub, representation, params, set.layout, stats, base);
+    return encode_probe_set(*hub, representation, params, set.layout, stats);
 }
 
 Vec3 probe_position(const ProbeSet& set, std::uint64_t i) {

@@ -45,15 +45,13 @@ struct ProbeLayout {
     std::vector<std::array<float, 3>> positions;  // kPositions only: one per probe
 };
 
-// Everything that changes how a payload decodes, as stored in a .zhp header: the storage fields
-// of CodecOptions (codec.h, the table's one parameter type; StorageParams is the same type). The
-// quantised layouts read all of them; the float representations read only the luminance weights
-// (ZH3 axes) and `kind` (see below).
-using StorageParams = CodecOptions;
 
 struct ProbeSet {
     std::string representation = "sh3";  // codec table name
-    StorageParams params;
+    // Everything that changes how the payload decodes, as stored in a .zhp header: the storage
+    // fields of CodecOptions (codec.h). The quantised layouts read all of them; the float
+    // representations read only the luminance weights (ZH3 axes) and `kind` (see below).
+    CodecOptions params;
     ProbeLayout layout;
     std::uint64_t count = 0;
     std::vector<std::uint8_t> payload;  // count * size_bytes, probe-major
@@ -61,10 +59,6 @@ struct ProbeSet {
     // nullptr when `representation` is not in the table.
     const Codec* codec() const { return find_codec(representation); }
 };
-
-// The storage fields of `params` (luminance .. axis_mode) over the encoder controls of `base`
-// (solver iterations and other encode-only knobs).
-CodecOptions codec_options(const StorageParams& params, const CodecOptions& base = {});
 
 // Checks every invariant above; kInvalidArgument naming the first broken one.
 Status validate_probe_set(const ProbeSet& set);
@@ -74,25 +68,24 @@ Status validate_probe_set(const ProbeSet& set);
 // (App. A.1) and the other representations store the band-scaled coefficients as they would a
 // radiance function (every representation in the table is linear per band, so this is exact
 // up to rounding). `out` must have codec->size_bytes bytes.
-void encode_probe(const Codec& codec, const StorageParams& params, const Sh3Radiance& hub, std::uint8_t* out,
-                  EncodeStats* stats, const CodecOptions& base = {});
-Sh3Radiance decode_probe(const Codec& codec, const StorageParams& params, const std::uint8_t* in);
+void encode_probe(const Codec& codec, const CodecOptions& params, const Sh3Radiance& hub, std::uint8_t* out,
+                  EncodeStats* stats);
+Sh3Radiance decode_probe(const Codec& codec, const CodecOptions& params, const std::uint8_t* in);
 
 // Builds a set from hub probes. Fails (kInvalidArgument) for an unknown representation, bad
 // params, or a layout that does not match hub.size(). Deterministic.
 Result<ProbeSet> encode_probe_set(std::span<const Sh3Radiance> hub, std::string_view representation,
-                                  const StorageParams& params, ProbeLayout layout, EncodeStats* stats = nullptr,
-                                  const CodecOptions& base = {});
+                                  const CodecOptions& params, ProbeLayout layout, EncodeStats* stats = nullptr);
 // Decodes every probe to the hub. Fails only for an invalid set.
 Result<std::vector<Sh3Radiance>> decode_probe_set(const ProbeSet& set);
 // What the runtime would see: encode the hub probes into a representation, then decode back to
 // the hub (a lossy preview, e.g. a JSON probe list "through" zh3_q16). Fails as encode_probe_set.
 Result<std::vector<Sh3Radiance>> round_trip_probes(std::span<const Sh3Radiance> hub, std::string_view representation,
-                                                   const StorageParams& params, ProbeLayout layout,
+                                                   const CodecOptions& params, ProbeLayout layout,
                                                    EncodeStats* stats = nullptr);
 // Decode then re-encode into another representation/params; the layout is kept.
-Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view representation, const StorageParams& params,
-                                   EncodeStats* stats = nullptr, const CodecOptions& base = {});
+Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view representation, const CodecOptions& params,
+                                   EncodeStats* stats = nullptr);
 
 // World position of probe i (origin for kNone). Precondition: i < count, valid set.
 Vec3 probe_position(const ProbeSet& set, std::uint64_t i);

@@ -53,7 +53,7 @@ RatioInterval ratio_interval(int sh_index, StoredKind kind, L2Bound l2_bound) {
 
 // ---- parameters ----------------------------------------------------------------------------
 
-Status validate_quant_params(const QuantParams& p, std::string_view layout_name) {
+Status validate_quant_params(const CodecOptions& p, std::string_view layout_name) {
     if (p.bits < kMinQuantBits || p.bits > kMaxQuantBits)
         return make_error(ErrorCode::kInvalidArgument, "quantisation bits must be " + std::to_string(kMinQuantBits) +
                                                            ".." + std::to_string(kMaxQuantBits) + ", got " +
@@ -130,7 +130,7 @@ std::uint8_t RatioCoder::encode(double ratio, bool* clamped) const {
     return static_cast<std::uint8_t>(e1 < e0 ? c0 + 1 : c0);
 }
 
-RatioCoder ratio_coder(int sh_index, const QuantParams& p) {
+RatioCoder ratio_coder(int sh_index, const CodecOptions& p) {
     RatioCoder c;
     c.interval = ratio_interval(sh_index, p.kind, p.l2_bound);
     c.mapping = p.zonal_mapping;
@@ -140,7 +140,7 @@ RatioCoder ratio_coder(int sh_index, const QuantParams& p) {
     return c;
 }
 
-RatioCoder zonal_coder(const QuantParams& p) {
+RatioCoder zonal_coder(const CodecOptions& p) {
     RatioCoder c;
     c.interval = zonal_l2_interval(p.kind);
     c.mapping = p.zonal_mapping;
@@ -348,7 +348,7 @@ std::array<double, 5> zonal_l2_direction(Vec3 axis) {
 
 // Zonal axes from (dequantised) L1, per channel: shares zh3.h's definition (luminance-weighted L1
 // or each channel's own optimal linear direction; +Z when the L1 is zero).
-std::array<Vec3, 3> axes_from_l1(const Coeffs& c, const QuantParams& p) {
+std::array<Vec3, 3> axes_from_l1(const Coeffs& c, const CodecOptions& p) {
     Sh2Radiance linear;
     for (int i = 0; i < 4; ++i)
         for (int k = 0; k < 3; ++k) linear[i][k] = static_cast<float>(c[static_cast<size_t>(i)][static_cast<size_t>(k)]);
@@ -372,7 +372,7 @@ double zonal_fit(const Coeffs& c, int k, const std::array<double, 5>& v) {
     return z;
 }
 
-void encode_impl(PackedLayout layout, const Sh3Radiance& hub, const QuantParams& p, std::uint8_t* out,
+void encode_impl(PackedLayout layout, const Sh3Radiance& hub, const CodecOptions& p, std::uint8_t* out,
                  EncodeStats* stats, const QuantEncodeControls& controls, Coeffs* decoded) {
     const size_t size = packed_size_bytes(layout);
     std::memset(out, 0, size);
@@ -430,7 +430,7 @@ void encode_impl(PackedLayout layout, const Sh3Radiance& hub, const QuantParams&
 
 namespace {
 // Certified: every channel with a positive DC has a non-negative irradiance minimum once decoded.
-bool decoded_non_negative(const std::uint8_t* bytes, const QuantParams& p) {
+bool decoded_non_negative(const std::uint8_t* bytes, const CodecOptions& p) {
     const Zh3 d = decode_zh3_q16(bytes, p);
     for (int k = 0; k < 3; ++k)
         if (d.linear[0][k] > 0.0f && zh3_min_irradiance_bound(d, p.axis_mode, p.luminance, k) < 0.0) return false;
@@ -442,7 +442,7 @@ bool decoded_non_negative(const std::uint8_t* bytes, const QuantParams& p) {
 // it). The caps after the float window s: s (1 - 2^-12), s (1 - 2^-8), s (1 - 2^-4), then halving
 // down to 0, where only the DC and the zonal code nearest 0 are left (always non-negative: the
 // zonal step is far below the DC).
-void encode_dering_q16(const Sh3Radiance& hub, const QuantParams& p, std::uint8_t* out, EncodeStats* stats,
+void encode_dering_q16(const Sh3Radiance& hub, const CodecOptions& p, std::uint8_t* out, EncodeStats* stats,
                        const QuantEncodeControls& controls) {
     QuantEncodeControls inner = controls;
     inner.dering = false;
@@ -467,7 +467,7 @@ void encode_dering_q16(const Sh3Radiance& hub, const QuantParams& p, std::uint8_
 }
 }  // namespace
 
-void encode_packed(PackedLayout layout, const Sh3Radiance& hub, const QuantParams& params, std::uint8_t* out,
+void encode_packed(PackedLayout layout, const Sh3Radiance& hub, const CodecOptions& params, std::uint8_t* out,
                    EncodeStats* stats, const QuantEncodeControls& controls) {
     QuantEncodeControls stored = controls;
     stored.exact_dc = false;  // the bytes always hold the quantised DC
@@ -475,7 +475,7 @@ void encode_packed(PackedLayout layout, const Sh3Radiance& hub, const QuantParam
     encode_impl(layout, hub, params, out, stats, stored, nullptr);
 }
 
-Zh3 decode_zh3_q16(const std::uint8_t* in, const QuantParams& p) {
+Zh3 decode_zh3_q16(const std::uint8_t* in, const CodecOptions& p) {
     const Sh3Radiance hub = decode_packed(PackedLayout::kZh3Q16, in, p);
     const Rgb dc = load_dc(in, effective_dc_format(PackedLayout::kZh3Q16, p.dc_format));
     const RatioCoder coder = zonal_coder(p);
@@ -486,7 +486,7 @@ Zh3 decode_zh3_q16(const std::uint8_t* in, const QuantParams& p) {
     return z;
 }
 
-Sh3Radiance decode_packed(PackedLayout layout, const std::uint8_t* in, const QuantParams& p) {
+Sh3Radiance decode_packed(PackedLayout layout, const std::uint8_t* in, const CodecOptions& p) {
     Coeffs q{};
     const Rgb dc = load_dc(in, effective_dc_format(layout, p.dc_format));
     for (int k = 0; k < 3; ++k) {
@@ -506,7 +506,7 @@ Sh3Radiance decode_packed(PackedLayout layout, const std::uint8_t* in, const Qua
     return hub_from_stored(q, p.kind);
 }
 
-Sh3Radiance quantize_roundtrip(PackedLayout layout, const Sh3Radiance& hub, const QuantParams& params,
+Sh3Radiance quantize_roundtrip(PackedLayout layout, const Sh3Radiance& hub, const CodecOptions& params,
                                EncodeStats* stats, const QuantEncodeControls& controls) {
     std::uint8_t bytes[32];
     Coeffs q{};

@@ -47,13 +47,12 @@ RatioInterval zonal_l2_interval(StoredKind kind);
 // The quantiser's parameters are CodecOptions (codec.h), the table's one parameter type; the
 // storage fields there (bits .. axis_mode) change the meaning of stored quantised bytes, and the
 // probe container stores all of them in its header, so non-default values round-trip through files.
-using QuantParams = CodecOptions;
 inline constexpr int kMinQuantBits = 2;
 inline constexpr int kMaxQuantBits = 8;
 
 // Checks the ranges and the combination with a layout (e.g. a half DC needs 6 bytes, which only
 // sh2_q has). `layout_name` may be any codec name; non-quantised names only get the range checks.
-Status validate_quant_params(const QuantParams& params, std::string_view layout_name);
+Status validate_quant_params(const CodecOptions& params, std::string_view layout_name);
 
 // ---- scalar quantiser ----------------------------------------------------------------------
 
@@ -77,8 +76,8 @@ struct RatioCoder {
     // Total: codes above 2 bv decode as 2 bv.
     double decode(std::uint8_t code) const;
 };
-RatioCoder ratio_coder(int sh_index, const QuantParams& params);  // sh_index 1..8
-RatioCoder zonal_coder(const QuantParams& params);                 // the ZH3 coefficient
+RatioCoder ratio_coder(int sh_index, const CodecOptions& params);  // sh_index 1..8
+RatioCoder zonal_coder(const CodecOptions& params);                 // the ZH3 coefficient
 
 // ---- DC formats ----------------------------------------------------------------------------
 
@@ -139,18 +138,18 @@ struct QuantEncodeControls {
 
 // Encodes the hub (radiance SH3) into `layout`; writes exactly packed_size_bytes(layout) bytes.
 // Non-finite coefficients are stored as ratio 0 / DC 0 and counted in stats->clamped_ratios.
-void encode_packed(PackedLayout layout, const Sh3Radiance& hub, const QuantParams& params, std::uint8_t* out,
+void encode_packed(PackedLayout layout, const Sh3Radiance& hub, const CodecOptions& params, std::uint8_t* out,
                    EncodeStats* stats, const QuantEncodeControls& controls = {});
 // Decodes any packed_size_bytes(layout) bytes to the hub (radiance SH3). Total: never traps.
-Sh3Radiance decode_packed(PackedLayout layout, const std::uint8_t* in, const QuantParams& params);
+Sh3Radiance decode_packed(PackedLayout layout, const std::uint8_t* in, const CodecOptions& params);
 
 // zh3_q16 bytes as the ZH3 they stand for (radiance linear SH and zonal coefficients, before the
 // zonal is expanded along the axis): what the decoder's irradiance is made of.
-Zh3 decode_zh3_q16(const std::uint8_t* in, const QuantParams& params);
+Zh3 decode_zh3_q16(const std::uint8_t* in, const CodecOptions& params);
 
 // encode_packed followed by decode_packed, except that controls.exact_dc keeps the float DC
 // (what the decoder would see if the DC were stored exactly). For error-budget studies.
-Sh3Radiance quantize_roundtrip(PackedLayout layout, const Sh3Radiance& hub, const QuantParams& params,
+Sh3Radiance quantize_roundtrip(PackedLayout layout, const Sh3Radiance& hub, const CodecOptions& params,
                                EncodeStats* stats, const QuantEncodeControls& controls = {});
 
 // ---- table entries that store a packed layout (Codec::packed) --------------------------------

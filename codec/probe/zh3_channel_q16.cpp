@@ -18,7 +18,7 @@ namespace zhc {
 namespace {
 const double kSqrtFourPiOverFive = std::sqrt(4.0 * kPi / 5.0);
 
-QuantParams per_channel(QuantParams p) {
+CodecOptions per_channel(CodecOptions p) {
     p.axis_mode = ZonalAxisMode::kPerChannel;
     return p;
 }
@@ -45,7 +45,7 @@ struct SearchContext {
     RatioCoder l1, zonal;
     std::array<double, 256> l1_value;
     std::array<bool, 256> known{};
-    explicit SearchContext(const QuantParams& p) : l1(ratio_coder(1, p)), zonal(zonal_coder(p)) {}
+    explicit SearchContext(const CodecOptions& p) : l1(ratio_coder(1, p)), zonal(zonal_coder(p)) {}
     double l1_ratio(std::uint8_t code) {
         if (!known[code]) {
             l1_value[code] = l1.decode(code);
@@ -82,13 +82,13 @@ double code_error(const ChannelCodeProblem& pr, SearchContext& cx, const std::ar
 }
 }  // namespace
 
-double channel_code_error(const ChannelCodeProblem& pr, const QuantParams& p, const std::array<std::uint8_t, 3>& l1,
+double channel_code_error(const ChannelCodeProblem& pr, const CodecOptions& p, const std::array<std::uint8_t, 3>& l1,
                           std::uint8_t* best_zonal) {
     SearchContext cx(p);
     return code_error(pr, cx, l1, best_zonal);
 }
 
-ChannelCodes solve_channel_codes(const ChannelCodeProblem& pr, const QuantParams& p,
+ChannelCodes solve_channel_codes(const ChannelCodeProblem& pr, const CodecOptions& p,
                                  const std::array<std::uint8_t, 3>* starts, int start_count, int* evaluations) {
     SearchContext cx(p);
     const int top = 2 * quant_half_range(p.bits);

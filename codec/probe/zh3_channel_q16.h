@@ -36,13 +36,13 @@ struct ChannelCodes {
 
 // E of given L1 codes with the best zonal code for them (nearest decoded zonal value to the
 // least-squares fit along the decoder's axis: E is quadratic in it with unit curvature).
-double channel_code_error(const ChannelCodeProblem& problem, const QuantParams& params,
+double channel_code_error(const ChannelCodeProblem& problem, const CodecOptions& params,
                           const std::array<std::uint8_t, 3>& l1, std::uint8_t* best_zonal);
 
 // Descent over the L1 code grid from each start (every step moves to the best of the 26
 // neighbours within +-1 code of each index while that lowers E), then the best zonal code.
 // Returns the codes with the lowest E over all starts; *evaluations counts the E evaluations.
-ChannelCodes solve_channel_codes(const ChannelCodeProblem& problem, const QuantParams& params,
+ChannelCodes solve_channel_codes(const ChannelCodeProblem& problem, const CodecOptions& params,
                                  const std::array<std::uint8_t, 3>* starts, int start_count, int* evaluations);
 
 }  // namespace zhc

@@ -161,7 +161,7 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
     vol["shAxes"] = options.sh_axes == GltfShAxes::kZhc ? "zhc" : "gltf";
     PackedLayout packed;
     if (packed_layout_from_name(set.representation, &packed)) {
-        const StorageParams& p = set.params;
+        const CodecOptions& p = set.params;
         vol["quantization"] = {{"bits", p.bits},
                                {"sqrt", p.sqrt_encoding},
                                {"l2Bound", p.l2_bound == L2Bound::kTight ? "tight" : "loose"},

@@ -117,7 +117,7 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
     std::memcpy(h + kOffMagic, kMagic, sizeof kMagic);
     le::store(h + kOffVersion, kProbeFileVersion, 2);
     le::store(h + kOffHeaderBytes, kProbeFileHeaderBytes, 2);
-    const StorageParams& p = set.params;
+    const CodecOptions& p = set.params;
     h[kOffKind] = static_cast<std::uint8_t>(p.kind);
     h[kOffBits] = static_cast<std::uint8_t>(p.bits);
     h[kOffDcFormat] = static_cast<std::uint8_t>(p.dc_format);
@@ -218,7 +218,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
                                                     " bytes, header says " + std::to_string(probe_bytes) + " (byte 64)");
     ProbeSet set;
     set.representation = rep;
-    StorageParams& p = set.params;
+    CodecOptions& p = set.params;
     p.kind = static_cast<StoredKind>(h[kOffKind]);
     p.bits = h[kOffBits];
     p.dc_format = static_cast<DcFormat>(h[kOffDcFormat]);

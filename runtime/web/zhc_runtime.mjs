@@ -102,7 +102,7 @@ const kL2ZonalHi = Math.sqrt(5.0);
 const kL2TightBound = Math.sqrt(15.0) / 2.0;
 const kL2LooseBound = Math.sqrt(5.0);
 
-// Quantisation parameters (QuantParams of codec/probe/quantize.h) with their glTF spellings.
+// Quantisation parameters (the storage fields of CodecOptions, codec/probe/codec.h) with their glTF spellings.
 export const DEFAULT_PARAMS = Object.freeze({
   bits: 8, sqrt: false, l2Bound: 'tight', dcFormat: 'r11g11b10f', kind: 'radiance',
   zonalMapping: 'affine', axisMode: 'luminance', luminanceWeights: DEFAULT_LUMINANCE,

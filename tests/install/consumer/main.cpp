@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
     const zhc::Sh3Radiance hub =
         zhc::project_latlong(image->rgb.data(), image->width, image->height, std::size_t(image->width) * 3);
     const zhc::Sh3Radiance hubs[1] = {hub};
-    auto set = zhc::encode_probe_set(hubs, "zh3_q16", zhc::StorageParams{}, zhc::ProbeLayout{});
+    auto set = zhc::encode_probe_set(hubs, "zh3_q16", zhc::CodecOptions{}, zhc::ProbeLayout{});
     if (!set) return 1;
     auto bytes = zhc::serialize_probe_set(*set);
     if (!bytes) return 1;
