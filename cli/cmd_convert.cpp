@@ -53,14 +53,11 @@ Result<Loaded> load_input(const Options& o) {
     if (!bytes) return bytes.error();
     Loaded in;
     if (looks_like_probe_file(*bytes)) {
-        auto set = parse_probe_set(*bytes, o.input);
-        if (!set) return set.error();
-        auto hub = decode_probe_set(*set);
-        if (!hub) return make_error(ErrorCode::kBadFormat, o.input + ": " + hub.error().message);
-        if (Status finite = check_finite_probes(*hub, o.input); !finite) return finite.error();
-        in.list.probes = std::move(hub).value();
-        in.list.layout = set->layout;
-        in.set = std::move(set).value();
+        auto file = parse_and_decode_probe_set(*bytes, o.input);
+        if (!file) return file.error();
+        in.list.probes = std::move(file->hub);
+        in.list.layout = file->set.layout;
+        in.set = std::move(file->set);
         in.kind = "zhp";
     } else if (looks_like_envmap(*bytes)) {
         EnvmapReadOptions ro;

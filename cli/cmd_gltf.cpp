@@ -33,15 +33,12 @@ Result<ProbeSet> load_probes(const std::string& path, const std::string& encodin
     auto bytes = read_file_bytes(path, std::uint64_t(2) << 30);
     if (!bytes) return bytes.error();
     if (looks_like_probe_file(*bytes)) {
-        auto set = parse_probe_set(*bytes, path);
-        if (!set) return set.error();
-        auto hub = decode_probe_set(*set);
-        if (!hub) return hub.error();
-        if (Status finite = check_finite_probes(*hub, path); !finite) return finite.error();
-        if (encoding.empty() || encoding == set->representation) return set;
+        auto file = parse_and_decode_probe_set(*bytes, path);
+        if (!file) return file.error();
+        if (encoding.empty() || encoding == file->set.representation) return std::move(file->set);
         CodecOptions params;
-        params.kind = set->params.kind;
-        return convert_probe_set(*set, encoding, params);
+        params.kind = file->set.params.kind;
+        return convert_probe_set(file->set, encoding, params);
     }
     if (looks_like_json(*bytes)) {
         auto list = parse_probe_json(*bytes, path);

@@ -536,6 +536,15 @@ Status check_finite_probes(std::span<const Sh3Radiance> probes, const std::strin
     return Ok{};
 }
 
+Result<DecodedProbeSet> parse_and_decode_probe_set(std::span<const std::uint8_t> bytes, const std::string& name) {
+    auto set = parse_probe_set(bytes, name);
+    if (!set) return set.error();
+    auto hub = decode_probe_set(*set);
+    if (!hub) return make_error(ErrorCode::kBadFormat, name + ": " + hub.error().message);
+    if (Status finite = check_finite_probes(*hub, name); !finite) return finite.error();
+    return DecodedProbeSet{std::move(set).value(), std::move(hub).value()};
+}
+
 Status write_probe_json(const std::string& path, const ProbeList& list) {
     if (!check_finite_probes(list.probes, path))
         return make_error(ErrorCode::kInvalidValue, path + ": a probe holds NaN/Inf; JSON cannot store it");

@@ -65,6 +65,14 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
 Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std::string& name,
                                  const ProbeFileLimits& limits = {}, ProbeFileInfo* info = nullptr);
 
+// parse_probe_set, then every probe decoded to the hub and checked with check_finite_probes: what
+// the verbs that compute with a file's probes (convert, audit, gltf embed) read.
+struct DecodedProbeSet {
+    ProbeSet set;
+    std::vector<Sh3Radiance> hub;
+};
+Result<DecodedProbeSet> parse_and_decode_probe_set(std::span<const std::uint8_t> bytes, const std::string& name);
+
 Status write_probe_file(const std::string& path, const ProbeSet& set, const ProbeFileWriteOptions& options = {});
 Result<ProbeSet> read_probe_file(const std::string& path, const ProbeFileLimits& limits = {},
                                  ProbeFileInfo* info = nullptr);

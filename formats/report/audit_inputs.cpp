@@ -67,14 +67,11 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
     // Probe files: the reference is each probe's SH3 (decoded from whatever the file stores, so a
     // quantised file is audited against its own decoded hub).
     if (looks_like_probe_file(*bytes)) {
-        auto set = parse_probe_set(*bytes, path);
-        if (!set) return set.error();
-        auto hub = decode_probe_set(*set);
-        if (!hub) return hub.error();
-        if (Status finite = check_finite_probes(*hub, path); !finite) return finite.error();
+        auto file = parse_and_decode_probe_set(*bytes, path);
+        if (!file) return file.error();
         in.kind = "probes";
-        in.probes = std::move(hub).value();
-        in.description = std::to_string(in.probes.size()) + " probes stored as " + set->representation +
+        in.probes = std::move(file->hub);
+        in.description = std::to_string(in.probes.size()) + " probes stored as " + file->set.representation +
                          ", reference: their SH3";
         return in;
     }
