@@ -20,6 +20,18 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 constexpr std::uint32_t kFormats[3] = {kVkFormatBc6hUfloat, kVkFormatBc5Unorm, kVkFormatBc4Unorm};
 const char* const kSuffixes[3] = {".iz", ".d", ".wa"};
 
+// The SH lightmap input of encode and audit, read with the verb's thread count.
+Result<std::unique_ptr<ShLightmapSource>> open_source(const std::vector<std::string>& inputs, int threads) {
+    LightmapStreamOptions so;
+    so.threads = threads;
+    return ShLightmapSource::open(inputs, so);
+}
+template <class R>
+void set_size(R& r, const ShLightmapSource& in) {
+    r.width = in.width();
+    r.height = in.height();
+}
+
 
 }  // namespace
 
@@ -35,14 +47,11 @@ Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::s
         if (output_failed) *output_failed = true;
         return e;
     };
-    LightmapStreamOptions so;
-    so.threads = o.threads;
-    auto src = ShLightmapSource::open(inputs, so);
+    auto src = open_source(inputs, o.threads);
     if (!src) return src.error();
     ShLightmapSource& in = **src;
     EncodeResult r;
-    r.width = in.width();
-    r.height = in.height();
+    set_size(r, in);
     r.coefficients = in.coefficients();
     const std::string ext = o.dds ? ".dds" : ".ktx2";
     std::vector<std::string> paths;
@@ -151,14 +160,11 @@ Result<DecodeResult> decode(const std::string& prefix, bool dds, const std::stri
 }
 
 Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOptions& o) {
-    LightmapStreamOptions so;
-    so.threads = o.threads;
-    auto src = ShLightmapSource::open(inputs, so);
+    auto src = open_source(inputs, o.threads);
     if (!src) return src.error();
     ShLightmapSource& in = **src;
     AuditResult r;
-    r.width = in.width();
-    r.height = in.height();
+    set_size(r, in);
     lightmap::AuditAccumulator acc(o.stride);
     const int rows = band_rows(r.width, o.threads, o.band_rows);
     lightmap::ShLightmap band;
