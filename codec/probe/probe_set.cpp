@@ -75,11 +75,10 @@ Status validate_probe_set(const ProbeSet& set) {
 
 void encode_probe(const Codec& codec, const CodecOptions& params, const Sh3Radiance& hub, std::uint8_t* out,
                   EncodeStats* stats) {
-    const CodecOptions& o = params;
     // Packed entries read every storage parameter themselves (kind: scaled bounds); the float
     // entries store what they are given, so irradiance is converted here.
-    if (codec.packed || params.kind != StoredKind::kIrradiance) codec.encode(hub, o, out, stats);
-    else codec.encode(as_radiance_type(to_irradiance(hub)), o, out, stats);
+    if (codec.packed || params.kind != StoredKind::kIrradiance) codec.encode(hub, params, out, stats);
+    else codec.encode(as_radiance_type(to_irradiance(hub)), params, out, stats);
 }
 
 Sh3Radiance decode_probe(const Codec& codec, const CodecOptions& params, const std::uint8_t* in) {
