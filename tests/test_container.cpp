@@ -3,6 +3,7 @@
 // truncation, every bit flip, trailing bytes, limits, unknown versions), golden container bytes,
 // determinism, and CLI behaviour including error paths and atomic outputs.
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -352,6 +353,24 @@ TEST(ProbeJson, RoundTripsExactlyAndChecksTheSchema) {
 }
 
 // ---- CLI ------------------------------------------------------------------------------------------
+
+// JSON cannot hold NaN/Inf: write_probe_json refuses such a probe (kInvalidValue, naming the file)
+// and leaves no file; the verbs refuse such input earlier, so this is the library's own guard.
+TEST(ProbeJson, WriteRefusesNonFiniteProbesAndWritesNothing) {
+    const std::string dir = test::temp_dir("probe_json_write_nan");
+    for (float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+        ProbeList list;
+        list.probes = grid_probes(2, 1, 1);
+        list.layout = grid_layout(2, 1, 1);
+        list.probes[1][4].g = bad;
+        const std::string path = dir + "/bad.json";
+        const Status st = write_probe_json(path, list);
+        ASSERT_FALSE(st.ok());
+        EXPECT_EQ(st.error().code, ErrorCode::kInvalidValue);
+        EXPECT_NE(st.error().message.find(path), std::string::npos) << st.error().message;
+        EXPECT_FALSE(fs::exists(path));
+    }
+}
 
 TEST(CliConvert, GridSh3ToZh3Q16AndBackAndInfo) {
     const std::string dir = test::temp_dir("container_cli");
