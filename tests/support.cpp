@@ -1,5 +1,7 @@
 #include "support.h"
 
+#include <gtest/gtest.h>
+
 #include "formats/probes/probe_file.h"
 
 #include <cmath>
@@ -173,7 +175,11 @@ CommandResult run_zhc(const std::vector<std::string>& args) {
 }
 
 std::string temp_dir(const std::string& name) {
-    const fs::path p = fs::temp_directory_path() / ("zhc_tests_" + std::to_string(::getuid())) / name;
+    // One folder per test: ctest runs tests in parallel processes, and two tests writing the same
+    // file names into one shared folder would race (a test sees the other's half-written file).
+    fs::path p = fs::temp_directory_path() / ("zhc_tests_" + std::to_string(::getuid())) / name;
+    if (const ::testing::TestInfo* t = ::testing::UnitTest::GetInstance()->current_test_info())
+        p /= std::string(t->test_suite_name()) + "." + t->name();
     std::error_code ec;
     fs::create_directories(p, ec);
     return p.string();

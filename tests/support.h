@@ -95,10 +95,10 @@ struct CommandResult {
 // Runs the zhc binary with the given arguments (shell-quoted here), capturing output.
 CommandResult run_zhc(const std::vector<std::string>& args);
 
-// A directory for one test's files: $TMPDIR/zhc_tests_<uid>/<name>, created if missing. It is NOT
-// emptied (it is shared across runs, builds and parallel test processes: run_zhc's "cli_runs"
-// holds every process's outputs under pid-unique names). Tests that check which files exist use
-// fresh_dir instead.
+// A directory for one test's files: $TMPDIR/zhc_tests_<uid>/<name>/<Suite.Test> (the running
+// test's name; <name> alone outside a test), created if missing, so tests run in parallel never
+// share a folder. It is NOT emptied (it outlives the run: run_zhc's "cli_runs" keeps outputs under
+// pid-unique names). Tests that check which files exist use fresh_dir instead.
 std::string temp_dir(const std::string& name);
 // temp_dir(name), emptied first (for one test's own folder only).
 std::string fresh_dir(const std::string& name);

@@ -122,7 +122,7 @@ void expect_rejected(const Bytes& b, const std::string& path, ErrorCode code, co
 }
 
 TEST(GltfProbes, HostileUrisRejectedBeforeReading) {
-    const std::string dir = test::temp_dir("gltf_hostile");
+    const std::string dir = test::fresh_dir("gltf_hostile");  // emptied: the symlink below is made anew every run
     fs::create_directories(dir + "/inner");
     test::write_bytes(dir + "/secret.bin", Bytes(36, 7));  // outside inner/
     const json base = gltf_json(write_model(make_scene(false), false));
@@ -142,7 +142,8 @@ TEST(GltfProbes, HostileUrisRejectedBeforeReading) {
     // Symlink escaping the directory: caught by the file-system guard.
     std::error_code ec;
     fs::create_symlink(dir + "/secret.bin", dir + "/inner/link.bin", ec);
-    if (!ec) {
+    ASSERT_FALSE(ec) << "cannot create a symbolic link in " << dir << ": " << ec.message();
+    {
         json doc = base;
         doc["buffers"][0]["uri"] = "link.bin";
         doc["buffers"][0]["byteLength"] = 36;

@@ -264,11 +264,18 @@ bool guard_resolve(FsGuard* g, const std::string& abs, fs::path* out) {
 // tinygltf looks for a file in the asset's directory and then in the working directory: only
 // the first can succeed here (a probe elsewhere is answered "no", it is not an error), so where
 // a URI resolves never depends on the working directory.
+// A path that lies inside the directory as written but resolves outside it (a symbolic link that
+// escapes) is refused with its own message rather than answered "not found".
 bool fs_exists(const std::string& abs, void* user) {
     auto* g = static_cast<FsGuard*>(user);
     std::error_code ec;
     const fs::path p = fs::weakly_canonical(fs::path(abs), ec);
-    if (ec || !inside(g->base, p)) return false;
+    if (ec) return false;
+    if (!inside(g->base, p)) {
+        if (g->error.empty() && inside(g->base, fs::path(abs).lexically_normal()) && fs::exists(p, ec))
+            g->error = "refusing to read '" + abs + "' outside the input's directory";
+        return false;
+    }
     return fs::is_regular_file(p, ec);
 }
 std::string fs_expand(const std::string& p, void*) { return p; }

@@ -21,8 +21,9 @@ fi
 # The installed command runs from the prefix.
 "$prefix/bin/zhc" --version >/dev/null
 
-# 1. CMake consumer.
-cmake -S "$consumer" -B "$work/cmake-build" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
+# 1. CMake consumer, with the generator zhc itself is built with (Ninja: scripts/setup.sh installs
+# ninja-build, not make, so CMake's default generator may have no build program on a fresh machine).
+cmake -S "$consumer" -B "$work/cmake-build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/cmake-build" >/dev/null
 "$work/cmake-build/zhc_consumer" "$envmap"
 
