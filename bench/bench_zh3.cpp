@@ -1,4 +1,5 @@
-// ZH3 encode cost (every zh3 codec-table entry, plus sh2/sh3 for scale), ratios against zh3_lum
+// ZH3 encode cost (every zh3 codec-table entry, the hallucinated and solved 16-byte entries, plus
+// sh2/sh3 for scale), ratios against zh3_lum
 // (the closed-form fit) measured in the same run, and the error-vs-iterations curve of the axis
 // solves. Single-threaded.
 //   bench_zh3 [REPEATS]
@@ -132,6 +133,10 @@ int main(int argc, char** argv) {
 
     std::vector<const Codec*> rows = {find_codec("sh3"), find_codec("sh2")};
     for (const Codec& c : zh3_codecs()) rows.push_back(&c);
+    // The hallucinated and solved 16-byte entries (codec/probe/zh3_hall.cpp, quantize.cpp): their
+    // solves are the costliest encodes in the table.
+    for (const char* name : {"hall_curve", "hall_curve_q", "hall_solved", "hall_solved_q16", "hall_adaptive_q16", "zh3_solved_q16"})
+        rows.push_back(find_codec(name));
     const Codec* lum = find_codec("zh3_lum");
     const double lum_ns = encode_ns(*lum, probes, defaults, repeats);
     const double lum_err = mean_eq11(*lum, probes, defaults);

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -510,62 +509,6 @@ TEST(HallAdaptiveLayout, GoldenBytes) {
             }
             EXPECT_EQ(test::read_bytes(path), all) << path;
         }
-}
-
-TEST(HallSolve, Timing) {
-    // us per probe (thread CPU time would be better; wall time on a shared machine, minimum of 3).
-    Rng rng(43);
-    std::vector<Sh3Radiance> probes;
-    for (const Map& m : maps())
-        for (int r = 0; r < 16; ++r) probes.push_back(rotate(m.sh, rotation_axis_angle(rng.dir(), 2 * kPi * rng.u())));
-    for (int i = 0; i < 128; ++i) probes.push_back(synthetic_interior(rng));
-    for (const char* name : {"hall_curve", "hall_curve_q", "hall_solved", "hall_solved_q16", "hall_adaptive_q16", "zh3_solved_q16"}) {
-        const Codec& c = *find_codec(name);
-        std::vector<std::uint8_t> b(c.size_bytes);
-        double best = 1e300;
-        for (int rep = 0; rep < 3; ++rep) {
-            const auto t0 = std::chrono::steady_clock::now();
-            for (const Sh3Radiance& p : probes) c.encode(p, {}, b.data(), nullptr);
-            best = std::min(best, std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() / probes.size());
-        }
-        std::printf("%-18s encode %8.3f us/probe\n", name, best);
-    }
-}
-
-TEST(HallExperiment, DISABLED_BestScaleDistribution) {
-    // Which per-probe hallucination scales the solve wants (continuous grid), on rotated maps and
-    // synthetic interiors; coefficient metric against SH3.
-    Rng rng(7);
-    std::vector<Sh3Radiance> probes;
-    for (const Map& m : maps())
-        for (int r = 0; r < 16; ++r) probes.push_back(rotate(m.sh, rotation_axis_angle(rng.dir(), 2 * kPi * rng.u())));
-    for (int i = 0; i < 100; ++i) probes.push_back(synthetic_interior(rng));
-    const CodecOptions o;
-    std::vector<double> grid;
-    for (int g = 0; g <= 40; ++g) grid.push_back(0.125 * g);
-    // ratio[probe][g] = RMSE ratio to SH2 (coefficient metric) at scale grid[g]
-    std::vector<std::vector<double>> ratio;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (const Sh3Radiance& p : probes) {
-        const double e2 = irradiance_sq_error(p, extend_to_sh3(truncate_to_sh2(p)));
-        std::vector<double> r;
-        for (double s : grid)
-            r.push_back(std::sqrt(irradiance_sq_error(p, hall_scaled_expand(hall_solve(p, s, ZonalAxisMode::kLuminance, o, nullptr), s, ZonalAxisMode::kLuminance, o)) / e2));
-        ratio.push_back(r);
-    }
-    const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() / (probes.size() * grid.size());
-    std::printf("%.2f us per solve\n", us);
-    for (int step : {1, 2, 3, 4}) for (int count : {4, 8, 16, 32}) {
-        if ((count - 1) * step >= static_cast<int>(grid.size())) continue;
-        double maps_sum = 0, synth_sum = 0, worst = 0;
-        for (size_t i = 0; i < probes.size(); ++i) {
-            double b = 1e300;
-            for (int c = 0; c < count; ++c) b = std::min(b, ratio[i][static_cast<size_t>(c * step)]);
-            (i < 128 ? maps_sum : synth_sum) += b;
-            worst = std::max(worst, b);
-        }
-        std::printf("step %.3f count %2d (max %.3f): maps %.4f synth %.4f worst %.4f\n", 0.125 * step, count, 0.125 * step * (count - 1), maps_sum / 128, synth_sum / (probes.size() - 128), worst);
-    }
 }
 
 }  // namespace

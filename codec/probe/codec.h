@@ -8,7 +8,11 @@
 // Contracts, for every entry:
 //  * encode writes exactly size_bytes bytes; it never reads or writes anything else.
 //  * decode and irradiance accept ANY size_bytes bytes (safe for untrusted input): they never
-//    crash or trap; garbage in gives finite-or-NaN numbers out, never undefined behaviour.
+//    crash or trap, never undefined behaviour. Garbage in gives numbers out: any float, +-Inf and
+//    NaN included where the bytes hold a float, half or shared-exponent field that encodes them
+//    (readers of files refuse those with check_finite_probes, formats/probes/probe_file.h). decode
+//    is a pure function of the bytes; irradiance agrees with the irradiance of decode's SH3 and
+//    is finite whenever that SH3 is (tests/test_codec_table.cpp, DecodeAcceptsArbitraryBytes).
 //  * the stored bytes are little-endian and the same on every machine; encode is deterministic.
 //  * L0 (DC) round-trips exactly for the float representations.
 #pragma once
