@@ -192,12 +192,17 @@ export function defineZhcLightProbes(core) {
       if (propertyType !== PropertyType.BUFFER || this.properties.size === 0) return this;
       // One bufferView per stored array, each padded to 4 bytes so that the next one (and any
       // float accessor) starts 4-byte aligned; write() trims byteLength back to the exact size.
+      // The writer lays a buffer out as: accessor data and images (each padded to 4 or 8), then
+      // the "other" bufferViews in push order. Other extensions push before this one (prewrite
+      // runs in extension-name order, and KHR_draco_mesh_compression pushes already in its
+      // Accessor prewrite) and their payloads need not be a multiple of 4 long, so the first array
+      // of each buffer gets `lead` zero bytes in front, skipped by its bufferView's byteOffset.
       this._pending = new Map();
       for (const volume of this.listVolumes()) {
         let buffer = volume.getBuffer();
         if (!buffer) volume.setBuffer(buffer = this.document.getRoot().listBuffers()[0] ?? this.document.createBuffer());
-        const views = context.otherBufferViews.get(buffer) ?? [];
-        context.otherBufferViews.set(buffer, views);
+        let views = context.otherBufferViews.get(buffer);
+        if (!views) context.otherBufferViews.set(buffer, views = []);
         const entry = {};
         for (const key of ACCESSOR_KEYS) {
           const a = volume.get('accessors')[key];
@@ -212,10 +217,11 @@ export function defineZhcLightProbes(core) {
     }
 
     _stage(views, bytes) {
-      const padded = new Uint8Array(bytes.byteLength + pad4(bytes.byteLength));
-      padded.set(bytes);
+      const lead = pad4(views.reduce((n, v) => n + v.byteLength, 0));
+      const padded = new Uint8Array(lead + bytes.byteLength + pad4(lead + bytes.byteLength));
+      padded.set(bytes, lead);
       views.push(padded);
-      return { padded, byteLength: bytes.byteLength };
+      return { padded, lead, byteLength: bytes.byteLength };
     }
 
     write(context) {
@@ -225,8 +231,9 @@ export function defineZhcLightProbes(core) {
         const index = context.otherBufferViewsIndexMap.get(staged.padded);
         const bv = json.bufferViews[index];
         if (index === undefined || !bv) throw new Error(`${ZHC_LIGHT_PROBES}: probe data was not written into a buffer`);
-        if ((bv.byteOffset ?? 0) % 4 !== 0) throw new Error(`${ZHC_LIGHT_PROBES}: probe bufferView not 4-byte aligned`);
+        bv.byteOffset = (bv.byteOffset ?? 0) + staged.lead;
         bv.byteLength = staged.byteLength;
+        if (bv.byteOffset % 4 !== 0) throw new Error(`${ZHC_LIGHT_PROBES}: probe bufferView not 4-byte aligned`);
         return index;
       };
       json.accessors = json.accessors || [];
