@@ -64,7 +64,7 @@ function localMatrix(n) {
     2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)];
   return [r[0] * sx, r[1] * sx, r[2] * sx, 0, r[3] * sy, r[4] * sy, r[5] * sy, 0, r[6] * sz, r[7] * sz, r[8] * sz, 0, tx, ty, tz, 1];
 }
-// For each volume: the world matrices of the nodes that reference it (in the default scene).
+// For each volume: the world matrices of the nodes that reference it (in every scene).
 function placements(json) {
   const out = (json.extensions?.ZHC_light_probes?.volumes ?? []).map(() => []);
   const nodes = json.nodes ?? [];
@@ -75,8 +75,7 @@ function placements(json) {
     for (const c of nodes[i].children ?? []) visit(c, m);
   };
   const I = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
-  const scene = json.scenes?.[json.scene ?? 0];
-  for (const r of scene?.nodes ?? []) visit(r, I);
+  for (const scene of json.scenes ?? []) for (const r of scene.nodes ?? []) visit(r, I);
   return out;
 }
 // Same multiset of world matrices per volume (node order may change: flatten reorders roots).
@@ -228,6 +227,27 @@ for (const inp of inputs) {
 for (const cmd of commands) {
   const tried = inputs.filter((i) => full.has(i.name) || cmd === 'copy' || cmd === 'optimize').length;
   console.log(`gltf-transform ${cmd} --config ...: probes kept bit for bit in ${(kept[cmd] ?? []).length}/${tried} inputs`);
+}
+
+// .gltf output (probe data in the external .bin) and merge (volumes of two assets in one).
+{
+  const inp = inputs.find((i) => i.name === 'placed.glb');
+  fs.mkdirSync(W('sep'), { recursive: true });
+  const r = gltfTransform(['copy', inp.file, W('sep/placed.gltf'), '--config', config]);
+  check(r.status === 0 && fs.existsSync(W('sep/placed.bin')), 'copy to .gltf + .bin');
+  if (r.status === 0) {
+    check((await validate(W('sep/placed.gltf'))).numErrors === 0, 'copy to .gltf: validator errors');
+    const got = extractAll(W('sep/placed.gltf'), 2, 'sep_placed');
+    check(got.every((g, v) => g.zhp.equals(inp.extracted[v].zhp) && g.json === inp.extracted[v].json), 'copy to .gltf keeps the probe bytes');
+  }
+  const a = inputs.find((i) => i.name === 'demo_probes.glb'), b = inputs.find((i) => i.name === 'baked_sh3.glb');
+  const m = gltfTransform(['merge', a.file, b.file, W('merged.glb'), '--config', config]);
+  check(m.status === 0, `merge: ${m.stderr}`);
+  if (m.status === 0) {
+    const got = extractAll(W('merged.glb'), 2, 'merged');
+    check(got[0].zhp.equals(a.extracted[0].zhp) && got[1].zhp.equals(b.extracted[0].zhp), 'merge keeps both assets\' volumes, in order');
+    check(samePlacements(placements(readJson(W('merged.glb')).json), [...a.placements, ...b.placements]), 'merge keeps placements');
+  }
 }
 
 // Something actually happened to the rest of the asset (else the test proves little): meshopt
