@@ -131,6 +131,14 @@ export function defineZhcLightProbes(core) {
       if (!ext) return this;
       const fail = (where, what) => { throw new Error(`${ZHC_LIGHT_PROBES}: ${where}: ${what}`); };
       if (!Array.isArray(ext.volumes) || ext.volumes.length === 0) fail('extensions.ZHC_light_probes', 'volumes is not a non-empty array');
+      // Other keys of the extension object: extras and index-free unknown keys are carried.
+      this._rootDef = {};
+      for (const [key, value] of Object.entries(ext)) {
+        if (key === 'volumes') continue;
+        if (key !== 'extras' && typeof value !== 'string' && typeof value !== 'boolean')
+          fail(`extensions.ZHC_light_probes.${key}`, 'unknown property that may reference a buffer; this version cannot renumber it');
+        this._rootDef[key] = clone(value);
+      }
       const used = new Set();
       const volumes = ext.volumes.map((vdef, vi) => {
         const where = `volumes[${vi}]`;
@@ -181,6 +189,8 @@ export function defineZhcLightProbes(core) {
       (json.nodes || []).forEach((nodeDef, ni) => {
         const ref = nodeDef.extensions?.[ZHC_LIGHT_PROBES];
         if (!ref) return;
+        for (const key of Object.keys(ref))
+          if (key !== 'volume') fail(`nodes[${ni}].extensions.ZHC_light_probes.${key}`, 'unknown property; this version cannot carry it');
         if (!Number.isInteger(ref.volume) || ref.volume < 0 || ref.volume >= volumes.length)
           fail(`nodes[${ni}].extensions.ZHC_light_probes.volume`, `index ${ref.volume} out of range`);
         context.nodes[ni].setExtension(ZHC_LIGHT_PROBES, volumes[ref.volume]);
@@ -275,7 +285,7 @@ export function defineZhcLightProbes(core) {
         nodeDef.extensions[ZHC_LIGHT_PROBES] = { volume: volumeIndex.get(volume) };
       }
       json.extensions = json.extensions || {};
-      json.extensions[ZHC_LIGHT_PROBES] = { volumes: defs };
+      json.extensions[ZHC_LIGHT_PROBES] = { volumes: defs, ...clone(this._rootDef ?? {}) };
       return this;
     }
   }

@@ -279,6 +279,16 @@ for (const inp of inputs.slice(0, 2)) {
   const r = gltfTransform(['copy', W('unknown_key.glb'), W('out_unknown_key.glb'), '--config', config]);
   check(r.status !== 0 && /futureAccessor/.test(r.stderr + r.stdout) && !fs.existsSync(W('out_unknown_key.glb')),
     `a volume with an unknown numeric key is refused (exit ${r.status})`);
+  // Index-free unknown keys (strings, booleans) and extras are carried verbatim.
+  const j2 = readJson(W('baked_zh3_q16.glb')).json;
+  j2.extensions.ZHC_light_probes.volumes[0].note = 'kept';
+  j2.extensions.ZHC_light_probes.volumes[0].extras = { tag: [1, 2] };
+  j2.extensions.ZHC_light_probes.extras = { rootTag: true };
+  fs.writeFileSync(W('string_key.glb'), glb(j2, Buffer.from(bin)));
+  const r2 = gltfTransform(['optimize', W('string_key.glb'), W('out_string_key.glb'), '--config', config]);
+  const e2 = r2.status === 0 ? readJson(W('out_string_key.glb')).json.extensions?.ZHC_light_probes : null;
+  check(e2 && e2.volumes[0].note === 'kept' && JSON.stringify(e2.volumes[0].extras) === '{"tag":[1,2]}' && e2.extras?.rootTag === true,
+    'index-free unknown volume keys and extras are carried');
 }
 
 // --- 5. the Extension from a script ----------------------------------------------------------------
