@@ -1,7 +1,9 @@
 // glTF-Transform CLI configuration that keeps zhc's ZHC_light_probes volumes:
 //
-//   gltf-transform --config runtime/web/gltf-transform.config.mjs optimize in.glb out.glb
+//   gltf-transform optimize in.glb out.glb --config runtime/web/gltf-transform.config.mjs
 //
+// (--config after the command: the 4.x CLI reads `gltf-transform --config PATH optimize ...` as
+// an unknown command "--config".)
 // The CLI (@gltf-transform/cli 4.x) imports this module and merges its default export into its
 // own configuration with Object.assign, so `extensions` *replaces* the CLI's list: it is
 // glTF-Transform's ALL_EXTENSIONS plus ZhcLightProbes (runtime/web/zhc_gltf_transform.mjs).
