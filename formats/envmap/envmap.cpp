@@ -182,7 +182,8 @@ Result<int> choose_part(const Imf::MultiPartInputFile& file, const std::string& 
 
 // Luminance/chroma (Y, RY, BY as Imf::RgbaOutputFile writes with WRITE_YC/WRITE_YCA): OpenEXR's
 // RgbaInputFile reconstructs full-resolution chroma and converts to RGB with the file's
-// chromaticities (ImfRgbaYca). It reads the first part only.
+// chromaticities (ImfRgbaYca), in the file's primaries; read_exr then takes them, like every EXR's
+// RGB, to Rec. 709 / D65 (envmap_colour.cpp). It reads the first part only.
 Status read_yc(std::span<const std::uint8_t> bytes, const std::string& name, Image& img, const Imath::Box2i& dw) {
     ExrMemoryStream stream(bytes, name);
     Imf::RgbaInputFile in(stream);
