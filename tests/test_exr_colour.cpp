@@ -414,6 +414,40 @@ TEST(ExrWindows, CroppedDataWindowIsReadAgainstTheDisplayWindow) {
     EXPECT_EQ(conv_twin.exit_code, 0) << conv_twin.err;
     EXPECT_TRUE(conv_twin.err.empty()) << conv_twin.err;
     EXPECT_EQ(test::read_bytes(dir + "/c.json"), test::read_bytes(dir + "/t.json"));
+    // dering, lightmap synth and audit: the same output as the zeroed twin's, and the warning.
+    const std::vector<std::vector<std::string>> verbs = {
+        {"dering", "IN", "-o", "OUT.json"}, {"lightmap", "synth", "IN", "-o", "OUT.exr", "--size", "16"}};
+    for (const auto& v : verbs) {
+        std::vector<std::string> out_paths;
+        for (const std::string& in : {cropped, twin}) {
+            std::vector<std::string> args;
+            for (const std::string& a : v) {
+                if (a == "IN") args.push_back(in);
+                else if (a.rfind("OUT", 0) == 0) args.push_back(out_paths.emplace_back(in + "." + v[0] + a.substr(3)));
+                else args.push_back(a);
+            }
+            const auto vr = test::run_zhc(args);
+            EXPECT_EQ(vr.exit_code, 0) << v[0] << ": " << vr.err;
+            EXPECT_EQ(vr.err.find("zhc: warning: " + cropped + ": data window") != std::string::npos, in == cropped)
+                << v[0] << ": " << vr.err;
+        }
+        if (v[0] == "dering") {  // the JSON names its input: compare the rest
+            auto a = nlohmann::json::parse(test::read_bytes(out_paths[0])), b = nlohmann::json::parse(test::read_bytes(out_paths[1]));
+            ASSERT_TRUE(a.contains("input") && b.contains("input"));
+            a.erase("input"), b.erase("input");
+            EXPECT_EQ(a, b);
+        } else {
+            EXPECT_EQ(test::read_bytes(out_paths[0]), test::read_bytes(out_paths[1])) << v[0];
+        }
+    }
+    double audit_rmse[2] = {-1, -2};
+    for (int k = 0; k < 2; ++k) {
+        const auto ar = test::run_zhc({"audit", k ? twin : cropped, "--representations", "sh3", "--json"});
+        ASSERT_EQ(ar.exit_code, 0) << ar.err;
+        EXPECT_EQ(ar.err.find("(100 64) - (923 383)") != std::string::npos, k == 0) << ar.err;
+        audit_rmse[k] = nlohmann::json::parse(ar.out)["files"][0]["representations"]["sh3"]["relative_rmse"].get<double>();
+    }
+    EXPECT_EQ(audit_rmse[0], audit_rmse[1]);
     const auto j = info_json(cropped);
     EXPECT_EQ(j["data_window"], "(100 64) - (923 383)");
     EXPECT_EQ(j["display_window"], "(0 0) - (1023 511)");
@@ -440,6 +474,42 @@ TEST(ExrWindows, DataWindowBeyondTheDisplayWindowIsCropped) {
     const auto s = test::run_zhc({"project", dir + "/shifted.exr"});
     EXPECT_EQ(s.exit_code, 0) << s.err;
     EXPECT_NE(s.err.find("are 0, data outside the display window is dropped"), std::string::npos) << s.err;
+}
+
+TEST(ExrWindows, CubeMapWithAPartialDataWindow) {
+    // A cube map (envmap attribute cube) whose data window holds only faces +X, -X, +Y: the
+    // display window (N x 6N) is the cube, the other three faces are 0.
+    const std::string dir = test::temp_dir("exr_windows_cube");
+    const int n = 16;
+    Image cube;
+    cube.width = n;
+    cube.height = 6 * n;
+    cube.rgb = render_cube(n, [](Vec3 d) { return Rgb{float(2 + d.x), float(2 + d.y), float(2 + d.z)}; });
+    Image zeroed = cube;
+    std::fill(zeroed.rgb.begin() + 3 * n * 3 * n, zeroed.rgb.end(), 0.0f);
+    {
+        Imf::Header header(Imath::Box2i({0, 0}, {n - 1, 6 * n - 1}), Imath::Box2i({0, 0}, {n - 1, 3 * n - 1}));
+        for (const char* ch : {"R", "G", "B"}) header.channels().insert(ch, Imf::Channel(Imf::FLOAT));
+        Imf::addEnvmap(header, Imf::ENVMAP_CUBE);
+        Imf::OutputFile out((dir + "/half_cube.exr").c_str(), header);
+        Imf::FrameBuffer fb;
+        char* base = reinterpret_cast<char*>(cube.rgb.data());
+        fb.insert("R", Imf::Slice(Imf::FLOAT, base, 12, size_t(n) * 12));
+        fb.insert("G", Imf::Slice(Imf::FLOAT, base + 4, 12, size_t(n) * 12));
+        fb.insert("B", Imf::Slice(Imf::FLOAT, base + 8, 12, size_t(n) * 12));
+        out.setFrameBuffer(fb);
+        out.writePixels(3 * n);
+    }
+    write_float_exr(dir + "/zeroed_cube.exr", n, 6 * n, zeroed.rgb, true);
+    const auto r = test::run_zhc({"project", dir + "/half_cube.exr", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("data window (0 0) - (15 47) differs from the display window (0 0) - (15 95)"), std::string::npos)
+        << r.err;
+    const Sh3Radiance got = parse_sh(r.out), want = cli_project(dir + "/zeroed_cube.exr");
+    EXPECT_EQ(test::sh_distance(got, want), 0.0);
+    write_float_exr(dir + "/full_cube.exr", n, 6 * n, cube.rgb, true);
+    EXPECT_GT(test::sh_distance(got, cli_project(dir + "/full_cube.exr")), 0.1);  // the zeros count
+    EXPECT_EQ(info_json(dir + "/half_cube.exr")["type"], "environment map (cube)");
 }
 
 TEST(ExrWindows, HugeDisplayWindowIsTooLargeBeforeAllocating) {
