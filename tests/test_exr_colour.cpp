@@ -290,7 +290,14 @@ TEST(ExrColour, ChromaticitiesThatDefineNoSpaceAreMalformed) {
               0);
     const auto r = test::run_zhc({"project", bad});
     expect_one_line_error(r, cli::kExitInvalidInput, "collinear");
-    EXPECT_NE(r.err.find("chromaticities"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("chromaticities: the red, green and blue primaries are collinear"), std::string::npos) << r.err;
+    const std::string dark = dir + "/white_y0.exr";
+    ASSERT_EQ(sh_run(quote(ZHC_TOOL_EXRSTDATTR) + " -chromaticities 0.64 0.33 0.3 0.6 0.15 0.06 0.3 0 " +
+                     quote(sample("studio")) + " " + quote(dark)),
+              0);
+    const auto w = test::run_zhc({"info", dark});
+    expect_one_line_error(w, cli::kExitInvalidInput, "white y 0");
+    EXPECT_NE(w.err.find("white point y 0 is not positive"), std::string::npos) << w.err;
 }
 #endif
 
@@ -385,9 +392,15 @@ TEST(ExrWindows, CroppedDataWindowIsReadAgainstTheDisplayWindow) {
     const auto r = test::run_zhc({"project", cropped, "--json"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const Sh3Radiance got = parse_sh(r.out), want = cli_project(twin);
-    // The whole sphere from the data window alone (what a reader ignoring the display window does).
-    auto img = read_envmap(cropped);
+    // The library hands the warning to EnvmapReadOptions::warn when one is set.
+    EnvmapReadOptions ro;
+    std::vector<std::string> warnings;
+    ro.warn = [&](const std::string& line) { warnings.push_back(line); };
+    auto img = read_envmap(cropped, ro);
     ASSERT_TRUE(img) << img.error().message;
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_EQ(r.err, "zhc: warning: " + warnings[0] + "\n");
+    // The whole sphere from the data window alone (what a reader ignoring the display window does).
     EXPECT_EQ(img->width, full.width);
     EXPECT_EQ(img->height, full.height);
     std::vector<float> inside;
