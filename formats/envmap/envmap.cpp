@@ -351,7 +351,7 @@ Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& n
                 << ": the display window is the whole map";
             if (!covers) msg << ", pixels outside the data window are 0";
             if (outside) msg << ", data outside the display window is dropped";
-            const std::string line = msg.str();
+            const std::string line = one_line(msg.str());
             if (o.warn) o.warn(line);
             else std::fprintf(stderr, "zhc: warning: %s\n", line.c_str());
             img = to_display_window(img, dw, disp);
