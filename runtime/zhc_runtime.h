@@ -99,7 +99,8 @@ enum zhc_zonal_mapping { ZHC_ZONAL_AFFINE = 0, ZHC_ZONAL_ZERO_PRESERVING = 1, ZH
 enum zhc_axis_mode { ZHC_AXIS_LUMINANCE = 0, ZHC_AXIS_PER_CHANNEL = 1 };
 enum zhc_irradz_model { ZHC_IRRADZ_HHD = 0, ZHC_IRRADZ_AHD = 1 };
 
-/* Error codes; the .zhp ones mirror zhc's reader (formats/probes/probe_file.h). */
+/* Error codes: one numbering with zhc's library (codec/status.h ErrorCode has the same value for
+ * every class both report; table in docs/inputs.md "Error classes"). */
 enum zhc_error {
     ZHC_OK = 0,
     ZHC_ERR_ARGUMENT = 1,       /* unknown encoding name, invalid zhc_probe_format, null pointer */
