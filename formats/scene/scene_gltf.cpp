@@ -38,11 +38,19 @@ Mat4 Reader::local_matrix(const json& n, const std::string& np) const {
     }
     if (n.contains("rotation")) {
         const auto v = numbers(n["rotation"], np + ".rotation", 4);
-        const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
-        if (!(len > 0)) fail(ErrorCode::kInvalidValue, np + ".rotation", "must be a unit quaternion (got zero)");
-        for (int i = 0; i < 4; ++i) q[i] = v[static_cast<size_t>(i)] / len;  // glTF requires unit; normalise rounding
+        for (int i = 0; i < 4; ++i) q[i] = v[static_cast<size_t>(i)];
     }
-    // M = T * R * S (glTF 2.0 spec, 5.25 node), R from the unit quaternion (x, y, z, w).
+    return trs_matrix(t, q, s, np + ".rotation");
+}
+
+// M = T * R * S (glTF 2.0 spec, 5.25 node), R from the quaternion (x, y, z, w) normalised (glTF
+// requires unit quaternions; this absorbs rounding and quantisation).
+Mat4 Reader::trs_matrix(Vec3 t, const double q_in[4], Vec3 s, const std::string& where) const {
+    const double len = std::sqrt(q_in[0] * q_in[0] + q_in[1] * q_in[1] + q_in[2] * q_in[2] + q_in[3] * q_in[3]);
+    if (!(len > 0)) fail(ErrorCode::kInvalidValue, where, "must be a unit quaternion (got zero)");
+    double q[4];
+    for (int i = 0; i < 4; ++i) q[i] = q_in[i] / len;
+    Mat4 m;
     const double x = q[0], y = q[1], z = q[2], w = q[3];
     const double r[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
                             {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
@@ -97,7 +105,15 @@ void Reader::walk() {
         const Mat4 world = mul(parent, local_matrix(n, np));
         for (double v : world.m)
             if (!std::isfinite(v)) fail(ErrorCode::kInvalidValue, np, "world transform is not finite");
-        if (n.contains("mesh")) add_mesh(index(n["mesh"], np + ".mesh", array_of(doc_, "meshes").size(), "meshes"), world);
+        if (n.contains("mesh")) {
+            const size_t mi = index(n["mesh"], np + ".mesh", array_of(doc_, "meshes").size(), "meshes");
+            // EXT_mesh_gpu_instancing: the mesh is drawn once per instance and not by itself.
+            Instancing inst;
+            inst.world = world;
+            if (n.contains("extensions") && n["extensions"].is_object() && n["extensions"].contains("EXT_mesh_gpu_instancing"))
+                inst = read_instancing(n["extensions"]["EXT_mesh_gpu_instancing"], world, np + ".extensions.EXT_mesh_gpu_instancing");
+            add_mesh(mi, inst);
+        }
         if (n.contains("extensions") && n["extensions"].is_object() && n["extensions"].contains("KHR_lights_punctual")) {
             const json& e = n["extensions"]["KHR_lights_punctual"];
             const std::string ep = np + ".extensions.KHR_lights_punctual.light";
