@@ -52,6 +52,8 @@ struct SceneEnvironment {
     double intensity = 1.0;
     double rotation_rad = 0;   // about +Z, right-hand rule
     std::string source;        // for reports (the map's path)
+    std::string label;         // the bake report's effect name when not a projected map (a glTF
+                               // image-based light's SH); empty: "environment"
 };
 
 enum class SkyKind : std::uint8_t { kConstant, kGradient };

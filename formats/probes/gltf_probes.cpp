@@ -17,7 +17,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <deque>
 #include <filesystem>
+#include <map>
 
 #include "formats/io/file_io.h"
 #include "formats/io/json_depth.h"
@@ -236,6 +238,9 @@ struct FsGuard {
     std::uint64_t max_total = 0;
     std::string error;
     ErrorCode code = ErrorCode::kBadFormat;
+    // External buffer files by canonical path: (buffer index, byteLength) in buffer order, the
+    // order tinygltf reads them in.
+    std::map<std::string, std::deque<std::pair<size_t, std::uint64_t>>> buffers;
 };
 
 }  // namespace
@@ -293,6 +298,36 @@ bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::strin
         g->error = "cannot read external file '" + abs + "'";
         if (err) *err += g->error + "\n";
         return false;
+    }
+    // A buffer's file holds at least its byteLength bytes; the first byteLength are the buffer
+    // (a longer file is valid glTF, as the Khronos validator has it), a shorter one is refused.
+    if (auto it = g->buffers.find(p.string()); it != g->buffers.end() && !it->second.empty()) {
+        const auto [index, length] = it->second.front();
+        it->second.pop_front();
+        if (size < length) {
+            g->code = ErrorCode::kTruncated;
+            g->error = "buffers[" + std::to_string(index) + "]: file '" + p.filename().string() + "' has " + std::to_string(size) +
+                       " bytes, fewer than the buffer's byteLength " + std::to_string(length);
+            if (err) *err += g->error + "\n";
+            return false;
+        }
+        if (g->read_total + length > g->max_total) {
+            g->code = ErrorCode::kTooLarge;
+            g->error = "buffers[" + std::to_string(index) + "]: external files above the size limit";
+            if (err) *err += g->error + "\n";
+            return false;
+        }
+        auto prefix = read_file_prefix(p.string(), static_cast<std::size_t>(length));
+        if (!prefix || prefix->bytes.size() != length) {
+            g->code = prefix ? ErrorCode::kTruncated : prefix.error().code;
+            g->error = prefix ? "buffers[" + std::to_string(index) + "]: file '" + p.filename().string() + "' changed while read"
+                              : prefix.error().message;
+            if (err) *err += g->error + "\n";
+            return false;
+        }
+        g->read_total += length;
+        out->assign(prefix->bytes.begin(), prefix->bytes.end());
+        return true;
     }
     if (size > g->max_bytes || g->read_total + size > g->max_total) {
         g->code = ErrorCode::kTooLarge;
@@ -419,6 +454,8 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
             if (!fs::is_regular_file(guard.base / rel, fe))
                 return fail(ErrorCode::kIoError, path,
                             "referenced file '" + rel + "' not found in " + guard.base.string() + " (buffers[" + std::to_string(i) + "].uri)");
+            const fs::path file = fs::weakly_canonical(guard.base / rel, fe);
+            if (!fe) guard.buffers[file.string()].push_back({i, b["byteLength"].get<std::uint64_t>()});
         }
 
     // tinygltf 2.7 refuses primitives whose index accessor has no bufferView, which is exactly

@@ -83,6 +83,7 @@ void Reader::walk() {
     } else {
         size_t scene = 0;
         if (doc_.contains("scene")) scene = index(doc_["scene"], "scene", scenes.size(), "scenes");
+        scene_ = scene;
         const std::string sp = at("scenes", scene);
         const json& sc = scenes[scene];
         if (!sc.is_object()) fail(ErrorCode::kInvalidValue, sp, "must be an object");
@@ -172,7 +173,7 @@ using namespace scene_gltf_detail;
 namespace fs = std::filesystem;
 
 Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::string& path, const SceneLoadOptions& options,
-                              const GltfLimits& gltf_limits) {
+                              const GltfLimits& gltf_limits, std::vector<std::string>* notes) {
     auto raw = load_gltf_raw(bytes, path, gltf_limits);
     if (!raw) return raw.error();
     try {
@@ -180,6 +181,7 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
         Reader r(path, doc, *raw, options, gltf_limits);
         r.read_light_defs();
         r.walk();
+        std::optional<SceneEnvironment> ibl = r.image_based_light();
         // extras.zhc: a zhc JSON scene (zhc axes) with optional version and probes.
         json extras = json::object();
         if (doc.contains("extras") && doc["extras"].is_object() && doc["extras"].contains("zhc")) extras = doc["extras"]["zhc"];
@@ -189,6 +191,13 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
             if (!extras["gltf_light_shadows"].is_boolean()) r.fail(ErrorCode::kInvalidValue, "extras.zhc.gltf_light_shadows", "must be true or false");
             shadows = extras["gltf_light_shadows"].get<bool>();
             extras.erase("gltf_light_shadows");
+        }
+        // An environment or sky in extras.zhc is the asset's zhc-specific instruction: it wins over
+        // an EXT_lights_image_based light, which is then not baked (and said so).
+        if (ibl && (extras.contains("environment") || extras.contains("sky"))) {
+            r.notes_.push_back(ibl->label + ": not used: extras.zhc." + (extras.contains("environment") ? "environment" : "sky") +
+                               " gives the scene's environment");
+            ibl.reset();
         }
         if (!extras.contains("version")) extras["version"] = 1;
         if (!extras.contains("probes")) extras["probes"] = default_probes(r);
@@ -205,6 +214,8 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
             s.lights.push_back(std::move(l));
         }
         s.occluders.insert(s.occluders.end(), r.occluders_.begin(), r.occluders_.end());
+        if (ibl) s.environment = std::move(ibl);
+        if (notes) *notes = r.notes_;
         if (Status v = validate_scene(s); !v) return make_error(v.error().code, path + ": " + v.error().message);
         if (Status b = check_ray_budget(s, options.limits, path); !b) return b.error();
         return s;
@@ -220,9 +231,10 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
 }  // namespace
 
 Result<Scene> parse_scene_gltf(std::span<const std::uint8_t> bytes, const std::string& path, const SceneLoadOptions& options,
-                               const GltfLimits& gltf_limits) {
+                               const GltfLimits& gltf_limits, std::vector<std::string>* notes) {
     // Messages echo names and values from the asset (and tinygltf's text): keep them one line.
-    auto s = parse_unchecked(bytes, path, options, gltf_limits);
+    if (notes) notes->clear();
+    auto s = parse_unchecked(bytes, path, options, gltf_limits, notes);
     if (!s) return make_error(s.error().code, one_line_message(s.error().message));
     return s;
 }

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -140,6 +141,10 @@ public:
     // KHR_lights_punctual (scene_gltf_lights.cpp)
     void read_light_defs();
     void add_light(size_t li, const Mat4& world, const std::string& where);
+    // EXT_lights_image_based (scene_gltf_lights.cpp): the environment the walked scene references
+    // (its SH3 radiance in zhc axes, rotation applied, intensity kept apart), or none; a light
+    // defined but not referenced leaves a note.
+    std::optional<SceneEnvironment> image_based_light();
 
     // mesh primitives as occluders (scene_gltf_geometry.cpp)
     const json* meshopt_ext(const json& v, std::string* name) const;
@@ -163,6 +168,8 @@ public:
 
     std::vector<SceneLight> lights_;
     std::vector<Occluder> occluders_;
+    std::vector<std::string> notes_;  // what was read but is not baked, for the report
+    std::optional<size_t> scene_;     // the scene walked (none: an asset without scenes)
     double lo_[3] = {INFINITY, INFINITY, INFINITY}, hi_[3] = {-INFINITY, -INFINITY, -INFINITY};
 
 private:
