@@ -481,12 +481,17 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
         if (draco_patch) {
             const std::size_t fake = patched["bufferViews"].size();
             patched["bufferViews"].push_back(json{{"buffer", 0}, {"byteLength", 1}});
-            for (const json& mesh : patched["meshes"])
-                for (const json& prim : mesh.value("primitives", json::array()))
-                    if (prim.is_object() && prim.contains("indices") && prim["indices"].is_number_unsigned()) {
+            // Only well-formed entries are touched (type-checked like needs_draco_index_patch);
+            // tinygltf then reports whatever else is malformed.
+            for (const json& mesh : patched["meshes"]) {
+                if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+                for (const json& prim : mesh["primitives"])
+                    if (prim.is_object() && prim.contains("indices") && prim["indices"].is_number_unsigned() &&
+                        prim["indices"].get<std::uint64_t>() < patched["accessors"].size()) {
                         json& acc = patched["accessors"][prim["indices"].get<size_t>()];
                         if (acc.is_object() && !acc.contains("bufferView")) acc["bufferView"] = fake;
                     }
+            }
         }
         patched_text = patched.dump();
         if (out.binary) {
