@@ -579,6 +579,36 @@ TEST(ExternalBuffer, ALongerBinReadsItsByteLengthAShorterOneIsRefused) {
     EXPECT_FALSE(fs::exists(shorter + "/out.glb"));
 }
 
+// The same for a base64 data: URI (gt_list.gltf with its .bin inlined by hand): the validator
+// accepts more bytes than byteLength, tinygltf alone would refuse them.
+TEST(ExternalBuffer, ADataUriLongerThanByteLengthToo) {
+    const std::string dir = test::fresh_dir("data_uri_length");
+    copy_gt_list(dir);
+    const auto bin = test::read_bytes(dir + "/gt_list.bin");
+    json base = json::parse(test::read_bytes(dir + "/gt_list.gltf"));
+    auto with = [&](std::vector<std::uint8_t> bytes, const std::string& name) {
+        json d = base;
+        d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(bytes);
+        const std::string t = d.dump(), p = dir + "/" + name + ".gltf";
+        test::write_bytes(p, std::vector<std::uint8_t>(t.begin(), t.end()));
+        return p;
+    };
+    auto longer = bin;
+    for (int i = 0; i < 7; ++i) longer.push_back(static_cast<std::uint8_t>(i));
+    const std::string exact = with(bin, "exact"), more = with(longer, "longer"), less = with({bin.begin(), bin.end() - 5}, "shorter");
+    for (const std::string& f : {exact, more}) {
+        const auto r = test::run_zhc({"bake", f, "-o", f + ".json", "--quiet"});
+        EXPECT_EQ(r.exit_code, 0) << f << ": " << r.err;
+    }
+    EXPECT_EQ(test::read_bytes(exact + ".json"), test::read_bytes(more + ".json"));
+    const auto r = test::run_zhc({"bake", less, "-o", less + ".json", "--quiet"});
+    EXPECT_EQ(r.exit_code, 4) << r.err;
+    EXPECT_NE(r.err.find("shorter.gltf: buffers[0]: the data: URI holds " + std::to_string(bin.size() - 5) + " bytes, fewer than the buffer's byteLength " +
+                         std::to_string(bin.size())), std::string::npos) << r.err;
+    EXPECT_LT(r.err.size(), 300u) << "the URI is not echoed";
+    EXPECT_FALSE(fs::exists(less + ".json"));
+}
+
 // ---- fields of the wrong JSON type while embedding ---------------------------------------------
 
 // One class each: push_back onto an object (scenes[i].nodes, bufferViews, accessors), a

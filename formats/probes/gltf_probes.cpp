@@ -473,11 +473,36 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
         for (size_t i = 0; i < out.doc["buffers"].size(); ++i)
             if (!out.doc["buffers"][i].contains("uri") && is_meshopt_fallback(out.doc["buffers"][i]) && !(i == 0 && out.binary && glb.has_bin))
                 fallback_buffers.push_back(i);
+    // A base64 data: URI holding more bytes than its buffer's byteLength is valid glTF (as a
+    // longer .bin file is): tinygltf is shown the decoded length and the buffer is cut back to
+    // byteLength after loading. One holding fewer is refused here, naming the buffer.
+    std::vector<std::pair<size_t, std::uint64_t>> long_data_uris;  // (buffer, declared byteLength)
+    if (out.doc.contains("buffers"))
+        for (size_t i = 0; i < out.doc["buffers"].size(); ++i) {
+            const json& b = out.doc["buffers"][i];
+            if (!b.contains("uri")) continue;
+            const std::string& uri = b["uri"].get_ref<const std::string&>();
+            const size_t comma = uri.find(',');
+            if (uri.rfind("data:", 0) != 0 || comma == std::string::npos || comma < 12 || uri.compare(comma - 7, 7, ";base64") != 0) continue;
+            const std::uint64_t chars = uri.size() - comma - 1;
+            if (chars % 4 != 0) continue;  // not base64: tinygltf refuses it
+            const std::uint64_t pad = chars == 0 ? 0 : (uri.back() == '=') + (chars >= 2 && uri[uri.size() - 2] == '=');
+            const std::uint64_t decoded = chars / 4 * 3 - pad, declared = b["byteLength"].get<std::uint64_t>();
+            if (decoded < declared)
+                return fail(ErrorCode::kTruncated, path, "buffers[" + std::to_string(i) + "]: the data: URI holds " + std::to_string(decoded) +
+                                                             " bytes, fewer than the buffer's byteLength " + std::to_string(declared));
+            if (decoded > declared) long_data_uris.push_back({i, declared});
+        }
     const bool draco_patch = needs_draco_index_patch(out.doc);
-    if (draco_patch || out.doc.contains("images") || !fallback_buffers.empty()) {
+    if (draco_patch || out.doc.contains("images") || !fallback_buffers.empty() || !long_data_uris.empty()) {
         json patched = out.doc;
         patched.erase("images");
         for (size_t i : fallback_buffers) patched["buffers"][i] = json{{"byteLength", 4}, {"uri", "data:application/octet-stream;base64,AAAAAA=="}};
+        for (const auto& [i, declared] : long_data_uris) {
+            const std::string& uri = patched["buffers"][i]["uri"].get_ref<const std::string&>();
+            const std::uint64_t chars = uri.size() - uri.find(',') - 1;
+            patched["buffers"][i]["byteLength"] = chars / 4 * 3 - (uri.back() == '=') - (uri[uri.size() - 2] == '=');
+        }
         if (draco_patch) {
             const std::size_t fake = patched["bufferViews"].size();
             patched["bufferViews"].push_back(json{{"buffer", 0}, {"byteLength", 1}});
@@ -524,6 +549,8 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     }
     for (size_t i : fallback_buffers)
         if (i < out.model.buffers.size()) out.model.buffers[i].data.clear();
+    for (const auto& [i, declared] : long_data_uris)
+        if (i < out.model.buffers.size() && out.model.buffers[i].data.size() > declared) out.model.buffers[i].data.resize(static_cast<size_t>(declared));
     out.fallback_buffers = fallback_buffers;
     return out;
 }
