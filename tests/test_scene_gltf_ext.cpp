@@ -522,6 +522,10 @@ TEST(ImageBasedLight, MalformedLightsAreRefusedNamingTheField) {
          "lights[0].rotation: must be a unit quaternion (got zero)"},
         {"lights", [](Asset& a) { a.doc["extensions"]["EXT_lights_image_based"]["lights"] = json::object(); },
          "extensions.EXT_lights_image_based.lights: must be an array"},
+        {"huge", [](Asset& a) { a.doc["extensions"]["EXT_lights_image_based"]["lights"][0]["irradianceCoefficients"][3] = {1e38, 0, 0}; },
+         "irradianceCoefficients[3]: too large"},
+        {"overflow", [](Asset& a) { a.doc["extensions"]["EXT_lights_image_based"]["lights"][0]["intensity"] = 1e300; },
+         "lights[0].intensity: intensity x irradianceCoefficients does not fit 32-bit floats"},
     };
     for (const Case& k : cases) {
         Asset a = ibl_asset(c, 1, {});

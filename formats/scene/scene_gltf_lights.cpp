@@ -147,7 +147,7 @@ std::optional<SceneEnvironment> Reader::image_based_light() {
         const auto rgb = numbers(c[i], at(cp, i), 3);
         for (int k = 0; k < 3; ++k) {
             const double v = rgb[static_cast<size_t>(k)] / kPi;
-            if (!(std::fabs(v) <= std::numeric_limits<float>::max() / 4)) fail(ErrorCode::kInvalidValue, at(cp, i), "too large for 32-bit floats");
+            if (!(std::fabs(v) <= 1e30)) fail(ErrorCode::kInvalidValue, at(cp, i), "too large (at most 1e30 in magnitude)");
             e[static_cast<int>(i)][k] = static_cast<float>(v);
         }
     }
@@ -172,6 +172,11 @@ std::optional<SceneEnvironment> Reader::image_based_light() {
     Sh3Radiance radiance = to_radiance(e);
     if (l.contains("rotation")) radiance = rotate(radiance, r);
     env.projected = rotate(radiance, transpose(zhc_to_gltf_rotation()));  // glTF frame -> zhc frame
+    // The baked probes are 32-bit floats: intensity x coefficients must stay far inside their range.
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!(std::fabs(double(env.projected[i][k])) * env.intensity <= 1e37))
+                fail(ErrorCode::kInvalidValue, p + ".intensity", "intensity x irradianceCoefficients does not fit 32-bit floats");
     const std::string name = l.contains("name") && l["name"].is_string() ? l["name"].get<std::string>() : "";
     env.label = std::string(kExt) + " " + (name.empty() ? at("lights", *li) : "'" + name + "'");
     env.source = env.label;
