@@ -25,6 +25,12 @@ using json = nlohmann::json;
 
 std::string data(const std::string& name) { return std::string(ZHC_TEST_DATA_DIR) + "/gltf/" + name; }
 
+// gt_list.gltf (+ gt_list.bin, tex.png), written by glTF-Transform, copied into `dir`.
+void copy_gt_list(const std::string& dir) {
+    for (const char* f : {"gt_list.gltf", "gt_list.bin", "tex.png"})
+        fs::copy_file(data(f), dir + "/" + f, fs::copy_options::overwrite_existing);
+}
+
 std::string base64(const std::vector<std::uint8_t>& b) {
     static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string out;
@@ -496,6 +502,38 @@ TEST(ImageBasedLight, TheReportNamesItAndWhatIsNotUsedIsSaid) {
     EXPECT_NE(r.err.find("not used"), std::string::npos) << r.err;
 }
 
+// No Debian or npm tool here writes EXT_lights_image_based: gt_list.gltf (glTF-Transform) edited by
+// hand to reference one. The environment adds to its lights: probe for probe, the bake differs
+// from the unedited file's by the light's SH alone (here a gradient along glTF +Z, intensity 0.5).
+TEST(ImageBasedLight, AddsToTheLightsOfARealFile) {
+    const std::string dir = test::fresh_dir("ibl_real");
+    copy_gt_list(dir);
+    json d = json::parse(test::read_bytes(dir + "/gt_list.gltf"));
+    ASSERT_FALSE(d["extras"]["zhc"].contains("sky"));
+    ASSERT_FALSE(d["extras"]["zhc"].contains("environment"));
+    json c = json::array();
+    for (int i = 0; i < 9; ++i) c.push_back({0.0, 0.0, 0.0});
+    c[0] = {kPi * 2 * std::sqrt(kPi), kPi * 2 * std::sqrt(kPi), 0.0};               // constant 1 (red, green)
+    c[2] = {0.0, 0.0, 2 * kPi / 3 * 0.5 * std::sqrt(4 * kPi / 3)};                     // 0.5 z_glTF (blue)
+    d["extensions"]["EXT_lights_image_based"]["lights"] = {{{"name", "hand"}, {"intensity", 0.5}, {"irradianceCoefficients", c},
+                                                            {"specularImageSize", 16}, {"specularImages", json::array()}}};
+    d["extensionsUsed"].push_back("EXT_lights_image_based");
+    d["scenes"][d.value("scene", 0)]["extensions"]["EXT_lights_image_based"]["light"] = 0;
+    const std::string t = d.dump(), edited = dir + "/ibl.gltf";
+    test::write_bytes(edited, std::vector<std::uint8_t>(t.begin(), t.end()));
+    const ProbeList plain = bake_cli(dir + "/gt_list.gltf", "ibl_real_plain"), lit = bake_cli(edited, "ibl_real_lit");
+    ASSERT_EQ(plain.probes.size(), lit.probes.size());
+    ASSERT_GT(plain.probes.size(), 0u);
+    for (size_t p = 0; p < plain.probes.size(); ++p)
+        for (int i = 0; i < 9; ++i)
+            for (int k = 0; k < 3; ++k) {
+                // zhc +X is glTF +Z: Y11 = -sqrt(3/4pi) x.
+                const double want = i == 0 && k < 2 ? 0.5 * 2 * std::sqrt(kPi) : i == 3 && k == 2 ? -0.5 * 0.5 * std::sqrt(4 * kPi / 3) : 0.0;
+                EXPECT_NEAR(lit.probes[p][i][k] - plain.probes[p][i][k], want, 2e-5 * (1 + std::fabs(plain.probes[p][i][k])))
+                    << "probe " << p << " coefficient " << i << " channel " << k;
+            }
+}
+
 TEST(ImageBasedLight, MalformedLightsAreRefusedNamingTheField) {
     const std::string dir = test::fresh_dir("ibl_refused");
     std::array<double, 9> c{};
@@ -539,12 +577,6 @@ TEST(ImageBasedLight, MalformedLightsAreRefusedNamingTheField) {
 }
 
 // ---- external buffers longer / shorter than byteLength ----------------------------------------
-
-// gt_list.gltf (+ gt_list.bin, tex.png), written by glTF-Transform, copied into `dir`.
-void copy_gt_list(const std::string& dir) {
-    for (const char* f : {"gt_list.gltf", "gt_list.bin", "tex.png"})
-        fs::copy_file(data(f), dir + "/" + f, fs::copy_options::overwrite_existing);
-}
 
 TEST(ExternalBuffer, ALongerBinReadsItsByteLengthAShorterOneIsRefused) {
     const std::string exact = test::fresh_dir("bin_exact"), longer = test::fresh_dir("bin_longer"), shorter = test::fresh_dir("bin_shorter");
