@@ -163,7 +163,7 @@ std::vector<std::uint8_t> glb_with_json(const std::string& path, const json& doc
 // The corpus scene: 125 boxes of 12 triangles under a rotated, translated parent.
 constexpr size_t kBoxes = 125, kBoxTriangles = 12;
 
-TEST(Instancing, GlTransformFloatInstancesBakeExactlyTheSceneOfPlainNodes) {
+TEST(GltfInstancing, GlTransformFloatInstancesBakeExactlyTheSceneOfPlainNodes) {
     const Scene nodes = scene_of(data("gi_nodes.glb")), inst = scene_of(data("gi_float.glb"));
     EXPECT_EQ(triangle_count(nodes), kBoxes * kBoxTriangles);
     EXPECT_EQ(triangle_count(inst), kBoxes * kBoxTriangles);  // was 12: one box
@@ -191,7 +191,7 @@ TEST(Instancing, GlTransformFloatInstancesBakeExactlyTheSceneOfPlainNodes) {
 // Normalized SHORT and BYTE rotations: every vertex within what the quantisation step allows.
 // A quaternion component off by at most step / 2 turns a vector of length r by at most about
 // 2 |dq| r with |dq| <= 2 * step / 2 (four components); boxes reach r <= 2.5 from their origin.
-TEST(Instancing, NormalizedShortAndByteRotationsPlaceEveryInstance) {
+TEST(GltfInstancing, NormalizedShortAndByteRotationsPlaceEveryInstance) {
     const Scene nodes = scene_of(data("gi_nodes.glb"));
     for (const auto& [file, step] : {std::pair<const char*, double>{"gi_rot_short.glb", 1 / 32767.0}, {"gi_rot_byte.glb", 1 / 127.0}}) {
         const Scene q = scene_of(data(file));
@@ -209,7 +209,7 @@ TEST(Instancing, NormalizedShortAndByteRotationsPlaceEveryInstance) {
     EXPECT_LE(max_diff(a.probes, b.probes), 1e-4 * max_coefficient(a.probes));
 }
 
-TEST(Instancing, GltfpackInstancedOutputBakesLikeItsInput) {
+TEST(GltfInstancing, GltfpackInstancedOutputBakesLikeItsInput) {
     // gltfpack -mi folded the parent transform into 125 instances with SHORT normalized rotations.
     const json j = glb_json(data("gp_instanced.glb"));
     ASSERT_TRUE(j.contains("extensionsUsed"));
@@ -255,7 +255,7 @@ Asset shadow_scene(int rotation_component, bool float_scale = true) {
     return a;
 }
 
-TEST(Instancing, OnlyTheInstancesShadowTheProbesUnderThem) {
+TEST(GltfInstancing, OnlyTheInstancesShadowTheProbesUnderThem) {
     for (int rc : {5126, 5122, 5120, 0}) {
         auto s = parse(shadow_scene(rc));
         ASSERT_TRUE(s.ok()) << rc << ": " << s.error().message;
@@ -282,7 +282,7 @@ TEST(Instancing, OnlyTheInstancesShadowTheProbesUnderThem) {
     EXPECT_NEAR(s->probes.max.y, 11 - 12.0 / 16, 1e-12);
 }
 
-TEST(Instancing, WhatTheExtensionDoesNotDefineIsRefusedNamingTheAttribute) {
+TEST(GltfInstancing, WhatTheExtensionDoesNotDefineIsRefusedNamingTheAttribute) {
     const std::string dir = test::fresh_dir("instancing_refused");
     struct Case {
         std::string file;
@@ -371,7 +371,7 @@ std::array<double, 9> analytic_radiance_sh() {
 constexpr double kBandFactor[3] = {kPi, 2 * kPi / 3, kPi / 4};  // Ramamoorthi & Hanrahan A_l
 int band(int i) { return i == 0 ? 0 : i < 4 ? 1 : 2; }
 
-TEST(ImageBasedLight, IrradianceCoefficientsAreRadianceTimesTheCosineLobeFactors) {
+TEST(GltfImageBasedLight, IrradianceCoefficientsAreRadianceTimesTheCosineLobeFactors) {
     // Derive the factor the reader uses: physical irradiance SH over radiance SH, band by band.
     const auto c = irradiance_sh_by_quadrature(analytic_radiance, 6000);
     const auto l = analytic_radiance_sh();
@@ -417,7 +417,7 @@ std::array<double, 9> analytic_radiance_zhc() {
     return l;
 }
 
-TEST(ImageBasedLight, BakesTheRadianceItsCoefficientsDescribe) {
+TEST(GltfImageBasedLight, BakesTheRadianceItsCoefficientsDescribe) {
     // Coefficients an exporter would write (quadrature), and the exact ones (A_l L_lm).
     const auto numeric = irradiance_sh_by_quadrature(analytic_radiance, 6000);
     std::array<double, 9> exact{};
@@ -438,7 +438,7 @@ TEST(ImageBasedLight, BakesTheRadianceItsCoefficientsDescribe) {
     }
 }
 
-TEST(ImageBasedLight, IntensityAndRotationApply) {
+TEST(GltfImageBasedLight, IntensityAndRotationApply) {
     // L = 1 + 0.5 z_glTF, exact coefficients; intensity 2; rotation 90 degrees about glTF +Y,
     // which turns +Z to +X: the scene sees L = 1 + 0.5 x_glTF = 1 + 0.5 y_zhc, times 2.
     std::array<double, 9> c{};
@@ -466,7 +466,7 @@ TEST(ImageBasedLight, IntensityAndRotationApply) {
     expect_probe(bake(*scaled)[0], want, 2e-6, "scaled quaternion");
 }
 
-TEST(ImageBasedLight, TheReportNamesItAndWhatIsNotUsedIsSaid) {
+TEST(GltfImageBasedLight, TheReportNamesItAndWhatIsNotUsedIsSaid) {
     const std::string dir = test::fresh_dir("ibl_report");
     std::array<double, 9> c{};
     c[0] = kPi * 2 * std::sqrt(kPi);  // constant radiance 1
@@ -505,7 +505,7 @@ TEST(ImageBasedLight, TheReportNamesItAndWhatIsNotUsedIsSaid) {
 // No Debian or npm tool here writes EXT_lights_image_based: gt_list.gltf (glTF-Transform) edited by
 // hand to reference one. The environment adds to its lights: probe for probe, the bake differs
 // from the unedited file's by the light's SH alone (here a gradient along glTF +Z, intensity 0.5).
-TEST(ImageBasedLight, AddsToTheLightsOfARealFile) {
+TEST(GltfImageBasedLight, AddsToTheLightsOfARealFile) {
     const std::string dir = test::fresh_dir("ibl_real");
     copy_gt_list(dir);
     json d = json::parse(test::read_bytes(dir + "/gt_list.gltf"));
@@ -534,7 +534,7 @@ TEST(ImageBasedLight, AddsToTheLightsOfARealFile) {
             }
 }
 
-TEST(ImageBasedLight, MalformedLightsAreRefusedNamingTheField) {
+TEST(GltfImageBasedLight, MalformedLightsAreRefusedNamingTheField) {
     const std::string dir = test::fresh_dir("ibl_refused");
     std::array<double, 9> c{};
     c[0] = 1;
@@ -578,7 +578,7 @@ TEST(ImageBasedLight, MalformedLightsAreRefusedNamingTheField) {
 
 // ---- external buffers longer / shorter than byteLength ----------------------------------------
 
-TEST(ExternalBuffer, ALongerBinReadsItsByteLengthAShorterOneIsRefused) {
+TEST(GltfBufferLength, ALongerBinReadsItsByteLengthAShorterOneIsRefused) {
     const std::string exact = test::fresh_dir("bin_exact"), longer = test::fresh_dir("bin_longer"), shorter = test::fresh_dir("bin_shorter");
     copy_gt_list(exact);
     copy_gt_list(longer);
@@ -617,7 +617,7 @@ TEST(ExternalBuffer, ALongerBinReadsItsByteLengthAShorterOneIsRefused) {
 
 // The same for a base64 data: URI (gt_list.gltf with its .bin inlined by hand): the validator
 // accepts more bytes than byteLength, tinygltf alone would refuse them.
-TEST(ExternalBuffer, ADataUriLongerThanByteLengthToo) {
+TEST(GltfBufferLength, ADataUriLongerThanByteLengthToo) {
     const std::string dir = test::fresh_dir("data_uri_length");
     copy_gt_list(dir);
     const auto bin = test::read_bytes(dir + "/gt_list.bin");
@@ -650,7 +650,7 @@ TEST(ExternalBuffer, ADataUriLongerThanByteLengthToo) {
 // One class each: push_back onto an object (scenes[i].nodes, bufferViews, accessors), a
 // container silently replaced before (extensions.ZHC_light_probes, extensionsUsed, nodes), an
 // entry of the wrong type (images[0]), value() on a non-object while loading (meshes[1]).
-TEST(EmbedFields, WrongJsonTypesAreRefusedNamingTheFieldFromBakeAndEmbed) {
+TEST(GltfEmbedFields, WrongJsonTypesAreRefusedNamingTheFieldFromBakeAndEmbed) {
     const std::string dir = test::fresh_dir("embed_fields");
     copy_gt_list(dir);
     const std::string probes = dir + "/p.zhp";
