@@ -2,7 +2,8 @@
 // occluders (docs/scene.md "glTF input"): TRIANGLES / TRIANGLE_STRIP / TRIANGLE_FAN (glTF 2.0 spec
 // 3.7.2.1), accessors and buffer views bound-checked, POSITION as FLOAT or KHR_mesh_quantization
 // integers, EXT_/KHR_meshopt_compression buffer views (gltf_meshopt.cpp) and
-// KHR_draco_mesh_compression primitives (gltf_draco.cpp).
+// KHR_draco_mesh_compression primitives (gltf_draco.cpp); EXT_mesh_gpu_instancing nodes draw each
+// primitive once per instance.
 #include "formats/scene/scene_gltf_reader.h"
 
 #include <algorithm>

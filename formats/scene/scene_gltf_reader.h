@@ -1,7 +1,8 @@
 // zhc/formats/scene/scene_gltf_reader.h — internal to formats/: the glTF scene reader shared by
 // scene_gltf.cpp (node tree, default probes, the public entry points), scene_gltf_lights.cpp
-// (KHR_lights_punctual) and scene_gltf_geometry.cpp (mesh primitives as occluders: accessors,
-// KHR_mesh_quantization, EXT_/KHR_meshopt_compression, KHR_draco_mesh_compression). glTF 2.0;
+// (KHR_lights_punctual, EXT_lights_image_based) and scene_gltf_geometry.cpp (mesh primitives as
+// occluders: accessors, KHR_mesh_quantization, EXT_/KHR_meshopt_compression,
+// KHR_draco_mesh_compression, EXT_mesh_gpu_instancing). glTF 2.0;
 // the format as zhc reads it: formats/scene/scene_gltf.h, docs/scene.md.
 #pragma once
 
