@@ -213,7 +213,10 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
             l.shadows = shadows;
             s.lights.push_back(std::move(l));
         }
-        s.occluders.insert(s.occluders.end(), r.occluders_.begin(), r.occluders_.end());
+        // Moved, not copied, when extras.zhc adds none: the mesh triangles are the bulk of the memory.
+        if (s.occluders.empty()) s.occluders = std::move(r.occluders_);
+        else s.occluders.insert(s.occluders.end(), r.occluders_.begin(), r.occluders_.end());
+        std::vector<Occluder>().swap(r.occluders_);
         if (ibl) s.environment = std::move(ibl);
         if (notes) *notes = r.notes_;
         if (Status v = validate_scene(s); !v) return make_error(v.error().code, path + ": " + v.error().message);
