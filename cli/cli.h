@@ -5,6 +5,9 @@
 #include <functional>
 #include <string>
 
+#include <vector>
+
+#include "codec/probe/codec.h"
 #include "codec/sh/sh.h"
 #include "codec/status.h"
 
@@ -41,8 +44,31 @@ int report_write(const Error& error);
 enum class RepresentationCount { kOne, kList };
 CLI::Option* add_representations_option(CLI::App* app, std::string& names, RepresentationCount count,
                                         const std::string& what, const std::string& old_spelling = "");
-// `--threads N`, N in 0..256, 0 = all cores (hardware_concurrency). Every verb that takes it gives
-// identical output for any count; the help shows the verb's default.
+// The codec-table entry a kOne `-r` value names. An unknown name prints select_codecs' one line
+// (the name and every known name: the same words in every verb that parses `-r`) and returns null;
+// the verb then exits kExitUsage.
+const Codec* representation_named(const std::string& name);
+
+// Which storage parameters (CodecOptions bits .. axis_mode, `zhc convert`'s --bits .. --axis) an
+// entry's bytes depend on, from what the table says of it (Codec::packed, its layout, the
+// zonal_axis trait): bits, square-root encoding and the DC format for every quantised layout; the
+// non-zonal L2 bound where the layout stores non-zonal L2 ratios (sh3_q28); the zonal mapping where
+// it stores a zonal ratio (zh3_q16, sh3_q28); the axis where the decoder takes it from the
+// parameters (ZonalAxis::kFromParams). The stored kind (radiance/irradiance) concerns every entry.
+struct StorageOptionUse {
+    bool bits = false, sqrt = false, dc = false, l2_bound = false, zonal_mapping = false, axis = false;
+};
+StorageOptionUse storage_options_used(const Codec& codec);
+
+// Refuses to write an output over one of the inputs: `output` and any of `inputs` name the same file
+// (compared as canonical paths, and with std::filesystem::equivalent when both exist, so another
+// spelling, a symlink or a hard link is caught). Prints "zhc: error: OPTION OUTPUT: is the input
+// INPUT (choose another output path)" and returns kExitUsage; kExitOk when they differ. Inputs
+// that are folders or do not exist never match.
+int refuse_output_over_input(const std::string& option, const std::string& output, const std::vector<std::string>& inputs);
+
+// `--threads N`, N in 0..256, 0 = all cores (hardware_concurrency), the default of every verb
+// (README "Options"). Every verb that takes it gives identical output for any count.
 CLI::Option* add_threads_option(CLI::App* app, int& threads, const std::string& what);
 // The worker count a --threads value means: 0 -> the machine's cores (at least 1).
 int resolve_threads(int threads);

@@ -45,8 +45,11 @@ std::string fmt(double v, const char* f = "%.4g") {
     return b;
 }
 
-std::vector<std::string> columns() {
-    return {"representation", "bytes", "rmse", "rel_rmse", "max_abs", "min_irr", "neg_frac", "chroma", "enc_ns", "dec_ns"};
+// The table columns; the timing columns only when timing is on (--no-timing leaves them out).
+std::vector<std::string> columns(bool timed) {
+    std::vector<std::string> c{"representation", "bytes", "rmse", "rel_rmse", "max_abs", "min_irr", "neg_frac", "chroma"};
+    if (timed) c.insert(c.end(), {"enc_ns", "dec_ns"});
+    return c;
 }
 // --runtime-cost: two more columns (SPIR-V instructions, GPU ns/eval) looked up by the row's name.
 void add_cost_columns(std::vector<std::vector<std::string>>& rows, const RuntimeCostTable* gpu) {
@@ -60,28 +63,78 @@ void add_cost_columns(std::vector<std::vector<std::string>>& rows, const Runtime
     }
 }
 
-std::vector<std::string> row_of(const RepresentationResult& r) {
+std::vector<std::string> row_of(const RepresentationResult& r, bool timed) {
     const ErrorMetrics& m = r.metrics;
-    return {std::string(r.codec->name), std::to_string(r.codec->size_bytes), fmt(m.rmse), fmt(m.relative_rmse, "%.4f"),
-            fmt(m.max_abs), fmt(m.min_irradiance), fmt(m.negative_fraction, "%.4f"), fmt(m.chromaticity_error, "%.4f"),
-            fmt(r.encode_ns, "%.0f"), fmt(r.decode_ns, "%.0f")};
+    std::vector<std::string> row{std::string(r.codec->name), std::to_string(r.codec->size_bytes), fmt(m.rmse),
+                                 fmt(m.relative_rmse, "%.4f"), fmt(m.max_abs), fmt(m.min_irradiance),
+                                 fmt(m.negative_fraction, "%.4f"), fmt(m.chromaticity_error, "%.4f")};
+    if (timed) row.insert(row.end(), {fmt(r.encode_ns, "%.0f"), fmt(r.decode_ns, "%.0f")});
+    return row;
 }
 
 
-nlohmann::ordered_json metrics_json(const RepresentationResult& r) {
+// encode_ns and decode_ns only when timing is on (--no-timing: absent, not 0).
+nlohmann::ordered_json metrics_json(const RepresentationResult& r, bool timed) {
     const ErrorMetrics& m = r.metrics;
-    return {{"rmse", m.rmse},
-            {"relative_rmse", m.relative_rmse},
-            {"max_abs", m.max_abs},
-            {"min_irradiance", m.min_irradiance},
-            {"negative_fraction", m.negative_fraction},
-            {"chromaticity_error", m.chromaticity_error},
-            {"bytes_per_probe", r.codec->size_bytes},
-            {"encode_ns", r.encode_ns},
-            {"decode_ns", r.decode_ns},
-            {"clamped_ratios", r.stats.clamped_ratios},
-            {"dering_clamped", r.stats.dering_clamped}};
+    nlohmann::ordered_json j{{"rmse", m.rmse},
+                             {"relative_rmse", m.relative_rmse},
+                             {"max_abs", m.max_abs},
+                             {"min_irradiance", m.min_irradiance},
+                             {"negative_fraction", m.negative_fraction},
+                             {"chromaticity_error", m.chromaticity_error},
+                             {"bytes_per_probe", r.codec->size_bytes}};
+    if (timed) {
+        j["encode_ns"] = r.encode_ns;
+        j["decode_ns"] = r.decode_ns;
+    }
+    j["clamped_ratios"] = r.stats.clamped_ratios;
+    j["dering_clamped"] = r.stats.dering_clamped;
+    return j;
 }
+
+// The gate failure in one line: per configured gate that some probe breaks, how many (input,
+// representation) pairs break it, and the worst probe's value against the threshold and where.
+std::string gate_summary(const AuditGates& gates, const AuditRun& run) {
+    struct Worst {
+        std::size_t pairs = 0;
+        double value = 0;
+        std::string where;
+    };
+    Worst rmse, relative, negative;
+    std::size_t pairs = 0, failing = 0;
+    auto note = [](Worst& w, bool breaks, double v, bool worse, const std::string& path, const Codec* c, std::size_t probe) {
+        if (!breaks) return;
+        if (w.pairs++ == 0 || worse) {
+            w.value = v;
+            w.where = path + ": " + std::string(c->name) + " at probe " + std::to_string(probe);
+        }
+    };
+    for (const InputAudit& in : run.inputs)
+        for (std::size_t c = 0; c < in.results.size() && c < in.extremes.size(); ++c) {
+            ++pairs;
+            failing += c < in.failing_probes.size() && !in.failing_probes[c].empty();
+            const InputAudit::Extremes& x = in.extremes[c];
+            const Codec* codec = in.results[c].codec;
+            note(rmse, gates.max_rmse >= 0 && x.rmse > gates.max_rmse, x.rmse, x.rmse > rmse.value, in.path, codec, x.rmse_probe);
+            note(relative, gates.max_relative_rmse >= 0 && x.relative_rmse > gates.max_relative_rmse, x.relative_rmse,
+                 x.relative_rmse > relative.value, in.path, codec, x.relative_rmse_probe);
+            note(negative, gates.fail_on_negative && x.min_irradiance < 0, x.min_irradiance, x.min_irradiance < negative.value,
+                 in.path, codec, x.min_irradiance_probe);
+        }
+    std::string s = std::to_string(failing) + " of " + std::to_string(pairs) + " (input, representation) pairs fail";
+    auto add = [&](const Worst& w, const std::string& gate, const std::string& what, const std::string& threshold) {
+        if (w.pairs == 0) return;
+        s += "; " + gate + ": " + std::to_string(w.pairs) + " pairs, worst " + what + " " + fmt(w.value) + " vs " + threshold +
+             " (" + w.where + ")";
+    };
+    add(rmse, "--max-rmse", "rmse", fmt(gates.max_rmse));
+    add(relative, "--max-relative-rmse", "relative rmse", fmt(gates.max_relative_rmse));
+    add(negative, "--fail-on-negative", "min irradiance", "0");
+    return s;
+}
+
+// The failures' detail for the text report: the first 10 lines, then how many more.
+constexpr std::size_t kGateDetailLines = 10;
 
 HtmlRow html_row(const RepresentationResult& r, bool timed) {
     HtmlRow h;
@@ -162,6 +215,10 @@ int run(const Options& o) {
     auto files = expand_audit_inputs(o.inputs);
     if (!files) return report(files.error());
     if (files->empty()) return report(make_error(ErrorCode::kInvalidArgument, "no audit inputs found"));
+    for (const auto& [option, path] : {std::pair<std::string, std::string>{"--markdown", o.markdown}, {"--html", o.html}})
+        if (!path.empty())
+            if (int rc = refuse_output_over_input(option, path, *files); rc != kExitOk) return rc;
+    const bool timed = !o.no_timing;
 
     const std::vector<Vec3> dirs = fibonacci_sphere(o.directions);
     Progress progress("zhc audit", "files", o.progress);
@@ -204,29 +261,32 @@ int run(const Options& o) {
             f["path"] = inputs[i].path;
             f["kind"] = inputs[i].kind;
             f["probes"] = inputs[i].probes.size();
+            f["reference"] = inputs[i].reference;
             nlohmann::ordered_json reps = nlohmann::ordered_json::object();
-            for (const RepresentationResult& r : result.inputs[i].results) reps[std::string(r.codec->name)] = metrics_json(r);
+            for (const RepresentationResult& r : result.inputs[i].results) reps[std::string(r.codec->name)] = metrics_json(r, timed);
             f["representations"] = reps;
             j["files"].push_back(f);
         }
         nlohmann::ordered_json agg = nlohmann::ordered_json::object();
-        for (const RepresentationResult& r : result.aggregate) agg[std::string(r.codec->name)] = metrics_json(r);
+        for (const RepresentationResult& r : result.aggregate) agg[std::string(r.codec->name)] = metrics_json(r, timed);
         j["aggregate"] = {{"files", inputs.size()}, {"representations", agg}};
         j["gates"] = {{"passed", failures.empty()}, {"failures", failures}};
+        if (!failures.empty()) j["gates"]["summary"] = gate_summary(aopt.gates, result);
         print_json("audit", j);
     } else {
         for (size_t i = 0; i < inputs.size(); ++i) {
             std::cout << inputs[i].path << " (" << inputs[i].description << ", " << o.directions << " directions)\n";
-            std::vector<std::vector<std::string>> rows{columns()};
-            for (const RepresentationResult& r : result.inputs[i].results) rows.push_back(row_of(r));
+            std::cout << "reference: " << inputs[i].reference << "\n";
+            std::vector<std::vector<std::string>> rows{columns(timed)};
+            for (const RepresentationResult& r : result.inputs[i].results) rows.push_back(row_of(r, timed));
             add_cost_columns(rows, gpu);
             print_table(std::cout, rows, false);
             std::cout << "\n";
         }
         if (inputs.size() > 1) {
             std::cout << "aggregate over " << inputs.size() << " files (mean rmse, rel_rmse, fractions, times; worst max_abs, min_irr)\n";
-            std::vector<std::vector<std::string>> rows{columns()};
-            for (const RepresentationResult& r : result.aggregate) rows.push_back(row_of(r));
+            std::vector<std::vector<std::string>> rows{columns(timed)};
+            for (const RepresentationResult& r : result.aggregate) rows.push_back(row_of(r, timed));
             add_cost_columns(rows, gpu);
             print_table(std::cout, rows, false);
         }
@@ -236,16 +296,16 @@ int run(const Options& o) {
         md << "# zhc audit\n\nIrradiance error against the reference at " << o.directions
            << " directions (environment maps: direct integration of the map; probe files: their SH3).\n\n";
         for (size_t i = 0; i < inputs.size(); ++i) {
-            md << "## " << inputs[i].path << "\n\n" << inputs[i].description << "\n\n";
-            std::vector<std::vector<std::string>> rows{columns()};
-            for (const RepresentationResult& r : result.inputs[i].results) rows.push_back(row_of(r));
+            md << "## " << inputs[i].path << "\n\n" << inputs[i].description << "\n\nReference: " << inputs[i].reference << ".\n\n";
+            std::vector<std::vector<std::string>> rows{columns(timed)};
+            for (const RepresentationResult& r : result.inputs[i].results) rows.push_back(row_of(r, timed));
             add_cost_columns(rows, gpu);
             print_table(md, rows, true);
             md << "\n";
         }
         md << "## Aggregate over " << inputs.size() << " files\n\n";
-        std::vector<std::vector<std::string>> rows{columns()};
-        for (const RepresentationResult& r : result.aggregate) rows.push_back(row_of(r));
+        std::vector<std::vector<std::string>> rows{columns(timed)};
+        for (const RepresentationResult& r : result.aggregate) rows.push_back(row_of(r, timed));
         add_cost_columns(rows, gpu);
         print_table(md, rows, true);
         const std::string text = md.str();
@@ -261,7 +321,15 @@ int run(const Options& o) {
         std::fprintf(stderr, "report: %s\n", o.html.c_str());
     }
     if (!failures.empty()) {
-        for (const std::string& f : failures) std::fprintf(stderr, "zhc: gate failed: %s\n", f.c_str());
+        // The detail (bounded) after the text report; JSON holds every failure in gates.failures.
+        // stderr gets one line: which gates, how many failures, the worst value and where.
+        if (!o.json) {
+            std::printf("\ngate failures (%zu):\n", failures.size());
+            for (std::size_t i = 0; i < failures.size() && i < kGateDetailLines; ++i) std::printf("  %s\n", failures[i].c_str());
+            if (failures.size() > kGateDetailLines)
+                std::printf("  ... %zu more (all of them: --json, gates.failures)\n", failures.size() - kGateDetailLines);
+        }
+        std::fprintf(stderr, "zhc: gate failed: %s\n", gate_summary(aopt.gates, result).c_str());
         return kExitGateFailed;
     }
     return kExitOk;

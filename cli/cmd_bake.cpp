@@ -48,11 +48,9 @@ int run(const Options& o) {
                      o.output.c_str());
         return kExitUsage;
     }
-    const Codec* codec = find_codec(o.to);
-    if (!codec) {
-        std::fprintf(stderr, "zhc: error: --representations %s: unknown representation\n", o.to.c_str());
-        return kExitUsage;
-    }
+    const Codec* codec = representation_named(o.to);
+    if (!codec) return kExitUsage;
+    if (int rc = refuse_output_over_input("-o", o.output, {o.scene}); rc != kExitOk) return rc;
     const int threads = resolve_threads(o.threads);
     SceneLoadOptions lo;
     lo.threads = threads;

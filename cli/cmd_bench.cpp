@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -35,11 +36,22 @@ struct Options {
 int run(const Options& o) {
     std::vector<std::string> inputs = o.inputs;
     if (inputs.empty()) {
-        if (!fs::exists(fs::path(ZHC_SAMPLE_ENVMAP_DIR) / "city.exr"))
-            return report(make_error(ErrorCode::kInvalidArgument,
-                                     "no maps given and the sample maps are not at " + std::string(ZHC_SAMPLE_ENVMAP_DIR)));
-        inputs.push_back(ZHC_SAMPLE_ENVMAP_DIR);
+        // No maps given: the sample maps, where ZHC_ENVMAP_DIR says (an installed zhc), else where
+        // the build found them (the folder the tests read); neither there: the maps are required.
+        const char* env = std::getenv("ZHC_ENVMAP_DIR");
+        const std::string dir = env && *env ? std::string(env) : std::string(ZHC_SAMPLE_ENVMAP_DIR);
+        std::error_code ec;
+        if (!fs::is_directory(dir, ec)) {
+            std::fprintf(stderr,
+                         "zhc: error: give environment maps: zhc bench MAP... (no maps given, and the sample maps' folder %s%s "
+                         "does not exist)\n",
+                         dir.c_str(), env && *env ? " (ZHC_ENVMAP_DIR)" : " (the build's)");
+            return kExitUsage;
+        }
+        inputs.push_back(dir);
     }
+    if (!o.html.empty())
+        if (int rc = refuse_output_over_input("--html", o.html, inputs); rc != kExitOk) return rc;
     auto files = expand_audit_inputs(inputs);
     if (!files) return report(files.error());
     auto chosen = select_codecs(o.representations);
@@ -209,7 +221,9 @@ int run(const Options& o) {
 const VerbRegistration registration(50, [](CLI::App& app) -> std::function<int()> {
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("bench", "Bytes, encode/decode/evaluation time and error of every representation, with Pareto plots");
-    sub->add_option("MAPS", o->inputs, "environment maps or folders (default: the eight sample maps)");
+    sub->add_option("MAPS", o->inputs,
+                    "environment maps or folders; none: the sample maps' folder, $ZHC_ENVMAP_DIR if set, else the one this "
+                    "zhc was built with (" ZHC_SAMPLE_ENVMAP_DIR "); exit 2 when it does not exist");
     add_representations_option(sub, o->representations, RepresentationCount::kList, "default: all");
     add_json_flag(sub, o->json);
     sub->add_option("--plots", o->plots, "folder for error_vs_encode_time.png and error_vs_bytes.png")->capture_default_str();

@@ -33,14 +33,35 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     LatLongConvention latlong = LatLongConvention::kOpenExr;
-    int threads = 1;
-    std::vector<CLI::Option*> storage_flags;  // the options that set CodecOptions
+    int threads = 0;
+    // The options that set CodecOptions' storage fields, each with the StorageOptionUse field saying
+    // whether an entry uses it (null: every entry does, --irradiance).
+    std::vector<std::pair<CLI::Option*, bool StorageOptionUse::*>> storage_flags;
     bool any_storage_flag() const {
-        for (const CLI::Option* opt : storage_flags)
+        for (const auto& [opt, use] : storage_flags)
             if (opt->count() > 0) return true;
         return false;
     }
 };
+
+// A storage option given for a representation that does not use it would be silently ignored:
+// refuse it, naming the option, the representation and the entries that do use it.
+int refuse_unused_storage_options(const Options& o, const std::string& rep) {
+    const Codec* codec = rep.empty() ? nullptr : find_codec(rep);
+    for (const auto& [opt, use] : o.storage_flags) {
+        if (opt->count() == 0) continue;
+        if (codec && (!use || storage_options_used(*codec).*use)) continue;
+        std::string users;
+        for (const Codec& c : codecs())
+            if (use && storage_options_used(c).*use) users += (users.empty() ? "" : ", ") + std::string(c.name);
+        if (!use) users = "every representation";
+        const std::string what = codec ? "the representation " + rep + " does not use it"
+                                       : "without -r/--representations the output is float SH3, which does not use it";
+        std::fprintf(stderr, "zhc: error: %s: %s (used by: %s)\n", opt->get_name().c_str(), what.c_str(), users.c_str());
+        return kExitUsage;
+    }
+    return kExitOk;
+}
 
 // What any input turns into: hub probes + layout, and the set itself when it was a container.
 struct Loaded {
@@ -107,12 +128,8 @@ int run(const Options& o) {
         std::fprintf(stderr, "zhc: error: %s: output extension must be .zhp or .json\n", o.output.c_str());
         return kExitUsage;
     }
-    if (!o.to.empty() && !find_codec(o.to)) {
-        std::string names;
-        for (const Codec& c : codecs()) names += (names.empty() ? "" : ", ") + std::string(c.name);
-        std::fprintf(stderr, "zhc: error: unknown representation '%s' (known: %s)\n", o.to.c_str(), names.c_str());
-        return kExitUsage;
-    }
+    if (!o.to.empty() && !representation_named(o.to)) return kExitUsage;
+    if (int rc = refuse_output_over_input("-o", o.output, {o.input}); rc != kExitOk) return rc;
     auto params = params_from(o);
     if (!params) return report(params.error());
     auto in = load_input(o);
@@ -129,6 +146,7 @@ int run(const Options& o) {
         // Same representation, no quantiser flags: keep the input's parameters too.
         if (!o.any_storage_flag()) *params = in->set->params;
     }
+    if (int rc = refuse_unused_storage_options(o, rep); rc != kExitOk) return rc;
     if (Status st = validate_quant_params(*params, rep.empty() ? "sh3" : rep); !st) {
         std::fprintf(stderr, "zhc: error: %s\n", st.error().message.c_str());
         return kExitUsage;
@@ -180,19 +198,28 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
         ->required();
     add_representations_option(sub, o->to, RepresentationCount::kOne, "default: the input container's; JSON output: none (float SH3)", "--to");
     auto& f = o->storage_flags;
-    f.push_back(sub->add_option("--bits", o->bits, "bits per quantised ratio (2..8, default 8)")->check(CLI::Range(2, 8)));
-    f.push_back(sub->add_flag("--sqrt", o->sqrt, "sign-preserving square-root encoding of the ratios"));
-    f.push_back(sub->add_option("--bound", o->bound, "non-zonal L2 bound: tight (sqrt(15)/2, default) or loose (sqrt(5))")
-        ->check(CLI::IsMember({"tight", "loose"})));
-    f.push_back(sub->add_option("--dc", o->dc, "DC format: r11g11b10f (default), rgb9e5, half (sh2_q only)")
-        ->check(CLI::IsMember({"r11g11b10f", "rgb9e5", "half"})));
-    f.push_back(sub->add_option("--zonal-map", o->zonal_map,
-                    "zonal L2 interval mapping: affine (default), zero (zero-preserving), symmetric (+-sqrt(5))")
-        ->check(CLI::IsMember({"affine", "zero", "symmetric"})));
-    f.push_back(sub->add_option("--axis", o->axis, "zh3_q16/hall_curve_q zonal axis: luminance (default) or channel (*_channel_q16: always channel)")
-        ->check(CLI::IsMember({"luminance", "channel"})));
-    f.push_back(sub->add_flag("--irradiance", o->irradiance,
-                              "store irradiance SH (irradiance-scaled bounds) instead of radiance"));
+    f.emplace_back(sub->add_option("--bits", o->bits, "bits per quantised ratio (2..8, default 8)")->check(CLI::Range(2, 8)),
+                   &StorageOptionUse::bits);
+    f.emplace_back(sub->add_flag("--sqrt", o->sqrt, "sign-preserving square-root encoding of the ratios"), &StorageOptionUse::sqrt);
+    f.emplace_back(sub->add_option("--bound", o->bound, "non-zonal L2 bound: tight (sqrt(15)/2, default) or loose (sqrt(5)); sh3_q28 only")
+                       ->check(CLI::IsMember({"tight", "loose"})),
+                   &StorageOptionUse::l2_bound);
+    f.emplace_back(sub->add_option("--dc", o->dc, "DC format: r11g11b10f (default), rgb9e5, half (sh2_q layouts only)")
+                       ->check(CLI::IsMember({"r11g11b10f", "rgb9e5", "half"})),
+                   &StorageOptionUse::dc);
+    f.emplace_back(sub->add_option("--zonal-map", o->zonal_map,
+                                   "zonal L2 interval mapping: affine (default), zero (zero-preserving), symmetric (+-sqrt(5))")
+                       ->check(CLI::IsMember({"affine", "zero", "symmetric"})),
+                   &StorageOptionUse::zonal_mapping);
+    f.emplace_back(sub->add_option("--axis", o->axis,
+                                   "zonal axis of the entries that take it from the parameters (zh3_q16, hall_curve_q, ...): "
+                                   "luminance (default) or channel")
+                       ->check(CLI::IsMember({"luminance", "channel"})),
+                   &StorageOptionUse::axis);
+    f.emplace_back(sub->add_flag("--irradiance", o->irradiance, "store irradiance SH (irradiance-scaled bounds) instead of radiance"),
+                   nullptr);
+    sub->footer("The quantiser options (--bits .. --axis) concern the quantised representations; one that the chosen "
+                "representation does not use is refused (exit 2).");
     sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")
         ->check(CLI::Range(0, 22));
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);

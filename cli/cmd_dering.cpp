@@ -31,7 +31,7 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     LatLongConvention latlong = LatLongConvention::kOpenExr;
-    int threads = 1;
+    int threads = 0;
 };
 
 struct Probe {
@@ -105,6 +105,7 @@ nlohmann::json rgb_rows(const Sh3Radiance& sh) {
 }
 
 int run(const Options& o) {
+    if (int rc = refuse_output_over_input("-o", o.output, {o.input}); rc != kExitOk) return rc;
     auto bytes = read_file_bytes(o.input, kMaxInputBytes);
     if (!bytes) return report(bytes.error());
     std::vector<Probe> probes;

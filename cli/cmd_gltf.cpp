@@ -54,6 +54,8 @@ int run_embed(const Options& o) {
         std::fprintf(stderr, "zhc: error: %s: output extension must be .glb or .gltf\n", o.output.c_str());
         return kExitUsage;
     }
+    if (!o.encoding.empty() && !representation_named(o.encoding)) return kExitUsage;
+    if (int rc = refuse_output_over_input("-o", o.output, {o.scene, o.probes}); rc != kExitOk) return rc;
     auto set = load_probes(o.probes, o.encoding);
     if (!set) return set.error().code == ErrorCode::kInvalidArgument ? (std::fprintf(stderr, "zhc: error: %s\n", set.error().message.c_str()), kExitUsage)
                                                                       : report(set.error());
@@ -97,6 +99,7 @@ int run_extract(const Options& o) {
         std::fprintf(stderr, "zhc: error: %s: output extension must be .zhp or .json\n", o.output.c_str());
         return kExitUsage;
     }
+    if (int rc = refuse_output_over_input("-o", o.output, {o.input}); rc != kExitOk) return rc;
     auto v = load_volume(o.input, o.volume);
     if (!v) return report(v.error());
     if (ext == ".zhp") {
@@ -113,6 +116,16 @@ int run_extract(const Options& o) {
 }
 
 int run_eval(const Options& o) {
+    // A direction is three numbers whose length is finite and not zero (what normalisation needs);
+    // anything else (0,0,0, NaN, Inf) is a usage error, found before the file is read.
+    const double len = o.dir.size() == 3 ? length(Vec3{o.dir[0], o.dir[1], o.dir[2]}) : 0.0;
+    if (!(len > 0.0) || !std::isfinite(len)) {
+        std::string given;
+        for (double d : o.dir) given += (given.empty() ? "" : ",") + std::to_string(d);
+        std::fprintf(stderr, "zhc: error: --dir %s: needs X,Y,Z, a direction in glTF axes (finite, not all zero)\n",
+                     given.c_str());
+        return kExitUsage;
+    }
     auto v = load_volume(o.input, o.volume);
     if (!v) return report(v.error());
     if (o.probe >= v->set.count) {
@@ -120,10 +133,7 @@ int run_eval(const Options& o) {
                      static_cast<unsigned long long>(v->set.count));
         return kExitUsage;
     }
-    if (o.dir.size() != 3) {
-        std::fprintf(stderr, "zhc: error: --dir needs X,Y,Z\n");
-        return kExitUsage;
-    }
+
     // The probe as stored in glTF order: grid volumes are reordered on extraction, so map the
     // glTF probe number back to zhc's order (gltf index j + ny (k + nz i) for zhc (i, j, k)).
     std::uint64_t zi = o.probe;
@@ -132,7 +142,7 @@ int run_eval(const Options& o) {
         const std::uint64_t j = o.probe % c[1], k = (o.probe / c[1]) % c[2], i = o.probe / (std::uint64_t(c[1]) * c[2]);
         zi = i + c[0] * (j + std::uint64_t(c[1]) * k);
     }
-    const Vec3 g = normalize_or({o.dir[0], o.dir[1], o.dir[2]}, {0, 1, 0});
+    const Vec3 g = (1.0 / len) * Vec3{o.dir[0], o.dir[1], o.dir[2]};
     const Vec3 n_zhc{g.z, g.x, g.y};  // (x, y, z)_zhc = (z, x, y)_glTF
     const Codec& codec = *v->set.codec();
     const Sh3Radiance hub = decode_probe(codec, v->set.params, v->set.payload.data() + zi * codec.size_bytes);

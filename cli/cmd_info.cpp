@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "json_output.h"
 #include "codec/probe/probe_set.h"
+#include "codec/probe/quantize.h"
 #include "formats/envmap/envmap.h"
 #include "formats/io/file_io.h"
 #include "formats/probes/gltf_probes.h"
@@ -47,6 +48,40 @@ const char* zonal_name(ZonalMapping m) {
         case ZonalMapping::kSymmetric: return "symmetric";
     }
     return "?";
+}
+
+// The axis a ZH3-style decoder expands the zonal term along: the entry's own when the table fixes
+// it (zh3_channel_q16: per channel), else the stored parameter.
+const char* axis_name(const Codec& codec, const CodecOptions& p) {
+    if (codec.traits.zonal_axis == ZonalAxis::kPerChannel) return "channel";
+    if (codec.traits.zonal_axis == ZonalAxis::kLuminance) return "luminance";
+    return p.axis_mode == ZonalAxisMode::kLuminance ? "luminance" : "channel";
+}
+
+// The one-line summary of a stored set, made from the same fields info prints beside it (the
+// storage parameters the entry uses, cli.h storage_options_used, the axis and the stored kind),
+// so the two cannot disagree. A float entry's bytes do not depend on the quantiser parameters: its
+// table summary, plus the kind when it stores irradiance.
+std::string stored_summary(const Codec& codec, const CodecOptions& p) {
+    std::string s;
+    if (codec.packed) {
+        const StorageOptionUse use = storage_options_used(codec);
+        const char* layout = codec.packed->layout == PackedLayout::kZh3Q16   ? "zh3_q16"
+                             : codec.packed->layout == PackedLayout::kSh3Q28 ? "sh3_q28"
+                                                                             : "sh2_q";
+        const std::string dc = p.dc_format == DcFormat::kR11G11B10F ? "R11G11B10F"
+                               : p.dc_format == DcFormat::kRGB9E5   ? "RGB9E5"
+                                                                    : "half-float";
+        s = std::string(codec.name) + " (" + layout + " layout), " + std::to_string(codec.size_bytes) + " bytes: " + dc +
+            " DC + " + std::to_string(p.bits) + "-bit " + (p.sqrt_encoding ? "square-root-encoded " : "") + "ratios";
+        if (use.l2_bound) s += std::string(", ") + (p.l2_bound == L2Bound::kTight ? "tight" : "loose") + " L2 bound";
+        if (use.zonal_mapping) s += std::string(", ") + zonal_name(p.zonal_mapping) + " zonal mapping";
+        if (codec.traits.zonal_axis != ZonalAxis::kNone) s += std::string(", zonal axis ") + axis_name(codec, p);
+    } else {
+        s = std::string(codec.summary);
+    }
+    if (p.kind == StoredKind::kIrradiance) s += "; stored as irradiance";
+    return s;
 }
 
 nlohmann::ordered_json layout_json(const ProbeLayout& l) {
@@ -115,7 +150,7 @@ int run(const Options& o) {
         j["type"] = "zhp probe container";
         j["version"] = info.version;
         j["representation"] = set->representation;
-        j["summary"] = std::string(codec->summary);
+        j["summary"] = stored_summary(*codec, p);
         j["probes"] = set->count;
         j["bytes_per_probe"] = codec->size_bytes;
         j["payload_bytes"] = set->payload.size();
@@ -132,7 +167,7 @@ int run(const Options& o) {
             j["l2_bound"] = p.l2_bound == L2Bound::kTight ? "tight" : "loose";
             j["dc_format"] = dc_name(p.dc_format);
             j["zonal_mapping"] = zonal_name(p.zonal_mapping);
-            j["axis"] = p.axis_mode == ZonalAxisMode::kLuminance ? "luminance" : "channel";
+            j["axis"] = axis_name(*codec, p);
         }
         j["luminance_weights"] = {p.luminance.r, p.luminance.g, p.luminance.b};
         auto hub = decode_probe_set(*set);

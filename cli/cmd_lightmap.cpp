@@ -32,7 +32,7 @@ struct Options {
     std::string part;       // synth: EXR part of the environment map
     LatLongConvention latlong = LatLongConvention::kOpenExr;  // synth: lat-long orientation
     std::string html;       // audit: also write the HTML report here (whole-image path)
-    int threads = 1, size = 256, height = 0, stride = 17, band_rows = 0;
+    int threads = 0, size = 256, height = 0, stride = 17, band_rows = 0;
     bool json = false, half = false;
     ProgressFlags progress;
 };
@@ -83,6 +83,9 @@ std::string inputs_text(const std::vector<std::string>& files) {
 
 int run_encode(const Options& o) {
     const auto files = input_files(o.inputs);
+    const std::string out_ext = o.container == "dds" ? ".dds" : ".ktx2";
+    for (const char* plane : {".iz", ".d", ".wa"})
+        if (int rc = refuse_output_over_input("-o", o.output + plane + out_ext, files); rc != kExitOk) return rc;
     lightmap_stream::EncodeOptions eo;
     eo.fit = lightmap::find_fit(o.solve)->fit;
     eo.bc6h_quality = bc6h_quality(o.quality);
@@ -117,6 +120,9 @@ int run_decode(const Options& o) {
     }
     const bool dds = container == "dds";
     const std::string ext = dds ? ".dds" : ".ktx2";
+    if (int rc = refuse_output_over_input("-o", o.output, {o.input + ".iz" + ext, o.input + ".d" + ext, o.input + ".wa" + ext});
+        rc != kExitOk)
+        return rc;
     Progress progress("zhc lightmap decode", "rows", o.progress);
     lightmap_stream::ProgressFn fn;
     if (progress.enabled()) fn = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
@@ -153,6 +159,7 @@ int run_audit_html(const Options& o, const std::string& input) {
 int run_audit(const Options& o) {
     const auto files = input_files(o.inputs);
     if (!o.html.empty()) {
+        if (int rc = refuse_output_over_input("--html", o.html, files); rc != kExitOk) return rc;
         if (files.size() != 1)
             return report(make_error(ErrorCode::kInvalidArgument, "lightmap audit --html takes one SH lightmap EXR"));
         if (const int rc = run_audit_html(o, files[0]); rc != kExitOk) return rc;
@@ -201,6 +208,7 @@ int run_audit(const Options& o) {
 }
 
 int run_synth(const Options& o) {
+    if (int rc = refuse_output_over_input("-o", o.output, {o.input}); rc != kExitOk) return rc;
     EnvmapReadOptions ro;
     ro.part = o.part;
     ro.latlong = o.latlong;

@@ -20,7 +20,7 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     LatLongConvention latlong = LatLongConvention::kOpenExr;
-    int threads = 1;
+    int threads = 0;
 };
 
 void print_sh3_table(const Sh3Radiance& sh) {

@@ -1,12 +1,14 @@
 // zhc — baked-lighting codecs for asset pipelines. See README.md.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "cli.h"
+#include "codec/probe/quantize.h"
 
 namespace zhc::cli {
 
@@ -71,9 +73,56 @@ CLI::Option* add_representations_option(CLI::App* app, std::string& names, Repre
     return opt;
 }
 
+const Codec* representation_named(const std::string& name) {
+    // select_codecs on the one name: its message names the value and lists the table ("," stands
+    // for an empty name, which select_codecs would read as the whole table).
+    auto one = select_codecs(name.empty() ? std::string_view(",") : std::string_view(name));
+    if (!one) {
+        report(one.error());
+        return nullptr;
+    }
+    return one->front();
+}
+
+StorageOptionUse storage_options_used(const Codec& codec) {
+    StorageOptionUse u;
+    if (codec.packed) {
+        u.bits = u.sqrt = u.dc = true;
+        const PackedLayout layout = codec.packed->layout;
+        u.l2_bound = layout == PackedLayout::kSh3Q28;
+        u.zonal_mapping = layout == PackedLayout::kSh3Q28 || layout == PackedLayout::kZh3Q16;
+    }
+    u.axis = codec.traits.zonal_axis == ZonalAxis::kFromParams;
+    return u;
+}
+
+int refuse_output_over_input(const std::string& option, const std::string& output, const std::vector<std::string>& inputs) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path out_canonical = fs::weakly_canonical(output, ec);
+    const bool out_exists = fs::exists(output, ec);
+    for (const std::string& input : inputs) {
+        if (!fs::is_regular_file(input, ec)) continue;  // folders and missing files: never the output
+        bool same = false;
+        if (out_exists) {
+            same = fs::equivalent(output, input, ec) && !ec;  // symlinks, hard links, other spellings
+        } else {
+            std::error_code ec2;
+            const fs::path in_canonical = fs::weakly_canonical(input, ec2);
+            same = !ec2 && !out_canonical.empty() && in_canonical == out_canonical;
+        }
+        if (same) {
+            std::fprintf(stderr, "zhc: error: %s %s: is the input %s (choose another output path)\n", option.c_str(),
+                         output.c_str(), input.c_str());
+            return kExitUsage;
+        }
+    }
+    return kExitOk;
+}
+
 CLI::Option* add_threads_option(CLI::App* app, int& threads, const std::string& what) {
     return app->add_option("--threads", threads,
-                           "worker threads, 0 = all cores (" + (what.empty() ? std::string("output identical for any count") : what) + ")")
+                           "worker threads, 0 = all cores, the default (" + (what.empty() ? std::string("output identical for any count") : what) + ")")
         ->check(CLI::Range(0, 256))
         ->capture_default_str();
 }

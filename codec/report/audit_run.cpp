@@ -49,6 +49,7 @@ InputAudit audit_input(const AuditInput& input, const std::vector<Vec3>& directi
     InputAudit out;
     out.path = input.path;
     out.failing_probes.resize(nc);
+    out.extremes.resize(nc);
     std::vector<MetricsAccumulator> acc(nc);
     std::vector<double> enc(nc), dec(nc);
     std::vector<EncodeStats> stats(nc);
@@ -64,6 +65,20 @@ InputAudit audit_input(const AuditInput& input, const std::vector<Vec3>& directi
             stats[c].clamped_ratios += s.results[c].stats.clamped_ratios;
             stats[c].dering_clamped = stats[c].dering_clamped || s.results[c].stats.dering_clamped;
             if (options.gates.fails(s.results[c].metrics)) out.failing_probes[c].push_back(p);
+            const ErrorMetrics& m = s.results[c].metrics;
+            InputAudit::Extremes& x = out.extremes[c];
+            if (p == 0 || m.rmse > x.rmse) {
+                x.rmse = m.rmse;
+                x.rmse_probe = p;
+            }
+            if (p == 0 || m.relative_rmse > x.relative_rmse) {
+                x.relative_rmse = m.relative_rmse;
+                x.relative_rmse_probe = p;
+            }
+            if (p == 0 || m.min_irradiance < x.min_irradiance) {
+                x.min_irradiance = m.min_irradiance;
+                x.min_irradiance_probe = p;
+            }
         }
         if (on_probe) on_probe(p, s.results);
     };

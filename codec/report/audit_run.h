@@ -22,6 +22,10 @@ struct AuditInput {
     std::string path;
     std::string kind;         // "envmap" or "probes"
     std::string description;  // one line for the report
+    // What the errors are measured against, one line (reports, JSON "reference"): the map's own
+    // irradiance, or the probes' SH3 as stored; for a lossy stored representation the line says
+    // that the reference is the stored data (auditing the same representation shows 0 error).
+    std::string reference;
     std::vector<Sh3Radiance> probes;
     LatLongImage map;                  // envmaps: the flux-preserving downsample used as reference
     std::vector<Rgb> map_reference;    // envmaps: E(n) at the audit directions
@@ -58,6 +62,13 @@ struct InputAudit {
     std::vector<RepresentationResult> results;         // per codec, pooled over the input's probes;
                                                        // times: mean over the timed probes
     std::vector<std::vector<std::size_t>> failing_probes;  // per codec: probes failing a gate, ascending
+    // Per codec, probe by probe: the values the gates test at their worst and the first probe
+    // where each occurs (gate summaries: "worst rmse 0.02 at probe 7").
+    struct Extremes {
+        double rmse = 0, relative_rmse = 0, min_irradiance = 0;
+        std::size_t rmse_probe = 0, relative_rmse_probe = 0, min_irradiance_probe = 0;
+    };
+    std::vector<Extremes> extremes;
 };
 
 // Called once per probe, in probe order on the calling thread, with each codec's result on it.

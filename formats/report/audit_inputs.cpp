@@ -66,6 +66,8 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
                               : std::string()) +
                          ", reference: the map integrated at " + std::to_string(in.map.width) + "x" +
                          std::to_string(in.map.height);
+        in.reference = "the map's irradiance, integrated directly at " + std::to_string(in.map.width) + "x" +
+                       std::to_string(in.map.height);
         return in;
     }
     // Probe files: the reference is each probe's SH3 (decoded from whatever the file stores, so a
@@ -77,6 +79,12 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         in.probes = std::move(file->hub);
         in.description = std::to_string(in.probes.size()) + " probes stored as " + file->set.representation +
                          ", reference: their SH3";
+        const Codec* stored = file->set.codec();
+        in.reference = stored && stored->traits.exact
+                           ? "the probes' SH3 irradiance (stored exactly as " + file->set.representation + ")"
+                           : "the stored data: the probes as decoded from " + file->set.representation +
+                                 ", not the lighting they were made from (" + file->set.representation +
+                                 " itself shows 0 error)";
         return in;
     }
     if (looks_like_json(*bytes)) {
@@ -85,6 +93,7 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         in.kind = "probes";
         in.probes = std::move(list->probes);
         in.description = std::to_string(in.probes.size()) + " probes (JSON), reference: their SH3";
+        in.reference = "the probes' SH3 irradiance (JSON float SH3)";
         return in;
     }
     // The same code and words as convert and info for a file of no known format (exit 4).

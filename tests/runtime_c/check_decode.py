@@ -21,6 +21,21 @@ OPTION_SETS = [[], ["--bits", "5", "--sqrt", "--dc", "rgb9e5", "--irradiance", "
                     "--zonal-map", "zero", "--bound", "loose"],
                ["--bits", "3", "--zonal-map", "symmetric"]]
 REL = 1e-6
+# The storage options each packed entry's bytes do not depend on: `zhc convert` refuses them (exit 2).
+UNUSED = {"zh3_q16": {"--bound"}, "zh3_solved_q16": {"--bound"}, "sh3_q28": {"--axis"},
+          "sh2_q": {"--axis", "--zonal-map", "--bound"}, "hall_curve_q": {"--zonal-map", "--bound"}}
+TAKES_VALUE = {"--bits", "--dc", "--axis", "--zonal-map", "--bound"}
+
+
+def options_for(enc, opts):
+    """opts without the options `enc` does not use."""
+    out, i = [], 0
+    while i < len(opts):
+        n = 2 if opts[i] in TAKES_VALUE else 1
+        if opts[i] not in UNUSED.get(enc, ()):
+            out += opts[i:i + n]
+        i += n
+    return out
 
 
 def run(args):
@@ -127,7 +142,7 @@ def main():
             for oi, opts in enumerate(option_sets):
                 zhp = os.path.join(work, "%s.%s.%d.zhp" % (base, enc, oi))
                 js = zhp + ".json"
-                run([zhc, "convert", inp, "--to", enc, "-o", zhp] + opts)
+                run([zhc, "convert", inp, "--to", enc, "-o", zhp] + options_for(enc, opts))
                 run([zhc, "convert", zhp, "-o", js])
                 lines = run([decoder, zhp]).splitlines()
                 with open(js) as f:

@@ -1,0 +1,423 @@
+// Small CLI traps a newcomer falls into: each test runs the zhc binary the way the trap was found
+// and checks the refusal, the message or the output that replaces the silent wrong answer.
+// (Rows that fit the CLI conformance table are in tests/conformance/cases.txt, ids trap_*.)
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "codec/probe/codec.h"
+#include "codec/probe/probe_set.h"
+#include "formats/probes/probe_file.h"
+#include "tests/support.h"
+
+namespace zhc {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::size_t count_lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+// The four golden probes, each scaled by an irregular factor: their DC values then differ between
+// the DC formats (the golden ones are exactly representable in all of them).
+std::vector<Sh3Radiance> probes_in_use() {
+    std::vector<Sh3Radiance> probes = test::golden_probes();
+    for (size_t p = 0; p < probes.size(); ++p)
+        for (int i = 0; i < 9; ++i)
+            for (int k = 0; k < 3; ++k) probes[p][i][k] *= static_cast<float>(1.0 + 0.1372 * double(p + 1) + 0.0113 * k);
+    return probes;
+}
+
+// A JSON probe list of probes_in_use() in `dir`.
+std::string golden_json(const std::string& dir) {
+    const std::string path = dir + "/golden.json";
+    ProbeList list;
+    list.probes = probes_in_use();
+    EXPECT_TRUE(write_probe_json(path, list).ok());
+    return path;
+}
+
+// ---- storage options an entry does not use ----------------------------------------------------
+
+struct StorageFlag {
+    std::vector<std::string> args;  // a non-default value
+    CodecOptions params;            // the same value in CodecOptions
+};
+std::vector<StorageFlag> storage_flags() {
+    std::vector<StorageFlag> f(6);
+    f[0].args = {"--bits", "4"};
+    f[0].params.bits = 4;
+    f[1].args = {"--sqrt"};
+    f[1].params.sqrt_encoding = true;
+    f[2].args = {"--bound", "loose"};
+    f[2].params.l2_bound = L2Bound::kLoose;
+    f[3].args = {"--dc", "rgb9e5"};
+    f[3].params.dc_format = DcFormat::kRGB9E5;
+    f[4].args = {"--zonal-map", "zero"};
+    f[4].params.zonal_mapping = ZonalMapping::kZeroPreserving;
+    f[5].args = {"--axis", "channel"};
+    f[5].params.axis_mode = ZonalAxisMode::kPerChannel;
+    return f;
+}
+
+// Every entry x every storage option: convert accepts the option exactly when the entry's decoded
+// probes depend on it (the obviously-correct twin: encode + decode through the library with and
+// without the value), and a refusal is exit 2 naming the option and the entry, with no output.
+TEST(CliTraps, StorageOptionRefusedExactlyWhereUnused) {
+    const std::string dir = test::fresh_dir("traps_storage");
+    const std::string in = golden_json(dir);
+    const std::vector<Sh3Radiance> probes = probes_in_use();
+    int refused = 0, accepted = 0;
+    for (const Codec& c : codecs()) {
+        const std::string name(c.name);
+        auto base = encode_probe_set(probes, name, CodecOptions{}, ProbeLayout{});
+        ASSERT_TRUE(base.ok()) << name;
+        const auto base_hub = decode_probe_set(*base);
+        ASSERT_TRUE(base_hub.ok());
+        for (const StorageFlag& flag : storage_flags()) {
+            auto set = encode_probe_set(probes, name, flag.params, ProbeLayout{});
+            ASSERT_TRUE(set.ok()) << name << " " << flag.args[0];
+            const auto hub = decode_probe_set(*set);
+            ASSERT_TRUE(hub.ok());
+            const bool used = *hub != *base_hub;
+            const std::string out = dir + "/" + name + flag.args[0].substr(2) + ".zhp";
+            std::vector<std::string> args{"convert", in, "-o", out, "-r", name};
+            args.insert(args.end(), flag.args.begin(), flag.args.end());
+            const auto r = test::run_zhc(args);
+            if (used) {
+                EXPECT_EQ(r.exit_code, 0) << name << " " << flag.args[0] << ": " << r.err;
+                auto file = read_probe_file(out);
+                ASSERT_TRUE(file.ok()) << name;
+                EXPECT_EQ(file->payload, set->payload) << name << " " << flag.args[0];
+                ++accepted;
+            } else {
+                EXPECT_EQ(r.exit_code, 2) << name << " " << flag.args[0] << " changes nothing, yet was accepted";
+                EXPECT_NE(r.err.find("zhc: error: " + flag.args[0] + ": the representation " + name + " does not use it"),
+                          std::string::npos)
+                    << r.err;
+                EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+                EXPECT_EQ(r.out, "");
+                EXPECT_FALSE(fs::exists(out)) << out;
+                ++refused;
+            }
+        }
+    }
+    EXPECT_GT(refused, 27);   // the float entries refuse all six
+    EXPECT_GT(accepted, 27);  // the quantised ones take most
+}
+
+// Without -r a JSON output is float SH3: a storage option (and --irradiance) would do nothing.
+TEST(CliTraps, StorageOptionRefusedForFloatJsonOutput) {
+    const std::string dir = test::fresh_dir("traps_storage_json");
+    const std::string in = golden_json(dir);
+    for (const std::vector<std::string>& flag : {std::vector<std::string>{"--sqrt"}, {"--irradiance"}, {"--bits", "5"}}) {
+        std::vector<std::string> args{"convert", in, "-o", dir + "/o.json"};
+        args.insert(args.end(), flag.begin(), flag.end());
+        const auto r = test::run_zhc(args);
+        EXPECT_EQ(r.exit_code, 2) << flag[0];
+        EXPECT_NE(r.err.find(flag[0] + ": without -r/--representations the output is float SH3"), std::string::npos) << r.err;
+    }
+}
+
+// ---- info's summary line agrees with the fields beside it --------------------------------------
+
+std::string upper_dc(const std::string& dc) {
+    if (dc == "r11g11b10f") return "R11G11B10F";
+    if (dc == "rgb9e5") return "RGB9E5";
+    return "half-float";
+}
+
+TEST(CliTraps, InfoSummaryAgreesWithFields) {
+    const std::string dir = test::fresh_dir("traps_info");
+    const std::string in = golden_json(dir);
+    const std::vector<std::vector<std::string>> combos = {
+        {"-r", "zh3_q16"},
+        {"-r", "zh3_q16", "--dc", "rgb9e5", "--axis", "channel"},
+        {"-r", "zh3_q16", "--bits", "4", "--sqrt", "--zonal-map", "symmetric", "--irradiance"},
+        {"-r", "sh3_q28", "--bound", "loose", "--zonal-map", "zero", "--bits", "6"},
+        {"-r", "sh2_q", "--dc", "half", "--sqrt"},
+        {"-r", "hall_curve_q", "--axis", "channel", "--bits", "3"},
+        {"-r", "zh3_channel_q16", "--dc", "rgb9e5"},
+        {"-r", "sh3", "--irradiance"},
+    };
+    for (size_t i = 0; i < combos.size(); ++i) {
+        const std::string out = dir + "/c" + std::to_string(i) + ".zhp";
+        std::vector<std::string> args{"convert", in, "-o", out};
+        args.insert(args.end(), combos[i].begin(), combos[i].end());
+        ASSERT_EQ(test::run_zhc(args).exit_code, 0) << combos[i][1];
+        const auto r = test::run_zhc({"info", out, "--json"});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const auto j = nlohmann::json::parse(r.out);
+        const std::string summary = j["summary"];
+        const std::string rep = j["representation"];
+        SCOPED_TRACE(rep + ": " + summary);
+        EXPECT_EQ(summary.find("(luminance axis)") != std::string::npos && j.contains("axis") && j["axis"] == "channel", false);
+        EXPECT_EQ(summary.find("stored as irradiance") != std::string::npos, j["kind"] == "irradiance");
+        const bool packed = j.contains("bits");
+        if (packed) {
+            EXPECT_NE(summary.find(upper_dc(j["dc_format"]) + " DC"), std::string::npos);
+            EXPECT_NE(summary.find(std::to_string(j["bits"].get<int>()) + "-bit "), std::string::npos);
+            EXPECT_EQ(summary.find("square-root") != std::string::npos, j["sqrt"].get<bool>());
+            // Named once, as the fields say: the other values never appear.
+            for (const char* dc : {"R11G11B10F DC", "RGB9E5 DC", "half-float DC"})
+                if (upper_dc(j["dc_format"]) + " DC" != dc) {
+                    EXPECT_EQ(summary.find(dc), std::string::npos);
+                }
+            if (rep == "sh3_q28") {
+                EXPECT_NE(summary.find(j["l2_bound"].get<std::string>() + " L2 bound"), std::string::npos);
+            } else {
+                EXPECT_EQ(summary.find("L2 bound"), std::string::npos);
+            }
+            if (rep == "sh3_q28" || rep == "zh3_q16" || rep == "zh3_channel_q16") {
+                EXPECT_NE(summary.find(j["zonal_mapping"].get<std::string>() + " zonal mapping"), std::string::npos);
+            }
+            if (rep == "sh3_q28" || rep == "sh2_q") {
+                EXPECT_EQ(summary.find("zonal axis"), std::string::npos);
+            } else {
+                EXPECT_NE(summary.find("zonal axis " + j["axis"].get<std::string>()), std::string::npos);
+            }
+        }
+        // The text output prints the same line.
+        const auto text = test::run_zhc({"info", out});
+        EXPECT_NE(text.out.find(summary), std::string::npos);
+    }
+    // The trap as found: --dc rgb9e5 --axis channel on zh3_q16.
+    const auto r = test::run_zhc({"info", dir + "/c1.zhp", "--json"});
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["axis"], "channel");
+    EXPECT_EQ(j["dc_format"], "rgb9e5");
+    EXPECT_NE(j["summary"].get<std::string>().find("RGB9E5 DC"), std::string::npos);
+    EXPECT_NE(j["summary"].get<std::string>().find("zonal axis channel"), std::string::npos);
+    // zh3_channel_q16 always decodes per channel: the axis field says so whatever the header holds.
+    const auto ch = nlohmann::json::parse(test::run_zhc({"info", dir + "/c6.zhp", "--json"}).out);
+    EXPECT_EQ(ch["axis"], "channel");
+}
+
+// ---- bench without maps -------------------------------------------------------------------------
+
+TEST(CliTraps, BenchWithoutMapsNeedsThem) {
+    const std::string dir = test::fresh_dir("traps_bench");
+    ASSERT_EQ(::setenv("ZHC_ENVMAP_DIR", (dir + "/nowhere").c_str(), 1), 0);
+    const auto r = test::run_zhc({"bench", "--no-plots", "-r", "sh3"});
+    ::unsetenv("ZHC_ENVMAP_DIR");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err.rfind("zhc: error: give environment maps: zhc bench MAP...", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("nowhere"), std::string::npos) << r.err;
+    EXPECT_EQ(count_lines(r.err), 1u);
+    EXPECT_EQ(r.out, "");
+    // ZHC_ENVMAP_DIR pointing at maps: they are benchmarked.
+    fs::create_directories(dir + "/maps");
+    fs::copy_file(test::envmap_paths()[0], dir + "/maps/" + fs::path(test::envmap_paths()[0]).filename().string());
+    ASSERT_EQ(::setenv("ZHC_ENVMAP_DIR", (dir + "/maps").c_str(), 1), 0);
+    const auto ok = test::run_zhc({"bench", "--no-plots", "-r", "sh3,sh2", "--repeats", "1", "--directions", "64", "--json"});
+    ::unsetenv("ZHC_ENVMAP_DIR");
+    ASSERT_EQ(ok.exit_code, 0) << ok.err;
+    EXPECT_EQ(nlohmann::json::parse(ok.out)["representations"].size(), 2u);
+    // The help says where maps come from.
+    const auto help = test::run_zhc({"bench", "--help"});
+    EXPECT_NE(help.out.find("ZHC_ENVMAP_DIR"), std::string::npos);
+}
+
+// ---- --threads: one default, the same output ----------------------------------------------------
+
+TEST(CliTraps, ThreadsDefaultIsZeroEverywhereAndOutputEqualsOneThread) {
+    for (const std::vector<std::string>& verb :
+         {std::vector<std::string>{"convert"}, {"bake"}, {"demo"}, {"audit"}, {"dering"}, {"project"}, {"lightmap", "encode"},
+          {"lightmap", "audit"}, {"lightmap", "synth"}}) {
+        std::vector<std::string> args = verb;
+        args.push_back("--help");
+        const auto r = test::run_zhc(args);
+        ASSERT_EQ(r.exit_code, 0) << verb[0];
+        // CLI11 prints the default after the type ("--threads INT:INT in [0 - 256]=0"), the help after.
+        const std::regex threads_help(R"(--threads INT:INT in \[0 - 256\]=0\s+worker threads, 0 = all cores, the default)");
+        EXPECT_TRUE(std::regex_search(r.out, threads_help)) << verb.back() << ":\n" << r.out;
+    }
+    // The output with the default equals the one-thread output (convert's projection).
+    const std::string dir = test::fresh_dir("traps_threads");
+    const std::string map = test::envmap_paths()[0];
+    ASSERT_EQ(test::run_zhc({"convert", map, "-o", dir + "/d.zhp", "-r", "zh3_q16"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"convert", map, "-o", dir + "/1.zhp", "-r", "zh3_q16", "--threads", "1"}).exit_code, 0);
+    EXPECT_EQ(test::read_bytes(dir + "/d.zhp"), test::read_bytes(dir + "/1.zhp"));
+    ASSERT_EQ(test::run_zhc({"dering", map, "-o", dir + "/d.json"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"dering", map, "-o", dir + "/1.json", "--threads", "1"}).exit_code, 0);
+    EXPECT_EQ(test::read_bytes(dir + "/d.json"), test::read_bytes(dir + "/1.json"));
+}
+
+// ---- audit: --no-timing leaves timing out; the reference of a stored file is named -------------
+
+TEST(CliTraps, NoTimingLeavesTimingOut) {
+    const std::string dir = test::fresh_dir("traps_no_timing");
+    const std::string in = golden_json(dir);
+    const std::vector<std::string> base{"audit", in, "-r", "sh3,zh3_q16", "--directions", "64"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> a = base;
+        a.insert(a.end(), extra.begin(), extra.end());
+        return test::run_zhc(a);
+    };
+    const auto text = with({"--no-timing", "--markdown", dir + "/r.md"});
+    ASSERT_EQ(text.exit_code, 0) << text.err;
+    EXPECT_NE(text.out.find("chroma"), std::string::npos);
+    EXPECT_EQ(text.out.find("enc_ns"), std::string::npos) << text.out;
+    EXPECT_EQ(text.out.find("dec_ns"), std::string::npos);
+    const auto md_bytes = test::read_bytes(dir + "/r.md");
+    const std::string md(md_bytes.begin(), md_bytes.end());
+    EXPECT_NE(md.find("chroma"), std::string::npos);
+    EXPECT_EQ(md.find("enc_ns"), std::string::npos);
+    const auto json = with({"--no-timing", "--json"});
+    ASSERT_EQ(json.exit_code, 0);
+    const auto j = nlohmann::json::parse(json.out);
+    for (const auto& [name, m] : j["aggregate"]["representations"].items()) {
+        EXPECT_TRUE(m.contains("rmse")) << name;
+        EXPECT_FALSE(m.contains("encode_ns")) << name;
+        EXPECT_FALSE(m.contains("decode_ns")) << name;
+    }
+    // Timing on: the columns and keys are there, with measured (positive) times.
+    const auto timed_text = with({});
+    EXPECT_NE(timed_text.out.find("enc_ns"), std::string::npos);
+    const auto tj = nlohmann::json::parse(with({"--json"}).out);
+    for (const auto& [name, m] : tj["aggregate"]["representations"].items()) EXPECT_GT(m["encode_ns"].get<double>(), 0.0) << name;
+}
+
+TEST(CliTraps, AuditOfStoredDataSaysSo) {
+    const std::string dir = test::fresh_dir("traps_reference");
+    const std::string in = golden_json(dir);
+    ASSERT_EQ(test::run_zhc({"convert", in, "-o", dir + "/q16.zhp", "-r", "zh3_q16"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"convert", in, "-o", dir + "/sh3.zhp", "-r", "sh3"}).exit_code, 0);
+    const auto r = test::run_zhc({"audit", dir + "/q16.zhp", "-r", "zh3_q16,sh3", "--directions", "64", "--no-timing", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    // The trap: zero error for the stored representation, because the reference IS the stored data.
+    EXPECT_EQ(j["files"][0]["representations"]["zh3_q16"]["rmse"].get<double>(), 0.0);
+    const std::string ref = j["files"][0]["reference"];
+    EXPECT_NE(ref.find("the stored data"), std::string::npos) << ref;
+    EXPECT_NE(ref.find("zh3_q16"), std::string::npos) << ref;
+    const auto text = test::run_zhc({"audit", dir + "/q16.zhp", "-r", "zh3_q16", "--directions", "64", "--no-timing"});
+    EXPECT_NE(text.out.find("reference: the stored data: the probes as decoded from zh3_q16"), std::string::npos) << text.out;
+    // An exactly stored file and a JSON list say what they are instead.
+    const auto exact = nlohmann::json::parse(
+        test::run_zhc({"audit", dir + "/sh3.zhp", in, "-r", "sh3", "--directions", "64", "--no-timing", "--json"}).out);
+    EXPECT_NE(exact["files"][0]["reference"].get<std::string>().find("stored exactly as sh3"), std::string::npos);
+    EXPECT_NE(exact["files"][1]["reference"].get<std::string>().find("JSON float SH3"), std::string::npos);
+    EXPECT_EQ(exact["files"][0]["reference"].get<std::string>().find("stored data"), std::string::npos);
+}
+
+// ---- gate failure: one line that says which gate, bounded detail --------------------------------
+
+TEST(CliTraps, GateFailureEndsWithOneLineSummary) {
+    const std::string dir = test::fresh_dir("traps_gate");
+    const std::string in = golden_json(dir);
+    // Every lossy entry fails a 1e-9 rmse gate on the golden probes; sh3 (exact) passes.
+    const auto r = test::run_zhc({"audit", in, "--directions", "64", "--no-timing", "--max-rmse", "1e-9"});
+    ASSERT_EQ(r.exit_code, 8) << r.err;
+    const auto j = nlohmann::json::parse(
+        test::run_zhc({"audit", in, "--directions", "64", "--no-timing", "--max-rmse", "1e-9", "--json"}).out);
+    const std::size_t failures = j["gates"]["failures"].size();
+    ASSERT_GT(failures, 10u);
+    // The slow twin of the worst value: the largest per-probe rmse over the lossy entries, from the
+    // per-probe audits (one probe per file).
+    double worst = 0;
+    std::string worst_name;
+    for (std::size_t p = 0; p < 4; ++p) {
+        ProbeList one;
+        one.probes = {probes_in_use()[p]};
+        const std::string path = dir + "/p" + std::to_string(p) + ".json";
+        ASSERT_TRUE(write_probe_json(path, one).ok());
+        // ordered_json: table order, the order the summary scans (first of equal values wins).
+        const auto pj = nlohmann::ordered_json::parse(test::run_zhc({"audit", path, "--directions", "64", "--no-timing", "--json"}).out);
+        for (const auto& [name, m] : pj["files"][0]["representations"].items())
+            if (m["rmse"].get<double>() > worst) {
+                worst = m["rmse"].get<double>();
+                worst_name = name + " at probe " + std::to_string(p);
+            }
+    }
+    // stderr: exactly one line, the summary.
+    EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+    EXPECT_EQ(r.err.rfind("zhc: gate failed: " + std::to_string(failures) + " of " +
+                              std::to_string(codecs().size()) + " (input, representation) pairs fail; --max-rmse: " +
+                              std::to_string(failures) + " pairs, worst rmse ",
+                          0),
+              0u)
+        << r.err;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.4g", worst);
+    EXPECT_NE(r.err.find(std::string("worst rmse ") + buf + " vs 1e-09 (" + in + ": " + worst_name + ")"), std::string::npos)
+        << r.err << " expected worst " << buf << " " << worst_name;
+    // stdout: the report, then at most 10 failure lines and the count of the rest.
+    EXPECT_NE(r.out.find("gate failures (" + std::to_string(failures) + "):"), std::string::npos);
+    EXPECT_NE(r.out.find("  ... " + std::to_string(failures - 10) + " more"), std::string::npos);
+    EXPECT_EQ(static_cast<std::size_t>(std::count(r.out.begin(), r.out.end(), '\n')) -
+                  count_lines(test::run_zhc({"audit", in, "--directions", "64", "--no-timing"}).out),
+              1u + 1u + 10u + 1u);  // blank, header, 10 lines, "... N more"
+    EXPECT_EQ(j["gates"]["summary"], r.err.substr(18, r.err.size() - 19));
+}
+
+// ---- an output path that is an input --------------------------------------------------------------
+
+// Runs args and checks the refusal: exit 2, one line naming the input, the input unchanged.
+void expect_refused(const std::vector<std::string>& args, const std::string& input) {
+    const auto before = test::read_bytes(input);
+    const auto r = test::run_zhc(args);
+    std::string cmd;
+    for (const auto& a : args) cmd += a + " ";
+    EXPECT_EQ(r.exit_code, 2) << cmd << "\n" << r.err;
+    EXPECT_NE(r.err.find(": is the input "), std::string::npos) << cmd << "\n" << r.err;
+    EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+    EXPECT_EQ(r.out, "") << cmd;
+    EXPECT_EQ(test::read_bytes(input), before) << cmd << ": the input changed";
+}
+
+TEST(CliTraps, OutputOverInputRefusedInEveryWritingVerb) {
+    const std::string dir = test::fresh_dir("traps_overwrite");
+    const std::string in = golden_json(dir);
+    const std::string zhp = dir + "/p.zhp";
+    ASSERT_EQ(test::run_zhc({"convert", in, "-o", zhp, "-r", "sh3"}).exit_code, 0);
+    // Spellings of the same file: the path itself, with ./ and ../, a symlink, a hard link.
+    const std::string base = fs::path(dir).filename().string();
+    fs::create_symlink(zhp, dir + "/sym.zhp");
+    fs::create_hard_link(zhp, dir + "/hard.zhp");
+    for (const std::string& same : {zhp, dir + "/./p.zhp", dir + "/../" + base + "/p.zhp", dir + "/sym.zhp", dir + "/hard.zhp"})
+        expect_refused({"convert", zhp, "-o", same}, zhp);
+    expect_refused({"convert", in, "-o", dir + "/./golden.json", "-r", "sh2"}, in);
+    // A symlinked folder in the output path.
+    fs::create_directory_symlink(dir, dir + "/again");
+    expect_refused({"convert", zhp, "-o", dir + "/again/p.zhp", "-r", "zh3_q16"}, zhp);
+    expect_refused({"dering", in, "-o", dir + "/again/golden.json"}, in);
+    // bake (a copy of the committed scene: the check must not depend on the refusal working).
+    const std::string scene = dir + "/scene.json";
+    fs::copy_file(std::string(ZHC_TEST_DATA_DIR) + "/../conformance/inputs/scene.json", scene);
+    expect_refused({"bake", scene, "-o", dir + "/./scene.json", "--quiet"}, scene);
+    // gltf embed (scene or probes as output) and extract.
+    const std::string glb = dir + "/s.glb";
+    fs::copy_file(std::string(ZHC_TEST_DATA_DIR) + "/gltf/gt_list.glb", glb);
+    expect_refused({"gltf", "embed", glb, zhp, "-o", glb}, glb);
+    const std::string lit = dir + "/lit.glb";
+    ASSERT_EQ(test::run_zhc({"gltf", "embed", glb, zhp, "-o", lit}).exit_code, 0);
+    // extract writes .zhp/.json: a glTF input named .json (read by content) stands in for the case.
+    fs::copy_file(lit, dir + "/lit.json");
+    expect_refused({"gltf", "extract", dir + "/lit.json", "-o", dir + "/../" + base + "/lit.json"}, dir + "/lit.json");
+    // lightmap synth / encode / decode / audit --html.
+    const std::string map = dir + "/map.exr";
+    fs::copy_file(test::envmap_paths()[0], map);
+    expect_refused({"lightmap", "synth", map, "-o", dir + "/./map.exr", "--size", "8"}, map);
+    const std::string lm = dir + "/lm.exr";
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", map, "-o", lm, "--size", "8"}).exit_code, 0);
+    fs::copy_file(lm, dir + "/lm.iz.ktx2");  // an input named like encode's first output
+    expect_refused({"lightmap", "encode", dir + "/lm.iz.ktx2", "-o", dir + "/lm"}, dir + "/lm.iz.ktx2");
+    fs::remove(dir + "/lm.iz.ktx2");
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", lm, "-o", dir + "/z"}).exit_code, 0);
+    expect_refused({"lightmap", "decode", dir + "/z", "-o", dir + "/z.d.ktx2"}, dir + "/z.d.ktx2");
+    expect_refused({"lightmap", "audit", lm, "--html", dir + "/./lm.exr"}, lm);
+    // audit --markdown over an input.
+    expect_refused({"audit", in, "-r", "sh3", "--markdown", dir + "/./golden.json"}, in);
+    // A different file next to the input is fine.
+    EXPECT_EQ(test::run_zhc({"convert", zhp, "-o", dir + "/other.zhp"}).exit_code, 0);
+}
+
+}  // namespace
+}  // namespace zhc
