@@ -207,7 +207,9 @@ TEST(AuditCli, AuditsProbeContainersAndNamesFailingProbes) {
     EXPECT_GT(j["files"][0]["representations"]["sh2"]["rmse"].get<double>(), 1e-3);
     auto gate = test::run_zhc({"audit", path, "--no-timing", "--representations", "sh2", "--max-rmse", "1e-6"});
     EXPECT_EQ(gate.exit_code, cli::kExitGateFailed);
-    EXPECT_NE(gate.err.find("at probe 0,1,2"), std::string::npos) << gate.err;
+    // The failing probes after the report on stdout; stderr's one line names the gate and the worst.
+    EXPECT_NE(gate.out.find("at probe 0,1,2"), std::string::npos) << gate.out;
+    EXPECT_NE(gate.err.find("--max-rmse: 1 pairs, worst rmse "), std::string::npos) << gate.err;
 }
 
 }  // namespace
