@@ -50,10 +50,10 @@ int run(const Options& o) {
         }
         inputs.push_back(dir);
     }
-    if (!o.html.empty())
-        if (int rc = refuse_output_over_input("--html", o.html, inputs); rc != kExitOk) return rc;
     auto files = expand_audit_inputs(inputs);
     if (!files) return report(files.error());
+    if (!o.html.empty())
+        if (int rc = refuse_output_over_input("--html", o.html, *files); rc != kExitOk) return rc;
     auto chosen = select_codecs(o.representations);
     if (!chosen) return report(chosen.error());
     const std::vector<const Codec*>& selected = *chosen;

@@ -7,6 +7,7 @@
 // probe list (detected by content). `eval` prints the irradiance zhc computes for probe I in the
 // glTF-space direction (X, Y, Z) — the reference the three.js client test compares against.
 // Outputs are written atomically.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -116,16 +117,26 @@ int run_extract(const Options& o) {
 }
 
 int run_eval(const Options& o) {
-    // A direction is three numbers whose length is finite and not zero (what normalisation needs);
-    // anything else (0,0,0, NaN, Inf) is a usage error, found before the file is read.
-    const double len = o.dir.size() == 3 ? length(Vec3{o.dir[0], o.dir[1], o.dir[2]}) : 0.0;
-    if (!(len > 0.0) || !std::isfinite(len)) {
+    // A direction is three finite numbers, not all zero; anything else (0,0,0, NaN, Inf) is a usage
+    // error, found before the file is read. Scaled by the largest magnitude first, so a tiny or huge
+    // (finite) vector still normalises.
+    const double m = o.dir.size() == 3 ? std::max({std::fabs(o.dir[0]), std::fabs(o.dir[1]), std::fabs(o.dir[2])}) : 0.0;
+    const bool finite = o.dir.size() == 3 && std::isfinite(o.dir[0]) && std::isfinite(o.dir[1]) && std::isfinite(o.dir[2]);
+    if (!finite || !(m > 0.0)) {
         std::string given;
-        for (double d : o.dir) given += (given.empty() ? "" : ",") + std::to_string(d);
-        std::fprintf(stderr, "zhc: error: --dir %s: needs X,Y,Z, a direction in glTF axes (finite, not all zero)\n",
-                     given.c_str());
+        for (double d : o.dir) {
+            char b[32];
+            std::snprintf(b, sizeof b, "%.9g", d);
+            if (!given.empty()) given += ',';
+            given += b;
+        }
+        std::fprintf(stderr, "zhc: error: --dir %s: needs X,Y,Z, a direction in glTF axes (finite, not all zero)\n", given.c_str());
         return kExitUsage;
     }
+    const Vec3 a{o.dir[0], o.dir[1], o.dir[2]};
+    const double len = length(a);
+    const Vec3 scaled = (1.0 / m) * a;  // only where the plain length under- or overflows
+    const Vec3 g = len > 0.0 && std::isfinite(len) ? (1.0 / len) * a : (1.0 / length(scaled)) * scaled;
     auto v = load_volume(o.input, o.volume);
     if (!v) return report(v.error());
     if (o.probe >= v->set.count) {
@@ -133,7 +144,6 @@ int run_eval(const Options& o) {
                      static_cast<unsigned long long>(v->set.count));
         return kExitUsage;
     }
-
     // The probe as stored in glTF order: grid volumes are reordered on extraction, so map the
     // glTF probe number back to zhc's order (gltf index j + ny (k + nz i) for zhc (i, j, k)).
     std::uint64_t zi = o.probe;
@@ -142,7 +152,6 @@ int run_eval(const Options& o) {
         const std::uint64_t j = o.probe % c[1], k = (o.probe / c[1]) % c[2], i = o.probe / (std::uint64_t(c[1]) * c[2]);
         zi = i + c[0] * (j + std::uint64_t(c[1]) * k);
     }
-    const Vec3 g = (1.0 / len) * Vec3{o.dir[0], o.dir[1], o.dir[2]};
     const Vec3 n_zhc{g.z, g.x, g.y};  // (x, y, z)_zhc = (z, x, y)_glTF
     const Codec& codec = *v->set.codec();
     const Sh3Radiance hub = decode_probe(codec, v->set.params, v->set.payload.data() + zi * codec.size_bytes);
