@@ -5,6 +5,7 @@
 #include <functional>
 #include <string>
 
+#include "codec/sh/sh.h"
 #include "codec/status.h"
 
 namespace zhc::cli {
@@ -49,6 +50,9 @@ int resolve_threads(int threads);
 CLI::Option* add_json_flag(CLI::App* app, bool& json, const std::string& what = "");
 // Environment-map reading: `--replace-non-finite` and `--part` (formats/envmap/envmap.h EnvmapReadOptions).
 void add_envmap_read_options(CLI::App* app, bool* replace_non_finite, std::string& part);
+// `--latlong openexr|gltf`: the orientation of a lat-long environment map (codec/sh/sh.h
+// LatLongConvention, docs/conventions.md). `set` (may be null) becomes true when the option is given.
+CLI::Option* add_latlong_option(CLI::App* app, LatLongConvention& convention, bool* set, const std::string& default_text);
 
 // A verb: `setup` adds the subcommand and its options to the app and returns the function that
 // runs it after parsing. Verbs register themselves with a static VerbRegistration.

@@ -35,6 +35,7 @@ struct Options {
     bool fail_on_negative = false;
     bool replace_non_finite = false;
     std::string part;
+    LatLongConvention latlong = LatLongConvention::kOpenExr;
     std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
 };
 
@@ -112,6 +113,7 @@ HtmlReport html_of(const Options& o, const AuditGates& gates, const AuditedFiles
                   {"timing", o.no_timing ? "off (--no-timing)" : "on: median of 5 batches, first 8 probes of each file"}};
     if (!o.part.empty()) h.settings.push_back({"EXR part", o.part});
     if (o.replace_non_finite) h.settings.push_back({"non-finite pixels", "replaced by 0"});
+    h.settings.push_back({"lat-long orientation", latlong_convention_name(o.latlong)});
     const bool timed = !o.no_timing;
     h.summary_caption = inputs.size() > 1 ? "Aggregate over " + std::to_string(inputs.size()) +
                                                 " files (mean rmse, relative rmse, fractions and times; worst max abs and min irradiance)"
@@ -171,6 +173,7 @@ int run(const Options& o) {
     lopt.threads = aopt.threads;
     lopt.replace_non_finite = o.replace_non_finite;
     lopt.part = o.part;
+    lopt.latlong = o.latlong;
     // After each input: its pictures (--images, --html) and the progress.
     std::vector<SpherePictures> pictures;
     bool output_failed = false;
@@ -284,6 +287,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     sub->add_option("--max-relative-rmse", o->max_relative_rmse, "gate: fail (exit 8) if any relative RMSE exceeds this");
     sub->add_flag("--fail-on-negative", o->fail_on_negative, "gate: fail (exit 8) if any reconstruction goes negative");
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
+    add_latlong_option(sub, o->latlong, nullptr, "default openexr");
     return [o] { return run(*o); };
 });
 

@@ -56,6 +56,10 @@ int run(const Options& o) {
     const int threads = resolve_threads(o.threads);
     SceneLoadOptions lo;
     lo.threads = threads;
+    // A lat-long environment map is read in the glTF ecosystem's orientation when the bake's output
+    // is glTF (and always for a glTF scene) unless the scene's environment.latlong says otherwise;
+    // the effects report names the orientation used.
+    if (gltf_out) lo.default_latlong = LatLongConvention::kGltf;
     // A glTF input is read once: it is both the scene and, for -o .glb/.gltf, the host asset.
     const bool gltf_in = is_gltf_path(o.scene);
     std::vector<std::uint8_t> input_asset;

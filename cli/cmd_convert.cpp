@@ -32,6 +32,7 @@ struct Options {
     int zstd = 0;
     bool replace_non_finite = false;
     std::string part;
+    LatLongConvention latlong = LatLongConvention::kOpenExr;
     int threads = 1;
     std::vector<CLI::Option*> storage_flags;  // the options that set CodecOptions
     bool any_storage_flag() const {
@@ -63,6 +64,7 @@ Result<Loaded> load_input(const Options& o) {
         EnvmapReadOptions ro;
         if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
         ro.part = o.part;
+        ro.latlong = o.latlong;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return img.error();
         in.list.probes.push_back(project_envmap(*img, resolve_threads(o.threads)));
@@ -194,6 +196,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")
         ->check(CLI::Range(0, 22));
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
+    add_latlong_option(sub, o->latlong, nullptr, "default openexr");
     add_threads_option(sub, o->threads, "environment map projection; result identical for any count");
     return [o] { return run(*o); };
 });

@@ -30,6 +30,7 @@ struct Options {
     bool punctual = false;
     bool replace_non_finite = false;
     std::string part;
+    LatLongConvention latlong = LatLongConvention::kOpenExr;
     int threads = 1;
 };
 
@@ -111,6 +112,7 @@ int run(const Options& o) {
         EnvmapReadOptions ro;
         if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
         ro.part = o.part;
+        ro.latlong = o.latlong;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return report(img.error());
         probes.push_back({"", project_envmap(*img, resolve_threads(o.threads))});
@@ -167,6 +169,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     sub->add_option("-o,--output", o->output, "output JSON (written atomically)")->required();
     sub->add_flag("--punctual", o->punctual, "source is punctual lights: extra windowing 0.92 / 0.73 first");
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
+    add_latlong_option(sub, o->latlong, nullptr, "default openexr");
     add_threads_option(sub, o->threads, "environment map projection; same result for any count");
     return [o] { return run(*o); };
 });

@@ -30,6 +30,7 @@ struct Options {
     std::string input, output, quality = "default", solve = "newton";
     std::string container;  // encode: "" = ktx2; decode: "" = auto
     std::string part;       // synth: EXR part of the environment map
+    LatLongConvention latlong = LatLongConvention::kOpenExr;  // synth: lat-long orientation
     std::string html;       // audit: also write the HTML report here (whole-image path)
     int threads = 1, size = 256, height = 0, stride = 17, band_rows = 0;
     bool json = false, half = false;
@@ -202,6 +203,7 @@ int run_audit(const Options& o) {
 int run_synth(const Options& o) {
     EnvmapReadOptions ro;
     ro.part = o.part;
+    ro.latlong = o.latlong;
     auto img = read_envmap(o.input, ro);
     if (!img) return report(img.error());
     const Sh3Radiance world = project_envmap(*img, o.threads);
@@ -259,6 +261,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     CLI::App* syn = lm->add_subcommand("synth", "synthetic SH lightmap: a sphere lit by an environment map's SH3");
     syn->add_option("ENVMAP", o->input, "EXR (lat-long or cube) or .hdr environment map")->required();
     add_envmap_read_options(syn, nullptr, o->part);
+    add_latlong_option(syn, o->latlong, nullptr, "default openexr");
     syn->add_option("-o,--output", o->output, "output SH lightmap EXR")->required();
     syn->add_option("--size", o->size, "width (and height, unless --height) in texels")->check(CLI::Range(4, 16384));
     syn->add_option("--height", o->height, "height in texels (default: --size)")->check(CLI::Range(4, 16384));

@@ -19,6 +19,7 @@ struct Options {
     bool json = false;
     bool replace_non_finite = false;
     std::string part;
+    LatLongConvention latlong = LatLongConvention::kOpenExr;
     int threads = 1;
 };
 
@@ -32,6 +33,7 @@ int run(const Options& o) {
     EnvmapReadOptions ro;
     if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
     ro.part = o.part;
+    ro.latlong = o.latlong;
     EnvmapInfo info;
     auto img = read_envmap(o.path, ro, &info);
     if (!img) return report(img.error());
@@ -46,6 +48,7 @@ int run(const Options& o) {
         j["height"] = img->height;
         j["format"] = info.format;
         j["layout"] = info.layout;
+        if (img->layout == EnvmapLayout::kLatLong) j["latlong"] = latlong_convention_name(img->latlong);
         j["kind"] = "radiance";
         j["basis"] = "zhc (ZH3 paper Eq. 4/5), index l(l+1)+m";
         nlohmann::ordered_json rows = nlohmann::ordered_json::array();
@@ -54,8 +57,10 @@ int run(const Options& o) {
         j["replaced_non_finite"] = info.replaced_non_finite;
         print_json("project", j);
     } else {
-        std::printf("%s: %dx%d %s %s (%s, %s)\n", o.path.c_str(), img->width, img->height, info.format.c_str(),
-                    info.layout.c_str(), info.channels.c_str(), info.compression.c_str());
+        const std::string orientation =
+            img->layout == EnvmapLayout::kLatLong ? std::string(" ") + latlong_convention_name(img->latlong) + " orientation" : "";
+        std::printf("%s: %dx%d %s %s%s (%s, %s)\n", o.path.c_str(), img->width, img->height, info.format.c_str(),
+                    info.layout.c_str(), orientation.c_str(), info.channels.c_str(), info.compression.c_str());
         print_sh3_table(sh);
         std::printf("projected in %.3f ms\n", ms);
     }
@@ -68,6 +73,7 @@ const VerbRegistration registration(20, [](CLI::App& app) -> std::function<int()
     sub->add_option("ENVMAP", o->path, "OpenEXR or Radiance .hdr lat-long map")->required();
     add_json_flag(sub, o->json, "key \"sh3\" holds 9 rows of [r, g, b]");
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
+    add_latlong_option(sub, o->latlong, nullptr, "default openexr");
     add_threads_option(sub, o->threads, "result identical for any count");
     return [o] { return run(*o); };
 });

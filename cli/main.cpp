@@ -95,6 +95,20 @@ void add_envmap_read_options(CLI::App* app, bool* replace_non_finite, std::strin
                     "multi-part EXR: the part to read (its name, or its index); default: the first with R, G, B or Y channels");
 }
 
+CLI::Option* add_latlong_option(CLI::App* app, LatLongConvention& convention, bool* set, const std::string& default_text) {
+    return app
+        ->add_option_function<std::string>(
+            "--latlong",
+            [&convention, set](const std::string& name) {
+                parse_latlong_convention(name, &convention);  // the check below admits only the two names
+                if (set) *set = true;
+            },
+            "lat-long map orientation: openexr (centre column +X, phi = pi(1 - 2u)) or gltf (the glTF "
+            "ecosystem's: centre column glTF +X = zhc +Y, phi = pi(3/2 - 2u)); cube maps are unaffected; " +
+                default_text)
+        ->check(CLI::IsMember({"openexr", "gltf"}));
+}
+
 // CLI11 reports a verb it does not know as "A subcommand is required": name the word instead
 // ("unknown verb 'bogus'", "unknown verb 'gltf bogus'"). Empty when the verbs on the command line
 // are all known.

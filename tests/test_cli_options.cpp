@@ -20,19 +20,19 @@ const std::vector<VerbOptions>& table() {
     static const std::vector<VerbOptions> t = {
         {{"demo"}, {"--threads"}},
         {{"bake"}, {"-r,--representations,--to", "--threads", "--progress", "--quiet"}},
-        {{"project"}, {"--json", "--threads", "--replace-non-finite", "--part"}},
-        {{"audit"}, {"-r,--representations", "--json", "--threads", "--replace-non-finite", "--part", "--progress", "--quiet"}},
-        {{"convert"}, {"-r,--representations,--to", "--threads", "--replace-non-finite", "--part"}},
+        {{"project"}, {"--json", "--threads", "--replace-non-finite", "--part", "--latlong"}},
+        {{"audit"}, {"-r,--representations", "--json", "--threads", "--replace-non-finite", "--part", "--latlong", "--progress", "--quiet"}},
+        {{"convert"}, {"-r,--representations,--to", "--threads", "--replace-non-finite", "--part", "--latlong"}},
         {{"info"}, {"--json"}},
         {{"bench"}, {"-r,--representations", "--json"}},
-        {{"dering"}, {"--threads", "--replace-non-finite", "--part"}},
+        {{"dering"}, {"--threads", "--replace-non-finite", "--part", "--latlong"}},
         {{"gltf", "embed"}, {"-r,--representations,--encoding"}},
         {{"gltf", "extract"}, {}},
         {{"gltf", "eval"}, {}},
         {{"lightmap", "encode"}, {"--threads", "--progress", "--quiet"}},
         {{"lightmap", "decode"}, {"--progress", "--quiet"}},
         {{"lightmap", "audit"}, {"--json", "--threads", "--progress", "--quiet"}},
-        {{"lightmap", "synth"}, {"--threads", "--part", "--progress", "--quiet"}},
+        {{"lightmap", "synth"}, {"--threads", "--part", "--latlong", "--progress", "--quiet"}},
     };
     return t;
 }
@@ -77,7 +77,7 @@ TEST(SharedOptions, EveryVerbListsTheSharedNames) {
                 << "zhc " << joined(v.verb) << ": " << o << " outside the shared -r,--representations spelling";
             // Every shared option this verb takes is in its row (a new one must be added there).
             const bool shared = o.find("--representations") != std::string::npos || o == "--threads" || o == "--json" ||
-                                o == "--part" || o == "--replace-non-finite" || o == "--progress" || o == "--quiet";
+                                o == "--part" || o == "--replace-non-finite" || o == "--latlong" || o == "--progress" || o == "--quiet";
             if (shared) {
                 EXPECT_NE(std::find(v.names.begin(), v.names.end(), o), v.names.end())
                     << "zhc " << joined(v.verb) << " lists " << o << " but its row in the table does not";

@@ -107,7 +107,7 @@ TEST(CodecTable, DecodeAcceptsArbitraryBytes) {
             ASSERT_EQ(std::memcmp(&d, &again, sizeof d), 0) << "decode is not a pure function of the bytes";
             bool finite = true;
             double mag = 0;
-            for (const Rgb& coef : d)
+            for (const Rgb& coef : d.c)
                 for (int k = 0; k < 3; ++k) {
                     finite = finite && std::isfinite(coef[k]);
                     mag += std::fabs(double(coef[k]));
@@ -118,7 +118,9 @@ TEST(CodecTable, DecodeAcceptsArbitraryBytes) {
                 const Rgb slow = irradiance(d, n);
                 for (int k = 0; k < 3; ++k) {
                     ASSERT_TRUE(std::isfinite(fast[k])) << "non-finite irradiance from a finite decode, trial " << trial;
-                    if (mag < 1e30) EXPECT_NEAR(fast[k], slow[k], 1e-4 * (1 + mag)) << "trial " << trial;
+                    if (mag < 1e30) {
+                        EXPECT_NEAR(fast[k], slow[k], 1e-4 * (1 + mag)) << "trial " << trial;
+                    }
                 }
             }
         }

@@ -52,6 +52,9 @@ struct SceneEnvironment {
     double intensity = 1.0;
     double rotation_rad = 0;   // about +Z, right-hand rule
     std::string source;        // for reports (the map's path)
+    // How a lat-long map's columns turn (codec/sh/sh.h; `projected` is already in zhc's frame).
+    LatLongConvention latlong = LatLongConvention::kOpenExr;
+    bool latlong_map = true;   // false: a cube map (its orientation is its format's)
 };
 
 enum class SkyKind : std::uint8_t { kConstant, kGradient };

@@ -14,6 +14,7 @@ LatLongImage downsample_for_audit(LatLongView map, int min_width, int min_height
     LatLongImage out;
     out.width = map.width / f;
     out.height = map.height / f;
+    out.convention = map.convention;
     out.rgb.assign(static_cast<size_t>(out.width) * static_cast<size_t>(out.height) * 3, 0.0f);
     for (int y = 0; y < out.height; ++y) {
         const double big = latlong_pixel_solid_angle(y, out.width, out.height);
@@ -40,7 +41,7 @@ std::vector<Rgb> integrate_irradiance(LatLongView map, const std::vector<Vec3>& 
         const double w = latlong_pixel_solid_angle(y, map.width, map.height);
         for (int x = 0; x < map.width; ++x) {
             const size_t i = static_cast<size_t>(y) * map.width + x;
-            const Vec3 d = latlong_direction(x, y, map.width, map.height);
+            const Vec3 d = latlong_direction(x, y, map.width, map.height, map.convention);
             px[i] = d.x;
             py[i] = d.y;
             pz[i] = d.z;

@@ -18,6 +18,7 @@ namespace zhc {
 struct LatLongView {
     const float* rgb = nullptr;
     int width = 0, height = 0;
+    LatLongConvention convention = LatLongConvention::kOpenExr;
 };
 
 // Flux-preserving box downsample by integer factors until the next halving would go below
@@ -25,7 +26,8 @@ struct LatLongView {
 struct LatLongImage {
     int width = 0, height = 0;
     std::vector<float> rgb;
-    LatLongView view() const { return {rgb.data(), width, height}; }
+    LatLongConvention convention = LatLongConvention::kOpenExr;  // the source's (a box downsample keeps it)
+    LatLongView view() const { return {rgb.data(), width, height, convention}; }
 };
 LatLongImage downsample_for_audit(LatLongView map, int min_width = 512, int min_height = 256);
 

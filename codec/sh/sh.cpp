@@ -139,9 +139,20 @@ std::vector<Vec3> fibonacci_sphere(int n) {
     return out;
 }
 
-Vec3 latlong_direction(double col, double row, int width, int height) {
+const char* latlong_convention_name(LatLongConvention convention) {
+    return convention == LatLongConvention::kGltf ? "gltf" : "openexr";
+}
+
+bool parse_latlong_convention(std::string_view name, LatLongConvention* out) {
+    if (name == "openexr") *out = LatLongConvention::kOpenExr;
+    else if (name == "gltf") *out = LatLongConvention::kGltf;
+    else return false;
+    return true;
+}
+
+Vec3 latlong_direction(double col, double row, int width, int height, LatLongConvention convention) {
     const double u = (col + 0.5) / width, v = (row + 0.5) / height;
-    const double phi = kPi * (1.0 - 2.0 * u), theta = kPi * v;
+    const double phi = kPi * ((convention == LatLongConvention::kGltf ? 1.5 : 1.0) - 2.0 * u), theta = kPi * v;
     const double st = std::sin(theta);
     return {st * std::cos(phi), st * std::sin(phi), std::cos(theta)};
 }
@@ -237,7 +248,23 @@ ZIntegrals z_antiderivatives(double z) {
 // so the integral over a pixel is (theta-factor integral over its row) x (phi-factor integral
 // over its column), both in closed form: five column sums per row and channel suffice. A constant
 // map projects to exactly 2 sqrt(pi) L in L00 and zero elsewhere, at any resolution.
-Sh3Radiance project_latlong(const float* rgb, int width, int height, size_t row_stride, int threads) {
+Sh3Radiance latlong_quarter_turn(const Sh3Radiance& sh, LatLongConvention convention) {
+    if (convention == LatLongConvention::kOpenExr) return sh;
+    // g(x, y, z) = f(y, -x, z): Y1-1 (-y) -> -Y11, Y11 (-x) -> Y1-1, Y2-2 (xy) -> -Y2-2,
+    // Y2-1 (-yz) -> -Y21, Y21 (-xz) -> Y2-1, Y22 (x^2 - y^2) -> -Y22; Y00, Y10, Y20 stay.
+    Sh3Radiance g;
+    const int from[9] = {0, 3, 2, 1, 4, 7, 6, 5, 8};
+    const bool negate[9] = {false, false, false, true, true, false, false, true, true};
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) g[i][k] = negate[i] ? 0.0f - sh[from[i]][k] : sh[from[i]][k];  // 0 - 0 is +0
+    return g;
+}
+
+Sh3Radiance project_latlong(const float* rgb, int width, int height, size_t row_stride, int threads,
+                            LatLongConvention convention) {
+    if (convention != LatLongConvention::kOpenExr)
+        return latlong_quarter_turn(project_latlong(rgb, width, height, row_stride, threads, LatLongConvention::kOpenExr),
+                                    convention);
     Sh3Radiance out;
     if (width <= 0 || height <= 0 || rgb == nullptr) return out;
     std::vector<double> column_integrals(static_cast<size_t>(width) * 5);

@@ -18,6 +18,8 @@
 //      direction = (sin theta cos phi, sin theta sin phi, cos theta).
 //    This is OpenEXR's Imf::LatLongMap orientation with (x, y, z)_zhc = (z, x, y)_OpenEXR (its +Y up
 //    becomes our +Z; its +Z, the image centre, becomes our +X), sampled at pixel centres.
+//    The glTF ecosystem's lat-long orientation (LatLongConvention::kGltf below) has the same rows
+//    and phi = pi (3/2 - 2u): the same map turned by +90 degrees about +Z.
 //  * Radiance and irradiance are distinct types. Irradiance is radiance convolved with the
 //    normalised clamped-cosine kernel, E(n) = (1/pi) * integral L(w) max(0, n.w) dw, so a constant
 //    radiance of 1 gives irradiance 1. In SH that is the per-band scale 1, 2/3, 1/4.
@@ -29,6 +31,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace zhc {
@@ -168,8 +171,24 @@ Sh3Radiance project_samples(std::span<const WeightedSample> samples);
 
 // n directions spread uniformly over the sphere (spherical Fibonacci lattice), deterministic.
 std::vector<Vec3> fibonacci_sphere(int n);
+
+// Which longitude a lat-long map's column stands for (docs/conventions.md). Both conventions have
+// u = (col + 0.5) / W, v = (row + 0.5) / H, theta = pi v (row 0 at the top, +Z) and
+// direction = (sin theta cos phi, sin theta sin phi, cos theta) in zhc's frame; they differ in phi:
+//   kOpenExr: phi = pi (1 - 2u)    centre column +X_zhc (OpenEXR's Imf::LatLongMap, its +Z)
+//   kGltf:    phi = pi (3/2 - 2u)  centre column +Y_zhc = glTF's +X; in glTF's Y-up axes
+//             u = 1/2 + atan2(z, x) / (2 pi), v = acos(y) / pi (three.js's equirectUv with its
+//             image flipped so row 0 is up, the Khronos glTF-IBL-Sampler, Blender, Bevy)
+// A kGltf map is the kOpenExr map turned by +90 degrees about +Z.
+enum class LatLongConvention : std::uint8_t { kOpenExr, kGltf };
+// "openexr" / "gltf", the spelling of the CLI's --latlong and the scenes' "latlong" key.
+const char* latlong_convention_name(LatLongConvention convention);
+// Parses that spelling; false for anything else.
+bool parse_latlong_convention(std::string_view name, LatLongConvention* out);
+
 // Direction of the centre of pixel (col, row) in a width x height latitude-longitude map.
-Vec3 latlong_direction(double col, double row, int width, int height);
+Vec3 latlong_direction(double col, double row, int width, int height,
+                       LatLongConvention convention = LatLongConvention::kOpenExr);
 // Exact solid angle of row `row` of a lat-long map of the given size, per pixel:
 // (2 pi / width) * (cos theta_top - cos theta_bottom).
 double latlong_pixel_solid_angle(int row, int width, int height);
@@ -181,8 +200,14 @@ double latlong_pixel_solid_angle(int row, int width, int height);
 // resolution. Uses the separable form (per-row Legendre-factor integrals, per-column cos/sin(m phi)
 // integrals) and splits rows over `threads` workers; the result does not depend on the thread
 // count (fixed-order reduction of per-row sums).
+// `convention` says how the map's columns turn (kGltf: the kOpenExr projection turned by a
+// quarter turn about +Z, exactly: latlong_quarter_turn).
 Sh3Radiance project_latlong(const float* rgb, int width, int height, size_t row_stride,
-                            int threads = 1);
+                            int threads = 1, LatLongConvention convention = LatLongConvention::kOpenExr);
+// The SH of a map read under `convention`, given its SH read under kOpenExr: unchanged for
+// kOpenExr; for kGltf the rotation by +90 degrees about +Z (g(x, y, z) = f(y, -x, z)), which only
+// moves and negates coefficients: [c0, c3, c2, -c1, -c4, c7, c6, -c5, -c8].
+Sh3Radiance latlong_quarter_turn(const Sh3Radiance& openexr, LatLongConvention convention);
 
 // ---- rotation ------------------------------------------------------------------------------
 

@@ -288,7 +288,8 @@ Sh3Radiance project_envmap(const Image& image, int threads) {
     if (image.layout == EnvmapLayout::kCubeVulkan)
         return project_cube(kCubeLayoutVulkan, image.rgb.data(), image.width, static_cast<size_t>(image.width) * 3,
                             threads);
-    return project_latlong(image.rgb.data(), image.width, image.height, static_cast<size_t>(image.width) * 3, threads);
+    return project_latlong(image.rgb.data(), image.width, image.height, static_cast<size_t>(image.width) * 3, threads,
+                           image.latlong);
 }
 
 namespace {
@@ -326,8 +327,9 @@ bool looks_like_envmap(std::span<const std::uint8_t> bytes) {
     return is_exr(bytes) || is_radiance(bytes) || ktx2_declares_cube(bytes) || dds_declares_cube(bytes);
 }
 
-Result<Image> read_envmap_memory(std::span<const std::uint8_t> bytes, const std::string& name,
-                                 const EnvmapReadOptions& options, EnvmapInfo* info) {
+namespace {
+Result<Image> read_envmap_any(std::span<const std::uint8_t> bytes, const std::string& name,
+                              const EnvmapReadOptions& options, EnvmapInfo* info) {
     if (bytes.empty()) return make_error(ErrorCode::kTruncated, name + ": file is empty");
     if (is_exr(bytes)) return read_exr(bytes, name, options, info);
     if (is_radiance(bytes)) return read_hdr(bytes, name, options, info);
@@ -339,6 +341,14 @@ Result<Image> read_envmap_memory(std::span<const std::uint8_t> bytes, const std:
     }
     return make_error(ErrorCode::kBadFormat,
                       name + ": not an OpenEXR, Radiance .hdr, KTX2 or DDS image (unknown magic bytes)");
+}
+}  // namespace
+
+Result<Image> read_envmap_memory(std::span<const std::uint8_t> bytes, const std::string& name,
+                                 const EnvmapReadOptions& options, EnvmapInfo* info) {
+    auto img = read_envmap_any(bytes, name, options, info);
+    if (img && img->layout == EnvmapLayout::kLatLong) img->latlong = options.latlong;
+    return img;
 }
 
 Result<Image> read_envmap(const std::string& path, const EnvmapReadOptions& options, EnvmapInfo* info) {

@@ -5,6 +5,8 @@
 //   phi = pi (1 - 2 (col + 0.5) / W),  theta = pi (row + 0.5) / H,
 //   direction = (sin theta cos phi, sin theta sin phi, cos theta).
 // That is OpenEXR's Imf::LatLongMap orientation with (x, y, z)_zhc = (z, x, y)_OpenEXR.
+// EnvmapReadOptions::latlong selects the glTF ecosystem's orientation instead (phi = pi (3/2 - 2u),
+// codec/sh/sh.h LatLongConvention); the image keeps it in Image::latlong.
 // Any width and height are accepted (not only 2:1).
 //
 // EXR files whose "envmap" attribute says cube (OpenEXR's cube layout, N x 6N, see
@@ -35,6 +37,7 @@ struct Image {
     int width = 0;
     int height = 0;
     EnvmapLayout layout = EnvmapLayout::kLatLong;
+    LatLongConvention latlong = LatLongConvention::kOpenExr;  // how a kLatLong image's columns turn
     std::vector<float> rgb;  // width * height * 3
     float* row(int y) { return rgb.data() + static_cast<size_t>(y) * static_cast<size_t>(width) * 3; }
     const float* row(int y) const { return rgb.data() + static_cast<size_t>(y) * static_cast<size_t>(width) * 3; }
@@ -52,6 +55,8 @@ struct EnvmapReadOptions {
     // Multi-part EXR: the part to read, by its "name" attribute (or by its index when no part has
     // that name). Empty: the first part with R, G, B or Y channels that is not deep.
     std::string part;
+    // The orientation of a lat-long map (cube maps have one fixed by their format).
+    LatLongConvention latlong = LatLongConvention::kOpenExr;
 };
 
 struct EnvmapInfo {
@@ -73,11 +78,12 @@ Result<Image> read_envmap(const std::string& path, const EnvmapReadOptions& opti
 Result<Image> read_envmap_memory(std::span<const std::uint8_t> bytes, const std::string& name,
                                  const EnvmapReadOptions& options = {}, EnvmapInfo* info = nullptr);
 
-// SH3 radiance projection of an image read by read_envmap, lat-long or cube.
+// SH3 radiance projection of an image read by read_envmap, lat-long (in its Image::latlong
+// orientation) or cube.
 Sh3Radiance project_envmap(const Image& image, int threads = 1);
 
 // The image as a width x height lat-long map (a lat-long image is returned unchanged when the
-// size matches). A cube map is resampled: each output pixel is the mean of 4 x 4 point samples of
+// size matches, in its own orientation). A cube map is resampled (into kOpenExr orientation): each output pixel is the mean of 4 x 4 point samples of
 // the cube (nearest pixel), for consumers that need lat-long pixels (the audit reference).
 Image envmap_as_latlong(const Image& image, int width, int height);
 

@@ -50,6 +50,7 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         EnvmapReadOptions ro;
         if (options.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
         ro.part = options.part;
+        ro.latlong = options.latlong;
         auto img = read_envmap_memory(*bytes, path, ro);
         if (!img) return img.error();
         in.kind = "envmap";
@@ -57,9 +58,12 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         // The reference integrates lat-long pixels: a cube map is resampled to a lat-long of 4N x 2N
         // (N the face size; at least the audit's 512 x 256).
         const Image ll = envmap_as_latlong(*img, std::max(512, 4 * img->width), std::max(256, 2 * img->width));
-        in.map = downsample_for_audit({ll.rgb.data(), ll.width, ll.height});
+        in.map = downsample_for_audit({ll.rgb.data(), ll.width, ll.height, ll.latlong});
         in.map_reference = integrate_irradiance(in.map.view(), dirs, options.threads);
         in.description = std::string(img->layout != EnvmapLayout::kLatLong ? "cube " : "") + "environment map " + std::to_string(img->width) + "x" + std::to_string(img->height) +
+                         (img->layout == EnvmapLayout::kLatLong && img->latlong != LatLongConvention::kOpenExr
+                              ? std::string(" (lat-long as ") + latlong_convention_name(img->latlong) + ")"
+                              : std::string()) +
                          ", reference: the map integrated at " + std::to_string(in.map.width) + "x" +
                          std::to_string(in.map.height);
         return in;

@@ -15,6 +15,7 @@ struct AuditLoadOptions {
     int threads = 1;
     bool replace_non_finite = false;
     std::string part;  // EXR part (EnvmapReadOptions::part)
+    LatLongConvention latlong = LatLongConvention::kOpenExr;  // EnvmapReadOptions::latlong
 };
 
 // Files and folders -> the list of files to audit (folders: their .exr/.hdr/.zhp/.json files,

@@ -178,8 +178,12 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
         if (!extras.contains("probes")) extras["probes"] = default_probes(r);
         const std::string text = extras.dump();
         std::string dir = fs::path(path).parent_path().string();
+        // A glTF scene's environment map is in the glTF ecosystem's lat-long orientation unless
+        // extras.zhc.environment.latlong says otherwise.
+        SceneLoadOptions json_options = options;
+        json_options.default_latlong = LatLongConvention::kGltf;
         auto scene = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()),
-                                      path + ": extras.zhc", dir, options);
+                                      path + ": extras.zhc", dir, json_options);
         if (!scene) return scene.error();
         Scene s = std::move(scene).value();
         if (s.lights.size() + r.lights_.size() > options.limits.max_lights)

@@ -345,17 +345,26 @@ Scene parse(const Reader& r, const json& doc, const std::string& name, const std
         r.fail(ErrorCode::kInvalidValue, "sky", "a scene has either \"environment\" or \"sky\", not both");
     if (doc.contains("environment")) {
         const std::string p = "environment";
-        const json& e = r.object(doc["environment"], p, {"map", "intensity", "rotation_deg"});
+        const json& e = r.object(doc["environment"], p, {"map", "intensity", "rotation_deg", "latlong"});
         SceneEnvironment env;
         const std::string map = r.string(r.field(e, p, "map"), p + ".map");
         if (map.empty()) r.fail(ErrorCode::kInvalidValue, p + ".map", "must not be empty");
         env.intensity = e.contains("intensity") ? r.non_negative(e["intensity"], p + ".intensity") : 1.0;
         env.rotation_rad = r.number_or(e, p, "rotation_deg", 0.0) * kDeg;
+        env.latlong = options.default_latlong;
+        if (e.contains("latlong")) {
+            const std::string name = r.string(e["latlong"], p + ".latlong");
+            if (!parse_latlong_convention(name, &env.latlong))
+                r.fail(ErrorCode::kInvalidValue, p + ".latlong", "must be \"openexr\" or \"gltf\" (got \"" + name + "\")");
+        }
         const fs::path mp(map);
         env.source = mp.is_absolute() || base_dir.empty() ? map : (fs::path(base_dir) / mp).string();
         if (options.load_environment) {
-            auto img = read_envmap(env.source);
+            EnvmapReadOptions ro;
+            ro.latlong = env.latlong;
+            auto img = read_envmap(env.source, ro);
             if (!img) throw Fail{make_error(img.error().code, name + ": environment.map: " + img.error().message)};
+            env.latlong_map = img->layout == EnvmapLayout::kLatLong;
             env.projected = project_envmap(*img, std::max(1, options.threads));
         }
         s.environment = env;
@@ -476,7 +485,8 @@ std::string scene_json(const Scene& s) {
     if (s.environment)
         doc["environment"] = {{"map", s.environment->source},
                               {"intensity", s.environment->intensity},
-                              {"rotation_deg", s.environment->rotation_rad / kDeg}};
+                              {"rotation_deg", s.environment->rotation_rad / kDeg},
+                              {"latlong", latlong_convention_name(s.environment->latlong)}};
     if (s.sky) {
         if (s.sky->kind == SkyKind::kConstant) {
             doc["sky"] = {{"type", "constant"}, {"radiance", rgb_json(s.sky->radiance)}};

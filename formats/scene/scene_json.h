@@ -35,6 +35,8 @@ struct SceneLoadOptions {
     SceneJsonLimits limits;
     int threads = 1;             // environment map projection
     bool load_environment = true;  // false: keep the map path in environment->source, SH zero
+    // environment.latlong when the scene does not say (glTF scenes and glTF outputs: kGltf).
+    LatLongConvention default_latlong = LatLongConvention::kOpenExr;
 };
 
 // `name` is used in messages; `base_dir` resolves the environment map path.
