@@ -68,8 +68,10 @@ int run(const Options& o) {
         if (!bytes) return report(bytes.error());
         input_asset = std::move(bytes).value();
     }
-    auto scene = gltf_in ? parse_scene_gltf(input_asset, o.scene, lo) : read_scene_file(o.scene, lo);
+    std::vector<std::string> notes;  // what the glTF defines that the bake does not use
+    auto scene = gltf_in ? parse_scene_gltf(input_asset, o.scene, lo, GltfLimits{}, &notes) : read_scene_file(o.scene, lo);
     if (!scene) return report(scene.error());
+    for (const std::string& n : notes) std::fprintf(stderr, "zhc: note: %s: %s\n", o.scene.c_str(), n.c_str());
     BakeOptions bo;
     bo.threads = threads;
     BakeReport rep;

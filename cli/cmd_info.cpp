@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include "cli.h"
@@ -138,8 +139,12 @@ int run(const Options& o) {
         if (!hub) return report(hub.error());
         probe_stats(*hub, j);
     } else if (looks_like_envmap(*bytes)) {
+        // info describes a file with NaN/Inf pixels instead of refusing it: it counts them, and its
+        // statistics read them as 0 (what --replace-non-finite does elsewhere).
         EnvmapInfo info;
-        auto img = read_envmap_memory(*bytes, o.path, {}, &info);
+        EnvmapReadOptions ro;
+        ro.non_finite = NonFinitePolicy::kReplaceZero;
+        auto img = read_envmap_memory(*bytes, o.path, ro, &info);
         if (!img) return report(img.error());
         j["type"] = "environment map (" + info.layout + ")";
         j["format"] = info.format;
@@ -147,6 +152,33 @@ int run(const Options& o) {
         j["height"] = img->height;
         j["channels"] = info.channels;
         j["compression"] = info.compression;
+        if (info.format == "openexr") {
+            if (info.has_chromaticities) {
+                // The attribute's floats at float precision (7 significant digits), not as doubles.
+                auto xy = [&](int i) {
+                    nlohmann::ordered_json p = nlohmann::ordered_json::array();
+                    for (int k = 0; k < 2; ++k) {
+                        char buf[32];
+                        std::snprintf(buf, sizeof buf, "%.7g", double(info.chromaticities[static_cast<size_t>(2 * i + k)]));
+                        p.push_back(std::strtod(buf, nullptr));
+                    }
+                    return p;
+                };
+                nlohmann::ordered_json cj;
+                cj["red"] = xy(0);
+                cj["green"] = xy(1);
+                cj["blue"] = xy(2);
+                cj["white"] = xy(3);
+                j["chromaticities"] = cj;
+            } else {
+                j["chromaticities"] = "none (Rec. 709 / D65)";
+            }
+            j["colour_conversion"] = info.colour_conversion;
+            j["data_window"] = info.data_window;
+            j["display_window"] = info.display_window;
+        }
+        j["non_finite_pixels"] = info.non_finite_pixels;
+        j["non_finite_values"] = info.replaced_non_finite;
         const Sh3Radiance sh = project_envmap(*img);
         probe_stats({sh}, j);
     } else if (looks_like_glb(*bytes) || (looks_like_json(*bytes) && is_gltf_json(*bytes))) {

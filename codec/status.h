@@ -11,17 +11,21 @@
 
 namespace zhc {
 
+// One numbering with the C runtime's `enum zhc_error` (runtime/zhc_runtime.h): the classes both
+// report have the same value (ZHC_ERR_ARGUMENT = 1 ... ZHC_ERR_TRAILING_BYTES = 8; 9 and 10 are the
+// runtime's ZHC_ERR_COMPRESSED and ZHC_ERR_NOT_GRID), the library-only ones start at 16. The CLI maps them to exit codes
+// (cli/main.cpp exit_code_for); the table of all three is in docs/inputs.md "Error classes".
 enum class ErrorCode {
-    kInvalidArgument,  // the caller's mistake: bad option, unknown representation name
-    kIoError,          // file missing, unreadable, not writable
-    kBadFormat,        // not the format it claims to be: bad magic, malformed header or field
-    kTruncated,        // ends before the data it declares
-    kTrailingBytes,    // data after the declared end
-    kChecksum,         // stored checksum does not match
-    kUnsupported,      // well-formed but uses a feature/version zhc does not support
-    kTooLarge,         // declared sizes exceed zhc's limits (checked before allocating)
-    kInvalidValue,     // NaN/Inf or otherwise unusable numbers in the data
-    kInternal,         // a bug in zhc
+    kInvalidArgument = 1,  // the caller's mistake: bad option, unknown representation name
+    kTruncated = 2,        // ends before the data it declares
+    kBadFormat = 3,        // not the format it claims to be: bad magic, malformed header or field
+    kUnsupported = 4,      // well-formed but uses a feature/version zhc does not support
+    kChecksum = 5,         // stored checksum does not match
+    kTooLarge = 6,         // declared sizes exceed zhc's limits (checked before allocating)
+    kInvalidValue = 7,     // NaN/Inf or otherwise unusable numbers in the data
+    kTrailingBytes = 8,    // data after the declared end
+    kIoError = 16,         // file missing, unreadable, not writable
+    kInternal = 17,        // a bug in zhc
 };
 
 struct Error {

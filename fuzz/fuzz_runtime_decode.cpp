@@ -2,7 +2,8 @@
 // bytes 1-3 the storage parameters (bits, sqrt, bound, DC format, zonal mapping, axis mode, kind,
 // luminance weights), the rest (zero-padded) is the stored probe; the runtime's decode and
 // irradiance must give the codec's bits (any NaN equals any NaN). The whole input is also parsed as
-// a .zhp file by the runtime and by formats/probe_file: same accept/reject and error class.
+// a .zhp file by the runtime and by formats/probe_file: same accept/reject and error class, and as a
+// probe volume (zhc_volume_from_zhp, sampled when accepted).
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -55,6 +56,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             std::abort();
         }
         if (rt == ZHC_OK && info.payload_offset + ref->payload.size() != size) std::abort();
+        // Probe volumes: zhc_zhp_open's code, then NOT_GRID for a valid non-grid file; an accepted
+        // grid samples anywhere (inside, outside, infinite and NaN positions) without crashing.
+        zhc_volume v;
+        const int vr = zhc_volume_from_zhp(&v, data, size);
+        if (rt != ZHC_OK ? vr != rt : (ref->layout.kind != ProbeLayoutKind::kGrid) != (vr == ZHC_ERR_NOT_GRID)) std::abort();
+        if (vr == ZHC_OK) {
+            const double points[4][3] = {{0, 0, 0}, {1e30, -1e30, 3}, {INFINITY, -INFINITY, 0}, {NAN, 1, NAN}};
+            const double n[3] = {0.6, -0.48, 0.64};
+            double e[3];
+            for (const auto& pt : points) zhc_volume_irradiance_d(&v, pt, n, e);
+        }
     }
     const auto table = codecs();
     if (size < 4 || table.empty()) return 0;

@@ -611,3 +611,80 @@ vec3 zhcIrradZIrradiance(vec3 iz, float wa, vec2 dUv, vec3 n, uint model) {
 vec3 zhcHlshIrradiance(vec3 iz, vec3 ca, vec3 cx, vec3 cy, vec3 m) {
     return iz * m.z + ca * (1.0 - m.z) + cx * m.x + cy * m.y;
 }
+
+// ---- probe volumes (docs/runtime.md "Probe volumes"; zhc_volume_* of runtime/zhc_runtime.h) --------
+//
+// A grid of probes: probe (x, y, z) is number x + nx (y + ny z) at origin + (x, y, z) * spacing,
+// its stored words at (number * words per probe) in the application's buffer. The irradiance at a
+// point blends the DECODED SH3 of the 8 probes of the cell containing it (the point clamped to the
+// grid's box) with trilinear weights, then evaluates once: the trilinear blend of the 8 probes'
+// irradiance (linearity). The stored words themselves must not be blended (ZH3's axis is per
+// probe, the packed coefficients are ratios times the DC); hardware filtering of stored bytes is
+// therefore wrong, and this does 8 fetches + decodes instead (probes of weight 0 are skipped).
+//
+// Binding: define ZHC_VOLUME_WORD(index) before including this file, as an expression giving the
+// uint at word `index` of the probe words (the .zhp payload / glTF accessor bytes as-is), e.g.
+//
+//   layout(std430, binding = 0) readonly buffer ZhcProbes { uint zhcProbeWords[]; };
+//   #define ZHC_VOLUME_WORD(i) zhcProbeWords[i]
+//   #include "zhc.glsl"                  // (or pasted: GLSL has no #include)
+//   uniform ZhcVolume uVolume;           // grid of the .zhp header / glTF "grid"
+//   uniform ZhcFormat uFormat;
+//   ...
+//   vec3 e = zhcVolumeIrradiance(uVolume, uFormat, worldPosition, worldNormal);
+//
+// Without ZHC_VOLUME_WORD the volume functions are not compiled (ZhcVolume and zhcFamilyWords are).
+
+struct ZhcVolume {
+    vec3 origin;   // position of probe (0, 0, 0)
+    vec3 spacing;  // > 0 (the application checks, as zhc_volume_init)
+    uvec3 counts;  // >= 1 each
+};
+
+// Words per probe of a layout family (27, 12, 15, 4, 7, 4).
+uint zhcFamilyWords(uint family) {
+    if (family == ZHC_LAYOUT_SH3_F32) return 27u;
+    if (family == ZHC_LAYOUT_SH2_F32) return 12u;
+    if (family == ZHC_LAYOUT_ZH3_F32) return 15u;
+    if (family == ZHC_LAYOUT_SH3_Q28) return 7u;
+    return 4u;
+}
+
+#ifdef ZHC_VOLUME_WORD
+// SH3 radiance of probe `probe` of the volume's buffer.
+ZhcSh3 zhcVolumeProbe(uint probe, ZhcFormat f) {
+    uint stride = zhcFamilyWords(f.family);
+    uint w[27];
+    for (uint k = 0u; k < 27u; ++k) w[k] = k < stride ? ZHC_VOLUME_WORD(probe * stride + k) : 0u;
+    return zhcDecode(w, f);
+}
+
+// Blended SH3 radiance at p: t = clamp((p - origin) / spacing, 0, counts - 1) (NaN: 0), cell
+// i0 = min(floor(t), counts - 2), weights prod (f or 1 - f), f = t - i0. ~8 x (fetch + decode +
+// 27 fma) + 20 flops.
+ZhcSh3 zhcVolumeSh3(ZhcVolume v, ZhcFormat f, vec3 p) {
+    uvec3 n = max(v.counts, uvec3(1u));
+    vec3 t = (p - v.origin) / v.spacing;
+    t = mix(vec3(0.0), t, greaterThanEqual(t, vec3(0.0)));  // below the box, or NaN: 0 (a select)
+    t = min(t, vec3(n - 1u));
+    uvec3 i0 = min(uvec3(t), max(n, uvec3(2u)) - 2u);
+    vec3 fr = t - vec3(i0);
+    ZhcSh3 acc = zhcZeroSh3();
+    for (uint c = 0u; c < 8u; ++c) {
+        uvec3 b = uvec3(c & 1u, (c >> 1) & 1u, c >> 2);
+        vec3 wv = mix(1.0 - fr, fr, notEqual(b, uvec3(0u)));
+        float w = wv.x * wv.y * wv.z;
+        if (w == 0.0) continue;
+        uvec3 q = i0 + b;
+        ZhcSh3 s = zhcVolumeProbe(q.x + n.x * (q.y + n.y * q.z), f);
+        for (int i = 0; i < 9; ++i) acc.c[i] += w * s.c[i];
+    }
+    return acc;
+}
+
+// Irradiance (zhc's normalised kernel) at position p for the surface normal `normal` (normalised
+// here; zero or not finite: +Z), both in the probe set's frame (zhc axes for a .zhp).
+vec3 zhcVolumeIrradiance(ZhcVolume v, ZhcFormat f, vec3 p, vec3 normal) {
+    return zhcIrradianceSh3(zhcVolumeSh3(v, f, p), zhcNormalizeOrZ(normal));
+}
+#endif

@@ -743,4 +743,75 @@ float3 zhc_irradz_irradiance(float3 iz, float wa, float2 dHemiOct, uint model, f
     return zhc_irradz_evaluate(zhc_irradz_lighting(iz, wa, zhc_decode_hemioct(dHemiOct)), model, n);
 }
 
+// ---- probe volumes (docs/runtime.md "Probe volumes"; zhc_volume_* of runtime/zhc_runtime.h) ------
+//
+// A grid of probes: probe (x, y, z) is number x + nx (y + ny z) at origin + (x, y, z) * spacing, its
+// stored words at (number * words per probe) in the application's buffer. The irradiance at a point
+// blends the DECODED SH3 of the 8 probes of the cell containing it (the point clamped to the grid's
+// box) with trilinear weights and evaluates once: by linearity, the trilinear blend of the 8 probes'
+// irradiance. Stored words must not be blended (ZH3's axis is per probe; packed coefficients are
+// ratios times the DC), so this fetches and decodes up to 8 probes (weight-0 probes are skipped).
+//
+// Binding: define ZHC_VOLUME_WORD(index) before including this file, as an expression giving the
+// uint at word `index` of the probe words (the .zhp payload / glTF accessor bytes as-is), e.g.
+//
+//   ByteAddressBuffer probeWords;
+//   #define ZHC_VOLUME_WORD(i) probeWords.Load(4u * (i))
+//   #include "zhc.hlsl"
+//   cbuffer Volume { ZhcVolume gVolume; ZhcFormat gFormat; };   // grid + format from the header
+//   float3 e = zhc_volume_irradiance(gVolume, gFormat, worldPosition, worldNormal);
+//
+// Without ZHC_VOLUME_WORD only the ZhcVolume struct is declared.
+struct ZhcVolume
+{
+    float3 origin;   // position of probe (0, 0, 0)
+    float3 spacing;  // > 0 (the application checks, as zhc_volume_init)
+    uint3 counts;    // >= 1 each
+};
+
+#ifdef ZHC_VOLUME_WORD
+// SH3 radiance of probe `probe` of the volume's buffer.
+ZhcSH3 zhc_volume_probe(uint probe, ZhcFormat f)
+{
+    uint stride = zhc_encoding_bytes(f.encoding) / 4u;
+    uint w[27];
+    [unroll] for (uint k = 0u; k < 27u; ++k) w[k] = k < stride ? ZHC_VOLUME_WORD(probe * stride + k) : 0u;
+    return zhc_decode_sh3(w, f);
+}
+
+// Blended SH3 radiance at p: t = clamp((p - origin) / spacing, 0, counts - 1) (NaN: 0), cell
+// i0 = min(floor(t), counts - 2), weights prod (f or 1 - f), f = t - i0.
+ZhcSH3 zhc_volume_sh3(ZhcVolume v, ZhcFormat f, float3 p)
+{
+    uint3 n = max(v.counts, uint3(1u, 1u, 1u));
+    float3 t = (p - v.origin) / v.spacing;
+    t = float3(t.x >= 0.0f ? t.x : 0.0f, t.y >= 0.0f ? t.y : 0.0f, t.z >= 0.0f ? t.z : 0.0f);  // below, or NaN: 0
+    t = min(t, float3(n - 1u));
+    uint3 i0 = min(uint3(t), max(n, uint3(2u, 2u, 2u)) - 2u);
+    float3 fr = t - float3(i0);
+    ZhcSH3 acc;
+    [unroll] for (int i = 0; i < 9; ++i) acc.c[i] = float3(0.0f, 0.0f, 0.0f);
+    [loop] for (uint c = 0u; c < 8u; ++c)
+    {
+        uint3 b = uint3(c & 1u, (c >> 1) & 1u, c >> 2);
+        float wx = b.x != 0u ? fr.x : 1.0f - fr.x;
+        float wy = b.y != 0u ? fr.y : 1.0f - fr.y;
+        float wz = b.z != 0u ? fr.z : 1.0f - fr.z;
+        float w = wx * wy * wz;
+        if (w == 0.0f) continue;
+        uint3 q = i0 + b;
+        ZhcSH3 s = zhc_volume_probe(q.x + n.x * (q.y + n.y * q.z), f);
+        [unroll] for (int j = 0; j < 9; ++j) acc.c[j] += w * s.c[j];
+    }
+    return acc;
+}
+
+// Irradiance (zhc's normalised kernel) at position p for the surface normal `normal` (normalised
+// here; zero or not finite: +Z), both in the probe set's frame (zhc axes for a .zhp).
+float3 zhc_volume_irradiance(ZhcVolume v, ZhcFormat f, float3 p, float3 normal)
+{
+    return zhc_sh3_irradiance(zhc_volume_sh3(v, f, p), zhc_normalize_or_z(normal));
+}
+#endif
+
 #endif  // ZHC_HLSL_INCLUDED

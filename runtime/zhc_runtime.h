@@ -19,6 +19,8 @@
  *   - IrradZ lightmaps (docs/irradz.md): HHD / AHD evaluation from (I_z, w_a, d), the BC5
  *     hemi-octahedral direction decode, HLSH evaluation and the HLSH hemisphere / cone multiply of a
  *     probe (probe occlusion).
+ *   - Probe volumes (zhc_volume): the irradiance at any point of a probe grid, trilinear blend of
+ *     the 8 surrounding probes' decoded SH3 (docs/runtime.md, "Probe volumes").
  *
  * Safety: every function here is total and safe for untrusted input unless its comment says
  * otherwise: any bytes decode to finite-or-NaN numbers, never undefined behaviour, never a read
@@ -97,7 +99,8 @@ enum zhc_zonal_mapping { ZHC_ZONAL_AFFINE = 0, ZHC_ZONAL_ZERO_PRESERVING = 1, ZH
 enum zhc_axis_mode { ZHC_AXIS_LUMINANCE = 0, ZHC_AXIS_PER_CHANNEL = 1 };
 enum zhc_irradz_model { ZHC_IRRADZ_HHD = 0, ZHC_IRRADZ_AHD = 1 };
 
-/* Error codes; the .zhp ones mirror zhc's reader (formats/probes/probe_file.h). */
+/* Error codes: one numbering with zhc's library (codec/status.h ErrorCode has the same value for
+ * every class both report; table in docs/inputs.md "Error classes"). */
 enum zhc_error {
     ZHC_OK = 0,
     ZHC_ERR_ARGUMENT = 1,       /* unknown encoding name, invalid zhc_probe_format, null pointer */
@@ -108,7 +111,8 @@ enum zhc_error {
     ZHC_ERR_TOO_LARGE = 6,      /* probe count > 2^26 or body > 2 GiB (zhc's default limits) */
     ZHC_ERR_INVALID_VALUE = 7,  /* non-finite luminance weights, grid values or positions */
     ZHC_ERR_TRAILING_BYTES = 8, /* bytes after the declared body */
-    ZHC_ERR_COMPRESSED = 9      /* valid .zhp whose body is zstd-compressed: out of this header's scope */
+    ZHC_ERR_COMPRESSED = 9,     /* valid .zhp whose body is zstd-compressed: out of this header's scope */
+    ZHC_ERR_NOT_GRID = 10       /* zhc_volume_from_zhp: a valid .zhp whose layout is not a grid (none, points) */
 };
 
 /* ---- the probe format ---------------------------------------------------------------------- */
@@ -856,6 +860,148 @@ static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const vo
  * info. Non-zero (a zhc_error) for a bad header. Safe for untrusted input. */
 static inline int zhc_probe_format_from_zhp(zhc_probe_format* f, const void* header, size_t size) {
     return zhc_zhp_parse_header(f, NULL, header, size);
+}
+
+/* ---- probe volumes (docs/runtime.md, "Probe volumes") --------------------------------------- */
+
+/* A grid of probes: probe (x, y, z) (x < counts[0], ...) is number x + counts[0] (y + counts[1] z),
+ * at origin + (x spacing[0], y spacing[1], z spacing[2]), its stored bytes at
+ * probes + number * probe_size. The volume REFERS to the caller's bytes (nothing is copied): they
+ * must outlive it. Fill it with zhc_volume_from_zhp or zhc_volume_init (which validate), not by hand. */
+typedef struct zhc_volume {
+    zhc_probe_format format;
+    const uint8_t* probes;  /* counts[0] counts[1] counts[2] probes of probe_size bytes */
+    size_t probe_size;      /* zhc_probe_size(&format) */
+    double origin[3];       /* position of probe (0, 0, 0), the probe set's frame (zhc axes for .zhp) */
+    double spacing[3];      /* > 0, finite */
+    uint32_t counts[3];     /* >= 1 each, product <= 2^26 */
+} zhc_volume;
+
+/* A volume from its parts: format (validated: ZHC_ERR_ARGUMENT), the stored probes (`size` bytes,
+ * at least counts[0] counts[1] counts[2] zhc_probe_size(format): else ZHC_ERR_TRUNCATED; bytes
+ * beyond that are ignored), the grid: every count >= 1 (ZHC_ERR_INVALID_VALUE), their product
+ * <= 2^26 (ZHC_ERR_TOO_LARGE, zhc's limit), origin finite and spacing finite and > 0, and the far
+ * corner origin + (count - 1) spacing finite (ZHC_ERR_INVALID_VALUE). Null pointers:
+ * ZHC_ERR_ARGUMENT. On any error v is zeroed (probes NULL). Safe for untrusted input. */
+static inline int zhc_volume_init(zhc_volume* v, const zhc_probe_format* format, const void* probes, size_t size,
+                                  const double origin[3], const double spacing[3], const uint32_t counts[3]) {
+    uint64_t count = 1;
+    int c;
+    if (!v) return ZHC_ERR_ARGUMENT;
+    memset(v, 0, sizeof *v);
+    if (!format || !probes || !origin || !spacing || !counts) return ZHC_ERR_ARGUMENT;
+    if (zhc_probe_format_validate(format) != ZHC_OK) return ZHC_ERR_ARGUMENT;
+    for (c = 0; c < 3; ++c) {
+        if (counts[c] < 1) return ZHC_ERR_INVALID_VALUE;
+        if (!isfinite(origin[c]) || !isfinite(spacing[c]) || !(spacing[c] > 0.0)) return ZHC_ERR_INVALID_VALUE;
+        if (!isfinite(origin[c] + (double)(counts[c] - 1) * spacing[c])) return ZHC_ERR_INVALID_VALUE;
+    }
+    for (c = 0; c < 3; ++c) {
+        count *= counts[c]; /* each factor <= 2^32 and checked below before the next: no overflow */
+        if (count > ((uint64_t)1 << 26)) return ZHC_ERR_TOO_LARGE;
+    }
+    if ((uint64_t)size / zhc_probe_size(format) < count) return ZHC_ERR_TRUNCATED;
+    v->format = *format;
+    v->probes = (const uint8_t*)probes;
+    v->probe_size = zhc_probe_size(format);
+    for (c = 0; c < 3; ++c) {
+        v->origin[c] = origin[c];
+        v->spacing[c] = spacing[c];
+        v->counts[c] = counts[c];
+    }
+    return ZHC_OK;
+}
+
+/* A volume from a whole .zhp file in memory (`file`, `size` bytes; the volume points into them):
+ * zhc_zhp_open's checks and error codes (ZHC_ERR_COMPRESSED for a zstd body), then
+ * ZHC_ERR_NOT_GRID for a valid file without a grid layout (none, or scattered `points`: see
+ * docs/runtime.md for what to do with those), then the grid checks of zhc_volume_init (an empty
+ * grid, spacing <= 0 or a far corner that overflows: ZHC_ERR_INVALID_VALUE). On error v is zeroed.
+ * Safe for untrusted input (any bytes, any size). */
+static inline int zhc_volume_from_zhp(zhc_volume* v, const void* file, size_t size) {
+    zhc_probe_format f;
+    zhc_zhp_info info;
+    int r;
+    if (!v) return ZHC_ERR_ARGUMENT;
+    memset(v, 0, sizeof *v);
+    r = zhc_zhp_open(&f, &info, file, size);
+    if (r != ZHC_OK) return r;
+    if (info.layout != 1) return ZHC_ERR_NOT_GRID;
+    return zhc_volume_init(v, &f, (const uint8_t*)file + info.payload_offset, (size_t)(size - info.payload_offset),
+                           info.grid_origin, info.grid_spacing, info.grid_counts);
+}
+
+/* The grid coordinate along one axis: t = (p - origin) / spacing clamped to [0, n - 1] (NaN: 0),
+ * the cell's first probe i0 (<= n - 2 when n >= 2, so that the cell [i0, i0 + 1] exists) and the
+ * weight f = t - i0 in [0, 1] of probe i0 + 1. For n = 1: i0 = 0, f = 0 (the one probe). */
+static inline void zhc__volume_axis(double p, double origin, double spacing, uint32_t n, uint32_t* i0, double* f) {
+    double t = (p - origin) / spacing;
+    const double hi = (double)(n - 1);
+    uint32_t i;
+    if (!(t >= 0.0)) t = 0.0; /* below the box, or NaN */
+    if (t > hi) t = hi;
+    i = (uint32_t)floor(t);
+    if (n >= 2 && i > n - 2) i = n - 2;
+    *i0 = i;
+    *f = n >= 2 ? t - (double)i : 0.0;
+}
+
+/* SH3 radiance at `position` (the probe set's frame): the trilinear blend of the decoded SH3 of the
+ * 8 probes of the grid cell containing the position (clamped to the grid's box first, so outside
+ * the box the value is that of the nearest point of the box), weights
+ * w = prod_axes (f or 1 - f), accumulated in double in a fixed order. Probes of weight 0 are not
+ * read (a probe that decodes to NaN affects only the cells around it). sh3[i*3+k] as
+ * zhc_decode_probe. An invalid volume (zeroed, or not from zhc_volume_init/from_zhp) gives zeros. */
+static inline void zhc_volume_sh3(const zhc_volume* v, const double position[3], double sh3[27]) {
+    uint32_t i0[3];
+    double f[3];
+    int c, corner, j;
+    memset(sh3, 0, 27 * sizeof(double));
+    if (!v || !v->probes || v->probe_size == 0) return;
+    for (c = 0; c < 3; ++c) zhc__volume_axis(position[c], v->origin[c], v->spacing[c], v->counts[c], &i0[c], &f[c]);
+    for (corner = 0; corner < 8; ++corner) {
+        const int bx = corner & 1, by = (corner >> 1) & 1, bz = (corner >> 2) & 1;
+        const double w = (bx ? f[0] : 1.0 - f[0]) * (by ? f[1] : 1.0 - f[1]) * (bz ? f[2] : 1.0 - f[2]);
+        size_t index;
+        float probe[27];
+        if (w == 0.0) continue; /* also every corner beyond a count-1 axis (its f is 0) */
+        index = (size_t)(i0[0] + (uint32_t)bx) +
+                (size_t)v->counts[0] * ((size_t)(i0[1] + (uint32_t)by) + (size_t)v->counts[1] * (size_t)(i0[2] + (uint32_t)bz));
+        zhc_decode_probe(&v->format, v->probes + index * v->probe_size, probe);
+        for (j = 0; j < 27; ++j) sh3[j] += w * (double)probe[j];
+    }
+}
+
+/* Irradiance (zhc's normalised kernel: constant radiance 1 gives 1) at `position` for a surface of
+ * normal `normal` (both in the probe set's frame; the normal is normalised here, zero or not
+ * finite: +Z): E(n) = sum_i s_l c_i Y_i(n), s_l = 1, 2/3, 1/4, of the blended SH3 c of
+ * zhc_volume_sh3. By linearity this equals the trilinear blend of the 8 probes' own irradiance at
+ * n. Decodes at most 8 probes, evaluates once. Double precision throughout. */
+static inline void zhc_volume_irradiance_d(const zhc_volume* v, const double position[3], const double normal[3],
+                                           double rgb[3]) {
+    double sh[27], n[3], y[9];
+    int i, k;
+    zhc_volume_sh3(v, position, sh);
+    zhc__normalize_or_z(normal, n);
+    zhc__sh3_basis(n, y);
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    for (i = 0; i < 9; ++i) {
+        const double s = i == 0 ? 1.0 : (i < 4 ? ZHC__BAND1 : ZHC__BAND2);
+        for (k = 0; k < 3; ++k) rgb[k] += s * sh[i * 3 + k] * y[i];
+    }
+}
+
+/* zhc_volume_irradiance_d with float arguments and result (the double result rounded once). */
+static inline void zhc_volume_irradiance(const zhc_volume* v, const float position[3], const float normal[3],
+                                         float rgb[3]) {
+    double p[3], n[3], e[3];
+    int c;
+    for (c = 0; c < 3; ++c) {
+        p[c] = position[c];
+        n[c] = normal[c];
+    }
+    zhc_volume_irradiance_d(v, p, n, e);
+    for (c = 0; c < 3; ++c) rgb[c] = (float)e[c];
 }
 
 /* ---- IrradZ lightmaps (codec/lightmap/irradz.h, codec/lightmap/lightmap.h, docs/irradz.md) ------------------- */

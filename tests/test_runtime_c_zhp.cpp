@@ -31,15 +31,25 @@ using namespace runtime_c_test;
 
 // ---- .zhp headers --------------------------------------------------------------------------
 
+// One numbering (codec/status.h): every class the runtime reports has ErrorCode's value.
+static_assert(int(ErrorCode::kInvalidArgument) == ZHC_ERR_ARGUMENT && int(ErrorCode::kTruncated) == ZHC_ERR_TRUNCATED &&
+              int(ErrorCode::kBadFormat) == ZHC_ERR_BAD_FORMAT && int(ErrorCode::kUnsupported) == ZHC_ERR_UNSUPPORTED &&
+              int(ErrorCode::kChecksum) == ZHC_ERR_CHECKSUM && int(ErrorCode::kTooLarge) == ZHC_ERR_TOO_LARGE &&
+              int(ErrorCode::kInvalidValue) == ZHC_ERR_INVALID_VALUE && int(ErrorCode::kTrailingBytes) == ZHC_ERR_TRAILING_BYTES,
+              "ErrorCode and zhc_error number the same classes alike");
+static_assert(int(ErrorCode::kIoError) > ZHC_ERR_NOT_GRID && int(ErrorCode::kInternal) > ZHC_ERR_NOT_GRID,
+              "the library-only classes do not reuse a runtime number");
+
+// The classes a .zhp reader can report: the same number in both.
 int expected_code(ErrorCode c) {
     switch (c) {
-        case ErrorCode::kTruncated: return ZHC_ERR_TRUNCATED;
-        case ErrorCode::kBadFormat: return ZHC_ERR_BAD_FORMAT;
-        case ErrorCode::kUnsupported: return ZHC_ERR_UNSUPPORTED;
-        case ErrorCode::kChecksum: return ZHC_ERR_CHECKSUM;
-        case ErrorCode::kTooLarge: return ZHC_ERR_TOO_LARGE;
-        case ErrorCode::kInvalidValue: return ZHC_ERR_INVALID_VALUE;
-        case ErrorCode::kTrailingBytes: return ZHC_ERR_TRAILING_BYTES;
+        case ErrorCode::kTruncated:
+        case ErrorCode::kBadFormat:
+        case ErrorCode::kUnsupported:
+        case ErrorCode::kChecksum:
+        case ErrorCode::kTooLarge:
+        case ErrorCode::kInvalidValue:
+        case ErrorCode::kTrailingBytes: return static_cast<int>(c);
         default: return -1;
     }
 }

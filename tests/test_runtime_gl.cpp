@@ -35,6 +35,8 @@
 #include "codec/probe/quantize.h"
 #include "codec/probe/zh3.h"
 #include "support.h"
+#include "zhc_runtime.h"
+#include "zhc_runtime_params.hpp"
 
 #ifndef ZHC_RUNTIME_GLSL_PATH
 #error "ZHC_RUNTIME_GLSL_PATH (path of runtime/zhc.glsl) must be defined by the build"
@@ -50,9 +52,13 @@ constexpr int kOutFloats = 30;  // per item: 27 SH3 radiance + 3 irradiance
 
 // The test main appended after zhc.glsl. Modes: 0 probe decode + irradiance, 1 IrradZ texel,
 // 2 DC unpacking, 3 HLSH.
+// Before zhc.glsl: the probe words, bound for the volume functions (ZHC_VOLUME_WORD).
+const char* kTestPrelude = R"(
+layout(std430, binding = 0) readonly buffer Words { uint words[]; };
+#define ZHC_VOLUME_WORD(i) words[i]
+)";
 const char* kTestMain = R"(
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Words { uint words[]; };
 layout(std430, binding = 1) readonly buffer Normals { float normals[]; };
 layout(std430, binding = 2) writeonly buffer Out { float outv[]; };
 uniform uint uCount;
@@ -63,6 +69,9 @@ uniform uvec4 uB;  // l2Bound, dcFormat, zonalMapping, axisMode
 uniform uint uKind;
 uniform vec3 uLum;
 uniform vec2 uCurve;
+uniform vec3 uVolOrigin;
+uniform vec3 uVolSpacing;
+uniform uvec3 uVolCounts;
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= uCount) return;
@@ -92,6 +101,12 @@ void main() {
         for (uint k = 0u; k < 4u; ++k)
             v[k] = uintBitsToFloat(uvec3(words[b + 3u * k], words[b + 3u * k + 1u], words[b + 3u * k + 2u]));
         vec3 e = zhcHlshIrradiance(v[0], v[1], v[2], v[3], n);
+        outv[o] = e.x; outv[o + 1u] = e.y; outv[o + 2u] = e.z;
+    } else if (uMode == 4u) {  // probe volume: normals[] holds position, normal per item
+        ZhcFormat f = ZhcFormat(uA.x, uA.y, uA.z, uA.w, uB.x, uB.y, uB.z, uB.w, uKind, uLum, uCurve);
+        vec3 p = vec3(normals[6u * i], normals[6u * i + 1u], normals[6u * i + 2u]);
+        vec3 nn = vec3(normals[6u * i + 3u], normals[6u * i + 4u], normals[6u * i + 5u]);
+        vec3 e = zhcVolumeIrradiance(ZhcVolume(uVolOrigin, uVolSpacing, uVolCounts), f, p, nn);
         outv[o] = e.x; outv[o + 1u] = e.y; outv[o + 2u] = e.z;
     } else {
         uint w = words[i];
@@ -137,7 +152,8 @@ protected:
             why_ = std::string("cannot read ") + ZHC_RUNTIME_GLSL_PATH;
             return;
         }
-        const std::string source = std::string(kEs ? "#version 310 es\n" : "#version 450\n") + library + kTestMain;
+        const std::string source =
+            std::string(kEs ? "#version 310 es\n" : "#version 450\n") + kTestPrelude + library + kTestMain;
         const char* src = source.c_str();
         GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
         glShaderSource(sh, 1, &src, nullptr);
@@ -181,6 +197,13 @@ public:
         std::uint32_t kind = 0;
         float lum[3] = {0, 0, 0}, curve[2] = {0, 0};
     };
+
+    // The grid of mode 4 (probe volume).
+    static void set_volume(const float origin[3], const float spacing[3], const std::uint32_t counts[3]) {
+        glProgramUniform3f(program_, glGetUniformLocation(program_, "uVolOrigin"), origin[0], origin[1], origin[2]);
+        glProgramUniform3f(program_, glGetUniformLocation(program_, "uVolSpacing"), spacing[0], spacing[1], spacing[2]);
+        glProgramUniform3ui(program_, glGetUniformLocation(program_, "uVolCounts"), counts[0], counts[1], counts[2]);
+    }
 
     // Runs the shader on `count` items; returns count * kOutFloats floats.
     static std::vector<float> run(const Uniforms& un, const std::vector<std::uint32_t>& words,
@@ -490,6 +513,123 @@ TEST_F(RuntimeGl, HlshMatchesTheCodec) {
     EXPECT_EQ(t.failures, 0) << t.first_failure;
     EXPECT_EQ(t.compared, 3L * kCount);
 }
+
+
+// Probe volumes (zhcVolumeIrradiance, mode 4) against the C header's zhc_volume_irradiance_d:
+// every codec table entry, a 6x5x4 grid (default parameters) and a 5x1x3 grid (batch parameters)
+// of random probes, points in and around the grid's box and at every probe, random normals.
+// Bound (in u, of the summed probe scales S of the cell's 8 corners, see runtime_gl_entries.inl):
+// each corner's decode and the evaluation 32 (kCQuant), blending 8 terms 16, and the trilinear
+// weights: t = (p - o) / s in float is off by ~ (|p| + |o|) / s + |t| units u per axis, which moves
+// each weight by at most 3 times that: 48 + 3 sum_axes ((|p| + |o|) / s + t + 2).
+template <class Fixture>
+void compare_volumes(int samples_per_grid) {
+    const std::vector<Sh3Radiance> maps = envmap_probes();
+    ASSERT_EQ(maps.size(), 8u);
+    std::printf("%-22s %8s %10s %8s\n", "volume", "samples", "max u S", "skipped");
+    for (const Codec& codec : codecs()) {
+        const auto it = glsl_entries().find(codec.name);
+        ASSERT_NE(it, glsl_entries().end()) << codec.name;
+        const GlslEntry& e = it->second;
+        std::mt19937_64 rng(0x701u + codec.size_bytes * 7 + codec.name.size());
+        std::uniform_real_distribution<double> u(0, 1);
+        Tally t;
+        long compared_samples = 0, skipped = 0;
+        for (int grid = 0; grid < 2; ++grid) {
+            const std::uint32_t counts[3] = {grid == 0 ? 6u : 5u, grid == 0 ? 5u : 1u, grid == 0 ? 4u : 3u};
+            const float origin_f[3] = {-1.5f, 2.0f, 0.25f}, spacing_f[3] = {0.75f, 0.5f, 1.25f};
+            const double origin[3] = {origin_f[0], origin_f[1], origin_f[2]};
+            const double spacing[3] = {spacing_f[0], spacing_f[1], spacing_f[2]};
+            const std::uint32_t count = counts[0] * counts[1] * counts[2];
+            const CodecOptions p = batch_params(e, codec.name, grid == 0 ? 0 : 5, rng);
+            std::vector<std::uint8_t> bytes(count * codec.size_bytes);
+            std::vector<Sh3Radiance> decoded;
+            for (std::uint32_t i = 0; i < count; ++i) {
+                encode_probe(codec, p, random_probe(rng, maps, int(i % 3)), bytes.data() + i * codec.size_bytes, nullptr);
+                decoded.push_back(decode_probe(codec, p, bytes.data() + i * codec.size_bytes));
+            }
+            zhc_probe_format fmt;
+            ASSERT_TRUE(runtime_format(codec.name, p, &fmt));
+            zhc_volume vol;
+            ASSERT_EQ(zhc_volume_init(&vol, &fmt, bytes.data(), bytes.size(), origin, spacing, counts), ZHC_OK);
+            // Items: position, normal (floats).
+            std::vector<float> items;
+            for (int i = 0; i < samples_per_grid + int(count); ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    const double size = counts[c] > 1 ? (counts[c] - 1) * spacing[c] : 2 * spacing[c];
+                    const double lo = counts[c] > 1 ? origin[c] - 0.25 * size : origin[c] - spacing[c];
+                    const std::uint32_t node = std::uint32_t(i - samples_per_grid);
+                    const std::uint32_t at = c == 0 ? node % counts[0] : (c == 1 ? node / counts[0] % counts[1] : node / (counts[0] * counts[1]));
+                    items.push_back(i < samples_per_grid ? float(lo + 1.5 * size * u(rng)) : float(origin[c] + at * spacing[c]));
+                }
+                const Vec3 n = test::uniform_direction(u(rng), u(rng));
+                items.push_back(float(n.x));
+                items.push_back(float(n.y));
+                items.push_back(float(n.z));
+            }
+            const std::size_t n_items = items.size() / 6;
+            std::vector<std::uint32_t> w(bytes.size() / 4);
+            std::memcpy(w.data(), bytes.data(), bytes.size());
+            typename Fixture::Uniforms un;
+            un.mode = 4;
+            un.a[0] = e.family;
+            un.a[1] = e.hallucination;
+            un.a[2] = static_cast<std::uint32_t>(p.bits);
+            un.a[3] = p.sqrt_encoding ? 1u : 0u;
+            un.b[0] = static_cast<std::uint32_t>(p.l2_bound);
+            un.b[1] = static_cast<std::uint32_t>(p.dc_format);
+            un.b[2] = static_cast<std::uint32_t>(p.zonal_mapping);
+            un.b[3] = axis_mode(e, p);
+            un.kind = static_cast<std::uint32_t>(p.kind);
+            un.lum[0] = static_cast<float>(p.luminance.r);
+            un.lum[1] = static_cast<float>(p.luminance.g);
+            un.lum[2] = static_cast<float>(p.luminance.b);
+            un.curve[0] = static_cast<float>(p.hallucinate_a);
+            un.curve[1] = static_cast<float>(p.hallucinate_b);
+            Fixture::set_volume(origin_f, spacing_f, counts);
+            const std::vector<float> gpu = Fixture::run(un, w, items, n_items);
+            for (std::size_t i = 0; i < n_items; ++i) {
+                const double pos[3] = {items[6 * i], items[6 * i + 1], items[6 * i + 2]};
+                const double nrm[3] = {items[6 * i + 3], items[6 * i + 4], items[6 * i + 5]};
+                double ref[3];
+                zhc_volume_irradiance_d(&vol, pos, nrm, ref);
+                // The cell's corners, their scales, the weight-error factor.
+                std::uint32_t i0[3];
+                double extra = 0;
+                for (int c = 0; c < 3; ++c) {
+                    const double tt = std::min(std::max((pos[c] - origin[c]) / spacing[c], 0.0), double(counts[c] - 1));
+                    i0[c] = std::min(std::uint32_t(tt), counts[c] >= 2 ? counts[c] - 2 : 0u);
+                    extra += (std::fabs(pos[c]) + std::fabs(origin[c])) / spacing[c] + tt + 2;
+                }
+                double scale[3] = {0, 0, 0};
+                bool defined = true;
+                for (int b = 0; b < 8; ++b) {
+                    const std::uint32_t q[3] = {i0[0] + (b & 1), i0[1] + ((b >> 1) & 1), i0[2] + (b >> 2)};
+                    if (q[0] >= counts[0] || q[1] >= counts[1] || q[2] >= counts[2]) continue;
+                    const Scale sc = probe_scale(e, p, decoded[q[0] + counts[0] * (q[1] + counts[1] * q[2])]);
+                    defined = defined && sc.defined;
+                    for (int k = 0; k < 3; ++k) scale[k] += sc.irradiance[k];
+                }
+                if (!defined) {
+                    ++skipped;
+                    continue;
+                }
+                ++compared_samples;
+                for (int k = 0; k < 3; ++k)
+                    check_value(t, &t.max_irr, ref[k], gpu[i * kOutFloats + std::size_t(k)], scale[k], 48 + 3 * extra,
+                                std::string(codec.name) + " grid " + std::to_string(grid) + " sample " + std::to_string(i) +
+                                    " channel " + std::to_string(k));
+            }
+        }
+        std::printf("%-22s %8ld %10.3f %8ld\n", std::string(codec.name).c_str(), compared_samples, t.max_irr, skipped);
+        EXPECT_EQ(t.failures, 0) << codec.name << ": " << t.first_failure;
+        EXPECT_EQ(skipped, 0) << codec.name;  // encoded probes: every axis well conditioned
+        EXPECT_EQ(t.compared, 3 * compared_samples) << codec.name;
+    }
+}
+
+TEST_F(RuntimeGl, ProbeVolumesMatchTheCHeader) { compare_volumes<RuntimeGl>(int(test::sample_count(10000))); }
+TEST_F(RuntimeGles, ProbeVolumesMatchTheCHeader) { compare_volumes<RuntimeGles>(int(test::sample_count(2000))); }
 
 }  // namespace
 }  // namespace zhc

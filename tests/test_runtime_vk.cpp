@@ -45,6 +45,8 @@
 #include "codec/probe/zh3.h"
 #include "support.h"
 #include "vk_compute.h"
+#include "zhc_runtime.h"
+#include "zhc_runtime_params.hpp"
 
 namespace zhc {
 namespace {
@@ -80,24 +82,26 @@ public:
     // Runs the kernel over `count` <= kCapacity items; returns kOutFloats floats per item (empty on
     // failure). One pipeline and one set of buffers serve every call (pipeline creation is the slow part).
     static constexpr std::size_t kCapacity = 1u << 17;
-    std::vector<float> run(const std::uint32_t params[16], const std::vector<std::uint32_t>& words,
+    // params: 16 uints, or 32 for the probe-volume mode (grid in params 16..24).
+    std::vector<float> run(const std::uint32_t* params, const std::vector<std::uint32_t>& words,
                            const std::vector<float>& normals4, std::size_t count) {
         std::string err;
         if (!kernel_) {
-            const std::size_t sizes[4] = {16 * 4, kCapacity * 27 * 4, kCapacity * 16, kCapacity * kOutFloats * 4};
+            const std::size_t sizes[4] = {32 * 4, kCapacity * 27 * 4, kCapacity * 16, kCapacity * kOutFloats * 4};
             kernel_ = context_->make_kernel(spirv_, sizes, &err);
             if (!kernel_) {
                 ADD_FAILURE() << err;
                 return {};
             }
         }
-        if (count > kCapacity || words.size() > kCapacity * 27 || normals4.size() < count * 4) {
+        if (count > kCapacity || words.size() > kCapacity * 27 || normals4.size() < count * 4 ||
+            normals4.size() > kCapacity * 4) {
             ADD_FAILURE() << "batch too large: " << count;
             return {};
         }
-        std::memcpy(kernel_->data(0), params, 16 * 4);
+        std::memcpy(kernel_->data(0), params, (params[15] == 3u ? 32 : 16) * 4);
         if (!words.empty()) std::memcpy(kernel_->data(1), words.data(), words.size() * 4);
-        std::memcpy(kernel_->data(2), normals4.data(), count * 16);
+        std::memcpy(kernel_->data(2), normals4.data(), normals4.size() * 4);  // the volume mode: 2 float4 per item
         if (kernel_->dispatch(static_cast<std::uint32_t>((count + 63) / 64), &err) < 0) {
             ADD_FAILURE() << err;
             return {};
@@ -236,14 +240,9 @@ struct Case {
     bool encoded = true;              // false: random bytes
 };
 
-// Compares one item; returns false (with a message) on a bound violation.
-bool compare_item(const Codec& codec, const CodecOptions& p, const std::uint8_t* bytes, Vec3 n, const float* gpu,
-                  bool encoded, Stats* st, std::string* msg) {
-    const Sh3Radiance d = decode_probe(codec, p, bytes);
-    Rgb e;
-    if (is_default(p)) e = codec.irradiance(bytes, p, n);
-    else e = irradiance(d, n);
-    // Per-channel scale T_k.
+// The per-channel scale T_k of a decoded probe d (see the file comment) and the axis condition
+// number kappa (infinite: ill-conditioned, T not finite).
+void probe_scales(const Codec& codec, const CodecOptions& p, const Sh3Radiance& d, double t[3], double* kappa_out) {
     const bool packed = is_packed(codec.name);
     double kappa = 1.0;
     if (lum_axis(codec, p)) {
@@ -259,8 +258,6 @@ bool compare_item(const Codec& codec, const CodecOptions& p, const std::uint8_t*
         if (num > 0) kappa = den > 0 ? num / den : INFINITY;
     }
     // The stored DC (decode_probe returns radiance; DC is band 0, unscaled).
-    double t[3];
-    bool any_nonfinite_ref = false;
     for (int k = 0; k < 3; ++k) {
         double s = 0, z = 0;
         for (int i = 0; i < 9; ++i) {
@@ -269,8 +266,23 @@ bool compare_item(const Codec& codec, const CodecOptions& p, const std::uint8_t*
         }
         const double l2s = p.kind == StoredKind::kIrradiance ? 4.0 : 1.0;
         t[k] = s + (packed ? 8.0 * std::sqrt(5.0) * std::fabs(double(d[0][k])) * l2s : 0.0) + kappa * z;
-        if (!std::isfinite(t[k])) any_nonfinite_ref = true;
     }
+    *kappa_out = kappa;
+}
+
+// Compares one item; returns false (with a message) on a bound violation.
+bool compare_item(const Codec& codec, const CodecOptions& p, const std::uint8_t* bytes, Vec3 n, const float* gpu,
+                  bool encoded, Stats* st, std::string* msg) {
+    const Sh3Radiance d = decode_probe(codec, p, bytes);
+    Rgb e;
+    if (is_default(p)) e = codec.irradiance(bytes, p, n);
+    else e = irradiance(d, n);
+    // Per-channel scale T_k.
+    double t[3], kappa = 1.0;
+    probe_scales(codec, p, d, t, &kappa);
+    bool any_nonfinite_ref = false;
+    for (int k = 0; k < 3; ++k)
+        if (!std::isfinite(t[k])) any_nonfinite_ref = true;
     ++st->items;
     if (any_nonfinite_ref) {
         if (std::isinf(kappa)) ++st->ill_conditioned;
@@ -578,6 +590,131 @@ TEST_F(RuntimeVk, IrradzMatchesTheCodec) {
         }
         std::printf("irradz %s: %zu texels, max error / (eps T) = %.3f\n", model == 0 ? "HHD" : "AHD", count, max_rel);
         EXPECT_EQ(failures, 0u) << first;
+    }
+}
+
+
+// Probe volumes (zhc_volume_irradiance, mode 3) against the C header's zhc_volume_irradiance_d:
+// every codec table entry, a 6x5x4 grid (default parameters) and a 5x1x3 grid (irradiance storage;
+// packed: 5 bits, sqrt, RGB9E5, per-channel axes, zero-preserving) of probes (lights, random SH,
+// sample maps), 10,000 points in and around the grid's box plus every probe position, random
+// normals. Bound: each corner's decode and the evaluation 32 eps T (the bound of the single-probe
+// comparisons, T summed over the cell's 8 corners), the 8-term blend 8 eps T, and the weights:
+// t = (p - o) / s in float is off by ~ ((|p| + |o|) / s + t) u per axis, moving each weight by up
+// to 3 times that: 1.5 eps T per unit of sum_axes ((|p| + |o|) / s + t + 2).
+TEST_F(RuntimeVk, ProbeVolumesMatchTheCHeader) {
+    const int samples = int(test::sample_count(10000));
+    std::printf("%-22s %8s %12s\n", "volume", "samples", "max err/eps T");
+    for (const Codec& codec : codecs()) {
+        const int id = hlsl_encoding(codec.name);
+        ASSERT_GE(id, 0) << codec.name;
+        std::mt19937_64 rng(0x766Fu + codec.size_bytes * 3 + codec.name.size());
+        std::uniform_real_distribution<double> u(0, 1);
+        double max_rel = 0;
+        long compared = 0, failures = 0;
+        std::string first;
+        for (int grid = 0; grid < 2; ++grid) {
+            const std::uint32_t counts[3] = {grid == 0 ? 6u : 5u, grid == 0 ? 5u : 1u, grid == 0 ? 4u : 3u};
+            const float origin_f[3] = {-1.5f, 2.0f, 0.25f}, spacing_f[3] = {0.75f, 0.5f, 1.25f};
+            const double origin[3] = {origin_f[0], origin_f[1], origin_f[2]};
+            const double spacing[3] = {spacing_f[0], spacing_f[1], spacing_f[2]};
+            const std::uint32_t count = counts[0] * counts[1] * counts[2];
+            CodecOptions p;
+            if (grid == 1) {
+                p.kind = StoredKind::kIrradiance;
+                if (is_packed(codec.name)) {
+                    p.bits = 5;
+                    p.sqrt_encoding = true;
+                    p.dc_format = DcFormat::kRGB9E5;
+                    p.axis_mode = ZonalAxisMode::kPerChannel;
+                    p.zonal_mapping = ZonalMapping::kZeroPreserving;
+                }
+            }
+            ASSERT_TRUE(validate_quant_params(p, codec.name).ok()) << codec.name;
+            std::vector<std::uint8_t> bytes(count * codec.size_bytes);
+            std::vector<Sh3Radiance> decoded;
+            for (std::uint32_t i = 0; i < count; ++i) {
+                const Sh3Radiance hub = i % 3 == 0 ? random_lights(rng) : (i % 3 == 1 ? random_sh(rng) : random_envmap(rng));
+                encode_probe(codec, p, hub, bytes.data() + i * codec.size_bytes, nullptr);
+                decoded.push_back(decode_probe(codec, p, bytes.data() + i * codec.size_bytes));
+            }
+            zhc_probe_format fmt;
+            ASSERT_TRUE(runtime_format(codec.name, p, &fmt));
+            zhc_volume vol;
+            ASSERT_EQ(zhc_volume_init(&vol, &fmt, bytes.data(), bytes.size(), origin, spacing, counts), ZHC_OK);
+            std::vector<float> items;  // position, 0, normal, 0
+            for (int i = 0; i < samples + int(count); ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    const double size = counts[c] > 1 ? (counts[c] - 1) * spacing[c] : 2 * spacing[c];
+                    const double lo = counts[c] > 1 ? origin[c] - 0.25 * size : origin[c] - spacing[c];
+                    const std::uint32_t node = std::uint32_t(i - samples);
+                    const std::uint32_t at = c == 0 ? node % counts[0] : (c == 1 ? node / counts[0] % counts[1] : node / (counts[0] * counts[1]));
+                    items.push_back(i < samples ? float(lo + 1.5 * size * u(rng)) : float(origin[c] + at * spacing[c]));
+                }
+                items.push_back(0.0f);
+                add_normal(rng, &items);
+            }
+            const std::size_t n_items = items.size() / 8;
+            std::uint32_t params[32] = {static_cast<std::uint32_t>(id),
+                                        static_cast<std::uint32_t>(p.bits),
+                                        p.sqrt_encoding ? 1u : 0u,
+                                        static_cast<std::uint32_t>(p.l2_bound),
+                                        static_cast<std::uint32_t>(p.dc_format),
+                                        static_cast<std::uint32_t>(p.zonal_mapping),
+                                        static_cast<std::uint32_t>(p.axis_mode),
+                                        static_cast<std::uint32_t>(p.kind),
+                                        float_bits(static_cast<float>(p.luminance.r)),
+                                        float_bits(static_cast<float>(p.luminance.g)),
+                                        float_bits(static_cast<float>(p.luminance.b)),
+                                        float_bits(static_cast<float>(p.hallucinate_a)),
+                                        float_bits(static_cast<float>(p.hallucinate_b)),
+                                        static_cast<std::uint32_t>(n_items),
+                                        static_cast<std::uint32_t>(codec.size_bytes / 4),
+                                        3u};
+            for (int c = 0; c < 3; ++c) {
+                params[16 + c] = float_bits(origin_f[c]);
+                params[19 + c] = float_bits(spacing_f[c]);
+                params[22 + c] = counts[c];
+            }
+            std::vector<std::uint32_t> words(bytes.size() / 4);
+            std::memcpy(words.data(), bytes.data(), bytes.size());
+            const std::vector<float> out = Gpu::get().run(params, words, items, n_items);
+            ASSERT_EQ(out.size(), n_items * kOutFloats);
+            for (std::size_t i = 0; i < n_items; ++i) {
+                const double pos[3] = {items[8 * i], items[8 * i + 1], items[8 * i + 2]};
+                const double nrm[3] = {items[8 * i + 4], items[8 * i + 5], items[8 * i + 6]};
+                double ref[3];
+                zhc_volume_irradiance_d(&vol, pos, nrm, ref);
+                std::uint32_t i0[3];
+                double extra = 0;
+                for (int c = 0; c < 3; ++c) {
+                    const double tt = std::min(std::max((pos[c] - origin[c]) / spacing[c], 0.0), double(counts[c] - 1));
+                    i0[c] = std::min(std::uint32_t(tt), counts[c] >= 2 ? counts[c] - 2 : 0u);
+                    extra += (std::fabs(pos[c]) + std::fabs(origin[c])) / spacing[c] + tt + 2;
+                }
+                double t[3] = {0, 0, 0};
+                for (int b = 0; b < 8; ++b) {
+                    const std::uint32_t q[3] = {i0[0] + (b & 1), i0[1] + ((b >> 1) & 1), i0[2] + (b >> 2)};
+                    if (q[0] >= counts[0] || q[1] >= counts[1] || q[2] >= counts[2]) continue;
+                    double tb[3], kappa;
+                    probe_scales(codec, p, decoded[q[0] + counts[0] * (q[1] + counts[1] * q[2])], tb, &kappa);
+                    for (int k = 0; k < 3; ++k) t[k] += tb[k];
+                }
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_TRUE(std::isfinite(t[k]) && std::isfinite(ref[k])) << codec.name << " item " << i;
+                    const double got = out[i * kOutFloats + 27 + std::size_t(k)];
+                    const double err = std::fabs(got - ref[k]);
+                    const double bound = (40 + 1.5 * extra) * FLT_EPSILON * t[k] + kFlushFloor;
+                    if (!(err <= bound) && failures++ == 0)
+                        first = std::string(codec.name) + " grid " + std::to_string(grid) + " item " + std::to_string(i) +
+                                " channel " + std::to_string(k) + ": shader " + std::to_string(got) + " C " + std::to_string(ref[k]);
+                    max_rel = std::max(max_rel, err / (FLT_EPSILON * t[k] + kFlushFloor));
+                }
+                ++compared;
+            }
+        }
+        std::printf("%-22s %8ld %12.3f\n", std::string(codec.name).c_str(), compared, max_rel);
+        EXPECT_EQ(failures, 0) << first;
     }
 }
 

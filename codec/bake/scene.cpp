@@ -444,8 +444,10 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
         for (int i = 0; i < 9; ++i)
             for (int k = 0; k < 3; ++k) e.sh[i * 3 + k] = double(sh[i][k]) * env.intensity;
         effects.push_back(std::move(e));
-        const std::string orientation = env.latlong_map ? std::string(", ") + latlong_convention_name(env.latlong) + " lat-long" : "";
-        info.push_back({"environment", "projected once" + orientation + std::string(env.rotation_rad != 0 ? ", rotated" : ""), 0, 0});
+        const std::string orientation = env.label.empty() && env.latlong_map ? std::string(", ") + latlong_convention_name(env.latlong) + " lat-long" : "";
+        info.push_back({env.label.empty() ? "environment" : env.label,
+                        (env.label.empty() ? "projected once" + orientation : std::string("SH coefficients")) +
+                            std::string(env.rotation_rad != 0 ? ", rotated" : ""), 0, 0});
     }
     if (scene.sky) {
         const SceneSky& sky = *scene.sky;

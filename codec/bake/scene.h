@@ -55,6 +55,8 @@ struct SceneEnvironment {
     // How a lat-long map's columns turn (codec/sh/sh.h; `projected` is already in zhc's frame).
     LatLongConvention latlong = LatLongConvention::kOpenExr;
     bool latlong_map = true;   // false: a cube map (its orientation is its format's)
+    std::string label;         // the bake report's effect name when not a projected map (a glTF
+                               // image-based light's SH); empty: "environment"
 };
 
 enum class SkyKind : std::uint8_t { kConstant, kGradient };

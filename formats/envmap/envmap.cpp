@@ -3,6 +3,7 @@
 #include "formats/envmap/envmap.h"
 
 #include <ImfChannelList.h>
+#include <ImfChromaticities.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfIO.h>
@@ -19,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -45,7 +47,8 @@ Status check_size(const std::string& name, std::uint64_t w, std::uint64_t h, con
 }
 
 Status check_finite(const std::string& name, Image& img, const EnvmapReadOptions& o, EnvmapInfo* info) {
-    std::uint64_t replaced = 0;
+    std::uint64_t replaced = 0, pixels = 0;
+    size_t last_pixel = SIZE_MAX;
     for (size_t i = 0; i < img.rgb.size(); ++i) {
         if (std::isfinite(img.rgb[i])) continue;
         if (o.non_finite == NonFinitePolicy::kReject) {
@@ -58,8 +61,9 @@ Status check_finite(const std::string& name, Image& img, const EnvmapReadOptions
         }
         img.rgb[i] = 0.0f;
         ++replaced;
+        if (i / 3 != last_pixel) ++pixels, last_pixel = i / 3;
     }
-    if (info) info->replaced_non_finite = replaced;
+    if (info) info->replaced_non_finite = replaced, info->non_finite_pixels = pixels;
     return Ok{};
 }
 
@@ -107,6 +111,22 @@ bool usable_channels(const Imf::ChannelList& channels) {
            channels.findChannel("Y") != nullptr;
 }
 
+// The channel names of a part, for messages: "R, G" (at most 16, each cut to 32 characters).
+std::string channel_names(const Imf::ChannelList& channels) {
+    std::string out;
+    int n = 0;
+    for (auto it = channels.begin(); it != channels.end(); ++it, ++n) {
+        if (n == 16) {
+            out += ", ...";
+            break;
+        }
+        std::string c = one_line(it.name());
+        if (c.size() > 32) c = c.substr(0, 32) + "...";
+        out += (n ? ", " : "") + c;
+    }
+    return n ? out : "none";
+}
+
 bool is_deep(const Imf::Header& h) {
     return h.hasType() && (h.type() == Imf::DEEPSCANLINE || h.type() == Imf::DEEPTILE);
 }
@@ -141,20 +161,29 @@ Result<int> choose_part(const Imf::MultiPartInputFile& file, const std::string& 
             return make_error(ErrorCode::kInvalidArgument,
                               name + ": OpenEXR file has no part named '" + wanted + "' (parts: " + labels + ")");
         const Imf::Header& h = file.header(found);
-        if (is_deep(h) || !usable_channels(h.channels()))
+        if (is_deep(h))
+            return make_error(ErrorCode::kUnsupported, name + ": OpenEXR part " + part_label(h, found) + " is deep");
+        if (!usable_channels(h.channels()))
             return make_error(ErrorCode::kUnsupported, name + ": OpenEXR part " + part_label(h, found) +
-                                                           " has no R, G, B (or Y) channels or is deep");
+                                                           " has no R, G, B (or Y) channels (it has: " +
+                                                           channel_names(h.channels()) + ")");
         return found;
     }
     for (int i = 0; i < parts; ++i)
         if (!is_deep(file.header(i)) && usable_channels(file.header(i).channels())) return i;
-    return make_error(ErrorCode::kUnsupported, name + ": OpenEXR file has no part with R, G, B (or Y) channels (parts: " +
-                                                   labels + ")");
+    // What each part has (at most 8 parts listed), so that an R-only or R, G file says so.
+    std::string have;
+    for (int i = 0; i < parts && i < 8; ++i)
+        have += std::string(i ? "; " : "") + "part " + part_label(file.header(i), i) + ": " +
+                (is_deep(file.header(i)) ? "deep, " : "") + channel_names(file.header(i).channels());
+    if (parts > 8) have += "; ...";
+    return make_error(ErrorCode::kUnsupported, name + ": OpenEXR file has no part with R, G, B (or Y) channels (" + have + ")");
 }
 
 // Luminance/chroma (Y, RY, BY as Imf::RgbaOutputFile writes with WRITE_YC/WRITE_YCA): OpenEXR's
 // RgbaInputFile reconstructs full-resolution chroma and converts to RGB with the file's
-// chromaticities (ImfRgbaYca). It reads the first part only.
+// chromaticities (ImfRgbaYca), in the file's primaries; read_exr then takes them, like every EXR's
+// RGB, to Rec. 709 / D65 (envmap_colour.cpp). It reads the first part only.
 Status read_yc(std::span<const std::uint8_t> bytes, const std::string& name, Image& img, const Imath::Box2i& dw) {
     ExrMemoryStream stream(bytes, name);
     Imf::RgbaInputFile in(stream);
@@ -173,6 +202,31 @@ Status read_yc(std::span<const std::uint8_t> bytes, const std::string& name, Ima
         img.rgb[3 * i + 2] = px[i].b;
     }
     return Ok{};
+}
+
+std::string window_text(const Imath::Box2i& b) {
+    std::ostringstream t;
+    t << "(" << b.min.x << " " << b.min.y << ") - (" << b.max.x << " " << b.max.y << ")";
+    return t.str();
+}
+
+// The data window's pixels placed in an image of the display window's size: where the data window
+// does not cover the display window the pixels are 0, and data outside the display window is
+// dropped. Both sizes were checked against the pixel limit.
+Image to_display_window(const Image& data, const Imath::Box2i& dw, const Imath::Box2i& disp) {
+    Image out;
+    out.width = static_cast<int>(std::int64_t(disp.max.x) - disp.min.x + 1);
+    out.height = static_cast<int>(std::int64_t(disp.max.y) - disp.min.y + 1);
+    out.layout = data.layout;
+    out.rgb.assign(static_cast<size_t>(out.width) * static_cast<size_t>(out.height) * 3, 0.0f);
+    const std::int64_t x0 = std::max(dw.min.x, disp.min.x), x1 = std::min(dw.max.x, disp.max.x);
+    const std::int64_t y0 = std::max(dw.min.y, disp.min.y), y1 = std::min(dw.max.y, disp.max.y);
+    if (x0 > x1 || y0 > y1) return out;
+    for (std::int64_t y = y0; y <= y1; ++y)
+        std::memcpy(out.row(static_cast<int>(y - disp.min.y)) + 3 * (x0 - disp.min.x),
+                    data.row(static_cast<int>(y - dw.min.y)) + 3 * (x0 - dw.min.x),
+                    static_cast<size_t>(x1 - x0 + 1) * 3 * sizeof(float));
+    return out;
 }
 
 Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& name, const EnvmapReadOptions& o,
@@ -206,19 +260,38 @@ Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& n
         if (w <= 0 || h <= 0) return make_error(ErrorCode::kBadFormat, name + ": empty data window");
         if (Status s = check_size(name, static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), o); !s)
             return s.error();
+        // The display window is the image that maps to the sphere (or the cube); see to_display_window.
+        const Imath::Box2i disp = header.displayWindow();
+        const std::int64_t dw_w = std::int64_t(disp.max.x) - disp.min.x + 1, dw_h = std::int64_t(disp.max.y) - disp.min.y + 1;
+        if (dw_w <= 0 || dw_h <= 0) return make_error(ErrorCode::kBadFormat, name + ": empty display window");
+        if (Status s = check_size(name + ": display window", static_cast<std::uint64_t>(dw_w),
+                                  static_cast<std::uint64_t>(dw_h), o);
+            !s)
+            return s.error();
         EnvmapLayout map_layout = EnvmapLayout::kLatLong;
         if (Imf::hasEnvmap(header)) {
             const int e = static_cast<int>(Imf::envmap(header));
             if (e == Imf::ENVMAP_CUBE) {
-                if (h != 6 * w)
-                    return make_error(ErrorCode::kBadFormat, name + ": cube-face environment map of " + std::to_string(w) + "x" +
-                                                                 std::to_string(h) + " pixels (a cube map is N x 6N)");
+                if (dw_h != 6 * dw_w)
+                    return make_error(ErrorCode::kBadFormat, name + ": cube-face environment map of " + std::to_string(dw_w) +
+                                                                 "x" + std::to_string(dw_h) +
+                                                                 " pixels (a cube map is N x 6N)");
                 map_layout = EnvmapLayout::kCubeOpenExr;
             } else if (e != Imf::ENVMAP_LATLONG) {
                 return make_error(ErrorCode::kUnsupported, name + ": unknown envmap attribute value " + std::to_string(e) +
                                                                " (0 lat-long and 1 cube are defined)");
             }
         }
+        // Chromaticities are checked before any pixel is read (the YC path decodes with them).
+        float chroma[8];
+        const bool has_chroma = Imf::hasChromaticities(header);
+        if (has_chroma) {
+            const Imf::Chromaticities& c = Imf::chromaticities(header);
+            const float v[8] = {c.red.x, c.red.y, c.green.x, c.green.y, c.blue.x, c.blue.y, c.white.x, c.white.y};
+            std::copy(v, v + 8, chroma);
+        }
+        auto colour = exr_colour_conversion(name, has_chroma ? chroma : nullptr, info);
+        if (!colour) return colour.error();
         const Imf::ChannelList& channels = header.channels();
         const bool has_rgb = channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
         const bool yc = !has_rgb && channels.findChannel("Y") && channels.findChannel("RY") && channels.findChannel("BY");
@@ -267,8 +340,24 @@ Result<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& n
                              (c->type == Imf::HALF ? " half" : c->type == Imf::FLOAT ? " float" : " uint");
             info->layout = map_layout == EnvmapLayout::kCubeOpenExr ? "cube" : "lat-long";
             info->part = part_label(header, *chosen);
+            info->data_window = window_text(dw);
+            info->display_window = window_text(disp);
+        }
+        if (dw != disp) {
+            const bool outside = dw.min.x < disp.min.x || dw.min.y < disp.min.y || dw.max.x > disp.max.x || dw.max.y > disp.max.y;
+            const bool covers = dw.min.x <= disp.min.x && dw.min.y <= disp.min.y && dw.max.x >= disp.max.x && dw.max.y >= disp.max.y;
+            std::ostringstream msg;
+            msg << name << ": data window " << window_text(dw) << " differs from the display window " << window_text(disp)
+                << ": the display window is the whole map";
+            if (!covers) msg << ", pixels outside the data window are 0";
+            if (outside) msg << ", data outside the display window is dropped";
+            const std::string line = one_line(msg.str());
+            if (o.warn) o.warn(line);
+            else std::fprintf(stderr, "zhc: warning: %s\n", line.c_str());
+            img = to_display_window(img, dw, disp);
         }
         if (Status s = check_finite(name, img, o, info); !s) return s.error();
+        if (Status s = apply_colour_conversion(name, *colour, img); !s) return s.error();
         return img;
     } catch (const std::exception& e) {
         const std::string what = one_line(e.what());

@@ -16,7 +16,9 @@
 // cube layout (kCubeVulkan, codec/sh/cubemap.h; formats/envmap/envmap_cube.h lists the variants).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -57,21 +59,35 @@ struct EnvmapReadOptions {
     std::string part;
     // The orientation of a lat-long map (cube maps have one fixed by their format).
     LatLongConvention latlong = LatLongConvention::kOpenExr;
+    // Non-fatal findings, one line each naming the file (an EXR whose data window differs from its
+    // display window). Empty: printed on stderr as "zhc: warning: <line>".
+    std::function<void(const std::string&)> warn;
 };
 
 struct EnvmapInfo {
     std::string format;       // "openexr", "radiance-hdr", "ktx2" or "dds"
     std::string compression;  // EXR compression name, "rle" or "flat" for .hdr
     std::string channels;     // e.g. "RGBA half"
-    std::uint64_t replaced_non_finite = 0;
+    std::uint64_t replaced_non_finite = 0;  // channel values replaced by 0 (NonFinitePolicy::kReplaceZero)
+    std::uint64_t non_finite_pixels = 0;    // pixels with at least one such value
     std::string layout = "lat-long";  // or "cube" (OpenEXR's or, for KTX2 / DDS, the APIs' layout)
     std::string part;                 // EXR: the part read ("#index" when it has no name)
+    // EXR colour: the chromaticities attribute (red, green, blue, white as x, y pairs) when present,
+    // and what the reader did with it (see docs/inputs.md "Colour spaces").
+    bool has_chromaticities = false;
+    std::array<float, 8> chromaticities{};
+    std::string colour_conversion;
+    // EXR windows, "(xmin ymin) - (xmax ymax)": the display window is what maps to the sphere.
+    std::string data_window, display_window;
 };
 
 // Reads an EXR (RGB or RGBA or Y or luminance/chroma Y RY BY, half/float/uint, any compression
 // OpenEXR supports, scanline or tiled, single- or multi-part, lat-long or cube) or a Radiance .hdr
 // (RGBE or XYZE, any of the eight orientations) or a KTX2 / DDS cube map (formats/envmap/envmap_cube.h),
 // detected by its magic bytes (not by the extension). Bytes after the data are an error (kTrailingBytes). See docs/inputs.md.
+// EXR pixels come out in zhc's working space (linear Rec. 709 primaries, D65 white), converted from
+// the file's chromaticities; the image is the EXR's display window (pixels outside the data window
+// are 0).
 Result<Image> read_envmap(const std::string& path, const EnvmapReadOptions& options = {},
                           EnvmapInfo* info = nullptr);
 // The same from bytes in memory; `name` is used in messages. Safe for untrusted input.

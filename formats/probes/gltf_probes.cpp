@@ -17,7 +17,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <deque>
 #include <filesystem>
+#include <map>
 
 #include "formats/io/file_io.h"
 #include "formats/io/json_depth.h"
@@ -236,6 +238,9 @@ struct FsGuard {
     std::uint64_t max_total = 0;
     std::string error;
     ErrorCode code = ErrorCode::kBadFormat;
+    // External buffer files by canonical path: (buffer index, byteLength) in buffer order, the
+    // order tinygltf reads them in.
+    std::map<std::string, std::deque<std::pair<size_t, std::uint64_t>>> buffers;
 };
 
 }  // namespace
@@ -293,6 +298,36 @@ bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::strin
         g->error = "cannot read external file '" + abs + "'";
         if (err) *err += g->error + "\n";
         return false;
+    }
+    // A buffer's file holds at least its byteLength bytes; the first byteLength are the buffer
+    // (a longer file is valid glTF, as the Khronos validator has it), a shorter one is refused.
+    if (auto it = g->buffers.find(p.string()); it != g->buffers.end() && !it->second.empty()) {
+        const auto [index, length] = it->second.front();
+        it->second.pop_front();
+        if (size < length) {
+            g->code = ErrorCode::kTruncated;
+            g->error = "buffers[" + std::to_string(index) + "]: file '" + p.filename().string() + "' has " + std::to_string(size) +
+                       " bytes, fewer than the buffer's byteLength " + std::to_string(length);
+            if (err) *err += g->error + "\n";
+            return false;
+        }
+        if (g->read_total + length > g->max_total) {
+            g->code = ErrorCode::kTooLarge;
+            g->error = "buffers[" + std::to_string(index) + "]: external files above the size limit";
+            if (err) *err += g->error + "\n";
+            return false;
+        }
+        auto prefix = read_file_prefix(p.string(), static_cast<std::size_t>(length));
+        if (!prefix || prefix->bytes.size() != length) {
+            g->code = prefix ? ErrorCode::kTruncated : prefix.error().code;
+            g->error = prefix ? "buffers[" + std::to_string(index) + "]: file '" + p.filename().string() + "' changed while read"
+                              : prefix.error().message;
+            if (err) *err += g->error + "\n";
+            return false;
+        }
+        g->read_total += length;
+        out->assign(prefix->bytes.begin(), prefix->bytes.end());
+        return true;
     }
     if (size > g->max_bytes || g->read_total + size > g->max_total) {
         g->code = ErrorCode::kTooLarge;
@@ -419,6 +454,8 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
             if (!fs::is_regular_file(guard.base / rel, fe))
                 return fail(ErrorCode::kIoError, path,
                             "referenced file '" + rel + "' not found in " + guard.base.string() + " (buffers[" + std::to_string(i) + "].uri)");
+            const fs::path file = fs::weakly_canonical(guard.base / rel, fe);
+            if (!fe) guard.buffers[file.string()].push_back({i, b["byteLength"].get<std::uint64_t>()});
         }
 
     // tinygltf 2.7 refuses primitives whose index accessor has no bufferView, which is exactly
@@ -436,20 +473,50 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
         for (size_t i = 0; i < out.doc["buffers"].size(); ++i)
             if (!out.doc["buffers"][i].contains("uri") && is_meshopt_fallback(out.doc["buffers"][i]) && !(i == 0 && out.binary && glb.has_bin))
                 fallback_buffers.push_back(i);
+    // A base64 data: URI holding more bytes than its buffer's byteLength is valid glTF (as a
+    // longer .bin file is): tinygltf is shown the decoded length and the buffer is cut back to
+    // byteLength after loading. One holding fewer is refused here, naming the buffer.
+    std::vector<std::pair<size_t, std::uint64_t>> long_data_uris;  // (buffer, declared byteLength)
+    if (out.doc.contains("buffers"))
+        for (size_t i = 0; i < out.doc["buffers"].size(); ++i) {
+            const json& b = out.doc["buffers"][i];
+            if (!b.contains("uri")) continue;
+            const std::string& uri = b["uri"].get_ref<const std::string&>();
+            const size_t comma = uri.find(',');
+            if (uri.rfind("data:", 0) != 0 || comma == std::string::npos || comma < 12 || uri.compare(comma - 7, 7, ";base64") != 0) continue;
+            const std::uint64_t chars = uri.size() - comma - 1;
+            if (chars % 4 != 0) continue;  // not base64: tinygltf refuses it
+            const std::uint64_t pad = chars == 0 ? 0 : (uri.back() == '=') + (chars >= 2 && uri[uri.size() - 2] == '=');
+            const std::uint64_t decoded = chars / 4 * 3 - pad, declared = b["byteLength"].get<std::uint64_t>();
+            if (decoded < declared)
+                return fail(ErrorCode::kTruncated, path, "buffers[" + std::to_string(i) + "]: the data: URI holds " + std::to_string(decoded) +
+                                                             " bytes, fewer than the buffer's byteLength " + std::to_string(declared));
+            if (decoded > declared) long_data_uris.push_back({i, declared});
+        }
     const bool draco_patch = needs_draco_index_patch(out.doc);
-    if (draco_patch || out.doc.contains("images") || !fallback_buffers.empty()) {
+    if (draco_patch || out.doc.contains("images") || !fallback_buffers.empty() || !long_data_uris.empty()) {
         json patched = out.doc;
         patched.erase("images");
         for (size_t i : fallback_buffers) patched["buffers"][i] = json{{"byteLength", 4}, {"uri", "data:application/octet-stream;base64,AAAAAA=="}};
+        for (const auto& [i, declared] : long_data_uris) {
+            const std::string& uri = patched["buffers"][i]["uri"].get_ref<const std::string&>();
+            const std::uint64_t chars = uri.size() - uri.find(',') - 1;
+            patched["buffers"][i]["byteLength"] = chars / 4 * 3 - (uri.back() == '=') - (uri[uri.size() - 2] == '=');
+        }
         if (draco_patch) {
             const std::size_t fake = patched["bufferViews"].size();
             patched["bufferViews"].push_back(json{{"buffer", 0}, {"byteLength", 1}});
-            for (const json& mesh : patched["meshes"])
-                for (const json& prim : mesh.value("primitives", json::array()))
-                    if (prim.is_object() && prim.contains("indices") && prim["indices"].is_number_unsigned()) {
+            // Only well-formed entries are touched (type-checked like needs_draco_index_patch);
+            // tinygltf then reports whatever else is malformed.
+            for (const json& mesh : patched["meshes"]) {
+                if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+                for (const json& prim : mesh["primitives"])
+                    if (prim.is_object() && prim.contains("indices") && prim["indices"].is_number_unsigned() &&
+                        prim["indices"].get<std::uint64_t>() < patched["accessors"].size()) {
                         json& acc = patched["accessors"][prim["indices"].get<size_t>()];
                         if (acc.is_object() && !acc.contains("bufferView")) acc["bufferView"] = fake;
                     }
+            }
         }
         patched_text = patched.dump();
         if (out.binary) {
@@ -482,6 +549,8 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     }
     for (size_t i : fallback_buffers)
         if (i < out.model.buffers.size()) out.model.buffers[i].data.clear();
+    for (const auto& [i, declared] : long_data_uris)
+        if (i < out.model.buffers.size() && out.model.buffers[i].data.size() > declared) out.model.buffers[i].data.resize(static_cast<size_t>(declared));
     out.fallback_buffers = fallback_buffers;
     return out;
 }

@@ -128,6 +128,38 @@ Status relocate_images(json& doc, const std::string& scene_path, const GltfEmbed
     return Ok{};
 }
 
+// Every field of the input the embedding reads, appends to or extends has the type glTF gives it
+// (checked before anything is changed, like the readers check theirs): an object where an array
+// belongs is refused naming it (kBadFormat), never replaced nor appended to.
+Status check_embed_fields(const json& doc, const std::string& path) {
+    auto bad = [&](const std::string& where, const char* want, const json& got) {
+        return fail(ErrorCode::kBadFormat, path, where + ": must be " + want + " (got " + got.type_name() + ")");
+    };
+    for (const char* key : {"bufferViews", "accessors", "nodes", "scenes", "images", "extensionsUsed"})
+        if (doc.contains(key) && !doc[key].is_array()) return bad(key, "an array", doc[key]);
+    if (doc.contains("scenes"))
+        for (size_t i = 0; i < doc["scenes"].size(); ++i) {
+            const std::string sp = "scenes[" + std::to_string(i) + "]";
+            const json& sc = doc["scenes"][i];
+            if (!sc.is_object()) return bad(sp, "an object", sc);
+            if (sc.contains("nodes") && !sc["nodes"].is_array()) return bad(sp + ".nodes", "an array", sc["nodes"]);
+        }
+    if (doc.contains("images"))
+        for (size_t i = 0; i < doc["images"].size(); ++i)
+            if (!doc["images"][i].is_object()) return bad("images[" + std::to_string(i) + "]", "an object", doc["images"][i]);
+    if (doc.contains("extensions")) {
+        const json& e = doc["extensions"];
+        if (!e.is_object()) return bad("extensions", "an object", e);
+        if (e.contains(kGltfProbeExtension)) {
+            const std::string ep = std::string("extensions.") + kGltfProbeExtension;
+            const json& z = e[kGltfProbeExtension];
+            if (!z.is_object()) return bad(ep, "an object", z);
+            if (z.contains("volumes") && !z["volumes"].is_array()) return bad(ep + ".volumes", "an array", z["volumes"]);
+        }
+    }
+    return Ok{};
+}
+
 }  // namespace
 
 Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t> scene_bytes, const std::string& scene_path,
@@ -139,6 +171,7 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
         return make_error(ErrorCode::kInvalidArgument, "--draco needs a probe set with explicit positions in a float encoding (sh3, sh2)");
     auto loaded = load(scene_bytes, scene_path, limits);
     if (!loaded) return loaded.error();
+    if (Status fields = check_embed_fields(loaded->doc, scene_path); !fields) return fields.error();
     // The output is the input's own JSON (order and values kept by ordered_json) with our
     // additions; tinygltf's model only supplies the bytes of each buffer.
     json doc = loaded->doc;
@@ -269,22 +302,21 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
     else tb["uri"] = data_uri(target);
 
     // The extension object (volumes appended to any existing ones), extensionsUsed, the node.
-    if (!doc.contains("extensions") || !doc["extensions"].is_object()) doc["extensions"] = json::object();
-    json& ext = doc["extensions"][kGltfProbeExtension];
-    if (!ext.is_object()) ext = json::object();
-    if (!ext.contains("volumes") || !ext["volumes"].is_array()) ext["volumes"] = json::array();
+    if (!doc.contains("extensions")) doc["extensions"] = json::object();
+    json& ext = doc["extensions"][kGltfProbeExtension];  // checked: absent (null) or an object
+    if (ext.is_null()) ext = json::object();
+    if (!ext.contains("volumes")) ext["volumes"] = json::array();
     const std::size_t volume_index = ext["volumes"].size();
     ext["volumes"].push_back(vol);
-    if (!doc.contains("extensionsUsed") || !doc["extensionsUsed"].is_array()) doc["extensionsUsed"] = json::array();
+    if (!doc.contains("extensionsUsed")) doc["extensionsUsed"] = json::array();
     json& used = doc["extensionsUsed"];
     if (std::find(used.begin(), used.end(), json(kGltfProbeExtension)) == used.end()) used.push_back(kGltfProbeExtension);
     if (options.add_node) {
-        if (!doc.contains("nodes") || !doc["nodes"].is_array()) doc["nodes"] = json::array();
+        if (!doc.contains("nodes")) doc["nodes"] = json::array();
         doc["nodes"].push_back(json{{"name", options.name}, {"extensions", {{kGltfProbeExtension, {{"volume", volume_index}}}}}});
         const std::size_t node = doc["nodes"].size() - 1;
-        if (doc.contains("scenes") && doc["scenes"].is_array())
-            for (json& scene : doc["scenes"]) {
-                if (!scene.is_object()) continue;
+        if (doc.contains("scenes"))
+            for (json& scene : doc["scenes"]) {  // checked: objects whose nodes, if any, are arrays
                 if (!scene.contains("nodes")) scene["nodes"] = json::array();
                 scene["nodes"].push_back(node);
             }

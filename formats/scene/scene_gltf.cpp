@@ -38,11 +38,19 @@ Mat4 Reader::local_matrix(const json& n, const std::string& np) const {
     }
     if (n.contains("rotation")) {
         const auto v = numbers(n["rotation"], np + ".rotation", 4);
-        const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
-        if (!(len > 0)) fail(ErrorCode::kInvalidValue, np + ".rotation", "must be a unit quaternion (got zero)");
-        for (int i = 0; i < 4; ++i) q[i] = v[static_cast<size_t>(i)] / len;  // glTF requires unit; normalise rounding
+        for (int i = 0; i < 4; ++i) q[i] = v[static_cast<size_t>(i)];
     }
-    // M = T * R * S (glTF 2.0 spec, 5.25 node), R from the unit quaternion (x, y, z, w).
+    return trs_matrix(t, q, s, np + ".rotation");
+}
+
+// M = T * R * S (glTF 2.0 spec, 5.25 node), R from the quaternion (x, y, z, w) normalised (glTF
+// requires unit quaternions; this absorbs rounding and quantisation).
+Mat4 Reader::trs_matrix(Vec3 t, const double q_in[4], Vec3 s, const std::string& where) const {
+    const double len = std::sqrt(q_in[0] * q_in[0] + q_in[1] * q_in[1] + q_in[2] * q_in[2] + q_in[3] * q_in[3]);
+    if (!(len > 0)) fail(ErrorCode::kInvalidValue, where, "must be a unit quaternion (got zero)");
+    double q[4];
+    for (int i = 0; i < 4; ++i) q[i] = q_in[i] / len;
+    Mat4 m;
     const double x = q[0], y = q[1], z = q[2], w = q[3];
     const double r[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
                             {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
@@ -75,6 +83,7 @@ void Reader::walk() {
     } else {
         size_t scene = 0;
         if (doc_.contains("scene")) scene = index(doc_["scene"], "scene", scenes.size(), "scenes");
+        scene_ = scene;
         const std::string sp = at("scenes", scene);
         const json& sc = scenes[scene];
         if (!sc.is_object()) fail(ErrorCode::kInvalidValue, sp, "must be an object");
@@ -97,7 +106,15 @@ void Reader::walk() {
         const Mat4 world = mul(parent, local_matrix(n, np));
         for (double v : world.m)
             if (!std::isfinite(v)) fail(ErrorCode::kInvalidValue, np, "world transform is not finite");
-        if (n.contains("mesh")) add_mesh(index(n["mesh"], np + ".mesh", array_of(doc_, "meshes").size(), "meshes"), world);
+        if (n.contains("mesh")) {
+            const size_t mi = index(n["mesh"], np + ".mesh", array_of(doc_, "meshes").size(), "meshes");
+            // EXT_mesh_gpu_instancing: the mesh is drawn once per instance and not by itself.
+            Instancing inst;
+            inst.world = world;
+            if (n.contains("extensions") && n["extensions"].is_object() && n["extensions"].contains("EXT_mesh_gpu_instancing"))
+                inst = read_instancing(n["extensions"]["EXT_mesh_gpu_instancing"], world, np + ".extensions.EXT_mesh_gpu_instancing");
+            add_mesh(mi, inst);
+        }
         if (n.contains("extensions") && n["extensions"].is_object() && n["extensions"].contains("KHR_lights_punctual")) {
             const json& e = n["extensions"]["KHR_lights_punctual"];
             const std::string ep = np + ".extensions.KHR_lights_punctual.light";
@@ -156,7 +173,7 @@ using namespace scene_gltf_detail;
 namespace fs = std::filesystem;
 
 Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::string& path, const SceneLoadOptions& options,
-                              const GltfLimits& gltf_limits) {
+                              const GltfLimits& gltf_limits, std::vector<std::string>* notes) {
     auto raw = load_gltf_raw(bytes, path, gltf_limits);
     if (!raw) return raw.error();
     try {
@@ -164,6 +181,7 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
         Reader r(path, doc, *raw, options, gltf_limits);
         r.read_light_defs();
         r.walk();
+        std::optional<SceneEnvironment> ibl = r.image_based_light();
         // extras.zhc: a zhc JSON scene (zhc axes) with optional version and probes.
         json extras = json::object();
         if (doc.contains("extras") && doc["extras"].is_object() && doc["extras"].contains("zhc")) extras = doc["extras"]["zhc"];
@@ -173,6 +191,13 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
             if (!extras["gltf_light_shadows"].is_boolean()) r.fail(ErrorCode::kInvalidValue, "extras.zhc.gltf_light_shadows", "must be true or false");
             shadows = extras["gltf_light_shadows"].get<bool>();
             extras.erase("gltf_light_shadows");
+        }
+        // An environment or sky in extras.zhc is the asset's zhc-specific instruction: it wins over
+        // an EXT_lights_image_based light, which is then not baked (and said so).
+        if (ibl && (extras.contains("environment") || extras.contains("sky"))) {
+            r.notes_.push_back(ibl->label + ": not used: extras.zhc." + (extras.contains("environment") ? "environment" : "sky") +
+                               " gives the scene's environment");
+            ibl.reset();
         }
         if (!extras.contains("version")) extras["version"] = 1;
         if (!extras.contains("probes")) extras["probes"] = default_probes(r);
@@ -192,7 +217,12 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
             l.shadows = shadows;
             s.lights.push_back(std::move(l));
         }
-        s.occluders.insert(s.occluders.end(), r.occluders_.begin(), r.occluders_.end());
+        // Moved, not copied, when extras.zhc adds none: the mesh triangles are the bulk of the memory.
+        if (s.occluders.empty()) s.occluders = std::move(r.occluders_);
+        else s.occluders.insert(s.occluders.end(), r.occluders_.begin(), r.occluders_.end());
+        std::vector<Occluder>().swap(r.occluders_);
+        if (ibl) s.environment = std::move(ibl);
+        if (notes) *notes = r.notes_;
         if (Status v = validate_scene(s); !v) return make_error(v.error().code, path + ": " + v.error().message);
         if (Status b = check_ray_budget(s, options.limits, path); !b) return b.error();
         return s;
@@ -208,9 +238,10 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
 }  // namespace
 
 Result<Scene> parse_scene_gltf(std::span<const std::uint8_t> bytes, const std::string& path, const SceneLoadOptions& options,
-                               const GltfLimits& gltf_limits) {
+                               const GltfLimits& gltf_limits, std::vector<std::string>* notes) {
     // Messages echo names and values from the asset (and tinygltf's text): keep them one line.
-    auto s = parse_unchecked(bytes, path, options, gltf_limits);
+    if (notes) notes->clear();
+    auto s = parse_unchecked(bytes, path, options, gltf_limits, notes);
     if (!s) return make_error(s.error().code, one_line_message(s.error().message));
     return s;
 }

@@ -13,6 +13,10 @@
 //    (decoded with libmeshoptimizer, sizes checked first) and primitives
 //    KHR_draco_mesh_compression-compressed (decoded with Draco, counts checked against the
 //    accessors);
+//  * EXT_mesh_gpu_instancing: a mesh node draws its mesh once per instance, world x T R S (i);
+//  * EXT_lights_image_based: the scene's image-based light as its environment (the 9 SH
+//    irradiance coefficients as SH3 radiance, with intensity and rotation; extras.zhc's
+//    environment or sky wins over it);
 //  * probe placement, sky, environment and extra lights/occluders from the optional root
 //    `extras.zhc` object: a zhc JSON scene (docs/scene.md, zhc axes) whose `version` and `probes`
 //    may be omitted (default probes: an 8 x 8 x 8 grid of cell centres over the bounds of the
@@ -36,6 +40,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "codec/bake/scene.h"
 #include "codec/status.h"
@@ -45,8 +50,11 @@
 namespace zhc {
 
 // `path` names the asset in messages and locates external buffers and the environment map.
+// `notes` (optional) receives one line per thing the asset defines that the bake does not use
+// (an image-based light no scene references, or one that extras.zhc overrides).
 Result<Scene> parse_scene_gltf(std::span<const std::uint8_t> bytes, const std::string& path,
-                               const SceneLoadOptions& options = {}, const GltfLimits& gltf_limits = {});
+                               const SceneLoadOptions& options = {}, const GltfLimits& gltf_limits = {},
+                               std::vector<std::string>* notes = nullptr);
 
 // True for paths ending in .gltf or .glb (any case).
 bool is_gltf_path(const std::string& path);

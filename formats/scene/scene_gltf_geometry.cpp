@@ -2,7 +2,8 @@
 // occluders (docs/scene.md "glTF input"): TRIANGLES / TRIANGLE_STRIP / TRIANGLE_FAN (glTF 2.0 spec
 // 3.7.2.1), accessors and buffer views bound-checked, POSITION as FLOAT or KHR_mesh_quantization
 // integers, EXT_/KHR_meshopt_compression buffer views (gltf_meshopt.cpp) and
-// KHR_draco_mesh_compression primitives (gltf_draco.cpp).
+// KHR_draco_mesh_compression primitives (gltf_draco.cpp); EXT_mesh_gpu_instancing nodes draw each
+// primitive once per instance.
 #include "formats/scene/scene_gltf_reader.h"
 
 #include <algorithm>
@@ -128,8 +129,8 @@ const json& Reader::accessor(size_t ai, const std::string& ap) const {
 
 // POSITION values: FLOAT, or (KHR_mesh_quantization) BYTE/UNSIGNED_BYTE/SHORT/UNSIGNED_SHORT,
 // normalized or not (glTF 2.0 spec 3.11: signed c / (2^(n-1) - 1) clamped at -1, unsigned
-// c / (2^n - 1)); transformed by `world` into zhc axes and bound-checked for finiteness.
-std::vector<Vec3> Reader::read_positions(size_t pa, std::uint64_t nv, const Mat4& world) {
+// c / (2^n - 1)); in the mesh's own (glTF) space, checked for finiteness.
+std::vector<Vec3> Reader::read_positions(size_t pa, std::uint64_t nv) {
     const std::string pap = at("accessors", pa);
     const json& pacc = accessor(pa, pap);
     if (!pacc.contains("type") || pacc["type"] != "VEC3") fail(ErrorCode::kInvalidValue, pap, "POSITION must be a VEC3 accessor");
@@ -169,7 +170,7 @@ std::vector<Vec3> Reader::read_positions(size_t pa, std::uint64_t nv, const Mat4
         }
         if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2]))
             fail(ErrorCode::kInvalidValue, pap, "vertex " + std::to_string(i) + " is not finite");
-        verts[i] = transformed(world, {f[0], f[1], f[2]}, pap, i);
+        verts[i] = {f[0], f[1], f[2]};
     }
     return verts;
 }
@@ -206,14 +207,118 @@ void Reader::add_triangles(const std::vector<Vec3>& verts, const std::vector<std
     }
 }
 
-void Reader::count_triangles(std::uint64_t t, const std::string& pp) {
-    triangles_ += t;
-    if (triangles_ > options_.limits.max_triangles)
-        fail(ErrorCode::kTooLarge, pp, "mesh triangles (with instances) exceed the limit of " + std::to_string(options_.limits.max_triangles));
+// The primitive's triangles, once per instance: each instance's world matrix is computed when it
+// is used and the transformed vertices go through one reused array, so instancing costs the
+// triangle occluders themselves and nothing per instance besides.
+void Reader::add_instances(const std::vector<Vec3>& local, const std::vector<std::uint32_t>& idx, std::uint64_t mode,
+                           const Instancing& inst, const std::string& where) {
+    std::vector<Vec3> verts(local.size());
+    for (std::uint64_t k = 0; k < inst.count; ++k) {
+        const Mat4 world = instance_world(inst, k);
+        for (size_t i = 0; i < local.size(); ++i) verts[i] = transformed(world, local[i], where, i);
+        add_triangles(verts, idx, mode);
+    }
+}
+
+// `t` triangles drawn `instances` times, checked against the limit (without overflow) before
+// anything is decoded.
+void Reader::count_triangles(std::uint64_t t, std::uint64_t instances, const std::string& pp) {
+    const std::uint64_t limit = options_.limits.max_triangles;
+    if (instances != 0 && t > (limit - std::min(triangles_, limit)) / instances)
+        fail(ErrorCode::kTooLarge, pp, "mesh triangles (with instances) exceed the limit of " + std::to_string(limit));
+    triangles_ += t * instances;
+}
+
+// ---- EXT_mesh_gpu_instancing ----------------------------------------------------------------
+
+// The extension object of a mesh node: TRANSLATION (VEC3 FLOAT), ROTATION (VEC4 FLOAT, or BYTE /
+// SHORT normalized), SCALE (VEC3 FLOAT), all optional, every attribute (custom `_NAME` ones
+// too) of the same count. A component type outside that table is kUnsupported, a wrong accessor
+// type or count kInvalidValue, each naming the attribute.
+Reader::Instancing Reader::read_instancing(const json& e, const Mat4& world, const std::string& ep) {
+    Instancing inst;
+    inst.world = world;
+    inst.extension = true;
+    inst.where = ep;
+    const std::string ap = ep + ".attributes";
+    if (!e.is_object() || !e.contains("attributes") || !e["attributes"].is_object()) fail(ErrorCode::kInvalidValue, ap, "missing or not an object");
+    const json& attrs = e["attributes"];
+    if (attrs.empty()) fail(ErrorCode::kInvalidValue, ap, "has no attribute (the instance count comes from them)");
+    const size_t n_acc = array_of(doc_, "accessors").size();
+    // The instance count: TRANSLATION's, else ROTATION's, else SCALE's, else the first custom
+    // attribute's; an attribute of another count is the one named.
+    std::string ref = attrs.begin().key();
+    for (const char* k : {"SCALE", "ROTATION", "TRANSLATION"})
+        if (attrs.contains(k)) ref = k;
+    {
+        const size_t ai = index(attrs[ref], ap + "." + ref, n_acc, "accessors");
+        inst.count = count(accessor(ai, at("accessors", ai)), "count", at("accessors", ai), true, 0);
+    }
+    for (auto it = attrs.begin(); it != attrs.end(); ++it) {
+        const std::string fp = ap + "." + it.key();
+        const size_t ai = index(it.value(), fp, n_acc, "accessors");
+        const std::string acp = at("accessors", ai);
+        const json& acc = accessor(ai, acp);
+        const std::uint64_t n = count(acc, "count", acp, true, 0);
+        if (n != inst.count)
+            fail(ErrorCode::kInvalidValue, fp, "has " + std::to_string(n) + " elements, " + ref + " " + std::to_string(inst.count) +
+                                                   " (all attributes of a node must have the same count)");
+        const bool t = it.key() == "TRANSLATION", r = it.key() == "ROTATION", s = it.key() == "SCALE";
+        if (!t && !r && !s) continue;  // custom attributes (_ID, ...) do not move geometry
+        const char* want_type = r ? "VEC4" : "VEC3";
+        if (!acc.contains("type") || acc["type"] != want_type)
+            fail(ErrorCode::kInvalidValue, fp, "must be a " + std::string(want_type) + " accessor (got " + (acc.contains("type") ? acc["type"].dump() : "none") + ")");
+        const std::uint64_t ct = count(acc, "componentType", acp, true, 0);
+        if (acc.contains("normalized") && !acc["normalized"].is_boolean()) fail(ErrorCode::kInvalidValue, acp + ".normalized", "must be true or false");
+        const bool normalized = acc.contains("normalized") && acc["normalized"].get<bool>();
+        const bool ok = ct == kFloat ? !normalized : r && normalized && (ct == kByte || ct == kShort);
+        if (!ok)
+            fail(ErrorCode::kUnsupported, fp,
+                 std::string(r ? "ROTATION must be FLOAT, or BYTE or SHORT normalized" : "must be FLOAT") +
+                     " (EXT_mesh_gpu_instancing; got componentType " + std::to_string(ct) + (normalized ? " normalized" : "") + ")");
+        if (n == 0) continue;
+        const std::uint64_t csize = ct == kFloat ? 4 : ct == kShort ? 2 : 1;
+        const View v = accessor_view(ai, n, (r ? 4 : 3) * csize, acp);
+        if (t) inst.t = v;
+        else if (s) inst.s = v;
+        else {
+            inst.r = v;
+            inst.r_type = ct;
+        }
+    }
+    return inst;
+}
+
+// World matrix of instance i: NodeWorldXform * InstanceXform, InstanceXform = T * R * S (the
+// extension's "Transformation Order"); without the extension the node's world matrix itself.
+Mat4 Reader::instance_world(const Instancing& inst, std::uint64_t i) const {
+    if (!inst.extension) return inst.world;
+    auto component = [&](const View& v, std::uint64_t ct, int k) -> double {
+        const std::uint8_t* c = v.data + i * v.stride + static_cast<std::uint64_t>(k) * (ct == kFloat ? 4 : ct == kShort ? 2 : 1);
+        if (ct == kShort) return std::max(static_cast<std::int16_t>(static_cast<std::uint16_t>(c[0] | c[1] << 8)) / 32767.0, -1.0);
+        if (ct == kByte) return std::max(static_cast<std::int8_t>(c[0]) / 127.0, -1.0);
+        const std::uint32_t bits = le32(c);
+        float x;
+        std::memcpy(&x, &bits, 4);
+        return x;
+    };
+    Vec3 t{0, 0, 0}, s{1, 1, 1};
+    double q[4] = {0, 0, 0, 1};
+    const std::string ip = inst.where + ".attributes";
+    if (inst.t.data) t = {component(inst.t, kFloat, 0), component(inst.t, kFloat, 1), component(inst.t, kFloat, 2)};
+    if (inst.s.data) s = {component(inst.s, kFloat, 0), component(inst.s, kFloat, 1), component(inst.s, kFloat, 2)};
+    if (inst.r.data)
+        for (int k = 0; k < 4; ++k) q[k] = component(inst.r, inst.r_type, k);
+    if (!finite3(t) || !finite3(s) || !std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]) || !std::isfinite(q[3]))
+        fail(ErrorCode::kInvalidValue, ip, "instance " + std::to_string(i) + " has a non-finite translation, rotation or scale");
+    const Mat4 w = mul(inst.world, trs_matrix(t, q, s, ip + ".ROTATION: instance " + std::to_string(i)));
+    for (double v : w.m)
+        if (!std::isfinite(v)) fail(ErrorCode::kInvalidValue, ip, "instance " + std::to_string(i) + ": world transform is not finite");
+    return w;
 }
 
 // KHR_draco_mesh_compression: the primitive's geometry from its Draco stream.
-void Reader::add_draco(const json& prim, const json& ext, const std::string& pp, std::uint64_t mode, const Mat4& world) {
+void Reader::add_draco(const json& prim, const json& ext, const std::string& pp, std::uint64_t mode, const Instancing& inst) {
     const std::string ep = pp + ".extensions.KHR_draco_mesh_compression";
     if (!ext.is_object()) fail(ErrorCode::kInvalidValue, ep, "must be an object");
     if (mode != 4) fail(ErrorCode::kUnsupported, pp + ".mode", "Draco-compressed primitives are read as TRIANGLES only");
@@ -226,7 +331,7 @@ void Reader::add_draco(const json& prim, const json& ext, const std::string& pp,
         ni = count(accessor(ia, at("accessors", ia)), "count", at("accessors", ia), true, 0);
     }
     if (ni % 3 != 0) fail(ErrorCode::kInvalidValue, pp, "TRIANGLES need a multiple of 3 indices (got " + std::to_string(ni) + ")");
-    count_triangles(ni / 3, pp);
+    count_triangles(ni / 3, inst.count, pp);
     if (nv > options_.limits.max_triangles * 3) fail(ErrorCode::kTooLarge, pp, std::to_string(nv) + " Draco points exceed 3 x the triangle limit");
     if (!ext.contains("attributes") || !ext["attributes"].is_object() || !ext["attributes"].contains("POSITION") ||
         !ext["attributes"]["POSITION"].is_number_integer())
@@ -243,15 +348,15 @@ void Reader::add_draco(const json& prim, const json& ext, const std::string& pp,
         const auto& q = mesh->positions[i];
         if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
             fail(ErrorCode::kInvalidValue, ep, "Draco vertex " + std::to_string(i) + " is not finite");
-        verts[i] = transformed(world, {q[0], q[1], q[2]}, ep, i);
+        verts[i] = {q[0], q[1], q[2]};
     }
     std::vector<std::uint32_t> idx;
     idx.reserve(mesh->faces.size() * 3);
     for (const auto& f : mesh->faces) idx.insert(idx.end(), f.begin(), f.end());
-    add_triangles(verts, idx, 4);
+    add_instances(verts, idx, 4, inst, ep);
 }
 
-void Reader::add_mesh(size_t mi, const Mat4& world) {
+void Reader::add_mesh(size_t mi, const Instancing& inst) {
     const std::string mp = at("meshes", mi);
     const json& mesh = array_of(doc_, "meshes")[mi];
     if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array())
@@ -268,7 +373,7 @@ void Reader::add_mesh(size_t mi, const Mat4& world) {
         if (!prim.contains("attributes") || !prim["attributes"].is_object() || !prim["attributes"].contains("POSITION"))
             fail(ErrorCode::kInvalidValue, pp + ".attributes.POSITION", "missing");
         if (prim.contains("extensions") && prim["extensions"].is_object() && prim["extensions"].contains("KHR_draco_mesh_compression")) {
-            add_draco(prim, prim["extensions"]["KHR_draco_mesh_compression"], pp, mode, world);
+            add_draco(prim, prim["extensions"]["KHR_draco_mesh_compression"], pp, mode, inst);
             continue;
         }
         const size_t pa = index(prim["attributes"]["POSITION"], pp + ".attributes.POSITION", n_acc, "accessors");
@@ -286,10 +391,10 @@ void Reader::add_mesh(size_t mi, const Mat4& world) {
         if (mode == 4 && ni % 3 != 0)
             fail(ErrorCode::kInvalidValue, indexed ? at("accessors", ia) : pap,
                  "TRIANGLES need a multiple of 3 " + std::string(indexed ? "indices" : "vertices") + " (got " + std::to_string(ni) + ")");
-        count_triangles(triangle_count(mode, ni), pp);
-        if (triangle_count(mode, ni) == 0) continue;
+        count_triangles(triangle_count(mode, ni), inst.count, pp);
+        if (triangle_count(mode, ni) == 0 || inst.count == 0) continue;
         if (nv > options_.limits.max_triangles * 3) fail(ErrorCode::kTooLarge, pap, std::to_string(nv) + " vertices exceed 3 x the triangle limit");
-        const std::vector<Vec3> verts = read_positions(pa, nv, world);
+        const std::vector<Vec3> verts = read_positions(pa, nv);
         std::vector<std::uint32_t> idx(ni);
         if (indexed) {
             const std::string iap = at("accessors", ia);
@@ -308,7 +413,7 @@ void Reader::add_mesh(size_t mi, const Mat4& world) {
         } else {
             for (std::uint64_t i = 0; i < ni; ++i) idx[i] = static_cast<std::uint32_t>(i);
         }
-        add_triangles(verts, idx, mode);
+        add_instances(verts, idx, mode, inst, pap);
     }
 }
 

@@ -1,6 +1,7 @@
 // zhc/formats/scene/scene_gltf_lights.cpp — KHR_lights_punctual lights of a glTF 2.0 scene
 // (docs/scene.md "glTF input"): the light definitions checked against the extension's constraints,
-// and each light node's instance in zhc axes and units (candela / lux -> zhc intensity).
+// and each light node's instance in zhc axes and units (candela / lux -> zhc intensity); and the
+// EXT_lights_image_based environment of the scene (its SH irradiance as zhc SH3 radiance).
 #include "formats/scene/scene_gltf_reader.h"
 
 #include <limits>
@@ -89,6 +90,97 @@ void Reader::add_light(size_t li, const Mat4& world, const std::string& where) {
         l.color[k] = static_cast<float>(v);
     }
     lights_.push_back(l);
+}
+
+// ---- EXT_lights_image_based ----------------------------------------------------------------
+
+// The scene's image-based light: scenes[s].extensions.EXT_lights_image_based.light indexes the root
+// extensions.EXT_lights_image_based.lights. Only `irradianceCoefficients` (9 x [r, g, b]),
+// `intensity` and `rotation` matter to probes; the specular cube images are not read.
+//
+// The coefficients are SH of the *physical* irradiance E(n) = integral L(w) max(0, n.w) dw in the
+// glTF frame, with zhc's basis (docs/conventions.md) evaluated on glTF (x, y, z) — the convention
+// of the extension's references (Ramamoorthi & Hanrahan 2001, E_lm = A_l L_lm with A_l = pi,
+// 2 pi / 3, pi / 4) and of Babylon.js, which divides them by pi to get a Lambertian surface's
+// exit radiance. zhc's irradiance is that exit radiance (normalised, E / pi), so
+//     radiance L_lm = c_lm / A_l  (= to_radiance(c / pi));
+// then `rotation` turns the environment (radiance from w arrives from R w, like a node's rotation
+// turns its content) and the glTF frame becomes zhc's ((x, y, z)_zhc = (z, x, y)_glTF).
+std::optional<SceneEnvironment> Reader::image_based_light() {
+    const char* kExt = "EXT_lights_image_based";
+    const json empty = json::object();
+    const json& root_ext = doc_.contains("extensions") && doc_["extensions"].is_object() ? doc_["extensions"] : empty;
+    size_t defined = 0;
+    const std::string lp = std::string("extensions.") + kExt + ".lights";
+    if (root_ext.contains(kExt)) {
+        const json& e = root_ext[kExt];
+        if (!e.is_object() || !e.contains("lights") || !e["lights"].is_array()) fail(ErrorCode::kInvalidValue, lp, "must be an array");
+        defined = e["lights"].size();
+    }
+    std::optional<size_t> li;
+    std::string sp;
+    if (scene_) {
+        sp = at("scenes", *scene_);
+        const json& sc = array_of(doc_, "scenes")[*scene_];
+        if (sc.contains("extensions") && sc["extensions"].is_object() && sc["extensions"].contains(kExt)) {
+            const json& r = sc["extensions"][kExt];
+            const std::string rp = sp + ".extensions." + kExt + ".light";
+            if (!r.is_object() || !r.contains("light")) fail(ErrorCode::kInvalidValue, rp, "missing");
+            li = index(r["light"], rp, defined, "extensions.EXT_lights_image_based.lights");
+        }
+    }
+    if (!li) {
+        if (defined > 0)
+            notes_.push_back(std::string(kExt) + ": " + std::to_string(defined) + " image-based light(s) defined, none referenced by " +
+                             (scene_ ? sp : std::string("the asset (it has no scene)")) + ": not used");
+        return std::nullopt;
+    }
+    const std::string p = at(lp, *li);
+    const json& l = root_ext[kExt]["lights"][*li];
+    if (!l.is_object()) fail(ErrorCode::kInvalidValue, p, "must be an object");
+    if (!l.contains("irradianceCoefficients")) fail(ErrorCode::kInvalidValue, p + ".irradianceCoefficients", "missing required field");
+    const json& c = l["irradianceCoefficients"];
+    const std::string cp = p + ".irradianceCoefficients";
+    if (!c.is_array() || c.size() != 9) fail(ErrorCode::kInvalidValue, cp, "must be an array of 9 [r, g, b] arrays (SH bands 0..2)");
+    Sh3Irradiance e;  // zhc's normalised irradiance: the coefficients / pi
+    for (size_t i = 0; i < 9; ++i) {
+        const auto rgb = numbers(c[i], at(cp, i), 3);
+        for (int k = 0; k < 3; ++k) {
+            const double v = rgb[static_cast<size_t>(k)] / kPi;
+            if (!(std::fabs(v) <= 1e30)) fail(ErrorCode::kInvalidValue, at(cp, i), "too large (at most 1e30 in magnitude)");
+            e[static_cast<int>(i)][k] = static_cast<float>(v);
+        }
+    }
+    SceneEnvironment env;
+    env.intensity = 1;
+    if (l.contains("intensity")) {
+        env.intensity = number(l["intensity"], p + ".intensity");
+        if (env.intensity < 0) fail(ErrorCode::kInvalidValue, p + ".intensity", "must be >= 0");
+    }
+    double q[4] = {0, 0, 0, 1};
+    if (l.contains("rotation")) {
+        const auto v = numbers(l["rotation"], p + ".rotation", 4);
+        const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
+        if (!(len > 0)) fail(ErrorCode::kInvalidValue, p + ".rotation", "must be a unit quaternion (got zero)");
+        for (int k = 0; k < 4; ++k) q[k] = v[static_cast<size_t>(k)] / len;
+    }
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    Mat3 r;
+    r.m = {1 - 2 * (y * y + z * z), 2 * (x * y - z * w),     2 * (x * z + y * w),
+           2 * (x * y + z * w),     1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+           2 * (x * z - y * w),     2 * (y * z + x * w),     1 - 2 * (x * x + y * y)};
+    Sh3Radiance radiance = to_radiance(e);
+    if (l.contains("rotation")) radiance = rotate(radiance, r);
+    env.projected = rotate(radiance, transpose(zhc_to_gltf_rotation()));  // glTF frame -> zhc frame
+    // The baked probes are 32-bit floats: intensity x coefficients must stay far inside their range.
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!(std::fabs(double(env.projected[i][k])) * env.intensity <= 1e37))
+                fail(ErrorCode::kInvalidValue, p + ".intensity", "intensity x irradianceCoefficients does not fit 32-bit floats");
+    const std::string name = l.contains("name") && l["name"].is_string() ? l["name"].get<std::string>() : "";
+    env.label = std::string(kExt) + " " + (name.empty() ? at("lights", *li) : "'" + name + "'");
+    env.source = env.label;
+    return env;
 }
 
 }  // namespace zhc::scene_gltf_detail

@@ -1,7 +1,8 @@
 // zhc/formats/scene/scene_gltf_reader.h — internal to formats/: the glTF scene reader shared by
 // scene_gltf.cpp (node tree, default probes, the public entry points), scene_gltf_lights.cpp
-// (KHR_lights_punctual) and scene_gltf_geometry.cpp (mesh primitives as occluders: accessors,
-// KHR_mesh_quantization, EXT_/KHR_meshopt_compression, KHR_draco_mesh_compression). glTF 2.0;
+// (KHR_lights_punctual, EXT_lights_image_based) and scene_gltf_geometry.cpp (mesh primitives as
+// occluders: accessors, KHR_mesh_quantization, EXT_/KHR_meshopt_compression,
+// KHR_draco_mesh_compression, EXT_mesh_gpu_instancing). glTF 2.0;
 // the format as zhc reads it: formats/scene/scene_gltf.h, docs/scene.md.
 #pragma once
 
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -120,13 +122,30 @@ public:
     // Triangles a primitive of `mode` with n elements yields (an upper bound for strips/fans).
     static std::uint64_t triangle_count(std::uint64_t mode, std::uint64_t n) { return mode == 4 ? n / 3 : n >= 3 ? n - 2 : 0; }
 
+    // The instances a mesh node draws: the node's world matrix alone, or (EXT_mesh_gpu_instancing)
+    // world x InstanceXform(i) for each of `count` instances, computed on demand from the
+    // attribute accessors (never stored per instance).
+    struct Instancing {
+        Mat4 world;
+        std::uint64_t count = 1;
+        bool extension = false;
+        std::string where;  // nodes[i].extensions.EXT_mesh_gpu_instancing
+        View t, r, s;       // data == nullptr: attribute absent
+        std::uint64_t r_type = 0;
+    };
+
     // node tree (scene_gltf.cpp)
     Mat4 local_matrix(const json& n, const std::string& np) const;
+    Mat4 trs_matrix(Vec3 t, const double q[4], Vec3 s, const std::string& where) const;
     void walk();
 
     // KHR_lights_punctual (scene_gltf_lights.cpp)
     void read_light_defs();
     void add_light(size_t li, const Mat4& world, const std::string& where);
+    // EXT_lights_image_based (scene_gltf_lights.cpp): the environment the walked scene references
+    // (its SH3 radiance in zhc axes, rotation applied, intensity kept apart), or none; a light
+    // defined but not referenced leaves a note.
+    std::optional<SceneEnvironment> image_based_light();
 
     // mesh primitives as occluders (scene_gltf_geometry.cpp)
     const json* meshopt_ext(const json& v, std::string* name) const;
@@ -135,15 +154,23 @@ public:
     View accessor_view(size_t ai, std::uint64_t count, std::uint64_t elem, const std::string& ap);
     std::uint64_t count_field(const json& obj, const char* key, const std::string& where, std::uint64_t fallback) const;
     const json& accessor(size_t ai, const std::string& ap) const;
-    std::vector<Vec3> read_positions(size_t pa, std::uint64_t nv, const Mat4& world);
+    std::vector<Vec3> read_positions(size_t pa, std::uint64_t nv);
     Vec3 transformed(const Mat4& world, Vec3 p, const std::string& where, std::uint64_t i);
     void add_triangles(const std::vector<Vec3>& verts, const std::vector<std::uint32_t>& idx, std::uint64_t mode);
-    void count_triangles(std::uint64_t t, const std::string& pp);
-    void add_draco(const json& prim, const json& ext, const std::string& pp, std::uint64_t mode, const Mat4& world);
-    void add_mesh(size_t mi, const Mat4& world);
+    void add_instances(const std::vector<Vec3>& local, const std::vector<std::uint32_t>& idx, std::uint64_t mode,
+                       const Instancing& inst, const std::string& where);
+    void count_triangles(std::uint64_t t, std::uint64_t instances, const std::string& pp);
+    void add_draco(const json& prim, const json& ext, const std::string& pp, std::uint64_t mode, const Instancing& inst);
+    void add_mesh(size_t mi, const Instancing& inst);
+
+    // EXT_mesh_gpu_instancing (scene_gltf_geometry.cpp)
+    Instancing read_instancing(const json& e, const Mat4& world, const std::string& ep);
+    Mat4 instance_world(const Instancing& inst, std::uint64_t i) const;
 
     std::vector<SceneLight> lights_;
     std::vector<Occluder> occluders_;
+    std::vector<std::string> notes_;  // what was read but is not baked, for the report
+    std::optional<size_t> scene_;     // the scene walked (none: an asset without scenes)
     double lo_[3] = {INFINITY, INFINITY, INFINITY}, hi_[3] = {-INFINITY, -INFINITY, -INFINITY};
 
 private:

@@ -18,7 +18,7 @@
 import * as THREE from 'three';
 import {
   PACKED_LAYOUTS, decodeAll, encodingInfo, gltfToZhcDir, irradiance as shIrradiance, makeParams, normalizeOr,
-  rotateZhcToGltf, toThreeConvention,
+  makeVolume, rotateZhcToGltf, toThreeConvention, volumeIrradiance,
 } from './zhc_runtime.mjs';
 
 export const EXTENSION = 'ZHC_light_probes';
@@ -50,6 +50,19 @@ export class ZhcProbeVolume {
   irradiance(p, dir) {
     const d = normalizeOr([dir[0], dir[1], dir[2]], [0, 1, 0]);
     return shIrradiance(this.probeSH(p), this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
+  }
+
+  // Irradiance at any point of a GRID volume: the trilinear blend of the 8 surrounding probes'
+  // decoded SH3 (the point clamped to the grid's box), evaluated at `normal`; position and normal in
+  // glTF / three.js axes, node-local (docs/runtime.md "Probe volumes"). The normal is normalised
+  // (zero: +Y). Throws for points / none layouts (scattered probes: see the docs) and for a grid
+  // whose spacing is not > 0.
+  irradianceAt(position, normal) {
+    if (this.layout !== 'grid') throw new Error(`zhc: volume '${this.name}' has layout ${this.layout}: irradianceAt needs a grid`);
+    if (!this.sh) this.#check(0);
+    if (!this.#volume) this.#volume = makeVolume({ sh: this.sh, ...this.grid });
+    const d = normalizeOr([normal[0], normal[1], normal[2]], [0, 1, 0]);
+    return volumeIrradiance(this.#volume, position, this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
   }
 
   // Position of probe p in glTF axes (node-local), [x, y, z].
@@ -86,6 +99,8 @@ export class ZhcProbeVolume {
     }
     return best;
   }
+
+  #volume = null;
 
   #check(p) {
     if (!this.sh) throw new Error(`zhc: volume '${this.name}' is not decoded (Draco point clouds need the Draco decoder)`);

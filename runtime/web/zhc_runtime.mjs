@@ -520,3 +520,97 @@ export function decodeAll(encoding, payload, count, params = DEFAULT_PARAMS) {
   for (let p = 0; p < count; p++) out.set(decodeProbe(encoding, payload, p * e.bytes, params), p * 27);
   return out;
 }
+
+// ---- probe volumes (docs/runtime.md "Probe volumes"; zhc_volume_* of runtime/zhc_runtime.h) -------
+//
+// A grid of probes decoded once to SH3 radiance; a sample blends the 8 probes of the cell around the
+// point (trilinear weights, the point clamped to the grid's box) on the DECODED SH3, then evaluates
+// the irradiance once. The same double operations in the same order as zhc_volume_irradiance of the
+// C header: volumeIrradiance returns the same float32 values (tests/js/runtime_decode.mjs).
+
+// A volume from its parts: { encoding, params (makeParams), bytes (Uint8Array: count x bytes per
+// probe, at least), origin, spacing, counts } (the grid as in .zhp / glTF: probe (x, y, z) is number
+// x + nx (y + ny z) at origin + (x sx, y sy, z sz)), or { sh (Float32Array(count x 27), decoded
+// radiance), origin, spacing, counts }. Throws Error naming the problem: counts integers >= 1,
+// origin and spacing finite, spacing > 0, far corner finite (zhc_volume_init's rules).
+export function makeVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, origin, spacing, counts }) {
+  const arr3 = (a, what) => {
+    if (!a || a.length !== 3) throw new Error(`zhc volume: ${what} must have 3 entries`);
+    return [Number(a[0]), Number(a[1]), Number(a[2])];
+  };
+  const o = arr3(origin, 'origin'), s = arr3(spacing, 'spacing'), n = arr3(counts, 'counts');
+  let count = 1;
+  for (let c = 0; c < 3; c++) {
+    if (!Number.isInteger(n[c]) || n[c] < 1 || n[c] > 0xffffffff) throw new Error(`zhc volume: counts[${c}] must be an integer >= 1`);
+    if (!Number.isFinite(o[c])) throw new Error(`zhc volume: origin[${c}] is not finite`);
+    if (!Number.isFinite(s[c]) || !(s[c] > 0)) throw new Error(`zhc volume: spacing[${c}] must be finite and > 0`);
+    if (!Number.isFinite(o[c] + (n[c] - 1) * s[c])) throw new Error(`zhc volume: the grid's far corner along axis ${c} is not finite`);
+    count *= n[c];
+    if (count > 2 ** 26) throw new Error('zhc volume: more than 2^26 probes');
+  }
+  let decoded = sh;
+  if (!decoded) {
+    const e = encodingInfo(encoding);
+    if (!bytes || bytes.length < count * e.bytes) throw new Error(`zhc volume: ${count} probes need ${count * e.bytes} bytes`);
+    decoded = decodeAll(encoding, bytes, count, params);
+  } else if (decoded.length < count * 27) {
+    throw new Error(`zhc volume: ${count} probes need ${count * 27} SH3 floats`);
+  }
+  return Object.freeze({ origin: o, spacing: s, counts: n, count, sh: decoded });
+}
+
+// A volume from a whole .zhp file (Uint8Array): parseZhp's checks, then a grid layout (throws
+// "not a grid" for none / positions: see docs/runtime.md for scattered probes) and makeVolume's.
+export function volumeFromZhp(bytes) {
+  const z = parseZhp(bytes);
+  if (z.layout !== 'grid') throw new Error(`zhc volume: the .zhp layout is ${z.layout}, not a grid`);
+  return makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid });
+}
+
+// Grid coordinate along one axis: [first probe of the cell, weight of the next] (zhc__volume_axis).
+function volumeAxis(p, origin, spacing, n) {
+  let t = (p - origin) / spacing;
+  const hi = n - 1;
+  if (!(t >= 0.0)) t = 0.0;  // below the box, or NaN
+  if (t > hi) t = hi;
+  let i = Math.floor(t);
+  if (n >= 2 && i > n - 2) i = n - 2;
+  return [i, n >= 2 ? t - i : 0.0];
+}
+
+// Blended SH3 radiance at `position` (the volume's frame): Float64Array(27), index i*3+k
+// (zhc_volume_sh3). Probes of weight 0 are skipped.
+export function volumeSH3(vol, position) {
+  const out = new Float64Array(27);
+  const [ix, fx] = volumeAxis(position[0], vol.origin[0], vol.spacing[0], vol.counts[0]);
+  const [iy, fy] = volumeAxis(position[1], vol.origin[1], vol.spacing[1], vol.counts[1]);
+  const [iz, fz] = volumeAxis(position[2], vol.origin[2], vol.spacing[2], vol.counts[2]);
+  const nx = vol.counts[0], ny = vol.counts[1], sh = vol.sh;
+  for (let corner = 0; corner < 8; corner++) {
+    const bx = corner & 1, by = (corner >> 1) & 1, bz = (corner >> 2) & 1;
+    const w = (bx ? fx : 1.0 - fx) * (by ? fy : 1.0 - fy) * (bz ? fz : 1.0 - fz);
+    if (w === 0.0) continue;
+    const base = ((ix + bx) + nx * ((iy + by) + ny * (iz + bz))) * 27;
+    for (let j = 0; j < 27; j++) out[j] += w * sh[base + j];
+  }
+  return out;
+}
+
+// Irradiance (zhc's normalised kernel) at `position` for the surface normal `normal` (normalised
+// here; zero or not finite: +Z), both in the volume's frame (zhc axes for a .zhp): float32 RGB,
+// the values zhc_volume_irradiance of the C header returns. volumeIrradianceD: the doubles.
+export function volumeIrradianceD(vol, position, normal) {
+  const sh = volumeSH3(vol, position);
+  const n = normalizeOr([normal[0], normal[1], normal[2]]);
+  const y = shBasis(n[0], n[1], n[2]);
+  const e = [0.0, 0.0, 0.0];
+  for (let i = 0; i < 9; i++) {
+    const s = IRRADIANCE_BAND_SCALE[BAND_OF[i]];
+    for (let k = 0; k < 3; k++) e[k] += s * sh[i * 3 + k] * y[i];
+  }
+  return e;
+}
+export function volumeIrradiance(vol, position, normal) {
+  const e = volumeIrradianceD(vol, position, normal);
+  return [f32(e[0]), f32(e[1]), f32(e[2])];
+}

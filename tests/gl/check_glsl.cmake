@@ -3,11 +3,16 @@
 # compiles it with glslangValidator (fails the test on any error or warning-as-error).
 file(READ "${LIBRARY}" library)
 if(STAGE STREQUAL "comp")
+  # The compute stage also binds the probe words for the volume functions (ZHC_VOLUME_WORD).
+  set(prelude "
+layout(std430, binding = 0) readonly buffer Words { uint words[]; };
+#define ZHC_VOLUME_WORD(i) words[i]
+")
   set(main "
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Words { uint words[]; };
 layout(std430, binding = 1) writeonly buffer Out { vec4 outv[]; };
 uniform ZhcFormat uFormat;
+uniform ZhcVolume uVolume;
 void main() {
     uint i = gl_GlobalInvocationID.x;
     uint w[27];
@@ -18,10 +23,12 @@ void main() {
     e += zhcIrradZIrradiance(vec3(1.0), 0.5, vec2(0.5), n, ZHC_IRRADZ_HHD);
     e += zhcHlshIrradiance(s.c[0], s.c[1], s.c[2], s.c[3], n);
     e += zhcUnpackR11G11B10F(w[0]) + zhcUnpackRGB9E5(w[1]) + vec3(zhcUnpackHalf(w[2]));
+    e += zhcVolumeIrradiance(uVolume, uFormat, vec3(float(i), 0.5, 2.0), n) + zhcVolumeSh3(uVolume, uFormat, n).c[4];
     outv[i] = vec4(e, 1.0);
 }
 ")
 else()
+  set(prelude "")
   set(main "
 uniform ZhcFormat uFormat;
 uniform highp uvec4 uWords;
@@ -45,7 +52,7 @@ endif()
 string(REPLACE " " "" tag "${VERSION}")
 file(MAKE_DIRECTORY "${OUT_DIR}")
 set(out "${OUT_DIR}/zhc_${tag}.${STAGE}")
-file(WRITE "${out}" "#version ${VERSION}\n${library}${main}")
+file(WRITE "${out}" "#version ${VERSION}\n${prelude}${library}${main}")
 execute_process(COMMAND "${VALIDATOR}" "${out}" RESULT_VARIABLE rc OUTPUT_VARIABLE log ERROR_VARIABLE log)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "glslangValidator ${out} failed:\n${log}")

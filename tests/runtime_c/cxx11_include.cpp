@@ -25,6 +25,19 @@ int zhc_runtime_cxx11_smoke() {
     zhc_hlsh_tables_init(&t, 0.0);
     zhc_hlsh_multiply(&t, sh, frame, iz, ca, cx, cy);
     r |= zhc_crc32(0, bytes, 9) != 0;
+    {
+        zhc_volume v;
+        const double origin[3] = {0, 0, 0}, spacing[3] = {1, 1, 1}, pd[3] = {0.5, 0, 0};
+        const uint32_t counts[3] = {1, 1, 1};
+        double e[3], blended[27];
+        zhc_probe_format sh3;
+        r |= zhc_probe_format_init(&sh3, "sh3");
+        r |= zhc_volume_init(&v, &sh3, bytes, sizeof bytes, origin, spacing, counts);
+        r |= zhc_volume_from_zhp(&v, bytes, sizeof bytes) == ZHC_OK;
+        zhc_volume_irradiance(&v, n, n, rgb);
+        zhc_volume_irradiance_d(&v, pd, nd, e);
+        zhc_volume_sh3(&v, pd, blended);
+    }
     r |= static_cast<int>(zhc_probe_size(&f)) + zhc_encoding_is_packed(f.encoding);
     return r + static_cast<int>(zhc_hallucinate_zonal(2, 1.0, 0.5, f.hallucinate_a, f.hallucinate_b));
 }

@@ -4,13 +4,16 @@
 //   binding 1  the probes' words (strideWords per probe), or per texel 6 floats (I_z rgb, w_a, d uv)
 //   binding 2  unit normals (float4, w unused)
 //   binding 3  output, 32 floats per item: decoded SH3 radiance (27), irradiance (3)
-// mode 0: probes; 1: IrradZ HHD; 2: IrradZ AHD (irradiance in floats 27..29).
-#include "zhc.hlsl"
-
+// mode 0: probes; 1: IrradZ HHD; 2: IrradZ AHD (irradiance in floats 27..29); 3: probe volume
+// (params 16..24: grid origin, spacing (float bits), counts; binding 2 holds position, normal as two
+// float4 per item; irradiance in floats 27..29).
 [[vk::binding(0, 0)]] StructuredBuffer<uint> params;
 [[vk::binding(1, 0)]] ByteAddressBuffer words;
 [[vk::binding(2, 0)]] StructuredBuffer<float4> normals;
 [[vk::binding(3, 0)]] RWStructuredBuffer<float> results;
+
+#define ZHC_VOLUME_WORD(i) words.Load(4u * (i))
+#include "zhc.hlsl"
 
 [numthreads(64, 1, 1)]
 void main(uint3 id : SV_DispatchThreadID)
@@ -21,6 +24,31 @@ void main(uint3 id : SV_DispatchThreadID)
     uint mode = params[15];
     float3 n = normals[i].xyz;
     uint o = 32u * i;
+    if (mode == 3u)
+    {
+        ZhcFormat f = zhc_default_format(params[0]);
+        f.bits = params[1];
+        f.sqrtEncoding = params[2];
+        f.l2Bound = params[3];
+        f.dcFormat = params[4];
+        f.zonalMapping = params[5];
+        f.axisMode = params[6];
+        f.kind = params[7];
+        f.lumR = asfloat(params[8]);
+        f.lumG = asfloat(params[9]);
+        f.lumB = asfloat(params[10]);
+        f.hallA = asfloat(params[11]);
+        f.hallB = asfloat(params[12]);
+        ZhcVolume v;
+        v.origin = asfloat(uint3(params[16], params[17], params[18]));
+        v.spacing = asfloat(uint3(params[19], params[20], params[21]));
+        v.counts = uint3(params[22], params[23], params[24]);
+        float3 e = zhc_volume_irradiance(v, f, normals[2u * i].xyz, normals[2u * i + 1u].xyz);
+        results[o + 27u] = e.x;
+        results[o + 28u] = e.y;
+        results[o + 29u] = e.z;
+        return;
+    }
     if (mode != 0u)
     {
         uint b = 4u * stride * i;
