@@ -11,6 +11,8 @@
 //     own shader chunk), the file's node under a translated, scaled root; a white Lambertian sphere
 //     per sample, no other light, tone mapping off, RGBA32F target, the pixel that shades the pole
 //     facing the camera (world normal d, three.js's sample point q);
+//     then the same with WebGPURenderer and three.js's WebGPU LightProbeGrid (Chromium's WebGPU on
+//     SwiftShader: --enable-unsafe-webgpu --use-webgpu-adapter=swiftshader; binary16 atlas only);
 //  4. the C header (tests/runtime_c/zhc_volume_sample: zhc_volume_from_zhp + zhc_volume_irradiance
 //     on the .zhp, q and d converted to zhc axes) gives E(q, d); three.js's MeshLambertMaterial
 //     shows BRDF_Lambert * irradiance = (albedo / pi) * (pi E) = E, so the pixel must equal E.
@@ -25,7 +27,8 @@
 //  * binary16 atlas: 2^-11 S + 2e-5 S (each stored coefficient rounded to binary16, relative 2^-11).
 //  * MeshStandardMaterial (roughness 1, metalness 0) with the grid against the same material lit by
 //    a THREE.LightProbe holding zhc's blended SH3 at q: 2e-5 of the probe render (same BRDF code).
-// Time bounded: the browser part times out after 180 s (Chromium killed).
+//  * WebGPU MeshStandardMaterial: its grid is binary16, the LightProbe twin float: 2^-11 S + 2e-5 S.
+// Time bounded: each browser page times out after 180 s (Chromium killed).
 import fs from 'node:fs';
 import path from 'node:path';
 import http from 'node:http';
@@ -110,8 +113,7 @@ const roots = {
   '/work/': work,
 };
 const types = { '.html': 'text/html', '.mjs': 'text/javascript', '.js': 'text/javascript', '.json': 'application/json', '.glb': 'model/gltf-binary' };
-let resolveResult;
-const result = new Promise((resolve) => { resolveResult = resolve; });
+let resolveResult, result;
 const served = [];
 const server = http.createServer((req, res) => {
   const url = new URL(req.url, 'http://127.0.0.1');
@@ -137,56 +139,71 @@ const server = http.createServer((req, res) => {
 });
 await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
 const port = server.address().port;
-const profile = fs.mkdtempSync(path.join(work, 'chromium-profile-'));
-const args = ['--headless=new', '--no-sandbox', '--disable-quic', '--no-first-run', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--disable-default-apps', '--disable-extensions', `--user-data-dir=${profile}`,
-  '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--enable-logging=stderr', '--v=0',
-  `http://127.0.0.1:${port}/test/three_grid.html`];
-const browser = spawn(chromium, args, { detached: true, stdio: ['ignore', 'ignore', 'pipe'] });
-let stderr = '';
-browser.stderr.on('data', (c) => { stderr += c; });
-const timeout = new Promise((resolve) => setTimeout(() => resolve(null), 180000));
-const body = await Promise.race([result, timeout]);
-try { process.kill(-browser.pid, 'SIGKILL'); } catch { /* already gone */ }
+// One headless Chromium per page (fresh profile); resolves to the page's report or null after 180 s.
+async function runPage(html, extraArgs, tag) {
+  result = new Promise((resolve) => { resolveResult = resolve; });
+  const profile = fs.mkdtempSync(path.join(work, 'chromium-profile-'));
+  const args = ['--headless=new', '--no-sandbox', '--disable-quic', '--no-first-run', '--disable-background-networking',
+    '--disable-component-update', '--disable-sync', '--disable-default-apps', '--disable-extensions', `--user-data-dir=${profile}`,
+    '--enable-unsafe-swiftshader', '--enable-logging=stderr', '--v=0', ...extraArgs, `http://127.0.0.1:${port}/test/${html}`];
+  const browser = spawn(chromium, args, { detached: true, stdio: ['ignore', 'ignore', 'pipe'] });
+  let stderr = '';
+  browser.stderr.on('data', (c) => { stderr += c; });
+  const timeout = new Promise((resolve) => setTimeout(() => resolve(null), 180000));
+  const body = await Promise.race([result, timeout]);
+  try { process.kill(-browser.pid, 'SIGKILL'); } catch { /* already gone */ }
+  fs.rmSync(profile, { recursive: true, force: true });
+  fs.writeFileSync(W(`chromium_stderr_${tag}.txt`), stderr);
+  check(body !== null, `${tag}: the page reported within 180 s`);
+  if (body === null) {
+    console.log(`served: ${served.join(' ')}`);
+    console.log(stderr.split('\n').slice(-30).join('\n'));
+    return null;
+  }
+  const consoleErrors = stderr.split('\n').filter((l) => /CONSOLE/.test(l) && /(Uncaught|Error)/.test(l));
+  for (const l of consoleErrors) console.log(`  chromium: ${l}`);
+  check(consoleErrors.length === 0, `${tag}: no console error in Chromium's log`);
+  check(/CONSOLE.*zhc three.js LightProbeGrid page done/.test(stderr), `${tag}: the page's console output reaches Chromium's log (so the check above can fail)`);
+  return JSON.parse(body);
+}
+const reports = {
+  webgl: await runPage('three_grid.html', ['--use-angle=swiftshader'], 'webgl'),
+  webgpu: await runPage('three_grid_webgpu.html', ['--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader', '--use-angle=swiftshader'], 'webgpu'),
+};
 server.close();
-fs.rmSync(profile, { recursive: true, force: true });
-fs.writeFileSync(W('chromium_stderr.txt'), stderr);
 
 // --- 4. assertions -----------------------------------------------------------------------------
-check(body !== null, 'the page reported within 180 s');
-if (body === null) {
-  console.log(`served: ${served.join(' ')}`);
-  console.log(stderr.split('\n').slice(-30).join('\n'));
-  process.exit(1);
+fs.writeFileSync(W('report.json'), JSON.stringify(reports, null, 1));
+if (reports.webgl === null || reports.webgpu === null) process.exit(1);
+for (const [tag, report] of Object.entries(reports)) {
+  console.log(`Chromium ${tag}: three.js r${report.three}, renderer "${report.renderer}"` + (tag === 'webgl'
+    ? `, WebGL2 ${report.webgl2}, EXT_color_buffer_float ${report.colorBufferFloat}, OES_texture_float_linear ${report.floatLinear}`
+    : `, WebGPU backend ${report.webgpuBackend}`));
+  for (const e of report.errors ?? []) console.log(`  page: ${e}`);
+  check((report.errors ?? []).length === 0, `${tag}: no console error, warning or exception in the page`);
+  check(report.three === '187', `${tag}: three.js r187 (the pinned version)`);
+  check(Array.isArray(report.files) && report.files.length === files.length, `${tag}: every file reported`);
 }
-const report = JSON.parse(body);
-fs.writeFileSync(W('report.json'), JSON.stringify(report, null, 1));
-console.log(`Chromium: three.js r${report.three}, WebGL2 ${report.webgl2}, EXT_color_buffer_float ${report.colorBufferFloat}, ` +
-  `OES_texture_float_linear ${report.floatLinear}, renderer "${report.renderer}"`);
-for (const e of report.errors ?? []) console.log(`  page: ${e}`);
-check((report.errors ?? []).length === 0, 'no console error, warning or exception in the page');
-const consoleErrors = stderr.split('\n').filter((l) => /CONSOLE/.test(l) && /(Uncaught|Error)/.test(l));
-for (const l of consoleErrors) console.log(`  chromium: ${l}`);
-check(consoleErrors.length === 0, 'no console error in Chromium\'s log');
-check(/CONSOLE.*zhc three.js LightProbeGrid page done/.test(stderr), 'the page\'s console output reaches Chromium\'s log (so the check above can fail)');
-check(report.webgl2 === true && report.colorBufferFloat === true && report.floatLinear === true, 'WebGL2 with EXT_color_buffer_float and OES_texture_float_linear');
-check(report.three === '187', 'three.js r187 (the pinned version)');
-check(Array.isArray(report.files) && report.files.length === files.length, 'every file reported');
+check(reports.webgl.webgl2 === true && reports.webgl.colorBufferFloat === true && reports.webgl.floatLinear === true,
+  'webgl: WebGL2 with EXT_color_buffer_float and OES_texture_float_linear');
+check(reports.webgpu.webgpuBackend === true, 'webgpu: WebGPURenderer runs on its WebGPU backend (not the WebGL fallback)');
 const TOL_FLOAT = 2e-5, TOL_HALF = 2 ** -11 + 2e-5, TOL_STANDARD = 2e-5, TOL_HALF_STORAGE = 2 ** -11;
-for (const r of report.files ?? []) {
+for (const [tag, report] of Object.entries(reports)) for (const r of report.files ?? []) {
   const f = files.find((x) => x.glb === r.glb);
-  check(r.samples.length === SAMPLES, `${r.glb}: ${SAMPLES} spheres rendered`);
-  check(r.rotationRefused === true, `${r.glb}: a rotated node is refused (three.js's grid is axis-aligned)`);
+  const gpu = tag === 'webgpu';
+  check(r.samples.length === SAMPLES, `${tag} ${r.glb}: ${SAMPLES} spheres rendered`);
+  check(r.rotationRefused === true, `${tag} ${r.glb}: a rotated node is refused (three.js's grid is axis-aligned)`);
+  check(r.halfAtlasType === true, `${tag} ${r.glb}: the binary16 atlas (WebGPU: lightProbeGrid's default) is HalfFloatType`);
   // Bounds: the node's world matrix (translation + scale) moves the box [origin - s/2, origin + (n - 1/2) s].
   const g = gltfGrid(W(f.glb)), e = r.nodeMatrix;
   let boundsErr = 0;
   for (let c = 0; c < 3; c++) {
     const lo = e[12 + c] + e[5 * c] * (g.origin[c] - 0.5 * g.spacing[c]);
     const hi = e[12 + c] + e[5 * c] * (g.origin[c] + (g.counts[c] - 0.5) * g.spacing[c]);
-    boundsErr = Math.max(boundsErr, Math.abs(r.boundsFloat[c] - lo), Math.abs(r.boundsFloat[3 + c] - hi),
-      Math.abs(r.boundsHalf[c] - lo), Math.abs(r.boundsHalf[3 + c] - hi));
+    boundsErr = Math.max(boundsErr, Math.abs(r.boundsHalf[c] - lo), Math.abs(r.boundsHalf[3 + c] - hi));
+    if (!gpu) boundsErr = Math.max(boundsErr, Math.abs(r.boundsFloat[c] - lo), Math.abs(r.boundsFloat[3 + c] - hi));
   }
-  check(boundsErr < 1e-9, `${r.glb}: the grid's world box is the node's probe box grown by half a cell (error ${boundsErr})`);
+  check(boundsErr < 1e-9, `${tag} ${r.glb}: the grid's world box is the node's probe box grown by half a cell (error ${boundsErr})`);
   const stat = () => ({ max: 0, sum: 0, n: 0, worstScaled: 0 });
   const lf = stat(), lh = stat(), sg = stat(), js = stat(), ht = stat(), hs = stat(), off = stat();
   let meanE = 0, jsAbs = 0;
@@ -203,9 +220,11 @@ for (const r of report.files ?? []) {
         st.worstScaled = Math.max(st.worstScaled, Math.abs(got - ref) / scaleBy);
         return Math.abs(got - ref) <= tol * scaleBy;
       };
-      const okF = add(lf, s.lambertFloat[k], E, TOL_FLOAT, S);
+      const okF = gpu || add(lf, s.lambertFloat[k], E, TOL_FLOAT, S);
       const okH = add(lh, s.lambertHalf[k], E, TOL_HALF, S);
-      const okS = add(sg, s.standardGrid[k], s.standardProbe[k], TOL_STANDARD, Math.abs(s.standardProbe[k]));
+      // WebGPU: its grid is the binary16 atlas, the LightProbe holds float SH: 2^-11 S more.
+      const okS = gpu ? add(sg, s.standardGrid[k], s.standardProbe[k], TOL_HALF, S)
+        : add(sg, s.standardGrid[k], s.standardProbe[k], TOL_STANDARD, Math.abs(s.standardProbe[k]));
       add(js, s.js[k], E, 0, 1);
       add(off, f.atSurface[i][k], E, 0, S);
       // binary16 atlas = the half twin (rendering error) and the half twin vs the exact probes
@@ -213,22 +232,22 @@ for (const r of report.files ?? []) {
       // coefficients in binary16's subnormal range, whose error is <= 2^-25).
       const okHT = add(ht, s.lambertHalf[k], s.halfTwin[k], TOL_FLOAT, S);
       const okHS = add(hs, s.halfTwin[k], E, TOL_HALF_STORAGE, S) || Math.abs(s.halfTwin[k] - E) <= TOL_HALF_STORAGE * S + 1e-7;
-      check(okHT, `${r.glb} sample ${i}: binary16 atlas pixel = its double twin within ${TOL_FLOAT} S`);
-      check(okHS, `${r.glb} sample ${i}: binary16 storage moves E by at most 2^-11 S`);
+      check(okHT, `${tag} ${r.glb} sample ${i}: binary16 atlas pixel = its double twin within ${TOL_FLOAT} S`);
+      check(okHS, `${tag} ${r.glb} sample ${i}: binary16 storage moves E by at most 2^-11 S`);
       jsAbs = Math.max(jsAbs, Math.abs(s.js[k] - E));
       if (!okF || !okH || !okS)
-        console.log(`  ${r.glb} sample ${i} ch ${k}: q ${s.q} d ${s.d}: C ${E}, Lambert float ${s.lambertFloat[k]}, half ` +
+        console.log(`  ${tag} ${r.glb} sample ${i} ch ${k}: q ${s.q} d ${s.d}: C ${E}, Lambert float ${s.lambertFloat[k]}, half ` +
           `${s.lambertHalf[k]}, Standard grid ${s.standardGrid[k]} vs LightProbe ${s.standardProbe[k]}, S ${S}`);
-      check(okF, `${r.glb} sample ${i}: float atlas pixel = C zhc_volume_irradiance within ${TOL_FLOAT} S`);
-      check(okH, `${r.glb} sample ${i}: binary16 atlas pixel within ${TOL_HALF.toExponential(3)} S`);
-      check(okS, `${r.glb} sample ${i}: MeshStandardMaterial with the grid = with a LightProbe of the blended SH within ${TOL_STANDARD}`);
-      check(E > 0 && s.standardGrid[k] > 0, `${r.glb} sample ${i}: lit (E > 0, Standard pixel > 0)`);
+      check(okF, `${tag} ${r.glb} sample ${i}: float atlas pixel = C zhc_volume_irradiance within ${TOL_FLOAT} S`);
+      check(okH, `${tag} ${r.glb} sample ${i}: binary16 atlas pixel within ${TOL_HALF.toExponential(3)} S`);
+      check(okS, `${tag} ${r.glb} sample ${i}: MeshStandardMaterial with the grid = with a LightProbe of the blended SH`);
+      check(E > 0 && s.standardGrid[k] > 0, `${tag} ${r.glb} sample ${i}: lit (E > 0, Standard pixel > 0)`);
     }
   });
   const fmt = (st) => `max ${st.max.toExponential(2)}, mean ${(st.sum / st.n).toExponential(2)} (max |diff|/S ${st.worstScaled.toExponential(2)})`;
-  console.log(`${r.glb} (${r.encoding} ${r.counts.join('x')} grid, node at scale ${f.rootScale}, mean E ${meanE.toPrecision(4)}): ` +
+  console.log(`${tag}: ${r.glb} (${r.encoding} ${r.counts.join('x')} grid, node at scale ${f.rootScale}, mean E ${meanE.toPrecision(4)}): ` +
     `${r.samples.length} spheres x 3 channels, relative error against the C header:`);
-  console.log(`  MeshLambertMaterial, float atlas:    ${fmt(lf)}`);
+  if (!gpu) console.log(`  MeshLambertMaterial, float atlas:    ${fmt(lf)}`);
   console.log(`  MeshLambertMaterial, binary16 atlas: ${fmt(lh)}`);
   console.log(`    binary16 atlas pixel vs its twin (rendering): ${fmt(ht)}`);
   console.log(`    binary16 twin vs C (what half storage loses): ${fmt(hs)}`);
@@ -236,6 +255,6 @@ for (const r of report.files ?? []) {
   console.log(`  (three.js's half-cell offset: E at the shaded point vs at three.js's sample point differs by mean ` +
     `${(off.sum / off.n).toExponential(2)}, max ${off.max.toExponential(2)} relative)`);
   console.log(`  JS irradianceAt (glTF) vs C (.zhp, zhc axes): max |diff| / mean E ${(jsAbs / meanE).toExponential(2)}`);
-  check(jsAbs <= 1e-6 * meanE, `${r.glb}: the plugin's irradianceAt agrees with the C header (1e-6 of the mean, js.runtime_volume's bound)`);
+  check(jsAbs <= 1e-6 * meanE, `${tag} ${r.glb}: the plugin's irradianceAt agrees with the C header (1e-6 of the mean, js.runtime_volume's bound)`);
 }
 finish('three.js LightProbeGrid');

@@ -1,4 +1,5 @@
-// The browser side of tests/js/three_grid.mjs: three.js r187's own LightProbeGridWebGL filled by
+// The browser side of tests/js/three_grid.mjs: three.js r187's own LightProbeGridWebGL (or, from
+// three_grid_webgpu.html, LightProbeGrid with WebGPURenderer) filled by
 // ZhcProbeVolume.lightProbeGrid from a zhc grid volume, lighting stock materials. For each sample
 // (/work/three_grid_spec.json) a white sphere is rendered alone (no other light, tone mapping off,
 // linear RGBA32F target): the sphere is turned so that its pole vertex (normal exactly +Y in
@@ -12,7 +13,6 @@
 // (irradianceAt, bit-identical to the C header) with the term scale of the sample.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { LightProbeGridWebGL } from 'three/addons/lighting/LightProbeGridWebGL.js';
 import { ZhcLightProbesPlugin } from '/runtime/web/zhc_light_probes_plugin.mjs';
 import { makeVolume, volumeSH3, volumeIrradiance, rotateZhcToGltf, rotateGltfToZhc, toThreeConvention, gltfToZhcDir } from '/runtime/web/zhc_runtime.mjs';
 
@@ -26,26 +26,39 @@ function termWeights(n) {
   return Y.map((v, i) => Math.abs(v) * s[i]);
 }
 
+// three_grid_webgpu.html sets window.zhcWebGPU and maps 'three' to three.webgpu.js: WebGPURenderer
+// with three.js's WebGPU LightProbeGrid (same atlas; binary16 by default, no float atlas: rgba32float
+// is not filterable in WebGPU without "float32-filterable").
+const WEBGPU = window.zhcWebGPU === true;
+
 async function main() {
   const spec = await (await fetch('/work/three_grid_spec.json')).json();
   const canvas = document.createElement('canvas');
-  const renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
+  const report = { webgpu: WEBGPU, three: THREE.REVISION, files: [] };
+  let renderer, GridClass;
+  if (WEBGPU) {
+    renderer = new THREE.WebGPURenderer({ canvas, antialias: false });
+    await renderer.init();
+    report.webgpuBackend = renderer.backend.isWebGPUBackend === true;
+    const info = renderer.backend.device?.adapterInfo ?? renderer.backend.adapter?.info;
+    report.renderer = info ? `${info.vendor} ${info.architecture} ${info.device} ${info.description}` : 'unknown';
+    GridClass = (await import('three/addons/lighting/LightProbeGrid.js')).LightProbeGrid;
+  } else {
+    renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
+    const gl = renderer.getContext();
+    const dbg = gl.getExtension('WEBGL_debug_renderer_info');
+    report.webgl2 = gl instanceof WebGL2RenderingContext;
+    report.colorBufferFloat = !!gl.getExtension('EXT_color_buffer_float');
+    report.floatLinear = !!gl.getExtension('OES_texture_float_linear');
+    report.renderer = dbg ? gl.getParameter(dbg.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);
+    GridClass = (await import('three/addons/lighting/LightProbeGridWebGL.js')).LightProbeGridWebGL;
+  }
   renderer.toneMapping = THREE.NoToneMapping;
-  const gl = renderer.getContext();
-  const dbg = gl.getExtension('WEBGL_debug_renderer_info');
-  const report = {
-    webgl2: gl instanceof WebGL2RenderingContext,
-    colorBufferFloat: !!gl.getExtension('EXT_color_buffer_float'),
-    floatLinear: !!gl.getExtension('OES_texture_float_linear'),
-    renderer: dbg ? gl.getParameter(dbg.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER),
-    three: THREE.REVISION,
-    files: [],
-  };
   const loader = new GLTFLoader();
   loader.register((parser) => new ZhcLightProbesPlugin(parser));
   const SIZE = 33, MID = 16;
-  const rt = new THREE.WebGLRenderTarget(SIZE, SIZE, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true });
-  const px = new Float32Array(4);
+  const rt = new (WEBGPU ? THREE.RenderTarget : THREE.WebGLRenderTarget)(SIZE, SIZE, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true });
+  let px = new Float32Array(4);
   for (const f of spec.files) {
     const gltf = await loader.loadAsync(`/work/${f.glb}`);
     const v = gltf.userData.zhcLightProbes[0];
@@ -59,13 +72,15 @@ async function main() {
     const node = v.nodes[0];
     const m = node.matrixWorld.clone();
     r.nodeMatrix = Array.from(m.elements);
-    const gridF = v.lightProbeGrid(LightProbeGridWebGL);                        // default: the node's matrixWorld
-    const gridH = v.lightProbeGrid(LightProbeGridWebGL, { matrixWorld: m, type: THREE.HalfFloatType });
-    r.boundsFloat = [...gridF.boundingBox.min.toArray(), ...gridF.boundingBox.max.toArray()];
+    // Default type (WebGL: float; WebGPU: binary16) at the node's matrixWorld (the default placement).
+    const gridF = WEBGPU ? null : v.lightProbeGrid(GridClass);
+    const gridH = WEBGPU ? v.lightProbeGrid(GridClass) : v.lightProbeGrid(GridClass, { matrixWorld: m, type: THREE.HalfFloatType });
+    r.halfAtlasType = gridH.texture.type === THREE.HalfFloatType;
+    r.boundsFloat = gridF ? [...gridF.boundingBox.min.toArray(), ...gridF.boundingBox.max.toArray()] : null;
     r.boundsHalf = [...gridH.boundingBox.min.toArray(), ...gridH.boundingBox.max.toArray()];
     // Refusals: a rotated node, a non-grid class argument.
     const rot = new THREE.Matrix4().makeRotationY(0.3).premultiply(m);
-    r.rotationRefused = (() => { try { v.lightProbeGrid(LightProbeGridWebGL, { matrixWorld: rot }); return false; } catch (e) { return /axis-aligned/.test(e.message); } })();
+    r.rotationRefused = (() => { try { v.lightProbeGrid(GridClass, { matrixWorld: rot }); return false; } catch (e) { return /axis-aligned/.test(e.message); } })();
     const e = m.elements, scale = [e[0], e[5], e[10]], t = [e[12], e[13], e[14]];
     const spacingW = [0, 1, 2].map((c) => scale[c] * v.grid.spacing[c]);
     const radius = 0.05 * Math.min(...spacingW);
@@ -85,12 +100,12 @@ async function main() {
       halfSh.set(rotateGltfToZhc(toThreeConvention(c)), p * 27);
     }
     const halfVol = makeVolume({ sh: halfSh, ...v.grid });
-    const shot = (scene) => {
+    const shot = async (scene) => {
       renderer.setRenderTarget(rt);
       renderer.setClearColor(0x000000, 0);
-      renderer.clear();
       renderer.render(scene, cam);
-      renderer.readRenderTargetPixels(rt, MID, MID, 1, 1, px);
+      if (WEBGPU) px = await renderer.readRenderTargetPixelsAsync(rt, MID, MID, 1, 1);
+      else renderer.readRenderTargetPixels(rt, MID, MID, 1, 1, px);
       renderer.setRenderTarget(null);
       return [px[0], px[1], px[2]];
     };
@@ -106,11 +121,13 @@ async function main() {
       cam.lookAt(centre);
       cam.updateMatrixWorld();
       const out = { q: s.q, d: s.d };
-      for (const [key, grid, material] of [['lambertFloat', gridF, lambert], ['lambertHalf', gridH, lambert], ['standardGrid', gridF, standard]]) {
+      const shots = WEBGPU ? [['lambertHalf', gridH, lambert], ['standardGrid', gridH, standard]]
+        : [['lambertFloat', gridF, lambert], ['lambertHalf', gridH, lambert], ['standardGrid', gridF, standard]];
+      for (const [key, grid, material] of shots) {
         const scene = new THREE.Scene();
         mesh.material = material;
         scene.add(mesh, grid);
-        out[key] = shot(scene);
+        out[key] = await shot(scene);
       }
       // The twin of the Standard render: three.js's LightProbe holding the SH blended by zhc's volume at q.
       {
@@ -121,7 +138,7 @@ async function main() {
         const scene = new THREE.Scene();
         mesh.material = standard;
         scene.add(mesh, new THREE.LightProbe(sh));
-        out.standardProbe = shot(scene);
+        out.standardProbe = await shot(scene);
       }
       out.js = v.irradianceAt(s.q, s.d);
       out.halfTwin = volumeIrradiance(halfVol, s.q, gltfToZhcDir(s.d));
