@@ -193,6 +193,8 @@ for (const [tag, report] of Object.entries(reports)) for (const r of report.file
   const gpu = tag === 'webgpu';
   check(r.samples.length === SAMPLES, `${tag} ${r.glb}: ${SAMPLES} spheres rendered`);
   check(r.rotationRefused === true, `${tag} ${r.glb}: a rotated node is refused (three.js's grid is axis-aligned)`);
+  check(Array.isArray(r.refusals) && r.refusals.length === 5 && r.refusals.every((x) => x === true),
+    `${tag} ${r.glb}: lightProbeGrid refuses a non-grid class, a byte type, a mirror, a points volume, spacing 0 (${r.refusals})`);
   check(r.halfAtlasType === true, `${tag} ${r.glb}: the binary16 atlas (WebGPU: lightProbeGrid's default) is HalfFloatType`);
   // Bounds: the node's world matrix (translation + scale) moves the box [origin - s/2, origin + (n - 1/2) s].
   const g = gltfGrid(W(f.glb)), e = r.nodeMatrix;

@@ -13,7 +13,7 @@
 // (irradianceAt, bit-identical to the C header) with the term scale of the sample.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { ZhcLightProbesPlugin } from '/runtime/web/zhc_light_probes_plugin.mjs';
+import { ZhcLightProbesPlugin, ZhcProbeVolume } from '/runtime/web/zhc_light_probes_plugin.mjs';
 import { makeVolume, volumeSH3, volumeIrradiance, rotateZhcToGltf, rotateGltfToZhc, toThreeConvention, gltfToZhcDir } from '/runtime/web/zhc_runtime.mjs';
 
 // |Y_i(n)| times zhc's band scale (1, 2/3, 1/4): the magnitude of coefficient i's term in E(n).
@@ -81,6 +81,16 @@ async function main() {
     // Refusals: a rotated node, a non-grid class argument.
     const rot = new THREE.Matrix4().makeRotationY(0.3).premultiply(m);
     r.rotationRefused = (() => { try { v.lightProbeGrid(GridClass, { matrixWorld: rot }); return false; } catch (e) { return /axis-aligned/.test(e.message); } })();
+    const throwsWith = (f, re) => { try { f(); return false; } catch (err) { return re.test(err.message); } };
+    const one = { name: 'one', encoding: 'sh3', count: 1, shAxes: 'zhc', sh: new Float32Array(27), positions: new Float32Array(3) };
+    r.refusals = [
+      throwsWith(() => v.lightProbeGrid(THREE.Object3D), /LightProbeGridWebGL or LightProbeGrid class/),
+      throwsWith(() => v.lightProbeGrid(GridClass, { type: THREE.UnsignedByteType }), /FloatType or THREE.HalfFloatType/),
+      throwsWith(() => v.lightProbeGrid(GridClass, { matrixWorld: new THREE.Matrix4().makeScale(1, -1, 1) }), /axis-aligned/),
+      throwsWith(() => new ZhcProbeVolume({ ...one, layout: 'points' }).lightProbeGrid(GridClass), /needs a grid/),
+      throwsWith(() => new ZhcProbeVolume({ ...one, layout: 'grid', grid: { origin: [0, 0, 0], spacing: [1, 0, 1], counts: [1, 1, 1] } })
+        .lightProbeGrid(GridClass), /spacing\[1\]/),
+    ];
     const e = m.elements, scale = [e[0], e[5], e[10]], t = [e[12], e[13], e[14]];
     const spacingW = [0, 1, 2].map((c) => scale[c] * v.grid.spacing[c]);
     const radius = 0.05 * Math.min(...spacingW);
