@@ -11,7 +11,8 @@
 //
 // Every volume is decoded at load by zhc_runtime.mjs into SH3 radiance (bit exact with zhc's own
 // decoder). Nodes that reference a volume get a child Object3D named "ZHC_light_probes" with
-// userData.zhcLightProbeVolume (the index) and userData.zhcLightProbes (the ZhcProbeVolume); three.js
+// userData.zhcLightProbeVolume (the index) and userData.zhcLightProbes (the ZhcProbeVolume), listed
+// in the volume's `nodes`; three.js
 // may use it as the node object itself when the node has nothing else. Positions and SH are in that
 // node's local space: for world space, transform positions by anchor.matrixWorld and rotate
 // world directions by the inverse of the anchor's world rotation before a lookup.
