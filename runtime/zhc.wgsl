@@ -45,8 +45,8 @@
 // WGSL specifics handled here: f32 only; no implicit conversions (every literal typed where it
 // matters); non-finite tests on the bits (WGSL has no isnan/isinf and lets compilers assume finite
 // maths); powers of two built from exponent bits (no exp2, no frexp); subnormals may be flushed by
-// the implementation, so halves are unpacked with integer ops (not unpack2x16float) and a
-// subnormal-only L1 vector is normalised from its integer mantissas; arrays indexed dynamically only
+// the implementation, so halves are unpacked with integer ops (not unpack2x16float) and the L1
+// vectors that give the zonal axes are rescaled from their bits (zhcScaledComponent); arrays indexed dynamically only
 // through `var` copies.
 //
 // Robustness: every function is total. Garbage words give finite-or-NaN/Inf results, never a
@@ -244,8 +244,11 @@ fn zhcZeroSh3() -> ZhcSh3 { return ZhcSh3(array<vec3<f32>, 9>()); }
 
 // ---- ZH3: zonal axes, expansion, evaluation (ZH3 paper Sec. 3, codec/probe/zh3.cpp) ----------------
 
+// -x by flipping the sign bit: an arithmetic negation may flush a subnormal x to zero.
+fn zhcNeg(x: f32) -> f32 { return bitcast<f32>(bitcast<u32>(x) ^ 0x80000000u); }
+
 // The L1 band of channel k as a vector: v = (-f11, -f1-1, f10), f1(d) = Y1 v.d.
-fn zhcL1Vector(s: ZhcSh3, k: i32) -> vec3<f32> { return vec3<f32>(-s.c[3][k], -s.c[1][k], s.c[2][k]); }
+fn zhcL1Vector(s: ZhcSh3, k: i32) -> vec3<f32> { return vec3<f32>(zhcNeg(s.c[3][k]), zhcNeg(s.c[1][k]), s.c[2][k]); }
 
 // Largest magnitude of v as the bit pattern of |component| (positive floats order like their bits).
 fn zhcMaxMagnitudeBits(v: vec3<f32>) -> u32 {
@@ -253,59 +256,60 @@ fn zhcMaxMagnitudeBits(v: vec3<f32>) -> u32 {
     return max(b.x, max(b.y, b.z));
 }
 
-// v 2^149 for a v whose components are all zero or subnormal, exact, from the integer mantissas:
-// WGSL lets implementations flush subnormal operands to zero (SwiftShader does), which would turn
-// the axis of a tiny but non-zero L1 into +Z where the codec (double) normalises it.
-fn zhcSubnormalUnits(v: vec3<f32>) -> vec3<f32> {
-    let b = bitcast<vec3<u32>>(v);
-    let mag = vec3<f32>(b & vec3<u32>(0x007FFFFFu));
-    return select(mag, -mag, (b & vec3<u32>(0x80000000u)) != vec3<u32>(0u));
+// x 2^e for e in [-252, 254] as two exact power-of-two multiplies (each factor in range).
+fn zhcLdexp(x: f32, e: i32) -> f32 { return x * zhcPow2(e >> 1u) * zhcPow2(e - (e >> 1u)); }
+
+// The exponent p of the magnitude with bit pattern mb > 0 (finite): |x| in [2^p, 2^(p+1)); subnormals
+// from the position of their leading mantissa bit.
+fn zhcExponentOfBits(mb: u32) -> i32 {
+    let eb = i32(mb >> 23u);
+    return select(eb - 127, i32(firstLeadingBit(mb)) - 149, eb == 0);
 }
 
-// 2^(1 - e) for m = f 2^e, f in [0.5, 1) (frexp), from the bit pattern of a normal m > 0.
-fn zhcFrexpScaleBits(mBits: u32) -> f32 { return zhcPow2(127 - i32(mBits >> 23u)); }
+// x 2^s, exact whenever the result is a normal float, also for a subnormal x (rebuilt from its
+// integer mantissa): WGSL lets implementations flush subnormal operands to zero (SwiftShader does),
+// which would lose the tiny components of an L1 vector that the codec (double) keeps, and turn the
+// axis of a tiny L1 into +Z. s in [-127, 149].
+fn zhcScaledComponent(x: f32, s: i32) -> f32 {
+    let b = bitcast<u32>(x);
+    if ((b & 0x7F800000u) != 0u) { return zhcLdexp(x, s); }
+    let r = zhcLdexp(f32(b & 0x007FFFFFu), max(s - 149, -252));
+    return select(r, -r, (b & 0x80000000u) != 0u);
+}
+fn zhcScaled3(v: vec3<f32>, s: i32) -> vec3<f32> {
+    return vec3<f32>(zhcScaledComponent(v.x, s), zhcScaledComponent(v.y, s), zhcScaledComponent(v.z, s));
+}
 
 // Unit vector along v; +Z when v is zero or not finite (codec normalize_or). v is first scaled by
-// a power of two so that its largest component is in [1, 2): the squared length can then neither
-// overflow nor underflow (the codec works in double); a subnormal-only v goes through its integer
-// mantissas first. ~12 flops + inverseSqrt.
+// a power of two so that its largest component is in [1, 2) (exact, subnormal components
+// included): the squared length can then neither overflow nor underflow (the codec works in
+// double). ~12 flops + inverseSqrt.
 fn zhcNormalizeOrZ(v: vec3<f32>) -> vec3<f32> {
     if (!zhcIsFinite3(v)) { return vec3<f32>(0.0, 0.0, 1.0); }
-    var u = v;
-    var mb = zhcMaxMagnitudeBits(v);
+    let mb = zhcMaxMagnitudeBits(v);
     if (mb == 0u) { return vec3<f32>(0.0, 0.0, 1.0); }
-    if (mb < 0x00800000u) {
-        u = zhcSubnormalUnits(v);
-        mb = zhcMaxMagnitudeBits(u);
-    }
-    let w = u * zhcFrexpScaleBits(mb);  // exact (power of two); max |w| in [1, 2)
+    let w = zhcScaled3(v, -zhcExponentOfBits(mb));
     return w * inverseSqrt(dot(w, w));
 }
 
 // Zonal axis of each channel (codec Axes / zh3_axis): the shared axis is the optimal linear
 // direction of the luminance-weighted L1, sum_k w_k v_k; per-channel axes are each channel's own.
-// The nine components are scaled together by a power of two first (exact) so the weighted sum
-// cannot overflow for any finite input (subnormal-only components: integer mantissas, as above).
-// ~40 flops, one or three inverseSqrt.
+// The nine components are scaled together by a power of two first (exact, as above) so the
+// weighted sum can neither overflow nor lose subnormal components. ~40 flops, one or three
+// inverseSqrt.
 fn zhcZonalAxes(s: ZhcSh3, f: ZhcFormat) -> array<vec3<f32>, 3> {
-    var v0 = zhcL1Vector(s, 0);
-    var v1 = zhcL1Vector(s, 1);
-    var v2 = zhcL1Vector(s, 2);
+    let v0 = zhcL1Vector(s, 0);
+    let v1 = zhcL1Vector(s, 1);
+    let v2 = zhcL1Vector(s, 2);
     if (f.axisMode == ZHC_AXIS_PER_CHANNEL) {
         return array<vec3<f32>, 3>(zhcNormalizeOrZ(v0), zhcNormalizeOrZ(v1), zhcNormalizeOrZ(v2));
     }
     var lum = vec3<f32>(0.0, 0.0, 1.0);
     if (zhcIsFinite3(v0) && zhcIsFinite3(v1) && zhcIsFinite3(v2) && zhcIsFinite3(f.luminance)) {
-        var mb = max(zhcMaxMagnitudeBits(v0), max(zhcMaxMagnitudeBits(v1), zhcMaxMagnitudeBits(v2)));
-        if (mb != 0u && mb < 0x00800000u) {
-            v0 = zhcSubnormalUnits(v0);
-            v1 = zhcSubnormalUnits(v1);
-            v2 = zhcSubnormalUnits(v2);
-            mb = max(zhcMaxMagnitudeBits(v0), max(zhcMaxMagnitudeBits(v1), zhcMaxMagnitudeBits(v2)));
-        }
-        let scale = select(1.0, zhcFrexpScaleBits(mb), mb != 0u);
-        lum = zhcNormalizeOrZ(f.luminance.r * (v0 * scale) + f.luminance.g * (v1 * scale) +
-                              f.luminance.b * (v2 * scale));
+        let mb = max(zhcMaxMagnitudeBits(v0), max(zhcMaxMagnitudeBits(v1), zhcMaxMagnitudeBits(v2)));
+        let e = select(0, -zhcExponentOfBits(mb), mb != 0u);
+        lum = zhcNormalizeOrZ(f.luminance.r * zhcScaled3(v0, e) + f.luminance.g * zhcScaled3(v1, e) +
+                              f.luminance.b * zhcScaled3(v2, e));
     }
     return array<vec3<f32>, 3>(lum, lum, lum);
 }

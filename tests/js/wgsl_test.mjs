@@ -424,6 +424,8 @@ let stderr = '';
 browser.stderr.on('data', (ch) => { stderr += ch; });
 const timeout = new Promise((resolve) => setTimeout(() => resolve(null), 420000));
 const body = await Promise.race([done, timeout]);
+// The page logs its last line just before posting /done: give Chromium's log a moment to carry it.
+for (let i = 0; i < 50 && body !== null && !/zhc wgsl page done/.test(stderr); i++) await new Promise((r) => setTimeout(r, 100));
 try { process.kill(-browser.pid, 'SIGKILL'); } catch { /* already gone */ }
 server.close();
 fs.rmSync(profile, { recursive: true, force: true });
