@@ -21,8 +21,13 @@
 //  3. a loopback HTTP server and headless Chromium (WebGPU on SwiftShader): tests/js/browser/
 //     wgsl_page.mjs compiles zhc.wgsl + tests/js/browser/wgsl_kernel.wgsl and runs every batch in a
 //     compute shader (zhcDecode + zhcIrradiance per probe, uniform random normals), posting the floats;
-//  4. asserts: no console error or WebGPU validation error, no compilation message, every probe of
-//     every encoding compared, every value within its bound; prints the per-encoding maxima.
+//  4. probe volumes (runtime/zhc_volume.wgsl, zhcVolumeIrradiance) per encoding on two grids of
+//     encoded probes (6x5x4 default parameters, 5x1x3 non-default ones, a count-1 axis), 10,000
+//     points in and around the box plus every probe's position, against a double-precision twin of
+//     zhc_volume_irradiance_d (the C header's sampler) over the JS runtime's decoded probes, with the
+//     bound of test_runtime_gl's volume test;
+//  5. asserts: no console error or WebGPU validation error, no compilation message, every probe and
+//     sample of every encoding compared, every value within its bound; prints the per-encoding maxima.
 // Time bounded: the browser part times out after 420 s (Chromium killed).
 import fs from 'node:fs';
 import path from 'node:path';
@@ -231,11 +236,24 @@ function formatBytes(e, p) {
   f.set([runtime.HALLUCINATE_CURVE_A, runtime.HALLUCINATE_CURVE_B], 16);
   return new Uint8Array(buf);
 }
-function jobBytes(kernel, stride, count, outFloats, normalFloats, fmt, words, normals) {
+// A job for the page (wgsl_page.mjs): header, the kernel's Job uniform (stride, count, grid), the
+// format uniform, the probe words, the item inputs.
+function jobBytes(kernel, count, outFloats, itemFloats, stride, grid, fmt, words, itemData) {
   const head = new Uint32Array(16);
-  head.set([kernel, stride, count, outFloats, normalFloats]);
-  return Buffer.concat([Buffer.from(head.buffer), Buffer.from(fmt), Buffer.from(words.buffer, words.byteOffset, words.byteLength),
-    Buffer.from(normals.buffer, normals.byteOffset, normals.byteLength)]);
+  head.set([kernel, count, outFloats, itemFloats, words.length]);
+  const job = new ArrayBuffer(64);
+  new Uint32Array(job, 0, 4).set([stride, count, 0, 0]);
+  if (grid) {
+    new Float32Array(job, 16, 8).set([...grid.origin, 0, ...grid.spacing, 0]);
+    new Uint32Array(job, 48, 4).set([...grid.counts, 0]);
+  }
+  return Buffer.concat([Buffer.from(head.buffer), Buffer.from(job), Buffer.from(fmt), Buffer.from(words.buffer, words.byteOffset, words.byteLength),
+    Buffer.from(itemData.buffer, itemData.byteOffset, itemData.byteLength)]);
+}
+function wordsOf(bytes) {
+  const words = new Uint32Array(bytes.length / 4);
+  new Uint8Array(words.buffer).set(bytes);
+  return words;
 }
 
 // --- error scale (tests/gl/runtime_gl_entries.inl probe_scale, check_value) -----------------------
@@ -351,6 +369,112 @@ function compareCase(c, gpu) {
   }
 }
 
+function decodeJob(c) {
+  loadCase(c, caseRand);
+  c.outFloats = kBatchSize * 30;
+  return jobBytes(0, kBatchSize, 30, 3, c.e.bytes / 4, null, formatBytes(c.e, c.p), wordsOf(c.bytes), c.normals);
+}
+
+// --- probe volumes (zhc_volume.wgsl) against a double twin of zhc_volume_irradiance_d -------------
+// Two grids per encoding, as test_runtime_gl's compare_volumes: 6x5x4 probes of batch 0 (default
+// parameters) and 5x1x3 of batch 5 (irradiance storage, 3 bits, loose bound, symmetric zonal map,
+// per-channel axes, RGB9E5 / half DC); 10,000 points in and around the box (1.5 times its size, a
+// count-1 axis 2 spacings wide) and every probe's own position, random unit normals.
+const kVolumeSamples = 10000;
+const volumeGrids = [{ counts: [6, 5, 4], batch: 0 }, { counts: [5, 1, 3], batch: 5 }];
+const volumeOrigin = [-1.5, 2.0, 0.25], volumeSpacing = [0.75, 0.5, 1.25];  // exact in float
+const volumeTallies = new Map(encodings.map((e) => [e.name, { ...tally(), samples: 0, skipped: 0 }]));
+function volumeJob(c) {
+  const z = runtime.parseZhp(new Uint8Array(fs.readFileSync(c.zhp)));
+  const counts = c.grid.counts, count = counts[0] * counts[1] * counts[2];
+  c.p = z.params;
+  c.bytes = z.payload.slice(0, count * c.e.bytes);
+  c.decoded = Array.from({ length: count }, (_, q) => runtime.decodeProbe(c.e.name, c.bytes, q * c.e.bytes, c.p));
+  const n = kVolumeSamples + count;
+  c.items = new Float32Array(6 * n);
+  for (let i = 0; i < n; i++) {
+    for (let a = 0; a < 3; a++) {
+      const size = counts[a] > 1 ? (counts[a] - 1) * volumeSpacing[a] : 2 * volumeSpacing[a];
+      const lo = counts[a] > 1 ? volumeOrigin[a] - 0.25 * size : volumeOrigin[a] - volumeSpacing[a];
+      const node = i - kVolumeSamples;
+      const at = a === 0 ? node % counts[0] : a === 1 ? Math.floor(node / counts[0]) % counts[1] : Math.floor(node / (counts[0] * counts[1]));
+      c.items[6 * i + a] = i < kVolumeSamples ? lo + 1.5 * size * caseRand() : volumeOrigin[a] + at * volumeSpacing[a];
+    }
+    const zz = 2 * caseRand() - 1, phi = 2 * Math.PI * caseRand(), r = Math.sqrt(Math.max(0, 1 - zz * zz));
+    c.items.set([r * Math.cos(phi), r * Math.sin(phi), zz], 6 * i + 3);
+  }
+  c.samples = n;
+  c.outFloats = 3 * n;
+  return jobBytes(1, n, 3, 6, c.e.bytes / 4, { origin: volumeOrigin, spacing: volumeSpacing, counts }, formatBytes(c.e, c.p),
+    wordsOf(c.bytes), c.items);
+}
+// Cell of one axis (zhc__volume_axis of zhc_runtime.h): t clamped to [0, n - 1] (NaN: 0), i0 =
+// min(floor(t), n - 2), f = t - i0 (0 for n = 1).
+function volumeAxis(x, o, sp, n) {
+  let t = (x - o) / sp;
+  if (!(t >= 0)) t = 0;
+  if (t > n - 1) t = n - 1;
+  let i = Math.floor(t);
+  if (n >= 2 && i > n - 2) i = n - 2;
+  return { i0: i, f: n >= 2 ? t - i : 0, t };
+}
+// zhc_volume_irradiance_d in double: blend of the decoded SH3 (float32, = zhc_decode_probe),
+// normalised normal (+Z when zero / not finite), band scales 1, 2/3, 1/4.
+function volumeIrradianceD(c, pos, nrm) {
+  const counts = c.grid.counts;
+  const ax = [0, 1, 2].map((a) => volumeAxis(pos[a], volumeOrigin[a], volumeSpacing[a], counts[a]));
+  const sh = new Float64Array(27);
+  const corners = [];
+  for (let corner = 0; corner < 8; corner++) {
+    const b = [corner & 1, (corner >> 1) & 1, corner >> 2];
+    const w = (b[0] ? ax[0].f : 1 - ax[0].f) * (b[1] ? ax[1].f : 1 - ax[1].f) * (b[2] ? ax[2].f : 1 - ax[2].f);
+    const q = b.map((bb, a) => ax[a].i0 + bb);
+    if (q.every((qq, a) => qq < counts[a])) corners.push(q[0] + counts[0] * (q[1] + counts[1] * q[2]));
+    if (w === 0) continue;
+    const d = c.decoded[q[0] + counts[0] * (q[1] + counts[1] * q[2])];
+    for (let j = 0; j < 27; j++) sh[j] += w * d[j];
+  }
+  let len = Math.hypot(nrm[0], nrm[1], nrm[2]);
+  const n = len > 0 && Number.isFinite(len) ? nrm.map((x) => x / len) : [0, 0, 1];
+  const y = runtime.shBasis(n[0], n[1], n[2]);
+  const rgb = [0, 0, 0];
+  for (let i = 0; i < 9; i++) {
+    const s = i === 0 ? 1 : i < 4 ? 2 / 3 : 0.25;
+    for (let k = 0; k < 3; k++) rgb[k] += s * sh[i * 3 + k] * y[i];
+  }
+  return { rgb, corners, ax };
+}
+// Bound (test_runtime_gl compare_volumes): u times the summed probe scales S of the cell's corners,
+// times 48 (decode and evaluation 32, blending 16) + 3 sum_axes ((|p| + |o|) / s + t + 2) (the
+// float error of t = (p - o) / s moves each weight by at most 3 times it).
+function compareVolume(c, gpu) {
+  const t = volumeTallies.get(c.e.name);
+  for (let i = 0; i < c.samples; i++) {
+    const pos = [c.items[6 * i], c.items[6 * i + 1], c.items[6 * i + 2]];
+    const nrm = [c.items[6 * i + 3], c.items[6 * i + 4], c.items[6 * i + 5]];
+    const { rgb, corners, ax } = volumeIrradianceD(c, pos, nrm);
+    let extra = 0;
+    for (let a = 0; a < 3; a++) extra += (Math.abs(pos[a]) + Math.abs(volumeOrigin[a])) / volumeSpacing[a] + ax[a].t + 2;
+    const scale = [0, 0, 0];
+    let defined = true;
+    for (const q of corners) {
+      const sc = probeScale(c.e, c.p, c.decoded[q]);
+      defined = defined && sc.defined;
+      for (let k = 0; k < 3; k++) scale[k] += sc.irradiance[k];
+    }
+    if (!defined) {
+      t.skipped++;
+      continue;
+    }
+    t.samples++;
+    for (let k = 0; k < 3; k++)
+      checkValue(t, 'maxIrr', rgb[k], gpu[3 * i + k], scale[k], 48 + 3 * extra,
+        () => `${c.e.name} grid ${c.grid.counts.join('x')} sample ${i} (position ${pos.join(',')}, normal ${nrm.join(',')}) channel ${k}`);
+  }
+}
+for (const e of encodings)
+  for (const grid of volumeGrids) cases.push({ e, volume: true, grid, zhp: W(`${e.name}_${grid.batch}.zhp`) });
+
 // --- 3. server + Chromium ---------------------------------------------------------------------
 const roots = { '/runtime/': path.join(repo, 'runtime'), '/test/': path.join(here, 'browser') };
 const types = { '.html': 'text/html', '.mjs': 'text/javascript', '.wgsl': 'text/plain' };
@@ -373,22 +497,20 @@ const server = http.createServer(async (req, res) => {
       return;
     }
     current = cases[nextCase++];
-    loadCase(current, caseRand);
-    const words = new Uint32Array(current.bytes.length / 4);
-    new Uint8Array(words.buffer).set(current.bytes);
     res.writeHead(200, { 'Content-Type': 'application/octet-stream' });
-    res.end(jobBytes(0, current.e.bytes / 4, kBatchSize, 30, 3, formatBytes(current.e, current.p), words, current.normals));
+    res.end(current.volume ? volumeJob(current) : decodeJob(current));
     return;
   }
   if (req.method === 'POST' && url.pathname === '/job/result') {
     const body = await readBody(req);
     const gpu = new Float32Array(body.buffer.slice(body.byteOffset, body.byteOffset + body.byteLength));
-    check(current && gpu.length === kBatchSize * 30, `result of job ${nextCase - 1}: ${kBatchSize * 30} floats`);
-    if (current && gpu.length === kBatchSize * 30) {
+    const want = current ? current.outFloats : 0;
+    check(current && gpu.length === want, `result of job ${nextCase - 1}: ${want} floats`);
+    if (current && gpu.length === want) {
       const tc = Date.now();
-      compareCase(current, gpu);
+      (current.volume ? compareVolume : compareCase)(current, gpu);
       compareMs += Date.now() - tc;
-      current.bytes = current.normals = null;
+      current.bytes = current.normals = current.items = current.decoded = null;
       jobsDone++;
     }
     res.end('ok');
@@ -465,6 +587,13 @@ for (const e of encodings) {
     check(t.failures === 0, `${e.name} ${what}: ${t.failures} values out of bound; first: ${t.firstFailure}`);
   check(v.skippedNonfinite + v.skippedIllcond === 0 && v.compared === v.probes * 30, `${e.name}: every valid probe compared (${v.compared} values)`);
   check(g.compared > g.probes * 30 / 2, `${e.name}: most random-byte values compared (${g.compared})`);
+}
+console.log('probe volumes: max error in u S (S summed over the cell\'s corners) of zhcVolumeIrradiance vs a double twin of zhc_volume_irradiance_d:');
+for (const e of encodings) {
+  const t = volumeTallies.get(e.name);
+  console.log(`${e.name.padEnd(22)} ${String(t.samples).padStart(7)} samples ${t.maxIrr.toFixed(3).padStart(8)} u S, skipped ${t.skipped}`);
+  check(t.failures === 0, `${e.name} volume: ${t.failures} values out of bound; first: ${t.firstFailure}`);
+  check(t.skipped === 0 && t.samples === volumeGrids.reduce((acc, g) => acc + kVolumeSamples + g.counts[0] * g.counts[1] * g.counts[2], 0) && t.compared === 3 * t.samples, `${e.name} volume: every sample compared (${t.samples})`);
 }
 console.log(`wall time: encoding ${((tEncoded - t0) / 1000).toFixed(1)} s, browser + comparison ${((tBrowser - tEncoded) / 1000).toFixed(1)} s ` +
   `(of which JS reference + comparison ${(compareMs / 1000).toFixed(1)} s), total ${((Date.now() - t0) / 1000).toFixed(1)} s`);

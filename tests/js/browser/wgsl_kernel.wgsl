@@ -1,22 +1,38 @@
-// Compute kernels of tests/js/wgsl_test.mjs, appended to runtime/zhc.wgsl by the page.
+// Compute kernels of tests/js/wgsl_test.mjs, appended to runtime/zhc.wgsl + runtime/zhc_volume.wgsl
+// by the page.
 // decode_kernel: item i = the probe words words[i * stride .. + stride) (stride <= 27) and the unit
-// normal normals[3 i .. 3 i + 2]; writes zhcDecode (27 floats, SH3 radiance) and zhcIrradiance
+// normal items[3 i .. 3 i + 2]; writes zhcDecode (27 floats, SH3 radiance) and zhcIrradiance
 // (3 floats) at out[30 i ..].
+// volume_kernel: item i = position items[6 i ..], normal items[6 i + 3 ..]; the grid's probe words
+// in words[]; writes zhcVolumeIrradiance (3 floats) at out[3 i ..].
+
+struct Job {
+    stride: u32,
+    count: u32,
+    pad0: u32,
+    pad1: u32,
+    origin: vec4<f32>,
+    spacing: vec4<f32>,
+    counts: vec4<u32>,
+}
 
 @group(0) @binding(0) var<uniform> fmt: ZhcFormat;
-@group(0) @binding(1) var<uniform> job: vec4<u32>;  // stride, count
+@group(0) @binding(1) var<uniform> job: Job;
 @group(0) @binding(2) var<storage, read> words: array<u32>;
-@group(0) @binding(3) var<storage, read> normals: array<f32>;
+@group(0) @binding(3) var<storage, read> items: array<f32>;
 @group(0) @binding(4) var<storage, read_write> outv: array<f32>;
+
+// The probe words of zhc_volume.wgsl's functions.
+fn zhcVolumeWord(i: u32) -> u32 { return words[i]; }
 
 @compute @workgroup_size(64)
 fn decode_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    let stride = min(job.x, 27u);
-    if (i >= job.y) { return; }
+    let stride = min(job.stride, 27u);
+    if (i >= job.count) { return; }
     var w: array<u32, 27>;
-    for (var j = 0u; j < stride; j++) { w[j] = words[i * job.x + j]; }
-    let n = vec3<f32>(normals[3u * i], normals[3u * i + 1u], normals[3u * i + 2u]);
+    for (var j = 0u; j < stride; j++) { w[j] = words[i * job.stride + j]; }
+    let n = vec3<f32>(items[3u * i], items[3u * i + 1u], items[3u * i + 2u]);
     let sh = zhcDecode(w, fmt);
     for (var c = 0u; c < 9u; c++) {
         outv[30u * i + 3u * c] = sh.c[c].x;
@@ -27,4 +43,16 @@ fn decode_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
     outv[30u * i + 27u] = e.x;
     outv[30u * i + 28u] = e.y;
     outv[30u * i + 29u] = e.z;
+}
+
+@compute @workgroup_size(64)
+fn volume_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= job.count) { return; }
+    let p = vec3<f32>(items[6u * i], items[6u * i + 1u], items[6u * i + 2u]);
+    let n = vec3<f32>(items[6u * i + 3u], items[6u * i + 4u], items[6u * i + 5u]);
+    let e = zhcVolumeIrradiance(ZhcVolume(job.origin.xyz, job.spacing.xyz, job.counts.xyz), fmt, p, n);
+    outv[3u * i] = e.x;
+    outv[3u * i + 1u] = e.y;
+    outv[3u * i + 2u] = e.z;
 }

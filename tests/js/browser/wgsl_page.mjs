@@ -1,10 +1,11 @@
 // Page of tests/js/wgsl_test.mjs: runs runtime/zhc.wgsl in a WebGPU compute shader on the jobs the
 // test server hands out and posts the raw float32 results back; the server compares them.
 //
-// Protocol: GET /job/next -> 204 when done, else a binary job: a 16-u32 header [kernel, stride,
-// count, reserved...], the ZhcFormat uniform (80 bytes), then `count * stride` u32 probe words and
-// `count * 3` f32 normals (kernel 0: decode + irradiance of one probe per item, 30 floats out;
-// other kernels: see wgsl_kernel.wgsl). POST /job/result: the output floats. POST /done: a JSON summary.
+// Protocol: GET /job/next -> 204 when done, else a binary job: a 16-u32 header [kernel, count,
+// outFloats, itemFloats, wordCount, 0...], the kernel's `Job` uniform (64 bytes), the ZhcFormat
+// uniform (80 bytes), `wordCount` u32 probe words and `count * itemFloats` f32 item inputs (kernel 0:
+// decode_kernel, kernel 1: volume_kernel of wgsl_kernel.wgsl). POST /job/result: the `count *
+// outFloats` output floats. POST /done: a JSON summary.
 
 const errors = window.zhcErrors;
 const summary = { webgpu: false, adapter: '', jobs: 0, compilation: [], errors };
@@ -24,7 +25,7 @@ async function main() {
   const device = await adapter.requestDevice({ requiredLimits: { maxStorageBufferBindingSize: adapter.limits.maxStorageBufferBindingSize } });
   device.addEventListener('uncapturederror', (e) => errors.push('uncaptured WebGPU error: ' + e.error.message));
   summary.webgpu = true;
-  const code = (await text('/runtime/zhc.wgsl')) + '\n' + (await text('/test/wgsl_kernel.wgsl'));
+  const code = [await text('/runtime/zhc.wgsl'), await text('/runtime/zhc_volume.wgsl'), await text('/test/wgsl_kernel.wgsl')].join('\n');
   device.pushErrorScope('validation');
   const module = device.createShaderModule({ code });
   const ci = await module.getCompilationInfo();
@@ -41,19 +42,20 @@ async function main() {
     if (!r.ok) throw new Error(`/job/next: HTTP ${r.status}`);
     const buf = await r.arrayBuffer();
     const head = new Uint32Array(buf, 0, 16);
-    const [kernel, stride, count, outFloats, normalFloats] = head;
-    const fmtBytes = buf.slice(64, 144);
-    const words = buf.slice(144, 144 + 4 * count * stride);
-    const normals = buf.slice(144 + 4 * count * stride, 144 + 4 * count * stride + 4 * count * normalFloats);
+    const [kernel, count, outFloats, itemFloats, wordCount] = head;
+    const jobBytes = buf.slice(64, 128);
+    const fmtBytes = buf.slice(128, 208);
+    const words = buf.slice(208, 208 + 4 * wordCount);
+    const itemData = buf.slice(208 + 4 * wordCount, 208 + 4 * wordCount + 4 * count * itemFloats);
     const mk = (data, usage) => {
       const b = device.createBuffer({ size: Math.max(16, data.byteLength), usage: usage | GPUBufferUsage.COPY_DST });
       device.queue.writeBuffer(b, 0, data);
       return b;
     };
     const fmt = mk(fmtBytes, GPUBufferUsage.UNIFORM);
-    const job = mk(new Uint32Array([stride, count, 0, 0]), GPUBufferUsage.UNIFORM);
+    const job = mk(jobBytes, GPUBufferUsage.UNIFORM);
     const wbuf = mk(words, GPUBufferUsage.STORAGE);
-    const nbuf = mk(normals, GPUBufferUsage.STORAGE);
+    const nbuf = mk(itemData, GPUBufferUsage.STORAGE);
     const outSize = 4 * count * outFloats;
     const out = device.createBuffer({ size: outSize, usage: GPUBufferUsage.STORAGE | GPUBufferUsage.COPY_SRC });
     const read = device.createBuffer({ size: outSize, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST });
