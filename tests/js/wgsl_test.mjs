@@ -85,6 +85,43 @@ for (const name of Object.keys(runtime.ENCODINGS)) {
 }
 for (const name of Object.keys(wgslTable)) check(name in runtime.ENCODINGS, `zhc.wgsl table line '${name}' is a runtime encoding`);
 
+// A second, independent WGSL front end (npm wgsl_reflect, a parser + reflection; Chromium's Tint is
+// the only full validator available): zhc.wgsl alone and with zhc_volume.wgsl and the test kernels
+// parse, the uniform layouts are the ones the file header documents (and formatBytes below writes),
+// the documented functions exist, and a broken copy is rejected (the check can fail).
+{
+  const { WgslReflect } = await import('wgsl_reflect/wgsl_reflect.module.js');  // (its package "main" does not load as ESM)
+  const volumeText = fs.readFileSync(path.join(repo, 'runtime', 'zhc_volume.wgsl'), 'utf8');
+  const kernelText = fs.readFileSync(path.join(here, 'browser', 'wgsl_kernel.wgsl'), 'utf8');
+  const parse = (code) => {
+    try {
+      return new WgslReflect(code);
+    } catch (err) {
+      return { error: String(err?.message ?? err) };
+    }
+  };
+  const alone = parse(wgslText), full = parse([wgslText, volumeText, kernelText].join('\n'));
+  check(!alone.error, `wgsl_reflect parses runtime/zhc.wgsl ${alone.error ?? ''}`);
+  check(!full.error, `wgsl_reflect parses zhc.wgsl + zhc_volume.wgsl + the test kernels ${full.error ?? ''}`);
+  check(!!parse(wgslText.replace('fn zhcNeg(x: f32) -> f32 {', 'fn zhcNeg(x: f32) -> f32 { let = ;')).error, 'wgsl_reflect rejects a broken copy');
+  if (!full.error) {
+    const layout = (name) => {
+      const st = full.structs.find((x) => x.name === name);
+      return st ? `${st.size}: ${st.members.map((m) => `${m.name}@${m.offset}`).join(' ')}` : 'missing';
+    };
+    check(layout('ZhcFormat') === '80: family@0 hallucination@4 bits@8 sqrtEncoding@12 l2Bound@16 dcFormat@20 zonalMapping@24 axisMode@28 kind@32 luminance@48 curve@64',
+      `ZhcFormat uniform layout (${layout('ZhcFormat')})`);
+    check(layout('ZhcVolume') === '48: origin@0 spacing@16 counts@32', `ZhcVolume uniform layout (${layout('ZhcVolume')})`);
+    const fns = new Set(full.functions.map((f) => f.name));
+    for (const f of ['zhcDecode', 'zhcIrradiance', 'zhcIrradianceSh3', 'zhcEvalSh3', 'zhcDecodeSh3F32', 'zhcDecodeSh2F32', 'zhcDecodeZh3F32',
+      'zhcDecodeZh3Q16', 'zhcDecodeSh3Q28', 'zhcDecodeSh2Q', 'zhcIrradianceSh3F32', 'zhcIrradianceSh2F32', 'zhcIrradianceZh3F32',
+      'zhcIrradianceZh3Q16', 'zhcIrradianceSh3Q28', 'zhcIrradianceSh2Q', 'zhcVolumeSh3', 'zhcVolumeIrradiance'])
+      check(fns.has(f), `WGSL function ${f} exists`);
+    check(!alone.error && alone.entry.compute.length === 0 && alone.storage.length === 0 && alone.uniforms.length === 0,
+      'runtime/zhc.wgsl declares no bindings and no entry points');
+  }
+}
+
 const isQuantised = (e) => e.family >= F.ZH3_Q16;
 const isZonal = (e) => e.family === F.ZH3_F32 || e.family === F.ZH3_Q16 || e.hallucination !== H.NONE;
 const hasL2 = (e) => e.family === F.SH3_F32 || e.family === F.SH3_Q28 || isZonal(e);
