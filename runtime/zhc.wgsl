@@ -18,13 +18,17 @@
 //   ...
 //   let e = zhcIrradianceZh3Q16(probes[i], uFormat, worldNormal);
 //
-// A shader specialised to one encoding builds the format from constants (pipeline-overridable or
-// not); every branch on `f.family` / `f.hallucination` then folds away in the compiler:
+// A shader specialised to one encoding builds the format from constants (`const`, or `override`
+// values set per pipeline through GPUProgrammableStage.constants); every branch on `f.family` /
+// `f.hallucination` then folds away in the compiler:
 //
 //   override ZHC_BITS: u32 = 8u;
-//   const fmt = ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, 8u, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
-//                         ZHC_ZONAL_AFFINE, ZHC_AXIS_LUMINANCE, ZHC_KIND_RADIANCE,
-//                         vec3f(0.2126, 0.7152, 0.0722), vec2f(0.6, 0.08));
+//   fn zhcMyFormat() -> ZhcFormat {
+//       return ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_BITS, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
+//                        ZHC_ZONAL_AFFINE, ZHC_AXIS_LUMINANCE, ZHC_KIND_RADIANCE,
+//                        vec3f(0.2126, 0.7152, 0.0722), vec2f(0.6, 0.08));
+//   }
+// (tests/js/browser/wgsl_kernel.wgsl compiles this example.)
 //
 // Decode to SH3 radiance first (to blend neighbouring probes, rotate, ...), then evaluate:
 // irradiance is linear in the coefficients, so blending decoded probes is exact:

@@ -22,6 +22,14 @@ struct Job {
 @group(0) @binding(3) var<storage, read> items: array<f32>;
 @group(0) @binding(4) var<storage, read_write> outv: array<f32>;
 
+// The specialised-format example of zhc.wgsl's header, compiled as written (not called).
+override ZHC_BITS: u32 = 8u;
+fn zhcMyFormat() -> ZhcFormat {
+    return ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_BITS, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
+                     ZHC_ZONAL_AFFINE, ZHC_AXIS_LUMINANCE, ZHC_KIND_RADIANCE,
+                     vec3f(0.2126, 0.7152, 0.0722), vec2f(0.6, 0.08));
+}
+
 // The probe words of zhc_volume.wgsl's functions.
 fn zhcVolumeWord(i: u32) -> u32 { return words[i]; }
 
