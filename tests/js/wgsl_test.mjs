@@ -23,9 +23,9 @@
 //     compute shader (zhcDecode + zhcIrradiance per probe, uniform random normals), posting the floats;
 //  4. probe volumes (runtime/zhc_volume.wgsl, zhcVolumeIrradiance) per encoding on two grids of
 //     encoded probes (6x5x4 default parameters, 5x1x3 non-default ones, a count-1 axis), 10,000
-//     points in and around the box plus every probe's position, against a double-precision twin of
-//     zhc_volume_irradiance_d (the C header's sampler) over the JS runtime's decoded probes, with the
-//     bound of test_runtime_gl's volume test;
+//     points in and around the box plus every probe's position, against the JS runtime's
+//     volumeIrradianceD (a port of the C header's zhc_volume_irradiance_d, bit-identical per
+//     js.runtime_volume) and the test's own double twin, with the bound of test_runtime_gl's volume test;
 //  5. asserts: no console error or WebGPU validation error, no compilation message, every probe and
 //     sample of every encoding compared, every value within its bound; prints the per-encoding maxima.
 // Time bounded: the browser part times out after 420 s (Chromium killed).
@@ -420,13 +420,14 @@ function decodeJob(c) {
 const kVolumeSamples = 10000;
 const volumeGrids = [{ counts: [6, 5, 4], batch: 0 }, { counts: [5, 1, 3], batch: 5 }];
 const volumeOrigin = [-1.5, 2.0, 0.25], volumeSpacing = [0.75, 0.5, 1.25];  // exact in float
-const volumeTallies = new Map(encodings.map((e) => [e.name, { ...tally(), samples: 0, skipped: 0 }]));
+const volumeTallies = new Map(encodings.map((e) => [e.name, { ...tally(), samples: 0, skipped: 0, twinMismatch: 0 }]));
 function volumeJob(c) {
   const z = runtime.parseZhp(new Uint8Array(fs.readFileSync(c.zhp)));
   const counts = c.grid.counts, count = counts[0] * counts[1] * counts[2];
   c.p = z.params;
   c.bytes = z.payload.slice(0, count * c.e.bytes);
   c.decoded = Array.from({ length: count }, (_, q) => runtime.decodeProbe(c.e.name, c.bytes, q * c.e.bytes, c.p));
+  c.vol = runtime.makeVolume({ encoding: c.e.name, params: c.p, bytes: c.bytes, origin: volumeOrigin, spacing: volumeSpacing, counts });
   const n = kVolumeSamples + count;
   c.items = new Float32Array(6 * n);
   for (let i = 0; i < n; i++) {
@@ -455,8 +456,9 @@ function volumeAxis(x, o, sp, n) {
   if (n >= 2 && i > n - 2) i = n - 2;
   return { i0: i, f: n >= 2 ? t - i : 0, t };
 }
-// zhc_volume_irradiance_d in double: blend of the decoded SH3 (float32, = zhc_decode_probe),
-// normalised normal (+Z when zero / not finite), band scales 1, 2/3, 1/4.
+// The test's own twin of zhc_volume_irradiance_d, written from docs/runtime.md "Probe volumes": blend
+// of the decoded SH3 (float32, = zhc_decode_probe) in double, normalised normal (+Z when zero / not
+// finite), band scales 1, 2/3, 1/4; also lists the cell's corners for the error scale.
 function volumeIrradianceD(c, pos, nrm) {
   const counts = c.grid.counts;
   const ax = [0, 1, 2].map((a) => volumeAxis(pos[a], volumeOrigin[a], volumeSpacing[a], counts[a]));
@@ -481,6 +483,9 @@ function volumeIrradianceD(c, pos, nrm) {
   }
   return { rgb, corners, ax };
 }
+// Reference: the runtime's volumeIrradianceD (the C header's zhc_volume_irradiance_d ported, the same
+// double operations: js.runtime_volume shows volumeIrradiance bit-identical with the C header), and
+// the twin above must agree with it to 1e-12 of S.
 // Bound (test_runtime_gl compare_volumes): u times the summed probe scales S of the cell's corners,
 // times 48 (decode and evaluation 32, blending 16) + 3 sum_axes ((|p| + |o|) / s + t + 2) (the
 // float error of t = (p - o) / s moves each weight by at most 3 times it).
@@ -489,7 +494,8 @@ function compareVolume(c, gpu) {
   for (let i = 0; i < c.samples; i++) {
     const pos = [c.items[6 * i], c.items[6 * i + 1], c.items[6 * i + 2]];
     const nrm = [c.items[6 * i + 3], c.items[6 * i + 4], c.items[6 * i + 5]];
-    const { rgb, corners, ax } = volumeIrradianceD(c, pos, nrm);
+    const { rgb: twin, corners, ax } = volumeIrradianceD(c, pos, nrm);
+    const rgb = runtime.volumeIrradianceD(c.vol, pos, nrm);
     let extra = 0;
     for (let a = 0; a < 3; a++) extra += (Math.abs(pos[a]) + Math.abs(volumeOrigin[a])) / volumeSpacing[a] + ax[a].t + 2;
     const scale = [0, 0, 0];
@@ -504,6 +510,10 @@ function compareVolume(c, gpu) {
       continue;
     }
     t.samples++;
+    for (let k = 0; k < 3; k++) {
+      const d = Math.abs(twin[k] - rgb[k]);
+      if (!(d <= 1e-12 * scale[k] + kAbs)) t.twinMismatch++;
+    }
     for (let k = 0; k < 3; k++)
       checkValue(t, 'maxIrr', rgb[k], gpu[3 * i + k], scale[k], 48 + 3 * extra,
         () => `${c.e.name} grid ${c.grid.counts.join('x')} sample ${i} (position ${pos.join(',')}, normal ${nrm.join(',')}) channel ${k}`);
@@ -547,7 +557,7 @@ const server = http.createServer(async (req, res) => {
       const tc = Date.now();
       (current.volume ? compareVolume : compareCase)(current, gpu);
       compareMs += Date.now() - tc;
-      current.bytes = current.normals = current.items = current.decoded = null;
+      current.bytes = current.normals = current.items = current.decoded = current.vol = null;
       jobsDone++;
     }
     res.end('ok');
@@ -625,11 +635,12 @@ for (const e of encodings) {
   check(v.skippedNonfinite + v.skippedIllcond === 0 && v.compared === v.probes * 30, `${e.name}: every valid probe compared (${v.compared} values)`);
   check(g.compared > g.probes * 30 / 2, `${e.name}: most random-byte values compared (${g.compared})`);
 }
-console.log('probe volumes: max error in u S (S summed over the cell\'s corners) of zhcVolumeIrradiance vs a double twin of zhc_volume_irradiance_d:');
+console.log('probe volumes: max error in u S (S summed over the cell\'s corners) of zhcVolumeIrradiance vs volumeIrradianceD (= zhc_volume_irradiance_d):');
 for (const e of encodings) {
   const t = volumeTallies.get(e.name);
   console.log(`${e.name.padEnd(22)} ${String(t.samples).padStart(7)} samples ${t.maxIrr.toFixed(3).padStart(8)} u S, skipped ${t.skipped}`);
   check(t.failures === 0, `${e.name} volume: ${t.failures} values out of bound; first: ${t.firstFailure}`);
+  check(t.twinMismatch === 0, `${e.name} volume: the test's twin equals runtime volumeIrradianceD (${t.twinMismatch} values differ)`);
   check(t.skipped === 0 && t.samples === volumeGrids.reduce((acc, g) => acc + kVolumeSamples + g.counts[0] * g.counts[1] * g.counts[2], 0) && t.compared === 3 * t.samples, `${e.name} volume: every sample compared (${t.samples})`);
 }
 console.log(`wall time: encoding ${((tEncoded - t0) / 1000).toFixed(1)} s, browser + comparison ${((tBrowser - tEncoded) / 1000).toFixed(1)} s ` +
