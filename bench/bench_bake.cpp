@@ -1,4 +1,4 @@
-// Scene-bake throughput (issue 9), plain timing main: ./build/bench/bench_bake [probes_per_axis]
+// Scene-bake throughput, plain timing main: ./build/bench/bench_bake [probes_per_axis]
 //
 //  * closed-form scenes: probe-lights per second on ONE thread, per light type and for a mixed
 //    scene, against the target of 10^6 per second per core (ratio printed), and against a floor

@@ -2,7 +2,7 @@
 // BC6H, BC5, BC4, write the KTX2 files) in Mtexel/s and peak memory, for synthetic lightmaps of
 // several sizes, beside a baseline measured in the same run: a plain OpenEXR read of the same file
 // (Imf::InputFile into one float frame buffer, no checks, no conversion). Also the IrradZ fit's
-// Newton solve against the golden-section reference (Solve::kSearch, what the fit was before) on the
+// Newton solve against the golden-section reference (Solve::kSearch, the talk's method) on the
 // same texels, one after the other in this process: the ratio survives a noisy machine.
 //   bench_lightmap [--sizes 1024,2048,4096] [--map FILE.exr] [--quality fast|default|slow]
 //                  [--ref-texels N] [--reps R] [--json FILE] [--keep DIR]

@@ -1,4 +1,4 @@
-// bench_runtime — what accuracy costs at runtime (issue 15 item 3): for every encoding of the codec
+// bench_runtime — what accuracy costs at runtime: for every encoding of the codec
 // table, the irradiance evaluation of runtime/zhc.hlsl straight from the stored words,
 //   (a) compiled: HLSL -> SPIR-V (glslangValidator's HLSL front end) -> spirv-opt -O, and counted:
 //       instructions inside the function bodies of the spirv-dis listing (after -O everything is

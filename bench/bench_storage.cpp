@@ -1,4 +1,4 @@
-// Storage benchmark (issue 5): encode / decode / irradiance time per probe of the quantised
+// Storage benchmark: encode / decode / irradiance time per probe of the quantised
 // layouts next to the float hub (sh3) measured in the same run, with the accuracy of each
 // (relative irradiance RMSE vs SH3 over the same synthetic probes). No data files needed.
 // Plain timing main: ./build/bench/bench_storage [probes]

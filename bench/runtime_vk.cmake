@@ -1,4 +1,4 @@
-# bench_runtime (issue 15): runtime/zhc.hlsl compiled per encoding (glslangValidator -> spirv-opt -O,
+# bench_runtime: runtime/zhc.hlsl compiled per encoding (glslangValidator -> spirv-opt -O,
 # counted with spirv-dis) and timed on Mesa lavapipe. Included from bench/CMakeLists.txt before
 # its per-benchmark loop: taken out of the generic list and defined here; left out without Vulkan.
 list(FILTER ZHC_BENCH_SOURCES EXCLUDE REGEX "bench_runtime\\.cpp$")

@@ -39,8 +39,8 @@ int report_write(const Error& error);
 // --- Shared option groups: every verb spells these the same way (README "Options"). -------------
 // The representation: `-r, --representations` in every verb that picks codec-table entries.
 // kList: a comma-separated subset (audit, bench; empty = all). kOne: exactly one name (convert,
-// bake, gltf embed). `old_spelling` ("--to", "--encoding") is that verb's earlier name, kept as
-// an alias. `what` completes the help text.
+// bake, gltf embed). `old_spelling` ("--to", "--encoding") is that verb's alias, accepted for existing
+// scripts. `what` completes the help text.
 enum class RepresentationCount { kOne, kList };
 CLI::Option* add_representations_option(CLI::App* app, std::string& names, RepresentationCount count,
                                         const std::string& what, const std::string& old_spelling = "");

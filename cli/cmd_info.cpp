@@ -217,7 +217,7 @@ int run(const Options& o) {
         const Sh3Radiance sh = project_envmap(*img);
         probe_stats({sh}, j);
     } else if (looks_like_glb(*bytes) || (looks_like_json(*bytes) && is_gltf_json(*bytes))) {
-        // glTF (issue 8): the asset's outline and its ZHC_light_probes volumes.
+        // glTF: the asset's outline and its ZHC_light_probes volumes.
         auto s = read_gltf_probes(*bytes, o.path);
         if (!s) return report(s.error());
         j["type"] = s->binary ? "glTF 2.0 binary (GLB)" : "glTF 2.0 (JSON)";

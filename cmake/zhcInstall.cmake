@@ -13,7 +13,7 @@ include(CMakePackageConfigHelpers)
 set(ZHC_CMAKE_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/zhc")
 
 # Public headers: every header of codec/ and formats/ except those whose first line says "internal to
-# codec/" and the internal ones that include a third-party library's headers (the third-party libraries stay at the edge, DESIGN.md; e.g.
+# codec/" and the internal ones that include a third-party library's headers (third-party libraries stay at the edge, out of codec/: README.md "Layout"; e.g.
 # formats/io/exr_memory.h). The umbrella headers include them all, so a new header needs no edit here.
 foreach(part codec formats)
   file(GLOB_RECURSE _headers RELATIVE "${PROJECT_SOURCE_DIR}/${part}" CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/${part}/*.h")

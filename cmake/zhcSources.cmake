@@ -1,4 +1,4 @@
-# Library and CLI sources are listed explicitly in each folder's CMakeLists.txt (issue 19: a build
+# Library and CLI sources are listed explicitly in each folder's CMakeLists.txt (a build
 # that says what it compiles). zhc_check_sources_listed(DIR LISTED...) then fails the configure
 # step, naming the file, when DIR holds a .cpp the list lacks (a file added without listing it, or
 # a merge that brought one) or the list names a missing one. The glob here only checks the list;

@@ -1,5 +1,5 @@
 // zhc/runtime/zhc.glsl — GPU decoders and evaluators for every stored zhc probe format and for the
-// IrradZ lightmap (issue 15). An include file: no #version line; prepend "#version 450" (desktop)
+// IrradZ lightmap. An include file: no #version line; prepend "#version 450" (desktop)
 // or "#version 310 es" (GLSL ES 3.10), compute or fragment stage. No extensions are used.
 //
 // Source of truth: the C++ codec (codec/probe/quantize.cpp, codec/probe/zh3.cpp, codec/probe/core_codecs.cpp,

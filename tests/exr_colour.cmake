@@ -1,4 +1,4 @@
-# test_exr_colour (issue 29): EXR chromaticities, luminance/chroma, data vs display window and
+# test_exr_colour: EXR chromaticities, luminance/chroma, data vs display window and
 # zhc info's EXR fields, on files written by OpenEXR's API and by Debian's exrstdattr (package
 # openexr, scripts/packages-test.txt): without it the exrstdattr cases are left out.
 target_link_libraries(test_exr_colour PRIVATE OpenEXR::OpenEXR)

@@ -1,4 +1,4 @@
-# test_real_world (issue 16): files written by other programs. It writes EXRs with OpenEXR's own
+# test_real_world: files written by other programs. It writes EXRs with OpenEXR's own
 # API and runs Debian's OpenEXR tools (package openexr) and ImageMagick (package imagemagick).
 # test_real_world_hostile: the hostile variants (trailing bytes, memory, .hdr orientations, JSON depth).
 find_package(OpenEXR CONFIG REQUIRED)

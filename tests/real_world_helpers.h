@@ -1,5 +1,5 @@
 // Helpers shared by test_real_world.cpp and test_real_world_hostile.cpp (files written by other
-// programs, issue 16): shell quoting, the CLI's projection, one-line errors, OpenEXR writers.
+// programs): shell quoting, the CLI's projection, one-line errors, OpenEXR writers.
 #pragma once
 
 #include <ImfChannelList.h>

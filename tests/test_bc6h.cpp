@@ -170,7 +170,7 @@ TEST(Bc6hEncode, QualityLevelsAreOrderedOnRealMaps) {
     EXPECT_LE(e[1], e[0]);
     EXPECT_LE(e[2], e[1]);
     EXPECT_LE(e[3], e[2]);
-    // The quality targets in this error domain (half bits, a piecewise-linear log2, the
+    // The quality targets in this error domain (half bits, a piecewise-linear log2, the
     // domain the encoder minimises): fast within 1.5 dB of exhaustive, default within 0.3 dB.
     const double fast_db = 10 * std::log10(e[1] / e[3]), default_db = 10 * std::log10(e[2] / e[3]);
     std::printf("  fast %.3f dB, default %.3f dB above exhaustive\n", fast_db, default_db);

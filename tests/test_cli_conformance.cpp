@@ -1,4 +1,4 @@
-// The CLI conformance suite (issue 19 item 5; KTX-Software's CTS is the model): every row of
+// The CLI conformance suite (KTX-Software's CTS is the model): every row of
 // tests/conformance/cases.txt is one command line with its expected exit code and expected output
 // (a stderr/stdout excerpt, a golden JSON file), run as its own test named after the row's id.
 // The format of the table and of the generated inputs: tests/conformance/README.md.

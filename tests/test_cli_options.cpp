@@ -1,6 +1,6 @@
-// The CLI's shared option names (issue 19): every verb spells the representation, thread count,
+// The CLI's shared option names: every verb spells the representation, thread count,
 // JSON output and environment-map reading options the same way (cli/cli.h add_*_option), keeps
-// its older spelling as an alias, and takes --threads over the same range.
+// its alias (--to, --encoding) where it has one, and takes --threads over the same range.
 #include <algorithm>
 #include <sstream>
 

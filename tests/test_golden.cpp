@@ -1,4 +1,4 @@
-// Golden metrics (issue 19), in the style of basis_universal's test table: for every lossy path,
+// Golden metrics, in the style of basis_universal's test table: for every lossy path,
 // on fixed small inputs, the error, the size and a 64-bit FNV-1a hash of the output bytes, each
 // checked against tests/golden/metrics.tsv.
 //

@@ -1,4 +1,4 @@
-// The HTML report (issue 20): `zhc audit --html` on two sample maps and `zhc demo` write one
+// The HTML report: `zhc audit --html` on two sample maps and `zhc demo` write one
 // self-contained file each; the table has one row per representation; headless Chromium opens
 // each from a file:// URL, every picture decodes, and a screenshot is not blank.
 #include <sys/wait.h>

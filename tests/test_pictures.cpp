@@ -1,5 +1,5 @@
-// The PNG pictures (issue 20): text in DejaVu Sans rendered with stb_truetype (not the old 3x5 pixel
-// font), PNGs through libpng that decode (stb_image) to the canvas's pixels and are smaller than
+// The PNG pictures: text in DejaVu Sans rendered with stb_truetype (proportional and anti-aliased),
+// PNGs through libpng that decode (stb_image) to the canvas's pixels and are smaller than
 // stb_image_write's for the same pixels; `zhc audit --images` and the demo's images.
 #include <stb_image_write.h>
 
@@ -71,7 +71,7 @@ TEST(Pictures, TextIsDejaVuSansNotThe3x5Font) {
     const Ink o = render("O", 24);
     EXPECT_GT(o.partial, 20u);
     EXPECT_GT(o.full, 10u);
-    // Proportional: four i's are much narrower than four M's (the 3x5 font was monospaced).
+    // Proportional: four i's are much narrower than four M's (a monospaced font fails this).
     EXPECT_LT(Canvas::text_width("iiii", 20) * 2, Canvas::text_width("MMMM", 20));
     // The advance text() returns is text_width's, and it grows with the size.
     Canvas c(300, 40);

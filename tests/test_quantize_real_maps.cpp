@@ -352,7 +352,7 @@ TEST(QuantRealMaps, Zh3Q16IrradianceRmseIsWithinFivePercentOfZh3Lum) {
     std::printf("%-15s", "q16 naive");
     for (double v : naive_vs_sh3) std::printf("%10.5f", v);
     std::printf("   (zonal fitted on the float axis, vs SH3)\n");
-    // Acceptance (issue 5): against the true irradiance, zh3_q16 is within 5% of zh3_lum on every map.
+    // Target: against the true irradiance, zh3_q16 is within 5% of zh3_lum on every map.
     for (size_t i = 0; i < paths.size(); ++i)
         EXPECT_LE(vs_true["zh3_q16"][i], 1.05 * vs_true["zh3_lum"][i]) << test::envmap_name(paths[i]);
     // Refitting the zonal coefficient on the decoder's axis is never worse than the naive order.

@@ -1,4 +1,4 @@
-// Real-world inputs (issue 16): environment maps and JSON written by other programs — OpenEXR's
+// Real-world inputs: environment maps and JSON written by other programs — OpenEXR's
 // own API (cube maps, luminance/chroma, multi-part), Debian's OpenEXR tools (exrenvmap,
 // exrmultipart, exrmaketiled), ImageMagick (.hdr) and a small Radiance writer of our own for the
 // orientations and XYZE no common tool writes — plus hostile variants (trailing bytes, a huge

@@ -1,4 +1,4 @@
-// Real-world inputs, hostile variants (issue 16; split from test_real_world.cpp): trailing bytes
+// Real-world inputs, hostile variants (the companion of test_real_world.cpp): trailing bytes
 // after every kind of EXR and .hdr, a huge declared image in a small file (peak memory), deep
 // files, Radiance .hdr in every orientation and XYZE (our own writer) and ImageMagick's, and JSON
 // nesting in every JSON reader.

@@ -271,7 +271,7 @@ TEST(Zh3RealMaps, IrradianceRmseTable) {
             std::printf("%12.3f\n", ratio / maps.size());
         }
     }
-    // Acceptance (issue 3), against the true irradiance: averaged over the maps, zh3_lum cuts RMSE
+    // Targets, against the true irradiance: averaged over the maps, zh3_lum cuts RMSE
     // against sh2 by at least a third and hall_curve by at least a fifth.
     auto mean_ratio = [&](const std::string& name) {
         double s = 0;

@@ -343,7 +343,7 @@ TEST(Zh3ChannelQ16, DeterministicAndTotalOnBadInput) {
 }
 
 // The acceptance numbers, from `zhc audit` itself: mean and worst ratio of irradiance RMSE to SH2's
-// over the eight sample maps (issue 18 item 5: mean <= 0.50 with 16 bytes).
+// over the eight sample maps (target: mean <= 0.50 with 16 bytes).
 TEST(Zh3ChannelQ16, AuditRatiosToSh2OnTheSampleMaps) {
     const auto paths = test::envmap_paths();
     ASSERT_EQ(paths.size(), 8u);

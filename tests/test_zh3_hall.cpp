@@ -1,5 +1,5 @@
 // Hallucinate-solve (hall_solved, hall_solved_q16) and the adaptive hallucination scale
-// (hall_adaptive_q16): codec/probe/zh3_hall.h, issue 18 items 3-4.
+// (hall_adaptive_q16): codec/probe/zh3_hall.h, docs/zh3.md.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -254,7 +254,7 @@ TEST(HallAudit, SampleMapsUnderRotationsAgainstTrueIrradiance) {
         rot_mean[name] = rsum / (maps().size() * kRotations);
         std::printf("%10.3f%10.3f%12.3f\n", mean_ratio[name], worst, rot_mean[name]);
     }
-    // Issue 18 item 4: never worse than SH2 on any map and rotation (float and 16-byte SH2), mean at
+    // Targets: never worse than SH2 on any map and rotation (float and 16-byte SH2), mean at
     // or below 0.62 of SH2 on the sample maps.
     for (size_t i = 0; i < rmse["sh2"].size(); ++i) {
         EXPECT_LE(rmse["hall_adaptive_q16"][i], rmse["sh2"][i]) << i;

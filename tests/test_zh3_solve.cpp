@@ -182,7 +182,7 @@ TEST(Zh3Solve, ReachesTheBestAxisFoundByExhaustiveSearch) {
     }
 }
 
-// ---- scale invariance (issue 18, finding 1) -------------------------------------------------------
+// ---- scale invariance -----------------------------------------------------------------------------
 
 Sh3Radiance scaled(const Sh3Radiance& in, double s) {
     Sh3Radiance out;
@@ -267,7 +267,7 @@ TEST(Zh3Solve, ResultAndIterationsDoNotDependOnTheLightingsUnits) {
                 mism[0], mism[1], double(its[0]) / probes.size(), double(its[1]) / probes.size(), worst);
 }
 
-// ---- multi-start against a brute-force axis search (issue 18, finding 2) ---------------------------
+// ---- multi-start against a brute-force axis search -------------------------------------------------
 
 // Slow twin of an axis solve: the objective on a Fibonacci sphere of `dirs`, then a compass search
 // on the tangent plane from each of the best grid points that are at least 0.3 rad apart (as axes),

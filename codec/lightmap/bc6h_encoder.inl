@@ -45,8 +45,8 @@ struct Encoded {
     std::int64_t err = std::numeric_limits<std::int64_t>::max();
 };
 
-// Nearest quantized endpoint to u, in closed form (checked equal to the search over q0 - 1, q0,
-// q0 + 1 it replaced, ties included, on a 1/8 grid of [-10, 65600) for every precision). Below 15
+// Nearest quantized endpoint to u, in closed form (checked equal to a search over q0 - 1, q0,
+// q0 + 1, ties included, on a 1/8 grid of [-10, 65600) for every precision). Below 15
 // bits the unquantized levels are 0, (q + 1/2) S for 0 < q < M, and 0xFFFF for q = M (S = 2^(16 -
 // bits), M = 2^bits - 1): the interior levels are the centres of the bins [q S, (q + 1) S), so
 // floor(u / S) is nearest except in the end bins, which compare with their one neighbour.
@@ -405,7 +405,7 @@ void encode_block_impl(const float rgb[16][3], Quality quality, std::uint8_t out
             // Blocks with a large error (> 16 half ULPs rms per value): the single best-scoring
             // partition with its most precise fitting mode, evaluated the same way. (Tuned with
             // bench_bc6h: from 6 ULPs the maps gain 0.01 dB, the lightmaps 0.3 dB, for 1.5x the
-            // time on lightmaps; from 12 ULPs (the previous threshold) the maps gain 0.01 dB and
+            // time on lightmaps; from 12 ULPs the maps gain 0.01 dB and
             // the lightmaps 0.27 dB for 4 % / 15 % more instructions per pixel; from 20 ULPs the
             // lightmaps lose another 0.23 dB, beyond the 1.5 dB bound. Guessing the partition
             // from a split along the principal axis instead of scoring was 1.1 dB worse.)
@@ -432,7 +432,7 @@ void encode_block_impl(const float rgb[16][3], Quality quality, std::uint8_t out
             // Both initial line fits per partition: the per-subset power iteration from (1, 1, 1)
             // (initial_endpoints) and fit_partition's (what fast and default start from), so that
             // exhaustive stays a superset of default's candidates (tested per block) and never
-            // loses to the previous exhaustive (which used only the first).
+            // loses to a search from the first alone.
             for (int p = 0; p < 32; ++p) {
                 SubsetFit two[2];
                 initial_endpoints(t, static_cast<std::uint16_t>(~kPartition[p]), two[0].a, two[0].b);

@@ -5,7 +5,7 @@
 // The encoder's solves: irradz_search.cpp (golden section, the reference) and irradz_newton.cpp
 // (Newton, the default); linear SH <-> HHD and blending: irradz_linear_sh.cpp.
 //
-// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk, seeds/004);
+// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk);
 // the slide formulas are re-derived in docs/irradz.md.
 #include "codec/lightmap/irradz.h"
 

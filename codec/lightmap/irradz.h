@@ -1,5 +1,5 @@
 // zhc/codec/lightmap/irradz.h — IrradZ directional lightmaps (Roughton, SIGGRAPH 2024 Advances talk,
-// seeds/004): the AHD and HHD lighting models, the IrradZ parameterisation (I_z, w_a, d), the
+// on hemispherical lighting): the AHD and HHD lighting models, the IrradZ parameterisation (I_z, w_a, d), the
 // hemispherical least-squares encoder, closed-form linear SH -> HHD, lightmap blending in linear SH,
 // and the HLSH hemisphere / cone multiply. Derivations: docs/irradz.md.
 //
@@ -62,7 +62,7 @@ const std::array<double, 81>& hemisphere_gram();
 enum class Solve {
     kNewton,  // the same least squares, d by Newton on the analytic reduced error (default)
     kSearch,  // talk: w_a by least squares with the hemispherical Gram matrix, d by golden-section
-    kOld,     // the old way: optimal linear direction + spherical Gram matrix (identity)
+    kOld,     // the talk's baseline ("old way"): optimal linear direction + spherical Gram matrix (identity)
 };
 
 struct EncodeOptions {

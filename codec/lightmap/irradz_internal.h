@@ -3,7 +3,7 @@
 // matrix and its sparsity, the HLSH projections; irradz.cpp), the clamped-cosine SH3 projection
 // (Funk-Hecke), the stored direction range, and the Newton solve for encode().
 //
-// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk, seeds/004);
+// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk);
 // the slide formulas are re-derived in docs/irradz.md.
 #pragma once
 

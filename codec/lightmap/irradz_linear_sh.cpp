@@ -3,7 +3,7 @@
 // HHD stands for, the exact inverse per channel (a quadratic in C_a), IrradZ from linear SH, and
 // lightmap blending in linear SH (the talk's method) or in the parameters (for comparison).
 //
-// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk, seeds/004);
+// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk);
 // the slide formulas are re-derived in docs/irradz.md.
 #include "codec/lightmap/irradz.h"
 

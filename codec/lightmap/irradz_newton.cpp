@@ -4,7 +4,7 @@
 // stereographic coordinates, from the best of four starts (the linear-SH closed form, straight up,
 // the rim). zhc's own derivation, docs/irradz.md ("The Newton solve of d").
 //
-// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk, seeds/004);
+// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk);
 // the slide formulas are re-derived in docs/irradz.md.
 #include "codec/lightmap/irradz.h"
 

@@ -5,7 +5,7 @@
 // "old way" (optimal linear direction, whole-sphere w_a) kept for comparison. The default solve,
 // Newton, is in irradz_newton.cpp. Derivations in docs/irradz.md ("Encoder").
 //
-// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk, seeds/004);
+// Source: Roughton, "IrradZ" (SIGGRAPH 2024 Advances in Real-Time Rendering talk);
 // the slide formulas are re-derived in docs/irradz.md.
 #include "codec/lightmap/irradz.h"
 

@@ -1,4 +1,4 @@
-// zhc/codec/probe/codec.h — the one codec table (DESIGN.md "A hub representation").
+// zhc/codec/probe/codec.h — the one codec table (README.md "Representations"; sh3 is the hub).
 //
 // Every representation zhc knows is one `Codec` entry: a name, a fixed stored size per probe,
 // encode from the hub (float SH3 radiance), decode to the hub, and irradiance evaluation.
@@ -56,7 +56,7 @@ enum class ZonalAxisMode : std::uint8_t {
     kPerChannel = 1,  // each channel's own optimal linear direction (Sec. 3.1)
 };
 
-// The one parameter type (issue 19): every entry's encode / decode / irradiance, the quantiser
+// The one parameter type: every entry's encode / decode / irradiance, the quantiser
 // (quantize.h) and the probe container (probe_set.h, ProbeSet::params) take it. Two groups of fields:
 //  * storage parameters (luminance .. axis_mode below): they change what stored bytes mean, so the
 //    .zhp header and the glTF extension store them and decoders need them;

@@ -1,5 +1,5 @@
 // Deringing SH3 lighting: P.-P. Sloan, "Deringing Spherical Harmonics", SIGGRAPH Asia 2017
-// Technical Briefs (seeds/001). Sec. 2.3: conservative minimum of an SH3 function; Sec. 2.4 /
+// Technical Briefs. Sec. 2.3: conservative minimum of an SH3 function; Sec. 2.4 /
 // Table 1 / Eq. 6: the windowing table and its bisection; Sec. 3: per-channel search, strongest
 // window applied to all channels, extra windowing of punctual sources. Derivations and the
 // reading of Table 1: docs/dering.md.

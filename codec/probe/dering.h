@@ -1,5 +1,5 @@
 // zhc/codec/probe/dering.h — non-negative SH3 lighting: conservative minimum and deringing
-// (Sloan 2017, "Deringing Spherical Harmonics", SIGGRAPH Asia Technical Briefs; seeds/001).
+// (Sloan 2017, "Deringing Spherical Harmonics", SIGGRAPH Asia Technical Briefs).
 //
 // Three pieces:
 //  * a conservative LOWER BOUND of the minimum of one SH3 function over the sphere (Sec. 2.3),

@@ -25,7 +25,7 @@ const double kL2ZonalLo = -std::sqrt(5.0) / 2.0;
 const double kL2ZonalHi = std::sqrt(5.0);
 // Wiederien & Sloan Sec. 3.2: max of sqrt(15) x y (etc.) on the sphere is at x = y = 1/sqrt(2).
 const double kL2TightBound = std::sqrt(15.0) / 2.0;
-// The older bound: the band-length bound sqrt(2l + 1) applied to each coefficient.
+// The looser band-length bound sqrt(2l + 1) applied to each coefficient.
 const double kL2LooseBound = std::sqrt(5.0);
 
 double band_scale(StoredKind kind, int l) {

@@ -9,7 +9,7 @@
 // Y_i(w) / Y_0 over directions w. Those intervals (radiance; irradiance scales L1 by 2/3, L2 by 1/4):
 //   L1, every m            [-sqrt(3), sqrt(3)]
 //   L2, m = 0 (zonal)      [-sqrt(5)/2, sqrt(5)]          (3z^2 - 1 ranges over [-1, 2])
-//   L2, m != 0             [-sqrt(15)/2, sqrt(15)/2]      (tight; the older bound is +-sqrt(5))
+//   L2, m != 0             [-sqrt(15)/2, sqrt(15)/2]      (tight; the band-length bound is +-sqrt(5))
 // So the DC is stored as an HDR float triple and every other coefficient as a small fixed-point
 // number: its ratio to the DC of its channel, mapped from its interval to [-1, 1].
 //

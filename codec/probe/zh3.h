@@ -7,8 +7,8 @@
 // channel's own), so the decoder needs nothing else.
 //
 // Codec-table entries (codec/probe/zh3.cpp, zh3_codecs() below): zh3_lum, zh3_channel, zh3_solved_lum,
-// zh3_solved_channel, hall_{ambdir,sphere,curve}[_channel], zh3_lum_dering (App. B; issue 4's
-// name, defined here), zh3_lum_dering_sphere. Derivations and choices: docs/zh3.md.
+// zh3_solved_channel, hall_{ambdir,sphere,curve}[_channel], zh3_lum_dering (App. B;
+// defined here), zh3_lum_dering_sphere. Derivations and choices: docs/zh3.md.
 #pragma once
 
 #include "codec/probe/codec.h"

@@ -1,4 +1,4 @@
-// zhc/codec/probe/zh3_hall.h — hallucinate-solve and the adaptive hallucination scale (issue 18, items 3-4).
+// zhc/codec/probe/zh3_hall.h — hallucinate-solve and the adaptive hallucination scale.
 //
 // The decoders are the curve hallucination of the ZH3 paper (Roughton et al. 2024, Sec. 3.4.3,
 // Eq. 21, Listing 1): from stored linear SH (DC f0, L1) the decoder derives the zonal axis a (the
@@ -51,7 +51,7 @@ double hall_axis_profile(const Sh3Radiance& target, double scale, ZonalAxisMode 
 // ---- hall_adaptive_q16: the scale code in byte 15 of the sh2_q layout -------------------------
 
 inline constexpr int kHallScaleCodeCount = 8;  // codes 0..7; larger byte values decode as 7
-// s = 0.5 * code for codes 0..7 (0 = plain linear SH, 2 = the curve as fitted, 7 = 3.5x); the set was
+// s = 0.5 * code for codes 0..7 (0 = plain linear SH, 2 = the curve as fitted, 7 = 3.5x); the set is
 // chosen by measurement (docs/zh3.md).
 double hall_scale_of_code(std::uint8_t code);
 

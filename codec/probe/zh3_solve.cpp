@@ -26,12 +26,12 @@ using namespace detail;  // zh3_internal.h, sh_l1.h and lbfgs.h
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Start axes (see solve_luminance / solve_channel). The shared-axis solve runs L-BFGS from the best
-// ranked start only: a second start left its converged mean error on the bench set unchanged (to 6
-// digits) at 1.3-2x the cost and did not move its worst case against a brute-force axis search
+// ranked start only: a second start leaves its converged mean error on the bench set unchanged (to 6
+// digits) at 1.3-2x the cost and does not move its worst case against a brute-force axis search
 // (10,000 random lightings: mean 1.000006, worst 1.029, 3 probes above 0.1 %). The per-channel
 // solve runs from every distinct start (the channel's L1 axis and two principal axes of its L2
-// form): from the best-ranked start alone it stopped in a poorer local minimum on about 1 random
-// probe in 300; now never more than 0.1 % above the brute force on those 10,000 (tests/test_zh3.cpp).
+// form): from the best-ranked start alone it stops in a poorer local minimum on about 1 random
+// probe in 300; from every start, never more than 0.1 % above the brute force on those 10,000 (tests/test_zh3.cpp).
 constexpr int kLumStarts = 1;
 constexpr int kChannelStarts = 4;
 // |Y2(a)|^2 = 5 / (4 pi) on the unit sphere (Eq. 8/9).

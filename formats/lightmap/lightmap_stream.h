@@ -70,7 +70,7 @@ struct AuditResult {
     lightmap::Audit audit;
     Timing timing;
 };
-// Every row is fitted (irradz's default solve and the old way) and block-compressed; the hemispherical error integral
+// Every row is fitted (irradz's default solve and the talk's baseline, "old way") and block-compressed; the hemispherical error integral
 // is taken on every stride-th texel (lightmap::audit's sampling), the PSNRs over every texel.
 Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOptions& options);
 

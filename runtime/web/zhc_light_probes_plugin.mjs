@@ -11,7 +11,8 @@
 //
 // Every volume is decoded at load by zhc_runtime.mjs into SH3 radiance (bit exact with zhc's own
 // decoder). Nodes that reference a volume get a child Object3D named "ZHC_light_probes" with
-// userData.zhcLightProbeVolume (the index) and userData.zhcLightProbes (the ZhcProbeVolume); three.js
+// userData.zhcLightProbeVolume (the index) and userData.zhcLightProbes (the ZhcProbeVolume), listed
+// in the volume's `nodes`; three.js
 // may use it as the node object itself when the node has nothing else. Positions and SH are in that
 // node's local space: for world space, transform positions by anchor.matrixWorld and rotate
 // world directions by the inverse of the anchor's world rotation before a lookup.
@@ -65,6 +66,65 @@ export class ZhcProbeVolume {
     return volumeIrradiance(this.#volume, position, this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
   }
 
+  // three.js's own probe grid (r187+: `LightProbeGridWebGL` for WebGLRenderer, `LightProbeGrid` for
+  // WebGPURenderer; pass the class, from 'three/addons/lighting/...') filled from this GRID volume's
+  // decoded probes, no bake: stock materials (MeshStandardMaterial, MeshLambertMaterial, ...) are then
+  // lit by zhc's probes. Add the returned grid to the scene ROOT: three.js reads its `position` as
+  // the world-space centre and its grid is axis-aligned. Options:
+  //   matrixWorld: where the volume's node is (default: the node's matrixWorld when the volume is
+  //     referenced by exactly one node, else identity); translation and positive scale only, a
+  //     rotation or mirror throws (three.js's grid cannot rotate). Call again after moving the node.
+  //   type: THREE.FloatType (default for LightProbeGridWebGL, what its own bake stores; filtering
+  //     needs OES_texture_float_linear) or THREE.HalfFloatType (default for the WebGPU LightProbeGrid,
+  //     whose bake stores half floats: rgba32float is not filterable in WebGPU without
+  //     "float32-filterable"; binary16 rounds each coefficient by up to 2^-11 relative).
+  // Layout (lightprobes_pars_fragment): one RGBA 3D texture n_x x n_y x 7 (n_z + 2); sub-volume t
+  // holds floats 4t..4t+3 of the 27 coefficients c_i,k (index 3i + k, three.js's SH convention, glTF
+  // axes, radiance), with a copy of its first / last slice on either side; probe (x, y, z) sits at its
+  // texel centre, so the hardware trilinear filter blends the same 8 probes with the same weights as
+  // zhc's volume. three.js samples at `position + normal * spacing / 2` (its offset against
+  // self-shadowing) and shades BRDF_Lambert * pi E, i.e. albedo * zhc's E there.
+  lightProbeGrid(GridClass, { matrixWorld, type } = {}) {
+    if (typeof GridClass !== 'function') throw new TypeError('zhc: lightProbeGrid needs three.js\'s LightProbeGridWebGL or LightProbeGrid class');
+    if (this.layout !== 'grid') throw new Error(`zhc: volume '${this.name}' has layout ${this.layout}: lightProbeGrid needs a grid`);
+    if (!this.sh) this.#check(0);
+    const vol = makeVolume({ sh: this.sh, ...this.grid });  // validates origin, spacing > 0, counts
+    const n = vol.counts, o = vol.origin, s = vol.spacing;
+    let m = matrixWorld;
+    if (m === undefined) {
+      if (this.nodes && this.nodes.length === 1) {
+        this.nodes[0].updateWorldMatrix(true, false);
+        m = this.nodes[0].matrixWorld;
+      } else m = new THREE.Matrix4();
+    }
+    const e = m.elements;  // column-major
+    const scale = [e[0], e[5], e[10]];
+    const offDiagonal = Math.max(Math.abs(e[1]), Math.abs(e[2]), Math.abs(e[4]), Math.abs(e[6]), Math.abs(e[8]), Math.abs(e[9]));
+    if (!(scale.every((x) => x > 0 && Number.isFinite(x)) && offDiagonal <= 1e-6 * Math.max(...scale) && e[3] === 0 && e[7] === 0 && e[11] === 0 && e[15] === 1))
+      throw new Error(`zhc: volume '${this.name}': three.js's probe grid is axis-aligned; its node may be translated and scaled, not rotated, mirrored or projected`);
+    const centre = [0, 1, 2].map((c) => e[12 + c] + scale[c] * (o[c] + 0.5 * (n[c] - 1) * s[c]));
+    const size = [0, 1, 2].map((c) => scale[c] * n[c] * s[c]);
+    const grid = new GridClass(size[0], size[1], size[2], n[0], n[1], n[2]);
+    if (grid.isLightProbeGrid !== true) throw new TypeError('zhc: lightProbeGrid needs three.js\'s LightProbeGridWebGL or LightProbeGrid class');
+    if (type === undefined) type = grid.type === 'LightProbeGridWebGL' ? THREE.FloatType : THREE.HalfFloatType;
+    if (type !== THREE.FloatType && type !== THREE.HalfFloatType) throw new Error('zhc: lightProbeGrid type must be THREE.FloatType or THREE.HalfFloatType');
+    grid.name = `${this.name ?? 'zhc'} (LightProbeGrid)`;
+    grid.position.fromArray(centre);
+    grid.updateMatrixWorld();
+    grid.updateBoundingBox();
+    const atlas = lightProbeGridAtlas(this, type === THREE.HalfFloatType);
+    const tex = new THREE.Data3DTexture(atlas.data, atlas.width, atlas.height, atlas.depth);
+    tex.format = THREE.RGBAFormat;
+    tex.type = type;
+    tex.minFilter = THREE.LinearFilter;
+    tex.magFilter = THREE.LinearFilter;
+    tex.generateMipmaps = false;
+    tex.unpackAlignment = 1;
+    tex.needsUpdate = true;
+    grid.texture = tex;
+    return grid;
+  }
+
   // Position of probe p in glTF axes (node-local), [x, y, z].
   position(p) {
     this.#check(p);
@@ -106,6 +166,30 @@ export class ZhcProbeVolume {
     if (!this.sh) throw new Error(`zhc: volume '${this.name}' is not decoded (Draco point clouds need the Draco decoder)`);
     if (!Number.isInteger(p) || p < 0 || p >= this.count) throw new RangeError(`zhc: probe ${p} out of range (${this.count} probes)`);
   }
+}
+
+// The texture data of three.js r187's LightProbeGridWebGL / LightProbeGrid atlas for a grid volume
+// (see ZhcProbeVolume.lightProbeGrid): {data, width: n_x, height: n_y, depth: 7 (n_z + 2)}, data a
+// Float32Array (or Uint16Array of binary16 when `half`) of RGBA texels, x fastest, then y, then slice.
+export function lightProbeGridAtlas(volume, half = false) {
+  const [nx, ny, nz] = volume.grid.counts;
+  const padded = nz + 2, depth = 7 * padded;
+  const data = half ? new Uint16Array(nx * ny * depth * 4) : new Float32Array(nx * ny * depth * 4);
+  const put = (x, y, slice, j, value) => {
+    data[((slice * ny + y) * nx + x) * 4 + j] = half ? THREE.DataUtils.toHalfFloat(value) : value;
+  };
+  for (let p = 0; p < volume.count; p++) {
+    const x = p % nx, y = Math.floor(p / nx) % ny, z = Math.floor(p / (nx * ny));
+    const c = toThreeConvention(volume.probeSHGltf(p));
+    for (let t = 0; t < 7; t++) {
+      const slices = [t * padded + 1 + z];
+      if (z === 0) slices.push(t * padded);
+      if (z === nz - 1) slices.push(t * padded + nz + 1);
+      for (const slice of slices)
+        for (let j = 0; j < 4; j++) put(x, y, slice, j, 4 * t + j < 27 ? c[4 * t + j] : 0);
+    }
+  }
+  return { data, width: nx, height: ny, depth };
 }
 
 // Parses one volume's JSON (and the accessor arrays already loaded) into a ZhcProbeVolume.
@@ -189,7 +273,12 @@ export class ZhcLightProbesPlugin {
       const pos = v.positions !== undefined ? (await this.parser.getDependency('accessor', v.positions)).array : null;
       volumes.push(buildVolume(v, coeffs, pos));
     }
-    for (const anchor of this.anchors) anchor.userData.zhcLightProbes = volumes[anchor.userData.zhcLightProbeVolume];
+    for (const v of volumes) v.nodes = [];
+    for (const anchor of this.anchors) {
+      const v = volumes[anchor.userData.zhcLightProbeVolume];
+      anchor.userData.zhcLightProbes = v;
+      if (v) v.nodes.push(anchor);
+    }
     result.userData = result.userData || {};
     result.userData.zhcLightProbes = volumes;
   }

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Every `zhc ... --json` output against its schema in docs/schema/ (issue 19).
+"""Every `zhc ... --json` output against its schema in docs/schema/.
 
 Usage: check_schemas.py ZHC SCHEMA_DIR ENVMAP WORK_DIR [GLTF_SCENE]
 

@@ -1,4 +1,4 @@
-# --- JSON outputs (issue 19): every `zhc ... --json` validates against docs/schema/<verb>.schema.json.
+# --- JSON outputs: every `zhc ... --json` validates against docs/schema/<verb>.schema.json.
 # Debian python3-jsonschema, run by the system interpreter (/usr/bin/python3: a pyenv or venv
 # python3 earlier on PATH would not see the Debian module).
 set(ZHC_SYSTEM_PYTHON /usr/bin/python3)

@@ -1,4 +1,4 @@
-# runtime/zhc.glsl (issue 15).
+# runtime/zhc.glsl.
 # test_runtime_gl runs it as a compute shader on Mesa llvmpipe (EGL + desktop GL 4.5 core), like
 # test_mesa_bc; it is built only when EGL/GL were found (tests/CMakeLists.txt filters it out
 # otherwise, and ZHC_REQUIRE_MESA_TEST makes that an error).

@@ -1,4 +1,4 @@
-// KTX2 cube maps written by another program (issue 16): ktx-parse (the npm KTX 2.0 parser and
+// KTX2 cube maps written by another program: ktx-parse (the npm KTX 2.0 parser and
 // serializer that glTF-Transform uses; installed with tests/js's dependencies) writes an RGBA32F
 // cube map, level 0 plus mip levels, whose texels hold an SH3 radiance function evaluated at each
 // texel centre's direction. The direction comes from the Vulkan "Cube Map Face Selection" table,

@@ -1,4 +1,4 @@
-// glTF inputs other programs wrote (issue 16), checked with the Khronos glTF-Validator:
+// glTF inputs other programs wrote, checked with the Khronos glTF-Validator:
 //  1. the corpus tests/data/gltf written by glTF-Transform and gltfpack is valid glTF (so zhc's
 //     tests read real, conforming files), including its legal no-scene and data-URI variants;
 //  2. `zhc bake IN.gltf -o OTHER/out.gltf|.glb` (and into the parent folder) writes outputs whose

@@ -203,7 +203,7 @@ function writeKtx2(file, n, faces) {
   fs.writeFileSync(file, write(c));
 }
 
-// three's RGBELoader decodes RGBE as m 2^(e-128) / 255, zhc (like stb_image and Walter's rgbe.c)
+// three's HDRLoader decodes RGBE as m 2^(e-128) / 255, zhc (like stb_image and Walter's rgbe.c)
 // as m 2^(e-128) / 256: three's values are scaled by 255/256 before magnitudes are compared.
 const kRgbe = 255 / 256;
 for (const m of maps) {

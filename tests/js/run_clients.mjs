@@ -113,7 +113,7 @@ for (const c of cases.filter((c) => c.out.endsWith('.glb'))) {
   check(worst < 1e-5, `${c.out}: three.js irradiance equals zhc's`);
 }
 
-// --- 3. zhc bake -o OUT.glb|.gltf (issue 9): a glTF scene with a KHR_lights_punctual light over the
+// --- 3. zhc bake -o OUT.glb|.gltf: a glTF scene with a KHR_lights_punctual light over the
 // triangle (the mesh occludes), and a JSON scene into a minimal asset; every output validates and
 // the three.js plugin finds the baked volume.
 const litScene = JSON.parse(JSON.stringify(scene));

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 15 acceptance: .zhp files written by `zhc convert` decode with runtime/zhc_runtime.h alone
+""".zhp files written by `zhc convert` decode with runtime/zhc_runtime.h alone
 (the strict-C99 tests/runtime_c/zhc_decode_zhp) to what `zhc convert FILE.zhp -o FILE.json` prints,
 within 1e-6 relative, for every packed encoding (and every float one) from sample maps and from
 JSON probe lists of random probes (layouts none, grid, positions), with default and non-default

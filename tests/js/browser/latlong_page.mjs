@@ -1,6 +1,6 @@
 // The browser side of tests/js/latlong_three.mjs: three.js's own equirectangular path, as a glTF
 // viewer built on three uses it. For each map in /work/latlong_spec.json:
-//  * load it with three's loader (RGBELoader for .hdr, EXRLoader for .exr), mapping
+//  * load it with three's loader (HDRLoader for .hdr, EXRLoader for .exr), mapping
 //    EquirectangularReflectionMapping;
 //  * make a cube map of it with WebGLCubeRenderTarget.fromEquirectangularTexture (three's
 //    CubeCamera inside) and read its six faces back (half float -> numbers);
@@ -10,7 +10,7 @@
 //    target), a narrow camera looking along each of spec.dirs (three axes), the centre pixel read back.
 // POSTs everything to /result.
 import * as THREE from 'three';
-import { RGBELoader } from 'three/addons/loaders/RGBELoader.js';
+import { HDRLoader } from 'three/addons/loaders/HDRLoader.js';
 import { EXRLoader } from 'three/addons/loaders/EXRLoader.js';
 import { LightProbeGenerator } from 'three/addons/lights/LightProbeGenerator.js';
 
@@ -26,7 +26,7 @@ async function main() {
   const camera = new THREE.PerspectiveCamera(2, 1, 0.1, 10);
   const pixels = new Float32Array(4 * 4 * 4);
   for (const m of spec.maps) {
-    const loader = m.url.endsWith('.hdr') ? new RGBELoader() : new EXRLoader();
+    const loader = m.url.endsWith('.hdr') ? new HDRLoader() : new EXRLoader();
     const tex = await loader.loadAsync(m.url);
     tex.mapping = THREE.EquirectangularReflectionMapping;
     const rt = new THREE.WebGLCubeRenderTarget(m.cube, { type: THREE.HalfFloatType });

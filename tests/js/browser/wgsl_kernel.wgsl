@@ -1,0 +1,66 @@
+// Compute kernels of tests/js/wgsl_test.mjs, appended to runtime/zhc.wgsl + runtime/zhc_volume.wgsl
+// by the page.
+// decode_kernel: item i = the probe words words[i * stride .. + stride) (stride <= 27) and the unit
+// normal items[3 i .. 3 i + 2]; writes zhcDecode (27 floats, SH3 radiance) and zhcIrradiance
+// (3 floats) at out[30 i ..].
+// volume_kernel: item i = position items[6 i ..], normal items[6 i + 3 ..]; the grid's probe words
+// in words[]; writes zhcVolumeIrradiance (3 floats) at out[3 i ..].
+
+struct Job {
+    stride: u32,
+    count: u32,
+    pad0: u32,
+    pad1: u32,
+    origin: vec4<f32>,
+    spacing: vec4<f32>,
+    counts: vec4<u32>,
+}
+
+@group(0) @binding(0) var<uniform> fmt: ZhcFormat;
+@group(0) @binding(1) var<uniform> job: Job;
+@group(0) @binding(2) var<storage, read> words: array<u32>;
+@group(0) @binding(3) var<storage, read> items: array<f32>;
+@group(0) @binding(4) var<storage, read_write> outv: array<f32>;
+
+// The specialised-format example of zhc.wgsl's header, compiled as written (not called).
+override ZHC_BITS: u32 = 8u;
+fn zhcMyFormat() -> ZhcFormat {
+    return ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_BITS, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
+                     ZHC_ZONAL_AFFINE, ZHC_AXIS_LUMINANCE, ZHC_KIND_RADIANCE,
+                     vec3f(0.2126, 0.7152, 0.0722), vec2f(0.6, 0.08));
+}
+
+// The probe words of zhc_volume.wgsl's functions.
+fn zhcVolumeWord(i: u32) -> u32 { return words[i]; }
+
+@compute @workgroup_size(64)
+fn decode_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    let stride = min(job.stride, 27u);
+    if (i >= job.count) { return; }
+    var w: array<u32, 27>;
+    for (var j = 0u; j < stride; j++) { w[j] = words[i * job.stride + j]; }
+    let n = vec3<f32>(items[3u * i], items[3u * i + 1u], items[3u * i + 2u]);
+    let sh = zhcDecode(w, fmt);
+    for (var c = 0u; c < 9u; c++) {
+        outv[30u * i + 3u * c] = sh.c[c].x;
+        outv[30u * i + 3u * c + 1u] = sh.c[c].y;
+        outv[30u * i + 3u * c + 2u] = sh.c[c].z;
+    }
+    let e = zhcIrradiance(w, fmt, n);
+    outv[30u * i + 27u] = e.x;
+    outv[30u * i + 28u] = e.y;
+    outv[30u * i + 29u] = e.z;
+}
+
+@compute @workgroup_size(64)
+fn volume_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= job.count) { return; }
+    let p = vec3<f32>(items[6u * i], items[6u * i + 1u], items[6u * i + 2u]);
+    let n = vec3<f32>(items[6u * i + 3u], items[6u * i + 4u], items[6u * i + 5u]);
+    let e = zhcVolumeIrradiance(ZhcVolume(job.origin.xyz, job.spacing.xyz, job.counts.xyz), fmt, p, n);
+    outv[3u * i] = e.x;
+    outv[3u * i + 1u] = e.y;
+    outv[3u * i + 2u] = e.z;
+}

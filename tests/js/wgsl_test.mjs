@@ -1,0 +1,648 @@
+// runtime/zhc.wgsl in headless Chromium's WebGPU (CTest: js.wgsl).
+// Usage: node wgsl_test.mjs ZHC_BINARY WORK_DIR [CHROMIUM]
+//
+// Reference chain: runtime/web/zhc_runtime.mjs returns the same float32 numbers as the codec's
+// decode_probe and irradiance(hub, n) (bit for bit, shown by js.runtime_decode against `zhc convert`),
+// and the C header runtime/zhc_runtime.h is compared with the same codec by test_runtime_c; the
+// WGSL results are compared here with the JS runtime, with the error metric and bounds of the GLSL /
+// HLSL tests (tests/gl/runtime_gl_entries.inl, ported below): every difference in units of u S,
+// u = 2^-24, S = the per-channel sum of the magnitudes of the evaluation's terms (quantised
+// coefficients counted at their ratio bound times the DC); bounds 16 (float layouts) / 32
+// (quantised) for irradiance, 16 for decoded coefficients, plus 2^-120 absolute (denormal flush).
+//
+//  1. every entry of the runtime's encoding table (ENCODINGS of zhc_runtime.mjs, which
+//     js.runtime_decode keeps equal to the codec table) must have a line in zhc.wgsl's table (family,
+//     hallucination, axis), else the test fails naming it;
+//  2. 10 batches x 10,000 probes per encoding (lit scenes with coloured directional / blurred lights
+//     and ambient, random Gaussian SH, fixtures' bake-like probes and special cases; exposure
+//     10^-3..10^3), each batch with its own header parameters (bits, sqrt, bound, DC format, zonal
+//     mapping, axis mode, radiance / irradiance storage, luminance weights), encoded by `zhc convert`;
+//     plus 2 batches x 10,000 probes of random bytes;
+//  3. a loopback HTTP server and headless Chromium (WebGPU on SwiftShader): tests/js/browser/
+//     wgsl_page.mjs compiles zhc.wgsl + tests/js/browser/wgsl_kernel.wgsl and runs every batch in a
+//     compute shader (zhcDecode + zhcIrradiance per probe, uniform random normals), posting the floats;
+//  4. probe volumes (runtime/zhc_volume.wgsl, zhcVolumeIrradiance) per encoding on two grids of
+//     encoded probes (6x5x4 default parameters, 5x1x3 non-default ones, a count-1 axis), 10,000
+//     points in and around the box plus every probe's position, against the JS runtime's
+//     volumeIrradianceD (a port of the C header's zhc_volume_irradiance_d, bit-identical per
+//     js.runtime_volume) and the test's own double twin, with the bound of test_runtime_gl's volume test;
+//  5. asserts: no console error or WebGPU validation error, no compilation message, every probe and
+//     sample of every encoding compared, every value within its bound; prints the per-encoding maxima.
+// Time bounded: the browser part times out after 420 s (Chromium killed).
+import fs from 'node:fs';
+import path from 'node:path';
+import http from 'node:http';
+import { execFile, spawn } from 'node:child_process';
+import { fileURLToPath } from 'node:url';
+import { promisify } from 'node:util';
+import { randomProbes, makeRand, checker } from './fixtures.mjs';
+import * as runtime from '../../runtime/web/zhc_runtime.mjs';
+
+const t0 = Date.now();
+const [zhc, workArg, chromiumArg] = process.argv.slice(2);
+if (!zhc || !workArg) {
+  console.error('usage: node wgsl_test.mjs ZHC_BINARY WORK_DIR [CHROMIUM]');
+  process.exit(2);
+}
+const chromium = chromiumArg || '/usr/bin/chromium';
+const work = path.resolve(workArg);
+fs.mkdirSync(work, { recursive: true });
+const here = path.dirname(fileURLToPath(import.meta.url));
+const repo = path.resolve(here, '..', '..');
+const W = (f) => path.join(work, f);
+const { check, finish } = checker();
+const execFileP = promisify(execFile);
+
+const kBatches = 10, kGarbageBatches = 2, kBatchSize = 10000;
+const kU = 2 ** -24, kAbs = 2 ** -120;
+const kCFloat = 16, kCQuant = 32, kCDecode = 16;
+
+// --- 1. zhc.wgsl's encoding table ------------------------------------------------------------------
+const wgslText = fs.readFileSync(path.join(repo, 'runtime', 'zhc.wgsl'), 'utf8');
+const constants = {};
+for (const m of wgslText.matchAll(/^const (ZHC_\w+): u32 = (\d+)u;/gm)) constants[m[1]] = Number(m[2]);
+const wgslTable = {};
+for (const m of wgslText.matchAll(/^\/\/\s+(\w+)\s+(ZHC_LAYOUT_\w+)\s+(ZHC_HALL_\w+)\s+(none|luminance|channel|header)\s*$/gm)) {
+  check(m[2] in constants && m[3] in constants, `zhc.wgsl: the table line of ${m[1]} names known constants`);
+  wgslTable[m[1]] = { family: constants[m[2]], hallucination: constants[m[3]], axis: m[4] };
+}
+// The test's own copies of the constants (the bounds depend on the family) must agree with the file.
+const F = { SH3_F32: 0, SH2_F32: 1, ZH3_F32: 2, ZH3_Q16: 3, SH3_Q28: 4, SH2_Q: 5 };
+const H = { NONE: 0, AMBDIR: 1, SPHERE: 2, CURVE: 3, CURVE_ADAPTIVE: 4 };
+for (const [k, v] of Object.entries(F)) check(constants[`ZHC_LAYOUT_${k}`] === v, `zhc.wgsl: ZHC_LAYOUT_${k} = ${v}u`);
+for (const [k, v] of Object.entries(H)) check(constants[`ZHC_HALL_${k}`] === v, `zhc.wgsl: ZHC_HALL_${k} = ${v}u`);
+const familyBytes = [108, 48, 60, 16, 28, 16];
+const encodings = [];
+for (const name of Object.keys(runtime.ENCODINGS)) {
+  const e = wgslTable[name];
+  check(e !== undefined, `runtime table entry '${name}' has a WGSL decoder line in runtime/zhc.wgsl`);
+  if (!e) continue;
+  const info = runtime.ENCODINGS[name];
+  check(familyBytes[e.family] === info.bytes, `${name}: zhc.wgsl's family has the entry's ${info.bytes} bytes`);
+  if (info.axisMode) check(e.axis === info.axisMode, `${name}: zhc.wgsl's axis column is the runtime's fixed '${info.axisMode}'`);
+  if (!process.env.ZHC_WGSL_ONLY || process.env.ZHC_WGSL_ONLY.split(',').includes(name))  // debugging aid
+    encodings.push({ name, ...e, bytes: info.bytes, packed: !!info.packed });
+}
+for (const name of Object.keys(wgslTable)) check(name in runtime.ENCODINGS, `zhc.wgsl table line '${name}' is a runtime encoding`);
+
+// A second, independent WGSL front end (npm wgsl_reflect, a parser + reflection; Chromium's Tint is
+// the only full validator available): zhc.wgsl alone and with zhc_volume.wgsl and the test kernels
+// parse, the uniform layouts are the ones the file header documents (and formatBytes below writes),
+// the documented functions exist, and a broken copy is rejected (the check can fail).
+{
+  const { WgslReflect } = await import('wgsl_reflect/wgsl_reflect.module.js');  // (its package "main" does not load as ESM)
+  const volumeText = fs.readFileSync(path.join(repo, 'runtime', 'zhc_volume.wgsl'), 'utf8');
+  const kernelText = fs.readFileSync(path.join(here, 'browser', 'wgsl_kernel.wgsl'), 'utf8');
+  const parse = (code) => {
+    try {
+      return new WgslReflect(code);
+    } catch (err) {
+      return { error: String(err?.message ?? err) };
+    }
+  };
+  const alone = parse(wgslText), full = parse([wgslText, volumeText, kernelText].join('\n'));
+  check(!alone.error, `wgsl_reflect parses runtime/zhc.wgsl ${alone.error ?? ''}`);
+  check(!full.error, `wgsl_reflect parses zhc.wgsl + zhc_volume.wgsl + the test kernels ${full.error ?? ''}`);
+  check(!!parse(wgslText.replace('fn zhcNeg(x: f32) -> f32 {', 'fn zhcNeg(x: f32) -> f32 { let = ;')).error, 'wgsl_reflect rejects a broken copy');
+  if (!full.error) {
+    const layout = (name) => {
+      const st = full.structs.find((x) => x.name === name);
+      return st ? `${st.size}: ${st.members.map((m) => `${m.name}@${m.offset}`).join(' ')}` : 'missing';
+    };
+    check(layout('ZhcFormat') === '80: family@0 hallucination@4 bits@8 sqrtEncoding@12 l2Bound@16 dcFormat@20 zonalMapping@24 axisMode@28 kind@32 luminance@48 curve@64',
+      `ZhcFormat uniform layout (${layout('ZhcFormat')})`);
+    check(layout('ZhcVolume') === '48: origin@0 spacing@16 counts@32', `ZhcVolume uniform layout (${layout('ZhcVolume')})`);
+    const fns = new Set(full.functions.map((f) => f.name));
+    for (const f of ['zhcDecode', 'zhcIrradiance', 'zhcIrradianceSh3', 'zhcEvalSh3', 'zhcDecodeSh3F32', 'zhcDecodeSh2F32', 'zhcDecodeZh3F32',
+      'zhcDecodeZh3Q16', 'zhcDecodeSh3Q28', 'zhcDecodeSh2Q', 'zhcIrradianceSh3F32', 'zhcIrradianceSh2F32', 'zhcIrradianceZh3F32',
+      'zhcIrradianceZh3Q16', 'zhcIrradianceSh3Q28', 'zhcIrradianceSh2Q', 'zhcVolumeSh3', 'zhcVolumeIrradiance'])
+      check(fns.has(f), `WGSL function ${f} exists`);
+    check(!alone.error && alone.entry.compute.length === 0 && alone.storage.length === 0 && alone.uniforms.length === 0,
+      'runtime/zhc.wgsl declares no bindings and no entry points');
+  }
+}
+
+const isQuantised = (e) => e.family >= F.ZH3_Q16;
+const isZonal = (e) => e.family === F.ZH3_F32 || e.family === F.ZH3_Q16 || e.hallucination !== H.NONE;
+const hasL2 = (e) => e.family === F.SH3_F32 || e.family === F.SH3_Q28 || isZonal(e);
+// The axis the shader is told: the entry's fixed one, else the header's.
+const axisMode = (e, p) => (e.axis === 'luminance' ? 0 : e.axis === 'channel' ? 1 : (p.axisMode === 'channel' ? 1 : 0));
+
+// --- 2. probes and parameters -------------------------------------------------------------------
+// Header parameters of batch b (tests/gl/runtime_gl_entries.inl batch_params): `flags` for zhc convert.
+function batchParams(e, b, rand) {
+  const p = { ...runtime.DEFAULT_PARAMS, luminanceWeights: [...runtime.DEFAULT_LUMINANCE] };
+  const flags = [];
+  if (b === 0) return { p, flags };
+  if (b % 4 === 3) p.luminanceWeights = [0.05 + rand(), 0.05 + rand(), 0.05 + rand()];
+  if (b % 2) {
+    p.kind = 'irradiance';
+    flags.push('--irradiance');
+  }
+  if (isQuantised(e)) {
+    p.bits = b === 1 ? 8 : 2 + (b * 3) % 7;
+    p.sqrt = ((b >> 1) % 2) === 1;
+    p.l2Bound = (Math.floor(b / 3) % 2) ? 'loose' : 'tight';
+    p.dcFormat = ['r11g11b10f', 'rgb9e5', 'half'][b % 3];
+    if (e.family !== F.SH2_Q && p.dcFormat === 'half') p.dcFormat = 'rgb9e5';
+    p.zonalMapping = ['affine', 'zero', 'symmetric'][(b >> 1) % 3];
+    p.axisMode = ((b >> 2) % 2) ? 'channel' : 'luminance';
+    flags.push('--bits', String(p.bits), '--bound', p.l2Bound, '--dc', p.dcFormat, '--zonal-map', p.zonalMapping, '--axis', p.axisMode);
+    if (p.sqrt) flags.push('--sqrt');
+  }
+  return { p, flags };
+}
+
+// Probe kinds (i % 10): 0-3 lit scenes, 4-6 random Gaussian SH, 7-9 fixtures' bake-like probes and
+// special cases; every probe times an exposure 10^(-3..3).
+const kY = (x, y, z) => runtime.shBasis(x, y, z);
+function batchProbes(seed) {
+  const rand = makeRand(seed);
+  const gauss = () => Math.sqrt(-2 * Math.log(1 - rand())) * Math.cos(2 * Math.PI * rand());
+  const dir = () => {
+    const z = 2 * rand() - 1, phi = 2 * Math.PI * rand(), r = Math.sqrt(Math.max(0, 1 - z * z));
+    return [r * Math.cos(phi), r * Math.sin(phi), z];
+  };
+  const fixtures = randomProbes(kBatchSize, seed ^ 0x5a5a);
+  const out = [];
+  for (let i = 0; i < kBatchSize; i++) {
+    const exposure = 10 ** (-3 + 6 * rand());
+    const sh = Array.from({ length: 9 }, () => [0, 0, 0]);
+    const kind = i % 10;
+    if (kind < 4) {
+      const amb = [0, 1, 2].map(() => exposure * rand() * 0.2);
+      for (let k = 0; k < 3; k++) sh[0][k] = amb[k] * 2 * Math.sqrt(Math.PI);
+      const lights = 1 + Math.floor(rand() * 4);
+      for (let l = 0; l < lights; l++) {
+        const d = dir(), b = kY(...d), s = exposure * 10 ** (2 * rand() - 1);
+        const col = [s * rand(), s * rand(), s * rand()];
+        // directional, or blurred (band l damped by exp(-w l (l + 1)): a smooth lobe)
+        const w = rand() < 0.5 ? 0 : 2 * rand();
+        for (let i2 = 0; i2 < 9; i2++) {
+          const l2 = i2 === 0 ? 0 : i2 < 4 ? 1 : 2;
+          const damp = Math.exp(-w * l2 * (l2 + 1));
+          for (let k = 0; k < 3; k++) sh[i2][k] += col[k] * b[i2] * damp;
+        }
+      }
+    } else if (kind < 7) {
+      for (let i2 = 0; i2 < 9; i2++) for (let k = 0; k < 3; k++) sh[i2][k] = exposure * gauss();
+      if (rand() < 0.5) for (let k = 0; k < 3; k++) sh[0][k] = Math.abs(sh[0][k]) * 4;
+    } else {
+      const f = fixtures[i];
+      const scale = i < 7 ? 1 : exposure;  // the special cases as they are
+      for (let i2 = 0; i2 < 9; i2++) for (let k = 0; k < 3; k++) sh[i2][k] = f[i2][k] * scale;
+    }
+    out.push(sh);
+  }
+  return out;
+}
+
+async function pool(jobs, width) {
+  const res = new Array(jobs.length);
+  let next = 0;
+  await Promise.all(Array.from({ length: width }, async () => {
+    while (next < jobs.length) {
+      const j = next++;
+      res[j] = await jobs[j]();
+    }
+  }));
+  return res;
+}
+
+// sh3 .zhp of every batch's probes, then every encoding x batch by `zhc convert`.
+const cases = [];  // { e, b, garbage, zhp | bytes, p }
+{
+  const jobs = [];
+  for (let b = 0; b < kBatches; b++) {
+    fs.writeFileSync(W(`batch${b}.json`), JSON.stringify({ format: 'zhc-probes', version: 1, kind: 'radiance', layout: { type: 'positions' },
+      probes: batchProbes(1000 + b).map((sh, i) => ({ position: [i % 100, Math.floor(i / 100), 0], sh3: sh })) }));
+    jobs.push(() => execFileP(zhc, ['convert', W(`batch${b}.json`), '-o', W(`batch${b}.zhp`), '--to', 'sh3']));
+  }
+  await pool(jobs, 2);
+  const rand = makeRand(4711);
+  const convert = [];
+  for (const e of encodings) {
+    for (let b = 0; b < kBatches + kGarbageBatches; b++) {
+      const garbage = b >= kBatches;
+      const { p, flags } = batchParams(e, garbage ? b - kBatches + 1 : b, rand);
+      const c = { e, b, garbage, p };
+      if (!garbage) {
+        c.zhp = W(`${e.name}_${b}.zhp`);
+        convert.push(() => execFileP(zhc, ['convert', W(`batch${b}.zhp`), '-o', c.zhp, '--to', e.name, ...flags]));
+      }
+      cases.push(c);
+    }
+  }
+  await pool(convert, 2);
+}
+const tEncoded = Date.now();
+console.log(`encoded ${encodings.length} encodings x ${kBatches} batches of ${kBatchSize} probes with zhc convert in ${((tEncoded - t0) / 1000).toFixed(1)} s`);
+
+// The job of one case: its probe bytes, header parameters (from the .zhp itself for encoded ones;
+// the batch's luminance weights override the header's, both sides decode with them), normals.
+function loadCase(c, rand) {
+  if (c.garbage) {
+    c.bytes = new Uint8Array(kBatchSize * c.e.bytes);
+    for (let j = 0; j < c.bytes.length; j++) c.bytes[j] = Math.floor(rand() * 256);
+  } else {
+    const z = runtime.parseZhp(new Uint8Array(fs.readFileSync(c.zhp)));
+    check(z.encoding === c.e.name && z.count === kBatchSize, `${c.zhp}: ${kBatchSize} ${c.e.name} probes`);
+    for (const key of ['bits', 'sqrt', 'l2Bound', 'dcFormat', 'zonalMapping', 'axisMode', 'kind'])
+      if (c.e.packed || key === 'kind') check(z.params[key] === c.p[key], `${c.zhp}: header ${key} ${z.params[key]} is the batch's ${c.p[key]}`);
+    c.p = { ...z.params, luminanceWeights: c.p.luminanceWeights };
+    c.bytes = z.payload;
+  }
+  c.normals = new Float32Array(kBatchSize * 3);
+  for (let i = 0; i < kBatchSize; i++) {
+    const z = 2 * rand() - 1, phi = 2 * Math.PI * rand(), r = Math.sqrt(Math.max(0, 1 - z * z));
+    c.normals.set([r * Math.cos(phi), r * Math.sin(phi), z], 3 * i);
+  }
+}
+const enumIndex = {
+  l2Bound: ['tight', 'loose'], dcFormat: ['r11g11b10f', 'rgb9e5', 'half'], zonalMapping: ['affine', 'zero', 'symmetric'],
+  kind: ['radiance', 'irradiance'],
+};
+// ZhcFormat in the uniform address space: 9 u32 at 0..32, luminance vec3 at 48, curve vec2 at 64; 80 bytes.
+function formatBytes(e, p) {
+  const buf = new ArrayBuffer(80);
+  const u = new Uint32Array(buf), f = new Float32Array(buf);
+  u.set([e.family, e.hallucination, p.bits, p.sqrt ? 1 : 0, enumIndex.l2Bound.indexOf(p.l2Bound),
+    enumIndex.dcFormat.indexOf(p.dcFormat), enumIndex.zonalMapping.indexOf(p.zonalMapping), axisMode(e, p),
+    enumIndex.kind.indexOf(p.kind)]);
+  f.set(p.luminanceWeights, 12);
+  f.set([runtime.HALLUCINATE_CURVE_A, runtime.HALLUCINATE_CURVE_B], 16);
+  return new Uint8Array(buf);
+}
+// A job for the page (wgsl_page.mjs): header, the kernel's Job uniform (stride, count, grid), the
+// format uniform, the probe words, the item inputs.
+function jobBytes(kernel, count, outFloats, itemFloats, stride, grid, fmt, words, itemData) {
+  const head = new Uint32Array(16);
+  head.set([kernel, count, outFloats, itemFloats, words.length]);
+  const job = new ArrayBuffer(64);
+  new Uint32Array(job, 0, 4).set([stride, count, 0, 0]);
+  if (grid) {
+    new Float32Array(job, 16, 8).set([...grid.origin, 0, ...grid.spacing, 0]);
+    new Uint32Array(job, 48, 4).set([...grid.counts, 0]);
+  }
+  return Buffer.concat([Buffer.from(head.buffer), Buffer.from(job), Buffer.from(fmt), Buffer.from(words.buffer, words.byteOffset, words.byteLength),
+    Buffer.from(itemData.buffer, itemData.byteOffset, itemData.byteLength)]);
+}
+function wordsOf(bytes) {
+  const words = new Uint32Array(bytes.length / 4);
+  new Uint8Array(words.buffer).set(bytes);
+  return words;
+}
+
+// --- error scale (tests/gl/runtime_gl_entries.inl probe_scale, check_value) -----------------------
+const ratioBoundRadiance = (i, bound) => (i < 4 ? Math.sqrt(3) : i === 6 ? Math.sqrt(5) : bound === 'tight' ? Math.sqrt(15) / 2 : Math.sqrt(5));
+function probeScale(e, p, d) {
+  const s = { irradiance: [0, 0, 0], coeff: Array.from({ length: 9 }, () => [0, 0, 0]), defined: true };
+  const quant = isQuantised(e);
+  const w = p.luminanceWeights;
+  const m = Array.from({ length: 9 }, () => [0, 0, 0]);
+  for (let k = 0; k < 3; k++) {
+    const dc = Math.abs(d[k]);
+    m[0][k] = dc;
+    for (let i = 1; i < 9; i++) m[i][k] = quant ? Math.max(Math.abs(d[i * 3 + k]), ratioBoundRadiance(i, p.l2Bound) * dc) : Math.abs(d[i * 3 + k]);
+  }
+  const kappa = [1, 1, 1];
+  const vec = (k) => [-d[9 + k], -d[3 + k], d[6 + k]];
+  const len = (v) => Math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  const vmag = (k) => Math.sqrt(m[1][k] * m[1][k] + m[2][k] * m[2][k] + m[3][k] * m[3][k]);
+  if (isZonal(e)) {
+    if (axisMode(e, p) === 0) {
+      const lum = [0, 0, 0];
+      let mag = 0, allZero = true;
+      for (let k = 0; k < 3; k++) {
+        const v = vec(k);
+        for (let j = 0; j < 3; j++) lum[j] += w[k] * v[j];
+        mag += Math.abs(w[k]) * vmag(k);
+        allZero = allZero && len(v) === 0;
+      }
+      const l = len(lum);
+      kappa.fill((mag === 0 || allZero) ? 1 : (l > 0 ? mag / l : Infinity));
+    } else {
+      for (let k = 0; k < 3; k++) {
+        const l = len(vec(k)), mag = vmag(k);
+        kappa[k] = (mag === 0 || l === 0) ? 1 : mag / l;
+        if (!Number.isFinite(l)) kappa[k] = Infinity;
+      }
+    }
+  }
+  const gOf = (a, b) => {
+    const pmax = Math.sqrt(3);
+    return Math.abs(a) * pmax + Math.abs(b) + Math.max(Math.abs(b), Math.abs(2 * a * pmax + b));
+  };
+  let g = 0;
+  if (e.hallucination === H.AMBDIR) g = 2 * Math.sqrt(15) / 3;
+  if (e.hallucination === H.SPHERE) g = gOf(2 * Math.sqrt(5) / 3, -Math.sqrt(5 / 3));
+  if (e.hallucination === H.CURVE) g = gOf(0.6, 0.08);
+  if (e.hallucination === H.CURVE_ADAPTIVE) g = gOf(3.5 * 0.6, 3.5 * 0.08);
+  if (p.kind === 'irradiance' && e.family === F.SH2_F32) g *= 8 / 3;
+  for (let k = 0; k < 3; k++) {
+    if (!Number.isFinite(kappa[k])) s.defined = false;
+    const l1 = m[1][k] + m[2][k] + m[3][k];
+    let l2 = 0, zonalScale = 0;
+    if (isZonal(e)) {
+      let f20 = 0;
+      for (let i = 4; i < 9; i++) f20 += d[i * 3 + k] * d[i * 3 + k];
+      f20 = Math.sqrt(f20);
+      if (quant && e.hallucination === H.NONE) f20 = Math.max(f20, Math.sqrt(5) * m[0][k]);
+      zonalScale = (f20 + g * vmag(k)) * (1 + kappa[k]);
+      l2 = 3 * runtime.kY20 * zonalScale;
+    } else if (hasL2(e)) {
+      for (let i = 4; i < 9; i++) l2 += 0.631 * m[i][k];
+    }
+    s.irradiance[k] = runtime.kY00 * m[0][k] + (2 / 3) * runtime.kY1 * l1 + 0.25 * l2;
+    for (let i = 0; i < 9; i++) s.coeff[i][k] = (i >= 4 && isZonal(e)) ? Math.sqrt(3) * zonalScale : m[i][k];
+  }
+  return s;
+}
+const FLT_MAX = 3.4028234663852886e38;
+function checkValue(t, key, ref, gpu, scale, c, what) {
+  if (!Number.isFinite(ref)) {
+    t.skippedNonfinite++;
+    return;
+  }
+  t.compared++;
+  if (!Number.isFinite(gpu)) {
+    if (scale * 64 >= FLT_MAX) {
+      t.overflowOk++;
+      return;
+    }
+  } else {
+    const err = Math.abs(gpu - ref);
+    const units = scale > 0 ? err / (kU * scale) : (err > 0 ? Infinity : 0);
+    if (err <= kAbs) return;
+    t[key] = Math.max(t[key], units);
+    if (err <= c * kU * scale + kAbs) return;
+  }
+  if (t.failures++ === 0) t.firstFailure = `${what()}: reference ${ref} wgsl ${gpu} scale ${scale.toExponential(4)} (${(Math.abs(gpu - ref) / (kU * scale)).toFixed(2)} u S, bound ${c})`;
+}
+const tally = () => ({ maxIrr: 0, maxDec: 0, compared: 0, skippedNonfinite: 0, skippedIllcond: 0, overflowOk: 0, failures: 0, firstFailure: '', probes: 0 });
+const tallies = new Map(encodings.map((e) => [e.name, { valid: tally(), garbage: tally() }]));
+
+// Compares one case's WGSL output (30 floats per probe) with the JS runtime.
+function compareCase(c, gpu) {
+  const t = tallies.get(c.e.name)[c.garbage ? 'garbage' : 'valid'];
+  const cIrr = isQuantised(c.e) ? kCQuant : kCFloat;
+  t.probes += kBatchSize;
+  for (let i = 0; i < kBatchSize; i++) {
+    const ref = runtime.decodeProbe(c.e.name, c.bytes, i * c.e.bytes, c.p);
+    const n = [c.normals[3 * i], c.normals[3 * i + 1], c.normals[3 * i + 2]];
+    const irr = runtime.irradiance(ref, n);
+    const s = probeScale(c.e, c.p, ref);
+    if (!s.defined) {
+      ++t[ref.every(Number.isFinite) ? 'skippedIllcond' : 'skippedNonfinite'];
+      continue;
+    }
+    const what = (v) => {  // built only for the first failure
+      const hex = Array.from(c.bytes.subarray(i * c.e.bytes, (i + 1) * c.e.bytes), (x) => x.toString(16).padStart(2, '0')).join('');
+      return `${c.e.name}${c.garbage ? ' random bytes' : ''} batch ${c.b} probe ${i} (bytes ${hex}, normal ${n.join(',')}) ${v}`;
+    };
+    for (let j = 0; j < 27; j++)
+      checkValue(t, 'maxDec', ref[j], gpu[30 * i + j], s.coeff[Math.floor(j / 3)][j % 3], kCDecode, () => what(`coefficient ${Math.floor(j / 3)}/${j % 3}`));
+    for (let k = 0; k < 3; k++) checkValue(t, 'maxIrr', irr[k], gpu[30 * i + 27 + k], s.irradiance[k], cIrr, () => what(`irradiance ${k}`));
+  }
+}
+
+function decodeJob(c) {
+  loadCase(c, caseRand);
+  c.outFloats = kBatchSize * 30;
+  return jobBytes(0, kBatchSize, 30, 3, c.e.bytes / 4, null, formatBytes(c.e, c.p), wordsOf(c.bytes), c.normals);
+}
+
+// --- probe volumes (zhc_volume.wgsl) against a double twin of zhc_volume_irradiance_d -------------
+// Two grids per encoding, as test_runtime_gl's compare_volumes: 6x5x4 probes of batch 0 (default
+// parameters) and 5x1x3 of batch 5 (irradiance storage, 3 bits, loose bound, symmetric zonal map,
+// per-channel axes, RGB9E5 / half DC); 10,000 points in and around the box (1.5 times its size, a
+// count-1 axis 2 spacings wide) and every probe's own position, random unit normals.
+const kVolumeSamples = 10000;
+const volumeGrids = [{ counts: [6, 5, 4], batch: 0 }, { counts: [5, 1, 3], batch: 5 }];
+const volumeOrigin = [-1.5, 2.0, 0.25], volumeSpacing = [0.75, 0.5, 1.25];  // exact in float
+const volumeTallies = new Map(encodings.map((e) => [e.name, { ...tally(), samples: 0, skipped: 0, twinMismatch: 0 }]));
+function volumeJob(c) {
+  const z = runtime.parseZhp(new Uint8Array(fs.readFileSync(c.zhp)));
+  const counts = c.grid.counts, count = counts[0] * counts[1] * counts[2];
+  c.p = z.params;
+  c.bytes = z.payload.slice(0, count * c.e.bytes);
+  c.decoded = Array.from({ length: count }, (_, q) => runtime.decodeProbe(c.e.name, c.bytes, q * c.e.bytes, c.p));
+  c.vol = runtime.makeVolume({ encoding: c.e.name, params: c.p, bytes: c.bytes, origin: volumeOrigin, spacing: volumeSpacing, counts });
+  const n = kVolumeSamples + count;
+  c.items = new Float32Array(6 * n);
+  for (let i = 0; i < n; i++) {
+    for (let a = 0; a < 3; a++) {
+      const size = counts[a] > 1 ? (counts[a] - 1) * volumeSpacing[a] : 2 * volumeSpacing[a];
+      const lo = counts[a] > 1 ? volumeOrigin[a] - 0.25 * size : volumeOrigin[a] - volumeSpacing[a];
+      const node = i - kVolumeSamples;
+      const at = a === 0 ? node % counts[0] : a === 1 ? Math.floor(node / counts[0]) % counts[1] : Math.floor(node / (counts[0] * counts[1]));
+      c.items[6 * i + a] = i < kVolumeSamples ? lo + 1.5 * size * caseRand() : volumeOrigin[a] + at * volumeSpacing[a];
+    }
+    const zz = 2 * caseRand() - 1, phi = 2 * Math.PI * caseRand(), r = Math.sqrt(Math.max(0, 1 - zz * zz));
+    c.items.set([r * Math.cos(phi), r * Math.sin(phi), zz], 6 * i + 3);
+  }
+  c.samples = n;
+  c.outFloats = 3 * n;
+  return jobBytes(1, n, 3, 6, c.e.bytes / 4, { origin: volumeOrigin, spacing: volumeSpacing, counts }, formatBytes(c.e, c.p),
+    wordsOf(c.bytes), c.items);
+}
+// Cell of one axis (zhc__volume_axis of zhc_runtime.h): t clamped to [0, n - 1] (NaN: 0), i0 =
+// min(floor(t), n - 2), f = t - i0 (0 for n = 1).
+function volumeAxis(x, o, sp, n) {
+  let t = (x - o) / sp;
+  if (!(t >= 0)) t = 0;
+  if (t > n - 1) t = n - 1;
+  let i = Math.floor(t);
+  if (n >= 2 && i > n - 2) i = n - 2;
+  return { i0: i, f: n >= 2 ? t - i : 0, t };
+}
+// The test's own twin of zhc_volume_irradiance_d, written from docs/runtime.md "Probe volumes": blend
+// of the decoded SH3 (float32, = zhc_decode_probe) in double, normalised normal (+Z when zero / not
+// finite), band scales 1, 2/3, 1/4; also lists the cell's corners for the error scale.
+function volumeIrradianceD(c, pos, nrm) {
+  const counts = c.grid.counts;
+  const ax = [0, 1, 2].map((a) => volumeAxis(pos[a], volumeOrigin[a], volumeSpacing[a], counts[a]));
+  const sh = new Float64Array(27);
+  const corners = [];
+  for (let corner = 0; corner < 8; corner++) {
+    const b = [corner & 1, (corner >> 1) & 1, corner >> 2];
+    const w = (b[0] ? ax[0].f : 1 - ax[0].f) * (b[1] ? ax[1].f : 1 - ax[1].f) * (b[2] ? ax[2].f : 1 - ax[2].f);
+    const q = b.map((bb, a) => ax[a].i0 + bb);
+    if (q.every((qq, a) => qq < counts[a])) corners.push(q[0] + counts[0] * (q[1] + counts[1] * q[2]));
+    if (w === 0) continue;
+    const d = c.decoded[q[0] + counts[0] * (q[1] + counts[1] * q[2])];
+    for (let j = 0; j < 27; j++) sh[j] += w * d[j];
+  }
+  let len = Math.hypot(nrm[0], nrm[1], nrm[2]);
+  const n = len > 0 && Number.isFinite(len) ? nrm.map((x) => x / len) : [0, 0, 1];
+  const y = runtime.shBasis(n[0], n[1], n[2]);
+  const rgb = [0, 0, 0];
+  for (let i = 0; i < 9; i++) {
+    const s = i === 0 ? 1 : i < 4 ? 2 / 3 : 0.25;
+    for (let k = 0; k < 3; k++) rgb[k] += s * sh[i * 3 + k] * y[i];
+  }
+  return { rgb, corners, ax };
+}
+// Reference: the runtime's volumeIrradianceD (the C header's zhc_volume_irradiance_d ported, the same
+// double operations: js.runtime_volume shows volumeIrradiance bit-identical with the C header), and
+// the twin above must agree with it to 1e-12 of S.
+// Bound (test_runtime_gl compare_volumes): u times the summed probe scales S of the cell's corners,
+// times 48 (decode and evaluation 32, blending 16) + 3 sum_axes ((|p| + |o|) / s + t + 2) (the
+// float error of t = (p - o) / s moves each weight by at most 3 times it).
+function compareVolume(c, gpu) {
+  const t = volumeTallies.get(c.e.name);
+  for (let i = 0; i < c.samples; i++) {
+    const pos = [c.items[6 * i], c.items[6 * i + 1], c.items[6 * i + 2]];
+    const nrm = [c.items[6 * i + 3], c.items[6 * i + 4], c.items[6 * i + 5]];
+    const { rgb: twin, corners, ax } = volumeIrradianceD(c, pos, nrm);
+    const rgb = runtime.volumeIrradianceD(c.vol, pos, nrm);
+    let extra = 0;
+    for (let a = 0; a < 3; a++) extra += (Math.abs(pos[a]) + Math.abs(volumeOrigin[a])) / volumeSpacing[a] + ax[a].t + 2;
+    const scale = [0, 0, 0];
+    let defined = true;
+    for (const q of corners) {
+      const sc = probeScale(c.e, c.p, c.decoded[q]);
+      defined = defined && sc.defined;
+      for (let k = 0; k < 3; k++) scale[k] += sc.irradiance[k];
+    }
+    if (!defined) {
+      t.skipped++;
+      continue;
+    }
+    t.samples++;
+    for (let k = 0; k < 3; k++) {
+      const d = Math.abs(twin[k] - rgb[k]);
+      if (!(d <= 1e-12 * scale[k] + kAbs)) t.twinMismatch++;
+    }
+    for (let k = 0; k < 3; k++)
+      checkValue(t, 'maxIrr', rgb[k], gpu[3 * i + k], scale[k], 48 + 3 * extra,
+        () => `${c.e.name} grid ${c.grid.counts.join('x')} sample ${i} (position ${pos.join(',')}, normal ${nrm.join(',')}) channel ${k}`);
+  }
+}
+for (const e of encodings)
+  for (const grid of volumeGrids) cases.push({ e, volume: true, grid, zhp: W(`${e.name}_${grid.batch}.zhp`) });
+
+// --- 3. server + Chromium ---------------------------------------------------------------------
+const roots = { '/runtime/': path.join(repo, 'runtime'), '/test/': path.join(here, 'browser') };
+const types = { '.html': 'text/html', '.mjs': 'text/javascript', '.wgsl': 'text/plain' };
+const caseRand = makeRand(99991);
+let nextCase = 0, current = null, jobsDone = 0;
+let compareMs = 0;
+let resolveDone;
+const done = new Promise((resolve) => { resolveDone = resolve; });
+const readBody = (req) => new Promise((resolve) => {
+  const chunks = [];
+  req.on('data', (ch) => chunks.push(ch));
+  req.on('end', () => resolve(Buffer.concat(chunks)));
+});
+const server = http.createServer(async (req, res) => {
+  const url = new URL(req.url, 'http://127.0.0.1');
+  if (req.method === 'GET' && url.pathname === '/job/next') {
+    if (nextCase >= cases.length) {
+      res.writeHead(204);
+      res.end();
+      return;
+    }
+    current = cases[nextCase++];
+    res.writeHead(200, { 'Content-Type': 'application/octet-stream' });
+    res.end(current.volume ? volumeJob(current) : decodeJob(current));
+    return;
+  }
+  if (req.method === 'POST' && url.pathname === '/job/result') {
+    const body = await readBody(req);
+    const gpu = new Float32Array(body.buffer.slice(body.byteOffset, body.byteOffset + body.byteLength));
+    const want = current ? current.outFloats : 0;
+    check(current && gpu.length === want, `result of job ${nextCase - 1}: ${want} floats`);
+    if (current && gpu.length === want) {
+      const tc = Date.now();
+      (current.volume ? compareVolume : compareCase)(current, gpu);
+      compareMs += Date.now() - tc;
+      current.bytes = current.normals = current.items = current.decoded = current.vol = null;
+      jobsDone++;
+    }
+    res.end('ok');
+    return;
+  }
+  if (req.method === 'POST' && url.pathname === '/done') {
+    const body = await readBody(req);
+    res.end('ok');
+    resolveDone(body.toString());
+    return;
+  }
+  const pathname = url.pathname === '/' ? '/test/wgsl.html' : decodeURIComponent(url.pathname);
+  for (const [prefix, dir] of Object.entries(roots)) {
+    if (!pathname.startsWith(prefix)) continue;
+    const file = path.resolve(dir, '.' + pathname.slice(prefix.length - 1));
+    if (!file.startsWith(dir + path.sep) || !fs.existsSync(file) || !fs.statSync(file).isFile()) break;
+    res.writeHead(200, { 'Content-Type': types[path.extname(file)] ?? 'application/octet-stream', 'Cache-Control': 'no-store' });
+    res.end(fs.readFileSync(file));
+    return;
+  }
+  res.writeHead(404);
+  res.end();
+});
+await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+const port = server.address().port;
+const profile = fs.mkdtempSync(path.join(work, 'chromium-profile-'));
+const args = ['--headless=new', '--no-sandbox', '--disable-gpu-sandbox', '--disable-quic', '--no-first-run', '--disable-background-networking',
+  '--disable-component-update', '--disable-sync', '--disable-default-apps', '--disable-extensions', `--user-data-dir=${profile}`,
+  '--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+  '--enable-logging=stderr', '--v=0', `http://127.0.0.1:${port}/test/wgsl.html`];
+const browser = spawn(chromium, args, { detached: true, stdio: ['ignore', 'ignore', 'pipe'] });
+let stderr = '';
+browser.stderr.on('data', (ch) => { stderr += ch; });
+const timeout = new Promise((resolve) => setTimeout(() => resolve(null), 420000));
+const body = await Promise.race([done, timeout]);
+// The page logs its last line just before posting /done: give Chromium's log a moment to carry it.
+for (let i = 0; i < 50 && body !== null && !/zhc wgsl page done/.test(stderr); i++) await new Promise((r) => setTimeout(r, 100));
+try { process.kill(-browser.pid, 'SIGKILL'); } catch { /* already gone */ }
+server.close();
+fs.rmSync(profile, { recursive: true, force: true });
+fs.writeFileSync(W('chromium_stderr.txt'), stderr);
+const tBrowser = Date.now();
+
+// --- 4. assertions -----------------------------------------------------------------------------
+check(body !== null, 'the page reported within 420 s');
+if (body === null) {
+  console.log(`jobs done: ${jobsDone} of ${cases.length}`);
+  console.log(stderr.split('\n').slice(-30).join('\n'));
+  finish('runtime/zhc.wgsl');
+}
+const report = JSON.parse(body);
+console.log(`Chromium WebGPU: ${report.webgpu}, adapter "${report.adapter}", ${report.jobs} jobs`);
+for (const e of report.errors ?? []) console.log(`  page: ${e}`);
+for (const m of report.compilation ?? []) console.log(`  compilation: ${m}`);
+check(report.webgpu === true, 'WebGPU adapter and device');
+check((report.errors ?? []).length === 0, 'no console error, warning, exception or WebGPU error in the page');
+check((report.compilation ?? []).length === 0, 'zhc.wgsl + kernel compile without any message');
+const consoleErrors = stderr.split('\n').filter((l) => /CONSOLE/.test(l) && /(Uncaught|Error)/.test(l));
+for (const l of consoleErrors) console.log(`  chromium: ${l}`);
+check(consoleErrors.length === 0, 'no console error in Chromium\'s log');
+check(/CONSOLE.*zhc wgsl page done/.test(stderr), 'the page\'s console output reaches Chromium\'s log (so the check above can fail)');
+check(jobsDone === cases.length, `every job ran (${jobsDone} of ${cases.length})`);
+
+console.log('max error in u S (irradiance) / u M (decoded coefficients) of WGSL vs the JS runtime (= the codec\'s floats):');
+console.log(`${'encoding'.padEnd(22)} ${'probes'.padStart(7)} ${'irr uS'.padStart(8)} ${'dec uS'.padStart(8)} ${'garbage'.padStart(7)} ${'irr uS'.padStart(8)} ${'dec uS'.padStart(8)} ${'nonfinite'.padStart(9)} ${'illcond'.padStart(8)} bounds`);
+for (const e of encodings) {
+  const { valid: v, garbage: g } = tallies.get(e.name);
+  const cIrr = isQuantised(e) ? kCQuant : kCFloat;
+  console.log(`${e.name.padEnd(22)} ${String(v.probes).padStart(7)} ${v.maxIrr.toFixed(3).padStart(8)} ${v.maxDec.toFixed(3).padStart(8)} ` +
+    `${String(g.probes).padStart(7)} ${g.maxIrr.toFixed(3).padStart(8)} ${g.maxDec.toFixed(3).padStart(8)} ${String(g.skippedNonfinite).padStart(9)} ` +
+    `${String(g.skippedIllcond).padStart(8)} ${cIrr}/${kCDecode}`);
+  check(v.probes >= 100000, `${e.name}: >= 100,000 valid probes (${v.probes})`);
+  for (const [what, t] of [['valid', v], ['random bytes', g]])
+    check(t.failures === 0, `${e.name} ${what}: ${t.failures} values out of bound; first: ${t.firstFailure}`);
+  check(v.skippedNonfinite + v.skippedIllcond === 0 && v.compared === v.probes * 30, `${e.name}: every valid probe compared (${v.compared} values)`);
+  check(g.compared > g.probes * 30 / 2, `${e.name}: most random-byte values compared (${g.compared})`);
+}
+console.log('probe volumes: max error in u S (S summed over the cell\'s corners) of zhcVolumeIrradiance vs volumeIrradianceD (= zhc_volume_irradiance_d):');
+for (const e of encodings) {
+  const t = volumeTallies.get(e.name);
+  console.log(`${e.name.padEnd(22)} ${String(t.samples).padStart(7)} samples ${t.maxIrr.toFixed(3).padStart(8)} u S, skipped ${t.skipped}`);
+  check(t.failures === 0, `${e.name} volume: ${t.failures} values out of bound; first: ${t.firstFailure}`);
+  check(t.twinMismatch === 0, `${e.name} volume: the test's twin equals runtime volumeIrradianceD (${t.twinMismatch} values differ)`);
+  check(t.skipped === 0 && t.samples === volumeGrids.reduce((acc, g) => acc + kVolumeSamples + g.counts[0] * g.counts[1] * g.counts[2], 0) && t.compared === 3 * t.samples, `${e.name} volume: every sample compared (${t.samples})`);
+}
+console.log(`wall time: encoding ${((tEncoded - t0) / 1000).toFixed(1)} s, browser + comparison ${((tBrowser - tEncoded) / 1000).toFixed(1)} s ` +
+  `(of which JS reference + comparison ${(compareMs / 1000).toFixed(1)} s), total ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+finish('runtime/zhc.wgsl');
