@@ -33,6 +33,7 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     LatLongConvention latlong = LatLongConvention::kOpenExr;
+    LdrDecoding ldr;
     int threads = 1;
     std::vector<CLI::Option*> storage_flags;  // the options that set CodecOptions
     bool any_storage_flag() const {
@@ -65,6 +66,7 @@ Result<Loaded> load_input(const Options& o) {
         if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
         ro.part = o.part;
         ro.latlong = o.latlong;
+        ro.ldr = o.ldr;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return img.error();
         in.list.probes.push_back(project_envmap(*img, resolve_threads(o.threads)));
@@ -197,6 +199,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
         ->check(CLI::Range(0, 22));
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
+    add_ldr_encoding_option(sub, o->ldr);
     add_threads_option(sub, o->threads, "environment map projection; result identical for any count");
     return [o] { return run(*o); };
 });

@@ -31,6 +31,7 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     LatLongConvention latlong = LatLongConvention::kOpenExr;
+    LdrDecoding ldr;
     int threads = 1;
 };
 
@@ -113,6 +114,7 @@ int run(const Options& o) {
         if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
         ro.part = o.part;
         ro.latlong = o.latlong;
+        ro.ldr = o.ldr;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return report(img.error());
         probes.push_back({"", project_envmap(*img, resolve_threads(o.threads))});
@@ -170,6 +172,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     sub->add_flag("--punctual", o->punctual, "source is punctual lights: extra windowing 0.92 / 0.73 first");
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
+    add_ldr_encoding_option(sub, o->ldr);
     add_threads_option(sub, o->threads, "environment map projection; same result for any count");
     return [o] { return run(*o); };
 });

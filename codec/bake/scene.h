@@ -55,6 +55,8 @@ struct SceneEnvironment {
     // How a lat-long map's columns turn (codec/sh/sh.h; `projected` is already in zhc's frame).
     LatLongConvention latlong = LatLongConvention::kOpenExr;
     bool latlong_map = true;   // false: a cube map (its orientation is its format's)
+    // 8-bit cube maps: how texels become radiance (formats/envmap/envmap.h parse_ldr_decoding).
+    std::string ldr_encoding = "auto";
 };
 
 enum class SkyKind : std::uint8_t { kConstant, kGradient };
