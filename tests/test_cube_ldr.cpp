@@ -29,6 +29,7 @@
 #include "codec/lightmap/bc6h.h"
 #include "formats/envmap/envmap.h"
 #include "formats/envmap/envmap_ldr.h"
+#include "formats/scene/scene_json.h"
 #include "cube_helpers.h"
 #include "support.h"
 
@@ -655,6 +656,41 @@ TEST(CubeLdr, RgbmAndRgbdRoundTrip) {
     EXPECT_EQ(r.exit_code, 4) << r.err;
     EXPECT_NE(r.err.find("face 0 texel (1, 1) has alpha 0"), std::string::npos) << r.err;
     EXPECT_EQ(test::run_zhc({"project", dir + "/rgbd0.ktx2", "--ldr-encoding", "rgbm:4"}).exit_code, 0);
+}
+
+TEST(CubeLdr, SceneEnvironmentTakesTheLdrEncoding) {
+    const int n = 32;
+    const Sh3Radiance a = test_sh();
+    const Image hdr = render_cube(n, [&](Vec3 d) { return evaluate(a, d); });
+    std::vector<float> target;
+    for (size_t i = 0; i < hdr.rgb.size() / 3; ++i) {
+        float e[4];
+        rgbm_encode(&hdr.rgb[3 * i], 8, e);
+        target.insert(target.end(), e, e + 4);
+    }
+    const std::string dir = test::fresh_dir("cube_ldr_scene");
+    test::write_bytes(dir + "/env.ktx2", ldr_file({"ktx2", Ldr::kRgba8, false}, n, all_faces(target, n, Ldr::kRgba8)));
+    auto scene_with = [&](const std::string& extra) {
+        const std::string text = R"({"format": "zhc-scene", "version": 1, "probes": {"positions": [[0, 0, 0]]},
+            "environment": {"map": "env.ktx2")" + extra + "}}";
+        Bytes tb;
+        for (char ch : text) tb.push_back(static_cast<std::uint8_t>(ch));
+        test::write_bytes(dir + "/scene.json", tb);
+        return read_scene_file(dir + "/scene.json");
+    };
+    auto rgbm = scene_with(R"(, "ldr_encoding": "rgbm:8")");
+    ASSERT_TRUE(rgbm) << rgbm.error().message;
+    ASSERT_TRUE(rgbm->environment);
+    EXPECT_EQ(rgbm->environment->ldr_encoding, "rgbm:8");
+    EXPECT_LT(test::sh_distance(rgbm->environment->projected, a), 3.3e-3);  // RgbmAndRgbdRoundTrip's bound for RGBA8
+    EXPECT_NE(scene_json(*rgbm).find("\"ldr_encoding\": \"rgbm:8\""), std::string::npos) << scene_json(*rgbm);
+    auto plain = scene_with("");
+    ASSERT_TRUE(plain) << plain.error().message;
+    EXPECT_GT(test::sh_distance(plain->environment->projected, a), 0.3);
+    auto bad = scene_with(R"(, "ldr_encoding": "rgbm")");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().code, ErrorCode::kInvalidValue);
+    EXPECT_NE(bad.error().message.find("environment.ldr_encoding"), std::string::npos) << bad.error().message;
 }
 
 // ---- 4. BC1 / BC3 faces written by ImageMagick -------------------------------------------------
