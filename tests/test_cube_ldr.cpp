@@ -838,3 +838,57 @@ TEST(CubeLdr, Ktx1HostileFilesAreRefusedCleanly) {
 
 }  // namespace
 }  // namespace zhc
+
+namespace zhc {
+namespace {
+
+// ---- 6. fuzz seeds ----------------------------------------------------------------------------
+// fuzz/corpus/fuzz_envmap/ holds small KTX 1 and 8-bit cube maps made by this test's writers
+// (ZHC_UPDATE_FUZZ_SEEDS=1 rewrites them); each must read as the cube it is.
+TEST(CubeLdr, FuzzSeedsReadAsCubes) {
+    const std::string dir = std::string(ZHC_TEST_DATA_DIR) + "/../../fuzz/corpus/fuzz_envmap/";
+    const Linear fn;
+    auto faces_of = [&](int n, Ldr f, bool srgb) { return all_faces(ldr_target(render_cube(n, fn), srgb), n, f); };
+    auto half_faces = [&](int n) {
+        Bytes b;
+        const Image cube = render_cube(n, fn);
+        for (int face = 0; face < 6; ++face) {
+            const Bytes f = encode_face(cube, face, Fmt::kRgba16f);
+            b.insert(b.end(), f.begin(), f.end());
+        }
+        return b;
+    };
+    Ktx1Spec le = spec(kHalf, 2, kRgba, 0x881A, 8, 0);
+    le.levels = 3;
+    le.kvd = std::string("KTXorientation\0S=r,T=d", 23);
+    Ktx1Spec be = spec(kHalf, 2, kRgba, 0x881A, 8, 0);
+    be.big_endian = true;
+    const struct {
+        const char* file;
+        Bytes bytes;
+        const char* format;
+    } seeds[] = {
+        {"cube-rgba16f.ktx", ktx1(le, 4, half_faces(4)), "ktx1"},
+        {"cube-rgba16f-big-endian.ktx", ktx1(be, 4, half_faces(4)), "ktx1"},
+        {"cube-bc1-srgb.ktx", ldr_file({"ktx1", Ldr::kBc1, true}, 8, faces_of(8, Ldr::kBc1, true)), "ktx1"},
+        {"cube-rgba8-srgb.ktx2", ldr_file({"ktx2", Ldr::kRgba8, true}, 4, faces_of(4, Ldr::kRgba8, true)), "ktx2"},
+        {"cube-bc3-dx10.dds", ldr_file({"dds", Ldr::kBc3, false}, 8, faces_of(8, Ldr::kBc3, false)), "dds"},
+        {"cube-dxt1-legacy.dds", ldr_file({"dds-legacy", Ldr::kBc1, false}, 8, faces_of(8, Ldr::kBc1, false)), "dds"},
+        {"cube-bgra8-legacy.dds", ldr_file({"dds-legacy", Ldr::kBgra8, false}, 4, faces_of(4, Ldr::kBgra8, false)), "dds"},
+    };
+    const char* update = std::getenv("ZHC_UPDATE_FUZZ_SEEDS");
+    for (const auto& s : seeds) {
+        SCOPED_TRACE(s.file);
+        if (update && std::string(update) == "1") test::write_bytes(dir + s.file, s.bytes);
+        const Bytes committed = test::read_bytes(dir + s.file);
+        EXPECT_EQ(committed, s.bytes) << "the committed seed differs from the writers' (ZHC_UPDATE_FUZZ_SEEDS=1 rewrites it)";
+        EnvmapInfo info;
+        auto img = read_with(committed, {}, &info);
+        ASSERT_TRUE(img) << img.error().message;
+        EXPECT_EQ(info.format, s.format);
+        EXPECT_LT(test::sh_distance(project_envmap(*img), fn.sh()), 0.05);
+    }
+}
+
+}  // namespace
+}  // namespace zhc
