@@ -78,7 +78,7 @@ Result<Loaded> load_input(const Options& o) {
         in.kind = "json";
     } else {
         return make_error(ErrorCode::kBadFormat,
-                          o.input + ": not an environment map (EXR/.hdr, KTX2/DDS cube map), .zhp probe file or JSON probe list");
+                          o.input + ": not an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map), .zhp probe file or JSON probe list");
     }
     return in;
 }
@@ -176,7 +176,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand(
         "convert", "Convert probes between environment maps, .zhp containers and JSON probe lists");
-    sub->add_option("IN", o->input, "environment map (EXR/.hdr or KTX2/DDS cube map: one probe), .zhp container or JSON probe list")
+    sub->add_option("IN", o->input, "environment map (EXR/.hdr or KTX2/KTX 1/DDS cube map: one probe), .zhp container or JSON probe list")
         ->required();
     sub->add_option("-o,--output", o->output, "output file: .zhp (container) or .json (float SH3 probe list)")
         ->required();

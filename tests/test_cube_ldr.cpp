@@ -23,6 +23,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -103,6 +104,14 @@ double bc3_alpha_twin(const std::uint8_t* b, int i) {
     if (idx == 6) return 0;
     if (idx == 7) return 1;
     return ((6 - idx) * a0 + (idx - 1) * a1) / (5.0 * 255.0);
+}
+
+// B10G11R11 unsigned float, round to nearest (the test's encoder; normal numbers only).
+std::uint32_t ufloat_enc_twin(double v, int mbits) {
+    int e = static_cast<int>(std::floor(std::log2(v)));
+    long m = std::lround((v / std::ldexp(1.0, e) - 1) * (1 << mbits));
+    if (m == (1 << mbits)) m = 0, ++e;
+    return static_cast<std::uint32_t>((e + 15) << mbits | m);
 }
 
 // ---- 8-bit formats: the test's encoders and the twins' decode of a face --------------------------
@@ -215,6 +224,57 @@ std::vector<double> decode_ldr_twin(const Bytes& faces, int n, Ldr f) {
             }
     }
     return out;
+}
+
+TEST(CubeLdr, BlockDecodersMatchTheTwins) {
+    // Random blocks cover both BC1 modes (colour0 > colour1 or not) and both BC3 alpha modes.
+    std::mt19937 rng(29);
+    int three_colour = 0, six_alpha = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        std::uint8_t b[16];
+        for (auto& v : b) v = static_cast<std::uint8_t>(rng());
+        if (trial % 7 == 0) b[8] = b[10], b[9] = b[11];  // equal colour endpoints
+        float bc1[16][4], bc1a[16][4], bc2[16][4], bc3[16][4];
+        ldr::decode_bc1(b + 8, false, bc1);
+        ldr::decode_bc1(b + 8, true, bc1a);
+        ldr::decode_bc2(b, bc2);
+        ldr::decode_bc3(b, bc3);
+        const bool four = bits(b + 8, 0, 16) > bits(b + 8, 16, 16);
+        three_colour += !four;
+        six_alpha += b[0] > b[1];
+        for (int i = 0; i < 16; ++i) {
+            double t[4], t4[4];
+            bc1_texel_twin(b + 8, i, false, t);
+            bc1_texel_twin(b + 8, i, true, t4);
+            const bool transparent = !four && bits(b + 8, 32 + 2 * i, 2) == 3;
+            for (int k = 0; k < 3; ++k) {
+                ASSERT_NEAR(bc1[i][k], t[k], 1e-6) << trial << " " << i;
+                ASSERT_NEAR(bc1a[i][k], t[k], 1e-6);
+                ASSERT_NEAR(bc2[i][k], t4[k], 1e-6);
+                ASSERT_NEAR(bc3[i][k], t4[k], 1e-6);
+            }
+            ASSERT_EQ(bc1[i][3], 1.0f);
+            ASSERT_EQ(bc1a[i][3], transparent ? 0.0f : 1.0f);
+            ASSERT_NEAR(bc2[i][3], bits(b, 4 * i, 4) / 15.0, 1e-7);
+            ASSERT_NEAR(bc3[i][3], bc3_alpha_twin(b, i), 1e-6) << trial << " " << i;
+        }
+    }
+    EXPECT_GT(three_colour, 1000);
+    EXPECT_GT(six_alpha, 1000);
+    EXPECT_LT(six_alpha, 19000);
+    // B10G11R11: the twin's encoding decodes to within half a mantissa step.
+    for (double v : {0.001, 0.2, 1.0, 1.7, 3.14159, 250.0, 60000.0}) {
+        float out[3];
+        ldr::decode_r11g11b10(ufloat_enc_twin(v, 6) | ufloat_enc_twin(v, 6) << 11 | ufloat_enc_twin(v, 5) << 22, out);
+        EXPECT_NEAR(out[0], v, v / 128 + 1e-9) << v;
+        EXPECT_NEAR(out[1], v, v / 128 + 1e-9) << v;
+        EXPECT_NEAR(out[2], v, v / 64 + 1e-9) << v;
+    }
+    float special[3];
+    ldr::decode_r11g11b10(31u << 6 | 31u << 17 | 1u << 11 | 31u << 27, special);  // R Inf, G NaN, B Inf
+    EXPECT_TRUE(std::isinf(special[0]));
+    EXPECT_TRUE(std::isnan(special[1]));
+    EXPECT_TRUE(std::isinf(special[2]));
 }
 
 // ---- containers ---------------------------------------------------------------------------------
@@ -355,13 +415,6 @@ const FloatCase kFloatCases[] = {
     {"BPTC_UNSIGNED_FLOAT", 0, 1, 0, 0x8E8F, 143, 1, 0, 16, 1e-2},
 };
 
-// B10G11R11 unsigned float, round to nearest (the test's encoder; values are normal numbers here).
-std::uint32_t ufloat_enc(double v, int mbits) {
-    int e = static_cast<int>(std::floor(std::log2(v)));
-    long m = std::lround((v / std::ldexp(1.0, e) - 1) * (1 << mbits));
-    if (m == (1 << mbits)) m = 0, ++e;
-    return static_cast<std::uint32_t>((e + 15) << mbits | m);
-}
 
 Bytes float_faces(const Image& cube, const FloatCase& c) {
     Bytes all;
@@ -377,7 +430,7 @@ Bytes float_faces(const Image& cube, const FloatCase& c) {
             for (int r = 0; r < n; ++r)
                 for (int col = 0; col < n; ++col) {
                     const float* p = cube.row(face * n + r) + 3 * col;
-                    put32(f, ufloat_enc(p[0], 6) | ufloat_enc(p[1], 6) << 11 | ufloat_enc(p[2], 5) << 22);
+                    put32(f, ufloat_enc_twin(p[0], 6) | ufloat_enc_twin(p[1], 6) << 11 | ufloat_enc_twin(p[2], 5) << 22);
                 }
         }
         if (c.vk == 90 || c.vk == 106) {  // drop alpha
@@ -646,6 +699,38 @@ TEST(CubeLdr, RgbmAndRgbdRoundTrip) {
             ASSERT_TRUE(plain);
             EXPECT_GT(test::sh_distance(project_envmap(*plain), a), 0.3);
         }
+    }
+    // The option reaches convert and dering as it reaches project.
+    {
+        const std::string dir = test::fresh_dir("cube_ldr_verbs");
+        std::vector<float> target;
+        for (size_t i = 0; i < hdr.rgb.size() / 3; ++i) {
+            float e[4];
+            rgbm_encode(&hdr.rgb[3 * i], 8, e);
+            target.insert(target.end(), e, e + 4);
+        }
+        const std::string file = dir + "/rgbm.ktx2";
+        test::write_bytes(file, ldr_file({"ktx2", Ldr::kRgba8, false}, n, all_faces(target, n, Ldr::kRgba8)));
+        auto l00 = [](const std::string& json_text, bool probe_list) {
+            const auto j = nlohmann::json::parse(json_text);
+            return (probe_list ? j["probes"][0]["sh3"] : j["sh3"])[0][0].get<double>();
+        };
+        const auto p = test::run_zhc({"project", file, "--json", "--ldr-encoding", "rgbm:8"});
+        ASSERT_EQ(p.exit_code, 0) << p.err;
+        EXPECT_NEAR(l00(p.out, false), a[0][0], 3.3e-3 * a[0][0]);
+        for (const char* opt : {"rgbm:8", "auto"}) {
+            SCOPED_TRACE(opt);
+            const auto c = test::run_zhc({"convert", file, "-o", dir + "/probe.json", "--ldr-encoding", opt});
+            ASSERT_EQ(c.exit_code, 0) << c.err;
+            const Bytes text = test::read_bytes(dir + "/probe.json");
+            const double got = l00(std::string(text.begin(), text.end()), true);
+            if (std::string(opt) == "auto") {
+                EXPECT_GT(std::fabs(got - a[0][0]), 0.3 * a[0][0]);
+            } else {
+                EXPECT_NEAR(got, l00(p.out, false), 1e-5 * a[0][0]);
+            }
+        }
+        EXPECT_EQ(test::run_zhc({"dering", file, "-o", dir + "/dering.json", "--ldr-encoding", "rgbm:8"}).exit_code, 0);
     }
     // RGBD cannot decode alpha 0: exit 4 (invalid input data) naming the texel.
     const std::string dir = test::fresh_dir("cube_ldr");
