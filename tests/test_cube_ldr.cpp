@@ -369,8 +369,10 @@ Bytes ktx1(const Ktx1Spec& s, int n, const Bytes& faces) {
         for (int face = 0; face < 6; ++face)
             for (std::uint64_t r = 0; r < rows; ++r) {
                 Bytes line(static_cast<size_t>(padded), 0);
-                for (std::uint64_t i = 0; i < row; ++i)
-                    line[i] = l == 0 ? faces[(static_cast<size_t>(face) * rows + r) * row + i] : static_cast<std::uint8_t>(37 * i + 11 * l);
+                for (std::uint64_t i = 0; i < row; ++i) {
+                    const size_t at = (static_cast<size_t>(face) * rows + r) * row + i;  // hostile specs may outgrow `faces`
+                    line[i] = l == 0 ? (at < faces.size() ? faces[at] : 0) : static_cast<std::uint8_t>(37 * i + 11 * l);
+                }
                 if (s.big_endian && s.type_size > 1)
                     for (std::uint64_t i = 0; i + s.type_size <= row; i += s.type_size)
                         std::reverse(line.begin() + static_cast<std::ptrdiff_t>(i), line.begin() + static_cast<std::ptrdiff_t>(i + s.type_size));
