@@ -10,6 +10,7 @@
 #include "codec/probe/codec.h"
 #include "codec/sh/sh.h"
 #include "codec/status.h"
+#include "formats/envmap/envmap.h"
 
 namespace zhc::cli {
 
@@ -79,6 +80,8 @@ void add_envmap_read_options(CLI::App* app, bool* replace_non_finite, std::strin
 // `--latlong openexr|gltf`: the orientation of a lat-long environment map (codec/sh/sh.h
 // LatLongConvention, docs/conventions.md). `set` (may be null) becomes true when the option is given.
 CLI::Option* add_latlong_option(CLI::App* app, LatLongConvention& convention, bool* set, const std::string& default_text);
+// --ldr-encoding auto|srgb|linear|rgbm:RANGE|rgbd:RANGE (8-bit cube maps, EnvmapReadOptions::ldr).
+CLI::Option* add_ldr_encoding_option(CLI::App* app, LdrDecoding& decoding);
 
 // A verb: `setup` adds the subcommand and its options to the app and returns the function that
 // runs it after parsing. Verbs register themselves with a static VerbRegistration.

@@ -36,6 +36,7 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     LatLongConvention latlong = LatLongConvention::kOpenExr;
+    LdrDecoding ldr;
     std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
 };
 
@@ -231,6 +232,7 @@ int run(const Options& o) {
     lopt.replace_non_finite = o.replace_non_finite;
     lopt.part = o.part;
     lopt.latlong = o.latlong;
+    lopt.ldr = o.ldr;
     // After each input: its pictures (--images, --html) and the progress.
     std::vector<SpherePictures> pictures;
     bool output_failed = false;
@@ -356,6 +358,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     sub->add_flag("--fail-on-negative", o->fail_on_negative, "gate: fail (exit 8) if any reconstruction goes negative");
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
+    add_ldr_encoding_option(sub, o->ldr);
     return [o] { return run(*o); };
 });
 

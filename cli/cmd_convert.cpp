@@ -33,6 +33,7 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     LatLongConvention latlong = LatLongConvention::kOpenExr;
+    LdrDecoding ldr;
     int threads = 0;
     // The options that set CodecOptions' storage fields, each with the StorageOptionUse field saying
     // whether an entry uses it (null: every entry does, --irradiance).
@@ -86,6 +87,7 @@ Result<Loaded> load_input(const Options& o) {
         if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
         ro.part = o.part;
         ro.latlong = o.latlong;
+        ro.ldr = o.ldr;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return img.error();
         in.list.probes.push_back(project_envmap(*img, resolve_threads(o.threads)));
@@ -97,7 +99,7 @@ Result<Loaded> load_input(const Options& o) {
         in.kind = "json";
     } else {
         return make_error(ErrorCode::kBadFormat,
-                          o.input + ": not an environment map (EXR/.hdr, KTX2/DDS cube map), .zhp probe file or JSON probe list");
+                          o.input + ": not an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map), .zhp probe file or JSON probe list");
     }
     return in;
 }
@@ -192,7 +194,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand(
         "convert", "Convert probes between environment maps, .zhp containers and JSON probe lists");
-    sub->add_option("IN", o->input, "environment map (EXR/.hdr or KTX2/DDS cube map: one probe), .zhp container or JSON probe list")
+    sub->add_option("IN", o->input, "environment map (EXR/.hdr or KTX2/KTX 1/DDS cube map: one probe), .zhp container or JSON probe list")
         ->required();
     sub->add_option("-o,--output", o->output, "output file: .zhp (container) or .json (float SH3 probe list)")
         ->required();
@@ -224,6 +226,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
         ->check(CLI::Range(0, 22));
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
+    add_ldr_encoding_option(sub, o->ldr);
     add_threads_option(sub, o->threads, "environment map projection; result identical for any count");
     return [o] { return run(*o); };
 });

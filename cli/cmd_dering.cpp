@@ -31,6 +31,7 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     LatLongConvention latlong = LatLongConvention::kOpenExr;
+    LdrDecoding ldr;
     int threads = 0;
 };
 
@@ -66,7 +67,7 @@ Result<std::vector<Probe>> parse_probe_list(const std::vector<std::uint8_t>& byt
     if (Status depth = check_json_depth(bytes, path); !depth) return depth.error();
     const nlohmann::json j = nlohmann::json::parse(bytes.begin(), bytes.end(), nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded())
-        return make_error(ErrorCode::kBadFormat, path + ": neither an environment map (EXR/.hdr, KTX2/DDS cube map) nor valid JSON");
+        return make_error(ErrorCode::kBadFormat, path + ": neither an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map) nor valid JSON");
     const nlohmann::json* list = nullptr;
     std::vector<Probe> probes;
     if (j.is_object() && j.contains("sh3")) {
@@ -114,6 +115,7 @@ int run(const Options& o) {
         if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
         ro.part = o.part;
         ro.latlong = o.latlong;
+        ro.ldr = o.ldr;
         auto img = read_envmap_memory(*bytes, o.input, ro);
         if (!img) return report(img.error());
         probes.push_back({"", project_envmap(*img, resolve_threads(o.threads))});
@@ -166,11 +168,12 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand(
         "dering", "Window SH3 radiance so its irradiance is non-negative (Sloan 2017 deringing)");
-    sub->add_option("IN", o->input, "environment map (EXR/.hdr, KTX2/DDS cube map) or JSON probe list")->required();
+    sub->add_option("IN", o->input, "environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map) or JSON probe list")->required();
     sub->add_option("-o,--output", o->output, "output JSON (written atomically)")->required();
     sub->add_flag("--punctual", o->punctual, "source is punctual lights: extra windowing 0.92 / 0.73 first");
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
+    add_ldr_encoding_option(sub, o->ldr);
     add_threads_option(sub, o->threads, "environment map projection; same result for any count");
     return [o] { return run(*o); };
 });

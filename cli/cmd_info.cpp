@@ -255,7 +255,7 @@ int run(const Options& o) {
         probe_stats(list->probes, j);
     } else {
         return report(make_error(ErrorCode::kBadFormat,
-                                 o.path + ": not an environment map (EXR/.hdr, KTX2/DDS cube map), .zhp probe file or JSON probe list"));
+                                 o.path + ": not an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map), .zhp probe file or JSON probe list"));
     }
     print_json_or_text(j, o.json);
     return kExitOk;

@@ -20,6 +20,7 @@ struct Options {
     bool replace_non_finite = false;
     std::string part;
     LatLongConvention latlong = LatLongConvention::kOpenExr;
+    LdrDecoding ldr;
     int threads = 0;
 };
 
@@ -34,6 +35,7 @@ int run(const Options& o) {
     if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
     ro.part = o.part;
     ro.latlong = o.latlong;
+    ro.ldr = o.ldr;
     EnvmapInfo info;
     auto img = read_envmap(o.path, ro, &info);
     if (!img) return report(img.error());
@@ -74,6 +76,7 @@ const VerbRegistration registration(20, [](CLI::App& app) -> std::function<int()
     add_json_flag(sub, o->json, "key \"sh3\" holds 9 rows of [r, g, b]");
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
+    add_ldr_encoding_option(sub, o->ldr);
     add_threads_option(sub, o->threads, "result identical for any count");
     return [o] { return run(*o); };
 });

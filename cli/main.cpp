@@ -158,6 +158,22 @@ CLI::Option* add_latlong_option(CLI::App* app, LatLongConvention& convention, bo
         ->check(CLI::IsMember({"openexr", "gltf"}));
 }
 
+CLI::Option* add_ldr_encoding_option(CLI::App* app, LdrDecoding& decoding) {
+    return app
+        ->add_option_function<std::string>(
+            "--ldr-encoding", [&decoding](const std::string& text) { parse_ldr_decoding(text, &decoding); },
+            "8-bit cube maps (KTX2 / KTX 1 / DDS RGBA8, BC1-3): auto (default: sRGB or linear as the format says), "
+            "srgb or linear (that transfer function whatever the format says), rgbm:RANGE (rgb * a * RANGE) or "
+            "rgbd:RANGE (rgb * (RANGE / 255) / a); docs/inputs.md")
+        ->check(
+            [](const std::string& text) {
+                return parse_ldr_decoding(text, nullptr)
+                           ? std::string()
+                           : "must be auto, srgb, linear, rgbm:RANGE or rgbd:RANGE with 0 < RANGE <= 65504 (got '" + text + "')";
+            },
+            "ENCODING");
+}
+
 // CLI11 reports a verb it does not know as "A subcommand is required": name the word instead
 // ("unknown verb 'bogus'", "unknown verb 'gltf bogus'"). Empty when the verbs on the command line
 // are all known.

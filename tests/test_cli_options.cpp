@@ -20,12 +20,12 @@ const std::vector<VerbOptions>& table() {
     static const std::vector<VerbOptions> t = {
         {{"demo"}, {"--threads"}},
         {{"bake"}, {"-r,--representations,--to", "--threads", "--progress", "--quiet"}},
-        {{"project"}, {"--json", "--threads", "--replace-non-finite", "--part", "--latlong"}},
-        {{"audit"}, {"-r,--representations", "--json", "--threads", "--replace-non-finite", "--part", "--latlong", "--progress", "--quiet"}},
-        {{"convert"}, {"-r,--representations,--to", "--threads", "--replace-non-finite", "--part", "--latlong"}},
+        {{"project"}, {"--json", "--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding"}},
+        {{"audit"}, {"-r,--representations", "--json", "--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding", "--progress", "--quiet"}},
+        {{"convert"}, {"-r,--representations,--to", "--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding"}},
         {{"info"}, {"--json"}},
         {{"bench"}, {"-r,--representations", "--json"}},
-        {{"dering"}, {"--threads", "--replace-non-finite", "--part", "--latlong"}},
+        {{"dering"}, {"--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding"}},
         {{"gltf", "embed"}, {"-r,--representations,--encoding"}},
         {{"gltf", "extract"}, {}},
         {{"gltf", "eval"}, {}},
@@ -77,7 +77,7 @@ TEST(SharedOptions, EveryVerbListsTheSharedNames) {
                 << "zhc " << joined(v.verb) << ": " << o << " outside the shared -r,--representations spelling";
             // Every shared option this verb takes is in its row (a new one must be added there).
             const bool shared = o.find("--representations") != std::string::npos || o == "--threads" || o == "--json" ||
-                                o == "--part" || o == "--replace-non-finite" || o == "--latlong" || o == "--progress" || o == "--quiet";
+                                o == "--part" || o == "--replace-non-finite" || o == "--latlong" || o == "--ldr-encoding" || o == "--progress" || o == "--quiet";
             if (shared) {
                 EXPECT_NE(std::find(v.names.begin(), v.names.end(), o), v.names.end())
                     << "zhc " << joined(v.verb) << " lists " << o << " but its row in the table does not";

@@ -57,6 +57,8 @@ struct SceneEnvironment {
     bool latlong_map = true;   // false: a cube map (its orientation is its format's)
     std::string label;         // the bake report's effect name when not a projected map (a glTF
                                // image-based light's SH); empty: "environment"
+    // 8-bit cube maps: how texels become radiance (formats/envmap/envmap.h parse_ldr_decoding).
+    std::string ldr_encoding = "auto";
 };
 
 enum class SkyKind : std::uint8_t { kConstant, kGradient };

@@ -413,7 +413,8 @@ Image envmap_as_latlong(const Image& image, int width, int height) {
 }
 
 bool looks_like_envmap(std::span<const std::uint8_t> bytes) {
-    return is_exr(bytes) || is_radiance(bytes) || ktx2_declares_cube(bytes) || dds_declares_cube(bytes);
+    return is_exr(bytes) || is_radiance(bytes) || ktx2_declares_cube(bytes) || ktx1_declares_cube(bytes) ||
+           dds_declares_cube(bytes);
 }
 
 namespace {
@@ -422,14 +423,16 @@ Result<Image> read_envmap_any(std::span<const std::uint8_t> bytes, const std::st
     if (bytes.empty()) return make_error(ErrorCode::kTruncated, name + ": file is empty");
     if (is_exr(bytes)) return read_exr(bytes, name, options, info);
     if (is_radiance(bytes)) return read_hdr(bytes, name, options, info);
-    if (is_ktx2(bytes) || is_dds(bytes)) {
-        auto img = is_ktx2(bytes) ? read_ktx2_cube(bytes, name, options, info) : read_dds_cube(bytes, name, options, info);
+    if (is_ktx2(bytes) || is_ktx1(bytes) || is_dds(bytes)) {
+        auto img = is_ktx2(bytes)   ? read_ktx2_cube(bytes, name, options, info)
+                   : is_ktx1(bytes) ? read_ktx1_cube(bytes, name, options, info)
+                                    : read_dds_cube(bytes, name, options, info);
         if (!img) return img.error();
         if (Status s = check_finite(name, *img, options, info); !s) return s.error();
         return img;
     }
     return make_error(ErrorCode::kBadFormat,
-                      name + ": not an OpenEXR, Radiance .hdr, KTX2 or DDS image (unknown magic bytes)");
+                      name + ": not an OpenEXR, Radiance .hdr, KTX2, KTX 1 or DDS image (unknown magic bytes)");
 }
 }  // namespace
 

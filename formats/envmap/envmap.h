@@ -50,6 +50,21 @@ enum class NonFinitePolicy {
     kReplaceZero,  // replace each non-finite channel value by 0 and count them
 };
 
+// How an 8-bit (LDR) cube map's texels become radiance (docs/inputs.md "8-bit cube maps"):
+// kAsFormat (default): the format's transfer function (sRGB formats: the sRGB EOTF; UNORM: as is);
+// kSrgb / kLinear: that transfer function whatever the format says; kRgbm: rgb * a * range;
+// kRgbd: rgb * (range / 255) / a (rgb by the format's transfer function, alpha linear). Float
+// formats ignore it.
+enum class LdrEncoding { kAsFormat, kSrgb, kLinear, kRgbm, kRgbd };
+struct LdrDecoding {
+    LdrEncoding encoding = LdrEncoding::kAsFormat;
+    float range = 1.0f;  // kRgbm / kRgbd: the largest value the encoding holds
+};
+// "auto", "srgb", "linear", "rgbm:RANGE", "rgbd:RANGE" (RANGE a finite number in (0, 65504]).
+// False for anything else.
+bool parse_ldr_decoding(const std::string& text, LdrDecoding* out);
+std::string ldr_decoding_name(const LdrDecoding& d);
+
 struct EnvmapReadOptions {
     std::uint64_t max_pixels = std::uint64_t(1) << 26;  // 8192 x 8192; checked before allocating
     std::uint64_t max_file_bytes = std::uint64_t(2) << 30;
@@ -59,13 +74,15 @@ struct EnvmapReadOptions {
     std::string part;
     // The orientation of a lat-long map (cube maps have one fixed by their format).
     LatLongConvention latlong = LatLongConvention::kOpenExr;
+    // 8-bit cube maps: how texels become radiance (LdrDecoding above).
+    LdrDecoding ldr;
     // Non-fatal findings, one line each naming the file (an EXR whose data window differs from its
     // display window). Empty: printed on stderr as "zhc: warning: <line>".
     std::function<void(const std::string&)> warn;
 };
 
 struct EnvmapInfo {
-    std::string format;       // "openexr", "radiance-hdr", "ktx2" or "dds"
+    std::string format;       // "openexr", "radiance-hdr", "ktx2", "ktx1" or "dds"
     std::string compression;  // EXR compression name, "rle" or "flat" for .hdr
     std::string channels;     // e.g. "RGBA half"
     std::uint64_t replaced_non_finite = 0;  // channel values replaced by 0 (NonFinitePolicy::kReplaceZero)
@@ -84,7 +101,7 @@ struct EnvmapInfo {
 // Reads an EXR (RGB or RGBA or Y or luminance/chroma Y RY BY, half/float/uint, any compression
 // OpenEXR supports, scanline or tiled, single- or multi-part, lat-long or cube) or a Radiance .hdr
 // (RGBE or XYZE, any of the eight orientations) or a KTX2 / DDS cube map (formats/envmap/envmap_cube.h),
-// detected by its magic bytes (not by the extension). Bytes after the data are an error (kTrailingBytes). See docs/inputs.md.
+// or a KTX 1 cube map, detected by its magic bytes (not by the extension). Bytes after the data are an error (kTrailingBytes). See docs/inputs.md.
 // EXR pixels come out in zhc's working space (linear Rec. 709 primaries, D65 white), converted from
 // the file's chromaticities; the image is the EXR's display window (pixels outside the data window
 // are 0).

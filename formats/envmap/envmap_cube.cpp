@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -13,6 +14,7 @@
 #include <zstd.h>
 
 #include "codec/lightmap/bc6h.h"
+#include "formats/envmap/envmap_ldr.h"
 #include "codec/sh/cubemap.h"
 #include "formats/io/le_bytes.h"
 
@@ -30,24 +32,48 @@ constexpr std::uint8_t kKtx2Identifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32
 Error fail(ErrorCode code, const std::string& name, const std::string& what) { return make_error(code, name + ": " + what); }
 
 // The pixel formats read, whatever the container calls them.
-enum class Texel { kRgba16f, kRgb16f, kRgba32f, kRgb32f, kE5b9g9r9, kBc6hUfloat };
+enum class Texel {
+    kRgba16f, kRgb16f, kRgba32f, kRgb32f, kE5b9g9r9, kBc6hUfloat, kB10g11r11,
+    // 8-bit (LDR): decoded by EnvmapReadOptions::ldr and the format's transfer function
+    kRgba8, kBgra8, kBgrx8, kRgb8, kBc1, kBc1a, kBc2, kBc3
+};
 
 struct TexelInfo {
     Texel texel;
     const char* channels;  // for EnvmapInfo
     std::uint64_t bytes;   // per texel, or per 4x4 block
     bool block;
+    bool ldr;
 };
 
 TexelInfo texel_info(Texel t) {
     switch (t) {
-        case Texel::kRgba16f: return {t, "RGBA half", 8, false};
-        case Texel::kRgb16f: return {t, "RGB half", 6, false};
-        case Texel::kRgba32f: return {t, "RGBA float", 16, false};
-        case Texel::kRgb32f: return {t, "RGB float", 12, false};
-        case Texel::kE5b9g9r9: return {t, "RGB9E5", 4, false};
-        default: return {t, "BC6H ufloat", 16, true};
+        case Texel::kRgba16f: return {t, "RGBA half", 8, false, false};
+        case Texel::kRgb16f: return {t, "RGB half", 6, false, false};
+        case Texel::kRgba32f: return {t, "RGBA float", 16, false, false};
+        case Texel::kRgb32f: return {t, "RGB float", 12, false, false};
+        case Texel::kE5b9g9r9: return {t, "RGB9E5", 4, false, false};
+        case Texel::kBc6hUfloat: return {t, "BC6H ufloat", 16, true, false};
+        case Texel::kB10g11r11: return {t, "B10G11R11 ufloat", 4, false, false};
+        case Texel::kRgba8: return {t, "RGBA8", 4, false, true};
+        case Texel::kBgra8: return {t, "BGRA8", 4, false, true};
+        case Texel::kBgrx8: return {t, "BGRX8", 4, false, true};
+        case Texel::kRgb8: return {t, "RGB8", 3, false, true};
+        case Texel::kBc1: return {t, "BC1 RGB", 8, true, true};
+        case Texel::kBc1a: return {t, "BC1 RGBA", 8, true, true};
+        case Texel::kBc2: return {t, "BC2", 16, true, true};
+        default: return {t, "BC3", 16, true, true};
     }
+}
+
+// A texel format and its transfer function (sRGB formats; only 8-bit formats have one).
+struct Format {
+    Texel texel;
+    bool srgb = false;
+};
+
+std::string channels_name(const TexelInfo& f, bool srgb) {
+    return std::string(f.channels) + (f.ldr ? (srgb ? " sRGB" : " UNORM") : "");
 }
 
 // Bytes of one face of mip level `level` of a cube of face size n (n <= 2^20: no overflow).
@@ -70,23 +96,69 @@ void decode_e5b9g9r9(std::uint32_t v, float out[3]) {
     for (int c = 0; c < 3; ++c) out[c] = std::ldexp(static_cast<float>((v >> (9 * c)) & 0x1ff), e - 24);
 }
 
-// Decodes one face (level 0, face size n) from `src` (face_bytes(f, n, 0) bytes) into rows
-// face*n .. face*n + n - 1 of img.
-void decode_face(const TexelInfo& f, const std::uint8_t* src, int n, int face, Image& img) {
+// The encoded RGBA (in [0, 1]) of an uncompressed 8-bit texel.
+void ldr_texel(Texel t, const std::uint8_t* p, float rgba[4]) {
+    constexpr float k = 1.0f / 255.0f;
+    switch (t) {
+        case Texel::kRgba8: for (int c = 0; c < 4; ++c) rgba[c] = p[c] * k; break;
+        case Texel::kRgb8: for (int c = 0; c < 3; ++c) rgba[c] = p[c] * k; rgba[3] = 1.0f; break;
+        default:  // BGRA / BGRX
+            rgba[0] = p[2] * k, rgba[1] = p[1] * k, rgba[2] = p[0] * k;
+            rgba[3] = t == Texel::kBgrx8 ? 1.0f : p[3] * k;
+            break;
+    }
+}
+
+// Decodes one face (level 0, face size n) from `src` (face_bytes(f, n, 0) bytes, rows packed)
+// into rows face*n .. face*n + n - 1 of img. 8-bit formats by `ldr` and `srgb`; kInvalidValue
+// naming the texel for an RGBD texel with alpha 0.
+Status decode_face(const TexelInfo& f, bool srgb, const LdrDecoding& ldr, const std::uint8_t* src, int n, int face, Image& img,
+                   const std::string& name) {
     const size_t nn = static_cast<size_t>(n);
-    if (f.block) {
+    auto put_ldr = [&](const float rgba[4], size_t r, size_t c) -> Status {
+        if (!ldr::decode_ldr_texel(rgba, srgb, ldr, img.row(face * n + static_cast<int>(r)) + 3 * c))
+            return fail(ErrorCode::kInvalidValue, name, "face " + std::to_string(face) + " texel (" + std::to_string(c) + ", " +
+                                                            std::to_string(r) + ") has alpha 0, which RGBD (--ldr-encoding " +
+                                                            ldr_decoding_name(ldr) + ") cannot decode");
+        return Ok{};
+    };
+    if (f.block && f.texel == Texel::kBc6hUfloat) {
         const auto half = bc6h::decode_image(src, static_cast<size_t>(face_bytes(f, nn, 0)), n, n);
         for (size_t r = 0; r < nn; ++r) {
             float* out = img.row(face * n + static_cast<int>(r));
             for (size_t i = 0; i < 3 * nn; ++i) out[i] = bc6h::half_to_float(half[r * 3 * nn + i]);
         }
-        return;
+        return Ok{};
+    }
+    if (f.block) {
+        const size_t bw = (nn + 3) / 4;
+        float rgba[16][4];
+        for (size_t by = 0; by < bw; ++by)
+            for (size_t bx = 0; bx < bw; ++bx) {
+                const std::uint8_t* blk = src + (by * bw + bx) * f.bytes;
+                switch (f.texel) {
+                    case Texel::kBc1: ldr::decode_bc1(blk, false, rgba); break;
+                    case Texel::kBc1a: ldr::decode_bc1(blk, true, rgba); break;
+                    case Texel::kBc2: ldr::decode_bc2(blk, rgba); break;
+                    default: ldr::decode_bc3(blk, rgba); break;
+                }
+                for (size_t y = 0; y < 4 && 4 * by + y < nn; ++y)
+                    for (size_t x = 0; x < 4 && 4 * bx + x < nn; ++x)
+                        if (Status s = put_ldr(rgba[4 * y + x], 4 * by + y, 4 * bx + x); !s) return s;
+            }
+        return Ok{};
     }
     for (size_t r = 0; r < nn; ++r) {
         float* out = img.row(face * n + static_cast<int>(r));
         const std::uint8_t* p = src + r * nn * f.bytes;
         for (size_t c = 0; c < nn; ++c, p += f.bytes) {
             float* o = out + 3 * c;
+            if (f.ldr) {
+                float rgba[4];
+                ldr_texel(f.texel, p, rgba);
+                if (Status s = put_ldr(rgba, r, c); !s) return s;
+                continue;
+            }
             switch (f.texel) {
                 case Texel::kRgba16f:
                 case Texel::kRgb16f:
@@ -96,10 +168,29 @@ void decode_face(const TexelInfo& f, const std::uint8_t* src, int n, int face, I
                 case Texel::kRgb32f:
                     for (int k = 0; k < 3; ++k) o[k] = getf32(p + 4 * k);
                     break;
+                case Texel::kB10g11r11: ldr::decode_r11g11b10(get32({p, 4}, 0), o); break;
                 default: decode_e5b9g9r9(get32({p, 4}, 0), o); break;
             }
         }
     }
+    return Ok{};
+}
+
+// Decodes the six faces of level 0 (`fb` bytes each, consecutive at `stride`), then, for an 8-bit
+// UNORM format read by its own transfer function, warns that it was read as linear.
+Status decode_cube(const TexelInfo& f, const Format& fmt, const std::uint8_t* level0, std::uint64_t stride, int n, Image& img,
+                   const std::string& name, const EnvmapReadOptions& o) {
+    for (int face = 0; face < 6; ++face)
+        if (Status s = decode_face(f, fmt.srgb, o.ldr, level0 + static_cast<std::uint64_t>(face) * stride, n, face, img, name); !s)
+            return s;
+    if (f.ldr && !fmt.srgb && o.ldr.encoding == LdrEncoding::kAsFormat) {
+        const std::string line = name + ": 8-bit UNORM cube map (" + channels_name(f, false) +
+                                 ") read as linear values, as its format says; if it stores sRGB colours or an HDR "
+                                 "encoding, say so with --ldr-encoding srgb|rgbm:RANGE|rgbd:RANGE";
+        if (o.warn) o.warn(line);
+        else std::fprintf(stderr, "zhc: warning: %s\n", line.c_str());
+    }
+    return Ok{};
 }
 
 // Face size n against the pixel limit (6 n^2 pixels), before any allocation.
@@ -124,23 +215,45 @@ Image make_cube(int n) {
 
 constexpr std::size_t kKtx2HeaderBytes = 80;  // identifier, 9 u32 fields, index (4 u32, 2 u64)
 
-Result<Texel> ktx2_texel(std::uint32_t vk, const std::string& name) {
+const char* const kBc7Refusal =
+    " is not supported: zhc has no BC7 decoder (BC1, BC2, BC3 and uncompressed 8-bit cube maps are read)";
+
+Result<Format> ktx2_texel(std::uint32_t vk, const std::string& name) {
     switch (vk) {
-        case 97: return Texel::kRgba16f;   // VK_FORMAT_R16G16B16A16_SFLOAT
-        case 90: return Texel::kRgb16f;    // VK_FORMAT_R16G16B16_SFLOAT
-        case 109: return Texel::kRgba32f;  // VK_FORMAT_R32G32B32A32_SFLOAT
-        case 106: return Texel::kRgb32f;   // VK_FORMAT_R32G32B32_SFLOAT
-        case 123: return Texel::kE5b9g9r9; // VK_FORMAT_E5B9G9R9_UFLOAT_PACK32
-        case 143: return Texel::kBc6hUfloat;
+        case 97: return Format{Texel::kRgba16f};   // VK_FORMAT_R16G16B16A16_SFLOAT
+        case 90: return Format{Texel::kRgb16f};    // VK_FORMAT_R16G16B16_SFLOAT
+        case 109: return Format{Texel::kRgba32f};  // VK_FORMAT_R32G32B32A32_SFLOAT
+        case 106: return Format{Texel::kRgb32f};   // VK_FORMAT_R32G32B32_SFLOAT
+        case 123: return Format{Texel::kE5b9g9r9}; // VK_FORMAT_E5B9G9R9_UFLOAT_PACK32
+        case 122: return Format{Texel::kB10g11r11}; // VK_FORMAT_B10G11R11_UFLOAT_PACK32
+        case 143: return Format{Texel::kBc6hUfloat};
+        case 37: return Format{Texel::kRgba8};         // VK_FORMAT_R8G8B8A8_UNORM
+        case 43: return Format{Texel::kRgba8, true};   // VK_FORMAT_R8G8B8A8_SRGB
+        case 44: return Format{Texel::kBgra8};         // VK_FORMAT_B8G8R8A8_UNORM
+        case 50: return Format{Texel::kBgra8, true};   // VK_FORMAT_B8G8R8A8_SRGB
+        case 23: return Format{Texel::kRgb8};          // VK_FORMAT_R8G8B8_UNORM
+        case 29: return Format{Texel::kRgb8, true};    // VK_FORMAT_R8G8B8_SRGB
+        case 131: return Format{Texel::kBc1};          // VK_FORMAT_BC1_RGB_UNORM_BLOCK
+        case 132: return Format{Texel::kBc1, true};    // VK_FORMAT_BC1_RGB_SRGB_BLOCK
+        case 133: return Format{Texel::kBc1a};         // VK_FORMAT_BC1_RGBA_UNORM_BLOCK
+        case 134: return Format{Texel::kBc1a, true};   // VK_FORMAT_BC1_RGBA_SRGB_BLOCK
+        case 135: return Format{Texel::kBc2};          // VK_FORMAT_BC2_UNORM_BLOCK
+        case 136: return Format{Texel::kBc2, true};    // VK_FORMAT_BC2_SRGB_BLOCK
+        case 137: return Format{Texel::kBc3};          // VK_FORMAT_BC3_UNORM_BLOCK
+        case 138: return Format{Texel::kBc3, true};    // VK_FORMAT_BC3_SRGB_BLOCK
         case 144:
             return fail(ErrorCode::kUnsupported, name,
                         "KTX2 vkFormat 144 (BC6H_SFLOAT_BLOCK, byte 12) is not supported: zhc's BC6H decoder reads "
                         "unsigned BC6H only");
+        case 145:
+        case 146:
+            return fail(ErrorCode::kUnsupported, name, "KTX2 vkFormat " + std::to_string(vk) + " (BC7, byte 12)" + kBc7Refusal);
         default:
             return fail(ErrorCode::kUnsupported, name,
                         "KTX2 vkFormat " + std::to_string(vk) +
                             " (byte 12) is not supported for cube maps (R16G16B16A16_SFLOAT, R16G16B16_SFLOAT, "
-                            "R32G32B32A32_SFLOAT, R32G32B32_SFLOAT, E5B9G9R9_UFLOAT_PACK32, BC6H_UFLOAT_BLOCK are)");
+                            "R32G32B32A32_SFLOAT, R32G32B32_SFLOAT, E5B9G9R9_UFLOAT_PACK32, B10G11R11_UFLOAT_PACK32, "
+                            "BC6H_UFLOAT_BLOCK, R8G8B8A8, B8G8R8A8, R8G8B8, BC1, BC2, BC3 UNORM / SRGB are)");
     }
 }
 
@@ -148,8 +261,11 @@ std::uint32_t ktx2_type_size(Texel t) {
     switch (t) {
         case Texel::kRgba16f:
         case Texel::kRgb16f: return 2;
-        case Texel::kBc6hUfloat: return 1;
-        default: return 4;
+        case Texel::kRgba32f:
+        case Texel::kRgb32f:
+        case Texel::kE5b9g9r9:
+        case Texel::kB10g11r11: return 4;
+        default: return 1;
     }
 }
 
@@ -158,34 +274,162 @@ std::uint32_t ktx2_type_size(Texel t) {
 constexpr std::uint32_t kDdsMagic = 0x20534444;          // "DDS "
 constexpr std::uint32_t kFourCcDx10 = 0x30315844;        // "DX10"
 constexpr std::uint32_t kDdpfFourCc = 0x4;
+constexpr std::uint32_t kDdpfAlphaPixels = 0x1;
+constexpr std::uint32_t kDdpfRgb = 0x40;
+constexpr std::uint32_t kFourCcDxt1 = 0x31545844;  // "DXT1"
+constexpr std::uint32_t kFourCcDxt3 = 0x33545844;  // "DXT3"
+constexpr std::uint32_t kFourCcDxt5 = 0x35545844;  // "DXT5"
+
+// A FourCC as its four characters when they are printable, else its number.
+std::string fourcc_text(std::uint32_t v) {
+    std::string t;
+    for (int k = 0; k < 4; ++k) {
+        const char c = static_cast<char>((v >> (8 * k)) & 0xff);
+        if (c < 0x20 || c > 0x7e) return std::to_string(v);
+        t += c;
+    }
+    return std::to_string(v) + " '" + t + "'";
+}
 constexpr std::uint32_t kCaps2Cubemap = 0x200;
 constexpr std::uint32_t kCaps2AllFaces = 0xFC00;         // +X -X +Y -Y +Z -Z
 constexpr std::uint32_t kCaps2Volume = 0x200000;
 constexpr std::uint32_t kMiscTextureCube = 0x4;
 
-Result<Texel> dxgi_texel(std::uint32_t f, const std::string& name) {
+Result<Format> dxgi_texel(std::uint32_t f, const std::string& name) {
     switch (f) {
-        case 10: return Texel::kRgba16f;  // DXGI_FORMAT_R16G16B16A16_FLOAT
-        case 2: return Texel::kRgba32f;   // DXGI_FORMAT_R32G32B32A32_FLOAT
-        case 6: return Texel::kRgb32f;    // DXGI_FORMAT_R32G32B32_FLOAT
-        case 67: return Texel::kE5b9g9r9; // DXGI_FORMAT_R9G9B9E5_SHAREDEXP
-        case 95: return Texel::kBc6hUfloat;
+        case 10: return Format{Texel::kRgba16f};  // DXGI_FORMAT_R16G16B16A16_FLOAT
+        case 2: return Format{Texel::kRgba32f};   // DXGI_FORMAT_R32G32B32A32_FLOAT
+        case 6: return Format{Texel::kRgb32f};    // DXGI_FORMAT_R32G32B32_FLOAT
+        case 67: return Format{Texel::kE5b9g9r9}; // DXGI_FORMAT_R9G9B9E5_SHAREDEXP
+        case 26: return Format{Texel::kB10g11r11}; // DXGI_FORMAT_R11G11B10_FLOAT
+        case 95: return Format{Texel::kBc6hUfloat};
+        case 28: return Format{Texel::kRgba8};        // DXGI_FORMAT_R8G8B8A8_UNORM
+        case 29: return Format{Texel::kRgba8, true};  // DXGI_FORMAT_R8G8B8A8_UNORM_SRGB
+        case 87: return Format{Texel::kBgra8};        // DXGI_FORMAT_B8G8R8A8_UNORM
+        case 91: return Format{Texel::kBgra8, true};  // DXGI_FORMAT_B8G8R8A8_UNORM_SRGB
+        case 88: return Format{Texel::kBgrx8};        // DXGI_FORMAT_B8G8R8X8_UNORM
+        case 93: return Format{Texel::kBgrx8, true};  // DXGI_FORMAT_B8G8R8X8_UNORM_SRGB
+        case 71: return Format{Texel::kBc1a};         // DXGI_FORMAT_BC1_UNORM
+        case 72: return Format{Texel::kBc1a, true};   // DXGI_FORMAT_BC1_UNORM_SRGB
+        case 74: return Format{Texel::kBc2};          // DXGI_FORMAT_BC2_UNORM
+        case 75: return Format{Texel::kBc2, true};    // DXGI_FORMAT_BC2_UNORM_SRGB
+        case 77: return Format{Texel::kBc3};          // DXGI_FORMAT_BC3_UNORM
+        case 78: return Format{Texel::kBc3, true};    // DXGI_FORMAT_BC3_UNORM_SRGB
         case 96:
             return fail(ErrorCode::kUnsupported, name,
                         "DDS DXGI format 96 (BC6H_SF16, byte 128) is not supported: zhc's BC6H decoder reads unsigned "
                         "BC6H only");
+        case 98:
+        case 99:
+            return fail(ErrorCode::kUnsupported, name, "DDS DXGI format " + std::to_string(f) + " (BC7, byte 128)" + kBc7Refusal);
         default:
             return fail(ErrorCode::kUnsupported, name,
                         "DDS DXGI format " + std::to_string(f) +
                             " (byte 128) is not supported for cube maps (R16G16B16A16_FLOAT, R32G32B32A32_FLOAT, "
-                            "R32G32B32_FLOAT, R9G9B9E5_SHAREDEXP, BC6H_UF16 are)");
+                            "R32G32B32_FLOAT, R9G9B9E5_SHAREDEXP, R11G11B10_FLOAT, BC6H_UF16, R8G8B8A8, B8G8R8A8, "
+                            "B8G8R8X8, BC1, BC2, BC3 UNORM / UNORM_SRGB are)");
     }
 }
+
+// ---- KTX 1 ----
+
+constexpr std::uint8_t kKtx1Identifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x31, 0x31, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
+constexpr std::size_t kKtx1HeaderBytes = 64;  // identifier, 13 u32 fields
+
+std::string hex4(std::uint32_t v) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "0x%04X", v);
+    return buf;
+}
+
+// A KTX 1 format: the texels as stored (by glType and glFormat for uncompressed data, by
+// glInternalFormat for compressed data), and glTypeSize (the byte-swap unit).
+struct Ktx1Format {
+    Format fmt;
+    std::uint32_t type_size;
+};
+
+Result<Ktx1Format> ktx1_format(std::uint32_t type, std::uint32_t format, std::uint32_t internal, const std::string& name) {
+    constexpr std::uint32_t kUnsignedByte = 0x1401, kFloat = 0x1406, kHalf = 0x140B, kHalfOes = 0x8D61,
+                            kUint10f11f11f = 0x8C3B, kUint5999 = 0x8C3E, kRgb = 0x1907, kRgba = 0x1908, kBgra = 0x80E1;
+    const bool half = type == kHalf || type == kHalfOes;
+    auto unsupported_combination = [&]() -> Error {
+        return fail(ErrorCode::kUnsupported, name, "KTX 1 glType " + hex4(type) + " / glFormat " + hex4(format) + " (bytes 16, 24) with glInternalFormat " +
+                                                       hex4(internal) + " (byte 28) is not supported");
+    };
+    // Compressed formats (glType and glFormat 0 by the specification; not used).
+    switch (internal) {
+        case 0x8E8F: return Ktx1Format{{Texel::kBc6hUfloat}, 1};  // GL_COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT
+        case 0x83F0: return Ktx1Format{{Texel::kBc1}, 1};         // GL_COMPRESSED_RGB_S3TC_DXT1_EXT
+        case 0x83F1: return Ktx1Format{{Texel::kBc1a}, 1};        // GL_COMPRESSED_RGBA_S3TC_DXT1_EXT
+        case 0x83F2: return Ktx1Format{{Texel::kBc2}, 1};         // GL_COMPRESSED_RGBA_S3TC_DXT3_EXT
+        case 0x83F3: return Ktx1Format{{Texel::kBc3}, 1};         // GL_COMPRESSED_RGBA_S3TC_DXT5_EXT
+        case 0x8C4C: return Ktx1Format{{Texel::kBc1, true}, 1};   // GL_COMPRESSED_SRGB_S3TC_DXT1_EXT
+        case 0x8C4D: return Ktx1Format{{Texel::kBc1a, true}, 1};  // GL_COMPRESSED_SRGB_ALPHA_S3TC_DXT1_EXT
+        case 0x8C4E: return Ktx1Format{{Texel::kBc2, true}, 1};   // GL_COMPRESSED_SRGB_ALPHA_S3TC_DXT3_EXT
+        case 0x8C4F: return Ktx1Format{{Texel::kBc3, true}, 1};   // GL_COMPRESSED_SRGB_ALPHA_S3TC_DXT5_EXT
+        case 0x8E8E:
+            return fail(ErrorCode::kUnsupported, name, "KTX 1 glInternalFormat 0x8E8E (GL_COMPRESSED_RGB_BPTC_SIGNED_FLOAT, byte 28) "
+                                                       "is not supported: zhc's BC6H decoder reads unsigned BC6H only");
+        case 0x8E8C:
+        case 0x8E8D:
+            return fail(ErrorCode::kUnsupported, name, "KTX 1 glInternalFormat " + hex4(internal) + " (BC7, byte 28)" + kBc7Refusal);
+        default: break;
+    }
+    switch (internal) {
+        case 0x881A:  // GL_RGBA16F
+        case 0x8814:  // GL_RGBA32F
+            if (format != kRgba) return unsupported_combination();
+            if (half && internal == 0x881A) return Ktx1Format{{Texel::kRgba16f}, 2};
+            if (type == kFloat) return Ktx1Format{{Texel::kRgba32f}, 4};
+            return unsupported_combination();
+        case 0x881B:  // GL_RGB16F
+        case 0x8815:  // GL_RGB32F
+            if (format != kRgb) return unsupported_combination();
+            if (half && internal == 0x881B) return Ktx1Format{{Texel::kRgb16f}, 2};
+            if (type == kFloat) return Ktx1Format{{Texel::kRgb32f}, 4};
+            return unsupported_combination();
+        case 0x8C3A:  // GL_R11F_G11F_B10F
+            if (format == kRgb && type == kUint10f11f11f) return Ktx1Format{{Texel::kB10g11r11}, 4};
+            return unsupported_combination();
+        case 0x8C3D:  // GL_RGB9_E5
+            if (format == kRgb && type == kUint5999) return Ktx1Format{{Texel::kE5b9g9r9}, 4};
+            return unsupported_combination();
+        case 0x8058:  // GL_RGBA8
+        case 0x8C43:  // GL_SRGB8_ALPHA8
+            if (type != kUnsignedByte || (format != kRgba && format != kBgra)) return unsupported_combination();
+            return Ktx1Format{{format == kRgba ? Texel::kRgba8 : Texel::kBgra8, internal == 0x8C43}, 1};
+        case 0x8051:  // GL_RGB8
+        case 0x8C41:  // GL_SRGB8
+            if (type != kUnsignedByte || format != kRgb) return unsupported_combination();
+            return Ktx1Format{{Texel::kRgb8, internal == 0x8C41}, 1};
+        default:
+            return fail(ErrorCode::kUnsupported, name, "KTX 1 glInternalFormat " + hex4(internal) +
+                                                           " (byte 28) is not supported (RGBA16F, RGB16F, RGBA32F, RGB32F, "
+                                                           "R11F_G11F_B10F, RGB9_E5, BPTC unsigned float, RGBA8, SRGB8_ALPHA8, "
+                                                           "RGB8, SRGB8, S3TC DXT1 / DXT3 / DXT5 and their sRGB forms are)");
+    }
+}
+
+// One face of a KTX 1 level: rows of uncompressed data are padded to 4 bytes (GL_UNPACK_ALIGNMENT 4).
+std::uint64_t ktx1_row_bytes(const TexelInfo& f, std::uint64_t m) { return f.block ? ((m + 3) / 4) * f.bytes : (m * f.bytes + 3) / 4 * 4; }
+std::uint64_t ktx1_face_bytes(const TexelInfo& f, std::uint64_t n, int level) {
+    const std::uint64_t m = std::max<std::uint64_t>(1, n >> level);
+    return ktx1_row_bytes(f, m) * (f.block ? (m + 3) / 4 : m);
+}
+std::uint64_t align4(std::uint64_t v) { return (v + 3) / 4 * 4; }
 
 }  // namespace
 
 bool is_ktx2(std::span<const std::uint8_t> b) { return b.size() >= 12 && std::memcmp(b.data(), kKtx2Identifier, 12) == 0; }
 bool is_dds(std::span<const std::uint8_t> b) { return b.size() >= 4 && get32(b, 0) == kDdsMagic; }
+
+bool is_ktx1(std::span<const std::uint8_t> b) { return b.size() >= 12 && std::memcmp(b.data(), kKtx1Identifier, 12) == 0; }
+
+bool ktx1_declares_cube(std::span<const std::uint8_t> b) {
+    if (!is_ktx1(b) || b.size() < kKtx1HeaderBytes) return false;
+    return get32(b, 52) == 6 || get32(b, 52) == 0x06000000u;  // numberOfFaces, either byte order
+}
 
 bool ktx2_declares_cube(std::span<const std::uint8_t> b) { return is_ktx2(b) && b.size() >= 40 && get32(b, 36) == 6; }
 
@@ -227,10 +471,10 @@ Result<Image> read_ktx2_cube(std::span<const std::uint8_t> b, const std::string&
         return fail(ErrorCode::kUnsupported, name, "KTX2 supercompressionScheme " + std::to_string(scheme) + " (" + what +
                                                        ", byte 44) is not supported for cube maps");
     }
-    auto texel = ktx2_texel(vk, name);
-    if (!texel) return texel.error();
-    const TexelInfo f = texel_info(*texel);
-    if (type_size != ktx2_type_size(*texel))
+    auto fmt = ktx2_texel(vk, name);
+    if (!fmt) return fmt.error();
+    const TexelInfo f = texel_info(fmt->texel);
+    if (type_size != ktx2_type_size(fmt->texel))
         return fail(ErrorCode::kBadFormat, name, "KTX2 typeSize " + std::to_string(type_size) + " (byte 16) does not match vkFormat " +
                                                      std::to_string(vk));
     if (Status s = check_cube_size(name, w, o); !s) return s.error();
@@ -300,11 +544,11 @@ Result<Image> read_ktx2_cube(std::span<const std::uint8_t> b, const std::string&
     }
     const int n = static_cast<int>(w);
     Image img = make_cube(n);
-    for (int face = 0; face < 6; ++face) decode_face(f, level0 + static_cast<std::uint64_t>(face) * fb, n, face, img);
+    if (Status s = decode_cube(f, *fmt, level0, fb, n, img, name, o); !s) return s.error();
     if (info) {
         info->format = "ktx2";
         info->compression = zstd ? "zstd" : "none";
-        info->channels = f.channels;
+        info->channels = channels_name(f, fmt->srgb);
         info->layout = "cube";
         info->part.clear();
     }
@@ -323,11 +567,9 @@ Result<Image> read_dds_cube(std::span<const std::uint8_t> b, const std::string& 
     const std::uint32_t h = get32(b, 12), w = get32(b, 16), mip_count = get32(b, 28), pf_flags = get32(b, 80),
                         fourcc = get32(b, 84), caps2 = get32(b, 112);
     std::size_t data_offset = 128;
-    Texel texel;
-    if (!(pf_flags & kDdpfFourCc))
-        return fail(ErrorCode::kUnsupported, name, "DDS pixel format without FourCC (flags at byte 80): uncompressed 8-bit "
-                                                   "formats are not supported for cube maps");
-    if (fourcc == kFourCcDx10) {
+    bool ignore_alpha = false;
+    Format fmt{Texel::kRgba16f};
+    if ((pf_flags & kDdpfFourCc) && fourcc == kFourCcDx10) {
         if (b.size() < 148)
             return fail(ErrorCode::kTruncated, name, "DDS DX10 header truncated (file ends before byte 148)");
         data_offset = 148;
@@ -347,7 +589,7 @@ Result<Image> read_dds_cube(std::span<const std::uint8_t> b, const std::string& 
             return fail(ErrorCode::kUnsupported, name, "DDS partial cube map (caps2 at byte 112 lacks some of the six face flags)");
         auto t = dxgi_texel(get32(b, 128), name);
         if (!t) return t.error();
-        texel = *t;
+        fmt = *t;
     } else {
         if (caps2 & kCaps2Volume)
             return fail(ErrorCode::kUnsupported, name, "DDS volume texture (caps2, byte 112): not a cube map");
@@ -355,18 +597,41 @@ Result<Image> read_dds_cube(std::span<const std::uint8_t> b, const std::string& 
             return fail(ErrorCode::kUnsupported, name, "DDS 2-D texture (caps2 at byte 112 without DDSCAPS2_CUBEMAP): not a cube map");
         if ((caps2 & kCaps2AllFaces) != kCaps2AllFaces)
             return fail(ErrorCode::kUnsupported, name, "DDS partial cube map (caps2 at byte 112 lacks some of the six face flags)");
-        if (fourcc == 113) texel = Texel::kRgba16f;       // D3DFMT_A16B16G16R16F
-        else if (fourcc == 116) texel = Texel::kRgba32f;  // D3DFMT_A32B32G32R32F
+        if (!(pf_flags & kDdpfFourCc)) {
+            // Uncompressed: 32-bit RGB(A) with 8-bit channel masks (D3DFMT_A8R8G8B8 / X8R8G8B8 /
+            // A8B8G8R8 / X8B8G8R8). The legacy header has no colour space: UNORM.
+            const std::uint32_t bits = get32(b, 88), rm = get32(b, 92), gm = get32(b, 96), bm = get32(b, 100),
+                                am = (pf_flags & kDdpfAlphaPixels) ? get32(b, 104) : 0;
+            if ((pf_flags & kDdpfRgb) && bits == 32 && gm == 0x0000ff00u && (am == 0 || am == 0xff000000u) &&
+                ((rm == 0x00ff0000u && bm == 0x000000ffu) || (rm == 0x000000ffu && bm == 0x00ff0000u))) {
+                const bool bgr = rm == 0x00ff0000u;
+                fmt.texel = bgr ? (am ? Texel::kBgra8 : Texel::kBgrx8) : Texel::kRgba8;
+                if (!bgr && !am) fmt.texel = Texel::kRgba8, ignore_alpha = true;
+            } else {
+                char buf[160];
+                std::snprintf(buf, sizeof buf,
+                              "DDS uncompressed pixel format (flags 0x%x at byte 80, %u bits, masks R %08x G %08x B %08x "
+                              "A %08x)",
+                              pf_flags, bits, rm, gm, bm, am);
+                return fail(ErrorCode::kUnsupported, name, std::string(buf) +
+                                                               " is not supported for cube maps (32-bit RGBA / BGRA / "
+                                                               "BGRX with 8-bit channels is)");
+            }
+        } else if (fourcc == 113) fmt.texel = Texel::kRgba16f;  // D3DFMT_A16B16G16R16F
+        else if (fourcc == 116) fmt.texel = Texel::kRgba32f;    // D3DFMT_A32B32G32R32F
+        else if (fourcc == kFourCcDxt1) fmt.texel = Texel::kBc1a;
+        else if (fourcc == kFourCcDxt3) fmt.texel = Texel::kBc2;
+        else if (fourcc == kFourCcDxt5) fmt.texel = Texel::kBc3;
         else
-            return fail(ErrorCode::kUnsupported, name, "DDS FourCC " + std::to_string(fourcc) +
+            return fail(ErrorCode::kUnsupported, name, "DDS FourCC " + fourcc_text(fourcc) +
                                                            " (byte 84) is not supported for cube maps (113 A16B16G16R16F, 116 "
-                                                           "A32B32G32R32F and DX10 are)");
+                                                           "A32B32G32R32F, DXT1, DXT3, DXT5 and DX10 are)");
     }
     if (w == 0 || h == 0 || w != h)
         return fail(ErrorCode::kBadFormat, name, "DDS cube map faces are " + std::to_string(w) + "x" + std::to_string(h) +
                                                      " (bytes 16, 12): cube faces are square and not empty");
     if (Status s = check_cube_size(name, w, o); !s) return s.error();
-    const TexelInfo f = texel_info(texel);
+    const TexelInfo f = texel_info(fmt.texel);
     if (mip_count > static_cast<std::uint32_t>(max_levels(w)))
         return fail(ErrorCode::kBadFormat, name, "DDS mipMapCount " + std::to_string(mip_count) + " (byte 28) exceeds the " +
                                                      std::to_string(max_levels(w)) + " levels of a " + std::to_string(w) +
@@ -384,12 +649,112 @@ Result<Image> read_dds_cube(std::span<const std::uint8_t> b, const std::string& 
                                                          std::to_string(data_offset + need) + ")");
     const int n = static_cast<int>(w);
     Image img = make_cube(n);
-    for (int face = 0; face < 6; ++face)
-        decode_face(f, b.data() + data_offset + static_cast<std::uint64_t>(face) * chain, n, face, img);
+    if (ignore_alpha) {
+        // X8B8G8R8: no alpha channel; decoded as RGBA8 with alpha 1.
+        std::vector<std::uint8_t> copy(b.begin() + static_cast<std::ptrdiff_t>(data_offset), b.end());
+        for (size_t i = 3; i < copy.size(); i += 4) copy[i] = 255;
+        if (Status s = decode_cube(f, fmt, copy.data(), chain, n, img, name, o); !s) return s.error();
+    } else if (Status s = decode_cube(f, fmt, b.data() + data_offset, chain, n, img, name, o); !s) {
+        return s.error();
+    }
     if (info) {
         info->format = "dds";
         info->compression = "none";
-        info->channels = f.channels;
+        info->channels = channels_name(f, fmt.srgb);
+        info->layout = "cube";
+        info->part.clear();
+    }
+    return img;
+}
+
+Result<Image> read_ktx1_cube(std::span<const std::uint8_t> b, const std::string& name, const EnvmapReadOptions& o,
+                             EnvmapInfo* info) {
+    if (!is_ktx1(b)) return fail(ErrorCode::kBadFormat, name, "not a KTX 1 file (bad identifier at byte 0)");
+    if (b.size() < kKtx1HeaderBytes)
+        return fail(ErrorCode::kTruncated, name, "KTX 1 header truncated (file of " + std::to_string(b.size()) +
+                                                     " bytes ends before byte 64)");
+    const std::uint32_t endianness = get32(b, 12);
+    if (endianness != 0x04030201u && endianness != 0x01020304u)
+        return fail(ErrorCode::kBadFormat, name, "KTX 1 endianness " + hex4(endianness) + " (byte 12) is neither 0x04030201 nor "
+                                                 "0x01020304");
+    const bool swap = endianness == 0x01020304u;  // written on a big-endian machine: every field byte-swapped
+    auto u32 = [&](std::uint64_t at) {
+        const std::uint32_t v = get32(b, static_cast<size_t>(at));
+        return swap ? (v >> 24) | ((v >> 8) & 0xff00u) | ((v << 8) & 0xff0000u) | (v << 24) : v;
+    };
+    const std::uint32_t type = u32(16), type_size = u32(20), format = u32(24), internal = u32(28), w = u32(36), h = u32(40),
+                        depth = u32(44), array_elements = u32(48), faces = u32(52), mip_count = u32(56), kvd = u32(60);
+    if (faces != 6) {
+        if (faces == 1)
+            return fail(ErrorCode::kUnsupported, name, "KTX 1 numberOfFaces 1 (byte 52): a 2-D texture, not a cube map");
+        return fail(ErrorCode::kBadFormat, name, "KTX 1 numberOfFaces " + std::to_string(faces) + " (byte 52) is neither 1 nor 6");
+    }
+    if (array_elements != 0)
+        return fail(ErrorCode::kUnsupported, name, "KTX 1 cube map array (numberOfArrayElements " + std::to_string(array_elements) +
+                                                       ", byte 48): one cube map is read");
+    if (w == 0 || h == 0 || w != h || depth != 0)
+        return fail(ErrorCode::kBadFormat, name, "KTX 1 cube map faces are " + std::to_string(w) + "x" + std::to_string(h) + "x" +
+                                                     std::to_string(depth) + " (bytes 36, 40, 44): cube faces are square and 2-D");
+    auto k1 = ktx1_format(type, format, internal, name);
+    if (!k1) return k1.error();
+    const TexelInfo f = texel_info(k1->fmt.texel);
+    if (type_size != k1->type_size)
+        return fail(ErrorCode::kBadFormat, name, "KTX 1 glTypeSize " + std::to_string(type_size) + " (byte 20) does not match glInternalFormat " +
+                                                     hex4(internal) + " (" + std::to_string(k1->type_size) + ")");
+    if (Status s = check_cube_size(name, w, o); !s) return s.error();
+    if (mip_count > static_cast<std::uint32_t>(max_levels(w)))
+        return fail(ErrorCode::kBadFormat, name, "KTX 1 numberOfMipmapLevels " + std::to_string(mip_count) + " (byte 56) exceeds the " +
+                                                     std::to_string(max_levels(w)) + " levels of a " + std::to_string(w) +
+                                                     "-pixel face");
+    const int levels = static_cast<int>(std::max<std::uint32_t>(1, mip_count));  // 0: level 0 only
+    const std::uint64_t size = b.size();
+    if (kvd % 4 != 0 || kvd > size - kKtx1HeaderBytes)
+        return fail(kvd % 4 ? ErrorCode::kBadFormat : ErrorCode::kTruncated, name,
+                    "KTX 1 bytesOfKeyValueData " + std::to_string(kvd) + " (byte 60) " +
+                        (kvd % 4 ? "is not a multiple of 4" : "runs past the file's " + std::to_string(size) + " bytes"));
+    // Levels: imageSize (one face's bytes for a non-array cube map; six faces' is accepted too, as
+    // some writers store it), then six faces, each padded to 4 bytes (cubePadding).
+    std::uint64_t pos = kKtx1HeaderBytes + kvd, level0 = 0;
+    for (int l = 0; l < levels; ++l) {
+        if (pos + 4 > size)
+            return fail(ErrorCode::kTruncated, name, "KTX 1 level " + std::to_string(l) + ": file ends before its imageSize (byte " +
+                                                         std::to_string(pos) + ")");
+        const std::uint64_t image_size = u32(pos), fb = ktx1_face_bytes(f, w, l);
+        if (image_size != fb && image_size != 6 * fb)
+            return fail(ErrorCode::kBadFormat, name, "KTX 1 level " + std::to_string(l) + " imageSize " + std::to_string(image_size) +
+                                                         " (byte " + std::to_string(pos) + "): one face of this size and format takes " +
+                                                         std::to_string(fb) + " bytes");
+        pos += 4;
+        if (l == 0) level0 = pos;
+        const std::uint64_t level_bytes = 6 * align4(fb);
+        if (level_bytes > size - pos)
+            return fail(ErrorCode::kTruncated, name, "KTX 1 level " + std::to_string(l) + " truncated: six faces take " +
+                                                         std::to_string(level_bytes) + " bytes from byte " + std::to_string(pos) +
+                                                         ", the file has " + std::to_string(size - pos));
+        pos = align4(pos + level_bytes);  // mipPadding
+    }
+    if (pos < size)
+        return fail(ErrorCode::kTrailingBytes, name, std::to_string(size - pos) + " trailing bytes after the KTX 1 data (which ends at byte " +
+                                                         std::to_string(pos) + ")");
+    // Level 0, each face with its row padding removed and, for a byte-swapped file, each
+    // glTypeSize unit put in this machine's order.
+    const int n = static_cast<int>(w);
+    const std::uint64_t fb = ktx1_face_bytes(f, w, 0), packed = face_bytes(f, w, 0);
+    const std::uint64_t row = ktx1_row_bytes(f, w), rows = f.block ? (w + 3) / 4 : w, packed_row = packed / rows;
+    std::vector<std::uint8_t> faces_data(static_cast<size_t>(6 * packed));
+    for (int face = 0; face < 6; ++face)
+        for (std::uint64_t r = 0; r < rows; ++r)
+            std::memcpy(faces_data.data() + face * packed + r * packed_row, b.data() + level0 + face * align4(fb) + r * row,
+                        static_cast<size_t>(packed_row));
+    if (swap && type_size > 1)
+        for (size_t i = 0; i + type_size <= faces_data.size(); i += type_size) std::reverse(faces_data.begin() + static_cast<std::ptrdiff_t>(i),
+                                                                                            faces_data.begin() + static_cast<std::ptrdiff_t>(i + type_size));
+    Image img = make_cube(n);
+    if (Status s = decode_cube(f, k1->fmt, faces_data.data(), packed, n, img, name, o); !s) return s.error();
+    if (info) {
+        info->format = "ktx1";
+        info->compression = "none";
+        info->channels = channels_name(f, k1->fmt.srgb);
         info->layout = "cube";
         info->part.clear();
     }

@@ -18,7 +18,19 @@
 //   TEXTURE2D, DDS_RESOURCE_MISC_TEXTURECUBE and arraySize 1. Data: for each face, its mip chain
 //   (mipMapCount levels, 0 meaning 1). Refused with kUnsupported: partial cube maps, 2-D and
 //   volume textures, cube arrays, BC6H_SF16 and other formats.
-// Both: every size is checked against the file and the pixel limit before anything is allocated;
+// KTX 1 (the KTX File Format Specification version 1.1, Khronos): numberOfFaces 6,
+//   numberOfArrayElements 0, square 2-D faces, either byte order (endianness 0x04030201, or
+//   0x01020304 for a file written on a big-endian machine: fields and glTypeSize units swapped);
+//   glInternalFormat RGBA16F / RGB16F (glType HALF_FLOAT or FLOAT), RGBA32F / RGB32F (FLOAT),
+//   R11F_G11F_B10F, RGB9_E5, COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT, RGBA8 / SRGB8_ALPHA8 (RGBA or
+//   BGRA), RGB8 / SRGB8, S3TC DXT1 / DXT3 / DXT5 and their sRGB forms. Key/value data is skipped;
+//   each level's imageSize is one face's bytes (rows padded to 4 bytes) or, as some writers store
+//   it, six faces'. Anything else: kUnsupported naming glInternalFormat in hex.
+// 8-bit formats (KTX2 R8G8B8A8 / B8G8R8A8 / R8G8B8 and BC1-3, UNORM or SRGB; DDS DXGI R8G8B8A8 /
+//   B8G8R8A8 / B8G8R8X8 / BC1-3, UNORM or UNORM_SRGB, legacy DXT1 / DXT3 / DXT5 and 32-bit RGB(A)
+//   masks, which are UNORM): decoded by EnvmapReadOptions::ldr (envmap_ldr.h); an UNORM format read
+//   by its own transfer function gets a warning that it was read as linear. BC7 is refused (kUnsupported).
+// All: every size is checked against the file and the pixel limit before anything is allocated;
 // short files are kTruncated, bytes after the last level kTrailingBytes, inconsistent fields
 // kBadFormat (exit 4), sizes over the limit kTooLarge (exit 6); every message is one line naming
 // the field and its byte offset.
@@ -34,12 +46,16 @@ namespace zhc {
 
 bool is_ktx2(std::span<const std::uint8_t> bytes);  // the KTX 2.0 identifier
 bool is_dds(std::span<const std::uint8_t> bytes);   // "DDS "
+bool is_ktx1(std::span<const std::uint8_t> bytes);  // the KTX 1 identifier «KTX 11»
+bool ktx1_declares_cube(std::span<const std::uint8_t> bytes);  // numberOfFaces 6
 // The header says cube map (KTX2 faceCount 6; DDS caps2 CUBEMAP or DX10 TEXTURECUBE).
 bool ktx2_declares_cube(std::span<const std::uint8_t> bytes);
 bool dds_declares_cube(std::span<const std::uint8_t> bytes);
 
 // Non-finite values are left in the image (read_envmap_memory applies the NonFinitePolicy).
 Result<Image> read_ktx2_cube(std::span<const std::uint8_t> bytes, const std::string& name,
+                             const EnvmapReadOptions& options, EnvmapInfo* info);
+Result<Image> read_ktx1_cube(std::span<const std::uint8_t> bytes, const std::string& name,
                              const EnvmapReadOptions& options, EnvmapInfo* info);
 Result<Image> read_dds_cube(std::span<const std::uint8_t> bytes, const std::string& name,
                             const EnvmapReadOptions& options, EnvmapInfo* info);

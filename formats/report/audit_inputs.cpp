@@ -51,6 +51,7 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         if (options.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
         ro.part = options.part;
         ro.latlong = options.latlong;
+        ro.ldr = options.ldr;
         auto img = read_envmap_memory(*bytes, path, ro);
         if (!img) return img.error();
         in.kind = "envmap";

@@ -8,6 +8,7 @@
 
 #include "codec/report/audit_run.h"
 #include "codec/status.h"
+#include "formats/envmap/envmap.h"
 
 namespace zhc {
 
@@ -16,6 +17,7 @@ struct AuditLoadOptions {
     bool replace_non_finite = false;
     std::string part;  // EXR part (EnvmapReadOptions::part)
     LatLongConvention latlong = LatLongConvention::kOpenExr;  // EnvmapReadOptions::latlong
+    LdrDecoding ldr;  // EnvmapReadOptions::ldr (8-bit cube maps)
 };
 
 // Files and folders -> the list of files to audit (folders: their .exr/.hdr/.zhp/.json files,

@@ -345,7 +345,7 @@ Scene parse(const Reader& r, const json& doc, const std::string& name, const std
         r.fail(ErrorCode::kInvalidValue, "sky", "a scene has either \"environment\" or \"sky\", not both");
     if (doc.contains("environment")) {
         const std::string p = "environment";
-        const json& e = r.object(doc["environment"], p, {"map", "intensity", "rotation_deg", "latlong"});
+        const json& e = r.object(doc["environment"], p, {"map", "intensity", "rotation_deg", "latlong", "ldr_encoding"});
         SceneEnvironment env;
         const std::string map = r.string(r.field(e, p, "map"), p + ".map");
         if (map.empty()) r.fail(ErrorCode::kInvalidValue, p + ".map", "must not be empty");
@@ -357,11 +357,20 @@ Scene parse(const Reader& r, const json& doc, const std::string& name, const std
             if (!parse_latlong_convention(name, &env.latlong))
                 r.fail(ErrorCode::kInvalidValue, p + ".latlong", "must be \"openexr\" or \"gltf\" (got \"" + name + "\")");
         }
+        LdrDecoding ldr;
+        if (e.contains("ldr_encoding")) {
+            env.ldr_encoding = r.string(e["ldr_encoding"], p + ".ldr_encoding");
+            if (!parse_ldr_decoding(env.ldr_encoding, &ldr))
+                r.fail(ErrorCode::kInvalidValue, p + ".ldr_encoding",
+                       "must be \"auto\", \"srgb\", \"linear\", \"rgbm:RANGE\" or \"rgbd:RANGE\" with 0 < RANGE <= 65504 (got \"" +
+                           env.ldr_encoding + "\")");
+        }
         const fs::path mp(map);
         env.source = mp.is_absolute() || base_dir.empty() ? map : (fs::path(base_dir) / mp).string();
         if (options.load_environment) {
             EnvmapReadOptions ro;
             ro.latlong = env.latlong;
+            ro.ldr = ldr;
             auto img = read_envmap(env.source, ro);
             if (!img) throw Fail{make_error(img.error().code, name + ": environment.map: " + img.error().message)};
             env.latlong_map = img->layout == EnvmapLayout::kLatLong;
@@ -487,6 +496,7 @@ std::string scene_json(const Scene& s) {
                               {"intensity", s.environment->intensity},
                               {"rotation_deg", s.environment->rotation_rad / kDeg},
                               {"latlong", latlong_convention_name(s.environment->latlong)}};
+    if (s.environment && s.environment->ldr_encoding != "auto") doc["environment"]["ldr_encoding"] = s.environment->ldr_encoding;
     if (s.sky) {
         if (s.sky->kind == SkyKind::kConstant) {
             doc["sky"] = {{"type", "constant"}, {"radiance", rgb_json(s.sky->radiance)}};

@@ -6,6 +6,7 @@
 // with API +Y = zhc +Z ((x, y, z)_zhc = (z, x, y)_API). `zhc project FILE --json` must give the
 // function's coefficients back (face 64: the texel quadrature's error is about 2e-6 of |L00|;
 // threshold 1e-4), and the same file read with the faces in another order must not.
+// An R8G8B8A8_SRGB cube written by ktx-parse checks the 8-bit sRGB decoding the same way.
 // Usage: node cube_ktx2.mjs ZHC WORKDIR
 import fs from 'node:fs';
 import path from 'node:path';
@@ -121,6 +122,84 @@ const ds = distance(project(swapped));
 console.log(`same cube with faces swapped: ${ds.toExponential(2)} of |L00|`);
 if (!(ds > 0.01)) {
   console.error('FAIL: a face-swapped cube projects like the right one');
+  failed = true;
+}
+
+// An 8-bit sRGB cube (VK_FORMAT_R8G8B8A8_SRGB) written by ktx-parse: texels hold the sRGB OETF of
+// f(d) = c + g . d (per channel), rounded to 8 bits. zhc decodes them with the sRGB EOTF; its SH
+// must be within sqrt(4 pi) e / |L00| + 1e-4 of f's, e the largest texel error of the bytes as
+// decoded here (an SH coefficient moves by at most e times the integral of |Y_i| <= sqrt(4 pi)).
+const lc = [0.45, 0.5, 0.55];
+const lg = [[0.2, -0.1, 0.15], [-0.12, 0.18, 0.1], [0.1, 0.1, -0.2]];
+const linearAt = (d, k) => lc[k] + lg[k][0] * d[0] + lg[k][1] * d[1] + lg[k][2] * d[2];
+const oetf = (v) => (v <= 0.0031308 ? 12.92 * v : 1.055 * v ** (1 / 2.4) - 0.055);
+const eotf = (v) => (v <= 0.04045 ? v / 12.92 : ((v + 0.055) / 1.055) ** 2.4);
+const y1 = Math.sqrt(3 / (4 * Math.PI)) * (4 * Math.PI) / 3;
+const linearSh = [];
+for (let i = 0; i < 9; ++i) linearSh.push([0, 0, 0]);
+for (let k = 0; k < 3; ++k) {
+  linearSh[0][k] = Math.sqrt(4 * Math.PI) * lc[k];
+  linearSh[1][k] = -y1 * lg[k][1];
+  linearSh[2][k] = y1 * lg[k][2];
+  linearSh[3][k] = -y1 * lg[k][0];
+}
+let texelError = 0;
+function makeSrgbKtx2(m) {
+  const data = new Uint8Array(6 * m * m * 4);
+  let o = 0;
+  for (let face = 0; face < 6; ++face)
+    for (let row = 0; row < m; ++row)
+      for (let col = 0; col < m; ++col) {
+        const r = apiDirection(face, (2 * (col + 0.5)) / m - 1, (2 * (row + 0.5)) / m - 1);
+        const len = Math.hypot(r[0], r[1], r[2]);
+        const d = [r[2] / len, r[0] / len, r[1] / len];
+        for (let k = 0; k < 3; ++k) {
+          const v = linearAt(d, k);
+          const byte = Math.round(Math.min(1, Math.max(0, oetf(v))) * 255);
+          texelError = Math.max(texelError, Math.abs(eotf(byte / 255) - v));
+          data[o++] = byte;
+        }
+        data[o++] = 255;
+      }
+  const c = createDefaultContainer();
+  c.vkFormat = 43;  // VK_FORMAT_R8G8B8A8_SRGB
+  c.typeSize = 1;
+  c.pixelWidth = m;
+  c.pixelHeight = m;
+  c.pixelDepth = 0;
+  c.layerCount = 0;
+  c.faceCount = 6;
+  c.levelCount = 1;
+  c.supercompressionScheme = 0;
+  c.levels = [{ levelData: data, uncompressedByteLength: data.byteLength }];
+  const dfd = c.dataFormatDescriptor[0];
+  dfd.transferFunction = 2;  // KHR_DF_TRANSFER_SRGB
+  dfd.bytesPlane = [4, 0, 0, 0, 0, 0, 0, 0];
+  dfd.samples = [0, 1, 2, 15].map((ch, s) => ({
+    bitOffset: 8 * s, bitLength: 7, channelType: ch | (ch === 15 ? 0x40 : 0), samplePosition: [0, 0, 0, 0],
+    sampleLower: 0, sampleUpper: 255,
+  }));
+  return write(c);
+}
+function distanceTo(sh, ref) {
+  let worst = 0;
+  for (let i = 0; i < 9; ++i) for (let k = 0; k < 3; ++k) worst = Math.max(worst, Math.abs(sh[i][k] - ref[i][k]));
+  return worst / Math.max(...ref[0]);
+}
+const srgbFile = path.join(work, 'cube_ktxparse_srgb8.ktx2');
+fs.writeFileSync(srgbFile, makeSrgbKtx2(64));
+const bound = (Math.sqrt(4 * Math.PI) * texelError) / Math.max(...linearSh[0]) + 1e-4;
+const ds8 = distanceTo(project(srgbFile), linearSh);
+console.log(`ktx-parse R8G8B8A8_SRGB cube (face 64): ${ds8.toExponential(2)} of |L00| (texel error ${texelError.toFixed(4)}, bound ${bound.toExponential(2)})`);
+if (!(ds8 < bound)) {
+  console.error('FAIL: the sRGB cube does not project to its function within the 8-bit bound');
+  failed = true;
+}
+const asLinear = JSON.parse(execFileSync(zhc, ['project', srgbFile, '--json', '--ldr-encoding', 'linear'], { encoding: 'utf8' })).sh3;
+const dl = distanceTo(asLinear, linearSh);
+console.log(`same cube read with --ldr-encoding linear: ${dl.toExponential(2)} of |L00|`);
+if (!(dl > 0.1)) {
+  console.error('FAIL: --ldr-encoding linear does not change the sRGB cube');
   failed = true;
 }
 process.exit(failed ? 1 : 0);
