@@ -27,7 +27,7 @@
 // Encodings: zh3_q16, zh3_solved_q16, zh3_dering_q16, zh3_channel_q16, zh3_solved_channel_q16,
 // sh3_q28, sh2_q. The hallucinating and float encodings throw (use lightProbeGrid for those).
 import { zhcIrradianceGlsl } from './zhc_irradiance.glsl.mjs';
-import { PACKED_LAYOUTS, parseZhp } from './zhc_runtime.mjs';
+import { ENCODINGS, PACKED_LAYOUTS, parseZhp } from './zhc_runtime.mjs';
 
 // Packed layout -> RGBA32UI texels per probe (16 bytes each, the last zero padded).
 export const COMPACT_TEXELS = Object.freeze({ zh3_q16: 1, sh3_q28: 2, sh2_q: 1 });
@@ -45,6 +45,9 @@ function compactLayout(encoding) {
 // zhc writes), 'same' when both share the grid's frame (a .zhp, or shAxes "gltf").
 export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same' } = {}) {
   const layout = compactLayout(encoding);
+  // The *_channel_q16 encodings imply per-channel axes whatever the params say (a .zhp header's
+  // axisMode field is the one of the luminance variants).
+  params = { ...params, axisMode: ENCODINGS[encoding].axisMode ?? params.axisMode };
   if (normalAxes !== 'gltf' && normalAxes !== 'same') throw new Error("zhcVolumeGlsl: normalAxes must be 'gltf' or 'same'");
   const texels = COMPACT_TEXELS[layout];
   const decode = {
@@ -269,7 +272,7 @@ uniform mat3 zhcWorldNormalToVolume;
   const add = `${begin}
 	{
 		vec3 zhcWorldPos = ( ( vec4( geometryPosition, 1.0 ) - viewMatrix[ 3 ] ) * viewMatrix ).xyz;
-		vec3 zhcWorldNormal = inverseTransformDirection( geometryNormal, viewMatrix );
+		vec3 zhcWorldNormal = transformNormalByInverseViewMatrix( geometryNormal, viewMatrix );
 		irradiance += PI * zhcVolumeIrradiance( zhcVolumeTex, zhcVolume, ( zhcWorldToVolume * vec4( zhcWorldPos, 1.0 ) ).xyz,
 			zhcWorldNormalToVolume * zhcWorldNormal );
 	}`;
