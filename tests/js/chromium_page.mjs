@@ -1,5 +1,5 @@
-// Shared scaffolding of the headless Chromium tests (js.three_grid, js.three_compact): a local HTTP server over a few directories, a POST /result endpoint for the page's
-// report, and one fresh headless Chromium per page (SwiftShader), killed after the report or 180 s.
+// Shared scaffolding of the headless Chromium tests (js.three_grid, js.three_compact): a local HTTP
+// server over a few directories, a POST /result endpoint for the page's report, and one fresh headless Chromium per page (SwiftShader), killed after the report or 180 s.
 import fs from 'node:fs';
 import path from 'node:path';
 import http from 'node:http';

@@ -18,6 +18,10 @@
 // each probe's irradiance scale (kY00 m0 + 2/3 kY1 (m1 + m2 + m3) + L2 part, m_i the coefficient
 // magnitude or its ratio bound times the DC; ZH3's zonal part grows with the axis' condition
 // number), X = sum over axes of (|p| + |o|) / s + t + 2 (the float grid coordinate's error).
+// (C) patched MeshStandardMaterial against its LightProbe twin: 2e-5 k T, T = sum_i s_l |c_i Y_i(n)|
+// of the blended SH3 (>= |E|), k the material's pixel per unit E (fitted per channel over the
+// samples): three.js's 6-digit irradiance constants (relative <= 2.0e-6) and float32 shading, as
+// js.three_grid's MeshStandardMaterial check.
 // (B) adds the path from the world to the grid frame on the GPU (model-view matrix, inverse view,
 // world-to-grid matrix, the interpolated pole normal): 16 u S + 3 x 16 u S sum over axes of
 // (|p_world| + |translation|) / (scale s).
@@ -226,9 +230,23 @@ for (const r of report.volumes ?? []) {
   });
   // sh2_q (L1 only) rings below 0 on some back-facing normals; the others are lit everywhere.
   check(lit >= (z.encoding === 'sh2_q' ? 16 : SAMPLES), `${r.name}: ${lit} of ${SAMPLES} samples lit in every channel`);
+  // (C) Standard: fitted pixel-per-E k and the twin comparison.
+  let worstC = 0;
+  for (let k = 0; k < 3; k++) {
+    let pe = 0, ee = 0;
+    v.samples.forEach((_, i) => { pe += r.standardProbe[i][k] * v.expected[i][k]; ee += v.expected[i][k] ** 2; });
+    const kk = pe / ee;
+    check(kk > 0.1 && kk < 10, `${r.name} channel ${k}: MeshStandardMaterial shows k E with k = ${kk.toPrecision(6)}`);
+    v.samples.forEach((_, i) => {
+      const diff = Math.abs(r.standard[i][k] - r.standardProbe[i][k]), T = r.termScale[i][k];
+      worstC = Math.max(worstC, diff / (kk * T));
+      check(diff <= 2e-5 * kk * T, `${r.name} sample ${i} channel ${k}: patched MeshStandardMaterial = LightProbe twin within 2e-5 k T (${(diff / (kk * T)).toExponential(2)})`);
+    });
+  }
   const fmt = (s) => `max ${s.maxUnits.toFixed(2)} u S, relative max ${s.maxRel.toExponential(2)} mean ${(s.sumRel / s.n).toExponential(2)}`;
   console.log(`  ${v.samples.length} samples x 3 channels (mean E ${meanE.toPrecision(4)}) against the C header:`);
   console.log(`    ShaderMaterial (A):            ${fmt(A)}`);
   console.log(`    patched MeshLambertMaterial (B): ${fmt(B)}`);
+  console.log(`    patched MeshStandardMaterial vs LightProbe twin (C): max ${worstC.toExponential(2)} k T`);
 }
 finish('three.js compact volume');

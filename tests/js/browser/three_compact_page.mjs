@@ -8,6 +8,8 @@
 //      SphereGeometry) turned to face the camera along the world direction of d and placed at the
 //      world position of q (the volume's matrixWorld: translation, uniform scale and, for .zhp
 //      volumes, the zhc -> glTF axis rotation); the centre pixel of a 33 x 33 target shades the pole.
+//  (C) a patched MeshStandardMaterial (roughness 1, metalness 0) and, as its twin, the same material
+//      lit by a THREE.LightProbe holding zhc's blended SH3 at q (JS volumeSH3, three.js's basis).
 // Reported: the pixels, GPU bytes per probe of the compact texture and of three.js's own grid
 // (LightProbeGridWebGL atlas via the plugin's lightProbeGrid, float and binary16), refusals.
 import * as THREE from 'three';
@@ -15,7 +17,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { LightProbeGridWebGL } from 'three/addons/lighting/LightProbeGridWebGL.js';
 import { ZhcLightProbesPlugin } from '/runtime/web/zhc_light_probes_plugin.mjs';
 import { compactVolume, compactVolumeFromZhp, patchMaterialWithVolume } from '/runtime/web/zhc_volume.glsl.mjs';
-import { parseZhp } from '/runtime/web/zhc_runtime.mjs';
+import { parseZhp, makeVolume, volumeFromZhp, volumeSH3, rotateZhcToGltf, toThreeConvention, gltfToZhcDir } from '/runtime/web/zhc_runtime.mjs';
 
 // zhc axes -> glTF axes: (x, y, z)_glTF = (y, z, x)_zhc (a rotation).
 const ZHC_TO_GLTF = new THREE.Matrix4().set(0, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 0, 0, 1);
@@ -45,6 +47,7 @@ async function main() {
       root.add(gltf.scene);
       root.updateMatrixWorld(true);
       matrixWorld = v.nodes[0].matrixWorld.clone();
+      r.shVolume = makeVolume({ sh: v.sh, ...v.grid });
       compact = v.compactVolume();  // the plugin's method; default placement: the node's matrixWorld
       r.defaultMatrix = compact.matrixWorld.every((x, i) => x === matrixWorld.elements[i]);
       const gridF = v.lightProbeGrid(LightProbeGridWebGL);
@@ -70,6 +73,7 @@ async function main() {
       root.updateMatrixWorld(true);
       matrixWorld = root.matrixWorld.clone().multiply(ZHC_TO_GLTF);
       compact = compactVolumeFromZhp(bytes, { THREE, matrixWorld });
+      r.shVolume = volumeFromZhp(bytes);
       r.count = parseZhp(bytes).count;
     }
     r.encoding = compact.encoding;
@@ -123,13 +127,16 @@ void main() {
     const rt = new THREE.WebGLRenderTarget(SIZE, SIZE, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true });
     const lambert = patchMaterialWithVolume(new THREE.MeshLambertMaterial({ color: 0xffffff }), compact, THREE);
     const plain = new THREE.MeshLambertMaterial({ color: 0xffffff });
+    const standard = patchMaterialWithVolume(new THREE.MeshStandardMaterial({ color: 0xffffff, roughness: 1, metalness: 0 }), compact, THREE);
+    const standardPlain = new THREE.MeshStandardMaterial({ color: 0xffffff, roughness: 1, metalness: 0 });
     const mesh = new THREE.Mesh(new THREE.SphereGeometry(radius, 64, 32), lambert);
     const cam = new THREE.PerspectiveCamera(20, 1, radius, 100 * radius);
     const px = new Float32Array(4);
-    const shot = (material) => {
+    const shot = (material, light) => {
       mesh.material = material;
       const scene = new THREE.Scene();
       scene.add(mesh);
+      if (light) scene.add(light);
       renderer.setRenderTarget(rt);
       renderer.setClearColor(0x000000, 0);
       renderer.render(scene, cam);
@@ -138,6 +145,9 @@ void main() {
       return [px[0], px[1], px[2]];
     };
     r.lambert = [];
+    r.standard = [];
+    r.standardProbe = [];
+    r.termScale = [];
     r.worldMax = 0;
     for (const s of f.samples) {
       const qW = new THREE.Vector3().fromArray(s.q).applyMatrix4(matrixWorld);
@@ -151,10 +161,26 @@ void main() {
       cam.lookAt(centre);
       cam.updateMatrixWorld();
       r.lambert.push(shot(lambert));
+      r.standard.push(shot(standard));
+      // The twin: zhc's blended SH3 at q (grid frame; coefficients in zhc axes for both kinds of
+      // volume here) rotated to glTF = world axes (the nodes are not rotated beyond zhc -> glTF).
+      const blended = Float32Array.from(volumeSH3(r.shVolume, s.q));
+      const g = toThreeConvention(rotateZhcToGltf(blended));
+      const sh = new THREE.SphericalHarmonics3();
+      for (let i = 0; i < 9; i++) sh.coefficients[i].set(g[i * 3], g[i * 3 + 1], g[i * 3 + 2]);
+      r.standardProbe.push(shot(standardPlain, new THREE.LightProbe(sh)));
+      // Term scale of the blended SH3 at the normal: sum_i s_l |c_i Y_i(n)| per channel (>= |E|).
+      const [x, y, z] = f.glb ? gltfToZhcDir(s.d) : s.d;
+      const Y = [0.28209479177387814, 0.4886025119029199 * y, 0.4886025119029199 * z, 0.4886025119029199 * x,
+        1.0925484305920792 * x * y, 1.0925484305920792 * y * z, 0.31539156525252005 * (3 * z * z - 1),
+        1.0925484305920792 * x * z, 0.5462742152960396 * (x * x - y * y)];
+      const sl = [1, 2 / 3, 2 / 3, 2 / 3, 0.25, 0.25, 0.25, 0.25, 0.25];
+      r.termScale.push([0, 1, 2].map((k) => Y.reduce((acc, yi, i) => acc + sl[i] * Math.abs(yi * blended[i * 3 + k]), 0)));
     }
     r.unpatched = shot(plain);  // the same scene without the volume: black (nothing else lights it)
     r.translationMax = Math.max(Math.abs(e[12]), Math.abs(e[13]), Math.abs(e[14]));
     r.scale = scale;
+    delete r.shVolume;
     report.volumes.push(r);
   }
   return report;
