@@ -11,12 +11,12 @@
 // bytes (which would be wrong: ratios times a per-probe DC, a per-probe zonal axis), no float
 // transcode; the only differences from the C header are float32 rounding in the shader.
 //
-//   zhcVolumeGlsl({ encoding, params, normalAxes })   GLSL ES 3.00 chunk (after zhc_irradiance's):
+//   zhcVolumeGlsl({ encoding, params, normalAxes })   GLSL ES 3.00 chunk (zhc_irradiance's included):
 //     struct ZhcVolume { vec3 origin; vec3 spacing; vec3 counts; };
 //     vec3 zhcVolumeIrradiance(highp usampler3D tex, ZhcVolume v, vec3 position, vec3 normal)
 //       position in the grid's frame (a glTF volume: its node's local glTF axes; a .zhp: zhc axes),
-//       normal in the same frame (normalised in the shader; zero: the frame's "up"); for shAxes "zhc"
-//       volumes in glTF axes the chunk maps the normal to zhc axes (normalAxes 'gltf').
+//       normal in the same frame (normalised in the shader; zero: +Z of the coefficients' axes); for
+//       shAxes "zhc" volumes in glTF axes the chunk maps the normal to zhc axes (normalAxes 'gltf').
 //     void zhcVolumeSh3(highp usampler3D tex, ZhcVolume v, vec3 position, out vec3 c[9])  blended SH3
 //   compactVolume(source, { THREE, matrixWorld })      texture payload + uniforms (+ a Data3DTexture
 //     when THREE is given) from a ZhcProbeVolume (the GLTFLoader plugin) or parseZhp(bytes)
