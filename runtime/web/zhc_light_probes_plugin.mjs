@@ -21,6 +21,7 @@ import {
   PACKED_LAYOUTS, decodeAll, encodingInfo, gltfToZhcDir, irradiance as shIrradiance, makeParams, normalizeOr,
   makeVolume, rotateZhcToGltf, toThreeConvention, volumeIrradiance,
 } from './zhc_runtime.mjs';
+import { compactVolume } from './zhc_volume.glsl.mjs';
 
 export const EXTENSION = 'ZHC_light_probes';
 
@@ -64,6 +65,14 @@ export class ZhcProbeVolume {
     if (!this.#volume) this.#volume = makeVolume({ sh: this.sh, ...this.grid });
     const d = normalizeOr([normal[0], normal[1], normal[2]], [0, 1, 0]);
     return volumeIrradiance(this.#volume, position, this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
+  }
+
+  // The compact path (zhc_volume.glsl.mjs): the stored probe bytes as an RGBA32UI Data3DTexture,
+  // its uniforms and GLSL chunk; patchMaterialWithVolume(material, volume.compactVolume(), THREE)
+  // lights a stock material with it. Options: matrixWorld (default: the single node's).
+  compactVolume(options = {}) {
+    if (this.draco) throw new Error(`zhc: volume '${this.name}' is Draco-compressed (not decoded)`);
+    return compactVolume(this, { THREE, ...options });
   }
 
   // three.js's own probe grid (r187+: `LightProbeGridWebGL` for WebGLRenderer, `LightProbeGrid` for

@@ -31,10 +31,10 @@
 // Time bounded: each browser page times out after 180 s (Chromium killed).
 import fs from 'node:fs';
 import path from 'node:path';
-import http from 'node:http';
-import { execFileSync, spawn } from 'node:child_process';
+import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { makeRand, checker } from './fixtures.mjs';
+import { chromiumPages } from './chromium_page.mjs';
 
 const [zhc, sampler, workArg, chromiumArg] = process.argv.slice(2);
 if (!zhc || !sampler || !workArg) {
@@ -105,72 +105,17 @@ for (const f of files) {
   f.atSurface = sampleC(f.zhp, f.samples.map(({ q, d }) => ({ q: q.map((x, c) => x - 0.5 * d[c] * g.spacing[c]), d })));
 }
 
-// --- 3. server + Chromium ---------------------------------------------------------------------
-const roots = {
-  '/runtime/web/': path.join(repo, 'runtime', 'web'),
-  '/three/': path.join(here, 'node_modules', 'three'),
-  '/test/': path.join(here, 'browser'),
-  '/work/': work,
-};
-const types = { '.html': 'text/html', '.mjs': 'text/javascript', '.js': 'text/javascript', '.json': 'application/json', '.glb': 'model/gltf-binary' };
-let resolveResult, result;
-const served = [];
-const server = http.createServer((req, res) => {
-  const url = new URL(req.url, 'http://127.0.0.1');
-  if (req.method === 'POST' && url.pathname === '/result') {
-    let body = '';
-    req.on('data', (c) => { body += c; });
-    req.on('end', () => { res.end('ok'); resolveResult(body); });
-    return;
-  }
-  const pathname = decodeURIComponent(url.pathname);
-  for (const [prefix, dir] of Object.entries(roots)) {
-    if (!pathname.startsWith(prefix)) continue;
-    const file = path.resolve(dir, '.' + pathname.slice(prefix.length - 1));
-    if (!file.startsWith(dir + path.sep) || !fs.existsSync(file) || !fs.statSync(file).isFile()) break;
-    served.push(pathname);
-    res.writeHead(200, { 'Content-Type': types[path.extname(file)] ?? 'application/octet-stream', 'Cache-Control': 'no-store' });
-    res.end(fs.readFileSync(file));
-    return;
-  }
-  res.writeHead(404);
-  res.end();
-  served.push(`404 ${pathname}`);
+// --- 3. server + Chromium (tests/js/chromium_page.mjs) -----------------------------------------
+const pages = await chromiumPages({
+  roots: { '/runtime/web/': path.join(repo, 'runtime', 'web'), '/three/': path.join(here, 'node_modules', 'three'), '/test/': path.join(here, 'browser'), '/work/': work },
+  work, chromium, check,
 });
-await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
-const port = server.address().port;
-// One headless Chromium per page (fresh profile); resolves to the page's report or null after 180 s.
-async function runPage(html, extraArgs, tag) {
-  result = new Promise((resolve) => { resolveResult = resolve; });
-  const profile = fs.mkdtempSync(path.join(work, 'chromium-profile-'));
-  const args = ['--headless=new', '--no-sandbox', '--disable-quic', '--no-first-run', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync', '--disable-default-apps', '--disable-extensions', `--user-data-dir=${profile}`,
-    '--enable-unsafe-swiftshader', '--enable-logging=stderr', '--v=0', ...extraArgs, `http://127.0.0.1:${port}/test/${html}`];
-  const browser = spawn(chromium, args, { detached: true, stdio: ['ignore', 'ignore', 'pipe'] });
-  let stderr = '';
-  browser.stderr.on('data', (c) => { stderr += c; });
-  const timeout = new Promise((resolve) => setTimeout(() => resolve(null), 180000));
-  const body = await Promise.race([result, timeout]);
-  try { process.kill(-browser.pid, 'SIGKILL'); } catch { /* already gone */ }
-  fs.rmSync(profile, { recursive: true, force: true });
-  fs.writeFileSync(W(`chromium_stderr_${tag}.txt`), stderr);
-  check(body !== null, `${tag}: the page reported within 180 s`);
-  if (body === null) {
-    console.log(`served: ${served.join(' ')}`);
-    console.log(stderr.split('\n').slice(-30).join('\n'));
-    return null;
-  }
-  const consoleErrors = stderr.split('\n').filter((l) => /CONSOLE/.test(l) && /(Uncaught|Error)/.test(l));
-  for (const l of consoleErrors) console.log(`  chromium: ${l}`);
-  check(consoleErrors.length === 0, `${tag}: no console error in Chromium's log`);
-  check(/CONSOLE.*zhc three.js LightProbeGrid page done/.test(stderr), `${tag}: the page's console output reaches Chromium's log (so the check above can fail)`);
-  return JSON.parse(body);
-}
+const DONE = 'zhc three.js LightProbeGrid page done';
 const reports = {
-  webgl: await runPage('three_grid.html', ['--use-angle=swiftshader'], 'webgl'),
-  webgpu: await runPage('three_grid_webgpu.html', ['--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader', '--use-angle=swiftshader'], 'webgpu'),
+  webgl: await pages.runPage('three_grid.html', ['--use-angle=swiftshader'], 'webgl', DONE),
+  webgpu: await pages.runPage('three_grid_webgpu.html', ['--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader', '--use-angle=swiftshader'], 'webgpu', DONE),
 };
-server.close();
+pages.close();
 
 // --- 4. assertions -----------------------------------------------------------------------------
 fs.writeFileSync(W('report.json'), JSON.stringify(reports, null, 1));

@@ -1,0 +1,297 @@
+// The compact path for three.js / WebGL2: a zhc probe grid sampled straight from its STORED bytes.
+//
+// The probes stay in their packed encoding (zh3_q16 and its relatives: 16 bytes per probe; sh3_q28:
+// 28 bytes, padded to 32; sh2_q: 16) in an integer 3D texture (RGBA32UI, one texel per 16 bytes,
+// NearestFilter, no mipmaps): probe (x, y, z) of an nx x ny x nz grid occupies texels
+// (T x + j, y, z), j < T, of an (T nx) x ny x nz texture, T = texels per probe (1, or 2 for sh3_q28:
+// the shader's w0, w1). The shader fetches the 8 corner probes of the cell holding the point
+// (texelFetch), decodes each to SH3 radiance, blends them with trilinear weights and evaluates the
+// irradiance once: the maths of zhc_volume_irradiance (runtime/zhc_runtime.h) and zhcVolumeIrradiance
+// (runtime/zhc.glsl), docs/runtime.md "Probe volumes". Exact to the decode: no filtering of stored
+// bytes (which would be wrong: ratios times a per-probe DC, a per-probe zonal axis), no float
+// transcode; the only differences from the C header are float32 rounding in the shader.
+//
+//   zhcVolumeGlsl({ encoding, params, normalAxes })   GLSL ES 3.00 chunk (zhc_irradiance's included):
+//     struct ZhcVolume { vec3 origin; vec3 spacing; vec3 counts; };
+//     vec3 zhcVolumeIrradiance(highp usampler3D tex, ZhcVolume v, vec3 position, vec3 normal)
+//       position in the grid's frame (a glTF volume: its node's local glTF axes; a .zhp: zhc axes),
+//       normal in the same frame (normalised in the shader; zero: +Z of the coefficients' axes); for
+//       shAxes "zhc" volumes in glTF axes the chunk maps the normal to zhc axes (normalAxes 'gltf').
+//     void zhcVolumeSh3(highp usampler3D tex, ZhcVolume v, vec3 position, out vec3 c[9])  blended SH3
+//   compactVolume(source, { THREE, matrixWorld })      texture payload + uniforms (+ a Data3DTexture
+//     when THREE is given) from a ZhcProbeVolume (the GLTFLoader plugin) or parseZhp(bytes)
+//   patchMaterialWithVolume(material, compact, THREE)  onBeforeCompile: a stock three.js material
+//     (MeshLambertMaterial, MeshStandardMaterial, MeshPhysicalMaterial, ...) gets the volume's
+//     irradiance (times pi, three.js's convention) added to its indirect diffuse light.
+//
+// Encodings: zh3_q16, zh3_solved_q16, zh3_dering_q16, zh3_channel_q16, zh3_solved_channel_q16,
+// sh3_q28, sh2_q. The hallucinating and float encodings throw (use lightProbeGrid for those).
+import { zhcIrradianceGlsl } from './zhc_irradiance.glsl.mjs';
+import { ENCODINGS, PACKED_LAYOUTS, parseZhp } from './zhc_runtime.mjs';
+
+// Packed layout -> RGBA32UI texels per probe (16 bytes each, the last zero padded).
+export const COMPACT_TEXELS = Object.freeze({ zh3_q16: 1, sh3_q28: 2, sh2_q: 1 });
+const COMPACT_ENCODINGS = Object.freeze(['zh3_q16', 'zh3_solved_q16', 'zh3_dering_q16', 'zh3_channel_q16',
+  'zh3_solved_channel_q16', 'sh3_q28', 'sh2_q']);
+
+function compactLayout(encoding) {
+  if (!COMPACT_ENCODINGS.includes(encoding))
+    throw new Error(`zhc compact volume: encoding ${encoding} is not supported (${COMPACT_ENCODINGS.join(', ')}; others: lightProbeGrid)`);
+  return PACKED_LAYOUTS[encoding];
+}
+
+// The volume chunk for one encoding and parameter set. normalAxes: 'gltf' when the shader's
+// normals are in glTF axes and the coefficients in zhc axes (a glTF volume with shAxes "zhc", what
+// zhc writes), 'same' when both share the grid's frame (a .zhp, or shAxes "gltf").
+export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same' } = {}) {
+  const layout = compactLayout(encoding);
+  // The *_channel_q16 encodings imply per-channel axes whatever the params say (a .zhp header's
+  // axisMode field is the one of the luminance variants).
+  params = { ...params, axisMode: ENCODINGS[encoding].axisMode ?? params.axisMode };
+  if (normalAxes !== 'gltf' && normalAxes !== 'same') throw new Error("zhcVolumeGlsl: normalAxes must be 'gltf' or 'same'");
+  const texels = COMPACT_TEXELS[layout];
+  const decode = {
+    zh3_q16: 'zhcSh3Zh3Q16(w0, c);',
+    sh3_q28: 'zhcSh3Sh3Q28(w0, texelFetch(tex, t + ivec3(1, 0, 0), 0), c);',
+    sh2_q: 'zhcSh3Sh2Q(w0, c);',
+  }[layout];
+  return `${zhcIrradianceGlsl(params)}
+// ---- zhc compact volume (runtime/web/zhc_volume.glsl.mjs): ${encoding}, ${texels} RGBA32UI texel(s) per probe ----
+#define ZHC_VOLUME_TEXELS ${texels}
+#define ZHC_VOLUME_NORMAL_FROM_GLTF ${normalAxes === 'gltf' ? 1 : 0}
+const float ZHC_SQRT3 = ${Math.fround(Math.sqrt(3)).toPrecision(9)};
+struct ZhcVolume {
+  vec3 origin;   // position of probe (0, 0, 0)
+  vec3 spacing;  // > 0
+  vec3 counts;   // integers >= 1 (as floats: exact below 2^24)
+};
+
+// Stored coefficients -> radiance (irradiance storage: L1 / (2/3), L2 / (1/4)).
+void zhcStoredToRadiance(inout vec3 c[9]) {
+#if ZHC_STORED_IRRADIANCE
+  for (int i = 1; i < 4; ++i) c[i] *= 1.5;
+  for (int i = 4; i < 9; ++i) c[i] *= 4.0;
+#endif
+}
+
+// zh3_q16 family -> SH3 radiance: linear SH from the ratios, the zonal L2 expanded on the axis of
+// the dequantised L1 (f20 [sqrt3 xy, -sqrt3 yz, (3z^2 - 1)/2, -sqrt3 xz, sqrt3/2 (x^2 - y^2)]).
+void zhcSh3Zh3Q16(uvec4 words, out vec3 c[9]) {
+  vec3 dc = zhcUnpackDc(words.x);
+  vec3 v[3];
+  vec3 zq;
+  c[0] = dc;
+  for (int k = 0; k < 3; ++k) {
+    uint w = words[k + 1];
+    float d = dc[k];
+    c[1][k] = zhcUnit(w & 255u) * ZHC_L1_HI * d;
+    c[2][k] = zhcUnit((w >> 8) & 255u) * ZHC_L1_HI * d;
+    c[3][k] = zhcUnit((w >> 16) & 255u) * ZHC_L1_HI * d;
+    zq[k] = zhcZonalRatio(w >> 24) * d;
+  }
+  for (int k = 0; k < 3; ++k) v[k] = vec3(-c[3][k], -c[1][k], c[2][k]);
+  for (int k = 0; k < 3; ++k) {
+    vec3 a = zhcZonalAxis(v, k);
+    float f = zq[k];
+    c[4][k] = f * (ZHC_SQRT3 * a.x * a.y);
+    c[5][k] = f * (-ZHC_SQRT3 * a.y * a.z);
+    c[6][k] = f * (0.5 * (3.0 * a.z * a.z - 1.0));
+    c[7][k] = f * (-ZHC_SQRT3 * a.x * a.z);
+    c[8][k] = f * (0.5 * ZHC_SQRT3 * (a.x * a.x - a.y * a.y));
+  }
+  zhcStoredToRadiance(c);
+}
+
+// sh3_q28 (w1.w is padding) -> SH3 radiance.
+void zhcSh3Sh3Q28(uvec4 w0, uvec4 w1, out vec3 c[9]) {
+  uint w[7] = uint[7](w0.x, w0.y, w0.z, w0.w, w1.x, w1.y, w1.z);
+  vec3 dc = zhcUnpackDc(w[0]);
+  c[0] = dc;
+  for (int i = 1; i < 9; ++i)
+    for (int k = 0; k < 3; ++k) c[i][k] = zhcRatio(i, (w[1 + 2 * k + (i - 1) / 4] >> (8 * ((i - 1) % 4))) & 255u) * dc[k];
+  zhcStoredToRadiance(c);
+}
+
+// sh2_q -> SH3 radiance (L2 zero).
+void zhcSh3Sh2Q(uvec4 words, out vec3 c[9]) {
+  vec3 dc = zhcUnpackDcSlot6(words);
+  c[0] = dc;
+  for (int i = 1; i < 4; ++i)
+    for (int k = 0; k < 3; ++k) c[i][k] = zhcRatio(i, zhcByte(words, 6 + 3 * k + i - 1)) * dc[k];
+  for (int i = 4; i < 9; ++i) c[i] = vec3(0.0);
+  zhcStoredToRadiance(c);
+}
+
+// SH3 radiance of grid probe q (integer coordinates inside the grid).
+void zhcVolumeProbe(highp usampler3D tex, ivec3 q, out vec3 c[9]) {
+  ivec3 t = ivec3(q.x * ZHC_VOLUME_TEXELS, q.y, q.z);
+  uvec4 w0 = texelFetch(tex, t, 0);
+  ${decode}
+}
+
+// Blended SH3 radiance at p: t = clamp((p - origin) / spacing, 0, counts - 1) (NaN: 0), cell
+// i0 = min(floor(t), counts - 2), weights prod (f or 1 - f), f = t - i0; probes of weight 0 skipped.
+void zhcVolumeSh3(highp usampler3D tex, ZhcVolume v, vec3 p, out vec3 acc[9]) {
+  ivec3 n = max(ivec3(v.counts), ivec3(1));
+  vec3 t = (p - v.origin) / v.spacing;
+  t = mix(vec3(0.0), t, greaterThanEqual(t, vec3(0.0)));  // below the box, or NaN: 0
+  t = min(t, vec3(n - 1));
+  ivec3 i0 = min(ivec3(t), max(n, ivec3(2)) - 2);
+  vec3 fr = t - vec3(i0);
+  for (int i = 0; i < 9; ++i) acc[i] = vec3(0.0);
+  for (int corner = 0; corner < 8; ++corner) {
+    ivec3 b = ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
+    vec3 wv = mix(1.0 - fr, fr, notEqual(b, ivec3(0)));
+    float w = wv.x * wv.y * wv.z;
+    if (w == 0.0) continue;
+    vec3 c[9];
+    zhcVolumeProbe(tex, i0 + b, c);
+    for (int i = 0; i < 9; ++i) acc[i] += w * c[i];
+  }
+}
+
+// Irradiance (zhc's normalised kernel: constant radiance 1 gives 1) at position p for the surface
+// normal n (normalised here; zero or not finite: the frame's up), both in the grid's frame.
+vec3 zhcVolumeIrradiance(highp usampler3D tex, ZhcVolume v, vec3 p, vec3 n) {
+  vec3 c[9];
+  zhcVolumeSh3(tex, v, p, c);
+#if ZHC_VOLUME_NORMAL_FROM_GLTF
+  n = n.zxy;
+#endif
+  return zhcIrradianceSh3(c, zhcNormalizeOrZ(n));
+}
+// ---- end zhc compact volume ----
+`;
+}
+
+// The texture payload of a grid: Uint32Array((T nx) * ny * nz * 4), probe (x, y, z)'s stored bytes
+// (little-endian words) at texel (T x, y, z) on, zero padded to T * 16 bytes.
+export function compactVolumeWords(bytes, bytesPerProbe, counts, texels) {
+  const [nx, ny, nz] = counts;
+  const count = nx * ny * nz;
+  if (bytes.length < count * bytesPerProbe) throw new Error(`zhc compact volume: ${count} probes need ${count * bytesPerProbe} bytes`);
+  if (bytesPerProbe > 16 * texels) throw new Error('zhc compact volume: probe larger than its texels');
+  if (new Uint8Array(new Uint32Array([1]).buffer)[0] !== 1) throw new Error('zhc compact volume: big-endian platform');
+  const out = new Uint32Array(count * texels * 4);
+  const u8 = new Uint8Array(out.buffer);
+  // Probe p = x + nx (y + ny z) sits at texel T x + T nx (y + ny z) = T p of the row-major texture.
+  for (let p = 0; p < count; p++) u8.set(bytes.subarray(p * bytesPerProbe, (p + 1) * bytesPerProbe), p * texels * 16);
+  return out;
+}
+
+// Column-major 4x4 helpers (three.js Matrix4.elements order), no three.js needed.
+function invertAffine(m) {
+  const a = [m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]];  // columns
+  const det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[3] * (a[1] * a[8] - a[2] * a[7]) + a[6] * (a[1] * a[5] - a[2] * a[4]);
+  if (!Number.isFinite(det) || det === 0) throw new Error('zhc compact volume: matrixWorld is singular');
+  if (m[3] !== 0 || m[7] !== 0 || m[11] !== 0 || m[15] !== 1) throw new Error('zhc compact volume: matrixWorld must be affine');
+  // Inverse of the 3x3 (column-major), then -inv * translation.
+  const inv = [
+    (a[4] * a[8] - a[5] * a[7]) / det, (a[2] * a[7] - a[1] * a[8]) / det, (a[1] * a[5] - a[2] * a[4]) / det,
+    (a[5] * a[6] - a[3] * a[8]) / det, (a[0] * a[8] - a[2] * a[6]) / det, (a[2] * a[3] - a[0] * a[5]) / det,
+    (a[3] * a[7] - a[4] * a[6]) / det, (a[1] * a[6] - a[0] * a[7]) / det, (a[0] * a[4] - a[1] * a[3]) / det,
+  ];
+  const t = [m[12], m[13], m[14]];
+  const r = [0, 1, 2].map((row) => -(inv[row] * t[0] + inv[3 + row] * t[1] + inv[6 + row] * t[2]));
+  return [inv[0], inv[1], inv[2], 0, inv[3], inv[4], inv[5], 0, inv[6], inv[7], inv[8], 0, r[0], r[1], r[2], 1];
+}
+
+// The compact volume of a grid: source = a ZhcProbeVolume (the GLTFLoader plugin; grid in its
+// node's local glTF axes) or parseZhp(bytes) of a .zhp (grid in zhc axes). Options: THREE (the
+// three.js module: adds `texture`, a Data3DTexture, and three.js `uniforms`), matrixWorld (the
+// grid frame -> world, column-major 16 numbers or a Matrix4; any invertible affine map, rotations
+// included; default: a ZhcProbeVolume's single node's matrixWorld, else identity).
+// Returns { encoding, layout, texelsPerProbe, gpuBytesPerProbe, gpuBytes, size: [w, h, d], data,
+// grid: { origin, spacing, counts }, glsl (zhcVolumeGlsl for it), texture?, uniforms? }.
+export function compactVolume(source, { THREE, matrixWorld } = {}) {
+  const isZhp = source.payload !== undefined;
+  if ((source.layout ?? 'grid') !== 'grid' || !source.grid) throw new Error(`zhc compact volume: needs a grid (layout ${source.layout})`);
+  const layout = compactLayout(source.encoding);
+  const texels = COMPACT_TEXELS[layout];
+  const bytes = isZhp ? source.payload : source.bytes;
+  const bytesPerProbe = source.bytesPerProbe;
+  const { origin, spacing, counts } = source.grid;
+  for (let c = 0; c < 3; c++) {
+    if (!Number.isInteger(counts[c]) || counts[c] < 1) throw new Error(`zhc compact volume: counts[${c}] must be an integer >= 1`);
+    if (!Number.isFinite(origin[c])) throw new Error(`zhc compact volume: origin[${c}] is not finite`);
+    if (!Number.isFinite(spacing[c]) || !(spacing[c] > 0)) throw new Error(`zhc compact volume: spacing[${c}] must be finite and > 0`);
+  }
+  if (counts[0] * texels > 2048 || counts[1] > 2048 || counts[2] > 2048) throw new Error('zhc compact volume: grid larger than a 3D texture (2048)');
+  const data = compactVolumeWords(bytes, bytesPerProbe, counts, texels);
+  const normalAxes = !isZhp && source.shAxes === 'zhc' ? 'gltf' : 'same';
+  const out = {
+    encoding: source.encoding, layout, texelsPerProbe: texels, gpuBytesPerProbe: 16 * texels, gpuBytes: data.byteLength,
+    size: [counts[0] * texels, counts[1], counts[2]], data, grid: { origin: [...origin], spacing: [...spacing], counts: [...counts] },
+    normalAxes, glsl: zhcVolumeGlsl({ encoding: source.encoding, params: source.params, normalAxes }),
+  };
+  let m = matrixWorld?.elements ?? matrixWorld;
+  if (!m && !isZhp && source.nodes?.length === 1) {
+    source.nodes[0].updateWorldMatrix?.(true, false);
+    m = source.nodes[0].matrixWorld.elements;
+  }
+  m = m ? Array.from(m) : [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+  out.matrixWorld = m;
+  out.worldToGrid = invertAffine(m);
+  if (THREE) {
+    const tex = new THREE.Data3DTexture(data, out.size[0], out.size[1], out.size[2]);
+    tex.format = THREE.RGBAIntegerFormat;
+    tex.type = THREE.UnsignedIntType;
+    tex.internalFormat = 'RGBA32UI';
+    tex.minFilter = tex.magFilter = THREE.NearestFilter;
+    tex.generateMipmaps = false;
+    tex.unpackAlignment = 1;
+    tex.needsUpdate = true;
+    out.texture = tex;
+    out.uniforms = {
+      zhcVolumeTex: { value: tex },
+      zhcVolume: { value: { origin: new THREE.Vector3(...origin), spacing: new THREE.Vector3(...spacing), counts: new THREE.Vector3(...counts) } },
+      // world -> grid frame for positions; normals: n_grid = M^T n_world (M = matrixWorld's 3x3).
+      zhcWorldToVolume: { value: new THREE.Matrix4().fromArray(out.worldToGrid) },
+      zhcWorldNormalToVolume: { value: new THREE.Matrix3().setFromMatrix4(new THREE.Matrix4().fromArray(m)).transpose() },
+    };
+  }
+  return out;
+}
+
+// A stock three.js material lit by the compact volume: onBeforeCompile adds pi E (three.js's
+// irradiance convention; BRDF_Lambert = albedo / pi makes a white Lambertian surface show E) at the
+// fragment's world position and normal, where three.js adds its light probes. The volume replaces
+// nothing else (add no LightProbeGrid for the same probes). compact = compactVolume(..., { THREE }).
+export function patchMaterialWithVolume(material, compact, THREE) {
+  if (!compact.uniforms) throw new Error('zhc compact volume: build it with compactVolume(source, { THREE })');
+  const begin = 'vec3 irradiance = getAmbientLightIrradiance( ambientLightColor );';
+  if (!THREE.ShaderChunk.lights_fragment_begin.includes(begin))
+    throw new Error('zhc compact volume: this three.js has no lights_fragment_begin irradiance line to patch');
+  const decl = `precision highp usampler3D;
+${compact.glsl}
+uniform highp usampler3D zhcVolumeTex;
+uniform ZhcVolume zhcVolume;
+uniform mat4 zhcWorldToVolume;
+uniform mat3 zhcWorldNormalToVolume;
+`;
+  const add = `${begin}
+	{
+		vec3 zhcWorldPos = ( ( vec4( geometryPosition, 1.0 ) - viewMatrix[ 3 ] ) * viewMatrix ).xyz;
+		vec3 zhcWorldNormal = transformNormalByInverseViewMatrix( geometryNormal, viewMatrix );
+		irradiance += PI * zhcVolumeIrradiance( zhcVolumeTex, zhcVolume, ( zhcWorldToVolume * vec4( zhcWorldPos, 1.0 ) ).xyz,
+			zhcWorldNormalToVolume * zhcWorldNormal );
+	}`;
+  const previous = material.onBeforeCompile;
+  material.onBeforeCompile = (shader, renderer) => {
+    previous?.call(material, shader, renderer);
+    Object.assign(shader.uniforms, compact.uniforms);
+    shader.fragmentShader = shader.fragmentShader
+      .replace('#include <lights_pars_begin>', `#include <lights_pars_begin>\n${decl}`)
+      .replace('#include <lights_fragment_begin>', THREE.ShaderChunk.lights_fragment_begin.replace(begin, add));
+  };
+  let h = 0x811c9dc5;  // FNV-1a of the chunk: one program per encoding and parameter set
+  for (let i = 0; i < compact.glsl.length; i++) h = Math.imul(h ^ compact.glsl.charCodeAt(i), 0x01000193) >>> 0;
+  const key = `zhc-compact-${h.toString(16)}`;
+  const previousKey = material.customProgramCacheKey?.bind(material);
+  material.customProgramCacheKey = () => `${previousKey ? previousKey() : ''}${key}`;
+  material.needsUpdate = true;
+  return material;
+}
+
+// parseZhp + compactVolume for a whole uncompressed .zhp file's bytes.
+export function compactVolumeFromZhp(bytes, options) { return compactVolume(parseZhp(bytes), options); }
