@@ -14,12 +14,22 @@
 // reported: mean, 95th percentile and max over N random points in the grid's box with random unit
 // normals (N = 100,000 by default, fixed seeds). Benchmarks never decide pass/fail.
 //
-// Usage: bench_volume [--samples N] [--gltf FILE] [--json FILE]
+// Sample cost (when built with glslangValidator, spirv-opt and spirv-dis): one HLSL compute kernel
+// per row that reads a position and a normal and writes the irradiance of one sample (packed rows:
+// zhc.hlsl's decode of the 8 corner probes, unrolled, no weight-0 skip; filterable rows: one
+// SampleLevel per texture at uvw = (clamp((p - origin) / spacing, 0, n - 1) + 0.5) / n, the
+// reconstruction, zhc_sh3_irradiance), HLSL -> SPIR-V (glslangValidator) -> spirv-opt -O, counted as
+// bench_runtime counts (function-body instructions), minus a skeleton kernel that writes p + n.
+//
+// Usage: bench_volume [--samples N] [--gltf FILE] [--json FILE] [--keep DIR]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <random>
 #include <string>
 #include <vector>
@@ -32,6 +42,8 @@
 #include "runtime/zhc_runtime.h"
 #include "runtime/zhc_volume_layouts.hpp"
 #include "timing.h"
+
+#include <unistd.h>
 
 namespace {
 
@@ -51,6 +63,9 @@ struct Stats {
 struct Row {
     std::string name, kind, textures;
     double bytes = 0;
+    int fetches = 0;       // texture fetches (filterable) or probe decodes (packed) per sample
+    int spirv = -1;        // SPIR-V instructions minus the skeleton; -1 not measured
+    std::string source;    // the HLSL kernel
     Stats err[2];
 };
 
@@ -82,18 +97,171 @@ Stats stats(std::vector<double> e) {
 
 double norm3(const double v[3]) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
+// ---- SPIR-V instruction counts ----------------------------------------------------------------
+
+const char* kKernelHead =
+    "[[vk::binding(1, 0)]] StructuredBuffer<float4> inputs;\n"
+    "[[vk::binding(2, 0)]] RWStructuredBuffer<float4> result;\n"
+    "[[vk::binding(3, 0)]] cbuffer Grid { float4 gOrigin; float4 gSpacing; uint4 gCounts; };\n";
+const char* kKernelMainHead =
+    "[numthreads(64, 1, 1)]\nvoid main(uint3 id : SV_DispatchThreadID)\n{\n"
+    "    float3 p = inputs[2u * id.x].xyz;\n    float3 nrm = inputs[2u * id.x + 1u].xyz;\n";
+const char* kKernelMainTail = "    result[id.x] = float4(e, 0.0f);\n}\n";
+
+std::string skeleton_kernel() {
+    return std::string(kKernelHead) + kKernelMainHead + "    float3 e = p + nrm;\n" + kKernelMainTail;
+}
+
+// Packed: the 8 corner probes decoded from the stored words and blended (zhc.hlsl), unrolled.
+std::string packed_kernel(int encoding) {
+    std::ostringstream s;
+    s << "[[vk::binding(0, 0)]] ByteAddressBuffer probeWords;\n#define ZHC_VOLUME_WORD(i) probeWords.Load(4u * (i))\n"
+         "#include \"zhc.hlsl\"\n"
+      << kKernelHead << kKernelMainHead
+      << "    const ZhcFormat f = zhc_default_format(" << encoding << "u);\n"
+         "    uint3 n = max(gCounts.xyz, uint3(1u, 1u, 1u));\n"
+         "    float3 t = (p - gOrigin.xyz) / gSpacing.xyz;\n"
+         "    t = float3(t.x >= 0.0f ? t.x : 0.0f, t.y >= 0.0f ? t.y : 0.0f, t.z >= 0.0f ? t.z : 0.0f);\n"
+         "    t = min(t, float3(n - 1u));\n"
+         "    uint3 i0 = min(uint3(t), max(n, uint3(2u, 2u, 2u)) - 2u);\n"
+         "    float3 fr = t - float3(i0);\n"
+         "    ZhcSH3 acc;\n"
+         "    [unroll] for (int i = 0; i < 9; ++i) acc.c[i] = float3(0.0f, 0.0f, 0.0f);\n"
+         "    [unroll] for (uint c = 0u; c < 8u; ++c)\n    {\n"
+         "        uint3 b = uint3(c & 1u, (c >> 1) & 1u, c >> 2);\n"
+         "        float w = (b.x != 0u ? fr.x : 1.0f - fr.x) * (b.y != 0u ? fr.y : 1.0f - fr.y) * (b.z != 0u ? fr.z : 1.0f - fr.z);\n"
+         "        uint3 q = i0 + b;\n"
+         "        ZhcSH3 s = zhc_volume_probe(q.x + n.x * (q.y + n.y * q.z), f);\n"
+         "        [unroll] for (int j = 0; j < 9; ++j) acc.c[j] += w * s.c[j];\n"
+         "    }\n"
+         "    float3 e = zhc_sh3_irradiance(acc, zhc_normalize_or_z(nrm));\n"
+      << kKernelMainTail;
+    return s.str();
+}
+
+std::string num(double v) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%.9g", v);
+    std::string r = b;
+    if (r.find_first_of(".e") == std::string::npos) r += ".0";
+    return r + "f";
+}
+
+// Filterable: one SampleLevel per texture, the reconstruction of zhc_layouts::reconstruct_sh3.
+std::string filter_kernel(L::Layout l) {
+    const auto tex = L::layout_textures(l);
+    std::ostringstream s;
+    s << "#include \"zhc.hlsl\"\n" << kKernelHead << "[[vk::binding(4, 0)]] SamplerState gSampler;\n";
+    for (std::size_t t = 0; t < tex.size(); ++t) s << "[[vk::binding(" << 5 + t << ", 0)]] Texture3D<float4> gT" << t << ";\n";
+    s << kKernelMainHead
+      << "    float3 n = float3(max(gCounts.xyz, uint3(1u, 1u, 1u)));\n"
+         "    float3 t = (p - gOrigin.xyz) / gSpacing.xyz;\n"
+         "    t = min(float3(t.x >= 0.0f ? t.x : 0.0f, t.y >= 0.0f ? t.y : 0.0f, t.z >= 0.0f ? t.z : 0.0f), n - 1.0f);\n"
+         "    float3 uvw = (t + 0.5f) / n;\n"
+         "    float v[36];\n";
+    for (std::size_t t = 0; t < tex.size(); ++t) {
+        s << "    { float4 x = gT" << t << ".SampleLevel(gSampler, uvw, 0.0f);";
+        for (int c = 0; c < 4; ++c) s << " v[" << 4 * t + static_cast<std::size_t>(c) << "] = x[" << c << "];";
+        s << " }\n";
+    }
+    s << "    ZhcSH3 sh;\n    [unroll] for (int i = 0; i < 9; ++i) sh.c[i] = float3(0.0f, 0.0f, 0.0f);\n";
+    const std::string lum = "float3(" + num(L::kLumW[0]) + ", " + num(L::kLumW[1]) + ", " + num(L::kLumW[2]) + ")";
+    auto unit_to_ratio = [&](int i, const std::string& u) {
+        double lo, hi;
+        L::ratio_interval(i, &lo, &hi);
+        return "(" + u + " * " + num((hi - lo) / 2) + " + " + num((hi + lo) / 2) + ")";
+    };
+    auto slot3 = [](int a) { return "float3(v[" + std::to_string(a) + "], v[" + std::to_string(a + 1) + "], v[" + std::to_string(a + 2) + "])"; };
+    switch (l) {
+        case L::Layout::kSh3F32:
+        case L::Layout::kSh3F16:
+        case L::Layout::kSh2F16:
+        case L::Layout::kSh2L2LumF16:
+            for (int i = 0; i < (l == L::Layout::kSh3F32 || l == L::Layout::kSh3F16 ? 9 : 4); ++i)
+                s << "    sh.c[" << i << "] = " << slot3(3 * i) << ";\n";
+            if (l == L::Layout::kSh2L2LumF16) {
+                s << "    float y0 = dot(" << lum << ", sh.c[0]);\n    float3 scale = y0 > 0.0f ? sh.c[0] / y0 : float3(0.0f, 0.0f, 0.0f);\n";
+                for (int i = 4; i < 9; ++i) s << "    sh.c[" << i << "] = v[" << 12 + i - 4 << "] * scale;\n";
+            }
+            break;
+        case L::Layout::kRatio8:
+            s << "    sh.c[0] = " << slot3(0) << ";\n";
+            for (int i = 1; i < 9; ++i) s << "    sh.c[" << i << "] = " << unit_to_ratio(i, slot3(4 + (i - 1) * 3)) << " * sh.c[0];\n";
+            break;
+        case L::Layout::kSh3Rgb9e5:
+        case L::Layout::kSh2Rgb9e5:
+        case L::Layout::kSh2Rgb9e5L2Lum:
+            s << "    sh.c[0] = " << slot3(0) << ";\n";
+            for (int i = 1; i < (l == L::Layout::kSh3Rgb9e5 ? 9 : 4); ++i)
+                s << "    sh.c[" << i << "] = " << slot3(4 * i) << " - " << num(L::offset(i)) << " * sh.c[0];\n";
+            if (l == L::Layout::kSh2Rgb9e5L2Lum) {
+                s << "    float y0 = dot(" << lum << ", sh.c[0]);\n    float3 scale = y0 > 0.0f ? sh.c[0] / y0 : float3(0.0f, 0.0f, 0.0f);\n";
+                for (int i = 4; i < 9; ++i)
+                    s << "    sh.c[" << i << "] = (v[" << (i < 7 ? 16 + i - 4 : 20 + i - 7) << "] - " << num(L::offset(i)) << " * y0) * scale;\n";
+            }
+            break;
+    }
+    s << "    float3 e = zhc_sh3_irradiance(sh, zhc_normalize_or_z(nrm));\n" << kKernelMainTail;
+    return s.str();
+}
+
+#ifdef ZHC_GLSLANG
+bool run(const std::string& command) {
+    const int rc = std::system(command.c_str());
+    if (rc != 0) std::fprintf(stderr, "failed (%d): %s\n", rc, command.c_str());
+    return rc == 0;
+}
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+// HLSL -> SPIR-V -> spirv-opt -O -> function-body instructions of the disassembly (-1: failed).
+int spirv_instructions(const std::string& dir, const std::string& name, const std::string& source) {
+    const std::string hlsl = dir + "/" + name + ".hlsl", raw = dir + "/" + name + ".spv", opt = dir + "/" + name + ".opt.spv",
+                      dis = dir + "/" + name + ".opt.spvasm";
+    std::ofstream(hlsl) << source;
+    if (!run(quote(ZHC_GLSLANG) + " -D -V -S comp -e main -I" + quote(ZHC_RUNTIME_DIR) + " " + quote(hlsl) + " -o " + quote(raw) +
+             " > " + quote(dir + "/" + name + ".log") + " 2>&1"))
+        return -1;
+    if (!run(quote(ZHC_SPIRV_OPT) + " -O " + quote(raw) + " -o " + quote(opt))) return -1;
+    if (!run(quote(ZHC_SPIRV_DIS) + " --no-header " + quote(opt) + " -o " + quote(dis))) return -1;
+    std::ifstream in(dis);
+    std::string line;
+    bool inside = false;
+    int count = 0;
+    while (std::getline(in, line)) {
+        auto has = [&](const char* op) {
+            const std::size_t q = line.find(op);
+            if (q == std::string::npos) return false;
+            const std::size_t e = q + std::strlen(op);
+            return e == line.size() || line[e] == ' ';
+        };
+        if (has("OpFunction")) {
+            inside = true;
+            continue;
+        }
+        if (has("OpFunctionEnd")) {
+            inside = false;
+            continue;
+        }
+        if (!inside || has("OpFunctionParameter") || has("OpLabel")) continue;
+        if (line.find_first_not_of(' ') != std::string::npos) ++count;
+    }
+    return count;
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
     int samples = 100000;
-    std::string json, gltf = ZHC_GLTF_SCENE;
+    std::string json, keep, gltf = ZHC_GLTF_SCENE;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--samples" && i + 1 < argc) samples = std::max(100, std::atoi(argv[++i]));
         else if (a == "--gltf" && i + 1 < argc) gltf = argv[++i];
         else if (a == "--json" && i + 1 < argc) json = argv[++i];
+        else if (a == "--keep" && i + 1 < argc) keep = argv[++i];
         else {
-            std::fprintf(stderr, "usage: %s [--samples N] [--gltf FILE] [--json FILE]\n", argv[0]);
+            std::fprintf(stderr, "usage: %s [--samples N] [--gltf FILE] [--json FILE] [--keep DIR]\n", argv[0]);
             return 2;
         }
     }
@@ -134,6 +302,8 @@ int main(int argc, char** argv) {
         r.kind = "integer texture, 8-probe decode + blend in the shader";
         r.textures = "stored bytes";
         r.bytes = double(find_codec(p)->size_bytes);
+        r.fetches = 8;
+        r.source = packed_kernel(zhc_encoding_from_name(p));
         rows.push_back(r);
     }
     for (L::Layout l : L::kAllLayouts) {
@@ -149,6 +319,8 @@ int main(int argc, char** argv) {
             r.textures += std::to_string(j - i) + " " + L::storage_name(t[i].storage, t[i].components);
             i = j;
         }
+        r.fetches = static_cast<int>(t.size());
+        r.source = filter_kernel(l);
         rows.push_back(r);
     }
 
@@ -203,12 +375,29 @@ int main(int argc, char** argv) {
                     ref.counts[2], samples, mean_ref);
     }
 
+#ifdef ZHC_GLSLANG
+    {
+        namespace fs = std::filesystem;
+        const fs::path dir = keep.empty() ? fs::temp_directory_path() / ("zhc_bench_volume_" + std::to_string(::getpid())) : fs::path(keep);
+        fs::create_directories(dir);
+        const int skeleton = spirv_instructions(dir.string(), "skeleton", skeleton_kernel());
+        for (Row& r : rows) {
+            const int c = spirv_instructions(dir.string(), r.name, r.source);
+            r.spirv = c >= 0 && skeleton >= 0 ? c - skeleton : -1;
+        }
+        if (keep.empty()) fs::remove_all(dir);
+    }
+#else
+    if (!keep.empty()) std::fprintf(stderr, "--keep: built without glslangValidator / spirv-opt / spirv-dis: no SPIR-V counts\n");
+#endif
     std::printf("\nerror of one sample vs the exact trilinear SH3 volume: |dE| / mean |E_ref| (demo | gltf)\n");
-    std::printf("%-22s %6s  %-34s %10s %10s %10s | %10s %10s %10s\n", "layout", "B/probe", "textures", "mean", "p95", "max", "mean",
-                "p95", "max");
+    std::printf("fetches: texture samples (filterable) or probe decodes (packed) per sample; SPIR-V: instructions after\n"
+                "spirv-opt -O minus the skeleton kernel's (-1: not measured)\n\n");
+    std::printf("%-22s %6s  %-26s %7s %6s %10s %10s %10s | %10s %10s %10s\n", "layout", "B/probe", "textures", "fetches", "SPIR-V",
+                "mean", "p95", "max", "mean", "p95", "max");
     for (const Row& r : rows)
-        std::printf("%-22s %6.0f  %-34s %10.3g %10.3g %10.3g | %10.3g %10.3g %10.3g\n", r.name.c_str(), r.bytes, r.textures.c_str(),
-                    r.err[0].mean, r.err[0].p95, r.err[0].max, r.err[1].mean, r.err[1].p95, r.err[1].max);
+        std::printf("%-22s %6.0f  %-26s %7d %6d %10.3g %10.3g %10.3g | %10.3g %10.3g %10.3g\n", r.name.c_str(), r.bytes, r.textures.c_str(),
+                    r.fetches, r.spirv, r.err[0].mean, r.err[0].p95, r.err[0].max, r.err[1].mean, r.err[1].p95, r.err[1].max);
     if (!json.empty()) {
         std::ofstream out(json);
         out << "{\n  \"benchmark\": \"volume\",\n  \"samples\": " << samples << ",\n  \"grids\": [\"demo\", \"" << gltf
@@ -217,10 +406,11 @@ int main(int argc, char** argv) {
             const Row& r = rows[i];
             char buf[768];
             std::snprintf(buf, sizeof buf,
-                          "    {\"layout\": \"%s\", \"kind\": \"%s\", \"textures\": \"%s\", \"bytes_per_probe\": %g, "
+                          "    {\"layout\": \"%s\", \"kind\": \"%s\", \"textures\": \"%s\", \"bytes_per_probe\": %g, \"fetches\": %d, "
+                          "\"spirv_instructions_minus_skeleton\": %d, "
                           "\"demo\": {\"mean\": %.6g, \"p95\": %.6g, \"max\": %.6g}, "
                           "\"gltf\": {\"mean\": %.6g, \"p95\": %.6g, \"max\": %.6g}}%s\n",
-                          r.name.c_str(), r.kind.c_str(), r.textures.c_str(), r.bytes, r.err[0].mean, r.err[0].p95, r.err[0].max,
+                          r.name.c_str(), r.kind.c_str(), r.textures.c_str(), r.bytes, r.fetches, r.spirv, r.err[0].mean, r.err[0].p95, r.err[0].max,
                           r.err[1].mean, r.err[1].p95, r.err[1].max, i + 1 < rows.size() ? "," : "");
             out << buf;
         }
