@@ -176,6 +176,7 @@ std::string filter_kernel(L::Layout l) {
         case L::Layout::kSh3F32:
         case L::Layout::kSh3F16:
         case L::Layout::kSh2F16:
+        case L::Layout::kSh2L2GreyF16:
         case L::Layout::kSh2L2LumF16:
             for (int i = 0; i < (l == L::Layout::kSh3F32 || l == L::Layout::kSh3F16 ? 9 : 4); ++i)
                 s << "    sh.c[" << i << "] = " << slot3(3 * i) << ";\n";
@@ -183,6 +184,8 @@ std::string filter_kernel(L::Layout l) {
                 s << "    float y0 = dot(" << lum << ", sh.c[0]);\n    float3 scale = y0 > 0.0f ? sh.c[0] / y0 : float3(0.0f, 0.0f, 0.0f);\n";
                 for (int i = 4; i < 9; ++i) s << "    sh.c[" << i << "] = v[" << 12 + i - 4 << "] * scale;\n";
             }
+            if (l == L::Layout::kSh2L2GreyF16)
+                for (int i = 4; i < 9; ++i) s << "    sh.c[" << i << "] = v[" << 12 + i - 4 << "].xxx;\n";
             break;
         case L::Layout::kRatio8:
             s << "    sh.c[0] = " << slot3(0) << ";\n";

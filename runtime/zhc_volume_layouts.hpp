@@ -43,15 +43,17 @@ enum class Layout {
     kSh3F32,       // 27 SH3 floats in 7 RGBA32F (three.js's float atlas): 112 B, exact up to float
     kSh3F16,       // the same in 7 RGBA16F (three.js's binary16 atlas): 56 B
     kSh2F16,       // L0 + L1 RGB (12 floats) in 3 RGBA16F: 24 B
-    kSh2L2LumF16,  // L0 + L1 RGB in 3 RGBA16F + L2 of the luminance (5 floats) in 2 RGBA16F: 40 B
+    kSh2L2GreyF16,  // L0 + L1 RGB in 3 RGBA16F + L2 of the luminance (5 floats) in 2 RGBA16F, added to every
+                    // channel unscaled (three.js PR #33125's "L1 color + L2 greyscale"): 40 B
+    kSh2L2LumF16,  // the same textures, L2 scaled per channel by the colour of the DC (L2_Y c_0k / Y_0): 40 B
     kRatio8,       // L0 RGB in RGBA16F + the 24 ratios c_ik / c_0k in 6 RGBA8_SNORM: 32 B (ratios filtered: biased)
     kSh3Rgb9e5,    // zhc: coefficient i of the 3 channels + offset_i L0 (>= 0) in RGB9_E5 texture i, 9 textures: 36 B
     kSh2Rgb9e5,    // zhc: the same for L0 + L1, 4 RGB9_E5: 16 B
     kSh2Rgb9e5L2Lum,  // zhc: 4 RGB9_E5 (L0 + L1) + L2 of the luminance + offset_i L0_Y in 2 RGB9_E5: 24 B
 };
-constexpr Layout kAllLayouts[] = {Layout::kSh3F32,     Layout::kSh3F16,     Layout::kSh2F16,
-                                  Layout::kSh2L2LumF16, Layout::kRatio8,     Layout::kSh3Rgb9e5,
-                                  Layout::kSh2Rgb9e5,  Layout::kSh2Rgb9e5L2Lum};
+constexpr Layout kAllLayouts[] = {Layout::kSh3F32,      Layout::kSh3F16,   Layout::kSh2F16,    Layout::kSh2L2GreyF16,
+                                  Layout::kSh2L2LumF16, Layout::kRatio8,   Layout::kSh3Rgb9e5, Layout::kSh2Rgb9e5,
+                                  Layout::kSh2Rgb9e5L2Lum};
 
 struct TextureSpec {
     Storage storage;
@@ -68,6 +70,7 @@ inline const char* layout_name(Layout l) {
         case Layout::kSh3F32: return "sh3_rgba32f";
         case Layout::kSh3F16: return "sh3_rgba16f";
         case Layout::kSh2F16: return "sh2_rgba16f";
+        case Layout::kSh2L2GreyF16: return "sh2_l2grey_rgba16f";
         case Layout::kSh2L2LumF16: return "sh2_l2lum_rgba16f";
         case Layout::kRatio8: return "ratio8";
         case Layout::kSh3Rgb9e5: return "sh3_rgb9e5";
@@ -83,6 +86,7 @@ inline std::vector<TextureSpec> layout_textures(Layout l) {
         case Layout::kSh3F32: return std::vector<TextureSpec>(7, TextureSpec{Storage::kF32, 4});
         case Layout::kSh3F16: return std::vector<TextureSpec>(7, h4);
         case Layout::kSh2F16: return {h4, h4, h4};
+        case Layout::kSh2L2GreyF16:
         case Layout::kSh2L2LumF16: return {h4, h4, h4, h4, h4};
         case Layout::kRatio8: return {h4, s4, s4, s4, s4, s4, s4};
         case Layout::kSh3Rgb9e5: return std::vector<TextureSpec>(9, e3);
@@ -204,6 +208,7 @@ inline void probe_values(Layout l, const float sh[27], double out[kSlots]) {
         case Layout::kSh2F16:
             for (int j = 0; j < 12; ++j) out[j] = sh[j];
             return;
+        case Layout::kSh2L2GreyF16:
         case Layout::kSh2L2LumF16:
             for (int j = 0; j < 12; ++j) out[j] = sh[j];
             for (int i = 4; i < 9; ++i) out[12 + i - 4] = lum(i);
@@ -237,6 +242,11 @@ inline void reconstruct_sh3(Layout l, const double v[kSlots], double sh[27]) {
             return;
         case Layout::kSh2F16:
             for (int j = 0; j < 12; ++j) sh[j] = v[j];
+            return;
+        case Layout::kSh2L2GreyF16:
+            for (int j = 0; j < 12; ++j) sh[j] = v[j];
+            for (int i = 4; i < 9; ++i)
+                for (int k = 0; k < 3; ++k) sh[i * 3 + k] = v[12 + i - 4];
             return;
         case Layout::kSh2L2LumF16: {
             for (int j = 0; j < 12; ++j) sh[j] = v[j];

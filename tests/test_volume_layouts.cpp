@@ -248,7 +248,7 @@ TEST(VolumeLayouts, LinearLayoutsReconstructTheirCoefficientsBeforeRounding) {
         float grey[27];
         for (int i = 0; i < 9; ++i)
             for (int k = 0; k < 3; ++k) grey[i * 3 + k] = sh[i][1];
-        for (L::Layout l : {L::Layout::kSh2L2LumF16, L::Layout::kSh2Rgb9e5L2Lum}) {
+        for (L::Layout l : {L::Layout::kSh2L2GreyF16, L::Layout::kSh2L2LumF16, L::Layout::kSh2Rgb9e5L2Lum}) {
             double v[L::kSlots], out[27];
             L::probe_values(l, grey, v);
             L::reconstruct_sh3(l, v, out);
@@ -308,13 +308,15 @@ double mean_error(const zhc_volume& ref, L::Layout l) {
 }
 
 // The headline of docs/runtime.md's table: zhc's RGB9_E5 layouts beat three.js's half layouts
-// (b) sh3_rgba16f, (c) sh2_rgba16f, (d) sh2_l2lum_rgba16f in error per GPU byte.
+// (b) sh3_rgba16f, (c) sh2_rgba16f, (d) sh2_l2grey_rgba16f (and its luminance-scaled variant) in
+// error per GPU byte.
 TEST(VolumeLayouts, Rgb9e5LayoutsBeatTheHalfLayoutsPerByte) {
     for (const Baked& b : {demo_grid(), gltf_grid()}) {
         OwnedVolume vol(b.probes, b.layout);
         ASSERT_NE(vol.v.probes, nullptr);
         using LL = L::Layout;
-        const double e_b = mean_error(vol.v, LL::kSh3F16), e_c = mean_error(vol.v, LL::kSh2F16), e_d = mean_error(vol.v, LL::kSh2L2LumF16);
+        const double e_b = mean_error(vol.v, LL::kSh3F16), e_c = mean_error(vol.v, LL::kSh2F16), e_d = mean_error(vol.v, LL::kSh2L2GreyF16),
+                     e_d_lum = mean_error(vol.v, LL::kSh2L2LumF16);
         const double e_full = mean_error(vol.v, LL::kSh3Rgb9e5), e_l1 = mean_error(vol.v, LL::kSh2Rgb9e5),
                      e_lum = mean_error(vol.v, LL::kSh2Rgb9e5L2Lum), e_ratio = mean_error(vol.v, LL::kRatio8);
         // Full colour L2 in 36 bytes: below (d)'s error at fewer bytes, within 0.5% of the exact volume,
@@ -322,13 +324,16 @@ TEST(VolumeLayouts, Rgb9e5LayoutsBeatTheHalfLayoutsPerByte) {
         EXPECT_LT(L::layout_bytes_per_probe(LL::kSh3Rgb9e5), L::layout_bytes_per_probe(LL::kSh2L2LumF16));
         EXPECT_LT(L::layout_bytes_per_probe(LL::kSh3Rgb9e5), L::layout_bytes_per_probe(LL::kSh3F16));
         EXPECT_LT(e_full, e_d);
+        EXPECT_LT(e_full, e_d_lum);
         EXPECT_LT(e_full, 5e-3);
         EXPECT_LT(e_b, e_full);  // half floats are the more precise: (b) keeps its place at 56 bytes
         // The same error as (c) and (d) (within 25%) at 2/3 and 3/5 of their bytes.
         EXPECT_LT(L::layout_bytes_per_probe(LL::kSh2Rgb9e5), L::layout_bytes_per_probe(LL::kSh2F16));
         EXPECT_LT(L::layout_bytes_per_probe(LL::kSh2Rgb9e5L2Lum), L::layout_bytes_per_probe(LL::kSh2L2LumF16));
         EXPECT_LT(e_l1, 1.25 * e_c);
-        EXPECT_LT(e_lum, 1.25 * e_d);
+        // Within 25% of the better of the two 40-byte luminance-L2 half layouts (grey wins on the demo
+        // grid, 0.047 vs 0.054; luminance-scaled on the glTF scene, 0.0037 vs 0.037).
+        EXPECT_LT(e_lum, 1.25 * std::min(e_d, e_d_lum));
         // Filtering ratios is not filtering the SH: the 8-bit ratio layout is worse than RGB9_E5 at 32 bytes.
         EXPECT_GT(e_ratio, 3 * e_full);
     }
