@@ -42,6 +42,11 @@
 #include "runtime/zhc_runtime.h"
 #include "runtime/zhc_volume_layouts.hpp"
 #include "timing.h"
+#ifdef ZHC_VK_TIMING
+#include <vulkan/vulkan.h>
+
+#include "vk_compute.h"
+#endif
 
 #include <unistd.h>
 
@@ -66,6 +71,11 @@ struct Row {
     int fetches = 0;       // texture fetches (filterable) or probe decodes (packed) per sample
     int spirv = -1;        // SPIR-V instructions minus the skeleton; -1 not measured
     std::string source;    // the HLSL kernel
+    std::vector<std::uint32_t> spv;  // its optimised SPIR-V
+    bool filtered = false;
+    L::Layout layout = L::Layout::kSh3F32;
+    double ns = NAN;         // lavapipe ns per sample; NAN not measured
+    double vs_model = NAN;   // max |GPU - CPU model| / mean |model| over the timed samples
     Stats err[2];
 };
 
@@ -102,10 +112,12 @@ double norm3(const double v[3]) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v
 const char* kKernelHead =
     "[[vk::binding(1, 0)]] StructuredBuffer<float4> inputs;\n"
     "[[vk::binding(2, 0)]] RWStructuredBuffer<float4> result;\n"
-    "[[vk::binding(3, 0)]] cbuffer Grid { float4 gOrigin; float4 gSpacing; uint4 gCounts; };\n";
+    "[[vk::binding(3, 0)]] StructuredBuffer<float4> grid;\n"
+    "#define gOrigin grid[0]\n#define gSpacing grid[1]\n#define gCounts asuint(grid[2])\n";
 const char* kKernelMainHead =
     "[numthreads(64, 1, 1)]\nvoid main(uint3 id : SV_DispatchThreadID)\n{\n"
-    "    float3 p = inputs[2u * id.x].xyz;\n    float3 nrm = inputs[2u * id.x + 1u].xyz;\n";
+    "    uint si = id.x & 65535u;\n"
+    "    float3 p = inputs[2u * si].xyz;\n    float3 nrm = inputs[2u * si + 1u].xyz;\n";
 const char* kKernelMainTail = "    result[id.x] = float4(e, 0.0f);\n}\n";
 
 std::string skeleton_kernel() {
@@ -216,8 +228,10 @@ bool run(const std::string& command) {
 }
 std::string quote(const std::string& s) { return "'" + s + "'"; }
 
-// HLSL -> SPIR-V -> spirv-opt -O -> function-body instructions of the disassembly (-1: failed).
-int spirv_instructions(const std::string& dir, const std::string& name, const std::string& source) {
+// HLSL -> SPIR-V -> spirv-opt -O -> function-body instructions of the disassembly (-1: failed);
+// the optimised binary in *words when given.
+int spirv_instructions(const std::string& dir, const std::string& name, const std::string& source,
+                       std::vector<std::uint32_t>* words = nullptr) {
     const std::string hlsl = dir + "/" + name + ".hlsl", raw = dir + "/" + name + ".spv", opt = dir + "/" + name + ".opt.spv",
                       dis = dir + "/" + name + ".opt.spvasm";
     std::ofstream(hlsl) << source;
@@ -248,6 +262,11 @@ int spirv_instructions(const std::string& dir, const std::string& name, const st
         if (!inside || has("OpFunctionParameter") || has("OpLabel")) continue;
         if (line.find_first_not_of(' ') != std::string::npos) ++count;
     }
+#ifdef ZHC_VK_TIMING
+    if (words) *words = vk::read_spirv(opt);
+#else
+    (void)words;
+#endif
     return count;
 }
 #endif
@@ -297,7 +316,8 @@ int main(int argc, char** argv) {
         grids.push_back({"gltf", *baked, probe_layout(scene->probes)});
     }
 
-    const char* packed[] = {"zh3_q16", "sh2_q", "sh3_q28"};
+    const char* packed[] = {"sh3", "zh3_q16", "sh2_q", "sh3_q28"};
+    std::string device;
     std::vector<Row> rows;
     for (const char* p : packed) {
         Row r;
@@ -324,6 +344,8 @@ int main(int argc, char** argv) {
         }
         r.fetches = static_cast<int>(t.size());
         r.source = filter_kernel(l);
+        r.filtered = true;
+        r.layout = l;
         rows.push_back(r);
     }
 
@@ -385,7 +407,7 @@ int main(int argc, char** argv) {
         fs::create_directories(dir);
         const int skeleton = spirv_instructions(dir.string(), "skeleton", skeleton_kernel());
         for (Row& r : rows) {
-            const int c = spirv_instructions(dir.string(), r.name, r.source);
+            const int c = spirv_instructions(dir.string(), r.name, r.source, &r.spv);
             r.spirv = c >= 0 && skeleton >= 0 ? c - skeleton : -1;
         }
         if (keep.empty()) fs::remove_all(dir);
@@ -393,27 +415,147 @@ int main(int argc, char** argv) {
 #else
     if (!keep.empty()) std::fprintf(stderr, "--keep: built without glslangValidator / spirv-opt / spirv-dis: no SPIR-V counts\n");
 #endif
+#ifdef ZHC_VK_TIMING
+    // lavapipe: every kernel on the demo grid, 65,536 distinct samples, 2^18 invocations per
+    // dispatch, median of 9 after a warm-up round, kernels in interleaved rounds.
+    {
+        if (std::strlen(ZHC_LVP_ICD) > 0) vk::force_icd(ZHC_LVP_ICD);
+        std::string error;
+        auto context = vk::Context::create(true, &error);
+        if (!context) {
+            std::fprintf(stderr, "Vulkan: %s (no lavapipe timing)\n", error.c_str());
+        } else {
+            device = context->device_name();
+            const Grid& g = grids[0];
+            std::vector<std::uint8_t> ref_bytes;
+            zhc_volume ref;
+            zhc_probe_format ref_fmt;
+            if (!encode(g, "sh3", &ref_bytes, &ref, &ref_fmt)) return 1;
+            constexpr std::uint32_t kSamples = 65536, kEvals = 1u << 18;
+            constexpr int kRepeats = 9;
+            std::vector<float> inputs(kSamples * 8);
+            std::mt19937_64 rng(99);
+            std::uniform_real_distribution<double> u(0.0, 1.0);
+            std::normal_distribution<double> gauss;
+            for (std::uint32_t i = 0; i < kSamples; ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    inputs[8 * i + static_cast<std::uint32_t>(c)] =
+                        static_cast<float>(ref.origin[c] + u(rng) * ref.spacing[c] * double(ref.counts[c] - 1));
+                    inputs[8 * i + 4 + static_cast<std::uint32_t>(c)] = static_cast<float>(gauss(rng));
+                }
+            }
+            float grid_buf[12] = {};
+            for (int c = 0; c < 3; ++c) {
+                grid_buf[c] = static_cast<float>(ref.origin[c]);
+                grid_buf[4 + c] = static_cast<float>(ref.spacing[c]);
+                std::memcpy(&grid_buf[8 + c], &ref.counts[c], 4);
+            }
+            struct Timed {
+                Row* row;
+                std::unique_ptr<vk::Kernel> kernel;
+                std::vector<double> seconds;
+                zhc_volume vol{};
+                std::vector<std::uint8_t> bytes;
+                std::vector<std::vector<std::uint8_t>> tex;
+            };
+            std::vector<Timed> timed;
+            timed.reserve(rows.size());
+            for (Row& r : rows) {
+                if (r.spv.empty()) continue;
+                Timed t;
+                t.row = &r;
+                std::vector<vk::Image3D> images;
+                if (r.filtered) {
+                    t.tex = L::volume_textures(ref, r.layout);
+                    const auto spec = L::layout_textures(r.layout);
+                    for (std::size_t i = 0; i < spec.size(); ++i) {
+                        VkFormat f = VK_FORMAT_E5B9G9R9_UFLOAT_PACK32;
+                        if (spec[i].storage == L::Storage::kF32) f = VK_FORMAT_R32G32B32A32_SFLOAT;
+                        if (spec[i].storage == L::Storage::kF16) f = VK_FORMAT_R16G16B16A16_SFLOAT;
+                        if (spec[i].storage == L::Storage::kSnorm8) f = spec[i].components == 4 ? VK_FORMAT_R8G8B8A8_SNORM : VK_FORMAT_R8_SNORM;
+                        images.push_back({static_cast<std::uint32_t>(f), ref.counts[0], ref.counts[1], ref.counts[2], t.tex[i]});
+                    }
+                } else {
+                    zhc_probe_format fmt;
+                    if (!encode(g, r.name.c_str(), &t.bytes, &t.vol, &fmt)) return 1;
+                }
+                const std::size_t sizes[4] = {std::max<std::size_t>(16, t.bytes.size()), inputs.size() * 4, std::size_t(kEvals) * 16,
+                                              sizeof grid_buf};
+                t.kernel = context->make_kernel(r.spv, sizes, images, &error);
+                if (!t.kernel) {
+                    std::fprintf(stderr, "%s: %s\n", r.name.c_str(), error.c_str());
+                    continue;
+                }
+                if (!t.bytes.empty()) std::memcpy(t.kernel->data(0), t.bytes.data(), t.bytes.size());
+                std::memcpy(t.kernel->data(1), inputs.data(), inputs.size() * 4);
+                std::memcpy(t.kernel->data(3), grid_buf, sizeof grid_buf);
+                timed.push_back(std::move(t));
+            }
+            for (int rep = 0; rep <= kRepeats; ++rep)
+                for (Timed& t : timed) {
+                    if (!t.kernel) continue;
+                    const double sec = t.kernel->dispatch(kEvals / 64, &error);
+                    if (sec < 0) {
+                        std::fprintf(stderr, "%s: %s\n", t.row->name.c_str(), error.c_str());
+                        t.kernel.reset();
+                        continue;
+                    }
+                    if (rep > 0) t.seconds.push_back(sec);
+                }
+            for (Timed& t : timed) {
+                if (!t.kernel || t.seconds.empty()) continue;
+                std::sort(t.seconds.begin(), t.seconds.end());
+                t.row->ns = t.seconds[t.seconds.size() / 2] / double(kEvals) * 1e9;
+                // The GPU's results against the CPU model at the same (float) inputs.
+                const float* out = reinterpret_cast<const float*>(t.kernel->data(2));
+                double worst = 0, mag = 0;
+                for (std::uint32_t i = 0; i < kSamples; ++i) {
+                    double pd[3], nd[3], e[3];
+                    for (int c = 0; c < 3; ++c) {
+                        pd[c] = inputs[8 * i + static_cast<std::uint32_t>(c)];
+                        nd[c] = inputs[8 * i + 4 + static_cast<std::uint32_t>(c)];
+                    }
+                    if (t.row->filtered) L::sample_irradiance(ref, t.row->layout, t.tex, pd, nd, e);
+                    else zhc_volume_irradiance_d(&t.vol, pd, nd, e);
+                    const double d[3] = {out[4 * i] - e[0], out[4 * i + 1] - e[1], out[4 * i + 2] - e[2]};
+                    worst = std::max(worst, norm3(d));
+                    mag += norm3(e) / kSamples;
+                }
+                t.row->vs_model = worst / mag;
+            }
+            timed.clear();  // kernels before the context
+        }
+    }
+#endif
     std::printf("\nerror of one sample vs the exact trilinear SH3 volume: |dE| / mean |E_ref| (demo | gltf)\n");
     std::printf("fetches: texture samples (filterable) or probe decodes (packed) per sample; SPIR-V: instructions after\n"
                 "spirv-opt -O minus the skeleton kernel's (-1: not measured)\n\n");
-    std::printf("%-22s %6s  %-26s %7s %6s %10s %10s %10s | %10s %10s %10s\n", "layout", "B/probe", "textures", "fetches", "SPIR-V",
-                "mean", "p95", "max", "mean", "p95", "max");
+    double base_ns = NAN;
     for (const Row& r : rows)
-        std::printf("%-22s %6.0f  %-26s %7d %6d %10.3g %10.3g %10.3g | %10.3g %10.3g %10.3g\n", r.name.c_str(), r.bytes, r.textures.c_str(),
-                    r.fetches, r.spirv, r.err[0].mean, r.err[0].p95, r.err[0].max, r.err[1].mean, r.err[1].p95, r.err[1].max);
+        if (r.name == "sh3") base_ns = r.ns;
+    std::printf("lavapipe: ns per sample on the demo grid (median of 9 dispatches of 2^18), vs sh3: ratio to the packed sh3\n"
+                "row; GPU-model: max |GPU - CPU model| / mean |E| (NaN: not measured)\n\n");
+    std::printf("%-22s %6s  %-26s %7s %6s %10s %10s %10s | %10s %10s %10s %8s %6s %9s\n", "layout", "B/probe", "textures", "fetches",
+                "SPIR-V", "mean", "p95", "max", "mean", "p95", "max", "ns", "vs sh3", "GPU-model");
+    for (const Row& r : rows)
+        std::printf("%-22s %6.0f  %-26s %7d %6d %10.3g %10.3g %10.3g | %10.3g %10.3g %10.3g %8.1f %6.2f %9.2g\n", r.name.c_str(), r.bytes,
+                    r.textures.c_str(), r.fetches, r.spirv, r.err[0].mean, r.err[0].p95, r.err[0].max, r.err[1].mean, r.err[1].p95,
+                    r.err[1].max, r.ns, r.ns / base_ns, r.vs_model);
     if (!json.empty()) {
         std::ofstream out(json);
-        out << "{\n  \"benchmark\": \"volume\",\n  \"samples\": " << samples << ",\n  \"grids\": [\"demo\", \"" << gltf
+        out << "{\n  \"benchmark\": \"volume\",\n  \"device\": \"" << device << "\",\n  \"samples\": " << samples << ",\n  \"grids\": [\"demo\", \"" << gltf
             << "\"],\n  \"rows\": [\n";
         for (std::size_t i = 0; i < rows.size(); ++i) {
             const Row& r = rows[i];
-            char buf[768];
+            char buf[1024];
             std::snprintf(buf, sizeof buf,
                           "    {\"layout\": \"%s\", \"kind\": \"%s\", \"textures\": \"%s\", \"bytes_per_probe\": %g, \"fetches\": %d, "
-                          "\"spirv_instructions_minus_skeleton\": %d, "
+                          "\"spirv_instructions_minus_skeleton\": %d, \"lavapipe_ns_per_sample\": %.4g, "
+                          "\"ratio_to_sh3\": %.4g, \"gpu_vs_model\": %.4g, "
                           "\"demo\": {\"mean\": %.6g, \"p95\": %.6g, \"max\": %.6g}, "
                           "\"gltf\": {\"mean\": %.6g, \"p95\": %.6g, \"max\": %.6g}}%s\n",
-                          r.name.c_str(), r.kind.c_str(), r.textures.c_str(), r.bytes, r.fetches, r.spirv, r.err[0].mean, r.err[0].p95, r.err[0].max,
+                          r.name.c_str(), r.kind.c_str(), r.textures.c_str(), r.bytes, r.fetches, r.spirv, std::isfinite(r.ns) ? r.ns : -1.0,
+                          std::isfinite(r.ns / base_ns) ? r.ns / base_ns : -1.0, std::isfinite(r.vs_model) ? r.vs_model : -1.0, r.err[0].mean, r.err[0].p95, r.err[0].max,
                           r.err[1].mean, r.err[1].p95, r.err[1].max, i + 1 < rows.size() ? "," : "");
             out << buf;
         }
