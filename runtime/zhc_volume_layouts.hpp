@@ -5,18 +5,19 @@
 //
 // Header-only C++17 on top of zhc_runtime.h. A layout is a list of textures of counts[0] x
 // counts[1] x counts[2] texels (texel (x, y, z) = probe (x, y, z), row-major x fastest: the order a
-// glTexImage3D / vkCmdCopyBufferToImage upload takes), each with 1 or 4 components stored as
-// float32, binary16 (half) or 8-bit SNORM. Every stored value is a LINEAR function of the probe's
-// decoded SH3 (coefficients, or coefficient / DC ratios mapped affinely to [-1, 1]), so a hardware
-// filter of texel values is the trilinear blend of the stored values:
+// glTexImage3D / vkCmdCopyBufferToImage upload takes), each with 1, 3 or 4 components stored as
+// float32, binary16 (half), 8-bit SNORM or RGB9_E5 (shared exponent). A hardware filter returns the
+// trilinear blend of the stored (rounded) texel values:
 //   filtered = sum_b w_b q(v_b),   w_b the weights of zhc_volume_sh3 (probes at texel centres,
 //   clamp-to-edge), q the storage rounding (float32, half round-to-nearest-even, SNORM8
-//   round(127 v) / 127).
-// The model blends the rounded values in double. Real GPUs also quantise the filter weights
-// (commonly to 8 bits of the fractional texel coordinate) and filter in reduced precision: not
-// modelled. The ratio layouts filter ratios and DC separately and multiply after the filter, which
-// is NOT the blend of the products: their error includes that covariance term (measured by
-// bench_volume, not assumed away).
+//   round(127 v) / 127, RGB9_E5 as GL/Vulkan specify it).
+// Where the stored values are linear in the probe's SH3 (every layout but ratio8), that is the blend
+// of the stored SH up to q (the *_l2lum / *_l2grey layouts then approximate colour L2 from the
+// luminance L2 by design). The model blends the rounded
+// values in double. Real GPUs also quantise the filter weights (commonly to 8 bits of the
+// fractional texel coordinate) and filter in reduced precision: not modelled. ratio8 stores
+// coefficient / DC ratios and multiplies the filtered ratio by the filtered DC, which is NOT the
+// blend of the products: its error includes that covariance term (measured by bench_volume).
 #pragma once
 
 #include <cmath>
