@@ -3,6 +3,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -63,9 +64,17 @@ struct Kernel::Impl {
     VkDescriptorSet set = VK_NULL_HANDLE;
     VkCommandPool command_pool = VK_NULL_HANDLE;
     VkCommandBuffer command_buffer = VK_NULL_HANDLE;
+    std::vector<VkImage> images;
+    std::vector<VkImageView> views;
+    std::vector<VkDeviceMemory> image_memories;
+    VkSampler sampler = VK_NULL_HANDLE;
     ~Impl() {
         if (!device) return;
         vkDeviceWaitIdle(device);
+        for (VkImageView v : views) vkDestroyImageView(device, v, nullptr);
+        for (VkImage i : images) vkDestroyImage(device, i, nullptr);
+        for (VkDeviceMemory m : image_memories) vkFreeMemory(device, m, nullptr);
+        if (sampler) vkDestroySampler(device, sampler, nullptr);
         if (command_pool) vkDestroyCommandPool(device, command_pool, nullptr);
         if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
         if (pipeline) vkDestroyPipeline(device, pipeline, nullptr);
@@ -151,6 +160,196 @@ std::unique_ptr<Context> Context::create(bool require_cpu, std::string* error) {
 
 std::unique_ptr<Kernel> Context::make_kernel(std::span<const std::uint32_t> spirv, std::span<const std::size_t> buffer_sizes,
                                              std::string* error) {
+    return make_kernel(spirv, buffer_sizes, {}, error);
+}
+
+namespace {
+
+std::uint32_t memory_type(const VkPhysicalDeviceMemoryProperties& mem, std::uint32_t bits, VkMemoryPropertyFlags want) {
+    for (std::uint32_t t = 0; t < mem.memoryTypeCount; ++t)
+        if ((bits & (1u << t)) && (mem.memoryTypes[t].propertyFlags & want) == want) return t;
+    return UINT32_MAX;
+}
+
+}  // namespace
+
+// Creates the sampler and the images of `in` (optimal tiling, device memory), uploads them through a
+// staging buffer, transitions them to SHADER_READ_ONLY_OPTIMAL and writes their descriptors
+// (sampler at binding `first`, images after it).
+bool Context::upload_images(Context::Impl& ctx, Kernel::Impl& k, std::span<const Image3D> in, std::uint32_t first,
+                            std::string* error) {
+    const VkDevice dev = k.device;
+    VkSamplerCreateInfo sci{};
+    sci.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
+    sci.magFilter = VK_FILTER_LINEAR;
+    sci.minFilter = VK_FILTER_LINEAR;
+    sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    sci.maxLod = 0.0f;
+    if (VkResult r = vkCreateSampler(dev, &sci, nullptr, &k.sampler); r != VK_SUCCESS) {
+        *error = vk_error("vkCreateSampler", r);
+        return false;
+    }
+    std::size_t staging_size = 0;
+    for (const Image3D& im : in) staging_size += (im.texels.size() + 15) / 16 * 16;
+    VkBufferCreateInfo bci{};
+    bci.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+    bci.size = std::max<std::size_t>(16, staging_size);
+    bci.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+    VkBuffer staging = VK_NULL_HANDLE;
+    VkDeviceMemory staging_memory = VK_NULL_HANDLE;
+    struct Cleanup {
+        VkDevice dev;
+        VkBuffer* b;
+        VkDeviceMemory* m;
+        ~Cleanup() {
+            if (*b) vkDestroyBuffer(dev, *b, nullptr);
+            if (*m) vkFreeMemory(dev, *m, nullptr);
+        }
+    } cleanup{dev, &staging, &staging_memory};
+    if (VkResult r = vkCreateBuffer(dev, &bci, nullptr, &staging); r != VK_SUCCESS) {
+        *error = vk_error("vkCreateBuffer (staging)", r);
+        return false;
+    }
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(dev, staging, &req);
+    VkMemoryAllocateInfo mai{};
+    mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    mai.allocationSize = req.size;
+    mai.memoryTypeIndex = memory_type(ctx.memory, req.memoryTypeBits,
+                                      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    if (mai.memoryTypeIndex == UINT32_MAX) {
+        *error = "no host-visible coherent memory type";
+        return false;
+    }
+    if (VkResult r = vkAllocateMemory(dev, &mai, nullptr, &staging_memory); r != VK_SUCCESS) {
+        *error = vk_error("vkAllocateMemory (staging)", r);
+        return false;
+    }
+    vkBindBufferMemory(dev, staging, staging_memory, 0);
+    void* mapped = nullptr;
+    if (VkResult r = vkMapMemory(dev, staging_memory, 0, VK_WHOLE_SIZE, 0, &mapped); r != VK_SUCCESS) {
+        *error = vk_error("vkMapMemory (staging)", r);
+        return false;
+    }
+    std::vector<VkDeviceSize> offsets;
+    {
+        std::size_t at = 0;
+        for (const Image3D& im : in) {
+            offsets.push_back(at);
+            if (!im.texels.empty()) std::memcpy(static_cast<std::uint8_t*>(mapped) + at, im.texels.data(), im.texels.size());
+            at += (im.texels.size() + 15) / 16 * 16;
+        }
+    }
+    vkUnmapMemory(dev, staging_memory);
+    for (const Image3D& im : in) {
+        VkImageCreateInfo ici{};
+        ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+        ici.imageType = VK_IMAGE_TYPE_3D;
+        ici.format = static_cast<VkFormat>(im.format);
+        ici.extent = {im.width, im.height, im.depth};
+        ici.mipLevels = 1;
+        ici.arrayLayers = 1;
+        ici.samples = VK_SAMPLE_COUNT_1_BIT;
+        ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+        ici.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+        ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+        VkImage image;
+        if (VkResult r = vkCreateImage(dev, &ici, nullptr, &image); r != VK_SUCCESS) {
+            *error = vk_error("vkCreateImage", r);
+            return false;
+        }
+        k.images.push_back(image);
+        VkMemoryRequirements ireq;
+        vkGetImageMemoryRequirements(dev, image, &ireq);
+        VkMemoryAllocateInfo imai{};
+        imai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+        imai.allocationSize = ireq.size;
+        imai.memoryTypeIndex = memory_type(ctx.memory, ireq.memoryTypeBits, 0);
+        VkDeviceMemory memory;
+        if (VkResult r = vkAllocateMemory(dev, &imai, nullptr, &memory); r != VK_SUCCESS) {
+            *error = vk_error("vkAllocateMemory (image)", r);
+            return false;
+        }
+        k.image_memories.push_back(memory);
+        vkBindImageMemory(dev, image, memory, 0);
+        VkImageViewCreateInfo vci{};
+        vci.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+        vci.image = image;
+        vci.viewType = VK_IMAGE_VIEW_TYPE_3D;
+        vci.format = ici.format;
+        vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        VkImageView view;
+        if (VkResult r = vkCreateImageView(dev, &vci, nullptr, &view); r != VK_SUCCESS) {
+            *error = vk_error("vkCreateImageView", r);
+            return false;
+        }
+        k.views.push_back(view);
+    }
+    // Upload: UNDEFINED -> TRANSFER_DST, copy, -> SHADER_READ_ONLY.
+    VkCommandBuffer cb = k.command_buffer;
+    VkCommandBufferBeginInfo begin{};
+    begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    vkBeginCommandBuffer(cb, &begin);
+    for (std::size_t i = 0; i < in.size(); ++i) {
+        VkImageMemoryBarrier b{};
+        b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+        b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        b.image = k.images[i];
+        b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+        b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &b);
+        VkBufferImageCopy copy{};
+        copy.bufferOffset = offsets[i];
+        copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        copy.imageExtent = {in[i].width, in[i].height, in[i].depth};
+        vkCmdCopyBufferToImage(cb, staging, k.images[i], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+        b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+        b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1, &b);
+    }
+    vkEndCommandBuffer(cb);
+    VkSubmitInfo submit{};
+    submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &cb;
+    if (VkResult r = vkQueueSubmit(k.queue, 1, &submit, VK_NULL_HANDLE); r != VK_SUCCESS) {
+        *error = vk_error("vkQueueSubmit (upload)", r);
+        return false;
+    }
+    vkQueueWaitIdle(k.queue);
+    // Descriptors.
+    VkDescriptorImageInfo sampler_info{k.sampler, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED};
+    std::vector<VkDescriptorImageInfo> image_infos(in.size());
+    std::vector<VkWriteDescriptorSet> writes(in.size() + 1);
+    writes[0] = {};
+    writes[0].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    writes[0].dstSet = k.set;
+    writes[0].dstBinding = first;
+    writes[0].descriptorCount = 1;
+    writes[0].descriptorType = VK_DESCRIPTOR_TYPE_SAMPLER;
+    writes[0].pImageInfo = &sampler_info;
+    for (std::size_t i = 0; i < in.size(); ++i) {
+        image_infos[i] = {VK_NULL_HANDLE, k.views[i], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+        writes[i + 1] = {};
+        writes[i + 1].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        writes[i + 1].dstSet = k.set;
+        writes[i + 1].dstBinding = first + 1 + static_cast<std::uint32_t>(i);
+        writes[i + 1].descriptorCount = 1;
+        writes[i + 1].descriptorType = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+        writes[i + 1].pImageInfo = &image_infos[i];
+    }
+    vkUpdateDescriptorSets(dev, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+    return true;
+}
+
+std::unique_ptr<Kernel> Context::make_kernel(std::span<const std::uint32_t> spirv, std::span<const std::size_t> buffer_sizes,
+                                             std::span<const Image3D> images_in, std::string* error) {
     const VkDevice dev = impl_->device;
     auto k = std::make_unique<Kernel::Impl>();
     k->device = dev;
@@ -217,9 +416,20 @@ std::unique_ptr<Kernel> Context::make_kernel(std::span<const std::uint32_t> spir
         bindings[i].descriptorCount = 1;
         bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
     }
+    const auto n_img = static_cast<std::uint32_t>(images_in.size());
+    if (n_img > 0) {
+        for (std::uint32_t i = 0; i <= n_img; ++i) {
+            VkDescriptorSetLayoutBinding b{};
+            b.binding = n + i;
+            b.descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_SAMPLER : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+            b.descriptorCount = 1;
+            b.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+            bindings.push_back(b);
+        }
+    }
     VkDescriptorSetLayoutCreateInfo dslci{};
     dslci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-    dslci.bindingCount = n;
+    dslci.bindingCount = static_cast<std::uint32_t>(bindings.size());
     dslci.pBindings = bindings.data();
     if (VkResult r = vkCreateDescriptorSetLayout(dev, &dslci, nullptr, &k->set_layout); r != VK_SUCCESS) {
         *error = vk_error("vkCreateDescriptorSetLayout", r);
@@ -244,12 +454,14 @@ std::unique_ptr<Kernel> Context::make_kernel(std::span<const std::uint32_t> spir
         *error = vk_error("vkCreateComputePipelines", r);
         return nullptr;
     }
-    VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, n};
+    const VkDescriptorPoolSize pool_sizes[3] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, n},
+                                                {VK_DESCRIPTOR_TYPE_SAMPLER, 1},
+                                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, n_img > 0 ? n_img : 1}};
     VkDescriptorPoolCreateInfo dpci{};
     dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     dpci.maxSets = 1;
-    dpci.poolSizeCount = 1;
-    dpci.pPoolSizes = &pool_size;
+    dpci.poolSizeCount = n_img > 0 ? 3 : 1;
+    dpci.pPoolSizes = pool_sizes;
     if (VkResult r = vkCreateDescriptorPool(dev, &dpci, nullptr, &k->pool); r != VK_SUCCESS) {
         *error = vk_error("vkCreateDescriptorPool", r);
         return nullptr;
@@ -293,6 +505,7 @@ std::unique_ptr<Kernel> Context::make_kernel(std::span<const std::uint32_t> spir
         *error = vk_error("vkAllocateCommandBuffers", r);
         return nullptr;
     }
+    if (n_img > 0 && !upload_images(*impl_, *k, images_in, n, error)) return nullptr;
     return std::unique_ptr<Kernel>(new Kernel(std::move(k)));
 }
 

@@ -25,6 +25,14 @@ std::vector<std::uint32_t> read_spirv(const std::string& path);
 
 class Context;
 
+// A sampled 3D image for Context::make_kernel: `format` a VkFormat, texels tightly packed
+// (x fastest, then y, then z), uploaded once; sampled with a linear, clamp-to-edge sampler.
+struct Image3D {
+    std::uint32_t format = 0;
+    std::uint32_t width = 1, height = 1, depth = 1;
+    std::span<const std::uint8_t> texels;
+};
+
 // A compute pipeline bound to `buffers.size()` storage buffers (bindings 0.. of set 0). Buffer
 // contents are host-visible: write with data(), dispatch, read with data().
 class Kernel {
@@ -59,10 +67,16 @@ public:
     // `buffer_sizes` (bytes, each > 0, zero-initialised). nullptr + *error on failure.
     std::unique_ptr<Kernel> make_kernel(std::span<const std::uint32_t> spirv, std::span<const std::size_t> buffer_sizes,
                                         std::string* error);
+    // The same, plus (when `images` is not empty) one sampler (VK_FILTER_LINEAR, clamp to edge,
+    // unnormalised coordinates off) at binding buffer_sizes.size() and the images as sampled images
+    // at the bindings after it.
+    std::unique_ptr<Kernel> make_kernel(std::span<const std::uint32_t> spirv, std::span<const std::size_t> buffer_sizes,
+                                        std::span<const Image3D> images, std::string* error);
 
 private:
     struct Impl;
     explicit Context(std::unique_ptr<Impl> impl);
+    static bool upload_images(Impl& ctx, Kernel::Impl& k, std::span<const Image3D> in, std::uint32_t first, std::string* error);
     std::unique_ptr<Impl> impl_;
 };
 

@@ -1,0 +1,463 @@
+// bench_volume — GPU volume layouts: error per GPU byte (docs/runtime.md, "GPU volume layouts").
+//
+// Two baked probe grids: the demo's (codec/bake default_scene, 8x8x4, as `zhc demo` bakes it) and a
+// baked glTF scene (tests/data/gltf/gi_nodes.glb: 1,500 instanced triangles, KHR_lights_punctual,
+// the default 8x8x8 grid over its bounds). Reference: the exact trilinear SH3 volume of the baked
+// probes stored as sh3 (float), sampled with zhc_volume_irradiance_d (double).
+// Rows:
+//  * packed encodings in an integer texture, the 8-probe decode + blend in the shader: exactly
+//    zhc_volume_irradiance_d of that encoding's volume (error = the encoding's own error);
+//  * filterable layouts (runtime/zhc_volume_layouts.hpp): texel values rounded to their storage
+//    format, hardware trilinear = the trilinear blend of the rounded values (filter-weight
+//    quantisation of real GPUs not modelled), reconstructed SH3, irradiance in double.
+// Error of one sample: |E - E_ref| (RGB Euclidean) / mean over the grid's samples of |E_ref|;
+// reported: mean, 95th percentile and max over N random points in the grid's box with random unit
+// normals (N = 100,000 by default, fixed seeds). Benchmarks never decide pass/fail.
+//
+// Sample cost (when built with glslangValidator, spirv-opt and spirv-dis): one HLSL compute kernel
+// per row that reads a position and a normal and writes the irradiance of one sample (packed rows:
+// zhc.hlsl's decode of the 8 corner probes, unrolled, no weight-0 skip; filterable rows: one
+// SampleLevel per texture at uvw = (clamp((p - origin) / spacing, 0, n - 1) + 0.5) / n, the
+// reconstruction, zhc_sh3_irradiance), HLSL -> SPIR-V (glslangValidator) -> spirv-opt -O, counted as
+// bench_runtime counts (function-body instructions), minus a skeleton kernel that writes p + n.
+// Timed (when built with Vulkan): the same kernels on Mesa lavapipe through tests/vk's harness
+// (sampled 3D images, linear clamp-to-edge sampler), demo grid, 65,536 distinct samples, 2^18
+// invocations per dispatch, median of 9 after a warm-up, kernels in interleaved rounds; the packed
+// sh3 row is the baseline. The GPU's results are compared with the CPU model at the same inputs.
+//
+// Usage: bench_volume [--samples N] [--gltf FILE] [--json FILE] [--keep DIR]
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "codec/bake/scene.h"
+#include "codec/probe/codec.h"
+#include "codec/probe/probe_set.h"
+#include "formats/io/file_io.h"
+#include "formats/scene/scene_gltf.h"
+#include "runtime/zhc_runtime.h"
+#include "runtime/zhc_volume_layouts.hpp"
+#include "tests/vk/volume_kernels.h"
+#include "timing.h"
+#ifdef ZHC_VK_TIMING
+#include <vulkan/vulkan.h>
+
+#include "vk_compute.h"
+#endif
+
+#include <unistd.h>
+
+namespace {
+
+using namespace zhc;
+namespace L = zhc_layouts;
+
+struct Grid {
+    std::string name;
+    std::vector<Sh3Radiance> probes;
+    ProbeLayout layout;
+};
+
+struct Stats {
+    double mean = 0, p95 = 0, max = 0;
+};
+
+struct Row {
+    std::string name, kind, textures;
+    double bytes = 0;
+    int fetches = 0;       // texture fetches (filterable) or probe decodes (packed) per sample
+    int spirv = -1;        // SPIR-V instructions minus the skeleton; -1 not measured
+    std::string source;    // the HLSL kernel
+    std::vector<std::uint32_t> spv;  // its optimised SPIR-V
+    bool filtered = false;
+    L::Layout layout = L::Layout::kSh3F32;
+    double ns = NAN;         // lavapipe ns per sample; NAN not measured
+    double vs_model = NAN;   // max |GPU - CPU model| / mean |model| over the timed samples
+    Stats err[2];
+};
+
+bool encode(const Grid& g, const char* rep, std::vector<std::uint8_t>* payload, zhc_volume* vol, zhc_probe_format* fmt) {
+    auto set = encode_probe_set(g.probes, rep, CodecOptions{}, g.layout);
+    if (!set) {
+        std::fprintf(stderr, "%s: %s\n", rep, set.error().message.c_str());
+        return false;
+    }
+    *payload = set->payload;
+    if (zhc_probe_format_init(fmt, rep) != ZHC_OK) return false;
+    const ProbeGrid& pg = g.layout.grid;
+    const double origin[3] = {pg.origin.x, pg.origin.y, pg.origin.z}, spacing[3] = {pg.spacing.x, pg.spacing.y, pg.spacing.z};
+    const std::uint32_t counts[3] = {pg.counts[0], pg.counts[1], pg.counts[2]};
+    return zhc_volume_init(vol, fmt, payload->data(), payload->size(), origin, spacing, counts) == ZHC_OK;
+}
+
+Stats stats(std::vector<double> e) {
+    Stats s;
+    if (e.empty()) return s;
+    std::sort(e.begin(), e.end());
+    double sum = 0;
+    for (double x : e) sum += x;
+    s.mean = sum / double(e.size());
+    s.p95 = e[std::min(e.size() - 1, static_cast<std::size_t>(0.95 * double(e.size())))];
+    s.max = e.back();
+    return s;
+}
+
+double norm3(const double v[3]) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+// ---- SPIR-V instruction counts (kernels: tests/vk/volume_kernels.h) --------------------------
+
+using zhc_volume_kernels::filter_kernel;
+using zhc_volume_kernels::packed_kernel;
+using zhc_volume_kernels::skeleton_kernel;
+
+#ifdef ZHC_GLSLANG
+bool run(const std::string& command) {
+    const int rc = std::system(command.c_str());
+    if (rc != 0) std::fprintf(stderr, "failed (%d): %s\n", rc, command.c_str());
+    return rc == 0;
+}
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+// HLSL -> SPIR-V -> spirv-opt -O -> function-body instructions of the disassembly (-1: failed);
+// the optimised binary in *words when given.
+int spirv_instructions(const std::string& dir, const std::string& name, const std::string& source,
+                       std::vector<std::uint32_t>* words = nullptr) {
+    const std::string hlsl = dir + "/" + name + ".hlsl", raw = dir + "/" + name + ".spv", opt = dir + "/" + name + ".opt.spv",
+                      dis = dir + "/" + name + ".opt.spvasm";
+    std::ofstream(hlsl) << source;
+    if (!run(quote(ZHC_GLSLANG) + " -D -V -S comp -e main -I" + quote(ZHC_RUNTIME_DIR) + " " + quote(hlsl) + " -o " + quote(raw) +
+             " > " + quote(dir + "/" + name + ".log") + " 2>&1"))
+        return -1;
+    if (!run(quote(ZHC_SPIRV_OPT) + " -O " + quote(raw) + " -o " + quote(opt))) return -1;
+    if (!run(quote(ZHC_SPIRV_DIS) + " --no-header " + quote(opt) + " -o " + quote(dis))) return -1;
+    std::ifstream in(dis);
+    std::string line;
+    bool inside = false;
+    int count = 0;
+    while (std::getline(in, line)) {
+        auto has = [&](const char* op) {
+            const std::size_t q = line.find(op);
+            if (q == std::string::npos) return false;
+            const std::size_t e = q + std::strlen(op);
+            return e == line.size() || line[e] == ' ';
+        };
+        if (has("OpFunction")) {
+            inside = true;
+            continue;
+        }
+        if (has("OpFunctionEnd")) {
+            inside = false;
+            continue;
+        }
+        if (!inside || has("OpFunctionParameter") || has("OpLabel")) continue;
+        if (line.find_first_not_of(' ') != std::string::npos) ++count;
+    }
+#ifdef ZHC_VK_TIMING
+    if (words) *words = vk::read_spirv(opt);
+#else
+    (void)words;
+#endif
+    return count;
+}
+#endif
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    int samples = 100000;
+    std::string json, keep, gltf = ZHC_GLTF_SCENE;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--samples" && i + 1 < argc) samples = std::max(100, std::atoi(argv[++i]));
+        else if (a == "--gltf" && i + 1 < argc) gltf = argv[++i];
+        else if (a == "--json" && i + 1 < argc) json = argv[++i];
+        else if (a == "--keep" && i + 1 < argc) keep = argv[++i];
+        else {
+            std::fprintf(stderr, "usage: %s [--samples N] [--gltf FILE] [--json FILE] [--keep DIR]\n", argv[0]);
+            return 2;
+        }
+    }
+    std::vector<Grid> grids;
+    {
+        const Scene scene = default_scene();
+        auto baked = bake_scene(scene);
+        if (!baked) {
+            std::fprintf(stderr, "demo bake: %s\n", baked.error().message.c_str());
+            return 1;
+        }
+        grids.push_back({"demo", *baked, probe_layout(scene.probes)});
+    }
+    {
+        auto bytes = read_file_bytes(gltf, std::uint64_t(1) << 30);
+        if (!bytes) {
+            std::fprintf(stderr, "%s\n", bytes.error().message.c_str());
+            return 1;
+        }
+        auto scene = parse_scene_gltf(*bytes, gltf);
+        if (!scene) {
+            std::fprintf(stderr, "%s\n", scene.error().message.c_str());
+            return 1;
+        }
+        auto baked = bake_scene(*scene);
+        if (!baked) {
+            std::fprintf(stderr, "%s: %s\n", gltf.c_str(), baked.error().message.c_str());
+            return 1;
+        }
+        grids.push_back({"gltf", *baked, probe_layout(scene->probes)});
+    }
+
+    const char* packed[] = {"sh3", "zh3_q16", "sh2_q", "sh3_q28"};
+    std::string device;
+    std::vector<Row> rows;
+    for (const char* p : packed) {
+        Row r;
+        r.name = p;
+        r.kind = "integer texture, 8-probe decode + blend in the shader";
+        r.textures = "stored bytes";
+        r.bytes = double(find_codec(p)->size_bytes);
+        r.fetches = 8;
+        r.source = packed_kernel(zhc_encoding_from_name(p));
+        rows.push_back(r);
+    }
+    for (L::Layout l : L::kAllLayouts) {
+        Row r;
+        r.name = L::layout_name(l);
+        r.kind = "hardware trilinear";
+        r.bytes = double(L::layout_bytes_per_probe(l));
+        std::vector<L::TextureSpec> t = L::layout_textures(l);
+        for (std::size_t i = 0; i < t.size();) {
+            std::size_t j = i;
+            while (j < t.size() && t[j].storage == t[i].storage && t[j].components == t[i].components) ++j;
+            if (!r.textures.empty()) r.textures += " + ";
+            r.textures += std::to_string(j - i) + " " + L::storage_name(t[i].storage, t[i].components);
+            i = j;
+        }
+        r.fetches = static_cast<int>(t.size());
+        r.source = filter_kernel(l);
+        r.filtered = true;
+        r.layout = l;
+        rows.push_back(r);
+    }
+
+    for (std::size_t gi = 0; gi < grids.size(); ++gi) {
+        const Grid& g = grids[gi];
+        std::vector<std::uint8_t> ref_bytes;
+        zhc_volume ref;
+        zhc_probe_format ref_fmt;
+        if (!encode(g, "sh3", &ref_bytes, &ref, &ref_fmt)) return 1;
+        // Sample points and normals, and the reference.
+        std::mt19937_64 rng(1234 + gi);
+        std::uniform_real_distribution<double> u(0.0, 1.0);
+        std::normal_distribution<double> gauss;
+        std::vector<std::array<double, 6>> pts(static_cast<std::size_t>(samples));
+        std::vector<std::array<double, 3>> eref(pts.size());
+        double mean_ref = 0;
+        for (std::size_t s = 0; s < pts.size(); ++s) {
+            for (int c = 0; c < 3; ++c)
+                pts[s][static_cast<std::size_t>(c)] = ref.origin[c] + u(rng) * ref.spacing[c] * double(ref.counts[c] - 1);
+            for (int c = 3; c < 6; ++c) pts[s][static_cast<std::size_t>(c)] = gauss(rng);
+            zhc_volume_irradiance_d(&ref, pts[s].data(), pts[s].data() + 3, eref[s].data());
+            mean_ref += norm3(eref[s].data());
+        }
+        mean_ref /= double(pts.size());
+        std::size_t ri = 0;
+        for (const char* p : packed) {
+            std::vector<std::uint8_t> bytes;
+            zhc_volume vol;
+            zhc_probe_format fmt;
+            if (!encode(g, p, &bytes, &vol, &fmt)) return 1;
+            std::vector<double> e(pts.size());
+            for (std::size_t s = 0; s < pts.size(); ++s) {
+                double rgb[3];
+                zhc_volume_irradiance_d(&vol, pts[s].data(), pts[s].data() + 3, rgb);
+                const double d[3] = {rgb[0] - eref[s][0], rgb[1] - eref[s][1], rgb[2] - eref[s][2]};
+                e[s] = norm3(d) / mean_ref;
+            }
+            rows[ri++].err[gi] = stats(e);
+        }
+        for (L::Layout l : L::kAllLayouts) {
+            const auto tex = L::volume_textures(ref, l);
+            std::vector<double> e(pts.size());
+            for (std::size_t s = 0; s < pts.size(); ++s) {
+                double rgb[3];
+                L::sample_irradiance(ref, l, tex, pts[s].data(), pts[s].data() + 3, rgb);
+                const double d[3] = {rgb[0] - eref[s][0], rgb[1] - eref[s][1], rgb[2] - eref[s][2]};
+                e[s] = norm3(d) / mean_ref;
+            }
+            rows[ri++].err[gi] = stats(e);
+        }
+        std::printf("grid %s: %u x %u x %u probes, %d samples, mean |E_ref| %.4g\n", g.name.c_str(), ref.counts[0], ref.counts[1],
+                    ref.counts[2], samples, mean_ref);
+    }
+
+#ifdef ZHC_GLSLANG
+    {
+        namespace fs = std::filesystem;
+        const fs::path dir = keep.empty() ? fs::temp_directory_path() / ("zhc_bench_volume_" + std::to_string(::getpid())) : fs::path(keep);
+        fs::create_directories(dir);
+        const int skeleton = spirv_instructions(dir.string(), "skeleton", skeleton_kernel());
+        for (Row& r : rows) {
+            const int c = spirv_instructions(dir.string(), r.name, r.source, &r.spv);
+            r.spirv = c >= 0 && skeleton >= 0 ? c - skeleton : -1;
+        }
+        if (keep.empty()) fs::remove_all(dir);
+    }
+#else
+    if (!keep.empty()) std::fprintf(stderr, "--keep: built without glslangValidator / spirv-opt / spirv-dis: no SPIR-V counts\n");
+#endif
+#ifdef ZHC_VK_TIMING
+    // lavapipe: every kernel on the demo grid, 65,536 distinct samples, 2^18 invocations per
+    // dispatch, median of 9 after a warm-up round, kernels in interleaved rounds.
+    {
+        if (std::strlen(ZHC_LVP_ICD) > 0) vk::force_icd(ZHC_LVP_ICD);
+        std::string error;
+        auto context = vk::Context::create(true, &error);
+        if (!context) {
+            std::fprintf(stderr, "Vulkan: %s (no lavapipe timing)\n", error.c_str());
+        } else {
+            device = context->device_name();
+            const Grid& g = grids[0];
+            std::vector<std::uint8_t> ref_bytes;
+            zhc_volume ref;
+            zhc_probe_format ref_fmt;
+            if (!encode(g, "sh3", &ref_bytes, &ref, &ref_fmt)) return 1;
+            constexpr std::uint32_t kSamples = 65536, kEvals = 1u << 18;
+            constexpr int kRepeats = 9;
+            std::vector<float> inputs(kSamples * 8);
+            std::mt19937_64 rng(99);
+            std::uniform_real_distribution<double> u(0.0, 1.0);
+            std::normal_distribution<double> gauss;
+            for (std::uint32_t i = 0; i < kSamples; ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    inputs[8 * i + static_cast<std::uint32_t>(c)] =
+                        static_cast<float>(ref.origin[c] + u(rng) * ref.spacing[c] * double(ref.counts[c] - 1));
+                    inputs[8 * i + 4 + static_cast<std::uint32_t>(c)] = static_cast<float>(gauss(rng));
+                }
+            }
+            float grid_buf[12] = {};
+            for (int c = 0; c < 3; ++c) {
+                grid_buf[c] = static_cast<float>(ref.origin[c]);
+                grid_buf[4 + c] = static_cast<float>(ref.spacing[c]);
+                std::memcpy(&grid_buf[8 + c], &ref.counts[c], 4);
+            }
+            struct Timed {
+                Row* row;
+                std::unique_ptr<vk::Kernel> kernel;
+                std::vector<double> seconds;
+                zhc_volume vol{};
+                std::vector<std::uint8_t> bytes;
+                std::vector<std::vector<std::uint8_t>> tex;
+            };
+            std::vector<Timed> timed;
+            timed.reserve(rows.size());
+            for (Row& r : rows) {
+                if (r.spv.empty()) continue;
+                Timed t;
+                t.row = &r;
+                std::vector<vk::Image3D> images;
+                if (r.filtered) {
+                    t.tex = L::volume_textures(ref, r.layout);
+                    const auto spec = L::layout_textures(r.layout);
+                    for (std::size_t i = 0; i < spec.size(); ++i) {
+                        VkFormat f = VK_FORMAT_E5B9G9R9_UFLOAT_PACK32;
+                        if (spec[i].storage == L::Storage::kF32) f = VK_FORMAT_R32G32B32A32_SFLOAT;
+                        if (spec[i].storage == L::Storage::kF16) f = VK_FORMAT_R16G16B16A16_SFLOAT;
+                        if (spec[i].storage == L::Storage::kSnorm8) f = spec[i].components == 4 ? VK_FORMAT_R8G8B8A8_SNORM : VK_FORMAT_R8_SNORM;
+                        images.push_back({static_cast<std::uint32_t>(f), ref.counts[0], ref.counts[1], ref.counts[2], t.tex[i]});
+                    }
+                } else {
+                    zhc_probe_format fmt;
+                    if (!encode(g, r.name.c_str(), &t.bytes, &t.vol, &fmt)) return 1;
+                }
+                const std::size_t sizes[4] = {std::max<std::size_t>(16, t.bytes.size()), inputs.size() * 4, std::size_t(kEvals) * 16,
+                                              sizeof grid_buf};
+                t.kernel = context->make_kernel(r.spv, sizes, images, &error);
+                if (!t.kernel) {
+                    std::fprintf(stderr, "%s: %s\n", r.name.c_str(), error.c_str());
+                    continue;
+                }
+                if (!t.bytes.empty()) std::memcpy(t.kernel->data(0), t.bytes.data(), t.bytes.size());
+                std::memcpy(t.kernel->data(1), inputs.data(), inputs.size() * 4);
+                std::memcpy(t.kernel->data(3), grid_buf, sizeof grid_buf);
+                timed.push_back(std::move(t));
+            }
+            for (int rep = 0; rep <= kRepeats; ++rep)
+                for (Timed& t : timed) {
+                    if (!t.kernel) continue;
+                    const double sec = t.kernel->dispatch(kEvals / 64, &error);
+                    if (sec < 0) {
+                        std::fprintf(stderr, "%s: %s\n", t.row->name.c_str(), error.c_str());
+                        t.kernel.reset();
+                        continue;
+                    }
+                    if (rep > 0) t.seconds.push_back(sec);
+                }
+            for (Timed& t : timed) {
+                if (!t.kernel || t.seconds.empty()) continue;
+                std::sort(t.seconds.begin(), t.seconds.end());
+                t.row->ns = t.seconds[t.seconds.size() / 2] / double(kEvals) * 1e9;
+                // The GPU's results against the CPU model at the same (float) inputs.
+                const float* out = reinterpret_cast<const float*>(t.kernel->data(2));
+                double worst = 0, mag = 0;
+                for (std::uint32_t i = 0; i < kSamples; ++i) {
+                    double pd[3], nd[3], e[3];
+                    for (int c = 0; c < 3; ++c) {
+                        pd[c] = inputs[8 * i + static_cast<std::uint32_t>(c)];
+                        nd[c] = inputs[8 * i + 4 + static_cast<std::uint32_t>(c)];
+                    }
+                    if (t.row->filtered) L::sample_irradiance(ref, t.row->layout, t.tex, pd, nd, e);
+                    else zhc_volume_irradiance_d(&t.vol, pd, nd, e);
+                    const double d[3] = {out[4 * i] - e[0], out[4 * i + 1] - e[1], out[4 * i + 2] - e[2]};
+                    worst = std::max(worst, norm3(d));
+                    mag += norm3(e) / kSamples;
+                }
+                t.row->vs_model = worst / mag;
+            }
+            timed.clear();  // kernels before the context
+        }
+    }
+#endif
+    std::printf("\nerror of one sample vs the exact trilinear SH3 volume: |dE| / mean |E_ref| (demo | gltf)\n");
+    std::printf("fetches: texture samples (filterable) or probe decodes (packed) per sample; SPIR-V: instructions after\n"
+                "spirv-opt -O minus the skeleton kernel's (-1: not measured)\n\n");
+    double base_ns = NAN;
+    for (const Row& r : rows)
+        if (r.name == "sh3") base_ns = r.ns;
+    std::printf("lavapipe: ns per sample on the demo grid (median of 9 dispatches of 2^18), vs sh3: ratio to the packed sh3\n"
+                "row; GPU-model: max |GPU - CPU model| / mean |E| (NaN: not measured)\n\n");
+    std::printf("%-22s %6s  %-26s %7s %6s %10s %10s %10s | %10s %10s %10s %8s %6s %9s\n", "layout", "B/probe", "textures", "fetches",
+                "SPIR-V", "mean", "p95", "max", "mean", "p95", "max", "ns", "vs sh3", "GPU-model");
+    for (const Row& r : rows)
+        std::printf("%-22s %6.0f  %-26s %7d %6d %10.3g %10.3g %10.3g | %10.3g %10.3g %10.3g %8.1f %6.2f %9.2g\n", r.name.c_str(), r.bytes,
+                    r.textures.c_str(), r.fetches, r.spirv, r.err[0].mean, r.err[0].p95, r.err[0].max, r.err[1].mean, r.err[1].p95,
+                    r.err[1].max, r.ns, r.ns / base_ns, r.vs_model);
+    if (!json.empty()) {
+        std::ofstream out(json);
+        out << "{\n  \"benchmark\": \"volume\",\n  \"device\": \"" << device << "\",\n  \"samples\": " << samples << ",\n  \"grids\": [\"demo\", \"" << gltf
+            << "\"],\n  \"rows\": [\n";
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+            const Row& r = rows[i];
+            char buf[1024];
+            std::snprintf(buf, sizeof buf,
+                          "    {\"layout\": \"%s\", \"kind\": \"%s\", \"textures\": \"%s\", \"bytes_per_probe\": %g, \"fetches\": %d, "
+                          "\"spirv_instructions_minus_skeleton\": %d, \"lavapipe_ns_per_sample\": %.4g, "
+                          "\"ratio_to_sh3\": %.4g, \"gpu_vs_model\": %.4g, "
+                          "\"demo\": {\"mean\": %.6g, \"p95\": %.6g, \"max\": %.6g}, "
+                          "\"gltf\": {\"mean\": %.6g, \"p95\": %.6g, \"max\": %.6g}}%s\n",
+                          r.name.c_str(), r.kind.c_str(), r.textures.c_str(), r.bytes, r.fetches, r.spirv, std::isfinite(r.ns) ? r.ns : -1.0,
+                          std::isfinite(r.ns / base_ns) ? r.ns / base_ns : -1.0, std::isfinite(r.vs_model) ? r.vs_model : -1.0, r.err[0].mean, r.err[0].p95, r.err[0].max,
+                          r.err[1].mean, r.err[1].p95, r.err[1].max, i + 1 < rows.size() ? "," : "");
+            out << buf;
+        }
+        if (!bench::finish_json(out, json)) return 1;
+    }
+    return 0;
+}
