@@ -2,6 +2,7 @@
 #   include/zhc/codec.h, include/zhc/formats.h      umbrella headers (#include <zhc/codec.h>)
 #   include/zhc/codec/*/*.h, include/zhc/formats/*/*.h  the public headers, by domain folder
 #   include/zhc/zhc_runtime.h                       the C99 runtime decoder (when runtime/ exists)
+#   include/zhc/zhc_volume_layouts.hpp              GPU volume layouts over it (C++17)
 #   lib/libzhc_codec.a, lib/libzhc_formats.a        static libraries
 #   lib/cmake/zhc/zhcConfig.cmake                   find_package(zhc): targets zhc::codec, zhc::formats
 #   lib/pkgconfig/zhc.pc                            pkg-config --static --cflags --libs zhc
@@ -46,7 +47,8 @@ if(EXISTS "${PROJECT_SOURCE_DIR}/runtime")
   install(DIRECTORY "${PROJECT_SOURCE_DIR}/runtime/" DESTINATION "${CMAKE_INSTALL_DATADIR}/zhc/runtime"
           PATTERN "CMakeLists.txt" EXCLUDE PATTERN "node_modules" EXCLUDE)
   if(EXISTS "${PROJECT_SOURCE_DIR}/runtime/zhc_runtime.h")
-    install(FILES "${PROJECT_SOURCE_DIR}/runtime/zhc_runtime.h" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/zhc")
+    install(FILES "${PROJECT_SOURCE_DIR}/runtime/zhc_runtime.h" "${PROJECT_SOURCE_DIR}/runtime/zhc_volume_layouts.hpp"
+            DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/zhc")
   endif()
 endif()
 
