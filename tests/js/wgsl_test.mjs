@@ -147,7 +147,13 @@ function batchParams(e, b, rand) {
     if (e.family !== F.SH2_Q && p.dcFormat === 'half') p.dcFormat = 'rgb9e5';
     p.zonalMapping = ['affine', 'zero', 'symmetric'][(b >> 1) % 3];
     p.axisMode = ((b >> 2) % 2) ? 'channel' : 'luminance';
-    flags.push('--bits', String(p.bits), '--bound', p.l2Bound, '--dc', p.dcFormat, '--zonal-map', p.zonalMapping, '--axis', p.axisMode);
+    // `zhc convert` refuses a storage option the entry does not use (cli/main.cpp storage_options_used):
+    // --bound is sh3_q28's, --zonal-map the zh3_q16 and sh3_q28 layouts', --axis only where the decoder
+    // takes the zonal axis from the parameters. An unused parameter does not change the decode.
+    flags.push('--bits', String(p.bits), '--dc', p.dcFormat);
+    if (e.family === F.SH3_Q28) flags.push('--bound', p.l2Bound);
+    if (e.family === F.ZH3_Q16 || e.family === F.SH3_Q28) flags.push('--zonal-map', p.zonalMapping);
+    if (e.axis === 'header') flags.push('--axis', p.axisMode);
     if (p.sqrt) flags.push('--sqrt');
   }
   return { p, flags };
