@@ -14,6 +14,7 @@
 #include "formats/report/html_report.h"
 #include "formats/report/plot.h"
 #include "formats/report/runtime_cost.h"
+#include "formats/report/volume_cost.h"
 
 namespace zhc::cli {
 namespace cmd_bench {  // one namespace per verb file: the CLI is a unity build
@@ -30,8 +31,32 @@ struct Options {
     int repeats = 7;
     int directions = 1024;
     std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
+    std::string volume_cost;   // bench_volume --json output: GPU volume layouts
     std::string html;
 };
+
+// "1.5e-03" style for errors, "-" for unmeasured (< 0) values.
+std::string volume_number(double v, const char* format) {
+    if (v < 0) return "-";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, format, v);
+    return buf;
+}
+
+// The best-per-byte line (formats/report/volume_cost.h): "16 B zh3_q16 (8.3e-02), 24 B ...".
+std::string best_per_byte_text(const VolumeCostTable& t) {
+    std::string s;
+    for (std::size_t i : volume_best_per_byte(t)) {
+        const VolumeLayoutCost& r = t.rows[i];
+        s += (s.empty() ? "" : ", ") + volume_number(r.bytes_per_probe, "%g") + " B " + r.layout + " (" +
+             volume_number(r.worst_mean(), "%.2g") + ")";
+    }
+    return s;
+}
+
+const char* kBestPerByteDefinition =
+    "best layout per GPU byte: for each budget of B bytes per probe, the layout with the lowest mean error (the larger of "
+    "the two grids' means) among the layouts of at most B bytes; listed where it changes";
 
 int run(const Options& o) {
     std::vector<std::string> inputs = o.inputs;
@@ -73,6 +98,12 @@ int run(const Options& o) {
         if (!t) return report(t.error());
         gpu = std::move(*t);
     }
+    VolumeCostTable volume;
+    if (!o.volume_cost.empty()) {
+        auto t = read_volume_cost(o.volume_cost);
+        if (!t) return report(t.error());
+        volume = std::move(*t);
+    }
     auto gpu_cost = [&](const BenchRow& r) -> const RuntimeCost* {
         auto it = gpu.by_name.find(std::string(r.codec->name));
         return it == gpu.by_name.end() ? nullptr : &it->second;
@@ -100,6 +131,30 @@ int run(const Options& o) {
                                                                {"gpu_ns_per_eval", c->ns_per_eval},
                                                                {"gpu_ratio_to_sh3", c->ratio_to_sh3}};
         }
+        if (!o.volume_cost.empty()) {
+            nlohmann::ordered_json v;
+            v["source"] = o.volume_cost;
+            v["device"] = volume.device;
+            v["gltf_grid"] = volume.gltf_grid;
+            v["rows"] = nlohmann::ordered_json::array();
+            for (const VolumeLayoutCost& r : volume.rows) {
+                auto grid = [](const VolumeGridError& e) { return nlohmann::ordered_json{{"mean", e.mean}, {"p95", e.p95}}; };
+                v["rows"].push_back({{"layout", r.layout},
+                                     {"bytes_per_probe", r.bytes_per_probe},
+                                     {"fetches", r.fetches},
+                                     {"spirv_instructions", r.spirv_instructions},
+                                     {"lavapipe_ns_per_sample", r.lavapipe_ns},
+                                     {"ratio_to_sh3", volume_ratio_to_sh3(volume, r)},
+                                     {"demo", grid(r.demo)},
+                                     {"gltf", grid(r.gltf)}});
+            }
+            v["best_per_byte"] = nlohmann::ordered_json::array();
+            for (std::size_t i : volume_best_per_byte(volume))
+                v["best_per_byte"].push_back({{"max_bytes_per_probe", volume.rows[i].bytes_per_probe},
+                                              {"layout", volume.rows[i].layout},
+                                              {"worst_mean_error", volume.rows[i].worst_mean()}});
+            j["volume_layouts"] = v;
+        }
         print_json("bench", j);
     } else {
         std::printf("%zu probes, %d directions, medians of %d repeats [min-max], single thread\n", probes.size(),
@@ -120,6 +175,19 @@ int run(const Options& o) {
             std::printf("\n");
         }
         if (!o.runtime_cost.empty()) std::printf("GPU cost: %s (%s)\n", gpu.device.c_str(), o.runtime_cost.c_str());
+        if (!o.volume_cost.empty()) {
+            std::printf("\nGPU volume layouts: %s (%s); error of one trilinear sample / mean irradiance, demo grid | glTF grid\n",
+                        o.volume_cost.c_str(), volume.device.c_str());
+            std::printf("%-22s %7s %7s %7s %11s %7s %9s %9s %9s %9s\n", "layout", "B/probe", "fetches", "SPIR-V", "lavapipe ns",
+                        "vs sh3", "demo mean", "demo p95", "glTF mean", "glTF p95");
+            for (const VolumeLayoutCost& r : volume.rows)
+                std::printf("%-22s %7s %7d %7s %11s %7s %9.2g %9.2g %9.2g %9.2g\n", r.layout.c_str(),
+                            volume_number(r.bytes_per_probe, "%g").c_str(), r.fetches,
+                            volume_number(r.spirv_instructions, "%.0f").c_str(), volume_number(r.lavapipe_ns, "%.4g").c_str(),
+                            volume_number(volume_ratio_to_sh3(volume, r), "%.2f").c_str(), r.demo.mean, r.demo.p95, r.gltf.mean,
+                            r.gltf.p95);
+            std::printf("%s: %s\n", kBestPerByteDefinition, best_per_byte_text(volume).c_str());
+        }
     }
     std::fflush(stdout);
     if (!o.html.empty()) {
@@ -136,6 +204,30 @@ int run(const Options& o) {
                       {"directions", std::to_string(o.directions)},
                       {"repeats", std::to_string(o.repeats)}};
         if (!o.runtime_cost.empty()) h.settings.push_back({"runtime cost", o.runtime_cost + " (" + gpu.device + ")"});
+        if (!o.volume_cost.empty()) {
+            h.settings.push_back({"volume cost", o.volume_cost + " (" + volume.device + ")"});
+            HtmlTable t;
+            t.id = "volume-layouts";
+            t.title = "GPU volume layouts";
+            t.intro = "One trilinear sample of a probe volume per GPU layout, from " + o.volume_cost + " (bench_volume --json, " +
+                      volume.device + "): GPU bytes per probe, texture fetches (or probe decodes), SPIR-V instructions after "
+                      "spirv-opt -O minus a skeleton kernel's, lavapipe ns per sample and its ratio to the packed sh3 row, and the "
+                      "error of one sample against the exact trilinear SH3 volume (|E - E_ref| over the mean |E_ref|) on the demo "
+                      "grid and the baked glTF scene" + (volume.gltf_grid.empty() ? "" : " (" + volume.gltf_grid + ")") +
+                      "; - is not measured.";
+            t.columns = {"layout", "bytes/probe", "fetches", "SPIR-V", "lavapipe ns", "vs sh3", "demo mean",
+                         "demo p95", "glTF mean", "glTF p95"};
+            auto cell = [](double v, const char* f) { return HtmlCell{volume_number(v, f), v}; };
+            for (const VolumeLayoutCost& r : volume.rows)
+                t.rows.push_back({HtmlCell{r.layout, 0}, cell(r.bytes_per_probe, "%g"), cell(r.fetches, "%.0f"),
+                                  cell(r.spirv_instructions, "%.0f"), cell(r.lavapipe_ns, "%.4g"),
+                                  cell(volume_ratio_to_sh3(volume, r), "%.2f"), cell(r.demo.mean, "%.2g"),
+                                  cell(r.demo.p95, "%.2g"), cell(r.gltf.mean, "%.2g"), cell(r.gltf.p95, "%.2g")});
+            std::string def = kBestPerByteDefinition;
+            def[0] = 'B';
+            t.notes = {def + ": " + best_per_byte_text(volume) + "."};
+            h.tables.push_back(std::move(t));
+        }
         h.summary_caption = "Means over " + std::to_string(probes.size()) + " probes; times are medians";
         std::vector<double> b, t, e, cost, cost_err;
         ScatterPlot by_bytes{"Error vs bytes per probe", "bytes per probe (log scale)", "mean relative irradiance rmse (log scale)", {}, {}};
@@ -234,6 +326,9 @@ const VerbRegistration registration(50, [](CLI::App& app) -> std::function<int()
     sub->add_option("--runtime-cost", o->runtime_cost,
                     "GPU cost per encoding from build/bench/bench_runtime --json FILE: adds SPIR-V instructions and "
                     "lavapipe ns/eval, and error_vs_runtime_cost.png");
+    sub->add_option("--volume-cost", o->volume_cost,
+                    "GPU volume layouts from build/bench/bench_volume --json FILE: adds a table (bytes/probe, fetches, SPIR-V, "
+                    "lavapipe ns, error on two grids) and the best layout per GPU byte to the output and the HTML report");
     return [o] { return run(*o); };
 });
 

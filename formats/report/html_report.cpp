@@ -566,6 +566,24 @@ std::string html_report(const HtmlReport& r) {
             o << "</ul>\n";
         }
     }
+    // Tables of their own.
+    for (const HtmlTable& t : r.tables) {
+        o << "<section id=\"" << html_escape(t.id) << "\">\n<h2>" << html_escape(t.title) << "</h2>\n<p>" << html_escape(t.intro)
+          << "</p>\n<table class=\"sortable\">\n<thead><tr>";
+        for (const std::string& c : t.columns) o << "<th scope=\"col\">" << html_escape(c) << "</th>";
+        o << "</tr></thead>\n<tbody>\n";
+        for (const std::vector<HtmlCell>& row : t.rows) {
+            o << "<tr>";
+            for (std::size_t c = 0; c < row.size(); ++c) {
+                if (c == 0) o << "<th scope=\"row\">" << html_escape(row[c].text) << "</th>";
+                else o << "<td data-v=\"" << sort_key(row[c].sort) << "\">" << html_escape(row[c].text) << "</td>";
+            }
+            o << "</tr>\n";
+        }
+        o << "</tbody></table>\n";
+        for (const std::string& n : t.notes) o << "<p class=\"note\">" << html_escape(n) << "</p>\n";
+        o << "</section>\n";
+    }
     // Plots.
     if (!r.plots.empty()) {
         o << "<h2>Plots</h2>\n";

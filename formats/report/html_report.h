@@ -69,6 +69,21 @@ struct HtmlInputSection {
     SpherePictures pictures;  // size 0: none
 };
 
+// A table of its own section (e.g. bench's GPU volume layouts): a heading, a paragraph, a sortable
+// table whose first column heads the rows, and notes under it.
+struct HtmlCell {
+    std::string text;
+    double sort = 0;  // the sort key of numeric cells (ignored in the first column)
+};
+struct HtmlTable {
+    std::string id;     // the section's id attribute
+    std::string title;  // heading
+    std::string intro;  // one paragraph
+    std::vector<std::string> columns;
+    std::vector<std::vector<HtmlCell>> rows;
+    std::vector<std::string> notes;  // paragraphs under the table
+};
+
 struct HtmlReport {
     std::string title;    // "zhc audit"
     std::string version;  // zhc's version
@@ -81,6 +96,7 @@ struct HtmlReport {
     std::vector<std::string> gate_failures;  // which probes failed which gate; empty = passed
     std::vector<HtmlInputSection> inputs;
     std::vector<ScatterPlot> plots;  // drawn as SVG
+    std::vector<HtmlTable> tables;   // sections after the gates, before the plots
     // The runtime evaluation cost columns: shown when some row has a cost; otherwise, when this is
     // non-empty, one "runtime cost" column whose cells say it was not given, and this note (how to
     // give it) under the table.

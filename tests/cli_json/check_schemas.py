@@ -114,6 +114,15 @@ check("audit", "audit", ["audit", ENVMAP, W("q16.zhp"), "--json", "--no-timing",
                          "--representations", "sh3,zh3_q16"])
 check("bench", "bench", ["bench", ENVMAP, "--json", "--no-plots", "--repeats", "1", "--directions", "16",
                          "--representations", "sh3,zh3_q16", "--runtime-cost", W("cost.json")])
+with open(W("volume.json"), "w") as f:
+    json.dump({"benchmark": "volume", "device": "schema test", "grids": ["demo", "scene.glb"], "rows": [
+        {"layout": "sh3", "bytes_per_probe": 108, "fetches": 8, "spirv_instructions_minus_skeleton": 1610,
+         "lavapipe_ns_per_sample": 1371, "demo": {"mean": 0, "p95": 0, "max": 0}, "gltf": {"mean": 0, "p95": 0, "max": 0}},
+        {"layout": "sh3_rgb9e5", "bytes_per_probe": 36, "fetches": 9, "spirv_instructions_minus_skeleton": -1,
+         "lavapipe_ns_per_sample": -1, "demo": {"mean": 1.5e-3, "p95": 3.3e-3, "max": 0.01},
+         "gltf": {"mean": 1.6e-3, "p95": 3.7e-3, "max": 0.02}}]}, f)
+check("bench", "bench", ["bench", ENVMAP, "--json", "--no-plots", "--repeats", "1", "--directions", "16",
+                         "--representations", "sh3", "--volume-cost", W("volume.json")])
 check("lightmap-audit", "lightmap audit", ["lightmap", "audit", W("lm.exr"), "--json", "--stride", "5"])
 
 # A failing gate still prints its JSON (exit 8): the gates object lists the failure.
