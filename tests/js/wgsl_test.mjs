@@ -142,13 +142,24 @@ function batchParams(e, b, rand) {
   if (isQuantised(e)) {
     p.bits = b === 1 ? 8 : 2 + (b * 3) % 7;
     p.sqrt = ((b >> 1) % 2) === 1;
-    p.l2Bound = (Math.floor(b / 3) % 2) ? 'loose' : 'tight';
     p.dcFormat = ['r11g11b10f', 'rgb9e5', 'half'][b % 3];
     if (e.family !== F.SH2_Q && p.dcFormat === 'half') p.dcFormat = 'rgb9e5';
-    p.zonalMapping = ['affine', 'zero', 'symmetric'][(b >> 1) % 3];
-    p.axisMode = ((b >> 2) % 2) ? 'channel' : 'luminance';
-    flags.push('--bits', String(p.bits), '--bound', p.l2Bound, '--dc', p.dcFormat, '--zonal-map', p.zonalMapping, '--axis', p.axisMode);
+    flags.push('--bits', String(p.bits), '--dc', p.dcFormat);
     if (p.sqrt) flags.push('--sqrt');
+    // `zhc convert` refuses a storage option the entry does not use (cli storage_options_used):
+    // those stay at their defaults, which is what the file's header then holds.
+    if (e.family === F.SH3_Q28) {
+      p.l2Bound = (Math.floor(b / 3) % 2) ? 'loose' : 'tight';
+      flags.push('--bound', p.l2Bound);
+    }
+    if (e.family === F.SH3_Q28 || e.family === F.ZH3_Q16) {
+      p.zonalMapping = ['affine', 'zero', 'symmetric'][(b >> 1) % 3];
+      flags.push('--zonal-map', p.zonalMapping);
+    }
+    if (e.axis === 'header') {
+      p.axisMode = ((b >> 2) % 2) ? 'channel' : 'luminance';
+      flags.push('--axis', p.axisMode);
+    }
   }
   return { p, flags };
 }
