@@ -19,11 +19,11 @@
 // Time bounded: the whole browser part times out after 120 s (Chromium killed).
 import fs from 'node:fs';
 import path from 'node:path';
-import http from 'node:http';
-import { execFile, execFileSync, spawn } from 'node:child_process';
+import { execFile, execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { promisify } from 'node:util';
 import { randomProbes, triangleScene, makeRand, checker } from './fixtures.mjs';
+import { chromiumPages } from './chromium_page.mjs';
 
 const [zhc, workArg, chromiumArg] = process.argv.slice(2);
 if (!zhc || !workArg) {
@@ -113,64 +113,15 @@ const roots = {
   '/test/': path.join(here, 'browser'),
   '/work/': work,
 };
-const types = { '.html': 'text/html', '.mjs': 'text/javascript', '.js': 'text/javascript', '.json': 'application/json', '.glb': 'model/gltf-binary' };
-let resolveResult;
-const result = new Promise((resolve) => { resolveResult = resolve; });
-const served = [];
-const server = http.createServer((req, res) => {
-  const url = new URL(req.url, 'http://127.0.0.1');
-  if (req.method === 'POST' && url.pathname === '/result') {
-    let body = '';
-    req.on('data', (c) => { body += c; });
-    req.on('end', () => { res.end('ok'); resolveResult(body); });
-    return;
-  }
-  const pathname = url.pathname === '/' ? '/test/index.html' : decodeURIComponent(url.pathname);
-  for (const [prefix, dir] of Object.entries(roots)) {
-    if (!pathname.startsWith(prefix)) continue;
-    const file = path.resolve(dir, '.' + pathname.slice(prefix.length - 1));
-    if (!file.startsWith(dir + path.sep) || !fs.existsSync(file) || !fs.statSync(file).isFile()) break;
-    served.push(pathname);
-    res.writeHead(200, { 'Content-Type': types[path.extname(file)] ?? 'application/octet-stream', 'Cache-Control': 'no-store' });
-    res.end(fs.readFileSync(file));
-    return;
-  }
-  res.writeHead(404);
-  res.end();
-  served.push(`404 ${pathname}`);
-});
-await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
-const port = server.address().port;
-const profile = fs.mkdtempSync(path.join(work, 'chromium-profile-'));
-const args = ['--headless=new', '--no-sandbox', '--disable-quic', '--no-first-run', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--disable-default-apps', '--disable-extensions', `--user-data-dir=${profile}`,
-  '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--enable-logging=stderr', '--v=0',
-  `http://127.0.0.1:${port}/test/index.html`];
-const browser = spawn(chromium, args, { detached: true, stdio: ['ignore', 'ignore', 'pipe'] });
-let stderr = '';
-browser.stderr.on('data', (c) => { stderr += c; });
-const timeout = new Promise((resolve) => setTimeout(() => resolve(null), 120000));
-const body = await Promise.race([result, timeout]);
-try { process.kill(-browser.pid, 'SIGKILL'); } catch { /* already gone */ }
-server.close();
-fs.rmSync(profile, { recursive: true, force: true });
-fs.writeFileSync(W('chromium_stderr.txt'), stderr);
+const pages = await chromiumPages({ roots, work, chromium, check, timeoutS: 120 });
+const report = await pages.runPage('index.html', ['--use-angle=swiftshader'], 'index', 'zhc runtime/web page done');
+pages.close();
 
 // --- 4. assertions -----------------------------------------------------------------------------
-check(body !== null, 'the page reported within 120 s');
-if (body === null) {
-  console.log(`served: ${served.join(' ')}`);
-  console.log(stderr.split('\n').slice(-30).join('\n'));
-  process.exit(1);
-}
-const report = JSON.parse(body);
+if (report === null) finish('runtime/web browser');
 console.log(`Chromium: WebGL2 ${report.webgl2}, EXT_color_buffer_float ${report.colorBufferFloat}, renderer "${report.renderer}"`);
 for (const e of report.errors ?? []) console.log(`  page: ${e}`);
 check((report.errors ?? []).length === 0, 'no console error, warning or exception in the page');
-const consoleErrors = stderr.split('\n').filter((l) => /CONSOLE/.test(l) && /(Uncaught|Error)/.test(l));
-for (const l of consoleErrors) console.log(`  chromium: ${l}`);
-check(consoleErrors.length === 0, 'no console error in Chromium\'s log');
-check(/CONSOLE.*zhc runtime\/web page done/.test(stderr), 'the page\'s console output reaches Chromium\'s log (so the check above can fail)');
 check(report.webgl2 === true && report.colorBufferFloat === true, 'WebGL2 with EXT_color_buffer_float');
 check(Array.isArray(report.files) && report.files.length === files.length, 'every file reported');
 // Bound for the shader (float32 arithmetic): every term of E is at most ~2 Y00 |DC| (|L1| <= sqrt(3)

@@ -23,13 +23,13 @@
 // Time bounded: the browser part times out after 120 s (Chromium killed).
 import fs from 'node:fs';
 import path from 'node:path';
-import http from 'node:http';
-import { execFileSync, spawn } from 'node:child_process';
+import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { createDefaultContainer, write } from 'ktx-parse';
 import * as THREE from 'three';
 import { EXRLoader } from 'three/examples/jsm/loaders/EXRLoader.js';
 import { checker } from './fixtures.mjs';
+import { chromiumPages } from './chromium_page.mjs';
 
 const [zhc, workArg, chromiumArg, envmapDir] = process.argv.slice(2);
 if (!zhc || !workArg || !chromiumArg || !envmapDir) {
@@ -121,54 +121,12 @@ const roots = {
   '/test/': path.join(here, 'browser'),
   '/work/': work,
 };
-const types = { '.html': 'text/html', '.mjs': 'text/javascript', '.js': 'text/javascript', '.json': 'application/json' };
-let resolveResult;
-const result = new Promise((resolve) => { resolveResult = resolve; });
-const server = http.createServer((req, res) => {
-  const url = new URL(req.url, 'http://127.0.0.1');
-  if (req.method === 'POST' && url.pathname === '/result') {
-    const chunks = [];
-    req.on('data', (c) => chunks.push(c));
-    req.on('end', () => { res.end('ok'); resolveResult(Buffer.concat(chunks).toString()); });
-    return;
-  }
-  const pathname = decodeURIComponent(url.pathname);
-  for (const [prefix, dir] of Object.entries(roots)) {
-    if (!pathname.startsWith(prefix)) continue;
-    const file = path.resolve(dir, '.' + pathname.slice(prefix.length - 1));
-    if (!file.startsWith(dir + path.sep) || !fs.existsSync(file) || !fs.statSync(file).isFile()) break;
-    res.writeHead(200, { 'Content-Type': types[path.extname(file)] ?? 'application/octet-stream', 'Cache-Control': 'no-store' });
-    res.end(fs.readFileSync(file));
-    return;
-  }
-  res.writeHead(404);
-  res.end();
-});
-await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
-const port = server.address().port;
-const profile = fs.mkdtempSync(path.join(work, 'chromium-profile-'));
-const args = ['--headless=new', '--no-sandbox', '--disable-quic', '--no-first-run', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--disable-default-apps', '--disable-extensions', `--user-data-dir=${profile}`,
-  '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--enable-logging=stderr', '--v=0',
-  `http://127.0.0.1:${port}/test/latlong.html`];
-const browser = spawn(chromiumArg, args, { detached: true, stdio: ['ignore', 'ignore', 'pipe'] });
-let stderr = '';
-browser.stderr.on('data', (c) => { stderr += c; });
-const timeout = new Promise((resolve) => setTimeout(() => resolve(null), 120000));
-const body = await Promise.race([result, timeout]);
-try { process.kill(-browser.pid, 'SIGKILL'); } catch { /* already gone */ }
-server.close();
-fs.rmSync(profile, { recursive: true, force: true });
-fs.writeFileSync(W('chromium_stderr.txt'), stderr);
-check(body !== null, 'the page reported within 120 s');
-if (body === null) {
-  console.log(stderr.split('\n').slice(-30).join('\n'));
-  finish('lat-long');
-}
-const report = JSON.parse(body);
+const pages = await chromiumPages({ roots, work, chromium: chromiumArg, check, timeoutS: 120 });
+const report = await pages.runPage('latlong.html', ['--use-angle=swiftshader'], 'latlong', 'zhc lat-long page done');
+pages.close();
+if (report === null) finish('lat-long');
 for (const e of report.errors ?? []) console.log(`  page: ${e}`);
 check((report.errors ?? []).length === 0, 'no console error, warning or exception in the page');
-check(/CONSOLE.*zhc lat-long page done/.test(stderr), 'the page\'s console output reaches Chromium\'s log');
 check(report.webgl2 === true && Array.isArray(report.maps) && report.maps.length === maps.length, 'WebGL2, every map reported');
 console.log(`three.js r${report.three} in Chromium (WebGL2 ${report.webgl2})`);
 

@@ -5,7 +5,7 @@
 // outFloats, itemFloats, wordCount, 0...], the kernel's `Job` uniform (64 bytes), the ZhcFormat
 // uniform (80 bytes), `wordCount` u32 probe words and `count * itemFloats` f32 item inputs (kernel 0:
 // decode_kernel, kernel 1: volume_kernel of wgsl_kernel.wgsl). POST /job/result: the `count *
-// outFloats` output floats. POST /done: a JSON summary.
+// outFloats` output floats. POST /result: a JSON summary.
 
 const errors = window.zhcErrors;
 const summary = { webgpu: false, adapter: '', jobs: 0, compilation: [], errors };
@@ -92,5 +92,5 @@ try {
   errors.push('exception: ' + (e && e.stack || e));
 }
 console.log('zhc wgsl page done');
-await fetch('/done', { method: 'POST', body: JSON.stringify(summary) });
+await fetch('/result', { method: 'POST', body: JSON.stringify(summary) });
 document.title = 'zhc runtime/zhc.wgsl test: done';
