@@ -247,7 +247,7 @@ Asset shadow_scene(int rotation_component, bool float_scale = true) {
     const size_t child = a.node({{"mesh", mesh}, {"extensions", {{"EXT_mesh_gpu_instancing", {{"attributes", attrs}}}}}}, false);
     a.node({{"translation", {0, 0, 2}}, {"children", {child}}});
     a.doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing", "KHR_lights_punctual"};
-    a.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "directional"}, {"intensity", kPi}}};
+    a.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({json{{"type", "directional"}, {"intensity", kPi}}});
     // -Z turned to -Y: rotation of -90 degrees about +X.
     a.node({{"rotation", {-std::sqrt(0.5), 0, 0, std::sqrt(0.5)}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
     // Probes in zhc axes ((x, y, z)_zhc = (z, x, y)_glTF): under instances 0, 1, 2 and at 15.
@@ -394,7 +394,7 @@ Asset ibl_asset(const std::array<double, 9>& grey, double intensity, const std::
     json light = {{"name", "studio"}, {"irradianceCoefficients", coeffs}, {"specularImageSize", 256}, {"specularImages", json::array()}};
     if (intensity != 1) light["intensity"] = intensity;
     if (!rotation.empty()) light["rotation"] = rotation;
-    a.doc["extensions"]["EXT_lights_image_based"]["lights"] = {light};
+    a.doc["extensions"]["EXT_lights_image_based"]["lights"] = json::array({light});
     a.doc["extensionsUsed"] = {"EXT_lights_image_based"};
     a.doc["scenes"][0]["extensions"]["EXT_lights_image_based"]["light"] = 0;
     return a;
@@ -515,8 +515,8 @@ TEST(GltfImageBasedLight, AddsToTheLightsOfARealFile) {
     for (int i = 0; i < 9; ++i) c.push_back({0.0, 0.0, 0.0});
     c[0] = {kPi * 2 * std::sqrt(kPi), kPi * 2 * std::sqrt(kPi), 0.0};               // constant 1 (red, green)
     c[2] = {0.0, 0.0, 2 * kPi / 3 * 0.5 * std::sqrt(4 * kPi / 3)};                     // 0.5 z_glTF (blue)
-    d["extensions"]["EXT_lights_image_based"]["lights"] = {{{"name", "hand"}, {"intensity", 0.5}, {"irradianceCoefficients", c},
-                                                            {"specularImageSize", 16}, {"specularImages", json::array()}}};
+    d["extensions"]["EXT_lights_image_based"]["lights"] = json::array({json{{"name", "hand"}, {"intensity", 0.5}, {"irradianceCoefficients", c},
+                                                                           {"specularImageSize", 16}, {"specularImages", json::array()}}});
     d["extensionsUsed"].push_back("EXT_lights_image_based");
     d["scenes"][d.value("scene", 0)]["extensions"]["EXT_lights_image_based"]["light"] = 0;
     const std::string t = d.dump(), edited = dir + "/ibl.gltf";
