@@ -33,6 +33,7 @@
 
 #include "codec/probe/codec.h"
 #include "vk_compute.h"
+#include "spirv_count.h"
 #include "timing.h"
 
 namespace {
@@ -122,28 +123,7 @@ Compiled compile(const std::string& dir, const std::string& name, const std::str
         return c;
     if (!run(quote(ZHC_SPIRV_OPT) + " -O " + quote(raw) + " -o " + quote(opt))) return c;
     if (!run(quote(ZHC_SPIRV_DIS) + " --no-header " + quote(opt) + " -o " + quote(dis))) return c;
-    std::ifstream in(dis);
-    std::string line;
-    bool inside = false;
-    int count = 0;
-    while (std::getline(in, line)) {
-        auto has = [&](const char* op) {
-            const std::size_t p = line.find(op);
-            if (p == std::string::npos) return false;
-            const std::size_t e = p + std::strlen(op);
-            return e == line.size() || line[e] == ' ';
-        };
-        if (has("OpFunction")) {
-            inside = true;
-            continue;
-        }
-        if (has("OpFunctionEnd")) {
-            inside = false;
-            continue;
-        }
-        if (!inside || has("OpFunctionParameter") || has("OpLabel")) continue;
-        if (line.find_first_not_of(' ') != std::string::npos) ++count;
-    }
+    const int count = bench::spirv_function_instructions(dis);
     c.instructions = count;
     c.spirv = vk::read_spirv(opt);
     return c;

@@ -46,6 +46,7 @@
 #include "runtime/zhc_runtime.h"
 #include "runtime/zhc_volume_layouts.hpp"
 #include "tests/vk/volume_kernels.h"
+#include "spirv_count.h"
 #include "timing.h"
 #ifdef ZHC_VK_TIMING
 #include <vulkan/vulkan.h>
@@ -138,28 +139,7 @@ int spirv_instructions(const std::string& dir, const std::string& name, const st
         return -1;
     if (!run(quote(ZHC_SPIRV_OPT) + " -O " + quote(raw) + " -o " + quote(opt))) return -1;
     if (!run(quote(ZHC_SPIRV_DIS) + " --no-header " + quote(opt) + " -o " + quote(dis))) return -1;
-    std::ifstream in(dis);
-    std::string line;
-    bool inside = false;
-    int count = 0;
-    while (std::getline(in, line)) {
-        auto has = [&](const char* op) {
-            const std::size_t q = line.find(op);
-            if (q == std::string::npos) return false;
-            const std::size_t e = q + std::strlen(op);
-            return e == line.size() || line[e] == ' ';
-        };
-        if (has("OpFunction")) {
-            inside = true;
-            continue;
-        }
-        if (has("OpFunctionEnd")) {
-            inside = false;
-            continue;
-        }
-        if (!inside || has("OpFunctionParameter") || has("OpLabel")) continue;
-        if (line.find_first_not_of(' ') != std::string::npos) ++count;
-    }
+    const int count = bench::spirv_function_instructions(dis);
 #ifdef ZHC_VK_TIMING
     if (words) *words = vk::read_spirv(opt);
 #else
