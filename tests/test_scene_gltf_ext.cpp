@@ -15,6 +15,7 @@
 #include "formats/io/file_io.h"
 #include "formats/probes/probe_file.h"
 #include "formats/scene/scene_gltf.h"
+#include "formats/report/html_report.h"
 #include "support.h"
 
 namespace zhc {
@@ -31,19 +32,7 @@ void copy_gt_list(const std::string& dir) {
         fs::copy_file(data(f), dir + "/" + f, fs::copy_options::overwrite_existing);
 }
 
-std::string base64(const std::vector<std::uint8_t>& b) {
-    static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (size_t i = 0; i < b.size(); i += 3) {
-        const std::uint32_t v = std::uint32_t(b[i]) << 16 | (i + 1 < b.size() ? std::uint32_t(b[i + 1]) << 8 : 0) |
-                                (i + 2 < b.size() ? std::uint32_t(b[i + 2]) : 0);
-        out += k[(v >> 18) & 63];
-        out += k[(v >> 12) & 63];
-        out += i + 1 < b.size() ? k[(v >> 6) & 63] : '=';
-        out += i + 2 < b.size() ? k[v & 63] : '=';
-    }
-    return out;
-}
+std::string base64(const std::vector<std::uint8_t>& b) { return base64_encode(b); }  // formats/report/html_report.h
 
 // A glTF asset written by hand: one data-URI buffer, accessors appended as needed.
 struct Asset {
