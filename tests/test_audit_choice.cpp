@@ -7,6 +7,9 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "codec/report/choice.h"
 #include "formats/report/audit_inputs.h"
@@ -276,6 +279,98 @@ TEST(AuditChoice, SampleMapsNonnegativeChoicesNeverGoNegativeOnAnyInput) {
     }
     // On these maps the unconstrained winners (sh3_q28, sh3) go negative somewhere: the constraint changes them.
     EXPECT_GE(differ, 1u);
+}
+
+// The CLI: constraints that need what the run lacks are usage errors; every output ends with (or,
+// in HTML, holds) the choice section, and the outputs agree on it.
+TEST(AuditChoice, CliRefusesConstraintsItCannotTest) {
+    const std::string map = test::envmap_paths()[0];
+    const std::vector<std::string> base{"audit", map, "--no-timing", "--directions", "64", "-r", "sh3,zh3_q16"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = base;
+        args.insert(args.end(), extra.begin(), extra.end());
+        return test::run_zhc(args);
+    };
+    const auto no_cost = with({"--max-instructions", "100"});
+    EXPECT_EQ(no_cost.exit_code, 2);
+    EXPECT_NE(no_cost.err.find("--max-instructions: needs --runtime-cost"), std::string::npos) << no_cost.err;
+    const auto no_time = with({"--max-encode-us", "5"});
+    EXPECT_EQ(no_time.exit_code, 2);
+    EXPECT_NE(no_time.err.find("--no-timing"), std::string::npos) << no_time.err;
+    EXPECT_EQ(with({"--require", "positive"}).exit_code, 2);
+    EXPECT_EQ(with({"--budget", "0"}).exit_code, 2);
+    EXPECT_EQ(with({"--budget", "-16"}).exit_code, 2);
+    EXPECT_EQ(with({"--max-instructions", "-1"}).exit_code, 2);
+}
+
+TEST(AuditChoice, CliTextMarkdownHtmlAndJsonCarryTheSameChoice) {
+    const std::string map = test::envmap_paths()[0];
+    const std::string dir = test::fresh_dir("audit_choice_cli");
+    const std::vector<std::string> args{"audit", map, "--no-timing", "--directions", "64", "-r", "sh3,sh2,zh3_q16,zh3_dering_q16",
+                                        "--budget", "8", "--require", "nonnegative"};
+    std::vector<std::string> files = args;
+    files.insert(files.end(), {"--markdown", dir + "/a.md", "--html", dir + "/a.html"});
+    const auto text = test::run_zhc(files);
+    ASSERT_EQ(text.exit_code, 0) << text.err;
+    std::vector<std::string> json_args = args;
+    json_args.push_back("--json");
+    const auto json = test::run_zhc(json_args);
+    ASSERT_EQ(json.exit_code, 0) << json.err;
+    // The in-process result for the same input: the CLI prints what choose_representations says.
+    std::vector<const Codec*> cs;
+    for (const char* n : {"sh3", "sh2", "zh3_q16", "zh3_dering_q16"}) cs.push_back(find_codec(n));
+    AuditOptions o;
+    o.timing = false;
+    auto got = audit_files({map}, fibonacci_sphere(64), cs, o, AuditLoadOptions{});
+    ASSERT_TRUE(got.ok());
+    ChoiceConstraints c;
+    c.nonnegative = true;
+    const ChoiceResult r = choose_representations(got->run.inputs, got->run.aggregate, {}, false, c, choice_budgets({8}));
+    const std::vector<std::uint8_t> md_bytes = test::read_bytes(dir + "/a.md");
+    const std::string md(md_bytes.begin(), md_bytes.end());
+    const std::vector<std::uint8_t> html_bytes = test::read_bytes(dir + "/a.html");
+    const std::string html(html_bytes.begin(), html_bytes.end());
+    // Text: the section is last, after the aggregate; Markdown: a "## Choice" section last.
+    const std::size_t at_text = text.out.find("\nchoice: ");
+    ASSERT_NE(at_text, std::string::npos);
+    EXPECT_NE(text.out.find("constraints (non-negative on every input)", at_text), std::string::npos);
+    const std::size_t at_md = md.find("\n## Choice\n");
+    ASSERT_NE(at_md, std::string::npos);
+    EXPECT_EQ(md.find("\n## ", at_md + 1), std::string::npos);
+    EXPECT_NE(html.find("<section id=\"choice\">"), std::string::npos);
+    const nlohmann::json doc = nlohmann::json::parse(json.out);
+    const nlohmann::json& budgets = doc.at("choice").at("budgets");
+    ASSERT_EQ(budgets.size(), r.budgets.size());
+    EXPECT_EQ(doc["choice"]["constraints"]["nonnegative"], true);
+    for (std::size_t i = 0; i < r.budgets.size(); ++i) {
+        const BudgetChoice& b = r.budgets[i];
+        const std::string budget = std::to_string(b.budget);
+        // The Markdown row of this budget: its cells, trimmed.
+        const std::size_t row = md.find("\n| " + budget + " ", at_md);
+        ASSERT_NE(row, std::string::npos) << budget;
+        std::vector<std::string> cells;
+        std::istringstream line(md.substr(row + 1, md.find('\n', row + 1) - row - 1));
+        for (std::string cell; std::getline(line, cell, '|');) {
+            const std::size_t a = cell.find_first_not_of(' '), e = cell.find_last_not_of(' ');
+            if (a != std::string::npos) cells.push_back(cell.substr(a, e - a + 1));
+        }
+        ASSERT_EQ(cells.size(), 9u) << md.substr(row, 120);
+        EXPECT_EQ(cells[1], name_of(r, b.choice));
+        EXPECT_EQ(cells[4], b.runner_up < 0 ? "-" : name_of(r, b.runner_up));
+        // JSON: the same choice and runner-up.
+        EXPECT_EQ(budgets[i]["budget_bytes"], b.budget);
+        EXPECT_EQ(budgets[i]["choice"].is_null() ? "none" : budgets[i]["choice"]["representation"].get<std::string>(),
+                  name_of(r, b.choice));
+        EXPECT_EQ(budgets[i]["runner_up"].is_null() ? "none" : budgets[i]["runner_up"]["representation"].get<std::string>(),
+                  name_of(r, b.runner_up));
+        if (b.choice >= 0) {
+            EXPECT_EQ(budgets[i]["choice"]["max_negative_fraction"], 0.0);
+        } else {
+            EXPECT_NE(text.out.find(budget + " bytes: none: "), std::string::npos);
+        }
+    }
+    EXPECT_EQ(name_of(r, at(r, 8).choice), "none");
+    EXPECT_EQ(name_of(r, at(r, 108).choice), "sh3");  // the only quadratic SH of the four, non-negative on this map
 }
 
 }  // namespace
