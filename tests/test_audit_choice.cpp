@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "codec/bake/scene.h"
 #include "codec/report/choice.h"
 #include "formats/report/audit_inputs.h"
 #include "support.h"
@@ -371,6 +372,62 @@ TEST(AuditChoice, CliTextMarkdownHtmlAndJsonCarryTheSameChoice) {
     }
     EXPECT_EQ(name_of(r, at(r, 8).choice), "none");
     EXPECT_EQ(name_of(r, at(r, 108).choice), "sh3");  // the only quadratic SH of the four, non-negative on this map
+}
+
+// zhc demo prints the choice on its baked grid (the same code: recomputed here from a bake of the
+// default scene) and says why it embeds zh3_q16; audit.md carries the same section.
+TEST(AuditChoice, DemoPrintsItsChoiceAndWhyItEmbedsZh3Q16) {
+    const std::string dir = test::fresh_dir("audit_choice_demo");
+    const auto run = test::run_zhc({"demo", "-o", dir, "--directions", "64", "--threads", "2"});
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    BakeOptions bo;
+    bo.threads = 2;
+    auto baked = bake_scene(default_scene(), bo, nullptr);
+    ASSERT_TRUE(baked.ok());
+    AuditInput grid;
+    grid.path = "baked grid";
+    grid.kind = "probes";
+    grid.probes = *baked;
+    std::vector<const Codec*> all;
+    for (const Codec& c : codecs()) all.push_back(&c);
+    AuditOptions o;
+    o.timing = false;
+    const std::vector<InputAudit> audited{audit_input(grid, fibonacci_sphere(64), all, o)};
+    const ChoiceResult r = choose_representations(audited, aggregate_inputs(audited), {}, false, {}, choice_budgets({}));
+    const std::vector<std::uint8_t> md_bytes = test::read_bytes(dir + "/audit.md");
+    const std::string md(md_bytes.begin(), md_bytes.end());
+    ASSERT_NE(md.find("\n## Choice\n"), std::string::npos);
+    for (const auto& row : choice_table(r)) {
+        // Every printed row's cells, in order, on one line of stdout and of audit.md.
+        std::string joined;
+        for (const std::string& cell : row) joined += cell + " ";
+        bool in_text = false, in_md = false;
+        std::istringstream out(run.out + "\n" + md);
+        for (std::string line; std::getline(out, line);) {
+            std::istringstream cells(line);
+            std::string got;
+            for (std::string w; cells >> w;)
+                if (w != "|") got += w + " ";
+            if (got == joined) (line.rfind("|", 0) == 0 ? in_md : in_text) = true;
+        }
+        EXPECT_TRUE(in_text) << joined;
+        EXPECT_TRUE(in_md) << joined;
+    }
+    // sh3 is the reference (the baked SH3): exact, the 108-byte choice.
+    EXPECT_EQ(name_of(r, at(r, 108).choice), "sh3");
+    EXPECT_EQ(r.candidates[at(r, 108).choice].error, 0.0);
+    const std::string best16 = name_of(r, at(r, 16).choice);
+    const std::size_t embedded = run.out.find("\nembedded: zh3_q16 (probes_zh3_q16.zhp, probes.glb)");
+    ASSERT_NE(embedded, std::string::npos) << run.out;
+    if (best16 == "zh3_q16") {
+        EXPECT_NE(run.out.find("the 16-byte choice on this scene.", embedded), std::string::npos);
+    } else {
+        EXPECT_NE(run.out.find("the 16-byte choice on this scene is " + best16, embedded), std::string::npos);
+        EXPECT_NE(run.out.find("-r " + best16, embedded), std::string::npos);  // how to embed it instead
+    }
+    EXPECT_NE(md.find("Embedded: zh3_q16"), std::string::npos);
+    const std::vector<std::uint8_t> html = test::read_bytes(dir + "/report.html");
+    EXPECT_NE(std::string(html.begin(), html.end()).find("<section id=\"choice\">"), std::string::npos);
 }
 
 }  // namespace
