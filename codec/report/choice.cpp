@@ -93,7 +93,8 @@ ChoiceResult choose_representations(const std::vector<InputAudit>& inputs,
         if (!ranked.empty()) {
             b.choice = ranked[0];
             const ChoiceCandidate& k = out.candidates[b.choice];
-            b.reason = "lowest relative rmse of the " + count_of(b.qualifying, "representation", "representations") +
+            b.reason = (b.qualifying == 1 ? std::string("the only representation")
+                                          : "lowest relative rmse of the " + std::to_string(b.qualifying) + " representations") +
                        " of at most " + std::to_string(budget) + " bytes" +
                        (constraints.any() ? " meeting the constraints" : "") + " (" + fmt(k.error) + ")";
             if (ranked.size() > 1) {
