@@ -14,6 +14,10 @@
 // Among the qualifying representations the lowest error wins; ties go to fewer bytes, then to
 // the codec-table order (so the choice is deterministic). The runner-up is the next one in that
 // order; the margin is the runner-up's error minus the choice's.
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <cstddef>
