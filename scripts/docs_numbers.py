@@ -137,12 +137,37 @@ def gen_demo_report(ctx):
     return "%.1f MB" % (os.path.getsize(os.path.join(ctx["tmp"], "demo", "report.html")) / 1e6)
 
 
+AUDIT_ZH3_Q16 = ["zh3_q16", "zh3_solved_q16", "zh3_channel_q16", "zh3_solved_channel_q16", "zh3_solved_channel"]
+
+
+def gen_audit_zh3_q16(ctx):
+    reprs = ["sh2"] + AUDIT_ZH3_Q16
+    args = ["--json", "--threads", "1", "-r", ",".join(reprs)]
+    out = subprocess.run([ctx["zhc"], "audit", ctx["maps"]] + args, check=True, stdout=subprocess.PIPE, cwd=ctx["tmp"]).stdout
+    d = json.loads(out)
+    rows = ["| representation | bytes | mean ratio to sh2 | worst ratio | encode us/probe (median over maps) |",
+            "| --- | --- | --- | --- | --- |"]
+    for name in AUDIT_ZH3_Q16:
+        ratios = [f["representations"][name]["rmse"] / f["representations"]["sh2"]["rmse"] for f in d["files"]]
+        enc = sorted(f["representations"][name]["encode_ns"] for f in d["files"])
+        bytes_ = d["files"][0]["representations"][name]["bytes_per_probe"]
+        label = "`%s`%s" % (name, "" if bytes_ == 16 else " (float, for reference)")
+        us = enc[len(enc) // 2] / 1e3
+        rows.append("| %s | %d | %.4f | %.3f | %s |" % (label, bytes_, sum(ratios) / len(ratios), max(ratios),
+                                                   "%.2f" % us if us < 1 else "%.1f" % us if us < 10 else "%.0f" % us))
+    return "\n".join([header("zhc audit examples/maps " + " ".join(args)),
+                      "Irradiance RMSE against each map's true irradiance (%d directions), as a ratio to `sh2`'s RMSE "
+                      "on the same map, over the %d sample maps; encode time from the same run, one thread." % (d["directions"], len(d["files"])),
+                      ""] + rows)
+
+
 # command (as written in the marker) -> generator
 GENERATORS = {
     "bench_bake --json": gen_bench_bake,
     "bench_runtime --json": gen_bench_runtime,
     "zhc lightmap encode (2048 x 2048)": gen_lightmap_encode,
     "zhc demo (size of report.html)": gen_demo_report,
+    "zhc audit --json (16-byte ZH3 entries)": gen_audit_zh3_q16,
 }
 
 
