@@ -15,6 +15,7 @@ The rule (also in the README's "Development" section):
   * each Markdown file's examples run in order, in one fresh folder per file, with `examples/` there
     holding the checked-in and generated inputs (scripts/make_examples.sh) and `zhc` on PATH, each
     through `bash -o pipefail -c`; a later example may read what an earlier one of the same file wrote;
+  * paths in an example are relative and stay in its folder (no `/...`, no `../...`);
   * no example changes a file it names as an input (an argument that exists before it runs and is
     not the value of -o/--output/--html/--markdown/--images/--plots or a `>` redirection), and no
     example changes anything under examples/.
@@ -80,6 +81,14 @@ def parse(path, text):
             e = re.match(r"exit (\d+)\b", comment)
             if e:
                 exit_code = int(e.group(1))
+        try:
+            outside = [w for w in words_of(stripped) if w.startswith("/") or w.startswith("../")]
+        except ValueError as e:
+            outside = []
+            problems.append("%s:%d: cannot split the command into words: %s" % (path, n, e))
+        if outside:
+            problems.append("%s:%d: %s: paths must be relative and stay in the folder the example runs in"
+                            % (path, n, ", ".join(outside)))
         examples.append(Example(path, n, stripped, exit_code))
     if fence is not None:
         problems.append("%s: a fenced block is not closed" % path)
@@ -249,15 +258,18 @@ def self_test():
         "```bash",                                # 18
         "zhc convert a.zhp -o 'my out.json' > log.txt   # exit 3 hmm",  # 19
         "```",                                    # 20
+        "```sh",                                  # 21
+        "zhc demo -o /tmp/demo",                  # 22: absolute path: a problem
+        "```",                                    # 23
     ])
     ex, pr = parse("t.md", text)
     got = [(e.line, e.exit_code) for e in ex]
     ok = True
-    if got != [(2, 0), (4, 8), (19, 3)]:
-        print("self-test: examples %s, expected [(2, 0), (4, 8), (19, 3)]" % got)
+    if got != [(2, 0), (4, 8), (19, 3), (22, 0)]:
+        print("self-test: examples %s, expected [(2, 0), (4, 8), (19, 3), (22, 0)]" % got)
         ok = False
-    if len(pr) != 1 or "t.md:12" not in pr[0]:
-        print("self-test: problems %s, expected one at t.md:12" % pr)
+    if len(pr) != 2 or "t.md:12" not in pr[0] or "t.md:22" not in pr[1]:
+        print("self-test: problems %s, expected one at t.md:12 and one at t.md:22" % pr)
         ok = False
     d = tempfile.mkdtemp()
     try:
