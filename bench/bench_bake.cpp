@@ -1,4 +1,4 @@
-// Scene-bake throughput, plain timing main: ./build/bench/bench_bake [probes_per_axis]
+// Scene-bake throughput, plain timing main: ./build/bench/bench_bake [probes_per_axis] [--json FILE]
 //
 //  * closed-form scenes: probe-lights per second on ONE thread, per light type and for a mixed
 //    scene, against the target of 10^6 per second per core (ratio printed), and against a floor
@@ -8,11 +8,15 @@
 //  * triangle meshes: a tessellated sphere of ~20k triangles (and ~200k) as the occluder of a
 //    sun: BVH build time, rays per second through the whole bake, the BVH query alone, and brute
 //    force over every triangle on a subset of the same rays.
-// Medians over 5 runs; the spread (min..max) is printed. Numbers never gate tests.
+// Medians over 5 runs in the thread's CPU time (one thread throughout, so a loaded machine slows the
+// run, not the numbers); the spread (min..max) is printed. Numbers never gate tests.
+// --json FILE also writes the numbers as one JSON object (scripts/docs_numbers.py makes docs tables of it).
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <random>
+#include <string>
 
 #include "codec/bake/occluders.h"
 #include "codec/bake/scene.h"
@@ -52,13 +56,39 @@ double probe_count(const Scene& s) {
     return double(s.probes.counts[0]) * s.probes.counts[1] * s.probes.counts[2];
 }
 
+// printf into a std::string (the --json rows).
+template <class... A>
+std::string format(const char* f, A... a) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf, f, a...);
+    return buf;
+}
+
+std::string join(const std::vector<std::string>& rows) {
+    std::string s;
+    for (size_t i = 0; i < rows.size(); ++i) s += (i ? ",\n    " : "\n    ") + rows[i];
+    return s + "\n  ";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-    const std::uint32_t n = argc > 1 ? static_cast<std::uint32_t>(std::atoi(argv[1])) : 64;
+    std::uint32_t n = 64;
+    std::string json;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--json" && i + 1 < argc) json = argv[++i];
+        else if (std::atoi(a.c_str()) >= 4) n = static_cast<std::uint32_t>(std::atoi(a.c_str()));
+        else {
+            std::fprintf(stderr, "usage: %s [probes_per_axis >= 4] [--json FILE]\n", argv[0]);
+            return 2;
+        }
+    }
+    std::vector<std::string> closed_rows, occluded_rows, mesh_rows;
+    double floor_rate = 0;
     const int lights = 16, repeats = 5;
     const double target = 1e6;
-    std::printf("bench_bake: %ux%ux%u probes, %d lights per scene, 1 thread, median of %d runs\n\n", n, n,
+    std::printf("bench_bake: %ux%ux%u probes, %d lights per scene, 1 thread, median of %d runs (thread CPU time)\n\n", n, n,
                 std::max<std::uint32_t>(1, n / 4), lights, repeats);
 
     // Floor: one basis evaluation and 27 multiply-adds per probe-light.
@@ -66,7 +96,7 @@ int main(int argc, char** argv) {
         const Scene s = grid_scene(n);
         const std::vector<Vec3> pos = probe_positions(s.probes);
         std::vector<double> acc(pos.size() * 27);
-        const auto t = bench::time_repeats(repeats, [&] {
+        const auto t = bench::time_repeats_cpu(repeats, [&] {
             for (int l = 0; l < lights; ++l)
                 for (size_t p = 0; p < pos.size(); ++p) {
                     const auto y = sh3_basis(normalize_or(pos[p] - Vec3{1.0 * l, 2, 3}, {0, 0, 1}));
@@ -74,8 +104,9 @@ int main(int argc, char** argv) {
                 }
             bench::keep(acc);
         });
+        floor_rate = pos.size() * lights / t.median_s;
         std::printf("floor (basis + 27 madds)   %10.3g probe-lights/s  (%.1f ns each)\n\n",
-                    pos.size() * lights / t.median_s, t.median_s * 1e9 / (pos.size() * lights));
+                    floor_rate, t.median_s * 1e9 / (pos.size() * lights));
     }
 
     std::printf("%-24s %14s %9s %10s %18s\n", "closed form", "probe-lights/s", "ns each", "vs 1e6/s", "spread (ms)");
@@ -99,10 +130,12 @@ int main(int argc, char** argv) {
             if (std::string(c.name) == "directional (delta)") l.angular_radius_rad = 0;
             s.lights.push_back(l);
         }
-        const auto t = bench::time_repeats(repeats, [&] { bench::keep(bake_scene(s)); });
+        const auto t = bench::time_repeats_cpu(repeats, [&] { bench::keep(bake_scene(s)); });
         const double rate = probe_count(s) * lights / t.median_s;
         std::printf("%-24s %14.3g %9.1f %9.2fx %8.1f..%-8.1f\n", c.name, rate, 1e9 / rate, rate / target,
                     t.min_s * 1e3, t.max_s * 1e3);
+        closed_rows.push_back(format("{\"case\": \"%s\", \"probe_lights_per_s\": %.6g, \"ns_each\": %.4g, \"vs_target\": %.4g}",
+                                     c.name, rate, 1e9 / rate, rate / target));
     }
 
     std::printf("\n%-40s %12s %12s %10s\n", "occluded", "rays/s", "ns per ray", "ms");
@@ -110,10 +143,12 @@ int main(int argc, char** argv) {
         Scene s = default_scene();
         s.probes.counts = {n, n, std::max<std::uint32_t>(1, n / 4)};
         BakeReport rep;
-        const auto t = bench::time_repeats(repeats, [&] { bench::keep(bake_scene(s, {}, &rep)); });
+        const auto t = bench::time_repeats_cpu(repeats, [&] { bench::keep(bake_scene(s, {}, &rep)); });
         std::printf("%-40s %12.3g %12.1f %10.1f  (%llu rays; whole bake incl. closed forms)\n",
                     "default scene (2 occluders, 3 traced)", rep.rays / t.median_s, t.median_s * 1e9 / rep.rays,
                     t.median_s * 1e3, static_cast<unsigned long long>(rep.rays));
+        occluded_rows.push_back(format("{\"case\": \"default scene\", \"rays\": %llu, \"rays_per_s\": %.6g}",
+                                       static_cast<unsigned long long>(rep.rays), rep.rays / t.median_s));
     }
     {
         std::mt19937 rng(3);
@@ -135,7 +170,7 @@ int main(int argc, char** argv) {
         sun.shadow_samples = 64;
         s.lights = {sun};
         BakeReport rep;
-        const auto t = bench::time_repeats(repeats, [&] { bench::keep(bake_scene(s, {}, &rep)); });
+        const auto t = bench::time_repeats_cpu(repeats, [&] { bench::keep(bake_scene(s, {}, &rep)); });
         std::printf("%-40s %12.3g %12.1f %10.1f  (%llu rays)\n", "1000 random occluders, sun 64 samples",
                     rep.rays / t.median_s, t.median_s * 1e9 / rep.rays, t.median_s * 1e3,
                     static_cast<unsigned long long>(rep.rays));
@@ -144,7 +179,7 @@ int main(int argc, char** argv) {
         const auto dirs = cone_sample_directions(sun.direction, sun.angular_radius_rad, 64);
         const size_t probes = std::min<size_t>(pos.size(), 512);
         int hits = 0;
-        const auto tb = bench::time_repeats(3, [&] {
+        const auto tb = bench::time_repeats_cpu(3, [&] {
             for (size_t p = 0; p < probes; ++p)
                 for (const Vec3& d : dirs) {
                     bool h = false;
@@ -155,6 +190,10 @@ int main(int argc, char** argv) {
         bench::keep(hits);
         std::printf("%-40s %12.3g %12.1f\n", "  same rays, brute force (no BVH)", probes * 64 / tb.median_s,
                     tb.median_s * 1e9 / (probes * 64));
+        occluded_rows.push_back(format("{\"case\": \"1000 random occluders\", \"rays\": %llu, \"rays_per_s\": %.6g, "
+                                       "\"brute_force_rays_per_s\": %.6g}",
+                                       static_cast<unsigned long long>(rep.rays), rep.rays / t.median_s,
+                                       probes * 64 / tb.median_s));
     }
     std::printf("\n%-40s %12s %12s %10s\n", "triangle-mesh occluder", "rays/s", "ns per ray", "ms");
     for (const int res : {100, 316}) {
@@ -169,9 +208,9 @@ int main(int argc, char** argv) {
         sun.shadow_samples = 64;
         s.lights = {sun};
         const size_t tris = s.occluders.size();
-        const auto tb0 = bench::time_repeats(3, [&] { bench::keep(OccluderBvh(s.occluders)); });
+        const auto tb0 = bench::time_repeats_cpu(3, [&] { bench::keep(OccluderBvh(s.occluders)); });
         BakeReport rep;
-        const auto t = bench::time_repeats(repeats, [&] { bench::keep(bake_scene(s, {}, &rep)); });
+        const auto t = bench::time_repeats_cpu(repeats, [&] { bench::keep(bake_scene(s, {}, &rep)); });
         char label[96];
         std::snprintf(label, sizeof label, "sphere mesh %zu tris, sun 64 samples", tris);
         std::printf("%-40s %12.3g %12.1f %10.1f  (%llu rays, whole bake; BVH build %.1f ms)\n", label,
@@ -183,7 +222,7 @@ int main(int argc, char** argv) {
         const std::vector<Vec3> pos = probe_positions(s.probes);
         const auto dirs = cone_sample_directions(sun.direction, sun.angular_radius_rad, 64);
         long hits = 0;
-        const auto tq = bench::time_repeats(repeats, [&] {
+        const auto tq = bench::time_repeats_cpu(repeats, [&] {
             for (const Vec3& p : pos)
                 for (const Vec3& d : dirs) hits += bvh.occluded(p, d, 1e-9, 1e30);
         });
@@ -192,7 +231,7 @@ int main(int argc, char** argv) {
                     1e9 / query_rate, tq.median_s * 1e3, 100.0 * hits / repeats / (double(pos.size()) * dirs.size()));
         const size_t probes = std::min<size_t>(pos.size(), res > 200 ? 8 : 64);
         long bhits = 0;
-        const auto tbf = bench::time_repeats(3, [&] {
+        const auto tbf = bench::time_repeats_cpu(3, [&] {
             for (size_t p = 0; p < probes; ++p)
                 for (const Vec3& d : dirs) {
                     bool h = false;
@@ -208,6 +247,18 @@ int main(int argc, char** argv) {
         const double brute_rate = double(probes) * dirs.size() / tbf.median_s;
         std::printf("%-40s %12.3g %12.1f %10s  (BVH query %.0fx faster)\n", "  brute force (early exit)", brute_rate,
                     1e9 / brute_rate, "", query_rate / brute_rate);
+        mesh_rows.push_back(format("{\"triangles\": %zu, \"bvh_build_ms\": %.4g, \"rays\": %llu, \"bake_rays_per_s\": %.6g, "
+                                   "\"query_rays_per_s\": %.6g, \"blocked_fraction\": %.4f, \"brute_force_rays_per_s\": %.6g}",
+                                   tris, tb0.median_s * 1e3, static_cast<unsigned long long>(rep.rays), rep.rays / t.median_s,
+                                   query_rate, double(hits) / repeats / (double(pos.size()) * dirs.size()), brute_rate));
+    }
+    if (!json.empty()) {
+        std::ofstream out(json);
+        out << "{\n  \"benchmark\": \"bake\",\n"
+            << format("  \"probes_per_axis\": %u, \"lights\": %d, \"repeats\": %d, \"threads\": 1, \"clock\": \"thread_cpu\",\n", n, lights, repeats)
+            << format("  \"floor_probe_lights_per_s\": %.6g,\n", floor_rate) << "  \"closed_form\": [" << join(closed_rows)
+            << "],\n  \"occluded\": [" << join(occluded_rows) << "],\n  \"meshes\": [" << join(mesh_rows).substr(0, join(mesh_rows).size() - 2);
+        if (!bench::finish_json(out, json)) return 1;
     }
     return 0;
 }

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <time.h>
+
 namespace zhc::bench {
 
 struct Timing {
@@ -22,6 +24,25 @@ Timing time_repeats(int repeats, F&& fn) {
         const auto a = std::chrono::steady_clock::now();
         fn();
         t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count());
+    }
+    std::sort(t.begin(), t.end());
+    return {t[t.size() / 2], t.front(), t.back()};
+}
+
+// The same in CPU time of the calling thread (CLOCK_THREAD_CPUTIME_ID): for single-threaded work on a
+// shared machine, where wall time also counts the time other processes held the core.
+template <class F>
+Timing time_repeats_cpu(int repeats, F&& fn) {
+    auto now = [] {
+        timespec ts{};
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+        return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+    };
+    std::vector<double> t;
+    for (int i = 0; i < repeats; ++i) {
+        const double a = now();
+        fn();
+        t.push_back(now() - a);
     }
     std::sort(t.begin(), t.end());
     return {t[t.size() / 2], t.front(), t.back()};
