@@ -241,6 +241,29 @@ TEST(SkyOcclusion, SameBytesForAnyThreadCount) {
     EXPECT_EQ(r1.mask_rays, r4.mask_rays);
 }
 
+TEST(SkyOcclusion, DefaultSceneRoofDimsTheSkyBelowIt) {
+    // The demo's scene: its roof (x, y < 0.5, z 3.6..3.8) and sphere only ever remove sky (the
+    // gradient sky is positive everywhere), and the top layer under the roof loses most of it.
+    const Scene s = default_scene();
+    Scene open = s;
+    open.occlusion.sky_samples = 0;
+    const auto occ = bake(s), ref = bake(open);
+    const auto pos = probe_positions(s.probes);
+    ASSERT_EQ(occ.size(), ref.size());
+    int under_roof = 0;
+    for (size_t i = 0; i < occ.size(); ++i) {
+        const double lost = double(ref[i][0][2]) - occ[i][0][2];  // blue L00
+        EXPECT_GE(lost, -1e-5) << i;
+        if (pos[i].x < 0 && pos[i].y < 0 && pos[i].z > 3) {
+            ++under_roof;
+            // The sky's blue L00 is 2 sqrt(pi) x its mean blue radiance; the roof hides most of the
+            // upper hemisphere from the top layer (0.35..0.55 below it).
+            EXPECT_GT(lost, 0.3 * project_gradient_sky(GradientSky{})[0][2]) << i;
+        }
+    }
+    EXPECT_EQ(under_roof, 16);
+}
+
 // ---- validity and dilation --------------------------------------------------------------------
 
 TEST(ProbeValidity, ProbesInsideABoxOrAClosedMeshAreInvalidAndDilated) {

@@ -124,7 +124,8 @@ struct Scene {
 };
 
 // The built-in default scene of `zhc demo`: the default gradient sky and sun (codec/bake/sky.h), three
-// coloured sphere lights, a box occluder under the sun and a sphere occluder, 8 x 8 x 4 probes.
+// coloured sphere lights, a box occluder under the sun and a sphere occluder (both also occlude
+// the sky), 8 x 8 x 4 probes.
 Scene default_scene();
 
 // Probe positions in index order (grid: x fastest, then y, then z) and the container layout.
