@@ -18,14 +18,15 @@
 //    the whole sphere (L00 only);
 //  * hemisphere light: constant radiance over the hemisphere around `direction` (Eq. 15, pi/2).
 //
-// Occluders (spheres, axis-aligned boxes, triangles of meshes) only matter for lights with
-// `shadows` on. Then:
+// Occluders (spheres, axis-aligned boxes, triangles of meshes) shadow the lights with `shadows`
+// on, and occlude the sky and the environment (below). Lights:
 //  * point, spot and zero-radius directional lights: one shadow ray (to the light / to infinity);
 //  * cone lights (sun with a radius, sphere lights, hemisphere lights): a fixed set of
 //    `shadow_samples` equal-solid-angle directions inside the cone (a spherical-Fibonacci spiral
 //    over the cap). The occluded samples' projection (each weighted by cone solid angle / N) is
 //    subtracted from the closed form; all samples visible -> the closed form exactly; all blocked
 //    -> exactly zero.
+//
 // Sky and environment occlusion (docs/scene.md "Probes near geometry"): with occluders and
 // `occlusion.sky_samples` = N > 0, each probe casts N fixed equal-area directions over the sphere
 // (a spherical-Fibonacci spiral); the blocked directions' projection, sum_k (4 pi / N) L(d_k) Y(d_k)
@@ -38,7 +39,8 @@
 // cell's centre region to the probe.
 //
 // Determinism: every probe is computed by itself with the effects in scene order, summed in
-// double, so the result is the same bytes whatever the thread count.
+// double; dilation reads only baked valid probes; so the result is the same bytes whatever the
+// thread count.
 #pragma once
 
 #include <array>
