@@ -7,10 +7,16 @@
 //    for 1000 random spheres/boxes (BVH stress), plus the brute-force (no BVH) rate for contrast;
 //  * triangle meshes: a tessellated sphere of ~20k triangles (and ~200k) as the occluder of a
 //    sun: BVH build time, rays per second through the whole bake, the BVH query alone, and brute
-//    force over every triangle on a subset of the same rays.
-// Medians over 5 runs in the thread's CPU time (one thread throughout, so a loaded machine slows the
-// run, not the numbers); the spread (min..max) is printed. Numbers never gate tests.
+//    force over every triangle on a subset of the same rays;
+//  * occlusion passes on the ~200k-triangle sphere (docs/scene.md "Probes near geometry"): rays per
+//    probe and probes per second of the sky/environment occlusion pass (whose rays also decide
+//    probe validity), the dilation, and the visibility-mask pass, each as a ratio of its rays/s to
+//    the shadow-ray throughput of the same mesh measured in the same run.
+// Medians over 5 runs (3 for the occlusion passes) in the thread's CPU time (one thread
+// throughout, so a loaded machine slows the run, not the numbers); the spread (min..max) is
+// printed. Numbers never gate tests.
 // --json FILE also writes the numbers as one JSON object (scripts/docs_numbers.py makes docs tables of it).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -142,6 +148,7 @@ int main(int argc, char** argv) {
     {
         Scene s = default_scene();
         s.probes.counts = {n, n, std::max<std::uint32_t>(1, n / 4)};
+        s.occlusion.sky_samples = 0;  // shadow rays only (the occlusion passes: the last section)
         BakeReport rep;
         const auto t = bench::time_repeats_cpu(repeats, [&] { bench::keep(bake_scene(s, {}, &rep)); });
         std::printf("%-40s %12.3g %12.1f %10.1f  (%llu rays; whole bake incl. closed forms)\n",
@@ -154,6 +161,7 @@ int main(int argc, char** argv) {
         std::mt19937 rng(3);
         std::uniform_real_distribution<double> u(-6, 6), u01(0, 1);
         Scene s = grid_scene(n / 2);
+        s.occlusion.sky_samples = 0;
         for (int i = 0; i < 1000; ++i) {
             Occluder o;
             o.kind = i % 2 ? OccluderKind::kSphere : OccluderKind::kBox;
@@ -200,6 +208,7 @@ int main(int argc, char** argv) {
         // A sphere of radius 1.5 hovering over the middle of the probe grid, lit by a sun with a
         // 3-degree radius and 64 samples: a mix of blocked rays (under it) and misses.
         Scene s = grid_scene(n / 2);
+        s.occlusion.sky_samples = 0;
         s.occluders = uv_sphere_triangles({0.3, -0.2, 4.5}, 1.5, res, res);
         SceneLight sun = light_of(LightKind::kDirectional, 0);
         sun.direction = {0.2, 0.1, 1};
@@ -252,12 +261,73 @@ int main(int argc, char** argv) {
                                    tris, tb0.median_s * 1e3, static_cast<unsigned long long>(rep.rays), rep.rays / t.median_s,
                                    query_rate, double(hits) / repeats / (double(pos.size()) * dirs.size()), brute_rate));
     }
+    
+    // Occlusion passes on the 200k-triangle mesh, against its shadow rays in the same run.
+    std::string occlusion_json = "null";
+    {
+        Scene s = grid_scene(n / 2);
+        // ~200k triangles: a sphere over the grid (shadows the sun) and one the probes sit around
+        // and inside (validity and masks have work).
+        s.occluders = uv_sphere_triangles({0.3, -0.2, 4.5}, 1.5, 224, 224);
+        const auto low = uv_sphere_triangles({-1.5, 1.0, 1.5}, 1.2, 224, 224);
+        s.occluders.insert(s.occluders.end(), low.begin(), low.end());
+        s.sky = SceneSky{};
+        SceneLight sun = light_of(LightKind::kDirectional, 0);
+        sun.direction = {0.2, 0.1, 1};
+        sun.angular_radius_rad = 3 * kPi / 180;
+        sun.shadows = true;
+        sun.shadow_samples = 64;
+        s.lights = {sun};
+        const double probes = probe_count(s);
+        std::printf("\nocclusion passes, %zu triangles, %.0f probes, 1 thread (median of 3)\n", s.occluders.size(), probes);
+        // Shadow rays alone (no sky occlusion): the reference throughput.
+        Scene shadow_only = s;
+        shadow_only.occlusion.sky_samples = 0;
+        // The sun effect's own time (the BVH build is outside every pass).
+        BakeReport rs;
+        std::vector<double> sun_ms;
+        for (int i = 0; i < 3; ++i) {
+            bench::keep(bake_scene(shadow_only, {}, &rs));
+            sun_ms.push_back(rs.effects[1].milliseconds);
+        }
+        std::sort(sun_ms.begin(), sun_ms.end());
+        const double sun_s = sun_ms[1] / 1e3, shadow_rate = rs.effects[1].rays / sun_s;
+        std::printf("%-34s %10s %12s %12s %10s\n", "pass", "rays/probe", "probes/s", "rays/s", "vs shadow");
+        std::printf("%-34s %10.1f %12.3g %12.3g %9.2fx  (BVH build %.0f ms, not in any pass)\n", "sun shadow rays (reference)",
+                    rs.effects[1].rays / probes, probes / sun_s, shadow_rate, 1.0, rs.occluder_build_ms);
+        std::vector<double> occ_ms, dil_ms, mask_ms;
+        BakeReport r;
+        for (int i = 0; i < 3; ++i) {
+            ProbeLeakData leak;
+            bench::keep(bake_scene(s, {}, &r, &leak));
+            occ_ms.push_back(r.occlusion_ms);
+            dil_ms.push_back(r.dilation_ms);
+            mask_ms.push_back(r.mask_ms);
+        }
+        auto median = [](std::vector<double> v) {
+            std::sort(v.begin(), v.end());
+            return v[v.size() / 2];
+        };
+        const double o_s = median(occ_ms) / 1e3, d_s = median(dil_ms) / 1e3, m_s = median(mask_ms) / 1e3;
+        std::printf("%-34s %10.1f %12.3g %12.3g %9.2fx\n", "sky occlusion + validity (nearest)", r.occlusion_rays / probes,
+                    probes / o_s, r.occlusion_rays / o_s, r.occlusion_rays / o_s / shadow_rate);
+        std::printf("%-34s %10s %12.3g %12s %10s  (%llu invalid, %llu dilated)\n", "dilation", "0", probes / d_s, "-", "-",
+                    static_cast<unsigned long long>(r.invalid_probes), static_cast<unsigned long long>(r.dilated_probes));
+        std::printf("%-34s %10.1f %12.3g %12.3g %9.2fx\n", "visibility masks (any hit)", r.mask_rays / probes, probes / m_s,
+                    r.mask_rays / m_s, r.mask_rays / m_s / shadow_rate);
+        occlusion_json = format("{\"triangles\": %zu, \"probes\": %.0f, \"shadow_rays_per_s\": %.6g, "
+                                "\"occlusion_rays_per_probe\": %.4g, \"occlusion_rays_per_s\": %.6g, \"dilation_probes_per_s\": %.6g, "
+                                "\"mask_rays_per_probe\": %.4g, \"mask_rays_per_s\": %.6g}",
+                                s.occluders.size(), probes, shadow_rate, r.occlusion_rays / probes, r.occlusion_rays / o_s,
+                                probes / d_s, r.mask_rays / probes, r.mask_rays / m_s);
+    }
     if (!json.empty()) {
         std::ofstream out(json);
         out << "{\n  \"benchmark\": \"bake\",\n"
             << format("  \"probes_per_axis\": %u, \"lights\": %d, \"repeats\": %d, \"threads\": 1, \"clock\": \"thread_cpu\",\n", n, lights, repeats)
             << format("  \"floor_probe_lights_per_s\": %.6g,\n", floor_rate) << "  \"closed_form\": [" << join(closed_rows)
-            << "],\n  \"occluded\": [" << join(occluded_rows) << "],\n  \"meshes\": [" << join(mesh_rows).substr(0, join(mesh_rows).size() - 2);
+            << "],\n  \"occluded\": [" << join(occluded_rows) << "],\n  \"occlusion_passes\": " << occlusion_json
+            << ",\n  \"meshes\": [" << join(mesh_rows).substr(0, join(mesh_rows).size() - 2);
         if (!bench::finish_json(out, json)) return 1;
     }
     return 0;

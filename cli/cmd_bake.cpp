@@ -1,5 +1,5 @@
 // zhc bake SCENE.json|SCENE.gltf|SCENE.glb -o PROBES.zhp|.json|.glb|.gltf [--threads N]
-//          [--to REPRESENTATION] [--zstd LEVEL]:
+//          [--to REPRESENTATION] [--zstd LEVEL] [--sky-samples N] [--invalid-fraction F]:
 // bakes the scene's probes (only the effects it lists; docs/scene.md) and writes them: a probe
 // container, a JSON probe list, or a glTF with the probes embedded (ZHC_light_probes,
 // docs/gltf-extension.md) — into a copy of the input asset when the scene is glTF, else into a
@@ -26,6 +26,8 @@ struct Options {
     std::string to = "sh3";
     int threads = 0;
     int zstd = 0;
+    int sky_samples = -1;        // -1: the scene's occlusion.sky_samples
+    double invalid_fraction = -1;  // < 0: the scene's occlusion.invalid_fraction
     ProgressFlags progress;  // --quiet also drops the effects report
 };
 
@@ -34,8 +36,15 @@ void print_report(const BakeReport& r) {
                 static_cast<unsigned long long>(r.probes));
     for (const BakeEffect& e : r.effects) std::printf("  %-24s %-42s %10.3f ms\n", e.name.c_str(), ("(" + e.method + ")").c_str(), e.milliseconds);
     if (r.effects.empty()) std::printf("  (none: the scene lists no lighting; every probe is zero)\n");
+    if (r.validity_checked)
+        std::printf("  probe validity (the same %llu rays/probe): %llu of %llu probes inside geometry, %llu dilated (%.3f ms)\n",
+                    static_cast<unsigned long long>(r.occlusion_rays / r.probes), static_cast<unsigned long long>(r.invalid_probes), static_cast<unsigned long long>(r.probes),
+                    static_cast<unsigned long long>(r.dilated_probes), r.dilation_ms);
+    if (r.mask_probes > 0)
+        std::printf("  visibility masks: %llu rays (%.1f rays/probe) %.3f ms\n", static_cast<unsigned long long>(r.mask_rays),
+                    double(r.mask_rays) / double(r.mask_probes), r.mask_ms);
     if (r.rays > 0)
-        std::printf("  occluder BVH built in %.3f ms; %llu shadow rays in total\n", r.occluder_build_ms,
+        std::printf("  occluder BVH built in %.3f ms; %llu rays in total\n", r.occluder_build_ms,
                     static_cast<unsigned long long>(r.rays));
     std::printf("bake total %.3f ms\n", r.total_ms);
 }
@@ -70,12 +79,16 @@ int run(const Options& o) {
     auto scene = gltf_in ? parse_scene_gltf(input_asset, o.scene, lo, GltfLimits{}, &notes) : read_scene_file(o.scene, lo);
     if (!scene) return report(scene.error());
     for (const std::string& n : notes) std::fprintf(stderr, "zhc: note: %s: %s\n", o.scene.c_str(), n.c_str());
+    if (o.sky_samples >= 0) scene->occlusion.sky_samples = o.sky_samples;
+    if (o.invalid_fraction >= 0) scene->occlusion.invalid_fraction = o.invalid_fraction;
+    if (Status b = check_ray_budget(*scene, SceneJsonLimits{}, o.scene); !b) return report(b.error());
     BakeOptions bo;
     bo.threads = threads;
     BakeReport rep;
+    ProbeLeakData leak;
     Progress progress("zhc bake", "probes", o.progress);
     if (progress.enabled()) bo.progress = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
-    auto probes = bake_scene(*scene, bo, &rep);
+    auto probes = bake_scene(*scene, bo, &rep, &leak);
     progress.finish();
     if (!probes) return report(probes.error());
     if (!o.progress.quiet) {
@@ -102,6 +115,10 @@ int run(const Options& o) {
     }
     auto set = encode_probe_set(*probes, o.to, CodecOptions{}, layout);
     if (!set) return report(set.error());
+    // Grid bakes of scenes with occluders carry validity and visibility masks (docs/scene.md
+    // "Probes near geometry"); empty otherwise.
+    set->validity = std::move(leak.validity);
+    set->visibility = std::move(leak.visibility);
     if (gltf_out) {
         // Into a copy of the input asset (everything of it kept, docs/gltf-extension.md), or into
         // a minimal asset for a JSON scene.
@@ -143,6 +160,8 @@ const VerbRegistration registration(15, [](CLI::App& app) -> std::function<int()
     sub->add_option("-o,--output", o->output, "output: .zhp (probe container), .json (float SH3 probe list), .glb/.gltf (probes embedded in glTF)")->required();
     add_threads_option(sub, o->threads, "output identical for any count");
     add_representations_option(sub, o->to, RepresentationCount::kOne, "stored in the .zhp/glTF (default sh3)", "--to")->capture_default_str();
+    sub->add_option("--sky-samples", o->sky_samples, "occlusion rays per probe for the sky/environment, probe validity (default: the scene's occlusion.sky_samples, 256; 0 = no occlusion)")->check(CLI::Range(0, 65536));
+    sub->add_option("--invalid-fraction", o->invalid_fraction, "a probe is invalid (dilated) when more than this fraction of its rays start inside geometry (default: the scene's occlusion.invalid_fraction, 0.25)")->check(CLI::Range(0.0, 1.0));
     sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")->check(CLI::Range(0, 22));
     sub->add_flag("--progress", o->progress.force, "progress on stderr even when it is not a terminal (one line per 10 %)");
     sub->add_flag("--quiet", o->progress.quiet, "do not print the effects report nor progress");

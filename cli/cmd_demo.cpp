@@ -1,7 +1,8 @@
 // zhc demo [-o DIR]: the main job on the built-in default scene (no input files).
 //
 // Bakes the default scene (gradient sky, sun, three coloured sphere lights, a roof and a sphere
-// occluder; codec/bake/scene.h default_scene) into a probe grid, encodes it with every representation
+// occluder that shadow the sun and lamps and occlude the sky; codec/bake/scene.h default_scene)
+// into a probe grid, encodes it with every representation
 // of the codec table, writes the probe containers, the scene, the audit table (reference: each
 // probe's baked SH3 irradiance) with its choice per byte budget (codec/report/choice.h) and
 // pictures of a few probes, and prints where everything is.
@@ -110,7 +111,7 @@ int run(const Options& o) {
     if (Status s = write_text(path("scene.json"), scene_json(scene)); !s) return report_output(s.error());
     outputs.push_back({path("scene.json"), "the built-in scene (zhc bake input)"});
     const auto& c = scene.probes.counts;
-    std::printf("zhc demo: built-in scene: gradient sky, sun, %zu sphere lights, %zu occluders; %ux%ux%u probe grid\n",
+    std::printf("zhc demo: built-in scene: gradient sky, sun, %zu sphere lights, %zu occluders (they shadow the sun and two lamps and occlude the sky); %ux%ux%u probe grid\n",
                 scene.lights.size() - 1, scene.occluders.size(), c[0], c[1], c[2]);
 
     // 2. Bake.

@@ -100,9 +100,11 @@ std::vector<Sh3Radiance> bake(const Scene& s) {
 }
 
 // zhc bake FILE -o DIR/TAG.json through the CLI, the probe list read back.
-ProbeList bake_cli(const std::string& file, const std::string& tag) {
+ProbeList bake_cli(const std::string& file, const std::string& tag, const std::vector<std::string>& extra = {}) {
     const std::string out = test::temp_dir("gltf_ext") + "/" + tag + ".json";
-    const auto r = test::run_zhc({"bake", file, "-o", out, "--threads", "2", "--quiet"});
+    std::vector<std::string> args = {"bake", file, "-o", out, "--threads", "2", "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = test::run_zhc(args);
     EXPECT_EQ(r.exit_code, 0) << file << ": " << r.err;
     auto list = read_probe_json(out);
     EXPECT_TRUE(list.ok()) << (list.ok() ? "" : list.error().message);
@@ -510,7 +512,23 @@ TEST(GltfImageBasedLight, AddsToTheLightsOfARealFile) {
     d["scenes"][d.value("scene", 0)]["extensions"]["EXT_lights_image_based"]["light"] = 0;
     const std::string t = d.dump(), edited = dir + "/ibl.gltf";
     test::write_bytes(edited, std::vector<std::uint8_t>(t.begin(), t.end()));
-    const ProbeList plain = bake_cli(dir + "/gt_list.gltf", "ibl_real_plain"), lit = bake_cli(edited, "ibl_real_lit");
+    // The asset's meshes occlude the environment (docs/scene.md "Probes near geometry"): the
+    // conversion factors are checked with that occlusion off (--sky-samples 0), then with it on
+    // the environment can only lose radiance (its red and green are constant 1 in every direction).
+    const std::vector<std::string> open_sky = {"--sky-samples", "0"};
+    const ProbeList plain = bake_cli(dir + "/gt_list.gltf", "ibl_real_plain", open_sky), lit = bake_cli(edited, "ibl_real_lit", open_sky);
+    {
+        const ProbeList plain_occ = bake_cli(dir + "/gt_list.gltf", "ibl_real_plain_occ"), lit_occ = bake_cli(edited, "ibl_real_lit_occ");
+        ASSERT_EQ(plain_occ.probes.size(), lit_occ.probes.size());
+        int occluded = 0;
+        for (size_t p = 0; p < plain_occ.probes.size(); ++p) {
+            const double added = double(lit_occ.probes[p][0][0]) - plain_occ.probes[p][0][0];
+            EXPECT_GE(added, -1e-5) << p;
+            EXPECT_LE(added, 0.5 * 2 * std::sqrt(kPi) + 1e-5) << p;
+            occluded += added < 0.5 * 2 * std::sqrt(kPi) - 1e-3;
+        }
+        EXPECT_GT(occluded, 0);
+    }
     ASSERT_EQ(plain.probes.size(), lit.probes.size());
     ASSERT_GT(plain.probes.size(), 0u);
     for (size_t p = 0; p < plain.probes.size(); ++p)

@@ -186,6 +186,9 @@ TEST(TriangleOccluder, QuadRemovesExactlyTheLightItHides) {
     // (the ray from (0,0,0) to (0,0,4) passes exactly through the shared edge).
     const Vec3 q0{-1, -1, 2}, q1{1, -1, 2}, q2{1, 1, 2}, q3{-1, 1, 2};
     s.occluders = {triangle_occluder(q0, q1, q2), triangle_occluder(q0, q2, q3)};
+    // About the lights' shadows: the sky stays unoccluded here (occlusion.sky_samples 0), so the
+    // references without occluders differ only by the lights (sky occlusion: test_scene_occlusion).
+    s.occlusion.sky_samples = 0;
     BakeReport rep;
     auto with = bake_scene(s, {}, &rep);
     Scene without_a = s;

@@ -67,7 +67,63 @@ bool ray_hits_triangle(const Occluder& tri, Vec3 o, Vec3 d, double t_min, double
     return t > t_min && t < t_max;
 }
 
+// ray_hits_triangle with the hit distance and the face: 0 miss, 1 front, 2 back.
+int ray_triangle_face(const Occluder& tri, Vec3 o, Vec3 d, double t_min, double t_max, double* t_out) {
+    const Vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+    const Vec3 p = cross(d, e2);
+    const double det = dot(e1, p);
+    if (det == 0.0 || !std::isfinite(det)) return 0;
+    const double inv = 1.0 / det;
+    const Vec3 s = o - tri.v0;
+    constexpr double kBary = 1e-10;  // as ray_hits_triangle
+    const double u = dot(s, p) * inv;
+    if (u < -kBary || u > 1.0 + kBary) return 0;
+    const Vec3 q = cross(s, e1);
+    const double v = dot(d, q) * inv;
+    if (v < -kBary || u + v > 1.0 + kBary) return 0;
+    const double t = dot(e2, q) * inv;
+    if (!(t > t_min && t < t_max)) return 0;
+    *t_out = t;
+    // det = e1 . (d x e2) = -d . (e1 x e2): det < 0 when d runs along the normal (a back face).
+    return det < 0 ? 2 : 1;
+}
+
 }  // namespace
+
+bool inside_solid(const Occluder& occ, Vec3 p) {
+    if (occ.kind == OccluderKind::kSphere) {
+        const Vec3 v = p - occ.center;
+        return dot(v, v) <= occ.radius * occ.radius;
+    }
+    if (occ.kind == OccluderKind::kBox)
+        return p.x >= occ.min.x && p.x <= occ.max.x && p.y >= occ.min.y && p.y <= occ.max.y && p.z >= occ.min.z &&
+               p.z <= occ.max.z;
+    return false;
+}
+
+RayHit ray_nearest(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
+    RayHit h;
+    if (occ.kind == OccluderKind::kTriangle) {
+        double t = 0;
+        const int face = ray_triangle_face(occ, o, d, t_min, t_max, &t);
+        if (face) h = {true, face == 2, t};
+        return h;
+    }
+    if (inside_solid(occ, o)) return {true, true, t_min};
+    if (occ.kind == OccluderKind::kSphere) {
+        const Vec3 oc = o - occ.center;
+        const double b = dot(d, oc), c = dot(oc, oc) - occ.radius * occ.radius;
+        const double disc = b * b - c;
+        if (disc < 0.0) return h;
+        const double t_near = -b - std::sqrt(disc);
+        if (t_near > t_min && t_near < t_max) h = {true, false, t_near};
+        return h;
+    }
+    double lo[3] = {occ.min.x, occ.min.y, occ.min.z}, hi[3] = {occ.max.x, occ.max.y, occ.max.z};
+    double enter = 0;
+    if (slab(lo, hi, o, d, t_min, t_max, &enter) && enter < t_max) h = {true, false, enter};
+    return h;
+}
 
 Occluder triangle_occluder(Vec3 a, Vec3 b, Vec3 c) {
     Occluder o;
@@ -234,6 +290,84 @@ bool OccluderBvh::occluded(Vec3 o, Vec3 d, double t_min, double t_max) const {
                 stack[top++] = n.right;
                 stack[top++] = n.left;
             }
+        }
+    }
+    return false;
+}
+
+RayHit OccluderBvh::nearest(Vec3 o, Vec3 d, double t_min, double t_max) const {
+    RayHit best;
+    if (nodes_.empty()) return best;
+    const double org[3] = {o.x, o.y, o.z}, dir[3] = {d.x, d.y, d.z};
+    double inv[3];
+    for (int a = 0; a < 3; ++a) inv[a] = dir[a] != 0.0 ? 1.0 / dir[a] : 0.0;
+    // The node's clipped interval against (t_min, far); false when the ray misses it.
+    auto node_hit = [&](const Node& n, double far) {
+        double t0 = t_min, t1 = far;
+        for (int a = 0; a < 3; ++a) {
+            if (dir[a] == 0.0) {
+                if (org[a] < n.lo[a] || org[a] > n.hi[a]) return false;
+                continue;
+            }
+            double ta = (n.lo[a] - org[a]) * inv[a], tb = (n.hi[a] - org[a]) * inv[a];
+            if (ta > tb) std::swap(ta, tb);
+            t0 = ta > t0 ? ta : t0;
+            t1 = tb < t1 ? tb : t1;
+            if (t0 > t1) return false;
+        }
+        return true;
+    };
+    std::uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    double far = t_max;
+    while (top > 0) {
+        const Node& n = nodes_[stack[--top]];
+        if (!node_hit(n, far)) {
+            bool inside = true;
+            for (int a = 0; a < 3; ++a) inside = inside && org[a] >= n.lo[a] && org[a] <= n.hi[a];
+            if (!inside) continue;
+        }
+        if (n.count > 0) {
+            for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
+                // Strictly nearer hits only (the interval's far end is the best so far, with the
+                // best's own t admitted through `<=` below): the first primitive wins a tie.
+                const RayHit h = ray_nearest(prims_[i], o, d, t_min, best.hit ? std::nextafter(far, far + 1.0) : far);
+                if (h.hit && (!best.hit || h.t < best.t)) {
+                    best = h;
+                    far = h.t;
+                }
+            }
+        } else if (top + 2 <= 128) {
+            if (dir[n.axis] < 0) {
+                stack[top++] = n.left;
+                stack[top++] = n.right;
+            } else {
+                stack[top++] = n.right;
+                stack[top++] = n.left;
+            }
+        }
+    }
+    return best;
+}
+
+bool OccluderBvh::inside_any_solid(Vec3 p) const {
+    if (nodes_.empty()) return false;
+    const double q[3] = {p.x, p.y, p.z};
+    std::uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const Node& n = nodes_[stack[--top]];
+        bool in = true;
+        for (int a = 0; a < 3; ++a) in = in && q[a] >= n.lo[a] && q[a] <= n.hi[a];
+        if (!in) continue;
+        if (n.count > 0) {
+            for (std::uint32_t i = n.first; i < n.first + n.count; ++i)
+                if (inside_solid(prims_[i], p)) return true;
+        } else if (top + 2 <= 128) {
+            stack[top++] = n.left;
+            stack[top++] = n.right;
         }
     }
     return false;

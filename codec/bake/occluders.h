@@ -58,6 +58,19 @@ std::vector<Occluder> uv_sphere_triangles(Vec3 c, double r, int n_lat, int n_lon
 // follow the policy above.
 bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max);
 
+// The nearest hit of a ray (probe validity, docs/scene.md "Probes near geometry"). `back`: the ray
+// starts inside a sphere or box (then t = t_min), or meets a triangle's back face: the side
+// opposite its normal (v1 - v0) x (v2 - v0), i.e. the triangle is wound clockwise as seen from
+// the ray's origin (glTF's front faces are counter-clockwise).
+struct RayHit {
+    bool hit = false;
+    bool back = false;
+    double t = 0;
+};
+RayHit ray_nearest(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max);
+// Is p inside (or on) a sphere or box occluder? (Triangles bound no volume.)
+bool inside_solid(const Occluder& occ, Vec3 p);
+
 class OccluderBvh {
 public:
     OccluderBvh() = default;
@@ -65,6 +78,11 @@ public:
     bool empty() const { return prims_.empty(); }
     // Any hit with t in (t_min, t_max)?
     bool occluded(Vec3 o, Vec3 d, double t_min, double t_max) const;
+    // The nearest hit with t in (t_min, t_max) (ties between primitives at the same t: the first
+    // in the tree's leaf order, so the answer is the same on every run).
+    RayHit nearest(Vec3 o, Vec3 d, double t_min, double t_max) const;
+    // Is p inside (or on) any sphere or box occluder?
+    bool inside_any_solid(Vec3 p) const;
     std::size_t node_count() const { return nodes_.size(); }
 
 private:

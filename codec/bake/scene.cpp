@@ -158,6 +158,31 @@ std::vector<Vec3> cone_sample_directions(Vec3 axis, double sigma, int count) {
     return out;
 }
 
+std::vector<Vec3> sphere_sample_directions(int count) {
+    std::vector<Vec3> out;
+    if (count <= 0) return out;
+    out.reserve(static_cast<size_t>(count));
+    const double golden = kPi * (3.0 - std::sqrt(5.0));
+    for (int k = 0; k < count; ++k) {
+        const double z = 1.0 - (2.0 * k + 1.0) / count;
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const double phi = golden * k;
+        out.push_back({r * std::cos(phi), r * std::sin(phi), z});
+    }
+    return out;
+}
+
+void sky_radiance(const SceneSky& sky, Vec3 d, double rgb[3]) {
+    if (sky.kind == SkyKind::kConstant) {
+        for (int k = 0; k < 3; ++k) rgb[k] = sky.radiance[k];
+        return;
+    }
+    const GradientSky& g = sky.gradient;
+    const double z = dot(normalize_or(g.up, {0, 0, 1}), d);
+    for (int k = 0; k < 3; ++k)
+        rgb[k] = z >= 0 ? double(g.horizon[k]) + (double(g.zenith[k]) - g.horizon[k]) * z : double(g.ground[k]);
+}
+
 Scene default_scene() {
     Scene s;
     s.probes.kind = ProbePlacementKind::kGrid;
@@ -260,6 +285,10 @@ Status validate_scene(const Scene& s) {
         for (const Vec3& p : s.probes.positions)
             if (!finite3(p)) return bad("probes.positions holds a non-finite position");
     }
+    if (s.occlusion.sky_samples < 0 || s.occlusion.sky_samples > 65536)
+        return bad("occlusion.sky_samples must be in [0, 65536]");
+    if (!(s.occlusion.invalid_fraction >= 0 && s.occlusion.invalid_fraction <= 1))
+        return bad("occlusion.invalid_fraction must be in [0, 1]");
     if (s.environment) {
         if (!std::isfinite(s.environment->intensity) || s.environment->intensity < 0)
             return bad("environment.intensity must be finite and >= 0");
@@ -326,6 +355,7 @@ namespace {
 struct Effect {
     enum Kind { kConstantSh, kLight } kind = kLight;
     double sh[27] = {};            // kConstantSh: environment or sky, the same at every probe
+    bool distant = false;          // environment or sky: occluded by the occlusion pass
     const SceneLight* light = nullptr;
     bool traced = false;           // light with shadows and a non-empty occluder set
     std::vector<Vec3> unit_cone;   // cone samples around +Z (rotated per probe), traced cone lights
@@ -426,33 +456,127 @@ void add_light_shadowed(const Effect& e, const OccluderBvh& bvh, Vec3 p, double 
 
 }  // namespace
 
-Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOptions& options, BakeReport* report) {
+namespace {
+
+// Runs fn(lo, hi, thread) over [0, count) in blocks of `block`, on `threads` threads. Each block is
+// independent, so the results do not depend on the thread count.
+template <class Fn>
+void parallel_blocks(size_t count, size_t block, int threads, Fn&& fn) {
+    const size_t blocks = (count + block - 1) / block;
+    const int n = std::max(1, std::min<int>(threads, static_cast<int>(std::max<size_t>(blocks, 1))));
+    std::atomic<size_t> next{0};
+    auto worker = [&](int t) {
+        for (size_t b = next++; b < blocks; b = next++) fn(b * block, std::min(count, (b + 1) * block), t);
+    };
+    if (n == 1) {
+        worker(0);
+        return;
+    }
+    std::vector<std::thread> pool;
+    for (int t = 0; t < n; ++t) pool.emplace_back(worker, t);
+    for (auto& th : pool) th.join();
+}
+
+// The visibility mask of grid probe (x, y, z): bit (cx + 2 cy + 4 cz) set when the probe is
+// visible from the cell on its side (cx, cy, cz). A cell beyond the grid keeps its bit set (it is
+// never sampled). Per cell kMaskPoints points (the centre, centre +- spacing/4 per axis); a point
+// inside a box/sphere occluder does not vote; the bit is set when at least half of the voting
+// points reach the probe unblocked (all points inside solids: set).
+std::uint8_t grid_visibility_mask(const OccluderBvh& bvh, const ProbeGrid& g, std::uint32_t x, std::uint32_t y,
+                                  std::uint32_t z, std::uint64_t* rays) {
+    const std::uint32_t idx[3] = {x, y, z};
+    const Vec3 p{g.origin.x + x * g.spacing.x, g.origin.y + y * g.spacing.y, g.origin.z + z * g.spacing.z};
+    std::uint8_t mask = 0;
+    for (int c = 0; c < 8; ++c) {
+        const int side[3] = {c & 1, (c >> 1) & 1, (c >> 2) & 1};
+        double centre[3], half[3];
+        bool inside_grid = true;
+        for (int a = 0; a < 3; ++a) {
+            const std::uint32_t n = g.counts[static_cast<size_t>(a)];
+            const double pa = a == 0 ? p.x : (a == 1 ? p.y : p.z), s = g.spacing[a];
+            if (n <= 1) {  // a flat axis: the sampled "cell" is the probe's own plane
+                if (side[a] == 0) inside_grid = false;
+                centre[a] = pa;
+                half[a] = 0;
+                continue;
+            }
+            // Cell on side 0 spans [i - 1, i], on side 1 [i, i + 1].
+            if ((side[a] == 0 && idx[a] == 0) || (side[a] == 1 && idx[a] + 1 >= n)) inside_grid = false;
+            centre[a] = pa + (side[a] ? 0.5 : -0.5) * s;
+            half[a] = 0.25 * s;
+        }
+        if (!inside_grid) {
+            mask = static_cast<std::uint8_t>(mask | (1u << c));
+            continue;
+        }
+        int votes = 0, reach = 0;
+        for (int k = 0; k < kMaskPoints; ++k) {
+            Vec3 q{centre[0], centre[1], centre[2]};
+            if (k > 0) {
+                const int b = k - 1;
+                q = {centre[0] + ((b & 1) ? half[0] : -half[0]), centre[1] + ((b & 2) ? half[1] : -half[1]),
+                     centre[2] + ((b & 4) ? half[2] : -half[2])};
+            }
+            if (bvh.inside_any_solid(q)) continue;
+            ++votes;
+            const Vec3 v = p - q;
+            const double len = length(v);
+            if (!(len > 2 * kRayEpsilon)) {
+                ++reach;
+                continue;
+            }
+            ++*rays;
+            if (!bvh.occluded(q, (1.0 / len) * v, kRayEpsilon, len - kRayEpsilon)) ++reach;
+        }
+        if (votes == 0 || 2 * reach >= votes) mask = static_cast<std::uint8_t>(mask | (1u << c));
+    }
+    return mask;
+}
+
+}  // namespace
+
+Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOptions& options, BakeReport* report,
+                                            ProbeLeakData* leak) {
     const auto t_start = Clock::now();
     if (Status s = validate_scene(scene); !s) return s.error();
+    if (leak) *leak = {};
     const std::vector<Vec3> positions = probe_positions(scene.probes);
     const size_t count = positions.size();
+    const bool grid = scene.probes.kind == ProbePlacementKind::kGrid;
+
+    const auto t_bvh = Clock::now();
+    const OccluderBvh bvh(scene.occluders);
+    const double bvh_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_bvh).count();
+    const int n_occ = bvh.empty() ? 0 : scene.occlusion.sky_samples;
+    const bool occlude_distant = n_occ > 0 && (scene.environment || scene.sky);
+    const bool validity = n_occ > 0 && grid;
+    const bool tracing = occlude_distant || validity;
 
     // Effects in scene order: environment, sky, lights.
     std::vector<Effect> effects;
     std::vector<BakeEffect> info;
+    const std::string occluded_method = "occluded: " + std::to_string(n_occ) + " rays/probe";
     if (scene.environment) {
         const SceneEnvironment& env = *scene.environment;
         Sh3Radiance sh = env.projected;
         if (env.rotation_rad != 0) sh = rotate(sh, rotation_axis_angle({0, 0, 1}, env.rotation_rad));
         Effect e;
         e.kind = Effect::kConstantSh;
+        e.distant = true;
         for (int i = 0; i < 9; ++i)
             for (int k = 0; k < 3; ++k) e.sh[i * 3 + k] = double(sh[i][k]) * env.intensity;
         effects.push_back(std::move(e));
         const std::string orientation = env.label.empty() && env.latlong_map ? std::string(", ") + latlong_convention_name(env.latlong) + " lat-long" : "";
         info.push_back({env.label.empty() ? "environment" : env.label,
                         (env.label.empty() ? "projected once" + orientation : std::string("SH coefficients")) +
-                            std::string(env.rotation_rad != 0 ? ", rotated" : ""), 0, 0});
+                            std::string(env.rotation_rad != 0 ? ", rotated" : "") +
+                            (occlude_distant ? ", " + occluded_method : std::string()), 0, 0});
     }
     if (scene.sky) {
         const SceneSky& sky = *scene.sky;
         Effect e;
         e.kind = Effect::kConstantSh;
+        e.distant = true;
         if (sky.kind == SkyKind::kConstant) {
             for (int k = 0; k < 3; ++k) e.sh[k] = 2.0 * kSqrtPi * sky.radiance[k];
         } else {
@@ -461,11 +585,39 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
                 for (int k = 0; k < 3; ++k) e.sh[i * 3 + k] = sh[i][k];
         }
         effects.push_back(std::move(e));
-        info.push_back({sky.kind == SkyKind::kConstant ? "sky (constant)" : "sky (gradient)", "closed form", 0, 0});
+        info.push_back({sky.kind == SkyKind::kConstant ? "sky (constant)" : "sky (gradient)",
+                        occlude_distant ? occluded_method : "closed form", 0, 0});
     }
-    const auto t_bvh = Clock::now();
-    const OccluderBvh bvh(scene.occluders);
-    const double bvh_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_bvh).count();
+    size_t last_distant = 0;  // index + 1 of the last distant effect (0: none)
+    for (size_t ei = 0; ei < effects.size(); ++ei)
+        if (effects[ei].distant) last_distant = ei + 1;
+    // Occlusion directions and, per direction, what its blocking removes: (4 pi / N) L(d) Y(d)
+    // summed over the distant effects (the environment's radiance is its SH3 evaluated at d).
+    std::vector<Vec3> dirs;
+    std::vector<double> removal;
+    if (tracing) {
+        dirs = sphere_sample_directions(n_occ);
+        if (occlude_distant) {
+            removal.assign(dirs.size() * 27, 0.0);
+            const double w = 4.0 * kPi / n_occ;
+            for (size_t k = 0; k < dirs.size(); ++k) {
+                const auto y = sh3_basis(dirs[k]);
+                double L[3] = {0, 0, 0};
+                if (scene.environment) {
+                    const double* env = effects[0].sh;
+                    for (int i = 0; i < 9; ++i)
+                        for (int c = 0; c < 3; ++c) L[c] += env[i * 3 + c] * y[static_cast<size_t>(i)];
+                }
+                if (scene.sky) {
+                    double sky[3];
+                    sky_radiance(*scene.sky, dirs[k], sky);
+                    for (int c = 0; c < 3; ++c) L[c] += sky[c];
+                }
+                for (int i = 0; i < 9; ++i)
+                    for (int c = 0; c < 3; ++c) removal[k * 27 + static_cast<size_t>(i * 3 + c)] = w * L[c] * y[static_cast<size_t>(i)];
+            }
+        }
+    }
     for (const SceneLight& l : scene.lights) {
         Effect e;
         e.kind = Effect::kLight;
@@ -494,62 +646,164 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
         info.push_back({effect_name(l), "closed form", 0, 0});
     }
 
-    // Probes in blocks; each block runs the effects in order into a double accumulator. Blocks are
-    // independent, so any thread count gives the same bytes.
+    // Probes in blocks; each block runs the occlusion pass, then the effects in order into a
+    // double accumulator. Blocks are independent, so any thread count gives the same bytes.
     constexpr size_t kBlock = 1024;
     const size_t blocks = (count + kBlock - 1) / kBlock;
     const int threads = std::max(1, std::min<int>(options.threads, static_cast<int>(std::max<size_t>(blocks, 1))));
     std::vector<Sh3Radiance> out(count);
-    std::vector<std::vector<double>> ms(static_cast<size_t>(threads), std::vector<double>(effects.size(), 0.0));
+    std::vector<std::uint8_t> valid(validity ? count : 0, 1);
+    std::vector<std::vector<double>> ms(static_cast<size_t>(threads), std::vector<double>(effects.size() + 1, 0.0));
     std::vector<std::vector<std::uint64_t>> rays(static_cast<size_t>(threads),
-                                                 std::vector<std::uint64_t>(effects.size(), 0));
-    std::atomic<size_t> next{0};
+                                                 std::vector<std::uint64_t>(effects.size() + 1, 0));
     std::mutex progress_mutex;
     std::uint64_t probes_done = 0;
-    auto worker = [&](int t) {
-        std::vector<double> acc(kBlock * 27);
-        for (size_t b = next++; b < blocks; b = next++) {
-            const size_t lo = b * kBlock, hi = std::min(count, lo + kBlock);
-            std::fill(acc.begin(), acc.end(), 0.0);
-            for (size_t ei = 0; ei < effects.size(); ++ei) {
-                const Effect& e = effects[ei];
-                const auto t0 = Clock::now();
-                if (e.kind == Effect::kConstantSh) {
-                    for (size_t p = lo; p < hi; ++p)
-                        for (int i = 0; i < 27; ++i) acc[(p - lo) * 27 + static_cast<size_t>(i)] += e.sh[i];
-                } else if (!e.traced) {
-                    for (size_t p = lo; p < hi; ++p) add_light_closed_form(*e.light, positions[p], &acc[(p - lo) * 27]);
-                } else {
-                    std::uint64_t r = 0;
-                    for (size_t p = lo; p < hi; ++p) add_light_shadowed(e, bvh, positions[p], &acc[(p - lo) * 27], &r);
-                    rays[static_cast<size_t>(t)][ei] += r;
+    const std::uint64_t invalid_limit =
+        static_cast<std::uint64_t>(std::floor(scene.occlusion.invalid_fraction * n_occ));  // invalid: back > limit
+    parallel_blocks(count, kBlock, threads, [&](size_t lo, size_t hi, int t) {
+        std::vector<double> acc((hi - lo) * 27, 0.0);
+        std::vector<int> blocked(hi - lo, 0);
+        std::vector<double> removed(occlude_distant ? (hi - lo) * 27 : 0, 0.0);
+        const size_t tz = static_cast<size_t>(t);
+        if (tracing) {
+            const auto t0 = Clock::now();
+            for (size_t p = lo; p < hi; ++p) {
+                int nb = 0;
+                std::uint64_t back = 0;
+                for (size_t k = 0; k < dirs.size(); ++k) {
+                    bool hit;
+                    if (validity) {
+                        const RayHit h = bvh.nearest(positions[p], dirs[k], kRayEpsilon, std::numeric_limits<double>::infinity());
+                        hit = h.hit;
+                        back += h.back;
+                    } else {
+                        hit = bvh.occluded(positions[p], dirs[k], kRayEpsilon, std::numeric_limits<double>::infinity());
+                    }
+                    if (!hit) continue;
+                    ++nb;
+                    if (occlude_distant)
+                        for (int i = 0; i < 27; ++i) removed[(p - lo) * 27 + static_cast<size_t>(i)] += removal[k * 27 + static_cast<size_t>(i)];
                 }
-                ms[static_cast<size_t>(t)][ei] += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+                blocked[p - lo] = nb;
+                if (validity && back > invalid_limit) valid[p] = 0;
             }
-            for (size_t p = lo; p < hi; ++p)
-                for (int i = 0; i < 9; ++i)
-                    for (int k = 0; k < 3; ++k)
-                        out[p][i][k] = static_cast<float>(acc[(p - lo) * 27 + static_cast<size_t>(i * 3 + k)]);
-            if (options.progress) {
-                const std::lock_guard<std::mutex> lock(progress_mutex);
-                probes_done += hi - lo;
-                options.progress(probes_done, count);
+            rays[tz][effects.size()] += (hi - lo) * dirs.size();
+            ms[tz][effects.size()] += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        }
+        for (size_t ei = 0; ei < effects.size(); ++ei) {
+            const Effect& e = effects[ei];
+            const auto t0 = Clock::now();
+            if (e.kind == Effect::kConstantSh) {
+                for (size_t p = lo; p < hi; ++p) {
+                    // A distant effect seen by no ray adds nothing (exactly zero).
+                    if (e.distant && occlude_distant && blocked[p - lo] == n_occ) continue;
+                    for (int i = 0; i < 27; ++i) acc[(p - lo) * 27 + static_cast<size_t>(i)] += e.sh[i];
+                }
+                if (occlude_distant && ei + 1 == last_distant)
+                    for (size_t p = lo; p < hi; ++p)
+                        if (blocked[p - lo] > 0 && blocked[p - lo] < n_occ)
+                            for (int i = 0; i < 27; ++i)
+                                acc[(p - lo) * 27 + static_cast<size_t>(i)] -= removed[(p - lo) * 27 + static_cast<size_t>(i)];
+            } else if (!e.traced) {
+                for (size_t p = lo; p < hi; ++p) add_light_closed_form(*e.light, positions[p], &acc[(p - lo) * 27]);
+            } else {
+                std::uint64_t r = 0;
+                for (size_t p = lo; p < hi; ++p) add_light_shadowed(e, bvh, positions[p], &acc[(p - lo) * 27], &r);
+                rays[tz][ei] += r;
+            }
+            ms[tz][ei] += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        }
+        for (size_t p = lo; p < hi; ++p)
+            for (int i = 0; i < 9; ++i)
+                for (int k = 0; k < 3; ++k)
+                    out[p][i][k] = static_cast<float>(acc[(p - lo) * 27 + static_cast<size_t>(i * 3 + k)]);
+        if (options.progress) {
+            const std::lock_guard<std::mutex> lock(progress_mutex);
+            probes_done += hi - lo;
+            options.progress(probes_done, count);
+        }
+    });
+
+    // Dilation: each invalid probe becomes the inverse-distance blend of the valid probes of the
+    // nearest grid shell (Chebyshev distance 1..kDilationShells) holding any, visited z, y, x
+    // ascending and summed in double. Only baked valid probes are read, so the order of the
+    // invalid probes does not matter.
+    const auto t_dil = Clock::now();
+    std::uint64_t invalid = 0, dilated = 0;
+    const ProbeLayout layout = probe_layout(scene.probes);
+    if (validity) {
+        const auto& g = layout.grid;
+        const long nx = g.counts[0], ny = g.counts[1], nz = g.counts[2];
+        std::vector<Sh3Radiance> dil(count);
+        std::vector<std::uint8_t> has(count, 0);
+        for (size_t i = 0; i < count; ++i) {
+            if (valid[i]) continue;
+            ++invalid;
+            const long x = static_cast<long>(i % static_cast<size_t>(nx)), y = static_cast<long>((i / static_cast<size_t>(nx)) % static_cast<size_t>(ny)),
+                       z = static_cast<long>(i / (static_cast<size_t>(nx) * static_cast<size_t>(ny)));
+            for (long r = 1; r <= kDilationShells; ++r) {
+                double sum[27] = {}, wsum = 0;
+                for (long dz = -r; dz <= r; ++dz)
+                    for (long dy = -r; dy <= r; ++dy)
+                        for (long dx = -r; dx <= r; ++dx) {
+                            if (std::max({std::labs(dx), std::labs(dy), std::labs(dz)}) != r) continue;
+                            const long X = x + dx, Y = y + dy, Z = z + dz;
+                            if (X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
+                            const size_t j = static_cast<size_t>(X + nx * (Y + ny * Z));
+                            if (!valid[j]) continue;
+                            const double d = std::sqrt(std::pow(dx * g.spacing.x, 2) + std::pow(dy * g.spacing.y, 2) +
+                                                       std::pow(dz * g.spacing.z, 2));
+                            const double w = 1.0 / d;
+                            wsum += w;
+                            for (int c = 0; c < 9; ++c)
+                                for (int k = 0; k < 3; ++k) sum[c * 3 + k] += w * out[j][c][k];
+                        }
+                if (wsum > 0) {
+                    for (int c = 0; c < 9; ++c)
+                        for (int k = 0; k < 3; ++k) dil[i][c][k] = static_cast<float>(sum[c * 3 + k] / wsum);
+                    has[i] = 1;
+                    ++dilated;
+                    break;
+                }
             }
         }
-    };
-    if (threads == 1) {
-        worker(0);
-    } else {
-        std::vector<std::thread> pool;
-        for (int t = 0; t < threads; ++t) pool.emplace_back(worker, t);
-        for (auto& th : pool) th.join();
+        for (size_t i = 0; i < count; ++i)
+            if (has[i]) out[i] = dil[i];
+    }
+    const double dil_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_dil).count();
+
+    // Visibility masks (asked for, grid, occluders).
+    double mask_ms = 0;
+    std::uint64_t mask_rays = 0;
+    if (leak && validity) {
+        const auto t_mask = Clock::now();
+        leak->validity = valid;
+        leak->visibility.assign(count, 0xFF);
+        const auto& g = layout.grid;
+        std::vector<std::uint64_t> mr(static_cast<size_t>(std::max(1, options.threads)), 0);
+        parallel_blocks(count, kBlock, std::max(1, options.threads), [&](size_t lo, size_t hi, int t) {
+            for (size_t i = lo; i < hi; ++i) {
+                const std::uint32_t x = static_cast<std::uint32_t>(i % g.counts[0]),
+                                    y = static_cast<std::uint32_t>((i / g.counts[0]) % g.counts[1]),
+                                    z = static_cast<std::uint32_t>(i / (size_t(g.counts[0]) * g.counts[1]));
+                leak->visibility[i] = grid_visibility_mask(bvh, g, x, y, z, &mr[static_cast<size_t>(t)]);
+            }
+        });
+        for (std::uint64_t r : mr) mask_rays += r;
+        mask_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_mask).count();
     }
 
     if (report) {
+        *report = BakeReport{};
         report->effects = info;
         report->probes = count;
         report->rays = 0;
         report->occluder_build_ms = bvh_ms;
+        for (int t = 0; t < threads; ++t) {
+            report->occlusion_ms += ms[static_cast<size_t>(t)][effects.size()];
+            report->occlusion_rays += rays[static_cast<size_t>(t)][effects.size()];
+        }
+        report->occlusion_probes = tracing ? count : 0;
         for (size_t ei = 0; ei < effects.size(); ++ei) {
             BakeEffect& be = report->effects[ei];
             for (int t = 0; t < threads; ++t) {
@@ -557,8 +811,22 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
                 be.rays += rays[static_cast<size_t>(t)][ei];
             }
             if (effects[ei].traced) be.method = "closed form, shadowed: " + std::to_string(be.rays) + " rays";
+            // The first distant effect carries the occlusion pass's rays and time.
+            if (effects[ei].distant && occlude_distant && ei == 0) {
+                be.rays += report->occlusion_rays;
+                be.milliseconds += report->occlusion_ms;
+            }
             report->rays += be.rays;
         }
+        if (tracing && !occlude_distant) report->rays += report->occlusion_rays;
+        report->invalid_probes = invalid;
+        report->dilated_probes = dilated;
+        report->dilation_ms = dil_ms;
+        report->mask_rays = mask_rays;
+        report->mask_probes = leak && validity ? count : 0;
+        report->validity_checked = validity;
+        report->mask_ms = mask_ms;
+        report->rays += mask_rays;
         report->total_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_start).count();
     }
     return out;

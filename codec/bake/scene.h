@@ -18,18 +18,29 @@
 //    the whole sphere (L00 only);
 //  * hemisphere light: constant radiance over the hemisphere around `direction` (Eq. 15, pi/2).
 //
-// Occluders (spheres, axis-aligned boxes, triangles of meshes) only matter for lights with
-// `shadows` on. Then:
+// Occluders (spheres, axis-aligned boxes, triangles of meshes) shadow the lights with `shadows`
+// on, and occlude the sky and the environment (below). Lights:
 //  * point, spot and zero-radius directional lights: one shadow ray (to the light / to infinity);
 //  * cone lights (sun with a radius, sphere lights, hemisphere lights): a fixed set of
 //    `shadow_samples` equal-solid-angle directions inside the cone (a spherical-Fibonacci spiral
 //    over the cap). The occluded samples' projection (each weighted by cone solid angle / N) is
 //    subtracted from the closed form; all samples visible -> the closed form exactly; all blocked
 //    -> exactly zero.
-// The environment and the sky are never shadowed (they are not lights).
+//
+// Sky and environment occlusion (docs/scene.md "Probes near geometry"): with occluders and
+// `occlusion.sky_samples` = N > 0, each probe casts N fixed equal-area directions over the sphere
+// (a spherical-Fibonacci spiral); the blocked directions' projection, sum_k (4 pi / N) L(d_k) Y(d_k)
+// with L the sky's / the environment's radiance in d_k, is subtracted from the closed forms: no
+// blocked ray -> the closed forms exactly, all blocked -> exactly zero. The same rays classify the
+// probe (grid layouts): more than `invalid_fraction` of them starting inside a box/sphere or meeting
+// a triangle's back face first -> invalid; its SH becomes the inverse-distance blend of the valid
+// probes of the nearest grid shell (at most kDilationShells steps away) holding any. Visibility
+// masks (ProbeSet::visibility): per grid probe and each of its 8 cells, kMaskPoints rays from the
+// cell's centre region to the probe.
 //
 // Determinism: every probe is computed by itself with the effects in scene order, summed in
-// double, so the result is the same bytes whatever the thread count.
+// double; dilation reads only baked valid probes; so the result is the same bytes whatever the
+// thread count.
 //
 // Experimental: this API may change between minor versions (docs/api.md "Public headers").
 // Thread safety (docs/api.md): every function here is reentrant and keeps no state between
@@ -100,7 +111,18 @@ struct ProbePlacement {
     std::vector<Vec3> positions;                // kPositions
 };
 
+// Occlusion of the sky/environment and probe validity (docs/scene.md "Probes near geometry").
+struct SceneOcclusion {
+    int sky_samples = 256;          // rays per probe; 0: sky/environment not occluded, no validity/masks
+    double invalid_fraction = 0.25;  // invalid when more than this fraction of rays see "inside"
+};
+// Visibility-mask rays per (probe, cell): the cell's centre and the 8 points centre +- spacing/4.
+constexpr int kMaskPoints = 9;
+// Dilation looks for valid probes in grid shells 1..kDilationShells around an invalid probe.
+constexpr int kDilationShells = 3;
+
 struct Scene {
+    SceneOcclusion occlusion;
     ProbePlacement probes;
     std::optional<SceneEnvironment> environment;
     std::optional<SceneSky> sky;
@@ -109,7 +131,8 @@ struct Scene {
 };
 
 // The built-in default scene of `zhc demo`: the default gradient sky and sun (codec/bake/sky.h), three
-// coloured sphere lights, a box occluder under the sun and a sphere occluder, 8 x 8 x 4 probes.
+// coloured sphere lights, a box occluder under the sun and a sphere occluder (both also occlude
+// the sky), 8 x 8 x 4 probes.
 Scene default_scene();
 
 // Probe positions in index order (grid: x fastest, then y, then z) and the container layout.
@@ -131,6 +154,15 @@ struct BakeReport {
     std::uint64_t rays = 0;
     double occluder_build_ms = 0;
     double total_ms = 0;
+    // Occlusion pass (sky/environment visibility and probe validity share its rays), validity
+    // dilation and visibility masks; zero when not run.
+    std::uint64_t occlusion_rays = 0, occlusion_probes = 0;
+    double occlusion_ms = 0;
+    bool validity_checked = false;  // grid with occluders and sky_samples > 0
+    std::uint64_t invalid_probes = 0, dilated_probes = 0;
+    double dilation_ms = 0;
+    std::uint64_t mask_rays = 0, mask_probes = 0;
+    double mask_ms = 0;
     // "sky (closed form): 0.3 ms; sun 'key' (closed form, shadowed: 4096 rays): 1.2 ms"
     std::string summary() const;
 };
@@ -142,14 +174,27 @@ struct BakeOptions {
     std::function<void(std::uint64_t done, std::uint64_t total)> progress;
 };
 
-// Bakes every probe (validate_scene first; kInvalidValue on a bad scene).
+// Leak-avoidance data of a grid bake (codec/probe/probe_set.h ProbeSet::validity/visibility).
+struct ProbeLeakData {
+    std::vector<std::uint8_t> validity;    // 1 valid, 0 inside geometry (dilated)
+    std::vector<std::uint8_t> visibility;  // bit (cx + 2 cy + 4 cz): visible from that cell
+};
+
+// Bakes every probe (validate_scene first; kInvalidValue on a bad scene). `leak`, when given, is
+// filled for grid layouts of scenes with occluders and sky_samples > 0 (else left empty); the
+// masks are traced only when it is asked for. The probes do not depend on `leak`.
 Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOptions& options = {},
-                                            BakeReport* report = nullptr);
+                                            BakeReport* report = nullptr, ProbeLeakData* leak = nullptr);
 
 // One light's radiance SH at probe position p, closed form, no shadows (the building block,
 // exposed for tests and benchmarks): accumulates into acc (27 doubles, coefficient-major RGB).
 void add_light_closed_form(const SceneLight& light, Vec3 p, double acc[27]);
 // The equal-solid-angle sample directions of a cone (unit, around `axis`), deterministic.
 std::vector<Vec3> cone_sample_directions(Vec3 axis, double sigma, int count);
+// The sky-occlusion directions: N equal-area directions over the sphere, z_k = 1 - (2k + 1)/N,
+// azimuth k pi (3 - sqrt 5) (a spherical-Fibonacci spiral), deterministic.
+std::vector<Vec3> sphere_sample_directions(int count);
+// Radiance of the scene's sky in unit direction d (the function the closed forms project).
+void sky_radiance(const SceneSky& sky, Vec3 d, double rgb[3]);
 
 }  // namespace zhc

@@ -58,6 +58,14 @@ struct ProbeSet {
     ProbeLayout layout;
     std::uint64_t count = 0;
     std::vector<std::uint8_t> payload;  // count * size_bytes, probe-major
+    // Leak-avoidance data of a baked grid (docs/scene.md "Probes near geometry"), both optional:
+    // empty, or exactly `count` bytes. validity[i]: 1 = valid, 0 = inside geometry (its SH is a
+    // blend of valid neighbours). visibility[i] (grid layouts only): bit (cx + 2 cy + 4 cz) set =
+    // the probe is visible from the grid cell on its side (cx, cy, cz), c = 1 towards +axis, 0
+    // towards -axis. Sampling a cell with lower corner probe (i0, j0, k0), corner (dx, dy, dz)
+    // reads bit 7 - (dx + 2 dy + 4 dz) of that corner probe.
+    std::vector<std::uint8_t> validity;
+    std::vector<std::uint8_t> visibility;
 
     // nullptr when `representation` is not in the table.
     const Codec* codec() const { return find_codec(representation); }

@@ -191,6 +191,27 @@ SceneSky read_sky(const Reader& r, const json& j) {
     return sky;
 }
 
+SceneOcclusion read_occlusion(const Reader& r, const json& j) {
+    const std::string p = "occlusion";
+    r.object(j, p, {"sky_samples", "invalid_fraction"});
+    SceneOcclusion o;
+    if (j.contains("sky_samples")) {
+        const json& s = j["sky_samples"];
+        const std::string sp = p + ".sky_samples";
+        if (!s.is_number_integer()) r.fail(ErrorCode::kInvalidValue, sp, "must be an integer (got " + Reader::type_of(s) + ")");
+        const std::int64_t n = s.is_number_unsigned() ? std::int64_t(std::min<std::uint64_t>(s.get<std::uint64_t>(), 1u << 30)) : s.get<std::int64_t>();
+        if (n < 0) r.fail(ErrorCode::kInvalidValue, sp, "must be >= 0 (got " + s.dump() + ")");
+        if (n > 65536) r.fail(ErrorCode::kTooLarge, sp, "above the limit of 65536");
+        o.sky_samples = static_cast<int>(n);
+    }
+    if (j.contains("invalid_fraction")) {
+        const double f = r.non_negative(j["invalid_fraction"], p + ".invalid_fraction");
+        if (f > 1) r.fail(ErrorCode::kInvalidValue, p + ".invalid_fraction", "must be in [0, 1] (got " + j["invalid_fraction"].dump() + ")");
+        o.invalid_fraction = f;
+    }
+    return o;
+}
+
 SceneLight read_light(const Reader& r, const json& j, const std::string& p, const SceneJsonLimits& limits) {
     if (!j.is_object()) r.object(j, p, {});
     const std::string type = r.string(r.field(j, p, "type"), p + ".type");
@@ -332,7 +353,7 @@ void read_occluder(const Reader& r, const json& j, const std::string& p, const S
 Scene parse(const Reader& r, const json& doc, const std::string& name, const std::string& base_dir,
             const SceneLoadOptions& options) {
     const SceneJsonLimits& limits = options.limits;
-    r.object(doc, "", {"format", "version", "description", "probes", "environment", "sky", "lights", "occluders"});
+    r.object(doc, "", {"format", "version", "description", "probes", "environment", "sky", "lights", "occluders", "occlusion"});
     if (doc.contains("format") && r.string(doc["format"], "format") != "zhc-scene")
         r.fail(ErrorCode::kBadFormat, "format", "must be \"zhc-scene\"");
     const json& version = r.field(doc, "", "version");
@@ -379,6 +400,7 @@ Scene parse(const Reader& r, const json& doc, const std::string& name, const std
         s.environment = env;
     }
     if (doc.contains("sky")) s.sky = read_sky(r, doc["sky"]);
+    if (doc.contains("occlusion")) s.occlusion = read_occlusion(r, doc["occlusion"]);
     if (doc.contains("lights")) {
         const json& a = r.array(doc["lights"], "lights", limits.max_lights, "lights");
         for (size_t i = 0; i < a.size(); ++i) s.lights.push_back(read_light(r, a[i], Reader::index("lights", i), limits));
@@ -410,10 +432,14 @@ Status check_ray_budget(const Scene& s, const SceneJsonLimits& limits, const std
                               (l.kind == LightKind::kDirectional && l.angular_radius_rad == 0);
         per_probe += punctual ? 1 : static_cast<std::uint64_t>(l.shadow_samples);
     }
+    // The occlusion pass (sky/environment, validity) and the visibility masks (8 cells per probe).
+    const bool grid = s.probes.kind == ProbePlacementKind::kGrid;
+    if (s.occlusion.sky_samples > 0 && (grid || s.sky || s.environment))
+        per_probe += static_cast<std::uint64_t>(s.occlusion.sky_samples) + (grid ? 8u * kMaskPoints : 0u);
     if (per_probe > 0 && probes > limits.max_rays / per_probe)
         return make_error(ErrorCode::kTooLarge, (name.empty() ? "" : name + ": ") + "lights: the bake would cast " +
                                                     std::to_string(probes) + " x " + std::to_string(per_probe) +
-                                                    " shadow rays, above the limit of " + std::to_string(limits.max_rays));
+                                                     " shadow rays, above the limit of " + std::to_string(limits.max_rays));
     return Ok{};
 }
 
@@ -506,6 +532,9 @@ std::string scene_json(const Scene& s) {
                           {"ground", rgb_json(g.ground)}, {"up", vec_json(g.up)}};
         }
     }
+    const SceneOcclusion defaults;
+    if (s.occlusion.sky_samples != defaults.sky_samples || s.occlusion.invalid_fraction != defaults.invalid_fraction)
+        doc["occlusion"] = {{"sky_samples", s.occlusion.sky_samples}, {"invalid_fraction", s.occlusion.invalid_fraction}};
     json lights = json::array();
     for (const SceneLight& l : s.lights) {
         json j;
