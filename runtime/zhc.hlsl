@@ -594,10 +594,10 @@ ZhcSH3 zhc_sh3_q28_stored(uint w[7], ZhcFormat f)
 float3 zhc_irradiance_floats(uint w[27], ZhcFormat f, float3 n)
 {
     bool irr = f.kind == ZHC_KIND_IRRADIANCE;
-    uint layout = zhc_encoding_layout(f.encoding);
-    if (layout == ZHC_LAYOUT_SH3_F32 || (layout == ZHC_LAYOUT_SH2_F32 && zhc_encoding_hallucination(f.encoding) == ZHC_DECODE_HALL_NONE))
+    uint fam = zhc_encoding_layout(f.encoding);
+    if (fam == ZHC_LAYOUT_SH3_F32 || (fam == ZHC_LAYOUT_SH2_F32 && zhc_encoding_hallucination(f.encoding) == ZHC_DECODE_HALL_NONE))
     {
-        ZhcSH3 s = zhc_stored_sh3_floats(w, layout == ZHC_LAYOUT_SH2_F32 ? 4u : 9u);
+        ZhcSH3 s = zhc_stored_sh3_floats(w, fam == ZHC_LAYOUT_SH2_F32 ? 4u : 9u);
         return irr ? zhc_sh3_evaluate(s, n) : zhc_sh3_irradiance(s, n);
     }
     float3 c[4], f20, a[3];
@@ -658,13 +658,13 @@ float3 zhc_irradiance_sh3_q28(uint w[7], ZhcFormat f, float3 n)
 
 float3 zhc_irradiance(uint w[27], ZhcFormat f, float3 n)
 {
-    uint layout = zhc_encoding_layout(f.encoding);
+    uint fam = zhc_encoding_layout(f.encoding);
     bool hall = zhc_encoding_hallucination(f.encoding) != ZHC_DECODE_HALL_NONE;
-    if (layout == ZHC_LAYOUT_ZH3_Q16)
+    if (fam == ZHC_LAYOUT_ZH3_Q16)
         return zhc_irradiance_zh3_q16(uint4(w[0], w[1], w[2], w[3]), f, n);
-    if (layout == ZHC_LAYOUT_SH2_Q && !hall) return zhc_irradiance_sh2_q(uint4(w[0], w[1], w[2], w[3]), f, n);
-    if (layout == ZHC_LAYOUT_SH2_Q) return zhc_irradiance_hall_curve_q(uint4(w[0], w[1], w[2], w[3]), f, n);
-    if (layout == ZHC_LAYOUT_SH3_Q28)
+    if (fam == ZHC_LAYOUT_SH2_Q && !hall) return zhc_irradiance_sh2_q(uint4(w[0], w[1], w[2], w[3]), f, n);
+    if (fam == ZHC_LAYOUT_SH2_Q) return zhc_irradiance_hall_curve_q(uint4(w[0], w[1], w[2], w[3]), f, n);
+    if (fam == ZHC_LAYOUT_SH3_Q28)
     {
         uint q[7] = { w[0], w[1], w[2], w[3], w[4], w[5], w[6] };
         return zhc_irradiance_sh3_q28(q, f, n);
@@ -718,9 +718,9 @@ ZhcSH3 zhc_decode_sh3_q28(uint w[7], ZhcFormat f) { return zhc_radiance_from_sto
 ZhcSH3 zhc_decode_floats(uint w[27], ZhcFormat f)
 {
     uint e = f.encoding;
-    uint layout = zhc_encoding_layout(e);
-    if (layout == ZHC_LAYOUT_SH3_F32 || (layout == ZHC_LAYOUT_SH2_F32 && zhc_encoding_hallucination(e) == ZHC_DECODE_HALL_NONE))
-        return zhc_radiance_from_stored(zhc_stored_sh3_floats(w, layout == ZHC_LAYOUT_SH2_F32 ? 4u : 9u), f.kind);
+    uint fam = zhc_encoding_layout(e);
+    if (fam == ZHC_LAYOUT_SH3_F32 || (fam == ZHC_LAYOUT_SH2_F32 && zhc_encoding_hallucination(e) == ZHC_DECODE_HALL_NONE))
+        return zhc_radiance_from_stored(zhc_stored_sh3_floats(w, fam == ZHC_LAYOUT_SH2_F32 ? 4u : 9u), f.kind);
     float3 c[4], f20, a[3];
     zhc_zh3_floats(w, e, f, c, f20, a);
     return zhc_sh3_from_zh3(c, f20, a, f.kind);
@@ -731,12 +731,12 @@ ZhcSH3 zhc_decode_sh3(uint w[27], ZhcFormat f)
 {
     uint e = f.encoding;
     uint4 p = uint4(w[0], w[1], w[2], w[3]);
-    uint layout = zhc_encoding_layout(e);
+    uint fam = zhc_encoding_layout(e);
     bool hall = zhc_encoding_hallucination(e) != ZHC_DECODE_HALL_NONE;
-    if (layout == ZHC_LAYOUT_ZH3_Q16) return zhc_decode_zh3_q16(p, f);
-    if (layout == ZHC_LAYOUT_SH2_Q && !hall) return zhc_decode_sh2_q(p, f);
-    if (layout == ZHC_LAYOUT_SH2_Q) return zhc_decode_hall_curve_q(p, f);
-    if (layout == ZHC_LAYOUT_SH3_Q28)
+    if (fam == ZHC_LAYOUT_ZH3_Q16) return zhc_decode_zh3_q16(p, f);
+    if (fam == ZHC_LAYOUT_SH2_Q && !hall) return zhc_decode_sh2_q(p, f);
+    if (fam == ZHC_LAYOUT_SH2_Q) return zhc_decode_hall_curve_q(p, f);
+    if (fam == ZHC_LAYOUT_SH3_Q28)
     {
         uint q[7] = { w[0], w[1], w[2], w[3], w[4], w[5], w[6] };
         return zhc_decode_sh3_q28(q, f);
