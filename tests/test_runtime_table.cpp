@@ -81,5 +81,31 @@ TEST(RuntimeTable, EveryCodecTableEntryHasARuntimeRow) {
     }
 }
 
+// ZHC_CODEC_STORAGE_FIELDS: every storage field (and the luminance weights) changes same_storage's
+// answer; an encoder control does not.
+TEST(RuntimeTable, SameStorageComparesExactlyTheStorageFields) {
+    const CodecOptions a;
+    EXPECT_TRUE(same_storage(a, a));
+    int fields = 0;
+#define ZHC_TEST_FIELD(field)                                                              \
+    {                                                                                      \
+        CodecOptions b;                                                                    \
+        b.field = decltype(b.field)(int(b.field) == 1 ? 0 : 1);                            \
+        EXPECT_FALSE(same_storage(a, b)) << #field;                                        \
+        ++fields;                                                                          \
+    }
+    ZHC_CODEC_STORAGE_FIELDS(ZHC_TEST_FIELD)
+#undef ZHC_TEST_FIELD
+    EXPECT_EQ(fields, 7);  // bits, sqrt_encoding, l2_bound, dc_format, kind, zonal_mapping, axis_mode
+    CodecOptions lum;
+    lum.luminance.g = 0.5;
+    EXPECT_FALSE(same_storage(a, lum));
+    CodecOptions controls;
+    controls.solver_iterations = 3;
+    controls.dering_punctual = true;
+    controls.hallucinate_a = 0.5;
+    EXPECT_TRUE(same_storage(a, controls));
+}
+
 }  // namespace
 }  // namespace zhc
