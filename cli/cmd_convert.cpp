@@ -117,13 +117,6 @@ Result<CodecOptions> params_from(const Options& o) {
     return p;
 }
 
-bool same_params(const CodecOptions& a, const CodecOptions& b) {
-    return a.bits == b.bits && a.sqrt_encoding == b.sqrt_encoding && a.l2_bound == b.l2_bound &&
-           a.dc_format == b.dc_format && a.kind == b.kind && a.zonal_mapping == b.zonal_mapping &&
-           a.axis_mode == b.axis_mode && a.luminance.r == b.luminance.r && a.luminance.g == b.luminance.g &&
-           a.luminance.b == b.luminance.b;
-}
-
 int run(const Options& o) {
     const std::string ext = file_extension(o.output);
     if (ext != ".zhp" && ext != ".json") {
@@ -157,7 +150,7 @@ int run(const Options& o) {
     EncodeStats stats;
     if (ext == ".zhp") {
         ProbeSet out;
-        if (in->set && in->set->representation == rep && same_params(in->set->params, *params)) {
+        if (in->set && in->set->representation == rep && same_storage(in->set->params, *params)) {
             out = *in->set;  // same representation and parameters: keep the bytes (no re-quantisation)
         } else {
             auto set = encode_probe_set(in->list.probes, rep, *params, in->list.layout, &stats);

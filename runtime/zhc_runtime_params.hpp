@@ -15,13 +15,10 @@ namespace zhc {
 // The runtime format of `codec` stored with `params`; false when the runtime does not know the name.
 inline bool runtime_format(std::string_view codec, const CodecOptions& params, zhc_probe_format* f) {
     if (zhc_probe_format_init(f, std::string(codec).c_str()) != ZHC_OK) return false;
-    f->bits = params.bits;
-    f->sqrt_encoding = params.sqrt_encoding;
-    f->l2_bound = int(params.l2_bound);
-    f->dc_format = int(params.dc_format);
-    f->zonal_mapping = int(params.zonal_mapping);
-    f->axis_mode = int(params.axis_mode);
-    f->kind = int(params.kind);
+    // zhc_probe_format's fields carry the names of CodecOptions' storage fields (codec.h).
+#define ZHC_COPY_STORAGE_FIELD(field) f->field = int(params.field);
+    ZHC_CODEC_STORAGE_FIELDS(ZHC_COPY_STORAGE_FIELD)
+#undef ZHC_COPY_STORAGE_FIELD
     f->luminance[0] = params.luminance.r;
     f->luminance[1] = params.luminance.g;
     f->luminance[2] = params.luminance.b;

@@ -24,6 +24,7 @@
 #include "codec/lightmap/lightmap.h"
 #include "codec/probe/probe_set.h"
 #include "codec/probe/quantize.h"
+#include "codec/probe/runtime_table.h"
 #include "formats/probes/probe_file.h"
 #include "runtime_c_helpers.h"
 #include "support.h"
@@ -103,6 +104,20 @@ TEST(RuntimeC, EveryCodecTableEntryIsKnownWithItsSizeInOrder) {
         EXPECT_EQ(zhc_encoding_size(int(e)), table[e].size_bytes) << name;
         PackedLayout layout;
         EXPECT_EQ(zhc_encoding_is_packed(int(e)) != 0, packed_layout_from_name(name, &layout)) << name;
+        // The generated row (the decoders choose by it) is the codec entry's runtime description;
+        // the bit-exact decode tests below show that the decoders it selects are the entry's.
+        const auto rt = runtime_entry(table[e]);
+        ASSERT_TRUE(rt.ok()) << rt.error().message;
+        const zhc_encoding_info* info = zhc_encoding_info_of(int(e));
+        ASSERT_NE(info, nullptr);
+        EXPECT_EQ(info->layout, unsigned(rt->layout)) << name;
+        EXPECT_EQ(info->hallucination, unsigned(rt->hallucination)) << name;
+        EXPECT_EQ(info->axis, unsigned(rt->axis)) << name;
+        EXPECT_EQ(info->axis, unsigned(table[e].traits.zonal_axis)) << name;
+        EXPECT_EQ(info->hallucination, unsigned(table[e].traits.hallucination)) << name;
+        if (table[e].packed) {
+            EXPECT_EQ(info->layout, unsigned(ZHC_LAYOUT_ZH3_Q16) + unsigned(table[e].packed->layout)) << name;
+        }
         zhc_probe_format f;
         ASSERT_EQ(zhc_probe_format_init(&f, name.c_str()), ZHC_OK);
         // The defaults are zhc convert's (CodecOptions) and the codec's curve constants.

@@ -33,6 +33,7 @@
 #include "codec/lightmap/lightmap.h"
 #include "codec/probe/probe_set.h"
 #include "codec/probe/quantize.h"
+#include "codec/probe/runtime_table.h"
 #include "codec/probe/zh3.h"
 #include "support.h"
 #include "zhc_runtime.h"
@@ -108,6 +109,18 @@ void main() {
         vec3 nn = vec3(normals[6u * i + 3u], normals[6u * i + 4u], normals[6u * i + 5u]);
         vec3 e = zhcVolumeIrradiance(ZhcVolume(uVolOrigin, uVolSpacing, uVolCounts), f, p, nn);
         outv[o] = e.x; outv[o + 1u] = e.y; outv[o + 2u] = e.z;
+    } else if (uMode == 5u) {  // the generated table: item i is encoding id i (ids past the end included)
+        outv[o] = float(zhcEncodingBytes(i));
+        outv[o + 1u] = float(zhcEncodingFamily(i));
+        outv[o + 2u] = float(zhcEncodingHallucination(i));
+        outv[o + 3u] = float(zhcEncodingAxis(i));
+        outv[o + 4u] = float(ZHC_ENCODING_COUNT);
+        outv[o + 5u] = float(ZHC_DEFAULT_BITS);
+        outv[o + 6u] = ZHC_DEFAULT_LUMINANCE.x; outv[o + 7u] = ZHC_DEFAULT_LUMINANCE.y;
+        outv[o + 8u] = ZHC_DEFAULT_LUMINANCE.z;
+        outv[o + 9u] = ZHC_DEFAULT_CURVE.x; outv[o + 10u] = ZHC_DEFAULT_CURVE.y;
+        outv[o + 11u] = float(ZHC_DEFAULT_SQRT_ENCODING + 2u * ZHC_DEFAULT_L2_BOUND + 4u * ZHC_DEFAULT_DC_FORMAT +
+                              16u * ZHC_DEFAULT_KIND + 32u * ZHC_DEFAULT_ZONAL_MAPPING + 128u * ZHC_DEFAULT_AXIS_MODE);
     } else {
         uint w = words[i];
         vec3 a = zhcUnpackR11G11B10F(w), b = zhcUnpackRGB9E5(w);
@@ -378,6 +391,43 @@ TEST_F(RuntimeGles, EveryCodecDecodesAndEvaluatesLikeTheCodec) {
 }
 
 // R11G11B10F, RGB9E5 and half unpacking are integer-exact: every code of every channel.
+// runtime/zhc.glsl's generated table functions and constants, run on the GPU, against the codec
+// table's runtime description: every id, and two ids past the end (bytes 0, family 0).
+template <class Fixture>
+void check_generated_table() {
+    const auto table = codecs();
+    const std::size_t n = table.size() + 2;
+    typename Fixture::Uniforms un;
+    un.mode = 5;
+    const std::vector<float> gpu = Fixture::run(un, {0u}, std::vector<float>(3 * n, 0.0f), n);
+    const CodecOptions d;
+    for (std::size_t e = 0; e < n; ++e) {
+        const float* r = gpu.data() + e * kOutFloats;
+        if (e >= table.size()) {
+            EXPECT_EQ(r[0], 0.0f) << "id " << e << " past the table: 0 bytes";
+            continue;
+        }
+        const auto rt = runtime_entry(table[e]);
+        ASSERT_TRUE(rt.ok()) << rt.error().message;
+        const std::string name(table[e].name);
+        EXPECT_EQ(r[0], float(table[e].size_bytes)) << name;
+        EXPECT_EQ(r[1], float(rt->layout)) << name;
+        EXPECT_EQ(r[2], float(rt->hallucination)) << name;
+        EXPECT_EQ(r[3], float(rt->axis)) << name;
+        EXPECT_EQ(r[4], float(table.size()));
+        EXPECT_EQ(r[5], float(d.bits));
+        EXPECT_EQ(r[6], float(d.luminance.r));
+        EXPECT_EQ(r[7], float(d.luminance.g));
+        EXPECT_EQ(r[8], float(d.luminance.b));
+        EXPECT_EQ(r[9], float(d.hallucinate_a));
+        EXPECT_EQ(r[10], float(d.hallucinate_b));
+        EXPECT_EQ(r[11], float(int(d.sqrt_encoding) + 2 * int(d.l2_bound) + 4 * int(d.dc_format) + 16 * int(d.kind) +
+                               32 * int(d.zonal_mapping) + 128 * int(d.axis_mode)));
+    }
+}
+TEST_F(RuntimeGl, GeneratedTableMatchesTheCodec) { check_generated_table<RuntimeGl>(); }
+TEST_F(RuntimeGles, GeneratedTableMatchesTheCodec) { check_generated_table<RuntimeGles>(); }
+
 TEST_F(RuntimeGl, DcUnpackingIsBitExact) {
     std::vector<std::uint32_t> w;
     for (std::uint32_t c = 0; c < 2048; ++c) w.push_back(c | (c << 11) | ((c & 0x3FF) << 22));  // R11G11B10F codes

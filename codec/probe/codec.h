@@ -68,6 +68,13 @@ enum class ZonalAxisMode : std::uint8_t {
 //  * encoder controls (solver_*, hallucinate_*, dering_punctual): they only choose which bytes an
 //    encoder writes (hallucinate_a/b are also decoder constants of the hall_* entries, fixed at the
 //    defaults in files). Each entry reads the fields that concern it.
+// The storage parameters of CodecOptions below, listed once: X(field) for each field that changes
+// what stored bytes mean, except `luminance` (three doubles, not an enum or integer). Code that
+// copies or compares the storage parameters walks this list (same_storage below,
+// runtime/zhc_runtime_params.hpp, the runtime table generator); a new storage field added to the
+// struct goes here too.
+#define ZHC_CODEC_STORAGE_FIELDS(X) X(bits) X(sqrt_encoding) X(l2_bound) X(dc_format) X(kind) X(zonal_mapping) X(axis_mode)
+
 struct CodecOptions {
     LuminanceWeights luminance;
     // ZH3 axis solve (ZH3 paper Sec. 3.3): L-BFGS iteration cap per start (a convergence guard; the
@@ -89,6 +96,15 @@ struct CodecOptions {
     bool dering_punctual = false;
 };
 
+// true when a and b have the same storage parameters (ZHC_CODEC_STORAGE_FIELDS and the luminance
+// weights, compared exactly): bytes stored under a decode the same under b.
+inline bool same_storage(const CodecOptions& a, const CodecOptions& b) {
+#define ZHC_SAME_FIELD(field) a.field == b.field &&
+    return ZHC_CODEC_STORAGE_FIELDS(ZHC_SAME_FIELD) a.luminance.r == b.luminance.r &&
+           a.luminance.g == b.luminance.g && a.luminance.b == b.luminance.b;
+#undef ZHC_SAME_FIELD
+}
+
 // What an encode noticed; all counters are per call and optional to read.
 struct EncodeStats {
     int clamped_ratios = 0;      // quantiser: ratios outside their bound interval, clamped
@@ -106,6 +122,16 @@ enum class ZonalAxis : std::uint8_t {
     kFromParams = 3,  // the storage parameters' axis mode (quantised layouts; the container stores it)
 };
 
+// The zonal L2 term a decoder hallucinates from the stored linear SH (ZH3 paper Sec. 3.4), as the
+// runtimes (runtime/) name it: their decoders choose by this, never by the entry's name or id.
+enum class ZonalHallucination : std::uint8_t {
+    kNone = 0,                // the L2 band is stored (or dropped)
+    kAmbientDirectional = 1,  // Eq. 14: f20 = sqrt(15)/3 |f1|
+    kSphere = 2,              // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
+    kCurve = 3,               // Eq. 21: f20 = (a p^2 + b p) f0
+    kCurveAdaptive = 4,       // Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout only)
+};
+
 // What code outside an entry may ask about it instead of testing its name. Each field is a fact
 // about the entry's bytes or decoder; tests check every one of them against the entry's functions
 // (tests/test_codec_table.cpp; zonal_axis against the GLSL and HLSL runtimes).
@@ -121,6 +147,7 @@ struct CodecTraits {
     // always stored a byte array, and they stay the same.)
     int float_bands = 0;
     ZonalAxis zonal_axis = ZonalAxis::kNone;
+    ZonalHallucination hallucination = ZonalHallucination::kNone;
 };
 
 struct Codec {

@@ -7,12 +7,13 @@
 #include "codec/probe/codec.h"
 
 // The parts of the table: one line per codec module, X(the module's part function), in table order.
-// The table's order is the runtime encoding ids (runtime/: zhc_runtime.h's enum, zhc.hlsl's
-// defines), so a new module's line goes last and no line ever moves or goes (the runtime tests
-// fail otherwise). This list is the only edit outside a new module's own files (plus its source
-// line in codec/CMakeLists.txt). Static self-registration would need no list, but objects of a
-// static library that nothing references are dropped by the linker, and the order would follow
-// the link order.
+// The table's order is the runtime encoding ids (the runtimes' generated tables, written by
+// `cmake --build build --target update_runtime_tables`, docs/runtime.md "Generated tables"), so a
+// new module's line goes last and no line ever moves or goes (the runtime tests fail otherwise).
+// This list is the only edit outside a new module's own files (plus its source line in
+// codec/CMakeLists.txt) and the regenerated runtime tables. Static self-registration would need no
+// list, but objects of a static library that nothing references are dropped by the linker, and the
+// order would follow the link order.
 #define ZHC_CODEC_PARTS(X)      \
     X(core_codecs)             \
     X(zh3_codecs)              \

@@ -564,7 +564,7 @@ const Codec kQuantized[] = {
                         ZonalAxis::kNone),
     packed_codec<kHallCurveQ>("hall_curve_q",
                               "sh2_q bytes, zonal L2 hallucinated at decode by the Eq. 21 curve (luminance axis)",
-                              kAxisFromParams),
+                              kAxisFromParams, ZonalHallucination::kCurve),
 };
 }  // namespace
 

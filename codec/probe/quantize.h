@@ -172,12 +172,13 @@ template <const PackedCodec& P>
 Rgb packed_entry_irradiance(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
     return irradiance(P.decode(in, o), n);
 }
-// A whole Codec entry for P: P's encode and decode, the irradiance above; `zonal_axis` is its trait
-// (codec.h CodecTraits).
+// A whole Codec entry for P: P's encode and decode, the irradiance above; `zonal_axis` and
+// `hallucination` are its traits (codec.h CodecTraits).
 template <const PackedCodec& P>
-constexpr Codec packed_codec(std::string_view name, std::string_view summary, ZonalAxis zonal_axis) {
+constexpr Codec packed_codec(std::string_view name, std::string_view summary, ZonalAxis zonal_axis,
+                             ZonalHallucination hallucination = ZonalHallucination::kNone) {
     return {name,     summary, packed_size_bytes(P.layout), P.encode, P.decode, packed_entry_irradiance<P>,
-            CodecTraits{.zonal_axis = zonal_axis}, &P};
+            CodecTraits{.zonal_axis = zonal_axis, .hallucination = hallucination}, &P};
 }
 
 // The codec table part of codec/probe/quantize.cpp: zh3_q16, zh3_solved_q16, sh3_q28, sh2_q, hall_curve_q.

@@ -87,6 +87,12 @@ constexpr auto kCurve = Hallucination::kCurve;
 
 constexpr CodecTraits kLumAxis{.zonal_axis = ZonalAxis::kLuminance};
 constexpr CodecTraits kChanAxis{.zonal_axis = ZonalAxis::kPerChannel};
+// The hall_* entries' traits: axis and the hallucination their decoder applies.
+template <Hallucination H, ZonalAxisMode M>
+constexpr CodecTraits kHall{.zonal_axis = M == kLum ? ZonalAxis::kLuminance : ZonalAxis::kPerChannel,
+                            .hallucination = H == kAmbDir   ? ZonalHallucination::kAmbientDirectional
+                                             : H == kSphere ? ZonalHallucination::kSphere
+                                                            : ZonalHallucination::kCurve};
 
 const Codec kZh3Codecs[] = {
     {"zh3_lum", "ZH3 fit (Eq. 9/10) on the luminance L1 axis, 15 floats", kZh3Floats * 4, encode_fit<kLum>,
@@ -98,17 +104,17 @@ const Codec kZh3Codecs[] = {
     {"zh3_solved_channel", "ZH3, per-channel axes solved by BFGS (Eq. 11), 15 floats", kZh3Floats * 4,
      encode_solved<kChan>, decode_zh3<kChan>, irradiance_zh3<kChan>, kChanAxis},
     {"hall_ambdir", "linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), luminance axis",
-     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kLum>, irradiance_hall<kAmbDir, kLum>, kLumAxis},
+     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kLum>, irradiance_hall<kAmbDir, kLum>, kHall<kAmbDir, kLum>},
     {"hall_sphere", "linear SH + zonal L2 hallucinated, sphere light (Eq. 20), luminance axis", kLinearFloats * 4,
-     encode_linear, decode_hall<kSphere, kLum>, irradiance_hall<kSphere, kLum>, kLumAxis},
+     encode_linear, decode_hall<kSphere, kLum>, irradiance_hall<kSphere, kLum>, kHall<kSphere, kLum>},
     {"hall_curve", "linear SH + zonal L2 hallucinated, curve fit (Eq. 21), luminance axis", kLinearFloats * 4,
-     encode_linear, decode_hall<kCurve, kLum>, irradiance_hall<kCurve, kLum>, kLumAxis},
+     encode_linear, decode_hall<kCurve, kLum>, irradiance_hall<kCurve, kLum>, kHall<kCurve, kLum>},
     {"hall_ambdir_channel", "linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), channel axes",
-     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kChan>, irradiance_hall<kAmbDir, kChan>, kChanAxis},
+     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kChan>, irradiance_hall<kAmbDir, kChan>, kHall<kAmbDir, kChan>},
     {"hall_sphere_channel", "linear SH + zonal L2 hallucinated, sphere light (Eq. 20), channel axes",
-     kLinearFloats * 4, encode_linear, decode_hall<kSphere, kChan>, irradiance_hall<kSphere, kChan>, kChanAxis},
+     kLinearFloats * 4, encode_linear, decode_hall<kSphere, kChan>, irradiance_hall<kSphere, kChan>, kHall<kSphere, kChan>},
     {"hall_curve_channel", "linear SH + zonal L2 hallucinated, curve fit (Eq. 21), channel axes",
-     kLinearFloats * 4, encode_linear, decode_hall<kCurve, kChan>, irradiance_hall<kCurve, kChan>, kChanAxis},
+     kLinearFloats * 4, encode_linear, decode_hall<kCurve, kChan>, irradiance_hall<kCurve, kChan>, kHall<kCurve, kChan>},
     {"zh3_lum_dering", "zh3_lum with the zonal L2 clamped for non-negative irradiance (App. B)",
      kZh3Floats * 4, encode_lum_dering, decode_zh3<kLum>, irradiance_zh3<kLum>, kLumAxis},
     {"zh3_lum_dering_sphere", "zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere",

@@ -551,13 +551,14 @@ constexpr PackedCodec kHallAdaptiveQ16{PackedLayout::kSh2Q, encode_q<true>, deco
 
 const Codec kHallCodecs[] = {
     {"hall_solved", "hall_curve's bytes and decoder; encoder solves the L1 for the error after hallucination", 48,
-     encode_solved, decode_solved, irradiance_solved, {.zonal_axis = ZonalAxis::kLuminance}},
+     encode_solved, decode_solved, irradiance_solved,
+     {.zonal_axis = ZonalAxis::kLuminance, .hallucination = ZonalHallucination::kCurve}},
     packed_codec<kHallSolvedQ16>("hall_solved_q16",
                                  "hall_curve_q's bytes and decoder; encoder solves the L1 (quantised, checked)",
-                                 ZonalAxis::kFromParams),
+                                 ZonalAxis::kFromParams, ZonalHallucination::kCurve),
     packed_codec<kHallAdaptiveQ16>("hall_adaptive_q16",
                                    "sh2_q bytes + per-probe hallucination scale code (byte 15), L1 solved for it",
-                                   ZonalAxis::kFromParams),
+                                   ZonalAxis::kFromParams, ZonalHallucination::kCurveAdaptive),
 };
 }  // namespace
 

@@ -27,12 +27,13 @@
 // Encodings: zh3_q16, zh3_solved_q16, zh3_dering_q16, zh3_channel_q16, zh3_solved_channel_q16,
 // sh3_q28, sh2_q. The hallucinating and float encodings throw (use lightProbeGrid for those).
 import { zhcIrradianceGlsl } from './zhc_irradiance.glsl.mjs';
-import { ENCODINGS, PACKED_LAYOUTS, parseZhp } from './zhc_runtime.mjs';
+import { ENCODINGS, ENCODING_TABLE, PACKED_LAYOUTS, parseZhp } from './zhc_runtime.mjs';
 
 // Packed layout -> RGBA32UI texels per probe (16 bytes each, the last zero padded).
 export const COMPACT_TEXELS = Object.freeze({ zh3_q16: 1, sh3_q28: 2, sh2_q: 1 });
-const COMPACT_ENCODINGS = Object.freeze(['zh3_q16', 'zh3_solved_q16', 'zh3_dering_q16', 'zh3_channel_q16',
-  'zh3_solved_channel_q16', 'sh3_q28', 'sh2_q']);
+// The packed entries decoded without hallucination (the codec table's generated rows).
+const COMPACT_ENCODINGS = Object.freeze(ENCODING_TABLE.filter((row) => row.layout in COMPACT_TEXELS &&
+  row.hallucination === 'none').map((row) => row.name));
 
 function compactLayout(encoding) {
   if (!COMPACT_ENCODINGS.includes(encoding))

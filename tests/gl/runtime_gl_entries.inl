@@ -33,52 +33,34 @@
 
 // ---- codec table -> GLSL format ----------------------------------------------------------------------
 
-// GLSL constants (runtime/zhc.glsl); checked against the file by glsl_entries().
-enum : std::uint32_t { kSh3F32 = 0, kSh2F32 = 1, kZh3F32 = 2, kZh3Q16 = 3, kSh3Q28 = 4, kSh2Q = 5 };
-enum : std::uint32_t { kHallNone = 0, kHallAmbdir = 1, kHallSphere = 2, kHallCurve = 3, kHallCurveAdaptive = 4 };
+// The layout families and hallucination models, as the runtimes number them (runtime/zhc.glsl's
+// ZHC_LAYOUT_* / ZHC_HALL_*, generated like zhc_runtime.h's from codec/probe/runtime_table.h).
+enum : std::uint32_t {
+    kSh3F32 = ZHC_LAYOUT_SH3_F32, kSh2F32 = ZHC_LAYOUT_SH2_F32, kZh3F32 = ZHC_LAYOUT_ZH3_F32,
+    kZh3Q16 = ZHC_LAYOUT_ZH3_Q16, kSh3Q28 = ZHC_LAYOUT_SH3_Q28, kSh2Q = ZHC_LAYOUT_SH2_Q
+};
+enum : std::uint32_t {
+    kHallNone = ZHC_HALL_NONE, kHallAmbdir = ZHC_HALL_AMBDIR, kHallSphere = ZHC_HALL_SPHERE,
+    kHallCurve = ZHC_HALL_CURVE, kHallCurveAdaptive = ZHC_HALL_CURVE_ADAPTIVE
+};
 
 struct GlslEntry {
     std::uint32_t family, hallucination;
-    ZonalAxis axis;  // the table's axis column; must equal the codec entry's CodecTraits::zonal_axis
+    ZonalAxis axis;  // where the zonal axis comes from: the codec entry's CodecTraits::zonal_axis
 };
 
-// runtime/zhc.glsl's table of the codec table's entries, its lines "//   NAME ZHC_LAYOUT_* ZHC_HALL_*
-// AXIS", with the values of the constants from its "const uint ZHC_... = Nu;" lines. The test takes
-// every entry's GLSL format from here; an entry missing from the file fails the test.
+// Every codec table entry's GLSL format: its runtime description (codec/probe/runtime_table.h), the
+// one runtime/zhc.glsl's generated table holds (test runtime_tables.check compares the file with
+// the codec table; RuntimeGl.GeneratedTableMatchesTheCodec runs the GLSL table functions).
 const std::map<std::string, GlslEntry, std::less<>>& glsl_entries() {
     static const std::map<std::string, GlslEntry, std::less<>> m = [] {
-        const std::string text = read_text(ZHC_RUNTIME_GLSL_PATH);
-        std::map<std::string, std::uint32_t> constants;
-        std::vector<std::vector<std::string>> rows;  // the table lines, split into words
-        std::istringstream lines(text);
-        for (std::string line; std::getline(lines, line);) {
-            std::istringstream in(line);
-            std::vector<std::string> w;
-            for (std::string word; in >> word;) w.push_back(word);
-            if (w.size() >= 5 && w[0] == "const" && w[1] == "uint" && w[3] == "=" && w[4].size() > 2 &&  // + a comment
-                w[4].substr(w[4].size() - 2) == "u;")
-                constants[w[2]] = static_cast<std::uint32_t>(std::stoul(w[4]));
-            else if (w.size() == 5 && w[0] == "//" && w[2].rfind("ZHC_LAYOUT_", 0) == 0 && w[3].rfind("ZHC_HALL_", 0) == 0)
-                rows.push_back(w);
-        }
-        const std::map<std::string, ZonalAxis> axes = {{"none", ZonalAxis::kNone},
-                                                        {"luminance", ZonalAxis::kLuminance},
-                                                        {"channel", ZonalAxis::kPerChannel},
-                                                        {"header", ZonalAxis::kFromParams}};
         std::map<std::string, GlslEntry, std::less<>> out;
-        for (const auto& w : rows) {
-            const bool known = constants.count(w[2]) && constants.count(w[3]) && axes.count(w[4]);
-            EXPECT_TRUE(known) << "runtime/zhc.glsl: unknown constant or axis in the table line of " << w[1];
-            if (known) out[w[1]] = GlslEntry{constants[w[2]], constants[w[3]], axes.at(w[4])};
+        for (const Codec& c : codecs()) {
+            const auto rt = runtime_entry(c);
+            EXPECT_TRUE(rt.ok()) << (rt.ok() ? "" : rt.error().message);
+            if (rt.ok())
+                out[std::string(c.name)] = GlslEntry{std::uint32_t(rt->layout), std::uint32_t(rt->hallucination), rt->axis};
         }
-        // The test's own copies of the constants (its bounds depend on the family) must agree.
-        const std::pair<const char*, std::uint32_t> mine[] = {
-            {"ZHC_LAYOUT_SH3_F32", kSh3F32}, {"ZHC_LAYOUT_SH2_F32", kSh2F32},   {"ZHC_LAYOUT_ZH3_F32", kZh3F32},
-            {"ZHC_LAYOUT_ZH3_Q16", kZh3Q16}, {"ZHC_LAYOUT_SH3_Q28", kSh3Q28},   {"ZHC_LAYOUT_SH2_Q", kSh2Q},
-            {"ZHC_HALL_NONE", kHallNone},    {"ZHC_HALL_AMBDIR", kHallAmbdir},  {"ZHC_HALL_SPHERE", kHallSphere},
-            {"ZHC_HALL_CURVE", kHallCurve},  {"ZHC_HALL_CURVE_ADAPTIVE", kHallCurveAdaptive}};
-        for (const auto& [name, value] : mine)
-            EXPECT_TRUE(constants.count(name) && constants[name] == value) << name << " in runtime/zhc.glsl";
         return out;
     }();
     return m;

@@ -10,9 +10,9 @@
 // coefficients counted at their ratio bound times the DC); bounds 16 (float layouts) / 32
 // (quantised) for irradiance, 16 for decoded coefficients, plus 2^-120 absolute (denormal flush).
 //
-//  1. every entry of the runtime's encoding table (ENCODINGS of zhc_runtime.mjs, which
-//     js.runtime_decode keeps equal to the codec table) must have a line in zhc.wgsl's table (family,
-//     hallucination, axis), else the test fails naming it;
+//  1. every entry of the runtime's generated encoding table (ENCODING_TABLE of zhc_runtime.mjs;
+//     runtime_tables.check keeps it and zhc.wgsl's equal to the codec table) takes its family,
+//     hallucination and axis from there; zhc.wgsl's ids and constants must agree;
 //  2. 10 batches x 10,000 probes per encoding (lit scenes with coloured directional / blurred lights
 //     and ambient, random Gaussian SH, fixtures' bake-like probes and special cases; exposure
 //     10^-3..10^3), each batch with its own header parameters (bits, sqrt, bound, DC format, zonal
@@ -61,29 +61,28 @@ const kCFloat = 16, kCQuant = 32, kCDecode = 16;
 const wgslText = fs.readFileSync(path.join(repo, 'runtime', 'zhc.wgsl'), 'utf8');
 const constants = {};
 for (const m of wgslText.matchAll(/^const (ZHC_\w+): u32 = (\d+)u;/gm)) constants[m[1]] = Number(m[2]);
-const wgslTable = {};
-for (const m of wgslText.matchAll(/^\/\/\s+(\w+)\s+(ZHC_LAYOUT_\w+)\s+(ZHC_HALL_\w+)\s+(none|luminance|channel|header)\s*$/gm)) {
-  check(m[2] in constants && m[3] in constants, `zhc.wgsl: the table line of ${m[1]} names known constants`);
-  wgslTable[m[1]] = { family: constants[m[2]], hallucination: constants[m[3]], axis: m[4] };
-}
 // The test's own copies of the constants (the bounds depend on the family) must agree with the file.
 const F = { SH3_F32: 0, SH2_F32: 1, ZH3_F32: 2, ZH3_Q16: 3, SH3_Q28: 4, SH2_Q: 5 };
 const H = { NONE: 0, AMBDIR: 1, SPHERE: 2, CURVE: 3, CURVE_ADAPTIVE: 4 };
 for (const [k, v] of Object.entries(F)) check(constants[`ZHC_LAYOUT_${k}`] === v, `zhc.wgsl: ZHC_LAYOUT_${k} = ${v}u`);
 for (const [k, v] of Object.entries(H)) check(constants[`ZHC_HALL_${k}`] === v, `zhc.wgsl: ZHC_HALL_${k} = ${v}u`);
+// Every entry's WGSL format comes from the runtime's generated table (ENCODING_TABLE of
+// zhc_runtime.mjs: layout, hallucination, axis), whose rows zhc.wgsl's generated table holds too
+// (runtime_tables.check compares both files with the codec table); the file's ids must be the rows'.
 const familyBytes = [108, 48, 60, 16, 28, 16];
 const encodings = [];
-for (const name of Object.keys(runtime.ENCODINGS)) {
-  const e = wgslTable[name];
-  check(e !== undefined, `runtime table entry '${name}' has a WGSL decoder line in runtime/zhc.wgsl`);
-  if (!e) continue;
+check(constants.ZHC_ENCODING_COUNT === runtime.ENCODING_TABLE.length, `zhc.wgsl: ZHC_ENCODING_COUNT = ${runtime.ENCODING_TABLE.length}u`);
+runtime.ENCODING_TABLE.forEach((row, id) => {
+  const name = row.name;
+  check(constants[`ZHC_ENC_${name.toUpperCase()}`] === id, `zhc.wgsl: ZHC_ENC_${name.toUpperCase()} = ${id}u`);
+  const e = { family: constants[`ZHC_LAYOUT_${row.layout.toUpperCase()}`], hallucination: constants[`ZHC_HALL_${row.hallucination.toUpperCase()}`], axis: row.axis };
+  check(e.family !== undefined && e.hallucination !== undefined, `${name}: zhc.wgsl defines its family and hallucination`);
   const info = runtime.ENCODINGS[name];
   check(familyBytes[e.family] === info.bytes, `${name}: zhc.wgsl's family has the entry's ${info.bytes} bytes`);
-  if (info.axisMode) check(e.axis === info.axisMode, `${name}: zhc.wgsl's axis column is the runtime's fixed '${info.axisMode}'`);
+  if (info.axisMode) check(e.axis === info.axisMode, `${name}: the table's axis is the runtime's fixed '${info.axisMode}'`);
   if (!process.env.ZHC_WGSL_ONLY || process.env.ZHC_WGSL_ONLY.split(',').includes(name))  // debugging aid
     encodings.push({ name, ...e, bytes: info.bytes, packed: !!info.packed });
-}
-for (const name of Object.keys(wgslTable)) check(name in runtime.ENCODINGS, `zhc.wgsl table line '${name}' is a runtime encoding`);
+});
 
 // A second, independent WGSL front end (npm wgsl_reflect, a parser + reflection; Chromium's Tint is
 // the only full validator available): zhc.wgsl alone and with zhc_volume.wgsl and the test kernels
@@ -156,7 +155,7 @@ function batchParams(e, b, rand) {
       p.zonalMapping = ['affine', 'zero', 'symmetric'][(b >> 1) % 3];
       flags.push('--zonal-map', p.zonalMapping);
     }
-    if (e.axis === 'header') {
+    if (e.axis === 'format') {
       p.axisMode = ((b >> 2) % 2) ? 'channel' : 'luminance';
       flags.push('--axis', p.axisMode);
     }
