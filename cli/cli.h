@@ -83,6 +83,16 @@ CLI::Option* add_latlong_option(CLI::App* app, LatLongConvention& convention, bo
 // --ldr-encoding auto|srgb|linear|rgbm:RANGE|rgbd:RANGE (8-bit cube maps, EnvmapReadOptions::ldr).
 CLI::Option* add_ldr_encoding_option(CLI::App* app, LdrDecoding& decoding);
 
+// `--depfile FILE`: after the verb succeeds, write a Make-syntax depfile naming the files it wrote
+// (targets) and every file it read (formats/io/depfile.h, docs/build-integration.md). main() runs
+// the verb under a FileRecorder and writes the depfile; nothing is written when the verb fails.
+CLI::Option* add_depfile_option(CLI::App* app);
+// Runs `verb` and, when --depfile was given, records its files and writes the depfile (temporary
+// file + rename) only if it returned kExitOk. If the depfile cannot be written (a path it cannot
+// express, an I/O error, or a verb that wrote nothing) the files the verb wrote are removed again and
+// the exit is kExitOutputFailed, so that no output stands without its depfile.
+int run_with_depfile(const std::function<int()>& verb);
+
 // A verb: `setup` adds the subcommand and its options to the app and returns the function that
 // runs it after parsing. Verbs register themselves with a static VerbRegistration.
 using VerbSetup = std::function<std::function<int()>(CLI::App& app)>;

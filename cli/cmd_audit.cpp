@@ -359,6 +359,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
     add_ldr_encoding_option(sub, o->ldr);
+    add_depfile_option(sub);
     return [o] { return run(*o); };
 });
 

@@ -240,6 +240,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
         s->add_option("--band-rows", o->band_rows, "rows per streamed band (rounded up to a multiple of 4; default: about 2^18 texels; output identical for any value)")
             ->check(CLI::Range(1, 1 << 20));
         add_progress_flags(s, o->progress);
+        add_depfile_option(s);
     };
     CLI::App* enc = lm->add_subcommand("encode", "SH lightmap EXR -> PREFIX.iz.ktx2 (BC6H) + PREFIX.d.ktx2 (BC5) + PREFIX.wa.ktx2 (BC4), or .dds");
     enc->add_option("IN", o->inputs,

@@ -4,7 +4,8 @@
 #   include/zhc/zhc_runtime.h                       the C99 runtime decoder (when runtime/ exists)
 #   include/zhc/zhc_volume_layouts.hpp              GPU volume layouts over it (C++17)
 #   lib/libzhc_codec.a, lib/libzhc_formats.a        static libraries
-#   lib/cmake/zhc/zhcConfig.cmake                   find_package(zhc): targets zhc::codec, zhc::formats
+#   lib/cmake/zhc/zhcConfig.cmake                   find_package(zhc): targets zhc::codec, zhc::formats, zhc::zhc
+#   lib/cmake/zhc/zhcBuild.cmake                    zhc_add_bake, zhc_add_lightmap (docs/build-integration.md)
 #   lib/pkgconfig/zhc.pc                            pkg-config --static --cflags --libs zhc
 #   share/zhc/runtime/                              runtime files (C header, GLSL, HLSL, web package)
 #   bin/zhc                                         the command
@@ -53,10 +54,11 @@ if(EXISTS "${PROJECT_SOURCE_DIR}/runtime")
 endif()
 
 configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/zhcConfig.cmake.in"
-                              "${PROJECT_BINARY_DIR}/zhcConfig.cmake" INSTALL_DESTINATION "${ZHC_CMAKE_DIR}")
+                              "${PROJECT_BINARY_DIR}/zhcConfig.cmake" INSTALL_DESTINATION "${ZHC_CMAKE_DIR}"
+                              PATH_VARS CMAKE_INSTALL_BINDIR)
 write_basic_package_version_file("${PROJECT_BINARY_DIR}/zhcConfigVersion.cmake" COMPATIBILITY SameMinorVersion)
 install(FILES "${PROJECT_BINARY_DIR}/zhcConfig.cmake" "${PROJECT_BINARY_DIR}/zhcConfigVersion.cmake"
-        DESTINATION "${ZHC_CMAKE_DIR}")
+              "${PROJECT_SOURCE_DIR}/cmake/zhcBuild.cmake" DESTINATION "${ZHC_CMAKE_DIR}")
 
 # zhc.pc locates the prefix from its own folder (${pcfiledir}), so `cmake --install --prefix P`
 # to any P gives a working file.
