@@ -93,6 +93,13 @@ CLI::Option* add_depfile_option(CLI::App* app);
 // the exit is kExitOutputFailed, so that no output stands without its depfile.
 int run_with_depfile(const std::function<int()>& verb);
 
+// `--paths-relative-to DIR` of the reports (--json, --markdown, --html): input paths are written
+// relative to DIR, so a report cached by a build farm does not name the folder it ran in.
+// shown_path(path, "") is `path` as given; else the lexical path from DIR to `path` (both made
+// absolute against the working directory first; no file system look-up, so symlinks stay).
+CLI::Option* add_paths_relative_to_option(CLI::App* app, std::string& base);
+std::string shown_path(const std::string& path, const std::string& base);
+
 // A verb: `setup` adds the subcommand and its options to the app and returns the function that
 // runs it after parsing. Verbs register themselves with a static VerbRegistration.
 using VerbSetup = std::function<std::function<int()>(CLI::App& app)>;

@@ -228,6 +228,23 @@ int run_with_depfile(const std::function<int()>& verb) {
     return kExitOk;
 }
 
+CLI::Option* add_paths_relative_to_option(CLI::App* app, std::string& base) {
+    return app->add_option("--paths-relative-to", base,
+                           "reports (--json, --markdown, --html) name input files relative to this folder "
+                           "(default: as given), so a cached report names no run folder")
+        ->type_name("DIR");
+}
+
+std::string shown_path(const std::string& path, const std::string& base) {
+    namespace fs = std::filesystem;
+    if (base.empty()) return path;
+    std::error_code ec;
+    const fs::path p = fs::absolute(path, ec).lexically_normal();
+    const fs::path b = fs::absolute(base, ec).lexically_normal();
+    const fs::path rel = p.lexically_relative(b);
+    return rel.empty() ? p.generic_string() : rel.generic_string();
+}
+
 // CLI11 reports a verb it does not know as "A subcommand is required": name the word instead
 // ("unknown verb 'bogus'", "unknown verb 'gltf bogus'"). Empty when the verbs on the command line
 // are all known.

@@ -149,6 +149,11 @@ TEST(DepfileCli, BakeNamesSceneAndEnvironmentMap) {
     EXPECT_EQ(rule.prerequisites[1], dir + "/scenes/../maps dir/c#it$y.exr");  // as opened: relative to the scene
     EXPECT_TRUE(fs::equivalent(rule.prerequisites[1], map));
 
+    // `zhc info --inputs` lists the same files, without baking (for rules that declare inputs).
+    auto info = run_zhc({"info", "--inputs", scene});
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_EQ(info.out, rule.prerequisites[0] + "\n" + rule.prerequisites[1] + "\n");
+
     // A failing command writes no depfile, and leaves an earlier one alone.
     fs::remove(dep);
     fs::remove(map);
@@ -172,6 +177,11 @@ TEST(DepfileCli, GltfSceneNamesItsBuffersAndEmbeddedImages) {
     EXPECT_EQ(rule.targets, std::vector<std::string>{out});
     EXPECT_EQ(rule.prerequisites,
               (std::vector<std::string>{dir + "/in/gt_list.gltf", dir + "/in/gt_list.bin", dir + "/in/tex.png"}));
+    // info --inputs: what loading the scene reads (-o .zhp reads exactly these; the image only
+    // when a glTF output in another folder embeds it).
+    auto info = run_zhc({"info", "--inputs", dir + "/in/gt_list.gltf"});
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_EQ(info.out, dir + "/in/gt_list.gltf\n" + dir + "/in/gt_list.bin\n");
     // gltf embed: the asset, its buffer and image, and the probe set.
     const std::string probes = dir + "/out/p.zhp";
     ASSERT_EQ(run_zhc({"bake", dir + "/in/gt_list.gltf", "-o", probes, "--quiet"}).exit_code, 0);

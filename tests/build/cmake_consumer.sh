@@ -47,7 +47,7 @@ expect() {  # expect WHAT "room hall lm"
     echo "FAIL: $what: ran [$got], expected [$want]" >&2
     exit 1
   fi
-  if ! ninja -C "$b" -n | grep -q "no work to do"; then
+  if ! grep -q "no work to do" <<< "$(ninja -C "$b" -n)"; then
     ninja -C "$b" -n -d explain >&2 || true
     echo "FAIL: $what: a second build would still run commands" >&2
     exit 1

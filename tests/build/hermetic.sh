@@ -9,7 +9,7 @@
 # input paths; with --paths-relative-to they are identical too.
 #   hermetic.sh ZHC ENVMAP GLTF_DATA_DIR
 set -euo pipefail
-zhc=$1 envmap=$2 gltf=$3
+zhc=$(realpath "$1") envmap=$(realpath "$2") gltf=$(realpath "$3")
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
@@ -32,22 +32,22 @@ cp -r "$a" "$b"
 run() {
   local p=$2 out=$3 t=$4
   mkdir -p "$out"
-  "$zhc" bake "$p/scenes/room.json" -o "$out/room.zhp" -r zh3_q16 --zstd 3 --threads "$t" --quiet
-  "$zhc" bake "$p/scenes/room.json" -o "$out/room.glb" --threads "$t" --quiet
-  "$zhc" bake "$p/hall/gt_list.gltf" -o "$out/hall.glb" --threads "$t" --quiet
+  "$zhc" bake "$p/scenes/room.json" -o "$out/room.zhp" -r zh3_q16 --zstd 3 --threads "$t" --quiet >/dev/null
+  "$zhc" bake "$p/scenes/room.json" -o "$out/room.glb" --threads "$t" --quiet >/dev/null
+  "$zhc" bake "$p/hall/gt_list.gltf" -o "$out/hall.glb" --threads "$t" --quiet >/dev/null
   "$zhc" convert "$p/maps/sky.exr" -o "$out/sky.zhp" -r sh3_q28 --threads "$t" >/dev/null
-  "$zhc" dering "$p/maps/sky.exr" -o "$out/sky.dering.json" --threads "$t" >/dev/null
+  "$zhc" dering "$p/maps/sky.exr" -o "$out/sky.dering.json" --threads "$t" --paths-relative-to "$p" >/dev/null
   "$zhc" lightmap synth "$p/maps/sky.exr" -o "$out/sh.exr" --size 24 --threads "$t" >/dev/null
   "$zhc" lightmap encode "$out/sh.exr" -o "$out/lm" --quality fast --threads "$t" --quiet >/dev/null
   "$zhc" lightmap encode "$out/sh.exr" -o "$out/lm" --container dds --quality fast --threads "$t" --quiet >/dev/null
   "$zhc" lightmap decode "$out/lm" -o "$out/back.exr" --container ktx2 --quiet >/dev/null
   "$zhc" audit "$p/maps/sky.exr" -r sh3,zh3_q16 --no-timing --threads "$t" --quiet --paths-relative-to "$p" \
-         --json --markdown "$out/audit.md" --html "$out/audit.html" > "$out/audit.json"
+         --json --markdown "$out/audit.md" --html "$out/audit.html" > "$out/audit.json" 2>/dev/null
 }
 
 mkdir -p "$work/tmp1" "$work/tmp2" "$work/home1" "$work/home2"
-(cd "$a" && env TMPDIR="$work/tmp1" HOME="$work/home1" LC_ALL=C TZ=UTC0 bash -c "$(declare -f run); zhc='$zhc'; run . . out 1")
-(cd / && env TMPDIR="$work/tmp2" HOME="$work/home2" LC_ALL=C.UTF-8 TZ=XST-14 bash -c "$(declare -f run); zhc='$zhc'; run / '$b' '$b/out' 3")
+(cd "$a" && env TMPDIR="$work/tmp1" HOME="$work/home1" LC_ALL=C TZ=UTC0 bash -c "set -euo pipefail; $(declare -f run); zhc='$zhc'; run . . out 1")
+(cd / && env TMPDIR="$work/tmp2" HOME="$work/home2" LC_ALL=C.UTF-8 TZ=XST-14 bash -c "set -euo pipefail; $(declare -f run); zhc='$zhc'; run / '$b' '$b/out' 3")
 
 files=(room.zhp room.glb hall.glb sky.zhp sky.dering.json sh.exr lm.iz.ktx2 lm.d.ktx2 lm.wa.ktx2 lm.iz.dds lm.d.dds lm.wa.dds
        back.exr audit.json audit.md audit.html)
