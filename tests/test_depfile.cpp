@@ -202,6 +202,13 @@ TEST(DepfileCli, LightmapEncodeNamesEveryPartAndEveryOutput) {
     EXPECT_EQ(rule.targets, std::vector<std::string>{sh});
     EXPECT_EQ(rule.prerequisites, std::vector<std::string>{std::string(ZHC_ENVMAP_DIR) + "/studio.exr"});
 
+    // The report names its input relative to --paths-relative-to, else as given.
+    r = run_zhc({"lightmap", "audit", sh, "--json", "--quality", "fast", "--paths-relative-to", dir + "/x/.."});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("\"input\": \"sh.exr\""), std::string::npos) << r.out;
+    r = run_zhc({"lightmap", "audit", sh, "--json", "--quality", "fast"});
+    EXPECT_NE(r.out.find("\"input\": \"" + sh + "\""), std::string::npos) << r.out;
+
     r = run_zhc({"lightmap", "encode", sh, "-o", dir + "/lm", "--quality", "fast", "--depfile", dir + "/enc.d"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     rule = read_rule(text_of(dir + "/enc.d"));
