@@ -1,16 +1,19 @@
 // zhc audit FILE|FOLDER... : every representation's irradiance error, size and speed per input.
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
 
 #include "formats/report/audit_inputs.h"
+#include "choice_output.h"
 #include "cli.h"
 #include "json_output.h"
 #include "progress.h"
 #include "table.h"
 #include "codec/report/audit_run.h"
+#include "codec/report/choice.h"
 #include "formats/io/file_io.h"
 #include "formats/report/html_report.h"
 #include "formats/report/runtime_cost.h"
@@ -39,6 +42,11 @@ struct Options {
     LdrDecoding ldr;
     std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
     std::string paths_base;    // --paths-relative-to
+    // The choice section (codec/report/choice.h): extra budgets and the constraints.
+    std::vector<std::size_t> budgets;
+    std::vector<std::string> require;  // "nonnegative"
+    long long max_instructions = -1;
+    double max_encode_us = -1;
 };
 
 std::string fmt(double v, const char* f = "%.4g") {
@@ -150,7 +158,7 @@ HtmlRow html_row(const RepresentationResult& r, bool timed) {
 
 HtmlReport html_of(const Options& o, const AuditGates& gates, const AuditedFiles& audited,
                    const std::vector<SpherePictures>& pictures, const RuntimeCostTable* gpu,
-                   const std::vector<double>& eval_ns) {
+                   const std::vector<double>& eval_ns, const ChoiceResult& choice) {
     const std::vector<AuditInput>& inputs = audited.inputs;
     const std::vector<RepresentationResult>& aggregate = audited.run.aggregate;
     HtmlReport h;
@@ -200,10 +208,23 @@ HtmlReport html_of(const Options& o, const AuditGates& gates, const AuditedFiles
         h.inputs.push_back(std::move(s));
     }
     apply_runtime_cost(h, gpu, o.runtime_cost);
+    // The choice right after the summary and gates (an HTML report is read from the top; its input
+    // sections with pictures are long); text, Markdown and JSON end with it.
+    h.tables.push_back(choice_html(choice));
     return h;
 }
 
 int run(const Options& o) {
+    // The choice's constraints need what they test: a runtime cost table, encode timing.
+    if (o.max_instructions >= 0 && o.runtime_cost.empty()) {
+        std::fprintf(stderr, "zhc: error: --max-instructions: needs --runtime-cost FILE (bench_runtime --json) for the "
+                             "SPIR-V instruction counts\n");
+        return kExitUsage;
+    }
+    if (o.max_encode_us >= 0 && o.no_timing) {
+        std::fprintf(stderr, "zhc: error: --max-encode-us: needs the encode timing that --no-timing turns off\n");
+        return kExitUsage;
+    }
     auto chosen = select_codecs(o.representations);
     if (!chosen) return report(chosen.error());
     const std::vector<const Codec*>& selected = *chosen;
@@ -256,6 +277,12 @@ int run(const Options& o) {
     const std::vector<AuditInput>& inputs = audited->inputs;
     const AuditRun& result = audited->run;
     const std::vector<std::string> failures = result.gates.messages();
+    ChoiceConstraints constraints;
+    constraints.nonnegative = std::find(o.require.begin(), o.require.end(), "nonnegative") != o.require.end();
+    constraints.max_instructions = o.max_instructions;
+    constraints.max_encode_us = o.max_encode_us;
+    const ChoiceResult choice = choose_representations(result.inputs, result.aggregate, choice_instructions(result.aggregate, gpu),
+                                                       timed, constraints, choice_budgets(o.budgets));
 
     if (o.json) {
         nlohmann::ordered_json j;
@@ -279,6 +306,7 @@ int run(const Options& o) {
         j["aggregate"] = {{"files", inputs.size()}, {"representations", agg}};
         j["gates"] = {{"passed", failures.empty()}, {"failures", failures}};
         if (!failures.empty()) j["gates"]["summary"] = gate_summary(aopt.gates, result);
+        j["choice"] = choice_json(choice);
         print_json("audit", j);
     } else {
         for (size_t i = 0; i < inputs.size(); ++i) {
@@ -297,6 +325,9 @@ int run(const Options& o) {
             add_cost_columns(rows, gpu);
             print_table(std::cout, rows, false);
         }
+        std::cout << "\nchoice: " << choice_intro(choice) << "\n";
+        print_table(std::cout, choice_table(choice), false);
+        for (const std::string& n : choice_notes(choice)) std::cout << "  " << n << "\n";
     }
     if (!o.markdown.empty()) {
         std::ostringstream md;
@@ -315,6 +346,11 @@ int run(const Options& o) {
         for (const RepresentationResult& r : result.aggregate) rows.push_back(row_of(r, timed));
         add_cost_columns(rows, gpu);
         print_table(md, rows, true);
+        md << "\n## Choice\n\n" << choice_intro(choice) << "\n\n";
+        print_table(md, choice_table(choice), true);
+        const std::vector<std::string> notes = choice_notes(choice);
+        if (!notes.empty()) md << "\n";
+        for (const std::string& n : notes) md << "- " << n << "\n";
         const std::string text = md.str();
         if (Status s = write_file_atomic(o.markdown, std::vector<std::uint8_t>(text.begin(), text.end())); !s)
             return report_output(s.error());
@@ -323,7 +359,7 @@ int run(const Options& o) {
         std::vector<double> eval_ns;  // CPU evaluation cost: cheap, measured only when timing is on
         if (!o.no_timing && !inputs[0].probes.empty())
             for (const Codec* c : selected) eval_ns.push_back(eval_ns_per_sample(*c, inputs[0].probes[0], dirs, aopt.codec_options));
-        if (Status s = write_html_report(o.html, html_of(o, aopt.gates, *audited, pictures, gpu, eval_ns)); !s)
+        if (Status s = write_html_report(o.html, html_of(o, aopt.gates, *audited, pictures, gpu, eval_ns, choice)); !s)
             return report_output(s.error());
         std::fprintf(stderr, "report: %s\n", o.html.c_str());
     }
@@ -347,12 +383,25 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     CLI::App* sub = app.add_subcommand("audit", "Irradiance error, size and speed of every representation on your lighting");
     sub->add_option("INPUTS", o->inputs, "environment maps (.exr, .hdr), probe files, or folders of them")->required();
     add_representations_option(sub, o->representations, RepresentationCount::kList, "default: all");
-    add_json_flag(sub, o->json, "files, aggregate, gates");
+    add_json_flag(sub, o->json, "files, aggregate, gates, choice");
     sub->add_option("--markdown", o->markdown, "also write the tables as Markdown to this file");
     sub->add_option("--html", o->html, "also write one self-contained HTML report (tables, gates, lit spheres, plots) to this file");
     sub->add_option("--runtime-cost", o->runtime_cost,
                     "GPU cost per encoding from build/bench/bench_runtime --json FILE: SPIR-V instructions and lavapipe ns/eval "
                     "columns (text, Markdown, HTML) and an error-vs-runtime-cost plot in the HTML report");
+    sub->add_option("--budget", o->budgets,
+                    "choice section: one more byte budget per probe (repeatable; 16, 28, 48, 60 and 108 are always there)")
+        ->check(CLI::Range(std::size_t(1), std::size_t(1) << 20));
+    sub->add_option("--require", o->require,
+                    "choice section: only representations with negative_fraction 0 on every input (nonnegative)")
+        ->check(CLI::IsMember({"nonnegative"}));
+    sub->add_option("--max-instructions", o->max_instructions,
+                    "choice section: only representations whose GPU evaluation has at most N SPIR-V instructions "
+                    "(needs --runtime-cost; one it does not list does not qualify)")
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--max-encode-us", o->max_encode_us,
+                    "choice section: only representations encoding a probe in at most N microseconds (the audit's timing)")
+        ->check(CLI::NonNegativeNumber);
     sub->add_option("--images", o->images, "write irradiance/error PNGs per input into this folder");
     sub->add_option("--directions", o->directions, "number of Fibonacci-lattice directions")->check(CLI::Range(16, 1 << 20));
     add_threads_option(sub, o->threads, "results do not depend on it");

@@ -3,7 +3,13 @@
 // Bakes the default scene (gradient sky, sun, three coloured sphere lights, a roof and a sphere
 // occluder; codec/bake/scene.h default_scene) into a probe grid, encodes it with every representation
 // of the codec table, writes the probe containers, the scene, the audit table (reference: each
-// probe's baked SH3 irradiance) and pictures of a few probes, and prints where everything is.
+// probe's baked SH3 irradiance) with its choice per byte budget (codec/report/choice.h) and
+// pictures of a few probes, and prints where everything is.
+//
+// The containers and the glTF hold zh3_q16 whatever the choice: the demo's outputs are a fixed
+// fixture (the runtime tests and the examples read probes_zh3_q16.zhp and probes.glb as zh3_q16),
+// and zh3_q16 is the ZH3 paper's own 16-byte layout. The demo prints the 16-byte choice beside it,
+// where zh3_q16 ranks, and the commands that embed the choice instead.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -11,9 +17,11 @@
 #include <sstream>
 #include <thread>
 
+#include "choice_output.h"
 #include "cli.h"
 #include "table.h"
 #include "codec/report/audit_run.h"
+#include "codec/report/choice.h"
 #include "codec/bake/scene.h"
 #include "formats/report/audit_inputs.h"
 #include "formats/io/file_io.h"
@@ -50,6 +58,36 @@ std::string fmt(double v, const char* f = "%.4g") {
 
 Status write_text(const std::string& path, const std::string& text) {
     return write_file_atomic(path, std::vector<std::uint8_t>(text.begin(), text.end()));
+}
+
+// Why the containers and the glTF hold zh3_q16, against the 16-byte choice (file comment).
+constexpr const char* kEmbedded = "zh3_q16";
+std::string embedded_note(const ChoiceResult& choice, const std::string& dir) {
+    const BudgetChoice* b16 = nullptr;
+    for (const BudgetChoice& b : choice.budgets)
+        if (b.budget == 16) b16 = &b;
+    const ChoiceCandidate* best = b16 ? choice.chosen(*b16) : nullptr;
+    // zh3_q16's rank among the 16-byte representations, by the choice's order (error, then table order).
+    std::vector<const ChoiceCandidate*> fit;
+    const ChoiceCandidate* embedded = nullptr;
+    for (const ChoiceCandidate& k : choice.candidates) {
+        if (k.codec->size_bytes > 16) continue;
+        fit.push_back(&k);
+        if (k.codec->name == kEmbedded) embedded = &k;
+    }
+    std::stable_sort(fit.begin(), fit.end(), [](const ChoiceCandidate* a, const ChoiceCandidate* c) { return a->error < c->error; });
+    if (!best || !embedded) return std::string(kEmbedded) + " (probes_zh3_q16.zhp, probes.glb)";
+    const std::size_t rank = static_cast<std::size_t>(std::find(fit.begin(), fit.end(), embedded) - fit.begin()) + 1;
+    std::string s = std::string(kEmbedded) + " (probes_zh3_q16.zhp, probes.glb), relative rmse " + fmt(embedded->error, "%.4f");
+    if (best == embedded) return s + ": the 16-byte choice on this scene.";
+    const std::string name(best->codec->name);
+    s += ", rank " + std::to_string(rank) + " of " + std::to_string(fit.size()) + " at 16 bytes; the 16-byte choice on this scene is " +
+         name + " (" + fmt(best->error, "%.4f") + "). The demo keeps zh3_q16, the ZH3 paper's 16-byte layout, so that its " +
+         "outputs keep one encoding whatever the scene or release (the runtime tests and examples read them as zh3_q16). "
+         "To embed the "
+         "choice: zhc convert " + (fs::path(dir) / "probes_sh3.zhp").string() + " -o probes_" + name + ".zhp -r " + name +
+         ", then zhc gltf embed SCENE.glb probes_" + name + ".zhp -o lit.glb.";
+    return s;
 }
 
 int run(const Options& o) {
@@ -146,11 +184,24 @@ int run(const Options& o) {
     std::ostringstream table;
     print_table(table, rows, false);
     std::fputs(table.str().c_str(), stdout);
+    // The choice per byte budget (no constraints: `zhc audit` takes them), from the same rows.
+    const std::vector<InputAudit> audited{audit};
+    const ChoiceResult choice =
+        choose_representations(audited, aggregate_inputs(audited), {}, false, ChoiceConstraints{}, choice_budgets({}));
+    std::printf("\nchoice: %s\n", choice_intro(choice).c_str());
+    std::ostringstream choice_text;
+    print_table(choice_text, choice_table(choice), false);
+    std::fputs(choice_text.str().c_str(), stdout);
+    const std::string why_embedded = embedded_note(choice, o.dir);
+    std::printf("\nembedded: %s\n", why_embedded.c_str());
     std::ostringstream md;
     md << "# zhc demo audit\n\n" << rep.probes << " probes of the built-in scene, baked (" << rep.summary()
        << ").\nIrradiance error of every representation against the baked SH3 at " << o.directions
        << " directions per probe.\n\n";
     print_table(md, rows, true);
+    md << "\n## Choice\n\n" << choice_intro(choice) << "\n\n";
+    print_table(md, choice_table(choice), true);
+    md << "\nEmbedded: " << why_embedded << "\n";
     if (Status s = write_text(path("audit.md"), md.str()); !s) return report_output(s.error());
     outputs.push_back({path("audit.md"), "the audit table (Markdown)"});
 
@@ -253,6 +304,8 @@ int run(const Options& o) {
             for (auto& th : pool) th.join();
         }
         apply_runtime_cost(h, o.runtime_cost.empty() ? nullptr : &gpu_table, o.runtime_cost);
+        h.tables.push_back(choice_html(choice));
+        h.tables.back().notes.push_back("Embedded: " + why_embedded);
         const std::string html_path = o.html.empty() ? path("report.html") : o.html;
         const std::string doc = html_report(h);
         if (Status s = write_text(html_path, doc); !s) return report_output(s.error());

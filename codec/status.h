@@ -3,6 +3,9 @@
 // Every failure carries a stable code and a one-line message naming the file (when there is
 // one), what is wrong and where (field, byte offset). The CLI maps codes to exit codes
 // (README "Exit codes").
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <string>

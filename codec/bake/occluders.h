@@ -19,6 +19,11 @@
 //    seams of a closed mesh ("watertight enough" for shadow rays);
 //  * the hit distance must lie in the open interval (t_min, t_max), like the other primitives;
 //  * a degenerate (zero-area) triangle never blocks.
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
+// An occluder set (and its BVH) is immutable once built: rays may be cast from many threads at once.
 #pragma once
 
 #include <cstdint>

@@ -30,6 +30,11 @@
 //
 // Determinism: every probe is computed by itself with the effects in scene order, summed in
 // double, so the result is the same bytes whatever the thread count.
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
+// BakeOptions::progress is called one call at a time (serialised across the bake's threads).
 #pragma once
 
 #include <array>

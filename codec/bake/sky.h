@@ -1,4 +1,8 @@
 // zhc/codec/bake/sky.h — closed-form SH3 of analytic skies and the built-in default lighting.
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include "codec/sh/sh.h"

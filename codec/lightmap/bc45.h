@@ -4,6 +4,9 @@
 // indices (bytes 2..7, little-endian, texel 0 in the low bits). r0 > r1: eight-value palette
 // r0, r1, (6 r0 + r1)/7 ... (r0 + 6 r1)/7; r0 <= r1: r0, r1, (4 r0 + r1)/5 ... (r0 + 4 r1)/5, 0, 1.
 // BC5 is a BC4 block for red followed by one for green (16 bytes). Decoders are total (any bytes).
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <cstddef>

@@ -10,6 +10,9 @@
 //
 // Encoder: error is measured in the half-float bit pattern domain (a piecewise-linear log2: bits
 // / 1024 ~ log2(v) + 15), which is also the domain BC6H interpolates in, so the fit is linear.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <cstddef>

@@ -8,6 +8,9 @@
 // codec table (codec/probe/codec.h), which is for world-space probes.
 //
 // Standard library only; no I/O.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <array>

@@ -1,6 +1,9 @@
 // zhc/codec/lightmap/lightmap.h — IrradZ lightmaps as textures: the per-texel SH3 radiance hub (tangent
 // frame), the IrradZ planes (I_z RGB, w_a, d), block compression to BC6H + BC5 + BC4 (2.5 bytes
 // per texel), and the audit numbers. Separate from the probe codec table. Standard library only.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <array>

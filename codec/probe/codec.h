@@ -15,6 +15,11 @@
 //    is finite whenever that SH3 is (tests/test_codec_table.cpp, DecodeAcceptsArbitraryBytes).
 //  * the stored bytes are little-endian and the same on every machine; encode is deterministic.
 //  * L0 (DC) round-trips exactly for the float representations.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
+// The codec table (codecs(), find_codec) is immutable after static initialisation: any thread
+// may use its entries at any time.
 #pragma once
 
 #include <cstddef>

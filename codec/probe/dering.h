@@ -11,6 +11,9 @@
 //  * helpers the audit uses (minimum irradiance, fraction of the sphere that is negative).
 //
 // See docs/dering.md for the derivations and for how Table 1's rows are read.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <array>

@@ -11,6 +11,9 @@
 //  * `params` pass validate_quant_params for that representation;
 //  * layout kGrid: counts multiply to `count`, origin and spacing finite;
 //    layout kPositions: positions.size() == count, all finite; layout kNone: nothing.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <array>

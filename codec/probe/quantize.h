@@ -16,6 +16,9 @@
 // Everything here is exact-arithmetic-free of platform dependence: double arithmetic with the
 // default rounding mode, no -ffast-math, so the bytes are the same on every machine.
 // Full byte layouts: docs/quantization.md.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <cstdint>

@@ -9,6 +9,9 @@
 // Codec-table entries (codec/probe/zh3.cpp, zh3_codecs() below): zh3_lum, zh3_channel, zh3_solved_lum,
 // zh3_solved_channel, hall_{ambdir,sphere,curve}[_channel], zh3_lum_dering (App. B;
 // defined here), zh3_lum_dering_sphere. Derivations and choices: docs/zh3.md.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include "codec/probe/codec.h"

@@ -4,6 +4,10 @@
 // by direct integration of the map (after a flux-preserving box downsample to no less than
 // 512x256), at directions spread uniformly over the sphere (spherical Fibonacci lattice). For
 // probes without a map (containers, baked grids) the reference is the hub's SH3 irradiance.
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <string>

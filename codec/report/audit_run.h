@@ -4,6 +4,11 @@
 // What `zhc audit` computes (the CLI only parses options, prints and maps to exit codes); reading
 // files and writing pictures is formats/report/audit_inputs.h. Results do not depend on the
 // thread count: probes are evaluated in parallel but pooled in probe order (MetricsAccumulator).
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
+// Callbacks in the options are called on the calling thread, one at a time.
 #pragma once
 
 #include <cstddef>

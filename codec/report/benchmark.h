@@ -1,5 +1,9 @@
 // zhc/codec/report/benchmark.h — what accuracy costs in time: per representation, bytes per probe,
 // encode ns/probe, irradiance evaluation ns/sample and error, over a set of probes.
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <vector>

@@ -29,6 +29,9 @@
 // Exact solid angle of a footprint [u0, u1] x [v0, v1]: the projected-rectangle formula
 //   Omega = F(u1, v1) - F(u0, v1) - F(u1, v0) + F(u0, v0),  F(a, b) = atan2(a b, sqrt(1 + a^2 + b^2))
 // (sum over the sphere: 4 pi). N = 1: each face is one pixel covering the whole face.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <cstddef>

@@ -24,6 +24,9 @@
 //    normalised clamped-cosine kernel, E(n) = (1/pi) * integral L(w) max(0, n.w) dw, so a constant
 //    radiance of 1 gives irradiance 1. In SH that is the per-band scale 1, 2/3, 1/4.
 //  * Colour is linear RGB; luminance weights default to Rec. 709.
+//
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
 #pragma once
 
 #include <array>

@@ -14,6 +14,11 @@
 // project_envmap projects either with exact per-pixel solid angles. KTX2 and DDS cube maps (the
 // containers game engines use for reflection/irradiance probes) are read in the graphics APIs'
 // cube layout (kCubeVulkan, codec/sh/cubemap.h; formats/envmap/envmap_cube.h lists the variants).
+//
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written.
 #pragma once
 
 #include <array>

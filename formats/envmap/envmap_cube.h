@@ -34,6 +34,11 @@
 // short files are kTruncated, bytes after the last level kTrailingBytes, inconsistent fields
 // kBadFormat (exit 4), sizes over the limit kTooLarge (exit 6); every message is one line naming
 // the field and its byte offset.
+//
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written.
 #pragma once
 
 #include <cstdint>

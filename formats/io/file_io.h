@@ -1,4 +1,11 @@
 // zhc/formats/io/file_io.h — bounded file reads and atomic file writes.
+//
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written, and the FileRecorder that a
+// ScopedFileRecording installs (below): it observes which files are opened and written, under its
+// own lock, and never changes what a call does.
 #pragma once
 
 #include <cstdint>

@@ -15,6 +15,11 @@
 // trailing bytes (kTrailingBytes), malformed fields (kBadFormat), unsupported features (kUnsupported)
 // and oversized dimensions (kTooLarge) are distinct codes. Besides 'DX10' it reads the legacy FourCCs
 // 'ATI1' / 'BC4U' (as BC4_UNORM) and 'ATI2' / 'BC5U' (as BC5_UNORM), data at byte 128.
+//
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written.
 #pragma once
 
 #include <cstdint>

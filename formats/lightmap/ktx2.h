@@ -5,6 +5,11 @@
 // or VK_FORMAT_BC4_UNORM_BLOCK (139), with a Basic Data Format Descriptor (docs/lightmap-formats.md).
 // The reader is strict and safe for untrusted bytes: sizes are checked against limits before
 // anything is allocated, and each kind of problem has its own error code and message.
+//
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written.
 #pragma once
 
 #include <cstdint>

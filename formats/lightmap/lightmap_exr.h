@@ -7,6 +7,11 @@
 // are ignored.
 // IrradZ EXR (what `zhc lightmap decode` writes): FLOAT channels "Iz.R", "Iz.G", "Iz.B", "wa",
 // "d.X", "d.Y", "d.Z" (d a unit tangent-frame vector).
+//
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written.
 #pragma once
 
 #include <cstdint>

@@ -6,6 +6,12 @@
 // height or the thread count: each 4x4 block depends only on its own texels (the last band holds the
 // image's partial bottom block row, whose missing rows repeat the last row as in the whole-image
 // encoder), and every per-texel fit is independent of the others.
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written.
 #pragma once
 
 #include <cstdint>

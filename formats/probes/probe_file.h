@@ -18,6 +18,11 @@
 //   {"format": "zhc-probes", "version": 1, "kind": "radiance",
 //    "layout": {"type": "grid", "origin": [x,y,z], "spacing": [x,y,z], "counts": [nx,ny,nz]},
 //    "probes": [{"position": [x,y,z], "sh3": [[r,g,b], ... 9 rows]}, ...]}
+//
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written.
 #pragma once
 
 #include <cstdint>

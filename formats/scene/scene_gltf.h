@@ -35,6 +35,12 @@
 // that does not decode to what it declares), kUnsupported (glTF 1.x/3.x, an unknown light type,
 // sparse or UNSIGNED_INT positions, an unknown meshopt mode/filter or codec version),
 // kTooLarge (a limit).
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written.
 #pragma once
 
 #include <cstdint>

@@ -7,6 +7,12 @@
 // Error codes: not JSON -> kBadFormat; a field missing, of the wrong type or out of range ->
 // kInvalidValue; an unknown "type" or "version" -> kUnsupported; above a limit -> kTooLarge;
 // the environment map unreadable -> the map reader's code (kIoError for a missing file).
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
+// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
+// guards it), which never changes the bytes read or written.
 #pragma once
 
 #include <cstdint>

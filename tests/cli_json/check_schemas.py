@@ -129,6 +129,42 @@ check("bench", "bench", ["bench", ENVMAP, "--json", "--no-plots", "--repeats", "
                          "--representations", "sh3", "--volume-cost", W("volume.json")])
 check("lightmap-audit", "lightmap audit", ["lightmap", "audit", W("lm.exr"), "--json", "--stride", "5"])
 
+# The choice section with every constraint: a budget below the smallest size, one above the largest,
+# --require nonnegative, --max-instructions against a cost table that lists only sh3.
+check("audit", "audit", ["audit", ENVMAP, "--json", "--no-timing", "--directions", "64", "--budget", "8",
+                         "--budget", "200", "--require", "nonnegative", "--max-instructions", "200",
+                         "--runtime-cost", W("cost.json")])
+check("audit", "audit", ["audit", ENVMAP, "--json", "--directions", "32", "--representations", "sh3,sh2,zh3_q16",
+                         "--max-encode-us", "1000000"])
+
+# Acceptance on the sample maps: with --require nonnegative every chosen representation (and
+# runner-up) has negative_fraction 0 on every input; a budget below the smallest size has no choice.
+MAPS = os.path.dirname(ENVMAP)
+doc = json.loads(run("audit", MAPS, "--json", "--no-timing", "--directions", "128", "--require", "nonnegative",
+                     "--budget", "8"))
+checked += 1
+if not schema_for("audit").is_valid(doc):
+    failures.append("audit %s --require nonnegative: the JSON does not validate" % MAPS)
+budgets = doc["choice"]["budgets"]
+if [b["budget_bytes"] for b in budgets] != [8, 16, 28, 48, 60, 108]:
+    failures.append("audit --budget 8: budgets %s" % [b["budget_bytes"] for b in budgets])
+if budgets[0]["choice"] is not None or budgets[0]["fitting"] != 0:
+    failures.append("audit --budget 8: a choice below the smallest size: %s" % budgets[0])
+if len(doc["files"]) < 2:
+    failures.append("audit %s: %d files, expected the sample maps" % (MAPS, len(doc["files"])))
+for b in budgets[1:]:
+    if b["choice"] is None:
+        failures.append("audit --require nonnegative: no choice at %d bytes (%s)" % (b["budget_bytes"], b["reason"]))
+    for role in ("choice", "runner_up"):
+        if b[role] is None:
+            continue
+        name = b[role]["representation"]
+        for f in doc["files"]:
+            nf = f["representations"][name]["negative_fraction"]
+            if nf != 0:
+                failures.append("audit --require nonnegative: %s %s at %d bytes has negative_fraction %g on %s"
+                                % (role, name, b["budget_bytes"], nf, f["path"]))
+
 # A failing gate still prints its JSON (exit 8): the gates object lists the failure.
 r = subprocess.run([ZHC, "audit", ENVMAP, "--json", "--no-timing", "--directions", "32", "--representations", "sh2",
                     "--max-rmse", "0"], capture_output=True, text=True)

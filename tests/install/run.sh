@@ -18,6 +18,24 @@ pc=$(find "$prefix" -name zhc.pc)
 if [ -d "$(dirname "$0")/../../runtime" ]; then
   [ -d "$prefix/share/zhc/runtime" ] || { echo "install: share/zhc/runtime missing" >&2; exit 1; }
 fi
+# The prefix holds exactly the public headers docs/api.md lists (plus the umbrella and runtime
+# headers), and each compiles on its own against the prefix (it includes nothing left out).
+docs=$(dirname "$0")/../../docs/api.md
+want=$(grep -oE '^\| `(codec|formats)/[^`]+\.h`' "$docs" | sed -E 's/^\| `//; s/`$//' | sort)
+have=$(cd "$prefix/include/zhc" && find codec formats -name '*.h' | sort)
+if [ "$want" != "$have" ]; then
+  echo "install: include/zhc differs from the public headers of docs/api.md:" >&2
+  diff <(echo "$want") <(echo "$have") >&2 || true
+  exit 1
+fi
+[ "$(echo "$want" | wc -l)" -ge 20 ] || { echo "install: docs/api.md lists too few public headers" >&2; exit 1; }
+nl_inc=$(pkg-config --cflags nlohmann_json 2>/dev/null || true)
+for h in $have codec.h formats.h; do
+  # shellcheck disable=SC2086
+  echo "#include <zhc/$h>" | c++ -std=c++20 -fsyntax-only -x c++ -I"$prefix/include" -I"$prefix/include/zhc" $nl_inc - ||
+    { echo "install: include/zhc/$h does not compile on its own" >&2; exit 1; }
+done
+
 # The installed command runs from the prefix.
 "$prefix/bin/zhc" --version >/dev/null
 

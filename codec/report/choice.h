@@ -1,0 +1,106 @@
+// zhc/codec/report/choice.h — which representation to use: per byte budget, the audited
+// representation with the lowest error that fits the budget and meets the user's constraints.
+//
+// The error is the audit's main metric, the relative irradiance rmse (rmse over the mean
+// reference irradiance), pooled across inputs as the audit's aggregate does (the mean over inputs,
+// each input counting once). A representation fits a budget of B bytes when it stores at most B
+// bytes per probe. Constraints (each off unless set):
+//   nonnegative       negative_fraction 0 on every input (no audited direction of any probe
+//                     reconstructs below 0 in any channel);
+//   max_instructions  the SPIR-V instruction count of its GPU evaluation (bench_runtime --json,
+//                     `--runtime-cost`) is at most N; a representation the cost table does not
+//                     list does not qualify;
+//   max_encode_us     its mean encode time per probe (the audit's timing) is at most N us.
+// Among the qualifying representations the lowest error wins; ties go to fewer bytes, then to
+// the codec-table order (so the choice is deterministic). The runner-up is the next one in that
+// order; the margin is the runner-up's error minus the choice's.
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
+// calls; calls may run concurrently on different arguments and on the same const ones.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "codec/report/audit_run.h"
+
+namespace zhc {
+
+struct ChoiceConstraints {
+    bool nonnegative = false;
+    long long max_instructions = -1;  // < 0: off
+    double max_encode_us = -1;        // < 0: off
+    bool any() const { return nonnegative || max_instructions >= 0 || max_encode_us >= 0; }
+    // "none", or the constraints in words: "non-negative on every input, <= 200 SPIR-V
+    // instructions, encode <= 5 us per probe".
+    std::string text() const;
+};
+
+// The budgets every choice reports: 16, 28, 48, 60 and 108 bytes (the table's sizes: the 16-byte
+// packed layouts, sh3_q28, linear SH, ZH3, SH3).
+inline const std::vector<std::size_t>& default_choice_budgets() {
+    static const std::vector<std::size_t> budgets{16, 28, 48, 60, 108};
+    return budgets;
+}
+// The default budgets and `extra`, ascending, each once (0 is dropped).
+std::vector<std::size_t> choice_budgets(const std::vector<std::size_t>& extra);
+
+// What the choice knows of one audited representation.
+struct ChoiceCandidate {
+    const Codec* codec = nullptr;
+    double error = 0;                   // aggregate relative rmse
+    double max_negative_fraction = 0;   // the largest negative_fraction over the inputs
+    double encode_ns = -1;              // aggregate mean encode time per probe; < 0: not measured
+    long long spirv_instructions = -1;  // < 0: not known
+    // The constraints it breaks (none: it qualifies).
+    bool goes_negative = false, over_instructions = false, cost_unknown = false, over_encode = false,
+         error_not_finite = false;
+    bool qualifies() const {
+        return !goes_negative && !over_instructions && !cost_unknown && !over_encode && !error_not_finite;
+    }
+};
+
+struct BudgetChoice {
+    std::size_t budget = 0;      // bytes per probe
+    std::size_t fitting = 0;     // representations of at most `budget` bytes
+    std::size_t qualifying = 0;  // of those, the ones meeting the constraints
+    int choice = -1;             // index into ChoiceResult::candidates; -1: none qualifies
+    int runner_up = -1;          // -1: none
+    double margin = 0;           // runner-up error minus the choice's (0 without a runner-up)
+    // One line: why the choice (or "none: ..." and why nothing qualifies).
+    std::string reason;
+};
+
+struct ChoiceResult {
+    ChoiceConstraints constraints;
+    std::size_t inputs = 0;                   // inputs pooled
+    std::vector<ChoiceCandidate> candidates;  // in the audit's (aggregate) order
+    std::vector<BudgetChoice> budgets;        // ascending
+    const ChoiceCandidate* chosen(const BudgetChoice& b) const { return b.choice < 0 ? nullptr : &candidates[b.choice]; }
+    const ChoiceCandidate* second(const BudgetChoice& b) const {
+        return b.runner_up < 0 ? nullptr : &candidates[b.runner_up];
+    }
+};
+
+// The choice for each budget from an audit's per-input results and aggregate (AuditRun).
+// `instructions` holds each aggregate row's SPIR-V instruction count (< 0: not known); it may be
+// empty when no runtime cost was given (then max_instructions disqualifies everything). encode_ns
+// is taken from the aggregate when `timed`.
+ChoiceResult choose_representations(const std::vector<InputAudit>& inputs,
+                                    const std::vector<RepresentationResult>& aggregate,
+                                    const std::vector<long long>& instructions, bool timed,
+                                    const ChoiceConstraints& constraints, const std::vector<std::size_t>& budgets);
+
+// The choice as a table for text and Markdown (row 0 is the header): budget, choice, bytes,
+// rel_rmse, runner_up, bytes, rel_rmse, margin ("+0.0184 (+16.5%)": the difference and the
+// percentage of the choice's error), qualifying ("12 of 14": qualifying of fitting). A budget with
+// no choice shows "none" and "-".
+std::vector<std::vector<std::string>> choice_table(const ChoiceResult& result);
+// One paragraph: the metric, the pooling, the constraints, how ties break.
+std::string choice_intro(const ChoiceResult& result);
+// The reasons of the budgets with no choice, one line each ("8 bytes: none: ...").
+std::vector<std::string> choice_notes(const ChoiceResult& result);
+
+}  // namespace zhc
