@@ -83,6 +83,23 @@ CLI::Option* add_latlong_option(CLI::App* app, LatLongConvention& convention, bo
 // --ldr-encoding auto|srgb|linear|rgbm:RANGE|rgbd:RANGE (8-bit cube maps, EnvmapReadOptions::ldr).
 CLI::Option* add_ldr_encoding_option(CLI::App* app, LdrDecoding& decoding);
 
+// `--depfile FILE`: after the verb succeeds, write a Make-syntax depfile naming the files it wrote
+// (targets) and every file it read (formats/io/depfile.h, docs/build-integration.md). main() runs
+// the verb under a FileRecorder and writes the depfile; nothing is written when the verb fails.
+CLI::Option* add_depfile_option(CLI::App* app);
+// Runs `verb` and, when --depfile was given, records its files and writes the depfile (temporary
+// file + rename) only if it returned kExitOk. If the depfile cannot be written (a path it cannot
+// express, an I/O error, or a verb that wrote nothing) the files the verb wrote are removed again and
+// the exit is kExitOutputFailed, so that no output stands without its depfile.
+int run_with_depfile(const std::function<int()>& verb);
+
+// `--paths-relative-to DIR` of the reports (--json, --markdown, --html): input paths are written
+// relative to DIR, so a report cached by a build farm does not name the folder it ran in.
+// shown_path(path, "") is `path` as given; else the lexical path from DIR to `path` (both made
+// absolute against the working directory first; no file system look-up, so symlinks stay).
+CLI::Option* add_paths_relative_to_option(CLI::App* app, std::string& base);
+std::string shown_path(const std::string& path, const std::string& base);
+
 // A verb: `setup` adds the subcommand and its options to the app and returns the function that
 // runs it after parsing. Verbs register themselves with a static VerbRegistration.
 using VerbSetup = std::function<std::function<int()>(CLI::App& app)>;

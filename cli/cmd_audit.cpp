@@ -41,6 +41,7 @@ struct Options {
     LatLongConvention latlong = LatLongConvention::kOpenExr;
     LdrDecoding ldr;
     std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
+    std::string paths_base;    // --paths-relative-to
     // The choice section (codec/report/choice.h): extra budgets and the constraints.
     std::vector<std::size_t> budgets;
     std::vector<std::string> require;  // "nonnegative"
@@ -167,7 +168,7 @@ HtmlReport html_of(const Options& o, const AuditGates& gates, const AuditedFiles
               "directly (box-downsampled to at least 512x256); probe files use their probes' SH3 irradiance. Errors at " +
               std::to_string(o.directions) + " Fibonacci-lattice directions per probe.";
     std::string given;
-    for (const std::string& i : o.inputs) given += (given.empty() ? "" : " ") + i;
+    for (const std::string& i : o.inputs) given += (given.empty() ? "" : " ") + shown_path(i, o.paths_base);
     h.settings = {{"inputs", given},
                   {"files audited", std::to_string(inputs.size())},
                   {"representations", o.representations.empty() ? "all (" + std::to_string(aggregate.size()) + ")" : o.representations},
@@ -269,6 +270,10 @@ int run(const Options& o) {
     };
     auto audited = audit_files(*files, dirs, selected, aopt, lopt, after_input);
     if (!audited) return output_failed ? report_output(audited.error()) : report(audited.error());
+    // Every report names the inputs as --paths-relative-to says (gate messages included).
+    for (AuditInput& in : audited->inputs) in.path = shown_path(in.path, o.paths_base);
+    for (InputAudit& in : audited->run.inputs) in.path = shown_path(in.path, o.paths_base);
+    for (auto& f : audited->run.gates.failures) f.path = shown_path(f.path, o.paths_base);
     const std::vector<AuditInput>& inputs = audited->inputs;
     const AuditRun& result = audited->run;
     const std::vector<std::string> failures = result.gates.messages();
@@ -408,6 +413,8 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     add_envmap_read_options(sub, &o->replace_non_finite, o->part);
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
     add_ldr_encoding_option(sub, o->ldr);
+    add_depfile_option(sub);
+    add_paths_relative_to_option(sub, o->paths_base);
     return [o] { return run(*o); };
 });
 

@@ -165,6 +165,7 @@ const VerbRegistration registration(15, [](CLI::App& app) -> std::function<int()
     sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")->check(CLI::Range(0, 22));
     sub->add_flag("--progress", o->progress.force, "progress on stderr even when it is not a terminal (one line per 10 %)");
     sub->add_flag("--quiet", o->progress.quiet, "do not print the effects report nor progress");
+    add_depfile_option(sub);
     return [o] { return run(*o); };
 });
 

@@ -221,6 +221,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
     add_ldr_encoding_option(sub, o->ldr);
     add_threads_option(sub, o->threads, "environment map projection; result identical for any count");
+    add_depfile_option(sub);
     return [o] { return run(*o); };
 });
 

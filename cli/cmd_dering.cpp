@@ -26,6 +26,7 @@ constexpr size_t kMaxProbes = size_t(1) << 24;
 
 struct Options {
     std::string input;
+    std::string paths_base;  // --paths-relative-to
     std::string output;
     bool punctual = false;
     bool replace_non_finite = false;
@@ -128,7 +129,7 @@ int run(const Options& o) {
     DeringOptions d;
     d.punctual = o.punctual;
     nlohmann::json out;
-    out["input"] = o.input;
+    out["input"] = shown_path(o.input, o.paths_base);
     out["kind"] = "radiance";
     out["basis"] = "zhc (ZH3 paper Eq. 4/5), index l(l+1)+m";
     out["method"] = "Sloan 2017 deringing: least Table 1 window making the irradiance bound non-negative";
@@ -175,6 +176,8 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     add_latlong_option(sub, o->latlong, nullptr, "default openexr");
     add_ldr_encoding_option(sub, o->ldr);
     add_threads_option(sub, o->threads, "environment map projection; same result for any count");
+    add_depfile_option(sub);
+    add_paths_relative_to_option(sub, o->paths_base);
     return [o] { return run(*o); };
 });
 

@@ -173,10 +173,12 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
         ->check(CLI::IsMember({"zhc", "gltf"}));
     embed->add_flag("--draco", o->draco, "store positions + coefficients as a Draco point cloud (points layout, sh3/sh2)");
     embed->add_option("--draco-bits", o->draco_bits, "Draco quantisation bits (0 = lossless, default)")->check(CLI::Range(0, 30));
+    add_depfile_option(embed);
     CLI::App* extract = sub->add_subcommand("extract", "Read a ZHC_light_probes volume back into a probe file");
     extract->add_option("IN", o->input, "glTF asset (.gltf or .glb)")->required();
     extract->add_option("-o,--output", o->output, "output: .zhp (container, bytes as stored) or .json (float SH3)")->required();
     extract->add_option("--volume", o->volume, "volume index (default 0)");
+    add_depfile_option(extract);
     CLI::App* eval = sub->add_subcommand("eval", "Print the irradiance of one embedded probe in a glTF-space direction");
     eval->add_option("IN", o->input, "glTF asset (.gltf or .glb)")->required();
     eval->add_option("--volume", o->volume, "volume index (default 0)");

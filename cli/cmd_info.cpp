@@ -15,6 +15,8 @@
 #include "formats/probes/gltf_probes.h"
 #include "formats/probes/probe_file.h"
 #include "formats/io/json_depth.h"
+#include "formats/scene/scene_gltf.h"
+#include "formats/scene/scene_json.h"
 
 namespace zhc::cli {
 namespace cmd_info {  // one namespace per verb file: the CLI is a unity build
@@ -23,6 +25,7 @@ namespace {
 struct Options {
     std::string path;
     bool json = false;
+    bool inputs = false;  // --inputs: FILE is a scene; list the files loading it reads
 };
 
 const char* layout_name(ProbeLayoutKind k) {
@@ -135,7 +138,36 @@ void print_json_or_text(const nlohmann::ordered_json& j, bool as_json) {
     }
 }
 
+// --inputs: the files `zhc bake FILE` reads to load the scene (the scene, its environment map,
+// glTF buffers), found by loading it under a FileRecorder, in the order they are opened.
+int run_inputs(const Options& o) {
+    FileRecorder recorder;
+    std::uint64_t file_bytes = 0;
+    {
+        ScopedFileRecording recording(&recorder);
+        auto bytes = read_file_bytes(o.path, GltfLimits{}.max_file_bytes);
+        if (!bytes) return report(bytes.error());
+        file_bytes = bytes->size();
+        SceneLoadOptions lo;
+        lo.threads = resolve_threads(0);
+        auto scene = is_gltf_path(o.path) ? parse_scene_gltf(*bytes, o.path, lo, GltfLimits{}, nullptr) : read_scene_file(o.path, lo);
+        if (!scene) return report(scene.error());
+    }
+    nlohmann::ordered_json j;
+    j["path"] = o.path;
+    j["file_bytes"] = file_bytes;
+    j["type"] = "scene inputs";
+    j["inputs"] = recorder.inputs();
+    if (o.json) {
+        print_json("info", j);
+    } else {
+        for (const std::string& f : recorder.inputs()) std::printf("%s\n", f.c_str());
+    }
+    return kExitOk;
+}
+
 int run(const Options& o) {
+    if (o.inputs) return run_inputs(o);
     auto bytes = read_file_bytes(o.path, std::uint64_t(2) << 30);
     if (!bytes) return report(bytes.error());
     nlohmann::ordered_json j;
@@ -266,6 +298,9 @@ const VerbRegistration registration(45, [](CLI::App& app) -> std::function<int()
     CLI::App* sub = app.add_subcommand("info", "Describe an environment map, .zhp probe container, JSON probe list or glTF asset");
     sub->add_option("FILE", o->path, "file to describe (type detected from its content)")->required();
     add_json_flag(sub, o->json);
+    sub->add_flag("--inputs", o->inputs,
+                  "FILE is a scene (JSON or glTF): list every file loading it reads, one per line or as \"inputs\" "
+                  "(for build rules that declare inputs; docs/build-integration.md)");
     return [o] { return run(*o); };
 });
 

@@ -32,6 +32,7 @@ struct Options {
     std::string part;       // synth: EXR part of the environment map
     LatLongConvention latlong = LatLongConvention::kOpenExr;  // synth: lat-long orientation
     std::string html;       // audit: also write the HTML report here (whole-image path)
+    std::string paths_base; // audit: --paths-relative-to
     int threads = 0, size = 256, height = 0, stride = 17, band_rows = 0;
     bool json = false, half = false;
     ProgressFlags progress;
@@ -149,7 +150,7 @@ int run_audit_html(const Options& o, const std::string& input) {
     const auto c = lightmap::compress(search, bc6h_quality(o.quality), bc45_quality(o.quality), o.threads);
     const auto after = lightmap::decompress(c);
     const auto a = lightmap::audit(*lm, search, old_way, after, static_cast<size_t>(o.stride));
-    const auto page = lightmap_audit_html(ZHC_VERSION, {{"input", input}, {"quality", o.quality},
+    const auto page = lightmap_audit_html(ZHC_VERSION, {{"input", shown_path(input, o.paths_base)}, {"quality", o.quality},
                                           {"stride", std::to_string(o.stride)}, {"threads", std::to_string(o.threads)}}, search, after, a);
     if (Status s = write_lightmap_html_report(o.html, page); !s) return report_output(s.error());
     std::fprintf(stderr, "report: %s\n", o.html.c_str());
@@ -181,7 +182,9 @@ int run_audit(const Options& o) {
     const std::string input = inputs_text(files);
     if (o.json) {
         nlohmann::ordered_json j;
-        j["input"] = input;
+        std::vector<std::string> shown;
+        for (const std::string& f : files) shown.push_back(shown_path(f, o.paths_base));
+        j["input"] = inputs_text(shown);
         j["width"] = r->width;
         j["height"] = r->height;
         j["quality"] = o.quality;
@@ -240,6 +243,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
         s->add_option("--band-rows", o->band_rows, "rows per streamed band (rounded up to a multiple of 4; default: about 2^18 texels; output identical for any value)")
             ->check(CLI::Range(1, 1 << 20));
         add_progress_flags(s, o->progress);
+        add_depfile_option(s);
     };
     CLI::App* enc = lm->add_subcommand("encode", "SH lightmap EXR -> PREFIX.iz.ktx2 (BC6H) + PREFIX.d.ktx2 (BC5) + PREFIX.wa.ktx2 (BC4), or .dds");
     enc->add_option("IN", o->inputs,
@@ -263,6 +267,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     aud->add_option("IN", o->inputs, "SH lightmap EXR(s), as for encode")->required();
     aud->add_option("--stride", o->stride, "audit every N-th texel")->check(CLI::Range(1, 1 << 20));
     add_json_flag(aud, o->json);
+    add_paths_relative_to_option(aud, o->paths_base);
     aud->add_option("--html", o->html, "also write one self-contained HTML report (pictures before/after block compression, error map, tables; reads the whole lightmap)");
     quality(aud);
     band(aud);

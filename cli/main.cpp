@@ -9,6 +9,8 @@
 
 #include "cli.h"
 #include "codec/probe/quantize.h"
+#include "formats/io/depfile.h"
+#include "formats/io/file_io.h"
 
 namespace zhc::cli {
 
@@ -174,6 +176,75 @@ CLI::Option* add_ldr_encoding_option(CLI::App* app, LdrDecoding& decoding) {
             "ENCODING");
 }
 
+namespace {
+std::string& depfile_path() {
+    static std::string path;
+    return path;
+}
+}  // namespace
+
+CLI::Option* add_depfile_option(CLI::App* app) {
+    return app->add_option("--depfile", depfile_path(),
+                           "also write a Make/Ninja depfile here: the files written, then every file read "
+                           "(docs/build-integration.md); not written when the command fails")
+        ->type_name("FILE");
+}
+
+int run_with_depfile(const std::function<int()>& verb) {
+    const std::string depfile = depfile_path();
+    if (depfile.empty()) return verb();
+    FileRecorder recorder;
+    int rc;
+    {
+        ScopedFileRecording recording(&recorder);
+        rc = verb();
+    }
+    if (rc != kExitOk) return rc;
+    const std::vector<std::string> outputs = recorder.outputs();
+    // A file the command wrote and also read (never the same as an input: refuse_output_over_input)
+    // is its own product, not a prerequisite.
+    std::vector<std::string> inputs;
+    for (const std::string& in : recorder.inputs())
+        if (std::find(outputs.begin(), outputs.end(), in) == outputs.end()) inputs.push_back(in);
+    auto undo = [&](const std::string& why) {
+        std::error_code ec;
+        for (const std::string& out : outputs) std::filesystem::remove(out, ec);
+        std::fprintf(stderr, "zhc: error: --depfile %s: %s (the files this command wrote are removed again)\n",
+                     depfile.c_str(), why.c_str());
+        return kExitOutputFailed;
+    };
+    std::vector<std::string> touched = inputs;
+    touched.insert(touched.end(), outputs.begin(), outputs.end());
+    for (const std::string& path : touched) {
+        std::error_code ec;
+        if (std::filesystem::exists(depfile, ec) && std::filesystem::exists(path, ec) &&
+            std::filesystem::equivalent(depfile, path, ec) && !ec)
+            return undo("is " + path + ", a file this command read or wrote (choose another path)");
+    }
+    auto text = make_depfile(outputs, inputs);
+    if (!text) return undo(text.error().message);
+    if (Status st = write_file_atomic(depfile, std::vector<std::uint8_t>(text->begin(), text->end())); !st)
+        return undo(st.error().message);
+    return kExitOk;
+}
+
+CLI::Option* add_paths_relative_to_option(CLI::App* app, std::string& base) {
+    return app->add_option("--paths-relative-to", base,
+                           "reports (--json, --markdown, --html) name input files relative to this folder "
+                           "(default: as given), so a cached report names no run folder")
+        ->type_name("DIR");
+}
+
+std::string shown_path(const std::string& path, const std::string& base) {
+    namespace fs = std::filesystem;
+    if (base.empty()) return path;
+    std::error_code ec;
+    const fs::path p = fs::absolute(path, ec).lexically_normal();
+    const fs::path b = fs::absolute(base, ec).lexically_normal();
+    const fs::path rel = p.lexically_relative(b);
+    return rel.empty() ? p.generic_string() : rel.generic_string();
+}
+
 // CLI11 reports a verb it does not know as "A subcommand is required": name the word instead
 // ("unknown verb 'bogus'", "unknown verb 'gltf bogus'"). Empty when the verbs on the command line
 // are all known.
@@ -229,7 +300,7 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < all.size() && i < runners.size(); ++i) {
         if (all[i]->parsed()) {
             try {
-                return runners[i]();
+                return run_with_depfile(runners[i]);
             } catch (const std::exception& e) {
                 std::fprintf(stderr, "zhc: internal error: %s\n", e.what());
                 return kExitInternal;

@@ -4,7 +4,8 @@
 #   include/zhc/zhc_runtime.h                       the C99 runtime decoder (when runtime/ exists)
 #   include/zhc/zhc_volume_layouts.hpp              GPU volume layouts over it (C++17)
 #   lib/libzhc_codec.a, lib/libzhc_formats.a        static libraries
-#   lib/cmake/zhc/zhcConfig.cmake                   find_package(zhc): targets zhc::codec, zhc::formats
+#   lib/cmake/zhc/zhcConfig.cmake                   find_package(zhc): targets zhc::codec, zhc::formats, zhc::zhc
+#   lib/cmake/zhc/zhcBuild.cmake                    zhc_add_bake, zhc_add_lightmap (with bin/zhc; docs/build-integration.md)
 #   lib/pkgconfig/zhc.pc                            pkg-config --static --cflags --libs zhc
 #   share/zhc/runtime/                              runtime files (C header, GLSL, HLSL, web package)
 #   bin/zhc                                         the command
@@ -52,8 +53,16 @@ if(TARGET zhc_formats)
 else()
   set(ZHC_CONFIG_HAS_FORMATS 0)
 endif()
+# ... and defines zhc::zhc and the build-step helpers (zhcBuild.cmake) when bin/zhc is installed.
+if(TARGET zhc)
+  set(ZHC_CONFIG_HAS_CLI 1)
+  install(FILES "${PROJECT_SOURCE_DIR}/cmake/zhcBuild.cmake" DESTINATION "${ZHC_CMAKE_DIR}")
+else()
+  set(ZHC_CONFIG_HAS_CLI 0)
+endif()
 configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/zhcConfig.cmake.in"
-                              "${PROJECT_BINARY_DIR}/zhcConfig.cmake" INSTALL_DESTINATION "${ZHC_CMAKE_DIR}")
+                              "${PROJECT_BINARY_DIR}/zhcConfig.cmake" INSTALL_DESTINATION "${ZHC_CMAKE_DIR}"
+                              PATH_VARS CMAKE_INSTALL_BINDIR)
 write_basic_package_version_file("${PROJECT_BINARY_DIR}/zhcConfigVersion.cmake" COMPATIBILITY SameMinorVersion)
 install(FILES "${PROJECT_BINARY_DIR}/zhcConfig.cmake" "${PROJECT_BINARY_DIR}/zhcConfigVersion.cmake"
         DESTINATION "${ZHC_CMAKE_DIR}")

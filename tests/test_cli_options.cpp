@@ -19,20 +19,20 @@ struct VerbOptions {
 const std::vector<VerbOptions>& table() {
     static const std::vector<VerbOptions> t = {
         {{"demo"}, {"--threads"}},
-        {{"bake"}, {"-r,--representations,--to", "--threads", "--progress", "--quiet"}},
+        {{"bake"}, {"-r,--representations,--to", "--threads", "--progress", "--quiet", "--depfile"}},
         {{"project"}, {"--json", "--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding"}},
-        {{"audit"}, {"-r,--representations", "--json", "--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding", "--progress", "--quiet"}},
-        {{"convert"}, {"-r,--representations,--to", "--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding"}},
+        {{"audit"}, {"-r,--representations", "--json", "--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding", "--progress", "--quiet", "--depfile", "--paths-relative-to"}},
+        {{"convert"}, {"-r,--representations,--to", "--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding", "--depfile"}},
         {{"info"}, {"--json"}},
         {{"bench"}, {"-r,--representations", "--json"}},
-        {{"dering"}, {"--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding"}},
-        {{"gltf", "embed"}, {"-r,--representations,--encoding"}},
-        {{"gltf", "extract"}, {}},
+        {{"dering"}, {"--threads", "--replace-non-finite", "--part", "--latlong", "--ldr-encoding", "--depfile", "--paths-relative-to"}},
+        {{"gltf", "embed"}, {"-r,--representations,--encoding", "--depfile"}},
+        {{"gltf", "extract"}, {"--depfile"}},
         {{"gltf", "eval"}, {}},
-        {{"lightmap", "encode"}, {"--threads", "--progress", "--quiet"}},
-        {{"lightmap", "decode"}, {"--progress", "--quiet"}},
-        {{"lightmap", "audit"}, {"--json", "--threads", "--progress", "--quiet"}},
-        {{"lightmap", "synth"}, {"--threads", "--part", "--latlong", "--progress", "--quiet"}},
+        {{"lightmap", "encode"}, {"--threads", "--progress", "--quiet", "--depfile"}},
+        {{"lightmap", "decode"}, {"--progress", "--quiet", "--depfile"}},
+        {{"lightmap", "audit"}, {"--json", "--threads", "--progress", "--quiet", "--depfile", "--paths-relative-to"}},
+        {{"lightmap", "synth"}, {"--threads", "--part", "--latlong", "--progress", "--quiet", "--depfile"}},
     };
     return t;
 }
@@ -77,7 +77,8 @@ TEST(SharedOptions, EveryVerbListsTheSharedNames) {
                 << "zhc " << joined(v.verb) << ": " << o << " outside the shared -r,--representations spelling";
             // Every shared option this verb takes is in its row (a new one must be added there).
             const bool shared = o.find("--representations") != std::string::npos || o == "--threads" || o == "--json" ||
-                                o == "--part" || o == "--replace-non-finite" || o == "--latlong" || o == "--ldr-encoding" || o == "--progress" || o == "--quiet";
+                                o == "--part" || o == "--replace-non-finite" || o == "--latlong" || o == "--ldr-encoding" || o == "--progress" || o == "--quiet" ||
+                                o == "--depfile" || o == "--paths-relative-to";
             if (shared) {
                 EXPECT_NE(std::find(v.names.begin(), v.names.end(), o), v.names.end())
                     << "zhc " << joined(v.verb) << " lists " << o << " but its row in the table does not";

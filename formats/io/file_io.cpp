@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -15,6 +16,38 @@ namespace zhc {
 
 namespace fs = std::filesystem;
 
+namespace {
+std::atomic<FileRecorder*> g_recorder{nullptr};
+void add_once(std::vector<std::string>& list, const std::string& path) {
+    if (std::find(list.begin(), list.end(), path) == list.end()) list.push_back(path);
+}
+}  // namespace
+
+void FileRecorder::add_input(const std::string& path) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    add_once(inputs_, path);
+}
+void FileRecorder::add_output(const std::string& path) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    add_once(outputs_, path);
+}
+std::vector<std::string> FileRecorder::inputs() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return inputs_;
+}
+std::vector<std::string> FileRecorder::outputs() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return outputs_;
+}
+ScopedFileRecording::ScopedFileRecording(FileRecorder* recorder) : previous_(g_recorder.exchange(recorder)) {}
+ScopedFileRecording::~ScopedFileRecording() { g_recorder.store(previous_); }
+void record_input(const std::string& path) {
+    if (FileRecorder* r = g_recorder.load()) r->add_input(path);
+}
+void record_output(const std::string& path) {
+    if (FileRecorder* r = g_recorder.load()) r->add_output(path);
+}
+
 Result<std::vector<std::uint8_t>> read_file_bytes(const std::string& path, std::uint64_t max_bytes) {
     std::error_code ec;
     const fs::file_status st = fs::status(path, ec);
@@ -22,6 +55,7 @@ Result<std::vector<std::uint8_t>> read_file_bytes(const std::string& path, std::
     if (fs::is_directory(st)) return make_error(ErrorCode::kIoError, path + ": is a directory, not a file");
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) return make_error(ErrorCode::kIoError, path + ": cannot open (" + std::strerror(errno) + ")");
+    record_input(path);
     std::vector<std::uint8_t> bytes;
     // Read in chunks: works for pipes and special files whose size is unknown, and never
     // allocates more than max_bytes + one chunk.
@@ -69,6 +103,7 @@ Status FileRangeReader::open(const std::string& path) {
     path_ = path;
     f_ = std::fopen(path.c_str(), "rb");
     if (!f_) return make_error(ErrorCode::kIoError, path + ": cannot open (" + std::strerror(errno) + ")");
+    record_input(path);
     return Ok{};
 }
 
@@ -109,6 +144,7 @@ Status write_via_temporary(const std::string& path, const std::function<Status(c
         fs::remove(tmp, ec);
         return make_error(ErrorCode::kIoError, path + ": cannot write (" + ec.message() + ")");
     }
+    record_output(path);
     return Ok{};
 }
 
@@ -204,6 +240,7 @@ Status AtomicFileSet::commit() {
         }
         renamed.push_back(paths_[i]);
     }
+    for (const auto& path : paths_) record_output(path);
     files_.clear();
     temps_.clear();
     paths_.clear();

@@ -3,12 +3,15 @@
 // Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
 // on different files and arguments. The only process-wide state touched is OpenEXR's own
 // global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
-// guards it), which never changes the bytes read or written.
+// guards it), which never changes the bytes read or written, and the FileRecorder that a
+// ScopedFileRecording installs (below): it observes which files are opened and written, under its
+// own lock, and never changes what a call does.
 #pragma once
 
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -84,6 +87,42 @@ Status write_via_temporary(const std::string& path, const std::function<Status(c
 
 // A fresh temporary name next to `path` (the one write_via_temporary and AtomicFileSet use).
 std::string temporary_path_for(const std::string& path);
+
+// Which files a command read and wrote, for build systems (`--depfile`, `zhc info --inputs`;
+// docs/build-integration.md). While a FileRecorder is installed (ScopedFileRecording), every
+// successful open for reading by read_file_bytes, read_file_prefix, FileRangeReader::open and the
+// lightmap readers reports the path as given to it, and every published output (write_file_atomic,
+// write_files_atomic, AtomicFileSet::commit, write_via_temporary, the streaming OpenEXR writer)
+// reports the path it was renamed to. Thread-safe: readers on worker threads report too. Paths are
+// kept in the order first seen, each once (by its spelling).
+class FileRecorder {
+public:
+    void add_input(const std::string& path);
+    void add_output(const std::string& path);
+    std::vector<std::string> inputs() const;
+    std::vector<std::string> outputs() const;
+
+private:
+    mutable std::mutex mutex_;
+    std::vector<std::string> inputs_, outputs_;
+};
+
+// Installs `recorder` as the process's recorder for its lifetime (they do not nest: the previous
+// one, usually none, is restored at the end).
+class ScopedFileRecording {
+public:
+    explicit ScopedFileRecording(FileRecorder* recorder);
+    ~ScopedFileRecording();
+    ScopedFileRecording(const ScopedFileRecording&) = delete;
+    ScopedFileRecording& operator=(const ScopedFileRecording&) = delete;
+
+private:
+    FileRecorder* previous_;
+};
+
+// Report a file read or published outside the functions above (no-op without a recorder).
+void record_input(const std::string& path);
+void record_output(const std::string& path);
 
 // Lower-case extension including the dot ("" when none): "a/b.EXR" -> ".exr".
 std::string file_extension(const std::string& path);

@@ -180,6 +180,7 @@ public:
         if (!ec && std::filesystem::is_regular_file(st)) {
             const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
             if (fd < 0) return make_error(ErrorCode::kIoError, path + ": cannot open (" + std::strerror(errno) + ")");
+            record_input(path);
             struct stat sb {};
             if (::fstat(fd, &sb) != 0) {
                 ::close(fd);
@@ -421,6 +422,7 @@ public:
         std::filesystem::rename(tmp_, path_, ec);
         if (ec) return make_error(ErrorCode::kIoError, path_ + ": cannot write (" + ec.message() + ")");
         tmp_.clear();
+        record_output(path_);
         return Ok{};
     }
 

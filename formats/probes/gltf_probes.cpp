@@ -232,7 +232,8 @@ Status precheck(const json& doc, const std::string& path, const GltfLimits& limi
 
 // File access for tinygltf: only regular files inside `base`, at most `max_bytes` each.
 struct FsGuard {
-    fs::path base;  // canonical
+    fs::path base;      // canonical
+    fs::path user_dir;  // the same folder as the caller named it (files are opened by that spelling)
     std::uint64_t max_bytes = 0;
     std::uint64_t read_total = 0;
     std::uint64_t max_total = 0;
@@ -251,6 +252,10 @@ bool inside(const fs::path& base, const fs::path& p) {
     for (; b != e; ++b, ++q)
         if (q == p.end() || *q != *b) return false;
     return true;
+}
+
+fs::path user_spelling(const fs::path& user_dir, const fs::path& base, const fs::path& file) {
+    return user_dir / file.lexically_relative(base);
 }
 
 namespace {
@@ -317,7 +322,7 @@ bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::strin
             if (err) *err += g->error + "\n";
             return false;
         }
-        auto prefix = read_file_prefix(p.string(), static_cast<std::size_t>(length));
+        auto prefix = read_file_prefix(user_spelling(g->user_dir, g->base, p).string(), static_cast<std::size_t>(length));
         if (!prefix || prefix->bytes.size() != length) {
             g->code = prefix ? ErrorCode::kTruncated : prefix.error().code;
             g->error = prefix ? "buffers[" + std::to_string(index) + "]: file '" + p.filename().string() + "' changed while read"
@@ -335,7 +340,7 @@ bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::strin
         if (err) *err += g->error + "\n";
         return false;
     }
-    auto bytes = read_file_bytes(p.string(), g->max_bytes);
+    auto bytes = read_file_bytes(user_spelling(g->user_dir, g->base, p).string(), g->max_bytes);
     if (!bytes) {
         g->code = bytes.error().code;
         g->error = bytes.error().message;
@@ -438,6 +443,7 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     FsGuard guard;
     std::error_code ec;
     fs::path dir = fs::path(path).parent_path();
+    guard.user_dir = dir;
     if (dir.empty()) dir = ".";
     guard.base = fs::weakly_canonical(dir, ec);
     if (ec) return fail(ErrorCode::kIoError, path, "cannot resolve the input's directory");

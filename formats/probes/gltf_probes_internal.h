@@ -39,6 +39,10 @@ Error fail(ErrorCode code, const std::string& path, const std::string& what);
 std::string uri_path(const std::string& uri);
 // Whether `p` lies inside `base` (both canonical).
 bool inside(const fs::path& base, const fs::path& p);
+// `file` (canonical, inside the canonical `base`) spelled from `user_dir`, the folder as the caller
+// named it (empty: the working directory): the path a build system sees in a depfile
+// (formats/io/file_io.h FileRecorder), relative when the asset was named by a relative path.
+fs::path user_spelling(const fs::path& user_dir, const fs::path& base, const fs::path& file);
 
 // GLB 2.0: header, JSON chunk padded with spaces, optional BIN chunk padded with zeros.
 std::vector<std::uint8_t> make_glb(const std::string& json_text, std::span<const std::uint8_t> bin);

@@ -89,6 +89,7 @@ Status relocate_images(json& doc, const std::string& scene_path, const GltfEmbed
     if (!doc.contains("images") || !doc["images"].is_array()) return Ok{};
     std::error_code ec;
     fs::path in_dir = fs::path(scene_path).parent_path();
+    const fs::path in_dir_as_named = in_dir;
     if (in_dir.empty()) in_dir = ".";
     fs::path out_dir = fs::absolute(fs::path(options.output_path), ec).parent_path();
     const fs::path in_base = fs::weakly_canonical(in_dir, ec);
@@ -111,7 +112,7 @@ Status relocate_images(json& doc, const std::string& scene_path, const GltfEmbed
             image["uri"] = path_uri(file.lexically_relative(out_base));
             continue;
         }
-        auto bytes = read_file_bytes(file.string(), limits.max_buffer_bytes);
+        auto bytes = read_file_bytes(user_spelling(in_dir_as_named, in_base, file).string(), limits.max_buffer_bytes);
         if (!bytes) return bytes.error();
         total += bytes->size();
         if (total > limits.max_total_bytes) return fail(ErrorCode::kTooLarge, scene_path, "images to embed exceed the limit of " + std::to_string(limits.max_total_bytes) + " bytes");

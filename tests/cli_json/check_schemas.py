@@ -107,6 +107,10 @@ check("info", "info", ["info", ENVMAP, "--json"])
 check("info", "info", ["info", W("q16.zhp"), "--json"])
 check("info", "info", ["info", W("sh3.zhp"), "--json"])
 check("info", "info", ["info", W("list.json"), "--json"])
+with open(W("scene.json"), "w") as f:  # info --inputs: a scene and the environment map behind it
+    json.dump({"format": "zhc-scene", "version": 1, "probes": {"positions": [[0, 0, 0]]},
+               "environment": {"map": os.path.abspath(ENVMAP)}}, f)
+check("info", "info", ["info", "--inputs", W("scene.json"), "--json"])
 if GLTF_SCENE:
     run("gltf", "embed", GLTF_SCENE, W("q16.zhp"), "-o", W("lit.glb"))
     check("info", "info", ["info", W("lit.glb"), "--json"])
