@@ -1,7 +1,7 @@
 // A real decoder in the tests: Mesa's software OpenGL (llvmpipe) through headless EGL
 // (EGL_MESA_platform_surfaceless, no display needed) uploads zhc's BC6H / BC4 / BC5 blocks with
 // glCompressedTexImage2D and reads them back with glGetTexImage. BC6H must match zhc's decoder bit
-// for bit (half floats); BC4/BC5 within 1/255.
+// for bit (half floats); BC4/BC5 within 1/255; BC7 (zhc's cube-map reader) byte for byte.
 #include "gl/egl_context.h"
 #define GL_GLEXT_PROTOTYPES
 #include <GL/gl.h>
@@ -14,6 +14,7 @@
 
 #include "codec/lightmap/bc45.h"
 #include "codec/lightmap/bc6h.h"
+#include "formats/envmap/bc7.h"
 #include "support.h"
 
 namespace zhc {
@@ -174,6 +175,57 @@ TEST_F(MesaContext, Bc4AndBc5MatchWithinTwoLevelsAndStructurally) {
                     channels == 1 ? 4 : 5, nblocks, worst, worst * 255, structural);
         EXPECT_EQ(structural, 0u);
         EXPECT_LE(worst, 2.0 / 255.0);
+    }
+}
+
+// Random blocks with every BC7 mode forced in turn (the mode's bit set, the bits below it clear)
+// and the reserved mode (low byte 0), as BPTC UNORM and as sRGB (the same stored values come back:
+// glGetTexImage does not decode sRGB).
+TEST_F(MesaContext, Bc7MatchesZhcDecoderByteForByte) {
+    std::mt19937_64 rng(13);
+    const int w = 256, h = 72;  // 64 x 18 blocks: 128 of each of the 9 mode codes
+    std::vector<std::uint8_t> blocks;
+    int modes_seen[9] = {};
+    for (int k = 0; k < (w / 4) * (h / 4); ++k) {
+        std::uint8_t b[16];
+        for (int j = 0; j < 16; j += 8) {
+            const std::uint64_t v = rng();
+            std::memcpy(b + j, &v, 8);
+        }
+        const int mode = k % 9;
+        b[0] = mode == 8 ? 0 : static_cast<std::uint8_t>((b[0] & ~((2u << mode) - 1)) | (1u << mode));
+        ++modes_seen[bc7::block_mode(b)];
+        blocks.insert(blocks.end(), b, b + 16);
+    }
+    for (int m = 0; m < 9; ++m) EXPECT_EQ(modes_seen[m], 128) << "mode " << m;
+    std::vector<std::uint8_t> ours(static_cast<size_t>(w) * h * 4);
+    for (int by = 0; by < h / 4; ++by)
+        for (int bx = 0; bx < w / 4; ++bx) {
+            std::uint8_t texels[16][4];
+            bc7::decode_block(blocks.data() + 16 * (static_cast<size_t>(by) * (w / 4) + bx), texels);
+            for (int t = 0; t < 16; ++t)
+                std::memcpy(&ours[4 * (static_cast<size_t>(4 * by + t / 4) * w + 4 * bx + t % 4)], texels[t], 4);
+        }
+    for (const GLenum format : {GLenum(GL_COMPRESSED_RGBA_BPTC_UNORM), GLenum(GL_COMPRESSED_SRGB_ALPHA_BPTC_UNORM)}) {
+        const auto gl = round_trip<std::uint8_t>(format, blocks, w, h, GL_RGBA, GL_UNSIGNED_BYTE, 4);
+        ASSERT_EQ(gl.size(), ours.size());
+        size_t mismatches = 0;
+        size_t per_mode[9] = {};
+        for (size_t i = 0; i < gl.size(); ++i)
+            if (gl[i] != ours[i]) {
+                const size_t t = i / 4, x = t % w, y = t / w;
+                const int mode = bc7::block_mode(blocks.data() + 16 * ((y / 4) * (w / 4) + x / 4));
+                if (mismatches < 5)
+                    ADD_FAILURE() << "texel (" << x << ", " << y << ") channel " << i % 4 << " mode " << mode << ": mesa "
+                                  << int(gl[i]) << " zhc " << int(ours[i]);
+                ++mismatches;
+                ++per_mode[mode];
+            }
+        EXPECT_EQ(mismatches, 0u) << "of " << gl.size();
+        std::printf("BC7 (%s): %zu blocks (%zu bytes) compared with Mesa, %zu mismatches (by mode:",
+                    format == GL_COMPRESSED_RGBA_BPTC_UNORM ? "UNORM" : "sRGB", blocks.size() / 16, gl.size(), mismatches);
+        for (const size_t n : per_mode) std::printf(" %zu", n);
+        std::printf(")\n");
     }
 }
 
