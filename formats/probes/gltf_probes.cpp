@@ -429,9 +429,20 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     } else {
         text.assign(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     }
+    if (looks_like_git_lfs_pointer(bytes)) return fail(ErrorCode::kBadFormat, path, "not a glTF asset" + git_lfs_hint(bytes));
     if (Status depth = check_json_depth(text, path); !depth) return depth.error();
-    out.doc = json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (out.doc.is_discarded()) return fail(ErrorCode::kBadFormat, path, "glTF JSON does not parse");
+    // Where the JSON breaks, as zhc's other JSON readers say it (line and column; in a GLB they
+    // count in its JSON chunk).
+    try {
+        out.doc = json::parse(text);
+    } catch (const json::parse_error& e) {
+        const std::string what = e.what();
+        const size_t at = what.find("at line ");
+        const std::string where = at == std::string::npos ? what : what.substr(at);
+        return fail(ErrorCode::kBadFormat, path, std::string("not valid glTF JSON") + (out.binary ? " (GLB JSON chunk) " : " ") + where);
+    } catch (const json::exception& e) {  // out_of_range: a number like 1e999
+        return fail(ErrorCode::kBadFormat, path, std::string("not valid glTF JSON (") + e.what() + ")");
+    }
     auto ok = precheck(out.doc, path, limits, out.binary ? &glb : nullptr);
     if (!ok) return ok.error();
 
@@ -454,8 +465,19 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
             if (!fs::is_regular_file(guard.base / rel, fe))
                 return fail(ErrorCode::kIoError, path,
                             "referenced file '" + rel + "' not found in " + guard.base.string() + " (buffers[" + std::to_string(i) + "].uri)");
+            // A file shorter than byteLength is named here (a longer one is read up to byteLength),
+            // with a hint when it is a Git LFS pointer left in place of the data.
+            const std::uint64_t declared = b["byteLength"].get<std::uint64_t>();
+            const std::uint64_t have = fs::file_size(guard.base / rel, fe);
+            if (!fe && have < declared) {
+                auto prefix = read_file_prefix((guard.base / rel).string(), 1024);
+                return fail(ErrorCode::kTruncated, path,
+                            "buffers[" + std::to_string(i) + "].uri: '" + rel + "' holds " + std::to_string(have) +
+                                " bytes, fewer than the buffer's byteLength " + std::to_string(declared) +
+                                (prefix ? git_lfs_hint(prefix->bytes) : std::string()));
+            }
             const fs::path file = fs::weakly_canonical(guard.base / rel, fe);
-            if (!fe) guard.buffers[file.string()].push_back({i, b["byteLength"].get<std::uint64_t>()});
+            if (!fe) guard.buffers[file.string()].push_back({i, declared});
         }
 
     // tinygltf 2.7 refuses primitives whose index accessor has no bufferView, which is exactly
