@@ -1,4 +1,5 @@
-// zhc info FILE [--json]: describe any file zhc reads (environment map, .zhp, JSON probe list).
+// zhc info FILE [--json]: describe any file zhc reads or writes (environment map, .zhp, JSON probe
+// list, glTF, lightmap EXR, lightmap KTX2 / DDS planes) and other 2-D KTX2 / DDS textures' headers.
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -11,6 +12,10 @@
 #include "codec/probe/probe_set.h"
 #include "codec/probe/quantize.h"
 #include "formats/envmap/envmap.h"
+#include "formats/envmap/envmap_cube.h"
+#include "formats/lightmap/dds.h"
+#include "formats/lightmap/ktx2.h"
+#include "formats/lightmap/lightmap_exr.h"
 #include "formats/io/file_io.h"
 #include "formats/probes/gltf_probes.h"
 #include "formats/probes/probe_file.h"
@@ -120,6 +125,50 @@ void probe_stats(const std::vector<Sh3Radiance>& hub, nlohmann::ordered_json& j)
 }
 
 // A JSON document with an "asset" object is glTF, not a probe list.
+bool is_exr(const std::vector<std::uint8_t>& b) { return b.size() >= 4 && b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01; }
+
+// A KTX2 / DDS that is not a cube map: zhc's lightmap planes, or a texture zhc does not read.
+bool is_2d_texture(const std::vector<std::uint8_t>& b) {
+    return (is_ktx2(b) && !ktx2_declares_cube(b)) || (is_dds(b) && !dds_declares_cube(b));
+}
+
+// Describes a 2-D KTX2 / DDS: an IrradZ plane zhc's lightmap reader reads, else the header as it
+// stands (a format or shape zhc does not read says so; a damaged plane is still an error).
+Status describe_2d_texture(const std::vector<std::uint8_t>& b, const std::string& path, nlohmann::ordered_json& j) {
+    const bool ktx = is_ktx2(b);
+    const std::string container = ktx ? "KTX2" : "DDS";
+    auto img = ktx ? decode_ktx2(b, path) : decode_dds(b, path);
+    if (img) {
+        const std::uint32_t vk = img->vk_format;
+        j["type"] = "IrradZ lightmap texture (" + container + ", 2-D)";
+        j["format"] = vk == kVkFormatBc6hUfloat ? "BC6H_UFLOAT" : vk == kVkFormatBc5Unorm ? "BC5_UNORM" : "BC4_UNORM";
+        j["plane"] = vk == kVkFormatBc6hUfloat ? "I_z: linear RGB irradiance at the normal"
+                     : vk == kVkFormatBc5Unorm ? "d: direction, hemi-octahedral (u, v)"
+                                               : "w_a: weight in [0, 1]";
+        j["width"] = img->width;
+        j["height"] = img->height;
+        j["block_bytes"] = img->blocks.size();
+        return Ok{};
+    }
+    if (img.error().code != ErrorCode::kUnsupported) return img.error();
+    auto h = ktx ? describe_ktx2_header(b, path) : describe_dds_header(b, path);
+    if (!h) return h.error();
+    j["type"] = container + " texture (not a cube map; not an IrradZ plane)";
+    j["format"] = h->format;
+    j["width"] = h->width;
+    j["height"] = h->height;
+    j["depth"] = h->depth;
+    j["layers"] = h->layers;
+    j["faces"] = h->faces;
+    j["levels"] = h->levels;
+    if (ktx) j["supercompression"] = h->supercompression;
+    // The lightmap reader's reason, without the path it starts with.
+    std::string why = img.error().message;
+    if (why.rfind(path + ": ", 0) == 0) why = why.substr(path.size() + 2);
+    j["read_by_zhc"] = "no: 2-D textures are read as IrradZ lightmap planes only (environment maps are cube maps); " + why;
+    return Ok{};
+}
+
 bool is_gltf_json(const std::vector<std::uint8_t>& bytes) {
     // Too deep for the parser: not sniffed here; the reader it goes to refuses it by the same scan.
     if (!check_json_depth(bytes, "")) return false;
@@ -205,6 +254,18 @@ int run(const Options& o) {
         auto hub = decode_probe_set(*set);
         if (!hub) return report(hub.error());
         probe_stats(*hub, j);
+    } else if (is_2d_texture(*bytes)) {
+        if (Status s = describe_2d_texture(*bytes, o.path, j); !s) return report(s.error());
+    } else if (auto lm = is_exr(*bytes) ? describe_lightmap_exr(*bytes, o.path) : Result<LightmapExrSummary>(LightmapExrSummary{});
+               lm && !lm->kind.empty()) {
+        // zhc's lightmap EXRs (SH lightmaps, IrradZ planes); other EXRs are environment maps.
+        j["type"] = lm->kind == "sh3"         ? "SH lightmap (OpenEXR, SH3 radiance per texel)"
+                    : lm->kind == "linear-sh" ? "linear SH lightmap (OpenEXR, L0 + L1 radiance per texel)"
+                                              : "IrradZ lightmap planes (OpenEXR, as lightmap decode writes)";
+        j["width"] = lm->width;
+        j["height"] = lm->height;
+        j["pixel_type"] = lm->pixel_type;
+        j["channels"] = lm->channels;
     } else if (looks_like_envmap(*bytes)) {
         // info describes a file with NaN/Inf pixels instead of refusing it: it counts them, and its
         // statistics read them as 0 (what --replace-non-finite does elsewhere).
@@ -287,7 +348,8 @@ int run(const Options& o) {
         probe_stats(list->probes, j);
     } else {
         return report(make_error(ErrorCode::kBadFormat,
-                                 o.path + ": not an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map), .zhp probe file or JSON probe list"));
+                                 o.path + ": not an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map), .zhp probe file or JSON probe list" +
+                                     git_lfs_hint(*bytes)));
     }
     print_json_or_text(j, o.json);
     return kExitOk;

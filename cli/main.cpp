@@ -164,7 +164,7 @@ CLI::Option* add_ldr_encoding_option(CLI::App* app, LdrDecoding& decoding) {
     return app
         ->add_option_function<std::string>(
             "--ldr-encoding", [&decoding](const std::string& text) { parse_ldr_decoding(text, &decoding); },
-            "8-bit cube maps (KTX2 / KTX 1 / DDS RGBA8, BC1-3): auto (default: sRGB or linear as the format says), "
+            "8-bit cube maps (KTX2 / KTX 1 / DDS RGBA8, BC1-3, BC7): auto (default: sRGB or linear as the format says), "
             "srgb or linear (that transfer function whatever the format says), rgbm:RANGE (rgb * a * RANGE) or "
             "rgbd:RANGE (rgb * (RANGE / 255) / a); docs/inputs.md")
         ->check(

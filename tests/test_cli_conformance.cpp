@@ -234,6 +234,13 @@ Bytes probes_zhp(bool grid = false) {
     return b.ok() ? *b : Bytes{};
 }
 
+// A Git LFS pointer file as git-lfs writes it (specification v1: version, oid, size lines).
+Bytes lfs_pointer() {
+    return bytes_of("version https://git-lfs.github.com/spec/v1\n"
+                    "oid sha256:4d7a214614ab2935c943f9e0ff69d22eadbb8f32b1258daaa5e2ca24d17e2393\n"
+                    "size 12345\n");
+}
+
 using Generator = std::function<void(const std::string& dir, const std::string& name)>;
 Generator file(std::function<Bytes(const std::string& dir)> make) {
     return [make](const std::string& dir, const std::string& name) { test::write_bytes(dir + "/" + name, make(dir)); };
@@ -367,6 +374,30 @@ const std::map<std::string, Generator>& generators() {
         {"sf16lm", triplet("ktx2", TripletEdit::kSignedIz)},
         {"hugelm", triplet("ktx2", TripletEdit::kHugeIz)},
         {"hugelmdds", triplet("dds", TripletEdit::kHugeIz)},
+        // 2-D KTX2 in a format zhc does not read: the BC6H plane relabelled BC7 (same block size).
+        {"bc7_2d.ktx2", [](const std::string& d, const std::string& n) {
+             triplet("ktx2", TripletEdit::kNone)(d, ".gen_2d");
+             test::write_bytes(d + "/" + n, patched32(test::read_bytes(d + "/.gen_2d.iz.ktx2"), 12, 145));
+             for (const char* p : {".iz.ktx2", ".d.ktx2", ".wa.ktx2"}) fs::remove(d + "/.gen_2d" + p);
+         }},
+        // IrradZ planes as lightmap decode writes them.
+        {"irradz.exr", [](const std::string& d, const std::string& n) {
+             triplet("ktx2", TripletEdit::kNone)(d, ".gen_iz");
+             run_ok({"lightmap", "decode", d + "/.gen_iz", "-o", d + "/" + n, "--quiet"});
+             for (const char* p : {".iz.ktx2", ".d.ktx2", ".wa.ktx2"}) fs::remove(d + "/.gen_iz" + p);
+         }},
+        // Git LFS pointers (what a checkout holds when git lfs did not fetch the content) where an
+        // EXR, a glTF, a lightmap EXR / KTX2 triplet or a glTF's .bin belongs.
+        {"lfs.exr", file([](const std::string&) { return lfs_pointer(); })},
+        {"lfs.gltf", file([](const std::string&) { return lfs_pointer(); })},
+        {"lfs_lm.exr", file([](const std::string&) { return lfs_pointer(); })},
+        {"lfslm", [](const std::string& d, const std::string& n) {
+             for (const char* p : {".iz.ktx2", ".d.ktx2", ".wa.ktx2"}) test::write_bytes(d + "/" + n + p, lfs_pointer());
+         }},
+        {"lfsbin.gltf", [](const std::string& d, const std::string& n) {
+             test::write_bytes(d + "/" + n, bytes_of(R"({"asset":{"version":"2.0"},"buffers":[{"uri":"lfsbin.bin","byteLength":1000}]})"));
+             test::write_bytes(d + "/lfsbin.bin", lfs_pointer());
+         }},
         // glTF: the four probes embedded into the corpus's plain triangle list.
         {"lit.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, GlbEdit::kNone); }},
         {"cut.glb", [](const std::string& d, const std::string& n) { embed_probes(d, n, GlbEdit::kCut); }},

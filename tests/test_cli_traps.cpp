@@ -419,5 +419,32 @@ TEST(CliTraps, OutputOverInputRefusedInEveryWritingVerb) {
     EXPECT_EQ(test::run_zhc({"convert", zhp, "-o", dir + "/other.zhp"}).exit_code, 0);
 }
 
+// zhc info on 2-D DDS textures ImageMagick writes (DXT1 and uncompressed, with mip chains): exit
+// 0 describing the header (format, size, levels) and why zhc does not read it, instead of refusing
+// the file as unknown.
+TEST(CliTraps, InfoDescribesTwoDimensionalTexturesImageMagickWrote) {
+    const std::string dir = test::fresh_dir("info_2d_dds");
+    struct Case {
+        const char* compression;
+        const char* format;
+    };
+    for (const Case& c : {Case{"dxt1", "FourCC 'DXT1'"}, Case{"none", "-bit uncompressed"}}) {
+        SCOPED_TRACE(c.compression);
+        const std::string path = dir + "/" + c.compression + ".dds";
+        const std::string cmd = "convert -size 16x8 gradient:red-blue -define dds:compression=" + std::string(c.compression) + " '" + path + "'";
+        ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+        const auto r = test::run_zhc({"info", path, "--json"});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const auto j = nlohmann::json::parse(r.out);
+        EXPECT_EQ(j["type"], "DDS texture (not a cube map; not an IrradZ plane)");
+        EXPECT_NE(j["format"].get<std::string>().find(c.format), std::string::npos) << j["format"];
+        EXPECT_EQ(j["width"], 16);
+        EXPECT_EQ(j["height"], 8);
+        EXPECT_EQ(j["levels"], 5);  // 16x8, 8x4, 4x2, 2x1, 1x1
+        EXPECT_EQ(j["faces"], 1);
+        EXPECT_EQ(j["read_by_zhc"].get<std::string>().rfind("no: ", 0), 0u) << j["read_by_zhc"];
+    }
+}
+
 }  // namespace
 }  // namespace zhc

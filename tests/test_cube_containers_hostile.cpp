@@ -80,7 +80,7 @@ std::vector<Hostile> hostile_set() {
         {"zstd_raw.ktx2", &ktx, {{44, 2}}, 4},  // says Zstandard, holds raw texels
         {"basislz.ktx2", &ktx, {{44, 1}}, 5},
         {"bc6h_sfloat.ktx2", &ktx, {{12, 144}, {16, 1}}, 5},
-        {"bc7.ktx2", &ktx, {{12, 145}, {16, 1}}, 5},  // BC7_UNORM: no BC7 decoder
+        {"astc.ktx2", &ktx, {{12, 157}, {16, 1}}, 5},  // ASTC_4x4_UNORM_BLOCK: no ASTC decoder
         {"huge.ktx2", &ktx, {{20, 60000}, {24, 60000}}, 6},
         {"not_square.ktx2", &ktx, {{24, 4}}, 4},
         {"level_length.ktx2", &ktx, {{80 + 8, 0xFFFFFFF0u}}, 4},  // level 0 byteLength

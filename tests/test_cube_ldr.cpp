@@ -29,9 +29,10 @@
 
 #include "codec/lightmap/bc6h.h"
 #include "formats/envmap/envmap.h"
+#include "formats/envmap/bc7.h"
 #include "formats/envmap/envmap_ldr.h"
 #include "formats/scene/scene_json.h"
-#include "cube_helpers.h"
+#include "cube_ldr_helpers.h"
 #include "support.h"
 
 namespace zhc {
@@ -40,37 +41,9 @@ namespace {
 using namespace cube_test;
 using Bytes = std::vector<std::uint8_t>;
 
-const double kSqrt4Pi = std::sqrt(4 * M_PI);
 constexpr double kQuadrature = 1e-4;  // of |L00|, the texel quadrature at N = 64
 
-// ---- the analytic function: constant + linear gradient per channel, f_k(d) = c_k + g_k . d ------
-struct Linear {
-    double c[3] = {0.45, 0.5, 0.55};
-    double g[3][3] = {{0.2, -0.1, 0.15}, {-0.12, 0.18, 0.1}, {0.1, 0.1, -0.2}};  // (x, y, z) per channel
-    double scale = 1.0;
-    Rgb operator()(Vec3 d) const {
-        Rgb out;
-        for (int k = 0; k < 3; ++k) out[k] = static_cast<float>(scale * (c[k] + g[k][0] * d.x + g[k][1] * d.y + g[k][2] * d.z));
-        return out;
-    }
-    // Its SH: L00 = sqrt(4 pi) c; with zhc's basis (Y1-1 = -Y1 y, Y10 = Y1 z, Y11 = -Y1 x,
-    // Y1 = sqrt(3 / 4 pi)) and the integral of d_j^2 = 4 pi / 3: L1-1 = -Y1 (4 pi / 3) g_y, etc.
-    Sh3Radiance sh() const {
-        Sh3Radiance a{};
-        const double y1 = std::sqrt(3 / (4 * M_PI)) * 4 * M_PI / 3;
-        for (int k = 0; k < 3; ++k) {
-            a[0][k] = static_cast<float>(scale * kSqrt4Pi * c[k]);
-            a[1][k] = static_cast<float>(-scale * y1 * g[k][1]);
-            a[2][k] = static_cast<float>(scale * y1 * g[k][2]);
-            a[3][k] = static_cast<float>(-scale * y1 * g[k][0]);
-        }
-        return a;
-    }
-};
-
-// ---- twins: the sRGB curves, slow block decoders --------------------------------------------
-double srgb_eotf_twin(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
-double srgb_oetf_twin(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055; }
+// ---- twins: slow block decoders --------------------------------------------
 std::uint8_t q8(double v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); }
 
 // Bit k of a little-endian byte string.
@@ -280,47 +253,6 @@ TEST(CubeLdr, BlockDecodersMatchTheTwins) {
 // ---- containers ---------------------------------------------------------------------------------
 void put32(Bytes& b, std::uint32_t v) { put32v(b, v); }
 
-// KTX2, one level (the 8-bit cases; float cases use cube_helpers' write_ktx2).
-Bytes ktx2_one_level(std::uint32_t vk, std::uint32_t type_size, int n, const Bytes& level) {
-    const std::uint32_t dfd_len = 44, index_end = 80 + 24;
-    const std::uint64_t offset = (index_end + dfd_len + 15) / 16 * 16;
-    Bytes b = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
-    for (std::uint32_t v : {vk, type_size, std::uint32_t(n), std::uint32_t(n), 0u, 0u, 6u, 1u, 0u, index_end, dfd_len, 0u, 0u}) put32(b, v);
-    put64v(b, 0);
-    put64v(b, 0);
-    put64v(b, offset);
-    put64v(b, level.size());
-    put64v(b, level.size());
-    put32(b, dfd_len);
-    put32(b, 0);
-    put32(b, 2u | (40u << 16));
-    b.resize(offset, 0);
-    b.insert(b.end(), level.begin(), level.end());
-    return b;
-}
-
-// DDS: DX10 header with `dxgi`, or legacy with FourCC `fourcc`, or legacy RGB with masks.
-struct DdsPf {
-    std::uint32_t dxgi = 0, fourcc = 0, flags = 0x4, bits = 0, masks[4] = {0, 0, 0, 0};
-};
-Bytes dds(const DdsPf& pf, int n, const Bytes& faces) {
-    Bytes b;
-    put32(b, 0x20534444);
-    for (std::uint32_t v : {124u, 0x1007u, std::uint32_t(n), std::uint32_t(n), 0u, 0u, 1u}) put32(b, v);
-    for (int i = 0; i < 11; ++i) put32(b, 0);
-    put32(b, 32);
-    put32(b, pf.dxgi ? 0x4u : pf.flags);
-    put32(b, pf.dxgi ? 0x30315844u : pf.fourcc);
-    put32(b, pf.bits);
-    for (std::uint32_t m : pf.masks) put32(b, m);
-    put32(b, 0x1008);
-    put32(b, 0x200 | 0xFC00);
-    for (int i = 0; i < 3; ++i) put32(b, 0);
-    if (pf.dxgi)
-        for (std::uint32_t v : {pf.dxgi, 3u, 0x4u, 1u, 0u}) put32(b, v);
-    b.insert(b.end(), faces.begin(), faces.end());
-    return b;
-}
 
 // KTX 1 (KTX File Format Specification 1.1): 64-byte header, key/value data, then per level
 // imageSize (one face's bytes, rows padded to 4) and six faces. `levels` > 1 adds levels whose
@@ -601,6 +533,51 @@ TEST(CubeLdr, EightBitFormatsProjectToTheFunctionWithinTheQuantisationBound) {
     }
 }
 
+// BC7 blocks (random, every mode and the reserved one) in KTX2, KTX 1 and DDS, UNORM and sRGB:
+// each container gives every texel as bc7::decode_block's bytes (test_bc7, test_mesa_bc check the
+// decoder) under the format's transfer function, and at N = 6 the partial edge blocks are cut.
+TEST(CubeLdr, Bc7InEveryContainer) {
+    std::mt19937_64 rng(77);
+    for (const int n : {8, 6}) {
+        const int bw = (n + 3) / 4;
+        Bytes faces;
+        for (int b = 0; b < 6 * bw * bw; ++b) {
+            std::uint8_t blk[16];
+            for (auto& v : blk) v = static_cast<std::uint8_t>(rng());
+            const int mode = b % 9;
+            blk[0] = mode == 8 ? 0 : static_cast<std::uint8_t>((blk[0] & ~((2u << mode) - 1)) | (1u << mode));
+            faces.insert(faces.end(), blk, blk + 16);
+        }
+        for (const bool srgb : {false, true}) {
+            const Bytes files[] = {ktx2_one_level(srgb ? 146 : 145, 1, n, faces), ktx1(spec(0, 1, 0, srgb ? 0x8E8Du : 0x8E8Cu, 0, 16), n, faces),
+                                   dds(DdsPf{srgb ? 99u : 98u}, n, faces)};
+            for (const Bytes& file : files) {
+                EnvmapInfo info;
+                auto img = read_with(file, {}, &info);
+                ASSERT_TRUE(img) << img.error().message;
+                EXPECT_EQ(info.channels, srgb ? "BC7 sRGB" : "BC7 UNORM");
+                ASSERT_EQ(img->width, n);
+                double worst = 0;
+                for (int face = 0; face < 6; ++face)
+                    for (int by = 0; by < bw; ++by)
+                        for (int bx = 0; bx < bw; ++bx) {
+                            std::uint8_t t[16][4];
+                            bc7::decode_block(faces.data() + 16 * (static_cast<size_t>(face * bw + by) * bw + bx), t);
+                            for (int i = 0; i < 16; ++i) {
+                                const int x = 4 * bx + i % 4, y = 4 * by + i / 4;
+                                if (x >= n || y >= n) continue;
+                                for (int k = 0; k < 3; ++k) {
+                                    const double v = t[i][k] / 255.0;
+                                    worst = std::max(worst, std::fabs(img->row(face * n + y)[3 * x + k] - (srgb ? srgb_eotf_twin(v) : v)));
+                                }
+                            }
+                        }
+                EXPECT_LT(worst, 2e-6) << "n " << n << (srgb ? " sRGB" : " UNORM");
+            }
+        }
+    }
+}
+
 TEST(CubeLdr, SrgbAndLinearChooseTheTransferFunction) {
     EXPECT_NEAR(ldr::srgb_to_linear(0.5f), 0.214041, 1e-6);  // the sRGB EOTF of 0.5
     EXPECT_NEAR(ldr::srgb_to_linear(0.04045f), 0.04045 / 12.92, 1e-7);
@@ -872,7 +849,7 @@ TEST(CubeLdr, Ktx1HostileFilesAreRefusedCleanly) {
     };
     cases.push_back({"astc", small_ktx1(spec(0, 1, 0, 0x93B0, 0, 16)), 5, "KTX 1 glInternalFormat 0x93B0 (byte 28) is not supported"});
     cases.push_back({"rgba4", small_ktx1(spec(0x8033, 2, kRgba, 0x8056, 2, 0)), 5, "KTX 1 glInternalFormat 0x8056"});
-    cases.push_back({"bc7", small_ktx1(spec(0, 1, 0, 0x8E8C, 0, 16)), 5, "BC7"});
+    cases.push_back({"etc2", small_ktx1(spec(0, 1, 0, 0x9278, 0, 16)), 5, "KTX 1 glInternalFormat 0x9278"});
     cases.push_back({"half as bytes", small_ktx1(spec(0x1401, 1, kRgba, 0x881A, 4, 0)), 5, "glType 0x1401"});
     cases.push_back({"one face", edit(52, 1), 5, "numberOfFaces 1"});
     cases.push_back({"array", edit(48, 2), 5, "numberOfArrayElements 2"});

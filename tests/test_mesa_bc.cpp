@@ -1,7 +1,7 @@
 // A real decoder in the tests: Mesa's software OpenGL (llvmpipe) through headless EGL
 // (EGL_MESA_platform_surfaceless, no display needed) uploads zhc's BC6H / BC4 / BC5 blocks with
 // glCompressedTexImage2D and reads them back with glGetTexImage. BC6H must match zhc's decoder bit
-// for bit (half floats); BC4/BC5 within 1/255.
+// for bit (half floats); BC4/BC5 within 1/255; BC7 (zhc's cube-map reader) byte for byte.
 #include "gl/egl_context.h"
 #define GL_GLEXT_PROTOTYPES
 #include <GL/gl.h>
@@ -14,6 +14,8 @@
 
 #include "codec/lightmap/bc45.h"
 #include "codec/lightmap/bc6h.h"
+#include "formats/envmap/bc7.h"
+#include "cube_ldr_helpers.h"
 #include "support.h"
 
 namespace zhc {
@@ -174,6 +176,143 @@ TEST_F(MesaContext, Bc4AndBc5MatchWithinTwoLevelsAndStructurally) {
                     channels == 1 ? 4 : 5, nblocks, worst, worst * 255, structural);
         EXPECT_EQ(structural, 0u);
         EXPECT_LE(worst, 2.0 / 255.0);
+    }
+}
+
+// Random blocks with every BC7 mode forced in turn (the mode's bit set, the bits below it clear)
+// and the reserved mode (low byte 0), as BPTC UNORM and as sRGB (the same stored values come back:
+// glGetTexImage does not decode sRGB).
+TEST_F(MesaContext, Bc7MatchesZhcDecoderByteForByte) {
+    std::mt19937_64 rng(13);
+    const int w = 256, h = 72;  // 64 x 18 blocks: 128 of each of the 9 mode codes
+    std::vector<std::uint8_t> blocks;
+    int modes_seen[9] = {};
+    for (int k = 0; k < (w / 4) * (h / 4); ++k) {
+        std::uint8_t b[16];
+        for (int j = 0; j < 16; j += 8) {
+            const std::uint64_t v = rng();
+            std::memcpy(b + j, &v, 8);
+        }
+        const int mode = k % 9;
+        b[0] = mode == 8 ? 0 : static_cast<std::uint8_t>((b[0] & ~((2u << mode) - 1)) | (1u << mode));
+        ++modes_seen[bc7::block_mode(b)];
+        blocks.insert(blocks.end(), b, b + 16);
+    }
+    for (int m = 0; m < 9; ++m) EXPECT_EQ(modes_seen[m], 128) << "mode " << m;
+    std::vector<std::uint8_t> ours(static_cast<size_t>(w) * h * 4);
+    for (int by = 0; by < h / 4; ++by)
+        for (int bx = 0; bx < w / 4; ++bx) {
+            std::uint8_t texels[16][4];
+            bc7::decode_block(blocks.data() + 16 * (static_cast<size_t>(by) * (w / 4) + bx), texels);
+            for (int t = 0; t < 16; ++t)
+                std::memcpy(&ours[4 * (static_cast<size_t>(4 * by + t / 4) * w + 4 * bx + t % 4)], texels[t], 4);
+        }
+    for (const GLenum format : {GLenum(GL_COMPRESSED_RGBA_BPTC_UNORM), GLenum(GL_COMPRESSED_SRGB_ALPHA_BPTC_UNORM)}) {
+        const auto gl = round_trip<std::uint8_t>(format, blocks, w, h, GL_RGBA, GL_UNSIGNED_BYTE, 4);
+        ASSERT_EQ(gl.size(), ours.size());
+        size_t mismatches = 0;
+        size_t per_mode[9] = {};
+        for (size_t i = 0; i < gl.size(); ++i)
+            if (gl[i] != ours[i]) {
+                const size_t t = i / 4, x = t % w, y = t / w;
+                const int mode = bc7::block_mode(blocks.data() + 16 * ((y / 4) * (w / 4) + x / 4));
+                if (mismatches < 5)
+                    ADD_FAILURE() << "texel (" << x << ", " << y << ") channel " << i % 4 << " mode " << mode << ": mesa "
+                                  << int(gl[i]) << " zhc " << int(ours[i]);
+                ++mismatches;
+                ++per_mode[mode];
+            }
+        EXPECT_EQ(mismatches, 0u) << "of " << gl.size();
+        std::printf("BC7 (%s): %zu blocks (%zu bytes) compared with Mesa, %zu mismatches (by mode:",
+                    format == GL_COMPRESSED_RGBA_BPTC_UNORM ? "UNORM" : "sRGB", blocks.size() / 16, gl.size(), mismatches);
+        for (const size_t n : per_mode) std::printf(" %zu", n);
+        std::printf(")\n");
+    }
+}
+
+// BC7 cube maps whose blocks Mesa's BPTC encoder wrote: llvmpipe compresses RGBA8 faces on
+// upload to a BPTC internal format (glTexImage2D), glGetCompressedTexImage returns its blocks and
+// glGetTexImage its own decode of them. The blocks go into KTX2 and DDS cube maps (containers
+// assembled by this test's writers, cube_ldr_helpers.h: no Debian 12 tool writes BC7 KTX2 / DDS)
+// that zhc reads: every texel must be Mesa's decode under the format's transfer function, and the
+// projection must be the analytic function's SH within the bound of the measured texel error.
+TEST_F(MesaContext, Bc7CubeMapsEncodedByMesaReadAndProject) {
+    using namespace cube_test;
+    const int n = 64;
+    const Linear fn;
+    const Image lin = render_cube(n, fn);
+    for (const bool srgb : {true, false}) {
+        SCOPED_TRACE(srgb ? "sRGB" : "UNORM");
+        Bytes blocks, mesa_texels;
+        for (int face = 0; face < 6; ++face) {
+            Bytes rgba;
+            for (int r = 0; r < n; ++r)
+                for (int c = 0; c < n; ++c) {
+                    const float* p = lin.row(face * n + r) + 3 * c;
+                    for (int k = 0; k < 3; ++k) {
+                        const double v = srgb ? srgb_oetf_twin(p[k]) : p[k];
+                        rgba.push_back(static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255)));
+                    }
+                    rgba.push_back(255);
+                }
+            GLuint tex = 0;
+            glGenTextures(1, &tex);
+            glBindTexture(GL_TEXTURE_2D, tex);
+            glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+            glPixelStorei(GL_PACK_ALIGNMENT, 1);
+            glTexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_COMPRESSED_SRGB_ALPHA_BPTC_UNORM : GL_COMPRESSED_RGBA_BPTC_UNORM, n, n, 0, GL_RGBA,
+                         GL_UNSIGNED_BYTE, rgba.data());
+            GLint compressed = 0, size = 0;
+            glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_COMPRESSED, &compressed);
+            glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_COMPRESSED_IMAGE_SIZE, &size);
+            ASSERT_EQ(compressed, GL_TRUE);
+            ASSERT_EQ(size, (n / 4) * (n / 4) * 16);
+            Bytes face_blocks(static_cast<size_t>(size)), face_texels(static_cast<size_t>(n) * n * 4);
+            glGetCompressedTexImage(GL_TEXTURE_2D, 0, face_blocks.data());
+            glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, face_texels.data());
+            ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+            glDeleteTextures(1, &tex);
+            blocks.insert(blocks.end(), face_blocks.begin(), face_blocks.end());
+            mesa_texels.insert(mesa_texels.end(), face_texels.begin(), face_texels.end());
+        }
+        int modes[9] = {};
+        for (size_t b = 0; b < blocks.size(); b += 16) ++modes[bc7::block_mode(blocks.data() + b)];
+        std::printf("Mesa's BC7 %s blocks by mode:", srgb ? "sRGB" : "UNORM");
+        for (const int m : modes) std::printf(" %d", m);
+        std::printf("\n");
+        const std::string dir = test::temp_dir("mesa_bc7");
+        const Bytes ktx2 = ktx2_one_level(srgb ? 146 : 145, 1, n, blocks);
+        DdsPf pf;
+        pf.dxgi = srgb ? 99 : 98;
+        const Bytes dds_file = dds(pf, n, blocks);
+        for (const auto& [name, file] : {std::pair<std::string, const Bytes*>{"cube.ktx2", &ktx2}, {"cube.dds", &dds_file}}) {
+            SCOPED_TRACE(name);
+            EnvmapReadOptions o;
+            o.warn = [](const std::string&) {};
+            EnvmapInfo info;
+            auto img = read_envmap_memory(*file, name, o, &info);
+            ASSERT_TRUE(img) << img.error().message;
+            EXPECT_EQ(info.channels, srgb ? "BC7 sRGB" : "BC7 UNORM");
+            double worst = 0, e = 0;
+            for (size_t i = 0; i < img->rgb.size(); ++i) {
+                const double byte = mesa_texels[4 * (i / 3) + i % 3] / 255.0;
+                worst = std::max(worst, std::fabs(img->rgb[i] - (srgb ? srgb_eotf_twin(byte) : byte)));
+                e = std::max(e, std::fabs(static_cast<double>(img->rgb[i]) - lin.rgb[i]));
+            }
+            EXPECT_LT(worst, 2e-6);  // Mesa's decode, by the transfer function
+            const double bound = e / fn.c[2] + 1e-4;  // sqrt(4 pi) e / |L00| + the quadrature's 1e-4
+            const double d = test::sh_distance(project_envmap(*img), fn.sh());
+            std::printf("%s %s: %.2e of |L00| (texel error %.4f, bound %.2e), |zhc - Mesa| %.1e\n", name.c_str(),
+                        srgb ? "sRGB" : "UNORM", d, e, bound, worst);
+            EXPECT_LT(d, bound);
+            EXPECT_LT(e, 0.1);  // the function, not noise (Mesa's fast encoder writes mode 4 blocks only)
+            // Through the CLI: project reads the file (the UNORM one with its read-as-linear warning).
+            const std::string path = dir + "/" + (srgb ? "srgb_" : "unorm_") + name;
+            test::write_bytes(path, *file);
+            const auto run = test::run_zhc({"project", path, "--json"});
+            EXPECT_EQ(run.exit_code, 0) << run.err;
+            EXPECT_EQ(run.err.find("read as linear") != std::string::npos, !srgb) << run.err;
+        }
     }
 }
 

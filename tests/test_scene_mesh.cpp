@@ -102,6 +102,11 @@ TEST(TriangleOccluder, BvhAgreesWithBruteForceOnMeshes) {
     ASSERT_GT(occ.size(), 22000u);
     const OccluderBvh bvh(occ);
     EXPECT_LT(bvh.node_count(), occ.size());
+    // Memory the tree holds: 80-byte primitives (not 160-byte Occluder copies) and 72-byte nodes,
+    // fewer nodes than primitives, the node reservation given back after the build.
+    const double per_primitive = static_cast<double>(bvh.memory_bytes()) / static_cast<double>(occ.size());
+    std::printf("BVH: %.1f bytes per primitive (%zu nodes for %zu primitives)\n", per_primitive, bvh.node_count(), occ.size());
+    EXPECT_LT(per_primitive, 80.0 + 72.0);
     int hits = 0;
     for (int i = 0; i < 6000; ++i) {
         const Vec3 o{0.75 * u(rng), 0.75 * u(rng), 0.75 * u(rng)};

@@ -46,13 +46,13 @@ bool slab(const double lo[3], const double hi[3], Vec3 o, Vec3 d, double t0, dou
 // Moller-Trumbore (1997): solve o + t d = v0 + u e1 + v e2 by Cramer's rule with
 // det = e1 . (d x e2). Policy in occluders.h: det == 0 (parallel, or a degenerate triangle) misses;
 // inclusive barycentric bounds widened by 1e-10; t in the open interval (t_min, t_max); both faces.
-bool ray_hits_triangle(const Occluder& tri, Vec3 o, Vec3 d, double t_min, double t_max) {
-    const Vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+bool ray_hits_triangle(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 o, Vec3 d, double t_min, double t_max) {
+    const Vec3 e1 = v1 - v0, e2 = v2 - v0;
     const Vec3 p = cross(d, e2);
     const double det = dot(e1, p);
     if (det == 0.0 || !std::isfinite(det)) return false;
     const double inv = 1.0 / det;
-    const Vec3 s = o - tri.v0;
+    const Vec3 s = o - v0;
     // Barycentric tolerance: Moller-Trumbore computes u, v per triangle, so on a shared edge the
     // two neighbours can both reject by a few ulps (not watertight). Growing every triangle by a
     // relative 1e-10 of its edges closes such cracks (rounding errors are ~1e-15 for well-posed
@@ -150,7 +150,7 @@ std::vector<Occluder> uv_sphere_triangles(Vec3 c, double r, int n_lat, int n_lon
 }
 
 bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
-    if (occ.kind == OccluderKind::kTriangle) return ray_hits_triangle(occ, o, d, t_min, t_max);
+    if (occ.kind == OccluderKind::kTriangle) return ray_hits_triangle(occ.v0, occ.v1, occ.v2, o, d, t_min, t_max);
     if (occ.kind == OccluderKind::kSphere) {
         // |o + t d - c|^2 = r^2 with |d| = 1: t^2 + 2 b t + c = 0, b = d.(o - c), c = |o - c|^2 - r^2.
         const Vec3 oc = o - occ.center;
@@ -173,7 +173,31 @@ bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
     return enter < t_max;
 }
 
-OccluderBvh::OccluderBvh(std::vector<Occluder> occluders) {
+// The compact form keeps only the doubles the primitive's kind uses (triangle: v0 v1 v2; sphere:
+// centre, radius; box: min, max), so the BVH holds 80 bytes per primitive instead of a copy of the
+// 160-byte Occluder; expand() gives back the same doubles, so every test computes what it did.
+OccluderBvh::Prim OccluderBvh::compact(const Occluder& o) {
+    Prim p;
+    p.kind = o.kind;
+    const Vec3 a = o.kind == OccluderKind::kTriangle ? o.v0 : o.kind == OccluderKind::kSphere ? o.center : o.min;
+    const Vec3 b = o.kind == OccluderKind::kTriangle ? o.v1 : o.kind == OccluderKind::kSphere ? Vec3{o.radius, 0, 0} : o.max;
+    const Vec3 c = o.kind == OccluderKind::kTriangle ? o.v2 : Vec3{};
+    const double v[9] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z};
+    std::copy(v, v + 9, p.p);
+    return p;
+}
+
+Occluder OccluderBvh::expand(const Prim& p) {
+    Occluder o;
+    o.kind = p.kind;
+    const Vec3 a{p.p[0], p.p[1], p.p[2]}, b{p.p[3], p.p[4], p.p[5]}, c{p.p[6], p.p[7], p.p[8]};
+    if (p.kind == OccluderKind::kTriangle) o.v0 = a, o.v1 = b, o.v2 = c;
+    else if (p.kind == OccluderKind::kSphere) o.center = a, o.radius = b.x;
+    else o.min = a, o.max = b;
+    return o;
+}
+
+OccluderBvh::OccluderBvh(const std::vector<Occluder>& occluders) {
     if (occluders.empty()) return;
     // Boxes and centroids once; the build permutes indices, then the primitives are stored in
     // leaf order (each leaf a contiguous range).
@@ -186,8 +210,10 @@ OccluderBvh::OccluderBvh(std::vector<Occluder> occluders) {
     for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
     nodes_.reserve(occluders.size() + 1);  // leaves of 2..4 primitives: < n nodes
     build(order, bounds, 0, static_cast<std::uint32_t>(order.size()), 0);
+    std::vector<Bounds>().swap(bounds);
+    nodes_.shrink_to_fit();  // the reservation was the bound n + 1; leaves hold 2..4 primitives
     prims_.reserve(occluders.size());
-    for (std::uint32_t i : order) prims_.push_back(occluders[i]);
+    for (std::uint32_t i : order) prims_.push_back(compact(occluders[i]));
 }
 
 std::uint32_t OccluderBvh::build(std::vector<std::uint32_t>& order, const std::vector<Bounds>& bounds,
@@ -278,8 +304,14 @@ bool OccluderBvh::occluded(Vec3 o, Vec3 d, double t_min, double t_max) const {
             if (!inside) continue;
         }
         if (n.count > 0) {
-            for (std::uint32_t i = n.first; i < n.first + n.count; ++i)
-                if (ray_hits(prims_[i], o, d, t_min, t_max)) return true;
+            for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
+                const Prim& p = prims_[i];
+                const bool hit = p.kind == OccluderKind::kTriangle
+                                     ? ray_hits_triangle({p.p[0], p.p[1], p.p[2]}, {p.p[3], p.p[4], p.p[5]}, {p.p[6], p.p[7], p.p[8]}, o,
+                                                         d, t_min, t_max)
+                                     : ray_hits(expand(p), o, d, t_min, t_max);
+                if (hit) return true;
+            }
         } else if (top + 2 <= 128) {
             // Nearer child (along the ray on the split axis) popped first: an any-hit query stops
             // sooner when the closer half blocks.

@@ -432,7 +432,7 @@ Result<Image> read_envmap_any(std::span<const std::uint8_t> bytes, const std::st
         return img;
     }
     return make_error(ErrorCode::kBadFormat,
-                      name + ": not an OpenEXR, Radiance .hdr, KTX2, KTX 1 or DDS image (unknown magic bytes)");
+                      name + ": not an OpenEXR, Radiance .hdr, KTX2, KTX 1 or DDS image (unknown magic bytes)" + git_lfs_hint(bytes));
 }
 }  // namespace
 

@@ -14,6 +14,7 @@
 #include <zstd.h>
 
 #include "codec/lightmap/bc6h.h"
+#include "formats/envmap/bc7.h"
 #include "formats/envmap/envmap_ldr.h"
 #include "codec/sh/cubemap.h"
 #include "formats/io/le_bytes.h"
@@ -35,7 +36,7 @@ Error fail(ErrorCode code, const std::string& name, const std::string& what) { r
 enum class Texel {
     kRgba16f, kRgb16f, kRgba32f, kRgb32f, kE5b9g9r9, kBc6hUfloat, kB10g11r11,
     // 8-bit (LDR): decoded by EnvmapReadOptions::ldr and the format's transfer function
-    kRgba8, kBgra8, kBgrx8, kRgb8, kBc1, kBc1a, kBc2, kBc3
+    kRgba8, kBgra8, kBgrx8, kRgb8, kBc1, kBc1a, kBc2, kBc3, kBc7
 };
 
 struct TexelInfo {
@@ -62,6 +63,7 @@ TexelInfo texel_info(Texel t) {
         case Texel::kBc1: return {t, "BC1 RGB", 8, true, true};
         case Texel::kBc1a: return {t, "BC1 RGBA", 8, true, true};
         case Texel::kBc2: return {t, "BC2", 16, true, true};
+        case Texel::kBc7: return {t, "BC7", 16, true, true};
         default: return {t, "BC3", 16, true, true};
     }
 }
@@ -140,6 +142,13 @@ Status decode_face(const TexelInfo& f, bool srgb, const LdrDecoding& ldr, const 
                     case Texel::kBc1: ldr::decode_bc1(blk, false, rgba); break;
                     case Texel::kBc1a: ldr::decode_bc1(blk, true, rgba); break;
                     case Texel::kBc2: ldr::decode_bc2(blk, rgba); break;
+                    case Texel::kBc7: {
+                        std::uint8_t texels[16][4];
+                        bc7::decode_block(blk, texels);
+                        for (int t = 0; t < 16; ++t)
+                            for (int c = 0; c < 4; ++c) rgba[t][c] = static_cast<float>(texels[t][c]) / 255.0f;
+                        break;
+                    }
                     default: ldr::decode_bc3(blk, rgba); break;
                 }
                 for (size_t y = 0; y < 4 && 4 * by + y < nn; ++y)
@@ -215,9 +224,6 @@ Image make_cube(int n) {
 
 constexpr std::size_t kKtx2HeaderBytes = 80;  // identifier, 9 u32 fields, index (4 u32, 2 u64)
 
-const char* const kBc7Refusal =
-    " is not supported: zhc has no BC7 decoder (BC1, BC2, BC3 and uncompressed 8-bit cube maps are read)";
-
 Result<Format> ktx2_texel(std::uint32_t vk, const std::string& name) {
     switch (vk) {
         case 97: return Format{Texel::kRgba16f};   // VK_FORMAT_R16G16B16A16_SFLOAT
@@ -245,15 +251,14 @@ Result<Format> ktx2_texel(std::uint32_t vk, const std::string& name) {
             return fail(ErrorCode::kUnsupported, name,
                         "KTX2 vkFormat 144 (BC6H_SFLOAT_BLOCK, byte 12) is not supported: zhc's BC6H decoder reads "
                         "unsigned BC6H only");
-        case 145:
-        case 146:
-            return fail(ErrorCode::kUnsupported, name, "KTX2 vkFormat " + std::to_string(vk) + " (BC7, byte 12)" + kBc7Refusal);
+        case 145: return Format{Texel::kBc7};          // VK_FORMAT_BC7_UNORM_BLOCK
+        case 146: return Format{Texel::kBc7, true};    // VK_FORMAT_BC7_SRGB_BLOCK
         default:
             return fail(ErrorCode::kUnsupported, name,
                         "KTX2 vkFormat " + std::to_string(vk) +
                             " (byte 12) is not supported for cube maps (R16G16B16A16_SFLOAT, R16G16B16_SFLOAT, "
                             "R32G32B32A32_SFLOAT, R32G32B32_SFLOAT, E5B9G9R9_UFLOAT_PACK32, B10G11R11_UFLOAT_PACK32, "
-                            "BC6H_UFLOAT_BLOCK, R8G8B8A8, B8G8R8A8, R8G8B8, BC1, BC2, BC3 UNORM / SRGB are)");
+                            "BC6H_UFLOAT_BLOCK, R8G8B8A8, B8G8R8A8, R8G8B8, BC1, BC2, BC3, BC7 UNORM / SRGB are)");
     }
 }
 
@@ -319,15 +324,14 @@ Result<Format> dxgi_texel(std::uint32_t f, const std::string& name) {
             return fail(ErrorCode::kUnsupported, name,
                         "DDS DXGI format 96 (BC6H_SF16, byte 128) is not supported: zhc's BC6H decoder reads unsigned "
                         "BC6H only");
-        case 98:
-        case 99:
-            return fail(ErrorCode::kUnsupported, name, "DDS DXGI format " + std::to_string(f) + " (BC7, byte 128)" + kBc7Refusal);
+        case 98: return Format{Texel::kBc7};          // DXGI_FORMAT_BC7_UNORM
+        case 99: return Format{Texel::kBc7, true};    // DXGI_FORMAT_BC7_UNORM_SRGB
         default:
             return fail(ErrorCode::kUnsupported, name,
                         "DDS DXGI format " + std::to_string(f) +
                             " (byte 128) is not supported for cube maps (R16G16B16A16_FLOAT, R32G32B32A32_FLOAT, "
                             "R32G32B32_FLOAT, R9G9B9E5_SHAREDEXP, R11G11B10_FLOAT, BC6H_UF16, R8G8B8A8, B8G8R8A8, "
-                            "B8G8R8X8, BC1, BC2, BC3 UNORM / UNORM_SRGB are)");
+                            "B8G8R8X8, BC1, BC2, BC3, BC7 UNORM / UNORM_SRGB are)");
     }
 }
 
@@ -371,9 +375,8 @@ Result<Ktx1Format> ktx1_format(std::uint32_t type, std::uint32_t format, std::ui
         case 0x8E8E:
             return fail(ErrorCode::kUnsupported, name, "KTX 1 glInternalFormat 0x8E8E (GL_COMPRESSED_RGB_BPTC_SIGNED_FLOAT, byte 28) "
                                                        "is not supported: zhc's BC6H decoder reads unsigned BC6H only");
-        case 0x8E8C:
-        case 0x8E8D:
-            return fail(ErrorCode::kUnsupported, name, "KTX 1 glInternalFormat " + hex4(internal) + " (BC7, byte 28)" + kBc7Refusal);
+        case 0x8E8C: return Ktx1Format{{Texel::kBc7}, 1};        // GL_COMPRESSED_RGBA_BPTC_UNORM
+        case 0x8E8D: return Ktx1Format{{Texel::kBc7, true}, 1};  // GL_COMPRESSED_SRGB_ALPHA_BPTC_UNORM
         default: break;
     }
     switch (internal) {
@@ -407,7 +410,7 @@ Result<Ktx1Format> ktx1_format(std::uint32_t type, std::uint32_t format, std::ui
             return fail(ErrorCode::kUnsupported, name, "KTX 1 glInternalFormat " + hex4(internal) +
                                                            " (byte 28) is not supported (RGBA16F, RGB16F, RGBA32F, RGB32F, "
                                                            "R11F_G11F_B10F, RGB9_E5, BPTC unsigned float, RGBA8, SRGB8_ALPHA8, "
-                                                           "RGB8, SRGB8, S3TC DXT1 / DXT3 / DXT5 and their sRGB forms are)");
+                                                           "RGB8, SRGB8, S3TC DXT1 / DXT3 / DXT5, BPTC UNORM (BC7) and their sRGB forms are)");
     }
 }
 

@@ -23,13 +23,14 @@
 //   0x01020304 for a file written on a big-endian machine: fields and glTypeSize units swapped);
 //   glInternalFormat RGBA16F / RGB16F (glType HALF_FLOAT or FLOAT), RGBA32F / RGB32F (FLOAT),
 //   R11F_G11F_B10F, RGB9_E5, COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT, RGBA8 / SRGB8_ALPHA8 (RGBA or
-//   BGRA), RGB8 / SRGB8, S3TC DXT1 / DXT3 / DXT5 and their sRGB forms. Key/value data is skipped;
+//   BGRA), RGB8 / SRGB8, S3TC DXT1 / DXT3 / DXT5, COMPRESSED_RGBA_BPTC_UNORM and their sRGB forms. Key/value data is skipped;
 //   each level's imageSize is one face's bytes (rows padded to 4 bytes) or, as some writers store
 //   it, six faces'. Anything else: kUnsupported naming glInternalFormat in hex.
-// 8-bit formats (KTX2 R8G8B8A8 / B8G8R8A8 / R8G8B8 and BC1-3, UNORM or SRGB; DDS DXGI R8G8B8A8 /
-//   B8G8R8A8 / B8G8R8X8 / BC1-3, UNORM or UNORM_SRGB, legacy DXT1 / DXT3 / DXT5 and 32-bit RGB(A)
-//   masks, which are UNORM): decoded by EnvmapReadOptions::ldr (envmap_ldr.h); an UNORM format read
-//   by its own transfer function gets a warning that it was read as linear. BC7 is refused (kUnsupported).
+// 8-bit formats (KTX2 R8G8B8A8 / B8G8R8A8 / R8G8B8, BC1-3 and BC7, UNORM or SRGB; DDS DXGI R8G8B8A8 /
+//   B8G8R8A8 / B8G8R8X8 / BC1-3 / BC7, UNORM or UNORM_SRGB, legacy DXT1 / DXT3 / DXT5 and 32-bit RGB(A)
+//   masks, which are UNORM; KTX 1 BPTC UNORM and its sRGB form): decoded by EnvmapReadOptions::ldr
+//   (envmap_ldr.h; BC7 blocks by bc7.h); an UNORM format read by its own transfer function gets a
+//   warning that it was read as linear.
 // All: every size is checked against the file and the pixel limit before anything is allocated;
 // short files are kTruncated, bytes after the last level kTrailingBytes, inconsistent fields
 // kBadFormat (exit 4), sizes over the limit kTooLarge (exit 6); every message is one line naming

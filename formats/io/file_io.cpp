@@ -11,6 +11,7 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <string_view>
 
 namespace zhc {
 
@@ -76,6 +77,20 @@ Result<std::vector<std::uint8_t>> read_file_bytes(const std::string& path, std::
     std::fclose(f);
     if (failed) return make_error(ErrorCode::kIoError, path + ": read error");
     return bytes;
+}
+
+bool looks_like_git_lfs_pointer(std::span<const std::uint8_t> bytes) {
+    // The specification's first line; pointers are under 1024 bytes ("version" key first).
+    static constexpr std::string_view kPrefixes[] = {"version https://git-lfs.github.com/spec/", "version https://hawser.github.com/spec/"};
+    if (bytes.size() >= 1024) return false;
+    const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    for (const std::string_view p : kPrefixes)
+        if (text.substr(0, p.size()) == p) return true;
+    return false;
+}
+
+std::string git_lfs_hint(std::span<const std::uint8_t> bytes) {
+    return looks_like_git_lfs_pointer(bytes) ? "; it looks like a Git LFS pointer (the content was not fetched): run git lfs pull" : "";
 }
 
 Result<FilePrefix> read_file_prefix(const std::string& path, std::size_t max_bytes) {

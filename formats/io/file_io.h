@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <functional>
 #include <mutex>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +23,13 @@ namespace zhc {
 
 // Whole file into memory; fails with kTooLarge (before allocating) when it exceeds max_bytes.
 Result<std::vector<std::uint8_t>> read_file_bytes(const std::string& path, std::uint64_t max_bytes);
+
+// A Git LFS pointer: the short text file ("version https://git-lfs.github.com/spec/v1", then oid
+// and size lines) a checkout holds in place of a file whose content Git LFS did not fetch.
+bool looks_like_git_lfs_pointer(std::span<const std::uint8_t> bytes);
+// "; it looks like a Git LFS pointer (the content was not fetched): run git lfs pull" for such
+// bytes, else "": appended to the messages of readers that did not recognise a file.
+std::string git_lfs_hint(std::span<const std::uint8_t> bytes);
 
 // The first min(size, max_bytes) bytes of a regular file, and its size (streaming readers check
 // a header first and read the rest piece by piece). Not for pipes: fails kIoError.

@@ -5,8 +5,11 @@
 //   0 magic "DDS "   4 DDS_HEADER (124 bytes, ddspf at 76)   128 DDS_HEADER_DXT10 (20 bytes)   148 data
 #include "formats/lightmap/dds.h"
 
+#include <algorithm>
+#include <bit>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
 #include "formats/io/file_io.h"
 #include "formats/io/le_bytes.h"
@@ -177,7 +180,7 @@ namespace {
 // min(size, 148) bytes): the image description without its blocks, and the data offset.
 Result<Ktx2Image> decode_dds_layout(std::span<const std::uint8_t> b, std::uint64_t size, const std::string& name,
                                     const DdsLimits& limits, std::uint64_t* data_offset_out) {
-    if (size < 4 || b.size() < 4 || get32(b, 0) != kMagic) return bad(ErrorCode::kBadFormat, name, "not a DDS file (bad magic at byte 0)");
+    if (size < 4 || b.size() < 4 || get32(b, 0) != kMagic) return bad(ErrorCode::kBadFormat, name, "not a DDS file (bad magic at byte 0)" + git_lfs_hint(b));
     if (size < kLegacyDataOffset || b.size() < kLegacyDataOffset)
         return bad(ErrorCode::kTruncated, name, "header truncated: file ends at byte " + std::to_string(size) +
                                                     ", inside " + field_at(static_cast<size_t>(size)) + " (the header needs 128 bytes)");
@@ -253,6 +256,50 @@ Result<Ktx2Image> decode_dds_layout(std::span<const std::uint8_t> b, std::uint64
     return img;
 }
 }  // namespace
+
+Result<TextureHeaderSummary> describe_dds_header(std::span<const std::uint8_t> b, const std::string& name) {
+    if (b.size() < 4 || get32(b, 0) != kMagic) return bad(ErrorCode::kBadFormat, name, "not a DDS file (bad magic at byte 0)" + git_lfs_hint(b));
+    if (b.size() < kLegacyDataOffset) return bad(ErrorCode::kTruncated, name, "header truncated (file ends before byte 128)");
+    TextureHeaderSummary out;
+    out.container = "DDS";
+    out.height = get32(b, 12), out.width = get32(b, 16);
+    const std::uint32_t flags = get32(b, 8), caps2 = get32(b, 112);
+    out.depth = (flags & 0x800000u) ? get32(b, 24) : 0;  // DDSD_DEPTH
+    out.levels = std::max<std::uint32_t>(1, get32(b, 28));
+    out.faces = (caps2 & 0x200u) ? static_cast<std::uint64_t>(std::popcount(caps2 & 0xFC00u)) : 1;
+    out.layers = 1;
+    const std::uint32_t pf_flags = get32(b, 80), fourcc = get32(b, 84);
+    if ((pf_flags & kDdpfFourCc) && fourcc == kFourCcDx10) {
+        if (b.size() < kLegacyDataOffset + 20) return bad(ErrorCode::kTruncated, name, "DX10 header truncated (file ends before byte 148)");
+        static const std::pair<std::uint32_t, const char*> kNames[] = {
+            {2, "R32G32B32A32_FLOAT"}, {6, "R32G32B32_FLOAT"}, {10, "R16G16B16A16_FLOAT"}, {26, "R11G11B10_FLOAT"},
+            {28, "R8G8B8A8_UNORM"}, {29, "R8G8B8A8_UNORM_SRGB"}, {67, "R9G9B9E5_SHAREDEXP"}, {71, "BC1_UNORM"},
+            {72, "BC1_UNORM_SRGB"}, {74, "BC2_UNORM"}, {75, "BC2_UNORM_SRGB"}, {77, "BC3_UNORM"}, {78, "BC3_UNORM_SRGB"},
+            {80, "BC4_UNORM"}, {81, "BC4_SNORM"}, {83, "BC5_UNORM"}, {84, "BC5_SNORM"}, {87, "B8G8R8A8_UNORM"},
+            {88, "B8G8R8X8_UNORM"}, {91, "B8G8R8A8_UNORM_SRGB"}, {93, "B8G8R8X8_UNORM_SRGB"}, {95, "BC6H_UF16"},
+            {96, "BC6H_SF16"}, {98, "BC7_UNORM"}, {99, "BC7_UNORM_SRGB"}};
+        const std::uint32_t dxgi = get32(b, 128);
+        out.format = "DXGI " + std::to_string(dxgi);
+        for (const auto& [v, n] : kNames)
+            if (v == dxgi) out.format = std::string(n) + " (DXGI " + std::to_string(dxgi) + ")";
+        out.layers = get32(b, 140);
+        if (get32(b, 136) & 0x4u) out.faces = 6;  // DDS_RESOURCE_MISC_TEXTURECUBE
+        if (get32(b, 132) == 4) out.depth = std::max<std::uint64_t>(out.depth, 1);  // TEXTURE3D
+    } else if (pf_flags & kDdpfFourCc) {
+        std::string t;
+        for (int k = 0; k < 4; ++k) {
+            const char c = static_cast<char>((fourcc >> (8 * k)) & 0xff);
+            t += (c >= 0x20 && c <= 0x7e) ? c : '?';
+        }
+        out.format = "FourCC '" + t + "' (" + std::to_string(fourcc) + ")";
+    } else {
+        char masks[96];
+        std::snprintf(masks, sizeof masks, "masks R 0x%08X, G 0x%08X, B 0x%08X, A 0x%08X", get32(b, 92), get32(b, 96), get32(b, 100),
+                      get32(b, 104));
+        out.format = std::to_string(get32(b, 88)) + "-bit uncompressed (" + masks + ")";
+    }
+    return out;
+}
 
 Result<Ktx2Image> decode_dds(std::span<const std::uint8_t> b, const std::string& name, const DdsLimits& limits) {
     std::uint64_t off = 0;

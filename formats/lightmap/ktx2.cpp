@@ -2,6 +2,7 @@
 #include "formats/lightmap/ktx2.h"
 
 #include <cstring>
+#include <utility>
 
 #include "formats/io/file_io.h"
 #include "formats/io/le_bytes.h"
@@ -108,6 +109,33 @@ Result<std::vector<std::uint8_t>> encode_ktx2(const Ktx2Image& img) {
     return out;
 }
 
+Result<TextureHeaderSummary> describe_ktx2_header(std::span<const std::uint8_t> b, const std::string& name) {
+    if (b.size() < 12 || std::memcmp(b.data(), kIdentifier, 12) != 0)
+        return bad(ErrorCode::kBadFormat, name, "not a KTX2 file (bad identifier at byte 0)" + git_lfs_hint(b));
+    if (b.size() < 48) return bad(ErrorCode::kTruncated, name, "header truncated (file ends before byte 48)");
+    static const std::pair<std::uint32_t, const char*> kNames[] = {
+        {23, "R8G8B8_UNORM"}, {29, "R8G8B8_SRGB"}, {37, "R8G8B8A8_UNORM"}, {43, "R8G8B8A8_SRGB"}, {44, "B8G8R8A8_UNORM"},
+        {50, "B8G8R8A8_SRGB"}, {90, "R16G16B16_SFLOAT"}, {97, "R16G16B16A16_SFLOAT"}, {106, "R32G32B32_SFLOAT"},
+        {109, "R32G32B32A32_SFLOAT"}, {122, "B10G11R11_UFLOAT_PACK32"}, {123, "E5B9G9R9_UFLOAT_PACK32"},
+        {131, "BC1_RGB_UNORM_BLOCK"}, {132, "BC1_RGB_SRGB_BLOCK"}, {133, "BC1_RGBA_UNORM_BLOCK"}, {134, "BC1_RGBA_SRGB_BLOCK"},
+        {135, "BC2_UNORM_BLOCK"}, {136, "BC2_SRGB_BLOCK"}, {137, "BC3_UNORM_BLOCK"}, {138, "BC3_SRGB_BLOCK"},
+        {139, "BC4_UNORM_BLOCK"}, {140, "BC4_SNORM_BLOCK"}, {141, "BC5_UNORM_BLOCK"}, {142, "BC5_SNORM_BLOCK"},
+        {143, "BC6H_UFLOAT_BLOCK"}, {144, "BC6H_SFLOAT_BLOCK"}, {145, "BC7_UNORM_BLOCK"}, {146, "BC7_SRGB_BLOCK"}};
+    TextureHeaderSummary out;
+    out.container = "KTX2";
+    const std::uint32_t vk = get32(b, 12);
+    out.format = "vkFormat " + std::to_string(vk);
+    for (const auto& [v, n] : kNames)
+        if (v == vk) out.format = std::string(n) + " (vkFormat " + std::to_string(vk) + ")";
+    if (vk == 0) out.format = "VK_FORMAT_UNDEFINED (vkFormat 0: Basis Universal or another format the DFD describes)";
+    out.width = get32(b, 20), out.height = get32(b, 24), out.depth = get32(b, 28);
+    out.layers = get32(b, 32), out.faces = get32(b, 36), out.levels = get32(b, 40);
+    const std::uint32_t scheme = get32(b, 44);
+    const char* schemes[] = {"none", "BasisLZ", "Zstandard", "ZLIB"};
+    out.supercompression = scheme < 4 ? schemes[scheme] : std::to_string(scheme);
+    return out;
+}
+
 std::uint64_t ktx2_level_bytes(std::uint32_t vk_format, int width, int height) {
     if (width <= 0 || height <= 0) return 0;
     return static_cast<std::uint64_t>((width + 3) / 4) * static_cast<std::uint64_t>((height + 3) / 4) * ktx2_block_bytes(vk_format);
@@ -120,7 +148,7 @@ namespace {
 Result<Ktx2Image> decode_ktx2_layout(std::span<const std::uint8_t> b, std::uint64_t size, const std::string& name,
                                      const Ktx2Limits& limits, std::uint64_t* data_offset) {
     if (b.size() < 12 || std::memcmp(b.data(), kIdentifier, 12) != 0)
-        return bad(ErrorCode::kBadFormat, name, "not a KTX2 file (bad identifier at byte 0)");
+        return bad(ErrorCode::kBadFormat, name, "not a KTX2 file (bad identifier at byte 0)" + git_lfs_hint(b));
     if (size < kDfdStart || b.size() < kDfdStart) return bad(ErrorCode::kTruncated, name, "header truncated (file ends before byte 104)");
     Ktx2Image img;
     img.vk_format = get32(b, 12);

@@ -54,6 +54,16 @@ struct BlockFileLayout {
     int width = 0, height = 0;
     std::uint64_t data_offset = 0;
 };
+// A KTX2 or DDS file's header as it stands (zhc info on textures zhc does not read: 2-D textures
+// in other formats, arrays, volumes): the fields, checked to lie inside the file, nothing more.
+struct TextureHeaderSummary {
+    std::string container;  // "KTX2" or "DDS"
+    std::string format;     // e.g. "BC7_UNORM_BLOCK (vkFormat 145)", "BC1_UNORM (DXGI 71)", "FourCC 'DXT1'"
+    std::uint64_t width = 0, height = 0, depth = 0, layers = 0, faces = 0, levels = 0;
+    std::string supercompression;  // KTX2: "none", "BasisLZ", "Zstandard", "ZLIB" or the number
+};
+Result<TextureHeaderSummary> describe_ktx2_header(std::span<const std::uint8_t> bytes, const std::string& name);
+Result<TextureHeaderSummary> describe_dds_header(std::span<const std::uint8_t> bytes, const std::string& name);
 Result<BlockFileLayout> read_ktx2_layout(const std::string& path, const Ktx2Limits& limits = {});
 Result<Ktx2Image> decode_ktx2(std::span<const std::uint8_t> bytes, const std::string& name, const Ktx2Limits& limits = {});
 Status write_ktx2(const std::string& path, const Ktx2Image& image);

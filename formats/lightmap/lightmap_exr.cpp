@@ -36,7 +36,7 @@ std::string sh_channel(int i, int k) { return "sh" + std::to_string(i) + "." + "
 Status check_exr_file(std::span<const std::uint8_t> b, const std::string& path, std::uint64_t max_texels,
                       ExrLayout* layout) {
     if (b.size() < 4 || !(b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01))
-        return make_error(ErrorCode::kBadFormat, path + ": not an OpenEXR file (bad magic at byte 0)");
+        return make_error(ErrorCode::kBadFormat, path + ": not an OpenEXR file (bad magic at byte 0)" + git_lfs_hint(b));
     auto check = [&](std::uint64_t w, std::uint64_t h) -> Status {
         if (w * h > max_texels)
             return make_error(ErrorCode::kTooLarge, path + ": " + std::to_string(w) + "x" + std::to_string(h) +
@@ -54,6 +54,46 @@ Status check_exr_file(std::span<const std::uint8_t> b, const std::string& path, 
 }
 
 }  // namespace
+
+Result<LightmapExrSummary> describe_lightmap_exr(std::span<const std::uint8_t> b, const std::string& name, std::uint64_t max_texels) {
+    ExrLayout layout;
+    if (Status s = check_exr_file(b, name, max_texels, &layout); !s) return s.error();
+    try {
+        Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
+        ExrMemoryStream stream(b, name);
+        Imf::InputFile file(stream, 0);
+        const Imath::Box2i dw = file.header().dataWindow();
+        LightmapExrSummary out;
+        out.width = dw.max.x - dw.min.x + 1;
+        out.height = dw.max.y - dw.min.y + 1;
+        const Imf::ChannelList& ch = file.header().channels();
+        int types = 0;
+        for (auto it = ch.begin(); it != ch.end(); ++it) {
+            out.channels.push_back(it.name());
+            types |= 1 << static_cast<int>(it.channel().type);
+        }
+        out.pixel_type = types == 1 << Imf::HALF ? "half" : types == 1 << Imf::FLOAT ? "float" : types == 1 << Imf::UINT ? "uint" : "mixed";
+        auto has_all = [&](const std::vector<std::string>& names) {
+            for (const auto& n : names)
+                if (!ch.findChannel(n)) return false;
+            return true;
+        };
+        std::vector<std::string> linear;
+        for (int i = 0; i < 4; ++i)
+            for (int k = 0; k < 3; ++k) linear.push_back(sh_channel(i, k));
+        bool any_l2 = false;
+        for (int i = 4; i < 9; ++i)
+            for (int k = 0; k < 3; ++k) any_l2 = any_l2 || ch.findChannel(sh_channel(i, k));
+        if (has_all(sh_lightmap_channel_names())) out.kind = "sh3";
+        else if (has_all(linear) && !any_l2) out.kind = "linear-sh";
+        else if (has_all(irradz_channel_names())) out.kind = "irradz";
+        return out;
+    } catch (const std::exception& e) {
+        std::string what = e.what();
+        if (const auto nl = what.find('\n'); nl != std::string::npos) what.resize(nl);
+        return make_error(ErrorCode::kBadFormat, name + ": cannot read OpenEXR (" + what + ")");
+    }
+}
 
 Result<lightmap::ShLightmap> read_sh_lightmap_exr(const std::string& path, const LightmapReadOptions& o) {
     auto bytes = read_file_bytes(path, o.max_file_bytes);

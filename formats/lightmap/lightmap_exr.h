@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,18 @@ public:
 std::vector<std::string> sh_lightmap_channel_names();
 std::vector<std::string> irradz_channel_names();
 
+// What a lightmap EXR is, from its header (zhc info): kind "sh3" (sh0.R .. sh8.B), "linear-sh"
+// (sh0.R .. sh3.B, none of sh4 .. sh8), "irradz" (Iz.R, Iz.G, Iz.B, wa, d.X, d.Y, d.Z) or ""
+// (none of these: not a lightmap EXR; an R, G, B coefficient file of a 4- or 9-file set is an
+// ordinary RGB image). The whole file is checked as the readers check it (truncation, trailing bytes).
+struct LightmapExrSummary {
+    std::string kind;
+    int width = 0, height = 0;
+    std::vector<std::string> channels;  // every channel of the first part, in the file's order
+    std::string pixel_type;             // "half", "float", "uint" or "mixed"
+};
+Result<LightmapExrSummary> describe_lightmap_exr(std::span<const std::uint8_t> bytes, const std::string& name,
+                                                 std::uint64_t max_texels = std::uint64_t(1) << 28);
 Result<lightmap::ShLightmap> read_sh_lightmap_exr(const std::string& path, const LightmapReadOptions& options = {});
 Status write_sh_lightmap_exr(const std::string& path, const lightmap::ShLightmap& lm);
 Status write_irradz_exr(const std::string& path, const lightmap::IrradzPlanes& planes);

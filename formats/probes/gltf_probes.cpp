@@ -16,7 +16,9 @@
 #include "formats/probes/gltf_probes_internal.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
+#include <functional>
 #include <deque>
 #include <filesystem>
 #include <map>
@@ -205,6 +207,23 @@ Status precheck(const json& doc, const std::string& path, const GltfLimits& limi
                 if (!why.empty()) return fail(ErrorCode::kBadFormat, path, where + ": uri rejected: " + why);
                 if (uri.rfind("data:", 0) == 0 && uri.size() > limits.max_buffer_bytes / 3 * 4 + 256)
                     return fail(ErrorCode::kTooLarge, path, where + ": data URI above the size limit");
+                if (uri.rfind("data:", 0) == 0) {
+                    // Named here rather than by tinygltf's "Failed to decode 'uri'".
+                    const size_t comma = uri.find(',');
+                    if (comma == std::string::npos || comma < 12 || uri.compare(comma - 7, 7, ";base64") != 0)
+                        return fail(ErrorCode::kBadFormat, path, where + ".uri: a data: URI that is not base64 (';base64,' is what glTF buffers use)");
+                    const size_t n = uri.size() - comma - 1;
+                    for (size_t k = comma + 1; k < uri.size(); ++k) {
+                        const char c = uri[k];
+                        const bool pad = c == '=' && k + 2 >= uri.size() && (k + 1 == uri.size() || uri[k + 1] == '=');
+                        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '/' || pad))
+                            return fail(ErrorCode::kBadFormat, path, where + ".uri: the data: URI's base64 has a character that is not base64 at offset " +
+                                                                     std::to_string(k - comma - 1) + " of its data");
+                    }
+                    if (n % 4 != 0)
+                        return fail(ErrorCode::kBadFormat, path, where + ".uri: the data: URI's base64 is " + std::to_string(n) +
+                                                                 " characters, not a multiple of 4");
+                }
             } else if (is_meshopt_fallback(bufs[i]) && !(i == 0 && glb && glb->has_bin)) {
                 // EXT/KHR_meshopt_compression: a fallback buffer needs no bytes (every view of it
                 // is decoded from a compressed buffer); nothing is loaded for it.
@@ -228,6 +247,85 @@ Status precheck(const json& doc, const std::string& path, const GltfLimits& limi
         }
     }
     return Ok{};
+}
+
+// The glTF 2.0 schema's required properties (and KHR_lights_punctual's, with its spot light's
+// "spot" object), checked before tinygltf so that a missing one is named by its glTF path
+// ("accessors[2].componentType") rather than by tinygltf's text ("'componentType' property is
+// missing in Accessor."). Only objects are looked into: a wrong type is reported by the readers
+// (or by tinygltf) as before.
+Status check_required(const json& doc, const std::string& path) {
+    struct Need {
+        const char* array;                 // top-level array (or extensions.KHR_lights_punctual.lights)
+        const char* child;                 // "" or a member array/object of each element
+        std::vector<const char*> required;
+    };
+    auto missing = [&](const std::string& where, const char* prop) {
+        return fail(ErrorCode::kBadFormat, path, where + "." + prop + ": required property is missing");
+    };
+    auto check_object = [&](const json& o, const std::string& where, const std::vector<const char*>& props) -> Status {
+        if (!o.is_object()) return Ok{};
+        for (const char* p : props)
+            if (!o.contains(p)) return missing(where, p);
+        return Ok{};
+    };
+    auto each = [&](const json& parent, const char* key, const std::string& where,
+                    const std::function<Status(const json&, const std::string&)>& f) -> Status {
+        if (!parent.is_object() || !parent.contains(key) || !parent[key].is_array()) return Ok{};
+        const json& a = parent[key];
+        for (size_t i = 0; i < a.size(); ++i)
+            if (Status s = f(a[i], where + (where.empty() ? "" : ".") + key + "[" + std::to_string(i) + "]"); !s) return s;
+        return Ok{};
+    };
+    auto member = [&](const json& o, const char* key, const std::string& where, const std::vector<const char*>& props) -> Status {
+        if (!o.is_object() || !o.contains(key)) return Ok{};
+        return check_object(o[key], where + "." + key, props);
+    };
+    Status s = each(doc, "accessors", "", [&](const json& a, const std::string& w) -> Status {
+        if (Status t = check_object(a, w, {"componentType", "count", "type"}); !t) return t;
+        if (Status t = member(a, "sparse", w, {"count", "indices", "values"}); !t) return t;
+        if (a.is_object() && a.contains("sparse") && a["sparse"].is_object()) {
+            if (Status t = member(a["sparse"], "indices", w + ".sparse", {"bufferView", "componentType"}); !t) return t;
+            if (Status t = member(a["sparse"], "values", w + ".sparse", {"bufferView"}); !t) return t;
+        }
+        return Ok{};
+    });
+    if (!s) return s;
+    s = each(doc, "animations", "", [&](const json& a, const std::string& w) -> Status {
+        if (Status t = check_object(a, w, {"channels", "samplers"}); !t) return t;
+        if (Status t = each(a, "channels", w, [&](const json& c, const std::string& cw) -> Status {
+                if (Status u = check_object(c, cw, {"sampler", "target"}); !u) return u;
+                return member(c, "target", cw, {"path"});
+            });
+            !t)
+            return t;
+        return each(a, "samplers", w, [&](const json& c, const std::string& cw) { return check_object(c, cw, {"input", "output"}); });
+    });
+    if (!s) return s;
+    s = each(doc, "bufferViews", "", [&](const json& b, const std::string& w) { return check_object(b, w, {"buffer", "byteLength"}); });
+    if (!s) return s;
+    s = each(doc, "cameras", "", [&](const json& c, const std::string& w) -> Status {
+        if (Status t = check_object(c, w, {"type"}); !t) return t;
+        if (Status t = member(c, "perspective", w, {"yfov", "znear"}); !t) return t;
+        return member(c, "orthographic", w, {"xmag", "ymag", "zfar", "znear"});
+    });
+    if (!s) return s;
+    s = each(doc, "meshes", "", [&](const json& m, const std::string& w) -> Status {
+        if (Status t = check_object(m, w, {"primitives"}); !t) return t;
+        return each(m, "primitives", w, [&](const json& p, const std::string& pw) { return check_object(p, pw, {"attributes"}); });
+    });
+    if (!s) return s;
+    s = each(doc, "skins", "", [&](const json& k, const std::string& w) { return check_object(k, w, {"joints"}); });
+    if (!s) return s;
+    if (doc.contains("extensions") && doc["extensions"].is_object() && doc["extensions"].contains("KHR_lights_punctual"))
+        s = each(doc["extensions"]["KHR_lights_punctual"], "lights", "extensions.KHR_lights_punctual",
+                 [&](const json& l, const std::string& w) -> Status {
+                     if (Status t = check_object(l, w, {"type"}); !t) return t;
+                     if (l.is_object() && l["type"] == "spot" && !l.contains("spot"))
+                         return fail(ErrorCode::kBadFormat, path, w + ".spot: required for a spot light, missing");
+                     return Ok{};
+                 });
+    return s;
 }
 
 // File access for tinygltf: only regular files inside `base`, at most `max_bytes` each.
@@ -311,8 +409,11 @@ bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::strin
         it->second.pop_front();
         if (size < length) {
             g->code = ErrorCode::kTruncated;
+            // A Git LFS pointer left where the data belongs gets a hint.
+            auto head = read_file_prefix(p.string(), 1024);
             g->error = "buffers[" + std::to_string(index) + "]: file '" + p.filename().string() + "' has " + std::to_string(size) +
-                       " bytes, fewer than the buffer's byteLength " + std::to_string(length);
+                       " bytes, fewer than the buffer's byteLength " + std::to_string(length) +
+                       (head ? git_lfs_hint(head->bytes) : std::string());
             if (err) *err += g->error + "\n";
             return false;
         }
@@ -434,11 +535,23 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     } else {
         text.assign(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     }
+    if (looks_like_git_lfs_pointer(bytes)) return fail(ErrorCode::kBadFormat, path, "not a glTF asset" + git_lfs_hint(bytes));
     if (Status depth = check_json_depth(text, path); !depth) return depth.error();
-    out.doc = json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (out.doc.is_discarded()) return fail(ErrorCode::kBadFormat, path, "glTF JSON does not parse");
+    // Where the JSON breaks, as zhc's other JSON readers say it (line and column; in a GLB they
+    // count in its JSON chunk).
+    try {
+        out.doc = json::parse(text);
+    } catch (const json::parse_error& e) {
+        const std::string what = e.what();
+        const size_t at = what.find("at line ");
+        const std::string where = at == std::string::npos ? what : what.substr(at);
+        return fail(ErrorCode::kBadFormat, path, std::string("not valid glTF JSON") + (out.binary ? " (GLB JSON chunk) " : " ") + where);
+    } catch (const json::exception& e) {  // out_of_range: a number like 1e999
+        return fail(ErrorCode::kBadFormat, path, std::string("not valid glTF JSON (") + e.what() + ")");
+    }
     auto ok = precheck(out.doc, path, limits, out.binary ? &glb : nullptr);
     if (!ok) return ok.error();
+    if (Status req = check_required(out.doc, path); !req) return req.error();
 
     FsGuard guard;
     std::error_code ec;

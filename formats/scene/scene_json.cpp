@@ -470,7 +470,7 @@ Result<Scene> parse_scene_json_unchecked(std::span<const std::uint8_t> bytes, co
     try {
         doc = json::parse(bytes.begin(), bytes.end());
     } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e999
-        return make_error(ErrorCode::kBadFormat, name + ": not valid JSON (" + e.what() + ")");
+        return make_error(ErrorCode::kBadFormat, name + ": not valid JSON (" + e.what() + ")" + git_lfs_hint(bytes));
     } catch (const std::bad_alloc&) {
         return make_error(ErrorCode::kTooLarge, name + ": out of memory while reading the scene");
     }

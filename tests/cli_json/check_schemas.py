@@ -111,6 +111,18 @@ with open(W("scene.json"), "w") as f:  # info --inputs: a scene and the environm
     json.dump({"format": "zhc-scene", "version": 1, "probes": {"positions": [[0, 0, 0]]},
                "environment": {"map": os.path.abspath(ENVMAP)}}, f)
 check("info", "info", ["info", "--inputs", W("scene.json"), "--json"])
+# Lightmap files: the SH EXR, its KTX2 / DDS planes, the IrradZ EXR, and a 2-D KTX2 in a format
+# zhc does not read (the BC6H plane relabelled BC7_UNORM_BLOCK, vkFormat 145: same block size).
+run("lightmap", "encode", W("lm.exr"), "-o", W("lm"), "--quality", "fast", "--quiet")
+run("lightmap", "encode", W("lm.exr"), "-o", W("lm"), "--container", "dds", "--quality", "fast", "--quiet")
+run("lightmap", "decode", W("lm"), "-o", W("iz.exr"), "--quiet")
+with open(W("lm.iz.ktx2"), "rb") as f:
+    relabelled = bytearray(f.read())
+relabelled[12:16] = (145).to_bytes(4, "little")
+with open(W("bc7_2d.ktx2"), "wb") as f:
+    f.write(relabelled)
+for name in ("lm.exr", "iz.exr", "lm.iz.ktx2", "lm.d.dds", "bc7_2d.ktx2"):
+    check("info", "info", ["info", W(name), "--json"])
 if GLTF_SCENE:
     run("gltf", "embed", GLTF_SCENE, W("q16.zhp"), "-o", W("lit.glb"))
     check("info", "info", ["info", W("lit.glb"), "--json"])
