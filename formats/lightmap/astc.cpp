@@ -220,9 +220,11 @@ std::optional<lightmap::IzLogRange> parse_range_value(const std::vector<std::uin
     if (s.find('\0') != std::string::npos) return std::nullopt;
     const char* p = s.c_str();
     char* end = nullptr;
+    if (*p == ' ' || *p == '\t') return std::nullopt;
     const float lo = std::strtof(p, &end);
     if (end == p || *end != ' ') return std::nullopt;
     p = end + 1;
+    if (*p == ' ' || *p == '\t') return std::nullopt;
     const float hi = std::strtof(p, &end);
     if (end == p || *end != '\0') return std::nullopt;
     if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi)) return std::nullopt;

@@ -374,6 +374,7 @@ std::optional<TargetSpec> parse_target(const std::string& text) {
     if (const auto colon = text.find(':'); colon != std::string::npos) {
         kind = text.substr(0, colon);
         fp = text.substr(colon + 1);
+        if (fp.empty()) return std::nullopt;
     }
     if (kind == "bc") {
         if (!fp.empty()) return std::nullopt;
