@@ -15,6 +15,7 @@
 #include "formats/lightmap/lightmap_exr.h"
 #include "formats/lightmap/lightmap_stream.h"
 #include "support.h"
+#include "zhc_runtime.h"
 
 namespace zhc {
 namespace {
@@ -312,6 +313,47 @@ TEST(LightmapAstc, AuditTargetsSideBySide) {
     EXPECT_FALSE(lightmap_stream::parse_target("astc:5x4"));
     EXPECT_FALSE(lightmap_stream::parse_target("astc:"));
     EXPECT_EQ(lightmap_stream::parse_target("astc-ldr:6x6")->footprint, (astc::Footprint{6, 6}));
+}
+
+// runtime/zhc_runtime.h's ASTC reconstruction from the textures' values (astcenc's decoder) equals
+// the codec's decode (lightmap_astc::decompress, then irradz::evaluate) bit for bit, both targets.
+TEST(LightmapAstc, RuntimeCReconstructionEqualsTheCodec) {
+    const auto p = sample_planes(24, 20, 3);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-0.25f, 1.25f);
+    const lightmap::IzLogRange r = lightmap::iz_log_range(0.003f, 7.5f);
+    for (int i = 0; i < 200000; ++i) {
+        const float t = i % 1000 == 0 ? std::nanf("") : u(rng);
+        const float a = zhc_irradz_iz_from_ldr(t, r.lo, r.hi), b = lightmap::iz_from_ldr(t, r);
+        ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << t;
+    }
+    for (bool ldr : {false, true}) {
+        lightmap_astc::Options o;
+        o.footprint = {6, 6};
+        o.ldr_iz = ldr;
+        float mn = 0, mx = 0;
+        lightmap::iz_extent(p.iz, mn, mx);
+        o.range = lightmap::iz_log_range(mn, mx);
+        auto c = lightmap_astc::compress(p, o, 2);
+        ASSERT_TRUE(c.ok());
+        auto planes = lightmap_astc::decompress(*c);
+        ASSERT_TRUE(planes.ok());
+        auto iz = astc::decode_rgba(c->iz.data(), c->iz.size(), p.width, p.height, o.footprint, !ldr);
+        auto dwa = astc::decode_rgba(c->dwa.data(), c->dwa.size(), p.width, p.height, o.footprint, false);
+        ASSERT_TRUE(iz.ok() && dwa.ok());
+        int checked = 0;
+        for (size_t i = 0; i < p.wa.size(); ++i)
+            for (int model = 0; model < 2; ++model) {
+                const Vec3 n = normalize_or(Vec3{std::sin(0.37 * double(i)), std::cos(0.21 * double(i)), 0.8}, {0, 0, 1});
+                const double nn[3] = {n.x, n.y, n.z};
+                float e[3];
+                zhc_irradz_irradiance_astc(&(*iz)[4 * i], &(*dwa)[4 * i], ldr ? 1 : 0, o.range.lo, o.range.hi, model, nn, e);
+                const Rgb want = irradz::evaluate(planes->texel(i), model == 0 ? irradz::Model::kHhd : irradz::Model::kAhd, n);
+                for (int k = 0; k < 3; ++k) ASSERT_EQ(e[k], want[k]) << "texel " << i << " ldr " << ldr;
+                ++checked;
+            }
+        EXPECT_EQ(checked, 2 * p.width * p.height);
+    }
 }
 
 }  // namespace
