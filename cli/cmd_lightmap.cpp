@@ -198,14 +198,19 @@ int run_audit_targets(const Options& o, const std::vector<std::string>& files) {
     const double texels = double(base.width) * base.height;
     const std::string input = inputs_text(files);
     if (o.json) {
+        // The plain audit's object (the BC target), then the targets side by side.
+        const auto& a = base.audit;
         nlohmann::ordered_json j;
         j["input"] = input;
         j["width"] = base.width;
         j["height"] = base.height;
         j["quality"] = o.quality;
-        j["texels_audited"] = (*r)[0].audit.texels_sampled;
-        j["mean_irradiance_at_normal"] = (*r)[0].audit.mean_iz;
-        j["hemi_rmse_fit"] = (*r)[0].audit.rmse_search;
+        j["texels_audited"] = a.texels_sampled;
+        j["mean_irradiance_at_normal"] = a.mean_iz;
+        j["hemi_rmse"] = {{"old_way", a.rmse_old}, {"search", a.rmse_search}, {"search_after_bc", a.rmse_after_bc}};
+        j["psnr_db"] = {{"iz_bc6h_log2", a.psnr_iz_log2}, {"wa_bc4", a.psnr_wa}, {"d_bc5", a.psnr_d}};
+        j["d_error_deg"] = {{"mean", a.d_mean_deg}, {"max", a.d_max_deg}};
+        j["mtexel_per_s"] = {{"irradz_fit", texels / base.timing.fit / 1e6}, {"block_compression", texels / base.timing.compress / 1e6}};
         nlohmann::ordered_json arr = nlohmann::ordered_json::array();
         for (const auto& t : *r) {
             nlohmann::ordered_json e;
@@ -216,8 +221,8 @@ int run_audit_targets(const Options& o, const std::vector<std::string>& files) {
             e["encode_mtexel_per_s"] = texels / std::max(1e-9, t.encode_seconds) / 1e6;
             arr.push_back(e);
         }
-        j["targets"] = arr;
         j["threads"] = o.threads;
+        j["targets"] = arr;
         print_json("lightmap audit", j);
         return kExitOk;
     }

@@ -124,6 +124,8 @@ with open(W("volume.json"), "w") as f:
 check("bench", "bench", ["bench", ENVMAP, "--json", "--no-plots", "--repeats", "1", "--directions", "16",
                          "--representations", "sh3", "--volume-cost", W("volume.json")])
 check("lightmap-audit", "lightmap audit", ["lightmap", "audit", W("lm.exr"), "--json", "--stride", "5"])
+check("lightmap-audit", "lightmap audit", ["lightmap", "audit", W("lm.exr"), "--json", "--stride", "5",
+                                          "--targets", "bc,astc:6x6,astc-ldr,plain-astc"])
 
 # A failing gate still prints its JSON (exit 8): the gates object lists the failure.
 r = subprocess.run([ZHC, "audit", ENVMAP, "--json", "--no-timing", "--directions", "32", "--representations", "sh2",
