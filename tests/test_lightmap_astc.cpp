@@ -315,6 +315,40 @@ TEST(LightmapAstc, AuditTargetsSideBySide) {
     EXPECT_EQ(lightmap_stream::parse_target("astc-ldr:6x6")->footprint, (astc::Footprint{6, 6}));
 }
 
+// Randomly corrupted ASTC KTX2 files (with key/value data): the reader accepts or refuses with one
+// line, never crashes; whatever it accepts decodes with astcenc (any 128-bit pattern is a block).
+TEST(LightmapAstc, CorruptedFilesNeverCrash) {
+    Ktx2Image img;
+    img.vk_format = astc::vk_format_ldr({6, 6});
+    img.width = 13;
+    img.height = 8;
+    std::mt19937 rng(5);
+    img.blocks.resize(ktx2_level_bytes(img.vk_format, 13, 8));
+    for (auto& b : img.blocks) b = static_cast<std::uint8_t>(rng());
+    img.key_values.push_back({lightmap_astc::kRangeKey, lightmap_astc::range_value({-3, 2})});
+    img.key_values.push_back({"KTXwriter", {'z', 'h', 'c', 0}});
+    const auto good = encode_ktx2(img);
+    ASSERT_TRUE(good.ok());
+    int accepted = 0;
+    for (int i = 0; i < 3000; ++i) {
+        auto b = *good;
+        const int flips = 1 + static_cast<int>(rng() % 4);
+        for (int k = 0; k < flips; ++k) b[rng() % b.size()] ^= static_cast<std::uint8_t>(1u << (rng() % 8));
+        if (i % 10 == 0) b.resize(rng() % b.size());
+        auto r = decode_ktx2(b, "c.ktx2");
+        if (!r) {
+            EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
+            continue;
+        }
+        ++accepted;
+        const auto f = astc::format_of_vk(r->vk_format);
+        if (!f) continue;
+        auto d = astc::decode_rgba(r->blocks.data(), r->blocks.size(), r->width, r->height, f->footprint, f->hdr);
+        EXPECT_TRUE(d.ok());
+    }
+    EXPECT_GT(accepted, 100);  // block bytes flipped: still valid files
+}
+
 // runtime/zhc_runtime.h's ASTC reconstruction from the textures' values (astcenc's decoder) equals
 // the codec's decode (lightmap_astc::decompress, then irradz::evaluate) bit for bit, both targets.
 TEST(LightmapAstc, RuntimeCReconstructionEqualsTheCodec) {

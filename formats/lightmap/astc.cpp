@@ -4,9 +4,12 @@
 #include <astcenc.h>
 
 #include <algorithm>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
+#include <tuple>
 
 namespace zhc::astc {
 namespace {
@@ -31,7 +34,7 @@ struct ContextDeleter {
 };
 using Context = std::unique_ptr<astcenc_context, ContextDeleter>;
 
-Result<Context> make_context(Footprint f, astcenc_profile profile, Effort effort, unsigned threads, unsigned flags) {
+Result<Context> make_context_uncached(Footprint f, astcenc_profile profile, Effort effort, unsigned threads, unsigned flags) {
     astcenc_config config{};
     const float quality = effort == Effort::kFast ? ASTCENC_PRE_FAST : (effort == Effort::kMedium ? ASTCENC_PRE_MEDIUM : ASTCENC_PRE_THOROUGH);
     astcenc_error e = astcenc_config_init(profile, static_cast<unsigned>(f.x), static_cast<unsigned>(f.y), 1, quality, flags, &config);
@@ -40,6 +43,46 @@ Result<Context> make_context(Footprint f, astcenc_profile profile, Effort effort
     e = astcenc_context_alloc(&config, threads, &raw);
     if (e != ASTCENC_SUCCESS) return make_error(ErrorCode::kInternal, std::string("astcenc_context_alloc: ") + astcenc_get_error_string(e));
     return Context(raw);
+}
+
+// Allocating a context builds astcenc's tables for the footprint (milliseconds): contexts are kept
+// in a pool by their settings and lent out one caller at a time. A context keeps no state between
+// images once reset, so a reused one writes the same bytes as a fresh one (tested: two runs).
+using Key = std::tuple<int, int, int, int, unsigned, unsigned>;
+std::mutex pool_mutex;
+std::multimap<Key, Context>& pool() {
+    static std::multimap<Key, Context> p;
+    return p;
+}
+struct Lease {
+    Key key;
+    Context ctx;
+    ~Lease() {
+        if (!ctx) return;
+        std::lock_guard<std::mutex> lock(pool_mutex);
+        pool().emplace(key, std::move(ctx));
+    }
+    astcenc_context* get() const { return ctx.get(); }
+};
+Result<std::unique_ptr<Lease>> make_context(Footprint f, astcenc_profile profile, Effort effort, unsigned threads, unsigned flags) {
+    auto lease = std::make_unique<Lease>();
+    lease->key = Key{f.x, f.y, static_cast<int>(profile), static_cast<int>(effort), threads, flags};
+    {
+        std::lock_guard<std::mutex> lock(pool_mutex);
+        auto it = pool().find(lease->key);
+        if (it != pool().end()) {
+            lease->ctx = std::move(it->second);
+            pool().erase(it);
+        }
+    }
+    if (!lease->ctx) {
+        auto c = make_context_uncached(f, profile, effort, threads, flags);
+        if (!c) return c.error();
+        lease->ctx = std::move(*c);
+    }
+    if (flags & ASTCENC_FLG_DECOMPRESS_ONLY) astcenc_decompress_reset(lease->get());
+    else astcenc_compress_reset(lease->get());
+    return lease;
 }
 
 }  // namespace
@@ -101,7 +144,7 @@ Result<std::vector<std::uint8_t>> encode(const float* values, int channels, int 
     if (channels == 3) swz = {ASTCENC_SWZ_R, ASTCENC_SWZ_G, ASTCENC_SWZ_B, ASTCENC_SWZ_1};
     std::vector<std::uint8_t> out(16 * block_count(f, width, height));
     std::vector<astcenc_error> errors(nthreads, ASTCENC_SUCCESS);
-    auto work = [&](unsigned t) { errors[t] = astcenc_compress_image(ctx->get(), &image, &swz, out.data(), out.size(), t); };
+    auto work = [&](unsigned t) { errors[t] = astcenc_compress_image((*ctx)->get(), &image, &swz, out.data(), out.size(), t); };
     std::vector<std::thread> pool;
     for (unsigned t = 1; t < nthreads; ++t) pool.emplace_back(work, t);
     work(0);
@@ -122,7 +165,7 @@ Result<std::vector<float>> decode_rgba(const std::uint8_t* blocks, std::size_t s
     void* slice = rgba.data();
     astcenc_image image{static_cast<unsigned>(width), static_cast<unsigned>(height), 1, ASTCENC_TYPE_F32, &slice};
     const astcenc_swizzle swz{ASTCENC_SWZ_R, ASTCENC_SWZ_G, ASTCENC_SWZ_B, ASTCENC_SWZ_A};
-    const astcenc_error e = astcenc_decompress_image(ctx->get(), blocks, size, &image, &swz, 0);
+    const astcenc_error e = astcenc_decompress_image((*ctx)->get(), blocks, size, &image, &swz, 0);
     if (e != ASTCENC_SUCCESS) return make_error(ErrorCode::kInternal, std::string("astcenc_decompress_image: ") + astcenc_get_error_string(e));
     return rgba;
 }
