@@ -4,6 +4,9 @@
 #include <astcenc.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -173,10 +176,6 @@ Result<std::vector<float>> decode_rgba(const std::uint8_t* blocks, std::size_t s
 }  // namespace zhc::astc
 
 // ---- IrradZ lightmaps as ASTC -----------------------------------------------------------------
-
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 namespace zhc::lightmap_astc {
 

@@ -15,6 +15,7 @@
 #include <optional>
 #include <vector>
 
+#include "codec/lightmap/lightmap.h"
 #include "codec/status.h"
 
 namespace zhc::astc {
@@ -52,7 +53,6 @@ Result<std::vector<float>> decode_rgba(const std::uint8_t* blocks, std::size_t s
 }  // namespace zhc::astc
 
 // ---- IrradZ lightmaps as ASTC (docs/lightmap-formats.md, "ASTC targets") ----------------------
-#include "codec/lightmap/lightmap.h"
 
 namespace zhc::lightmap_astc {
 
