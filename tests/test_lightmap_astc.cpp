@@ -94,6 +94,15 @@ TEST(LightmapAstc, Ktx2DfdAndKeyValueData) {
     ASSERT_FALSE(r.ok());
     EXPECT_EQ(r.error().code, ErrorCode::kBadFormat);
     EXPECT_NE(r.error().message.find("NUL-terminated key"), std::string::npos) << r.error().message;
+    // Key/value data above 32 KiB is refused (read_ktx2_layout reads the first 64 KiB of a file).
+    auto big = img;
+    big.key_values.push_back({"zhc.padding", std::vector<std::uint8_t>(40000, 'x')});
+    EXPECT_FALSE(encode_ktx2(big).ok());  // nor written
+    auto big_bytes = *bytes;
+    test::put32(big_bytes, 60, 40000);
+    auto rb = decode_ktx2(big_bytes, "big.ktx2");
+    ASSERT_FALSE(rb.ok());
+    EXPECT_NE(rb.error().message.find("exceeds the limit 32768"), std::string::npos) << rb.error().message;
     // UNORM: no qualifiers, 0 .. 0xFFFFFFFF.
     img.vk_format = astc::vk_format_ldr({4, 4});
     img.blocks.assign(ktx2_level_bytes(img.vk_format, 13, 7), 0);

@@ -20,6 +20,8 @@ constexpr std::size_t kHeaderBytes = 12 + 9 * 4;     // identifier + 9 u32 field
 constexpr std::size_t kIndexBytes = 4 * 4 + 2 * 8;   // dfd/kvd offsets+lengths, sgd offset+length
 constexpr std::size_t kLevelIndexBytes = 3 * 8;      // one level
 constexpr std::size_t kDfdStart = kHeaderBytes + kIndexBytes + kLevelIndexBytes;  // 104
+// Key/value data is read whole from the file's first 64 KiB by read_ktx2_layout as well: at most 32 KiB.
+constexpr std::uint32_t kMaxKvdBytes = 32768;
 
 // Khronos Data Format: colour models and sample layout for the three formats.
 constexpr std::uint32_t kModelBc4 = 131, kModelBc5 = 132, kModelBc6h = 133, kModelAstc = 162;
@@ -113,6 +115,7 @@ Result<std::vector<std::uint8_t>> ktx2_header(std::uint32_t vk_format, int width
     const std::size_t level_bytes = ktx2_level_bytes(vk_format, width, height);
     const auto dfd = make_dfd(vk_format);
     const auto kvd = encode_ktx2_key_values(key_values);
+    if (kvd.size() > kMaxKvdBytes) return make_error(ErrorCode::kInvalidArgument, "ktx2: key/value data above 32768 bytes");
     const std::size_t kvd_offset = kvd.empty() ? 0 : kDfdStart + dfd.size();
     const std::size_t level_offset = align_up(kDfdStart + dfd.size() + kvd.size(), bb);  // lcm(block bytes, 4) = block bytes
     std::vector<std::uint8_t> out(kIdentifier, kIdentifier + 12);
@@ -193,8 +196,11 @@ Result<Ktx2Image> decode_ktx2_layout(std::span<const std::uint8_t> b, std::uint6
     if (std::memcmp(b.data() + dfd_off, expected_dfd.data(), expected_dfd.size()) != 0)
         return bad(ErrorCode::kBadFormat, name, "data format descriptor does not describe vkFormat " + std::to_string(img.vk_format) +
                                                     " (byte " + std::to_string(dfd_off) + ")");
+    if (kvd_len > kMaxKvdBytes)
+        return bad(ErrorCode::kBadFormat, name, "key/value data of " + std::to_string(kvd_len) + " bytes exceeds the limit " +
+                                                    std::to_string(kMaxKvdBytes) + " (byte 60)");
     if (kvd_len != 0) {
-        // Key/value data is allowed (and ignored) if it lies between the DFD and the level data.
+        // Key/value data must lie between the DFD and the level data; every entry is parsed.
         if (kvd_off < dfd_off + dfd_len || static_cast<std::uint64_t>(kvd_off) + kvd_len > lvl_off ||
             static_cast<std::uint64_t>(kvd_off) + kvd_len > b.size())
             return bad(ErrorCode::kBadFormat, name, "key/value data outside its place (bytes 56-63)");
