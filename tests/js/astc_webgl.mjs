@@ -12,7 +12,12 @@
 //     cos against glibc's: at most 1 float ulp, counted);
 //  4. headless Chromium's WebGL2 on SwiftShader (WEBGL_compressed_texture_astc, profile "ldr") decodes
 //     every LDR texture, an independent ASTC decoder: texel for texel against astcenc's, within
-//     the bound stated below. HDR textures only if the extension lists the "hdr" profile.
+//     the bound stated below. HDR textures only if the extension lists the "hdr" profile;
+//  5. runtime/zhc.wgsl's IrradZ functions (zhcIrradZIzFromLdr, zhcIrradZIrradianceAstc) in Chromium's
+//     WebGPU (SwiftShader) on astcenc's texels of every case, both models, against the JS runtime:
+//     I_z through the LDR range within 8 u (3 + 3|x|) (2^x + 2^lo) (exp2's 3 + 2|x| ulp and the
+//     roundings of x; HDR: passed through exactly), the irradiance within that error times
+//     F = 1 + (1 + 1/d_z)/d_z plus 16 u |I_z| F (the bound of test_runtime_gl's IrradZ test).
 //
 // LDR bound: astcenc returns the specification's decode, the unorm16 value as float16; a decoder
 // with 8-bit intermediate precision (decode_unorm8 behaviour) differs by at most half an 8-bit
@@ -24,7 +29,7 @@ import { fileURLToPath } from 'node:url';
 import { read } from 'ktx-parse';
 import { makeRand, checker } from './fixtures.mjs';
 import { chromiumPages } from './chromium_page.mjs';
-import { irradzIrradianceAstc, parseIzLog2Range } from '../../runtime/web/zhc_runtime.mjs';
+import { irradzIrradianceAstc, parseIzLog2Range, izFromLdr, decodeHemioct } from '../../runtime/web/zhc_runtime.mjs';
 
 const [zhc, texelsTool, workArg, envmapDir, chromiumArg] = process.argv.slice(2);
 if (!zhc || !texelsTool || !workArg || !envmapDir) {
@@ -36,6 +41,7 @@ const work = path.resolve(workArg);
 fs.rmSync(work, { recursive: true, force: true });
 fs.mkdirSync(work, { recursive: true });
 const here = path.dirname(fileURLToPath(import.meta.url));
+const repo = path.resolve(here, '..', '..');
 const W = (f) => path.join(work, f);
 const { check, finish } = checker();
 const run = (...args) => execFileSync(zhc, args, { maxBuffer: 1 << 28 }).toString();
@@ -106,7 +112,7 @@ for (const map of maps) {
           jsWorstUlp = Math.max(jsWorstUlp, u);
         }
       }
-    cases.push({ tag, iz, dwa, hdr: v.target === 'astc' });
+    cases.push({ tag, iz, dwa, hdr: v.target === 'astc', range, normals });
   }
 }
 console.log(`JS irradzIrradianceAstc vs the C header: ${jsExact} of ${jsTotal} values bit-exact, worst ${jsWorstUlp} ulp`);
@@ -154,4 +160,55 @@ if (stats.hdr.textures > 0)
   console.log(`HDR: ${stats.hdr.textures} textures, ${stats.hdr.exact} of ${stats.hdr.total} equal, worst relative ${stats.hdr.worstRel.toExponential(3)}`);
 else console.log('HDR: the extension has no hdr profile here; ASTC HDR I_z is decoded by astcenc only');
 check(stats.ldr.textures === maps.length * 5, `every LDR texture compared (${stats.ldr.textures})`);
+
+// 5. WGSL in WebGPU.
+const items = [];
+for (const c of cases)
+  for (let i = 0; i < N; i++)
+    for (let model = 0; model < 2; model++) items.push({ c, i, model });
+const buf = new ArrayBuffer(48 * items.length), f32v = new Float32Array(buf), u32v = new Uint32Array(buf);
+items.forEach(({ c, i, model }, j) => {
+  f32v.set(c.iz.subarray(4 * i, 4 * i + 3), 12 * j);
+  f32v.set(c.dwa.subarray(4 * i, 4 * i + 3), 12 * j + 3);
+  f32v.set(c.normals.subarray(3 * i, 3 * i + 3), 12 * j + 6);
+  f32v[12 * j + 9] = c.range ? c.range[0] : 0;
+  f32v[12 * j + 10] = c.range ? c.range[1] : 1;
+  u32v[12 * j + 11] = (c.range ? 1 : 0) | (model << 1);
+});
+fs.writeFileSync(W('irradz_items.bin'), Buffer.from(buf));
+const gpuPages = await chromiumPages({ roots: { '/test/': path.join(here, 'browser'), '/work/': work, '/runtime/': path.join(repo, 'runtime') },
+  work, chromium, check });
+const wg = await gpuPages.runPage('irradz_wgsl.html', ['--disable-gpu-sandbox', '--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader',
+  '--use-angle=swiftshader'], 'wgsl', 'zhc irradz wgsl page done');
+gpuPages.close();
+if (wg === null) process.exit(1);
+check(wg.errors.length === 0, `WebGPU page without errors: ${wg.errors.join('; ')}`);
+check(wg.webgpu && wg.compilation.length === 0, `zhc.wgsl + the IrradZ kernel compile without a message: ${wg.compilation.join('; ')}`);
+const U = 2 ** -24;
+let worstIz = 0, worstE = 0, failures = 0, compared = 0;
+if (Array.isArray(wg.out) && wg.out.length === 6 * items.length)
+  items.forEach(({ c, i, model }, j) => {
+    const t = Array.from(c.iz.subarray(4 * i, 4 * i + 3)), dwa = Array.from(c.dwa.subarray(4 * i, 4 * i + 3)), n = Array.from(c.normals.subarray(3 * i, 3 * i + 3));
+    const want = irradzIrradianceAstc(t, dwa, c.range, model, n);
+    const dz = Math.max(decodeHemioct(dwa[0], dwa[1])[2], Math.cos((85 * Math.PI) / 180));
+    const F = 1 + (1 + 1 / dz) / dz;
+    for (let k = 0; k < 3; k++) {
+      const izRef = c.range ? izFromLdr(t[k], c.range[0], c.range[1]) : Math.fround(t[k]);
+      let izScale = 0;
+      if (c.range) {
+        const x = c.range[0] + Math.min(Math.max(t[k], 0), 1) * (c.range[1] - c.range[0]);
+        izScale = U * (3 + 3 * Math.abs(x)) * (2 ** x + 2 ** c.range[0]);
+      }
+      const izErr = Math.abs(wg.out[6 * j + 3 + k] - izRef), eErr = Math.abs(wg.out[6 * j + k] - want[k]);
+      const eScale = 16 * U * Math.abs(izRef) * F + 8 * izScale * F;
+      if (c.range) worstIz = Math.max(worstIz, izErr / izScale);
+      worstE = Math.max(worstE, eScale > 0 ? eErr / eScale : eErr === 0 ? 0 : Infinity);
+      compared++;
+      if (!(izErr <= 8 * izScale) || !(eErr <= eScale)) {
+        if (failures++ < 5) console.log(`  WGSL ${c.tag} texel ${i} model ${model} channel ${k}: I_z ${wg.out[6 * j + 3 + k]} vs ${izRef}, E ${wg.out[6 * j + k]} vs ${want[k]}`);
+      }
+    }
+  });
+console.log(`WGSL (WebGPU): ${compared} values; LDR I_z worst ${worstIz.toFixed(3)} x u (3 + 3|x|) (2^x + 2^lo) (bound 8), irradiance worst ${worstE.toFixed(3)} of its bound`);
+check(compared === 3 * items.length && failures === 0, `WGSL IrradZ within the bounds on every value (${failures} failures, ${compared} compared)`);
 finish('astc webgl');
