@@ -346,7 +346,8 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
         ->check(CLI::IsMember({"ktx2", "dds"}));
     enc->add_option("--target", o->target,
                     "bc (default: BC6H + BC5 + BC4, 2.5 B/texel) | astc (ASTC HDR I_z + ASTC LDR d,w_a; KTX2 only) | "
-                    "astc-ldr (I_z in ASTC LDR by a per-texture log2 range, for GPUs without ASTC HDR)")
+                    "astc-ldr (I_z in ASTC LDR by a per-texture log2 range, for GPUs without ASTC HDR); ASTC effort from --quality: "
+                    "fast, default = medium, slow = thorough")
         ->check(CLI::IsMember({"bc", "astc", "astc-ldr"}));
     enc->add_option("--footprint", o->footprint, "ASTC block footprint: 4x4 (default, 2 B/texel), 5x5, 6x6 (0.89 B/texel), 8x8")
         ->check(CLI::IsMember({"4x4", "5x5", "6x6", "8x8"}));
