@@ -153,7 +153,8 @@ int run_decode(const Options& o) {
 
 // audit --html: the report needs the whole image's planes, so this path reads the whole lightmap
 // (one EXR, at most 4096 x 4096) as before streaming.
-int run_audit_html(const Options& o, const std::string& input) {
+// extra: rows appended to the summary table (audit --targets: one per target).
+int run_audit_html(const Options& o, const std::string& input, const std::vector<LightmapHtmlRow>& extra = {}) {
     LightmapReadOptions ro;
     ro.threads = o.threads;
     auto lm = read_sh_lightmap_exr(input, ro);
@@ -165,14 +166,16 @@ int run_audit_html(const Options& o, const std::string& input) {
     const auto c = lightmap::compress(search, bc6h_quality(o.quality), bc45_quality(o.quality), o.threads);
     const auto after = lightmap::decompress(c);
     const auto a = lightmap::audit(*lm, search, old_way, after, static_cast<size_t>(o.stride));
-    const auto page = lightmap_audit_html(ZHC_VERSION, {{"input", input}, {"quality", o.quality},
-                                          {"stride", std::to_string(o.stride)}, {"threads", std::to_string(o.threads)}}, search, after, a);
+    auto page = lightmap_audit_html(ZHC_VERSION, {{"input", input}, {"quality", o.quality},
+                                    {"stride", std::to_string(o.stride)}, {"threads", std::to_string(o.threads)}}, search, after, a);
+    page.rows.insert(page.rows.end(), extra.begin(), extra.end());
     if (Status s = write_lightmap_html_report(o.html, page); !s) return report_output(s.error());
     std::fprintf(stderr, "report: %s\n", o.html.c_str());
     return kExitOk;
 }
 
-// audit --targets: the targets side by side on the same fit.
+// audit --targets: the targets side by side on the same fit (and with --html, one summary row each
+// in the BC report).
 int run_audit_targets(const Options& o, const std::vector<std::string>& files) {
     std::vector<lightmap_stream::TargetSpec> specs;
     for (const auto& t : o.targets) {
@@ -197,6 +200,15 @@ int run_audit_targets(const Options& o, const std::vector<std::string>& files) {
     if (!r) return report(r.error());
     const double texels = double(base.width) * base.height;
     const std::string input = inputs_text(files);
+    if (!o.html.empty()) {
+        std::vector<LightmapHtmlRow> rows;
+        for (const auto& t : *r) {
+            char name[128];
+            std::snprintf(name, sizeof name, "target %s (%.3f bytes/texel)", t.spec.name.c_str(), double(t.bytes) / texels);
+            rows.push_back({name, t.audit.rmse_after_bc, t.audit.rmse_after_bc / t.audit.mean_iz});
+        }
+        if (const int rc = run_audit_html(o, files[0], rows); rc != kExitOk) return rc;
+    }
     if (o.json) {
         // The plain audit's object (the BC target), then the targets side by side.
         const auto& a = base.audit;
@@ -248,17 +260,14 @@ int run_audit_targets(const Options& o, const std::vector<std::string>& files) {
 
 int run_audit(const Options& o) {
     const auto files = input_files(o.inputs);
-    if (!o.targets.empty()) {
-        if (!o.html.empty())
-            return report(make_error(ErrorCode::kInvalidArgument, "lightmap audit: --targets and --html are separate runs"));
-        return run_audit_targets(o, files);
-    }
     if (!o.html.empty()) {
         if (int rc = refuse_output_over_input("--html", o.html, files); rc != kExitOk) return rc;
         if (files.size() != 1)
             return report(make_error(ErrorCode::kInvalidArgument, "lightmap audit --html takes one SH lightmap EXR"));
-        if (const int rc = run_audit_html(o, files[0]); rc != kExitOk) return rc;
     }
+    if (!o.targets.empty()) return run_audit_targets(o, files);
+    if (!o.html.empty())
+        if (const int rc = run_audit_html(o, files[0]); rc != kExitOk) return rc;
     lightmap_stream::AuditOptions ao;
     ao.bc6h_quality = bc6h_quality(o.quality);
     ao.bc45_quality = bc45_quality(o.quality);

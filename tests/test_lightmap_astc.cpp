@@ -281,6 +281,14 @@ TEST(LightmapAstc, CliRefusesDdsAndBrokenFiles) {
     r = test::run_zhc({"lightmap", "decode", dir + "/l", "-o", dir + "/l2.exr"});
     EXPECT_EQ(r.exit_code, 4);
     EXPECT_NE(r.err.find("zhc.iz_log2_range"), std::string::npos) << r.err;
+    // --targets with --html: one summary row per target in the report.
+    r = test::run_zhc({"lightmap", "audit", exr, "--targets", "bc,astc:6x6", "--html", dir + "/t.html"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto page = test::read_bytes(dir + "/t.html");
+    const std::string html(page.begin(), page.end());
+    EXPECT_NE(html.find("target astc:6x6 ("), std::string::npos);
+    EXPECT_NE(html.find("target bc (2.500 bytes/texel)"), std::string::npos);
+    EXPECT_NE(r.out.find("astc:6x6"), std::string::npos) << r.out;
     r = test::run_zhc({"lightmap", "audit", exr, "--targets", "bc,astc:7x7"});
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.err.find("astc:7x7"), std::string::npos) << r.err;
