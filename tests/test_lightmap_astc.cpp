@@ -281,6 +281,13 @@ TEST(LightmapAstc, CliRefusesDdsAndBrokenFiles) {
     r = test::run_zhc({"lightmap", "decode", dir + "/l", "-o", dir + "/l2.exr"});
     EXPECT_EQ(r.exit_code, 4);
     EXPECT_NE(r.err.find("zhc.iz_log2_range"), std::string::npos) << r.err;
+    // Two processes, 1 and 3 threads, other band heights: the same files.
+    for (const char* target : {"astc", "astc-ldr"}) {
+        ASSERT_EQ(test::run_zhc({"lightmap", "encode", exr, "-o", dir + "/p1", "--target", target, "--threads", "1"}).exit_code, 0);
+        ASSERT_EQ(test::run_zhc({"lightmap", "encode", exr, "-o", dir + "/p3", "--target", target, "--threads", "3", "--band-rows", "4"}).exit_code, 0);
+        for (const char* part : {".iz.ktx2", ".dwa.ktx2"})
+            EXPECT_EQ(test::read_bytes(dir + "/p1" + part), test::read_bytes(dir + "/p3" + part)) << target << part;
+    }
     // --targets with --html: one summary row per target in the report.
     r = test::run_zhc({"lightmap", "audit", exr, "--targets", "bc,astc:6x6", "--html", dir + "/t.html"});
     ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <numeric>
 #include <optional>
 
 #include "formats/lightmap/dds.h"
@@ -404,9 +405,11 @@ Result<std::vector<TargetAudit>> audit_targets(const std::vector<std::string>& i
     ShLightmapSource& in = **src;
     AuditResult r;
     set_size(r, in);
-    // Bands of whole block rows for every footprint: a multiple of 4 * 5 * 6 * 8 / gcds = 120 rows.
+    // Bands of whole block rows for every footprint: a multiple of the lcm of 4 and their heights.
+    int unit = 4;
+    for (const auto& t : targets) unit = std::lcm(unit, t.footprint.y);
     int rows = band_rows(r.width, o.threads, o.band_rows);
-    rows = (rows + 119) / 120 * 120;
+    rows = (rows + unit - 1) / unit * unit;
     std::vector<TargetAudit> out(targets.size());
     std::vector<lightmap::AuditAccumulator> accs;
     for (size_t k = 0; k < targets.size(); ++k) {
