@@ -33,6 +33,8 @@ struct Options {
     LatLongConvention latlong = LatLongConvention::kOpenExr;  // synth: lat-long orientation
     std::string html;       // audit: also write the HTML report here (whole-image path)
     std::string paths_base; // audit: --paths-relative-to
+    std::string target = "bc", footprint = "4x4";  // encode
+    std::vector<std::string> targets;               // audit: side-by-side comparison
     int threads = 0, size = 256, height = 0, stride = 17, band_rows = 0;
     bool json = false, half = false;
     ProgressFlags progress;
@@ -84,10 +86,18 @@ std::string inputs_text(const std::vector<std::string>& files) {
 
 int run_encode(const Options& o) {
     const auto files = input_files(o.inputs);
+    const bool astc = o.target != "bc";
+    if (astc && o.container == "dds")
+        return report(make_error(ErrorCode::kUnsupported, "--container dds: DDS has no ASTC formats; --target " + o.target +
+                                                              " writes KTX2 only (PREFIX.iz.ktx2, PREFIX.dwa.ktx2)"));
     const std::string out_ext = o.container == "dds" ? ".dds" : ".ktx2";
-    for (const char* plane : {".iz", ".d", ".wa"})
+    const std::vector<const char*> planes = astc ? std::vector<const char*>{".iz", ".dwa"} : std::vector<const char*>{".iz", ".d", ".wa"};
+    for (const char* plane : planes)
         if (int rc = refuse_output_over_input("-o", o.output + plane + out_ext, files); rc != kExitOk) return rc;
     lightmap_stream::EncodeOptions eo;
+    eo.target = o.target == "astc" ? lightmap_stream::Target::kAstc
+                                   : (o.target == "astc-ldr" ? lightmap_stream::Target::kAstcLdr : lightmap_stream::Target::kBc);
+    eo.footprint = {o.footprint[0] - '0', o.footprint[2] - '0'};  // CLI11 checked: 4x4, 5x5, 6x6, 8x8
     eo.fit = lightmap::find_fit(o.solve)->fit;
     eo.bc6h_quality = bc6h_quality(o.quality);
     eo.bc45_quality = bc45_quality(o.quality);
@@ -102,8 +112,9 @@ int run_encode(const Options& o) {
     if (!r) return output_failed ? report_output(r.error()) : report(r.error());
     const std::string ext = eo.dds ? ".dds" : ".ktx2";
     const double texels = double(r->width) * r->height;
-    std::printf("%s: %dx%d texels -> %s.{iz,d,wa}%s (%llu bytes of blocks, %.3f bytes/texel)\n", inputs_text(files).c_str(), r->width,
-                r->height, o.output.c_str(), ext.c_str(), static_cast<unsigned long long>(r->block_bytes), double(r->block_bytes) / texels);
+    std::printf("%s: %dx%d texels -> %s.%s%s (%s; %llu bytes of blocks, %.3f bytes/texel)\n", inputs_text(files).c_str(), r->width,
+                r->height, o.output.c_str(), astc ? "{iz,dwa}" : "{iz,d,wa}", ext.c_str(),
+                astc ? (o.target + " " + o.footprint).c_str() : "bc", static_cast<unsigned long long>(r->block_bytes), double(r->block_bytes) / texels);
     std::printf("IrradZ fit %.3f s (%.2f Mtexel/s), block compression (%s) %.3f s (%.2f Mtexel/s), %d thread(s)\n", r->timing.fit,
                 texels / r->timing.fit / 1e6, o.quality.c_str(), r->timing.compress, texels / r->timing.compress / 1e6, o.threads);
     return kExitOk;
@@ -131,14 +142,20 @@ int run_decode(const Options& o) {
     auto r = lightmap_stream::decode(o.input, dds, o.output, o.band_rows, fn, &output_failed);
     progress.finish();
     if (!r) return output_failed ? report_output(r.error()) : report(r.error());
-    std::printf("%s.{iz,d,wa}%s: %dx%d -> %s (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)\n", o.input.c_str(), ext.c_str(), r->width, r->height,
-                o.output.c_str());
+    if (r->target == lightmap_stream::Target::kBc)
+        std::printf("%s.{iz,d,wa}%s: %dx%d -> %s (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)\n", o.input.c_str(), ext.c_str(), r->width, r->height,
+                    o.output.c_str());
+    else
+        std::printf("%s.{iz,dwa}.ktx2 (%s %dx%d): %dx%d -> %s (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)\n", o.input.c_str(),
+                    r->target == lightmap_stream::Target::kAstc ? "astc" : "astc-ldr", r->footprint.x, r->footprint.y, r->width,
+                    r->height, o.output.c_str());
     return kExitOk;
 }
 
 // audit --html: the report needs the whole image's planes, so this path reads the whole lightmap
 // (one EXR, at most 4096 x 4096) as before streaming.
-int run_audit_html(const Options& o, const std::string& input) {
+// extra: rows appended to the summary table (audit --targets: one per target).
+int run_audit_html(const Options& o, const std::string& input, const std::vector<LightmapHtmlRow>& extra = {}) {
     LightmapReadOptions ro;
     ro.threads = o.threads;
     auto lm = read_sh_lightmap_exr(input, ro);
@@ -150,10 +167,95 @@ int run_audit_html(const Options& o, const std::string& input) {
     const auto c = lightmap::compress(search, bc6h_quality(o.quality), bc45_quality(o.quality), o.threads);
     const auto after = lightmap::decompress(c);
     const auto a = lightmap::audit(*lm, search, old_way, after, static_cast<size_t>(o.stride));
-    const auto page = lightmap_audit_html(ZHC_VERSION, {{"input", shown_path(input, o.paths_base)}, {"quality", o.quality},
-                                          {"stride", std::to_string(o.stride)}, {"threads", std::to_string(o.threads)}}, search, after, a);
+    auto page = lightmap_audit_html(ZHC_VERSION, {{"input", shown_path(input, o.paths_base)}, {"quality", o.quality},
+                                    {"stride", std::to_string(o.stride)}, {"threads", std::to_string(o.threads)}}, search, after, a);
+    page.rows.insert(page.rows.end(), extra.begin(), extra.end());
     if (Status s = write_lightmap_html_report(o.html, page); !s) return report_output(s.error());
     std::fprintf(stderr, "report: %s\n", o.html.c_str());
+    return kExitOk;
+}
+
+// audit --targets: the targets side by side on the same fit (and with --html, one summary row each
+// in the BC report).
+int run_audit_targets(const Options& o, const std::vector<std::string>& files) {
+    std::vector<lightmap_stream::TargetSpec> specs;
+    for (const auto& t : o.targets) {
+        auto spec = lightmap_stream::parse_target(t);
+        if (!spec)
+            return report(make_error(ErrorCode::kInvalidArgument, "--targets: " + t +
+                                                                      ": not bc, astc[:NxN], astc-ldr[:NxN], astc-split[:NxN] or plain-astc[:NxN] "
+                                                                      "(N x N: 4x4, 5x5, 6x6, 8x8)"));
+        specs.push_back(*spec);
+    }
+    lightmap_stream::AuditOptions ao;
+    ao.bc6h_quality = bc6h_quality(o.quality);
+    ao.bc45_quality = bc45_quality(o.quality);
+    ao.threads = o.threads;
+    ao.band_rows = o.band_rows;
+    ao.stride = static_cast<size_t>(o.stride);
+    Progress progress("zhc lightmap audit", "rows", o.progress);
+    if (progress.enabled()) ao.progress = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
+    lightmap_stream::AuditResult base;
+    auto r = lightmap_stream::audit_targets(files, ao, specs, &base);
+    progress.finish();
+    if (!r) return report(r.error());
+    const double texels = double(base.width) * base.height;
+    const std::string input = inputs_text(files);
+    if (!o.html.empty()) {
+        std::vector<LightmapHtmlRow> rows;
+        for (const auto& t : *r) {
+            char name[128];
+            std::snprintf(name, sizeof name, "target %s (%.3f bytes/texel)", t.spec.name.c_str(), double(t.bytes) / texels);
+            rows.push_back({name, t.audit.rmse_after_bc, t.audit.rmse_after_bc / t.audit.mean_iz});
+        }
+        if (const int rc = run_audit_html(o, files[0], rows); rc != kExitOk) return rc;
+    }
+    if (o.json) {
+        // The plain audit's object (the BC target), then the targets side by side.
+        const auto& a = base.audit;
+        nlohmann::ordered_json j;
+        j["input"] = input;
+        j["width"] = base.width;
+        j["height"] = base.height;
+        j["quality"] = o.quality;
+        j["texels_audited"] = a.texels_sampled;
+        j["mean_irradiance_at_normal"] = a.mean_iz;
+        j["hemi_rmse"] = {{"old_way", a.rmse_old}, {"search", a.rmse_search}, {"search_after_bc", a.rmse_after_bc}};
+        j["psnr_db"] = {{"iz_bc6h_log2", a.psnr_iz_log2}, {"wa_bc4", a.psnr_wa}, {"d_bc5", a.psnr_d}};
+        j["d_error_deg"] = {{"mean", a.d_mean_deg}, {"max", a.d_max_deg}};
+        j["mtexel_per_s"] = {{"irradz_fit", texels / base.timing.fit / 1e6}, {"block_compression", texels / base.timing.compress / 1e6}};
+        nlohmann::ordered_json arr = nlohmann::ordered_json::array();
+        for (const auto& t : *r) {
+            nlohmann::ordered_json e;
+            e["target"] = t.spec.name;
+            e["bytes_per_texel"] = double(t.bytes) / texels;
+            e["hemi_rmse"] = t.audit.rmse_after_bc;
+            if (!t.spec.plain) e["psnr_db"] = {{"iz_log2", t.audit.psnr_iz_log2}, {"wa", t.audit.psnr_wa}, {"d", t.audit.psnr_d}};
+            e["encode_mtexel_per_s"] = texels / std::max(1e-9, t.encode_seconds) / 1e6;
+            arr.push_back(e);
+        }
+        j["threads"] = o.threads;
+        j["targets"] = arr;
+        print_json("lightmap audit", j);
+        return kExitOk;
+    }
+    const auto& a0 = (*r)[0].audit;
+    std::printf("%s: %dx%d texels, %zu audited (every %d-th), quality %s, %d thread(s)\n", input.c_str(), base.width, base.height,
+                a0.texels_sampled, o.stride, o.quality.c_str(), o.threads);
+    std::printf("hemispherical irradiance RMSE vs SH3 (mean irradiance at normal %.5g): fit before compression %.6g (%.2f%%)\n", a0.mean_iz,
+                a0.rmse_search, 100 * a0.rmse_search / a0.mean_iz);
+    std::printf("%-16s %8s %12s %8s %10s %8s %8s %12s\n", "target", "B/texel", "hemi RMSE", "%", "I_z log2", "w_a", "d", "Mtexel/s");
+    for (const auto& t : *r) {
+        const auto& a = t.audit;
+        if (t.spec.plain)
+            std::printf("%-16s %8.3f %12.6g %7.2f%% %10s %8s %8s %12.3f\n", t.spec.name.c_str(), double(t.bytes) / texels, a.rmse_after_bc,
+                        100 * a.rmse_after_bc / a.mean_iz, "-", "-", "-", texels / std::max(1e-9, t.encode_seconds) / 1e6);
+        else
+            std::printf("%-16s %8.3f %12.6g %7.2f%% %10.2f %8.2f %8.2f %12.3f\n", t.spec.name.c_str(), double(t.bytes) / texels,
+                        a.rmse_after_bc, 100 * a.rmse_after_bc / a.mean_iz, a.psnr_iz_log2, a.psnr_wa, a.psnr_d,
+                        texels / std::max(1e-9, t.encode_seconds) / 1e6);
+    }
+    std::printf("(PSNR in dB: I_z log2-domain, w_a and d against the fit; plain-astc: irradiance at the normal only, no direction)\n");
     return kExitOk;
 }
 
@@ -163,8 +265,10 @@ int run_audit(const Options& o) {
         if (int rc = refuse_output_over_input("--html", o.html, files); rc != kExitOk) return rc;
         if (files.size() != 1)
             return report(make_error(ErrorCode::kInvalidArgument, "lightmap audit --html takes one SH lightmap EXR"));
-        if (const int rc = run_audit_html(o, files[0]); rc != kExitOk) return rc;
     }
+    if (!o.targets.empty()) return run_audit_targets(o, files);
+    if (!o.html.empty())
+        if (const int rc = run_audit_html(o, files[0]); rc != kExitOk) return rc;
     lightmap_stream::AuditOptions ao;
     ao.bc6h_quality = bc6h_quality(o.quality);
     ao.bc45_quality = bc45_quality(o.quality);
@@ -253,6 +357,13 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     enc->add_option("-o,--output", o->output, "output prefix")->required();
     enc->add_option("--container", o->container, "ktx2 (default) | dds (DX10 header): PREFIX.{iz,d,wa}.ktx2 or .dds")
         ->check(CLI::IsMember({"ktx2", "dds"}));
+    enc->add_option("--target", o->target,
+                    "bc (default: BC6H + BC5 + BC4, 2.5 B/texel) | astc (ASTC HDR I_z + ASTC LDR d,w_a; KTX2 only) | "
+                    "astc-ldr (I_z in ASTC LDR by a per-texture log2 range, for GPUs without ASTC HDR); ASTC effort from --quality: "
+                    "fast, default = medium, slow = thorough")
+        ->check(CLI::IsMember({"bc", "astc", "astc-ldr"}));
+    enc->add_option("--footprint", o->footprint, "ASTC block footprint: 4x4 (default, 2 B/texel), 5x5, 6x6 (0.89 B/texel), 8x8")
+        ->check(CLI::IsMember({"4x4", "5x5", "6x6", "8x8"}));
     enc->add_option("--solve", o->solve, "IrradZ fit: " + choices_help(lightmap::fits()))
         ->check(CLI::IsMember(choice_names(lightmap::fits())));
     quality(enc);
@@ -265,6 +376,10 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     band(dec);
     CLI::App* aud = lm->add_subcommand("audit", "hemispherical error before/after block compression, PSNR per texture, speed");
     aud->add_option("IN", o->inputs, "SH lightmap EXR(s), as for encode")->required();
+    aud->add_option("--targets", o->targets,
+                    "compare texture targets side by side (comma-separated): bc, astc[:NxN], astc-ldr[:NxN], astc-split[:NxN] "
+                    "(d and w_a in two textures), plain-astc[:NxN] (Godot-style irradiance only); NxN 4x4 (default), 5x5, 6x6, 8x8")
+        ->delimiter(',');
     aud->add_option("--stride", o->stride, "audit every N-th texel")->check(CLI::Range(1, 1 << 20));
     add_json_flag(aud, o->json);
     add_paths_relative_to_option(aud, o->paths_base);

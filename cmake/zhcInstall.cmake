@@ -73,7 +73,7 @@ file(RELATIVE_PATH ZHC_PC_TO_PREFIX "/root/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/
 string(REGEX REPLACE "/$" "" ZHC_PC_TO_PREFIX "${ZHC_PC_TO_PREFIX}")
 if(TARGET zhc_formats)
   set(ZHC_PC_LIBS "-lzhc_formats -lzhc_codec")
-  set(ZHC_PC_LIBS_PRIVATE "-lmeshoptimizer")
+  set(ZHC_PC_LIBS_PRIVATE "-lmeshoptimizer -lastcenc")
   set(ZHC_PC_REQUIRES_PRIVATE "OpenEXR libzstd nlohmann_json draco tinygltf libpng")
 else()
   set(ZHC_PC_LIBS "-lzhc_codec")

@@ -11,6 +11,7 @@
 
 #include "codec/lightmap/bc45.h"
 #include "codec/lightmap/bc6h.h"
+#include "formats/lightmap/astc.h"
 #include "formats/lightmap/ktx2.h"
 
 namespace zhc::fuzz {
@@ -23,9 +24,17 @@ inline void check_refusal(const Error& e) {
 // Exactly the blocks of its size, and zhc's decoders total on them (every bit pattern decodes to
 // something defined: finite halves for BC6H, [0, 1] for BC4/BC5).
 inline void check_texture(const Ktx2Image& img) {
-    const std::size_t bw = (img.width + 3) / 4, bh = (img.height + 3) / 4;
+    const auto dims = ktx2_block_dims(img.vk_format);
+    const std::size_t bw = (img.width + dims[0] - 1) / dims[0], bh = (img.height + dims[1] - 1) / dims[1];
     if (img.blocks.size() != bw * bh * ktx2_block_bytes(img.vk_format)) std::abort();
-    if (img.vk_format == kVkFormatBc6hUfloat) {
+    if (const auto f = astc::format_of_vk(img.vk_format)) {
+        // ASTC (KTX2 only): astcenc's decoder on every block; LDR values stay in [0, 1].
+        auto v = astc::decode_rgba(img.blocks.data(), img.blocks.size(), img.width, img.height, f->footprint, f->hdr);
+        if (!v) std::abort();
+        if (!f->hdr)
+            for (float x : *v)
+                if (!(x >= 0.0f && x <= 1.0f)) std::abort();
+    } else if (img.vk_format == kVkFormatBc6hUfloat) {
         const auto halfs = bc6h::decode_image(img.blocks.data(), img.blocks.size(), img.width, img.height);
         if (halfs.size() != static_cast<std::size_t>(img.width) * img.height * 3) std::abort();
     } else {

@@ -664,6 +664,19 @@ vec3 zhcIrradZIrradiance(vec3 iz, float wa, vec2 dUv, vec3 n, uint model) {
     return ca * h + cd * max(0.0, dot(n, d));
 }
 
+// ASTC targets (docs/lightmap-formats.md, "ASTC targets"): I_z from the ASTC HDR texture as sampled,
+// d and w_a from one ASTC LDR texture: dwa = its rgb = (u, v, w_a). The LDR fallback stores I_z as
+// t in [0, 1] with the texture's range (lo, hi) from its KTX2 key "zhc.iz_log2_range":
+// I_z = 2^(lo + t (hi - lo)) - 2^lo (codec iz_from_ldr, computed there in double; here exp2's
+// precision, 3 + 2|x| ulp in GLSL).
+vec3 zhcIrradZIzFromLdr(vec3 t, vec2 loHi) {
+    vec3 x = loHi.x + clamp(t, 0.0, 1.0) * (loHi.y - loHi.x);
+    return exp2(x) - exp2(loHi.x);
+}
+vec3 zhcIrradZIrradianceAstc(vec3 iz, vec3 dwa, vec3 n, uint model) {
+    return zhcIrradZIrradiance(iz, dwa.z, dwa.xy, n, model);
+}
+
 // HLSH (probe occlusion, codec irradz::evaluate(Hlsh)): I(m) = I_z m_z + C_a (1 - m_z) + c_x m_x +
 // c_y m_y, m in the frame of the normal. 12 flops.
 vec3 zhcHlshIrradiance(vec3 iz, vec3 ca, vec3 cx, vec3 cy, vec3 m) {

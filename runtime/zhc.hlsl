@@ -801,6 +801,19 @@ float3 zhc_irradz_irradiance(float3 iz, float wa, float2 dHemiOct, uint model, f
     return zhc_irradz_evaluate(zhc_irradz_lighting(iz, wa, zhc_decode_hemioct(dHemiOct)), model, n);
 }
 
+// ASTC targets (docs/lightmap-formats.md, "ASTC targets"): I_z from the ASTC HDR texture as sampled,
+// (u, v, w_a) = the rgb of one ASTC LDR texture. The LDR fallback: I_z = 2^(lo + t (hi - lo)) - 2^lo
+// per channel, t the sampled value, (lo, hi) the KTX2 key "zhc.iz_log2_range" (codec iz_from_ldr).
+float3 zhc_irradz_iz_from_ldr(float3 t, float2 loHi)
+{
+    float3 x = loHi.x + saturate(t) * (loHi.y - loHi.x);
+    return exp2(x) - exp2(loHi.x);
+}
+float3 zhc_irradz_irradiance_astc(float3 iz, float3 dwa, uint model, float3 n)
+{
+    return zhc_irradz_irradiance(iz, dwa.z, dwa.xy, model, n);
+}
+
 // ---- probe volumes (docs/runtime.md "Probe volumes"; zhc_volume_* of runtime/zhc_runtime.h) ------
 //
 // A grid of probes: probe (x, y, z) is number x + nx (y + ny z) at origin + (x, y, z) * spacing, its

@@ -680,3 +680,46 @@ fn zhcIrradiance(w: array<u32, 27>, f: ZhcFormat, n: vec3<f32>) -> vec3<f32> {
     if (f.family == ZHC_LAYOUT_SH2_Q) { return zhcIrradianceSh2Q(vec4<u32>(w[0], w[1], w[2], w[3]), f, n); }
     return vec3<f32>(0.0);
 }
+
+// ---- IrradZ lightmaps (codec/lightmap/irradz.h, codec/lightmap/lightmap.cpp, docs/irradz.md) ----------
+// The sampled texture values -> irradiance at the tangent-space unit normal n (surface normal +Z),
+// as zhcIrradZIrradiance of zhc.glsl. BC: iz = BC6H rgb, wa = BC4 r, dUv = BC5 rg. ASTC targets
+// (docs/lightmap-formats.md "ASTC targets"): iz = the ASTC HDR texture's rgb, or for the LDR fallback
+// zhcIrradZIzFromLdr(its rgb, vec2(lo, hi)) with the KTX2 key "zhc.iz_log2_range"; dwa = the
+// (u, v, w_a) texture's rgb.
+const ZHC_IRRADZ_HHD: u32 = 0u;  // E(n) = C_a (1 + n_z) / 2 + C_d max(0, n.d)
+const ZHC_IRRADZ_AHD: u32 = 1u;  // E(n) = C_a + C_d max(0, n.d)
+const ZHC_IRRADZ_MIN_DZ: f32 = 0.087155742747658166;  // cos 85 deg
+const ZHC_IRRADZ_MAX_SIN: f32 = 0.99619469809174555;  // sin 85 deg
+
+// Hemi-octahedral (u, v) -> unit direction with z >= 0 (codec decode_hemioct).
+fn zhcDecodeHemiOct(uv: vec2<f32>) -> vec3<f32> {
+    let ab = 2.0 * clamp(uv, vec2<f32>(0.0), vec2<f32>(1.0)) - 1.0;
+    let p = vec2<f32>(ab.x + ab.y, ab.x - ab.y) * 0.5;
+    return zhcNormalizeOrZ(vec3<f32>(p, max(0.0, 1.0 - abs(p.x) - abs(p.y))));
+}
+
+fn zhcIrradZIrradiance(iz: vec3<f32>, wa: f32, dUv: vec2<f32>, n: vec3<f32>, model: u32) -> vec3<f32> {
+    var d = zhcDecodeHemiOct(dUv);
+    if (!(d.z >= ZHC_IRRADZ_MIN_DZ)) {
+        // Below 85 degrees: keep the azimuth (d.xy is not zero: |d| = 1 and d.z < 0.09).
+        let h = d.xy * inverseSqrt(dot(d.xy, d.xy));
+        d = vec3<f32>(h * ZHC_IRRADZ_MAX_SIN, ZHC_IRRADZ_MIN_DZ);
+    }
+    let w = clamp(wa, 0.0, 1.0);
+    let ca = w * iz;
+    let cd = (1.0 - w) * iz / d.z;
+    var h = 1.0;
+    if (model == ZHC_IRRADZ_HHD) { h = (1.0 + n.z) * 0.5; }
+    return ca * h + cd * max(0.0, dot(n, d));
+}
+
+// The ASTC LDR fallback: I_z = 2^(lo + t (hi - lo)) - 2^lo per channel (codec iz_from_ldr).
+fn zhcIrradZIzFromLdr(t: vec3<f32>, loHi: vec2<f32>) -> vec3<f32> {
+    let x = loHi.x + clamp(t, vec3<f32>(0.0), vec3<f32>(1.0)) * (loHi.y - loHi.x);
+    return exp2(x) - exp2(loHi.x);
+}
+
+fn zhcIrradZIrradianceAstc(iz: vec3<f32>, dwa: vec3<f32>, n: vec3<f32>, model: u32) -> vec3<f32> {
+    return zhcIrradZIrradiance(iz, dwa.z, dwa.xy, n, model);
+}

@@ -1140,6 +1140,28 @@ static inline void zhc_irradz_irradiance_texel(const float i_z[3], float w_a, fl
     zhc_irradz_irradiance(i_z, (double)w_a, d, model, n, rgb);
 }
 
+/* ASTC targets (docs/lightmap-formats.md, "ASTC targets"): I_z in ASTC HDR RGB (as for BC6H, the
+ * texture value is I_z) and d, w_a in one ASTC LDR RGB texture: (u, v, w_a) = the texel's (r, g, b).
+ * The LDR fallback stores I_z per channel as t in [0, 1] with the texture's range (lo, hi) from its KTX2
+ * key "zhc.iz_log2_range" (codec/lightmap/lightmap.cpp iz_from_ldr):
+ *   I_z = 2^(lo + t (hi - lo)) - 2^lo, t clamped to [0, 1] (NaN gives 0), in double, rounded once. */
+static inline float zhc_irradz_iz_from_ldr(float t, float lo, float hi) {
+    const double u = t >= 0 ? (t < 1 ? (double)t : 1.0) : 0.0;
+    return (float)(exp2((double)lo + u * ((double)hi - (double)lo)) - exp2((double)lo));
+}
+
+/* An ASTC texel: iz_texel = the I_z texture's RGB (ldr = 0: ASTC HDR; ldr = 1: the LDR fallback with
+ * its range lo, hi), dwa = the (u, v, w_a) texture's RGB. */
+static inline void zhc_irradz_irradiance_astc(const float iz_texel[3], const float dwa[3], int ldr, float lo, float hi, int model,
+                                              const double n[3], float rgb[3]) {
+    float iz[3];
+    double d[3];
+    int k;
+    for (k = 0; k < 3; ++k) iz[k] = ldr ? zhc_irradz_iz_from_ldr(iz_texel[k], lo, hi) : iz_texel[k];
+    zhc_decode_hemioct(dwa[0], dwa[1], d);
+    zhc_irradz_irradiance(iz, (double)dwa[2], d, model, n, rgb);
+}
+
 /* HLSH evaluation at tangent-space unit normal m: I(m) = I_z m_z + C_a (1 - m_z) + c_x m_x + c_y m_y. */
 static inline void zhc_hlsh_evaluate(const float i_z[3], const float c_a[3], const float c_x[3], const float c_y[3],
                                      const double m[3], float rgb[3]) {

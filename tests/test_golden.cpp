@@ -13,6 +13,10 @@
 //           hemispherical irradiance RMSE against its SH3 (lightmap::audit), hash of the planes;
 //           "search_bc" / "newton_bc" = that solve, then BC6H + BC5 + BC4 at default quality
 //           ("newton_bc" is the `zhc lightmap encode` output).
+//   astc    the newton planes through the ASTC targets (formats/lightmap/astc.h, astcenc 4.2 at
+//           medium effort): "astc_4x4", "astc_6x6" (HDR I_z + LDR (u, v, w_a)), "astc_ldr_4x4"
+//           (the LDR range fallback): hemispherical RMSE after decoding, bytes and hash of the blocks.
+//           Listed after every other row (one block at the end of the table).
 //
 // A row fails when its size or hash changes, or its error leaves [value - tolerance, value +
 // tolerance] (absolute, stored in the file: 0.1% of the value when generated). A codec entry
@@ -32,12 +36,14 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include "codec/report/audit.h"
 #include "codec/lightmap/bc45.h"
 #include "codec/lightmap/bc6h.h"
 #include "codec/probe/codec.h"
 #include "codec/lightmap/lightmap.h"
+#include "formats/lightmap/astc.h"
 #include "formats/report/audit_inputs.h"
 #include "support.h"
 
@@ -167,7 +173,7 @@ void block_rows(const std::string& input, const std::vector<float>& rgb, const s
 
 // Every row, recomputed.
 std::vector<Row> compute_rows() {
-    std::vector<Row> rows;
+    std::vector<Row> rows, astc_rows;
     const std::vector<Vec3> dirs = fibonacci_sphere(kDirections);
     for (const std::string& path : test::envmap_paths()) {
         const std::string map = test::envmap_name(path);
@@ -247,7 +253,30 @@ std::vector<Row> compute_rows() {
         const lightmap::Audit an = lightmap::audit(lm, newton, old_way, lightmap::decompress(cn), 1);
         rows.push_back(make_row("irradz", "newton", lmname, plane_bytes, "hemi_rmse", an.rmse_search, planes_hash(newton)));
         rows.push_back(make_row("irradz", "newton_bc", lmname, blocks_size(cn), "hemi_rmse", an.rmse_after_bc, blocks_hash(cn)));
+        // The ASTC targets on the same planes.
+        for (const auto& [name, fp, ldr] : {std::tuple{"astc_4x4", astc::Footprint{4, 4}, false},
+                                            std::tuple{"astc_6x6", astc::Footprint{6, 6}, false},
+                                            std::tuple{"astc_ldr_4x4", astc::Footprint{4, 4}, true}}) {
+            lightmap_astc::Options ao;
+            ao.footprint = fp;
+            ao.ldr_iz = ldr;
+            float mn = 0, mx = 0;
+            lightmap::iz_extent(newton.iz, mn, mx);
+            ao.range = lightmap::iz_log_range(mn, mx);
+            auto ca = lightmap_astc::compress(newton, ao, 1);
+            EXPECT_TRUE(ca.ok());
+            if (!ca) continue;
+            auto da = lightmap_astc::decompress(*ca);
+            EXPECT_TRUE(da.ok());
+            if (!da) continue;
+            const lightmap::Audit aa = lightmap::audit(lm, newton, old_way, *da, 1);
+            Hash h;
+            h.bytes(ca->iz);
+            h.bytes(ca->dwa);
+            astc_rows.push_back(make_row("astc", name, lmname, ca->bytes(), "hemi_rmse", aa.rmse_after_bc, h.h));
+        }
     }
+    rows.insert(rows.end(), astc_rows.begin(), astc_rows.end());
     return rows;
 }
 
@@ -331,6 +360,7 @@ TEST(Golden, TableCoversEveryPath) {
     EXPECT_EQ(per_kind["bc5"], 2 * 2 * maps);
     EXPECT_EQ(per_kind["bc4"], 2 * 2 * maps);
     EXPECT_EQ(per_kind["irradz"], 5 * maps);
+    EXPECT_EQ(per_kind["astc"], 3 * maps);
 }
 
 }  // namespace

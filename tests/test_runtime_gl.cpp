@@ -52,7 +52,7 @@ constexpr double kCFloat = 16, kCQuant = 32, kCDecode = 16, kCLightmap = 16;
 constexpr int kOutFloats = 30;  // per item: 27 SH3 radiance + 3 irradiance
 
 // The test main appended after zhc.glsl. Modes: 0 probe decode + irradiance, 1 IrradZ texel,
-// 2 DC unpacking, 3 HLSH.
+// 2 DC unpacking, 3 HLSH, 4 probe volume, 5 the ASTC LDR fallback's I_z decode.
 // Before zhc.glsl: the probe words, bound for the volume functions (ZHC_VOLUME_WORD).
 const char* kTestPrelude = R"(
 layout(std430, binding = 0) readonly buffer Words { uint words[]; };
@@ -102,6 +102,11 @@ void main() {
         for (uint k = 0u; k < 4u; ++k)
             v[k] = uintBitsToFloat(uvec3(words[b + 3u * k], words[b + 3u * k + 1u], words[b + 3u * k + 2u]));
         vec3 e = zhcHlshIrradiance(v[0], v[1], v[2], v[3], n);
+        outv[o] = e.x; outv[o + 1u] = e.y; outv[o + 2u] = e.z;
+    } else if (uMode == 5u) {  // ASTC LDR fallback: I_z from t with the texture's (lo, hi)
+        uint b = i * 5u;
+        vec3 t = uintBitsToFloat(uvec3(words[b], words[b + 1u], words[b + 2u]));
+        vec3 e = zhcIrradZIzFromLdr(t, uintBitsToFloat(uvec2(words[b + 3u], words[b + 4u])));
         outv[o] = e.x; outv[o + 1u] = e.y; outv[o + 2u] = e.z;
     } else if (uMode == 4u) {  // probe volume: normals[] holds position, normal per item
         ZhcFormat f = ZhcFormat(uA.x, uA.y, uA.z, uA.w, uB.x, uB.y, uB.z, uB.w, uKind, uLum, uCurve);
@@ -459,6 +464,46 @@ TEST_F(RuntimeGl, DcUnpackingIsBitExact) {
     }
     EXPECT_EQ(mismatches, 0);
     std::printf("DC unpacking: %zu words, %ld mismatches (R11G11B10F, RGB9E5, binary16 all codes)\n", w.size(), mismatches);
+}
+
+// The ASTC LDR fallback's range decode (zhcIrradZIzFromLdr) against lightmap::iz_from_ldr, on ranges
+// of 1 to 16 stops anywhere in [-14, 16]. GLSL's exp2 is within 3 + 2|x| ulp (GLSL 4.50 4.5.1);
+// x = lo + t (hi - lo) adds 3 roundings of size u |x| (absolute, so ln 2 u |x| 2^x after exp2),
+// and the subtraction of 2^lo one more: |gpu - codec| <= 8 u (3 + 3 |x|) (2^x + 2^lo).
+TEST_F(RuntimeGl, AstcLdrRangeDecodeMatchesTheCodec) {
+    constexpr int kItems = 100000;
+    std::mt19937_64 rng(0xA57C);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<std::uint32_t> w(kItems * 5);
+    std::vector<float> normals(kItems * 3, 0.0f), in(kItems * 5);
+    for (int i = 0; i < kItems; ++i) {
+        const float lo = static_cast<float>(-14 + 29 * u(rng)), hi = static_cast<float>(lo + 1 + 15 * u(rng) * u(rng));
+        const float v[5] = {static_cast<float>(u(rng)), static_cast<float>(i % 9 == 0 ? 0.0 : u(rng)),
+                            static_cast<float>(i % 11 == 0 ? 1.0 : u(rng)), lo, hi};
+        for (int j = 0; j < 5; ++j) {
+            in[5 * i + j] = v[j];
+            std::memcpy(&w[5 * i + j], &v[j], 4);
+        }
+    }
+    Uniforms un;
+    un.mode = 5;
+    const std::vector<float> gpu = run(un, w, normals, kItems);
+    double worst = 0;
+    long failures = 0;
+    for (int i = 0; i < kItems; ++i) {
+        const float* v = in.data() + 5 * i;
+        const lightmap::IzLogRange r{v[3], v[4]};
+        for (int k = 0; k < 3; ++k) {
+            const double ref = lightmap::iz_from_ldr(v[k], r), g = gpu[static_cast<size_t>(i) * kOutFloats + static_cast<size_t>(k)];
+            const double x = double(r.lo) + double(v[k]) * (double(r.hi) - double(r.lo));
+            const double scale = kU * (3 + 3 * std::fabs(x)) * (std::exp2(x) + std::exp2(double(r.lo)));
+            worst = std::max(worst, std::fabs(g - ref) / scale);
+            if (!(std::fabs(g - ref) <= 8 * scale) && failures++ < 5)
+                ADD_FAILURE() << "item " << i << " channel " << k << ": codec " << ref << " gpu " << g;
+        }
+    }
+    std::printf("ASTC LDR range decode: %d items, max error %.3f x u (3 + 3|x|) (2^x + 2^lo) (bound 8)\n", kItems, worst);
+    EXPECT_EQ(failures, 0);
 }
 
 // IrradZ texels (BC6H I_z, BC4 w_a, BC5 hemi-octahedral d) -> irradiance at tangent normals.

@@ -594,6 +594,46 @@ TEST_F(RuntimeVk, IrradzMatchesTheCodec) {
 }
 
 
+// The ASTC LDR fallback's range decode (zhc_irradz_iz_from_ldr, mode 4) against lightmap::iz_from_ldr
+// on ranges of 1 to 16 stops in [-14, 16]: the bound of RuntimeGl.AstcLdrRangeDecodeMatchesTheCodec,
+// |gpu - codec| <= 8 u (3 + 3 |x|) (2^x + 2^lo), x = lo + t (hi - lo) (exp2's error grows with |x|).
+TEST_F(RuntimeVk, AstcLdrRangeDecodeMatchesTheCodec) {
+    std::mt19937_64 rng(0xA57C2);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const std::size_t count = 100000;
+    std::vector<std::uint32_t> words(count * 5);
+    std::vector<float> normals(count * 4, 0.0f);
+    for (std::size_t i = 0; i < count; ++i) {
+        const float lo = static_cast<float>(-14 + 29 * u(rng)), hi = static_cast<float>(lo + 1 + 15 * u(rng) * u(rng));
+        const float v[5] = {static_cast<float>(u(rng)), static_cast<float>(i % 9 == 0 ? 0.0 : u(rng)),
+                            static_cast<float>(i % 11 == 0 ? 1.0 : u(rng)), lo, hi};
+        for (int j = 0; j < 5; ++j) words[5 * i + static_cast<size_t>(j)] = float_bits(v[j]);
+    }
+    std::uint32_t params[16] = {};
+    params[13] = static_cast<std::uint32_t>(count);
+    params[14] = 5;
+    params[15] = 4;
+    const std::vector<float> out = Gpu::get().run(params, words, normals, count);
+    ASSERT_EQ(out.size(), count * kOutFloats);
+    double worst = 0;
+    std::size_t failures = 0;
+    std::string first;
+    for (std::size_t i = 0; i < count; ++i) {
+        const lightmap::IzLogRange r{bits_float(words[5 * i + 3]), bits_float(words[5 * i + 4])};
+        for (int k = 0; k < 3; ++k) {
+            const float t = bits_float(words[5 * i + static_cast<size_t>(k)]);
+            const double ref = lightmap::iz_from_ldr(t, r), g = out[i * kOutFloats + 27 + static_cast<size_t>(k)];
+            const double x = double(r.lo) + double(t) * (double(r.hi) - double(r.lo));
+            const double scale = (FLT_EPSILON / 2) * (3 + 3 * std::fabs(x)) * (std::exp2(x) + std::exp2(double(r.lo)));
+            worst = std::max(worst, std::fabs(g - ref) / scale);
+            if (!(std::fabs(g - ref) <= 8 * scale) && failures++ == 0)
+                first = "item " + std::to_string(i) + " channel " + std::to_string(k) + ": shader " + std::to_string(g) + " C++ " + std::to_string(ref);
+        }
+    }
+    std::printf("ASTC LDR range decode (HLSL): %zu items, max error %.3f x u (3 + 3|x|) (2^x + 2^lo) (bound 8)\n", count, worst);
+    EXPECT_EQ(failures, 0u) << first;
+}
+
 // Probe volumes (zhc_volume_irradiance, mode 3) against the C header's zhc_volume_irradiance_d:
 // every codec table entry, a 6x5x4 grid (default parameters) and a 5x1x3 grid (irradiance storage;
 // packed: 5 bits, sqrt, RGB9E5, per-channel axes, zero-preserving) of probes (lights, random SH,

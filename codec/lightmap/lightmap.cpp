@@ -29,11 +29,12 @@ void add_log2_sq_errors(const float* reference, const float* decoded, std::size_
 
 // Adds texel i's HHD errors of the three encodings to s, o, b and its I_z to iz.
 void add_texel_errors(const ShLightmap& lm, size_t i, const IrradzPlanes& search, const IrradzPlanes& old_way,
-                      const IrradzPlanes& after_bc, double& s, double& o, double& b, double& iz) {
+                      const IrradzPlanes& after_bc, double& s, double& o, double& b, double& iz,
+                      irradz::Model after_model = irradz::Model::kHhd) {
     const Sh3Irradiance t = to_irradiance(lm.texels[i]);
     s += irradz::hemispherical_mse(t, search.texel(i), irradz::Model::kHhd);
     o += irradz::hemispherical_mse(t, old_way.texel(i), irradz::Model::kHhd);
-    b += irradz::hemispherical_mse(t, after_bc.texel(i), irradz::Model::kHhd);
+    b += irradz::hemispherical_mse(t, after_bc.texel(i), after_model);
     const Rgb e = evaluate(t, {0, 0, 1});
     iz += (e.r + e.g + e.b) / 3.0;
 }
@@ -172,6 +173,35 @@ IrradzPlanes decompress(const Compressed& c) {
     return p;
 }
 
+IzLogRange iz_log_range(float min_positive, float max_value) {
+    IzLogRange r;
+    if (!(max_value > 0) || !std::isfinite(max_value)) return r;
+    const double top = std::log2(double(max_value));
+    const double lo = std::max(top - 16, min_positive > 0 ? std::log2(double(min_positive)) : top - 16);
+    r.lo = static_cast<float>(lo);
+    r.hi = static_cast<float>(std::log2(double(max_value) + std::exp2(double(r.lo))));
+    if (!(r.hi > r.lo)) r.hi = std::nextafter(r.lo, 1e30f);
+    return r;
+}
+
+void iz_extent(const std::vector<float>& rgb, float& min_positive, float& max_value) {
+    for (float v : rgb) {
+        if (v > 0 && (min_positive <= 0 || v < min_positive)) min_positive = v;
+        if (v > max_value) max_value = v;
+    }
+}
+
+float iz_to_ldr(float v, IzLogRange r) {
+    const double x = v > 0 ? double(v) : 0.0;
+    const double t = (std::log2(x + std::exp2(double(r.lo))) - double(r.lo)) / (double(r.hi) - double(r.lo));
+    return static_cast<float>(std::clamp(t, 0.0, 1.0));
+}
+
+float iz_from_ldr(float t, IzLogRange r) {
+    const double lo = r.lo, hi = r.hi, u = t >= 0 ? std::min(double(t), 1.0) : 0.0;  // NaN -> 0
+    return static_cast<float>(std::exp2(lo + u * (hi - lo)) - std::exp2(lo));
+}
+
 double log2_psnr(const float* reference, const float* decoded, std::size_t count) {
     double mse = 0;
     add_log2_sq_errors(reference, decoded, count, mse);
@@ -214,7 +244,7 @@ void AuditAccumulator::add(const ShLightmap& lm, const IrradzPlanes& search, con
     // The texels audit() samples: global index next_, next_ + stride, ...
     const size_t n = lm.texels.size();
     for (; next_ < texels_ + n; next_ += stride_) {
-        add_texel_errors(lm, next_ - texels_, search, old_way, after_bc, s_, o_, b_, iz_);
+        add_texel_errors(lm, next_ - texels_, search, old_way, after_bc, s_, o_, b_, iz_, after_model_);
         ++sampled_;
     }
     add_log2_sq_errors(search.iz.data(), after_bc.iz.data(), search.iz.size(), mse_iz_);

@@ -109,14 +109,31 @@ Audit audit(const ShLightmap& lm, const IrradzPlanes& search, const IrradzPlanes
 // same order as audit() on the whole image, so the same numbers (tested).
 class AuditAccumulator {
 public:
-    explicit AuditAccumulator(std::size_t stride) : stride_(stride < 1 ? 1 : stride) {}
+    explicit AuditAccumulator(std::size_t stride, irradz::Model after_model = irradz::Model::kHhd)
+        : stride_(stride < 1 ? 1 : stride), after_model_(after_model) {}
     void add(const ShLightmap& band, const IrradzPlanes& search, const IrradzPlanes& old_way, const IrradzPlanes& after_bc);
     Audit result() const;
 
 private:
-    std::size_t stride_, next_ = 0, sampled_ = 0, texels_ = 0, iz_values_ = 0;
+    std::size_t stride_;
+    irradz::Model after_model_;
+    std::size_t next_ = 0, sampled_ = 0, texels_ = 0, iz_values_ = 0;
     double s_ = 0, o_ = 0, b_ = 0, iz_ = 0, mse_iz_ = 0, mw_ = 0, md_ = 0, ang_ = 0, amax_ = 0;
 };
+
+// The LDR range encoding of I_z (the ASTC LDR fallback, docs/lightmap-formats.md): one range per
+// texture, t = (log2(v + 2^lo) - lo) / (hi - lo) in [0, 1] per channel, decoded as
+// v = 2^(lo + t (hi - lo)) - 2^lo (so t = 0 is exactly 0). iz_log_range picks lo = log2 of the
+// smallest positive I_z, but at least log2(max) - 16, and hi = log2(max + 2^lo) (both rounded to
+// float: the file stores them as floats); an image without positive values gets lo = -14, hi = -13.
+struct IzLogRange {
+    float lo = -14, hi = -13;
+};
+IzLogRange iz_log_range(float min_positive, float max_value);
+// Scans rgb (3 per texel) for the smallest positive and the largest value (NaN and negatives skipped).
+void iz_extent(const std::vector<float>& rgb, float& min_positive, float& max_value);
+float iz_to_ldr(float v, IzLogRange r);    // clamped to [0, 1]
+float iz_from_ldr(float t, IzLogRange r);  // computed in double, rounded to float once
 
 // log2-PSNR of HDR RGB values: l(v) = log2(max(v, 2^-14)) (v clamped to BC6H's [0, 65504]),
 // PSNR = 10 log10(30^2 / MSE_l): 30 = log2(65504) - (-14) rounded, the representable log range.

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <utility>
 
+#include "formats/lightmap/astc.h"
+
 #include "formats/io/file_io.h"
 #include "formats/io/le_bytes.h"
 
@@ -19,15 +21,35 @@ constexpr std::size_t kHeaderBytes = 12 + 9 * 4;     // identifier + 9 u32 field
 constexpr std::size_t kIndexBytes = 4 * 4 + 2 * 8;   // dfd/kvd offsets+lengths, sgd offset+length
 constexpr std::size_t kLevelIndexBytes = 3 * 8;      // one level
 constexpr std::size_t kDfdStart = kHeaderBytes + kIndexBytes + kLevelIndexBytes;  // 104
+// Key/value data is read whole from the file's first 64 KiB by read_ktx2_layout as well: at most 32 KiB.
+constexpr std::uint32_t kMaxKvdBytes = 32768;
 
 // Khronos Data Format: colour models and sample layout for the three formats.
-constexpr std::uint32_t kModelBc4 = 131, kModelBc5 = 132, kModelBc6h = 133;
+constexpr std::uint32_t kModelBc4 = 131, kModelBc5 = 132, kModelBc6h = 133, kModelAstc = 162;
 constexpr std::uint32_t kPrimariesBt709 = 1, kTransferLinear = 1;
-constexpr std::uint32_t kQualifierFloat = 0x80;  // in the channelType|qualifiers byte
+constexpr std::uint32_t kQualifierFloat = 0x80, kQualifierSigned = 0x40;  // in the channelType|qualifiers byte
 
 
 // The DFD zhc writes (and the only one it accepts) for a format: dfdTotalSize + one basic block.
 std::vector<std::uint8_t> make_dfd(std::uint32_t vk_format) {
+    if (const auto astc_format = astc::format_of_vk(vk_format)) {
+        // ASTC: one 128-bit sample of KHR_DF_CHANNEL_ASTC_DATA (0); SFLOAT (HDR) marks it float and
+        // signed with the range [-1, 1] (as libktx's vk2dfd), UNORM (LDR) is [0, 0xFFFFFFFF].
+        const bool hdr = astc_format->hdr;
+        std::vector<std::uint8_t> d;
+        put32(d, 4 + 24 + 16);
+        put32(d, 0);
+        put32(d, 2u | (40u << 16));
+        put32(d, kModelAstc | (kPrimariesBt709 << 8) | (kTransferLinear << 16));
+        put32(d, static_cast<std::uint32_t>(astc_format->footprint.x - 1) | (static_cast<std::uint32_t>(astc_format->footprint.y - 1) << 8));
+        put32(d, 16);
+        put32(d, 0);
+        put32(d, (127u << 16) | ((hdr ? kQualifierFloat | kQualifierSigned : 0u) << 24));
+        put32(d, 0);
+        put32(d, hdr ? 0xBF800000u : 0u);
+        put32(d, hdr ? 0x3F800000u : 0xFFFFFFFFu);
+        return d;
+    }
     const bool bc5 = vk_format == kVkFormatBc5Unorm, bc6 = vk_format == kVkFormatBc6hUfloat;
     const std::uint32_t samples = bc5 ? 2 : 1;
     const std::uint32_t block_size = 24 + 16 * samples;
@@ -61,6 +83,7 @@ Error bad(ErrorCode code, const std::string& name, const std::string& what) {
 }  // namespace
 
 std::size_t ktx2_block_bytes(std::uint32_t vk_format) {
+    if (astc::format_of_vk(vk_format)) return 16;
     switch (vk_format) {
         case kVkFormatBc4Unorm: return 8;
         case kVkFormatBc5Unorm:
@@ -69,13 +92,33 @@ std::size_t ktx2_block_bytes(std::uint32_t vk_format) {
     }
 }
 
-Result<std::vector<std::uint8_t>> ktx2_header(std::uint32_t vk_format, int width, int height) {
+std::array<int, 2> ktx2_block_dims(std::uint32_t vk_format) {
+    if (const auto f = astc::format_of_vk(vk_format)) return {f->footprint.x, f->footprint.y};
+    return {4, 4};
+}
+
+std::vector<std::uint8_t> encode_ktx2_key_values(const std::vector<Ktx2KeyValue>& kv) {
+    std::vector<std::uint8_t> out;
+    for (const auto& e : kv) {
+        put32(out, static_cast<std::uint32_t>(e.key.size() + 1 + e.value.size()));
+        out.insert(out.end(), e.key.begin(), e.key.end());
+        out.push_back(0);
+        out.insert(out.end(), e.value.begin(), e.value.end());
+        out.resize(align_up(out.size(), 4), 0);
+    }
+    return out;
+}
+
+Result<std::vector<std::uint8_t>> ktx2_header(std::uint32_t vk_format, int width, int height, const std::vector<Ktx2KeyValue>& key_values) {
     const std::size_t bb = ktx2_block_bytes(vk_format);
     if (bb == 0) return make_error(ErrorCode::kInvalidArgument, "ktx2: unsupported vkFormat " + std::to_string(vk_format));
     if (width <= 0 || height <= 0) return make_error(ErrorCode::kInvalidArgument, "ktx2: empty image");
-    const std::size_t level_bytes = static_cast<size_t>((width + 3) / 4) * static_cast<size_t>((height + 3) / 4) * bb;
+    const std::size_t level_bytes = ktx2_level_bytes(vk_format, width, height);
     const auto dfd = make_dfd(vk_format);
-    const std::size_t level_offset = align_up(kDfdStart + dfd.size(), bb);  // lcm(block bytes, 4) = block bytes
+    const auto kvd = encode_ktx2_key_values(key_values);
+    if (kvd.size() > kMaxKvdBytes) return make_error(ErrorCode::kInvalidArgument, "ktx2: key/value data above 32768 bytes");
+    const std::size_t kvd_offset = kvd.empty() ? 0 : kDfdStart + dfd.size();
+    const std::size_t level_offset = align_up(kDfdStart + dfd.size() + kvd.size(), bb);  // lcm(block bytes, 4) = block bytes
     std::vector<std::uint8_t> out(kIdentifier, kIdentifier + 12);
     put32(out, vk_format);
     put32(out, 1);  // typeSize: 1 for block-compressed formats
@@ -88,20 +131,21 @@ Result<std::vector<std::uint8_t>> ktx2_header(std::uint32_t vk_format, int width
     put32(out, 0);  // supercompressionScheme: none
     put32(out, static_cast<std::uint32_t>(kDfdStart));
     put32(out, static_cast<std::uint32_t>(dfd.size()));
-    put32(out, 0);  // kvdByteOffset
-    put32(out, 0);  // kvdByteLength
+    put32(out, static_cast<std::uint32_t>(kvd_offset));
+    put32(out, static_cast<std::uint32_t>(kvd.size()));
     put64(out, 0);  // sgdByteOffset
     put64(out, 0);  // sgdByteLength
     put64(out, level_offset);
     put64(out, level_bytes);
     put64(out, level_bytes);  // uncompressedByteLength (no supercompression)
     out.insert(out.end(), dfd.begin(), dfd.end());
+    out.insert(out.end(), kvd.begin(), kvd.end());
     out.resize(level_offset, 0);
     return out;
 }
 
 Result<std::vector<std::uint8_t>> encode_ktx2(const Ktx2Image& img) {
-    auto out = ktx2_header(img.vk_format, img.width, img.height);
+    auto out = ktx2_header(img.vk_format, img.width, img.height, img.key_values);
     if (!out) return out;
     if (img.blocks.size() != ktx2_level_bytes(img.vk_format, img.width, img.height))
         return make_error(ErrorCode::kInvalidArgument, "ktx2: block data does not match the image size");
@@ -138,7 +182,8 @@ Result<TextureHeaderSummary> describe_ktx2_header(std::span<const std::uint8_t> 
 
 std::uint64_t ktx2_level_bytes(std::uint32_t vk_format, int width, int height) {
     if (width <= 0 || height <= 0) return 0;
-    return static_cast<std::uint64_t>((width + 3) / 4) * static_cast<std::uint64_t>((height + 3) / 4) * ktx2_block_bytes(vk_format);
+    const auto [bx, by] = ktx2_block_dims(vk_format);
+    return static_cast<std::uint64_t>((width + bx - 1) / bx) * static_cast<std::uint64_t>((height + by - 1) / by) * ktx2_block_bytes(vk_format);
 }
 
 namespace {
@@ -157,7 +202,7 @@ Result<Ktx2Image> decode_ktx2_layout(std::span<const std::uint8_t> b, std::uint6
     const std::size_t bb = ktx2_block_bytes(img.vk_format);
     if (bb == 0)
         return bad(ErrorCode::kUnsupported, name, "unsupported vkFormat " + std::to_string(img.vk_format) +
-                                                      " (byte 12; zhc reads 139 BC4, 141 BC5, 143 BC6H_UFLOAT)");
+                                                      " (byte 12; zhc reads 139 BC4, 141 BC5, 143 BC6H_UFLOAT, ASTC 4x4/5x5/6x6/8x8 UNORM and SFLOAT)");
     if (type_size != 1) return bad(ErrorCode::kBadFormat, name, "typeSize must be 1 for block formats (byte 16)");
     if (w == 0 || h == 0) return bad(ErrorCode::kBadFormat, name, "zero pixelWidth/pixelHeight (bytes 20-27)");
     if (w > static_cast<std::uint32_t>(limits.max_dimension) || h > static_cast<std::uint32_t>(limits.max_dimension))
@@ -179,14 +224,35 @@ Result<Ktx2Image> decode_ktx2_layout(std::span<const std::uint8_t> b, std::uint6
     if (std::memcmp(b.data() + dfd_off, expected_dfd.data(), expected_dfd.size()) != 0)
         return bad(ErrorCode::kBadFormat, name, "data format descriptor does not describe vkFormat " + std::to_string(img.vk_format) +
                                                     " (byte " + std::to_string(dfd_off) + ")");
+    if (kvd_len > kMaxKvdBytes)
+        return bad(ErrorCode::kBadFormat, name, "key/value data of " + std::to_string(kvd_len) + " bytes exceeds the limit " +
+                                                    std::to_string(kMaxKvdBytes) + " (byte 60)");
     if (kvd_len != 0) {
-        // Key/value data is allowed (and ignored) if it lies between the DFD and the level data.
-        if (kvd_off < dfd_off + dfd_len || static_cast<std::uint64_t>(kvd_off) + kvd_len > lvl_off)
+        // Key/value data must lie between the DFD and the level data; every entry is parsed.
+        if (kvd_off < dfd_off + dfd_len || static_cast<std::uint64_t>(kvd_off) + kvd_len > lvl_off ||
+            static_cast<std::uint64_t>(kvd_off) + kvd_len > b.size())
             return bad(ErrorCode::kBadFormat, name, "key/value data outside its place (bytes 56-63)");
+        // Entries: u32 keyAndValueByteLength, NUL-terminated key, value, padding to 4 bytes.
+        std::size_t at = kvd_off;
+        const std::size_t end = static_cast<std::size_t>(kvd_off) + kvd_len;
+        while (at < end) {
+            if (end - at < 4) return bad(ErrorCode::kBadFormat, name, "key/value entry truncated (byte " + std::to_string(at) + ")");
+            const std::uint32_t len = get32(b, at);
+            if (len > end - at - 4) return bad(ErrorCode::kBadFormat, name, "key/value entry longer than the data (byte " + std::to_string(at) + ")");
+            const auto* p = b.data() + at + 4;
+            const auto* nul = static_cast<const std::uint8_t*>(std::memchr(p, 0, len));
+            if (nul == nullptr || nul == p)
+                return bad(ErrorCode::kBadFormat, name, "key/value entry without a NUL-terminated key (byte " + std::to_string(at) + ")");
+            Ktx2KeyValue e;
+            e.key.assign(reinterpret_cast<const char*>(p), static_cast<std::size_t>(nul - p));
+            e.value.assign(nul + 1, p + len);
+            img.key_values.push_back(std::move(e));
+            at = align_up(at + 4 + len, 4);
+        }
     } else if (kvd_off != 0) {
         return bad(ErrorCode::kBadFormat, name, "kvdByteOffset without kvdByteLength (byte 56)");
     }
-    const std::uint64_t expected = static_cast<std::uint64_t>((w + 3) / 4) * ((h + 3) / 4) * bb;
+    const std::uint64_t expected = ktx2_level_bytes(img.vk_format, static_cast<int>(w), static_cast<int>(h));
     if (lvl_len != expected || lvl_ulen != expected)
         return bad(ErrorCode::kBadFormat, name, "level 0 byteLength " + std::to_string(lvl_len) + " but " +
                                                     std::to_string(w) + "x" + std::to_string(h) + " needs " +
@@ -221,6 +287,7 @@ Result<BlockFileLayout> read_ktx2_layout(const std::string& path, const Ktx2Limi
     auto img = decode_ktx2_layout(prefix->bytes, prefix->file_size, path, limits, &l.data_offset);
     if (!img) return img.error();
     l.vk_format = img->vk_format;
+    l.key_values = std::move(img->key_values);
     l.width = img->width;
     l.height = img->height;
     return l;

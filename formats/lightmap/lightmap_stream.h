@@ -21,6 +21,7 @@
 
 #include "codec/lightmap/lightmap.h"
 #include "codec/status.h"
+#include "formats/lightmap/astc.h"
 
 namespace zhc::lightmap_stream {
 
@@ -37,7 +38,17 @@ struct Timing {
     double read = 0, fit = 0, compress = 0, write = 0;  // seconds
 };
 
+// Texture targets (docs/lightmap-formats.md): bc = BC6H I_z + BC5 d + BC4 w_a (PREFIX.{iz,d,wa});
+// astc = ASTC HDR I_z + ASTC LDR (u, v, w_a) (PREFIX.{iz,dwa}.ktx2); astc-ldr = the same with I_z in
+// ASTC LDR through lightmap::iz_to_ldr (range in the key "zhc.iz_log2_range" of PREFIX.iz.ktx2).
+enum class Target { kBc, kAstc, kAstcLdr };
+
+// The ASTC effort of a quality preset's BC settings: fast -> kFast, default -> kMedium, slow -> kThorough.
+astc::Effort astc_effort(bc6h::Quality q);
+
 struct EncodeOptions {
+    Target target = Target::kBc;
+    astc::Footprint footprint;  // ASTC targets
     Fit fit = Fit::kNewton;
     bc6h::Quality bc6h_quality = bc6h::Quality::kDefault;
     bc45::Quality bc45_quality = bc45::Quality::kDefault;
@@ -48,7 +59,7 @@ struct EncodeOptions {
 };
 struct EncodeResult {
     int width = 0, height = 0, coefficients = 9;
-    std::uint64_t block_bytes = 0;  // the three levels together
+    std::uint64_t block_bytes = 0;  // the levels of all textures together
     Timing timing;
 };
 // inputs: see ShLightmapSource (one SH3 or linear-SH EXR, or 4 / 9 per-coefficient EXRs).
@@ -58,8 +69,10 @@ Result<EncodeResult> encode(const std::vector<std::string>& inputs, const std::s
 
 struct DecodeResult {
     int width = 0, height = 0;
+    Target target = Target::kBc;
+    astc::Footprint footprint;
 };
-// PREFIX.{iz,d,wa}.{ktx2|dds} -> IrradZ EXR (write_irradz_exr's channels and bytes), block row band
+// PREFIX.{iz,d,wa}.{ktx2|dds} or PREFIX.{iz,dwa}.ktx2 (the target from PREFIX.iz.ktx2's vkFormat) -> IrradZ EXR (write_irradz_exr's channels and bytes), block row band
 // by block row band.
 Result<DecodeResult> decode(const std::string& prefix, bool dds, const std::string& output, int band_rows_requested,
                             const ProgressFn& progress, bool* output_failed = nullptr);
@@ -76,6 +89,27 @@ struct AuditResult {
     lightmap::Audit audit;
     Timing timing;
 };
+
+// audit_targets: one column of the side-by-side comparison. kind "plain" is a Godot-style
+// lightmap: ASTC HDR I_z only (the irradiance at the normal, no direction), rendered as the
+// constant I_z (irradz::Model::kAhd with w_a = 1); split_dwa measures the two-texture packing.
+struct TargetSpec {
+    Target target = Target::kBc;
+    astc::Footprint footprint;
+    bool split_dwa = false, plain = false;
+    std::string name;  // as given to --targets
+};
+// "bc", "astc:4x4", "astc-ldr:6x6", "astc-split:4x4", "plain-astc:4x4" (footprint optional, default 4x4).
+std::optional<TargetSpec> parse_target(const std::string& s);
+struct TargetAudit {
+    TargetSpec spec;
+    std::uint64_t bytes = 0;  // block bytes of all its textures
+    double encode_seconds = 0;
+    lightmap::Audit audit;  // rmse_after_bc and the PSNRs are this target's
+};
+// The same fit, every target compressed and decoded band by band; one TargetAudit per spec.
+Result<std::vector<TargetAudit>> audit_targets(const std::vector<std::string>& inputs, const AuditOptions& options,
+                                               const std::vector<TargetSpec>& targets, AuditResult* base = nullptr);
 // Every row is fitted (irradz's default solve and the talk's baseline, "old way") and block-compressed; the hemispherical error integral
 // is taken on every stride-th texel (lightmap::audit's sampling), the PSNRs over every texel.
 Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOptions& options);

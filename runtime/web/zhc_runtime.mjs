@@ -664,3 +664,67 @@ export function volumeIrradiance(vol, position, normal) {
   const e = volumeIrradianceD(vol, position, normal);
   return [f32(e[0]), f32(e[1]), f32(e[2])];
 }
+
+// ---- IrradZ lightmaps (docs/irradz.md, docs/lightmap-formats.md; the IrradZ section of runtime/zhc_runtime.h) ----
+// The texture values in, the irradiance at a tangent-space unit normal out: BC (I_z from BC6H, w_a
+// from BC4, (u, v) from BC5) and the ASTC targets (I_z from ASTC HDR, or from the LDR fallback through
+// izFromLdr with the texture's "zhc.iz_log2_range"; (u, v, w_a) from one ASTC LDR RGB texture).
+// The arithmetic is the C header's, in doubles, rounding to float32 where it does; Math.pow, atan2,
+// sin and cos are V8's (within an ulp of glibc's; js.astc_webgl measures the difference).
+export const IRRADZ_HHD = 0, IRRADZ_AHD = 1;
+const IRRADZ_MAX_THETA = (85.0 * PI) / 180.0;
+const clampNum = (v, lo, hi) => (v < lo ? lo : hi < v ? hi : v);  // std::clamp, NaN kept
+const maxNum = (a, b) => (a < b ? b : a);  // std::max: max(0, NaN) = 0
+
+// Hemi-octahedral (u, v) in [0, 1]^2 -> unit direction with z >= 0 (zhc_decode_hemioct).
+export function decodeHemioct(u, v) {
+  const a = 2.0 * clampNum(f32(u), 0.0, 1.0) - 1, b = 2.0 * clampNum(f32(v), 0.0, 1.0) - 1;
+  const px = (a + b) / 2, py = (a - b) / 2;
+  return normalizeOr([px, py, maxNum(0.0, 1 - Math.abs(px) - Math.abs(py))]);
+}
+
+// zhc_irradz_irradiance: i_z float RGB, w_a, unit d, model, tangent normal n -> float RGB.
+export function irradzIrradiance(iz, wa, dIn, model, n) {
+  let d = normalizeOr(dIn);
+  if (!(d[2] >= Math.cos(IRRADZ_MAX_THETA))) {
+    const phi = Math.atan2(d[1], d[0]);
+    d = [Math.sin(IRRADZ_MAX_THETA) * Math.cos(phi), Math.sin(IRRADZ_MAX_THETA) * Math.sin(phi), Math.cos(IRRADZ_MAX_THETA)];
+  }
+  const w = clampNum(wa, 0.0, 1.0);
+  const h = model === IRRADZ_AHD ? 1.0 : (1 + n[2]) / 2;
+  const c = maxNum(0.0, n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
+  const out = [0, 0, 0];
+  for (let k = 0; k < 3; k++) {
+    const ca = f32(w * f32(iz[k])), cd = f32(((1 - w) * f32(iz[k])) / d[2]);
+    out[k] = f32(ca * h + cd * c);
+  }
+  return out;
+}
+
+// LDR fallback: t in [0, 1] (NaN -> 0) -> I_z = 2^(lo + t (hi - lo)) - 2^lo (zhc_irradz_iz_from_ldr).
+export function izFromLdr(t, lo, hi) {
+  const tt = f32(t);
+  const u = tt >= 0 ? (tt < 1 ? tt : 1.0) : 0.0;
+  return f32(Math.pow(2, f32(lo) + u * (f32(hi) - f32(lo))) - Math.pow(2, f32(lo)));
+}
+
+// The "zhc.iz_log2_range" value of a KTX2 file's key/value data ("lo hi", NUL-terminated) -> [lo, hi].
+export function parseIzLog2Range(bytes) {
+  const text = new TextDecoder().decode(bytes).replace(/\0$/, '');
+  const m = /^(\S+) (\S+)$/.exec(text);
+  const lo = m ? f32(Number(m[1])) : NaN, hi = m ? f32(Number(m[2])) : NaN;
+  if (!Number.isFinite(lo) || !Number.isFinite(hi) || !(lo < hi)) throw new Error(`zhc.iz_log2_range: not "lo hi" with lo < hi: ${text}`);
+  return [lo, hi];
+}
+
+// BC texel: I_z (BC6H), w_a (BC4), (u, v) (BC5) -> irradiance (zhc_irradz_irradiance_texel).
+export function irradzIrradianceTexel(iz, wa, u, v, model, n) {
+  return irradzIrradiance(iz, f32(wa), decodeHemioct(u, v), model, n);
+}
+
+// ASTC texel: izTexel = the I_z texture's RGB (range = null: ASTC HDR; [lo, hi]: the LDR fallback),
+// dwa = the (u, v, w_a) texture's RGB (zhc_irradz_irradiance_astc).
+export function irradzIrradianceAstc(izTexel, dwa, range, model, n) {
+  const iz = range ? izTexel.slice(0, 3).map((t) => izFromLdr(t, range[0], range[1])) : izTexel.slice(0, 3).map(f32);
+  return irradzIrradiance(iz, f32(dwa[2]), decodeHemioct(dwa[0], dwa[1]), model, n);
+}

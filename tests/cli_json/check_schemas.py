@@ -140,6 +140,8 @@ with open(W("volume.json"), "w") as f:
 check("bench", "bench", ["bench", ENVMAP, "--json", "--no-plots", "--repeats", "1", "--directions", "16",
                          "--representations", "sh3", "--volume-cost", W("volume.json")])
 check("lightmap-audit", "lightmap audit", ["lightmap", "audit", W("lm.exr"), "--json", "--stride", "5"])
+check("lightmap-audit", "lightmap audit", ["lightmap", "audit", W("lm.exr"), "--json", "--stride", "5",
+                                          "--targets", "bc,astc:6x6,astc-ldr,plain-astc"])
 
 # The choice section with every constraint: a budget below the smallest size, one above the largest,
 # --require nonnegative, --max-instructions against a cost table that lists only sh3.

@@ -9,7 +9,7 @@ src=$(cd "$1" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 disabled=()
-for pkg in OpenEXR Imath zstd nlohmann_json PkgConfig TinyGLTF draco meshoptimizer PNG CLI11 GTest benchmark; do
+for pkg in OpenEXR Imath zstd nlohmann_json PkgConfig TinyGLTF draco meshoptimizer astcenc PNG CLI11 GTest benchmark; do
   disabled+=("-DCMAKE_DISABLE_FIND_PACKAGE_${pkg}=ON")
 done
 cmake -S "$src/tests/install/subdir_consumer" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \

@@ -6,7 +6,8 @@
 //   binding 3  output, 32 floats per item: decoded SH3 radiance (27), irradiance (3)
 // mode 0: probes; 1: IrradZ HHD; 2: IrradZ AHD (irradiance in floats 27..29); 3: probe volume
 // (params 16..24: grid origin, spacing (float bits), counts; binding 2 holds position, normal as two
-// float4 per item; irradiance in floats 27..29).
+// float4 per item; irradiance in floats 27..29); 4: the ASTC LDR fallback's I_z decode
+// (zhc_irradz_iz_from_ldr; per item 5 floats t rgb, lo, hi; result in floats 27..29).
 [[vk::binding(0, 0)]] StructuredBuffer<uint> params;
 [[vk::binding(1, 0)]] ByteAddressBuffer words;
 [[vk::binding(2, 0)]] StructuredBuffer<float4> normals;
@@ -44,6 +45,15 @@ void main(uint3 id : SV_DispatchThreadID)
         v.spacing = asfloat(uint3(params[19], params[20], params[21]));
         v.counts = uint3(params[22], params[23], params[24]);
         float3 e = zhc_volume_irradiance(v, f, normals[2u * i].xyz, normals[2u * i + 1u].xyz);
+        results[o + 27u] = e.x;
+        results[o + 28u] = e.y;
+        results[o + 29u] = e.z;
+        return;
+    }
+    if (mode == 4u)
+    {
+        uint b = 20u * i;
+        float3 e = zhc_irradz_iz_from_ldr(asfloat(words.Load3(b)), asfloat(words.Load2(b + 12u)));
         results[o + 27u] = e.x;
         results[o + 28u] = e.y;
         results[o + 29u] = e.z;
