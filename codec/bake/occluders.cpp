@@ -364,7 +364,7 @@ RayHit OccluderBvh::nearest(Vec3 o, Vec3 d, double t_min, double t_max) const {
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
                 // Strictly nearer hits only (the interval's far end is the best so far, with the
                 // best's own t admitted through `<=` below): the first primitive wins a tie.
-                const RayHit h = ray_nearest(prims_[i], o, d, t_min, best.hit ? std::nextafter(far, far + 1.0) : far);
+                const RayHit h = ray_nearest(expand(prims_[i]), o, d, t_min, best.hit ? std::nextafter(far, far + 1.0) : far);
                 if (h.hit && (!best.hit || h.t < best.t)) {
                     best = h;
                     far = h.t;
@@ -396,7 +396,7 @@ bool OccluderBvh::inside_any_solid(Vec3 p) const {
         if (!in) continue;
         if (n.count > 0) {
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i)
-                if (inside_solid(prims_[i], p)) return true;
+                if (inside_solid(expand(prims_[i]), p)) return true;
         } else if (top + 2 <= 128) {
             stack[top++] = n.left;
             stack[top++] = n.right;
