@@ -201,10 +201,18 @@ void encode_bc4(const float in[16], Quality quality, std::uint8_t out[8]) {
     if (quality == Quality::kDefault) {
         // Local search around the best pair (keeps its palette kind).
         const Best start = b;
+        // The fast path skips repeats: the start pair (b.err is its error already) and a pair that
+        // clamps to one already tried (it cannot beat it); the others in the same order.
+        int tried[25], n = 0;
         for (int d0 = -2; d0 <= 2; ++d0)
             for (int d1 = -2; d1 <= 2; ++d1) {
                 const int a = start.r0 + d0, c = start.r1 + d1;
                 if ((start.r0 > start.r1) != (a > c)) continue;
+                if constexpr (kFast) {
+                    const int key = std::clamp(a, 0, 255) * 256 + std::clamp(c, 0, 255);
+                    if (key == start.r0 * 256 + start.r1 || std::find(tried, tried + n, key) != tried + n) continue;
+                    tried[n++] = key;
+                }
                 consider<kFast>(v, a, c, b);
             }
         refine<kFast>(v, b);
