@@ -32,7 +32,7 @@ void palette(int r0, int r1, float pal[8]) {
 struct Quotients {
     float by7[7 * 255 + 1], by5[5 * 255 + 1];
 };
-const Quotients& quotients() {
+[[maybe_unused]] const Quotients& quotients() {
     static const Quotients q = [] {
         Quotients r{};
         for (int n = 0; n <= 7 * 255; ++n) r.by7[n] = static_cast<float>(n) / 7.0f;
@@ -41,7 +41,7 @@ const Quotients& quotients() {
     }();
     return q;
 }
-void palette_fast(int r0, int r1, float pal[8]) {
+[[maybe_unused]] void palette_fast(int r0, int r1, float pal[8]) {
     const Quotients& q = quotients();
     pal[0] = static_cast<float>(r0);
     pal[1] = static_cast<float>(r1);
