@@ -6,6 +6,7 @@
 // same texels, one after the other in this process: the ratio survives a noisy machine.
 //   bench_lightmap [--sizes 1024,2048,4096] [--map FILE.exr] [--quality fast|default|slow]
 //                  [--ref-texels N] [--reps R] [--json FILE] [--keep DIR]
+// End to end: the CPU time of stages read .. write summed (the pipeline on one thread).
 // Every stage runs on one thread. Times: wall and this thread's CPU time (Mtexel/s from the CPU
 // time, which other processes on the shared cores do not inflate; the wall time is printed too).
 // Peak memory: VmHWM of /proc/self/status after each stage, the high-water mark reset before the
@@ -202,6 +203,14 @@ SizeResult run_size(const Sh3Radiance& world, int size, const std::string& dir, 
     return res;
 }
 
+// The pipeline's time per texel: read, fit, BC6H, BC5, BC4 and write one after the other on one
+// thread (CPU or wall seconds for the whole image), what `zhc lightmap encode --threads 1` spends.
+double end_to_end(const SizeResult& r, bool wall) {
+    double s = 0;
+    for (int i = 1; i <= 6; ++i) s += wall ? r.stage[i].wall_s : r.stage[i].cpu_s;
+    return s;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -293,6 +302,8 @@ int main(int argc, char** argv) {
             const double m = st.texels / st.cpu_s / 1e6;
             std::printf("  %-30s %12.3f %16.3f %10.0f %12.3f\n", kStageNames[s], m, st.texels / st.wall_s / 1e6, st.peak, m / base);
         }
+        std::printf("  %-30s %12.3f %16.3f\n", "end to end (stages 2-7)", r.stage[1].texels / end_to_end(r, false) / 1e6,
+                    r.stage[1].texels / end_to_end(r, true) / 1e6);
         std::printf("  fit: newton / reference speed on the same %.0f texels: %.2fx (%.3f vs %.3f us/texel)\n", r.stage[7].texels,
                     r.stage[7].cpu_s / r.stage[8].cpu_s, r.stage[8].cpu_s / r.stage[8].texels * 1e6,
                     r.stage[7].cpu_s / r.stage[7].texels * 1e6);
@@ -305,7 +316,9 @@ int main(int argc, char** argv) {
         for (size_t i = 0; i < results.size(); ++i) {
             const SizeResult& r = results[i];
             out << "    {\"size\": " << r.size << ", \"peak_is_per_stage\": " << (r.peak_reset ? "true" : "false")
-                << ", \"fit_speedup_newton_vs_reference\": " << r.stage[7].cpu_s / r.stage[8].cpu_s << ", \"stages\": [\n";
+                << ", \"fit_speedup_newton_vs_reference\": " << r.stage[7].cpu_s / r.stage[8].cpu_s
+                << ", \"end_to_end_cpu_s\": " << end_to_end(r, false)
+                << ", \"end_to_end_mtexel_per_s\": " << r.stage[1].texels / end_to_end(r, false) / 1e6 << ", \"stages\": [\n";
             for (int s = 0; s < kStages; ++s) {
                 const StageResult& st = r.stage[s];
                 char buf[400];

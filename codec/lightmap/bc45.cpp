@@ -4,7 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <thread>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace zhc::bc45 {
 namespace {
@@ -22,8 +27,39 @@ void palette(int r0, int r1, float pal[8]) {
     }
 }
 
-// Best indices and squared error (255 units) for the endpoint pair.
-float assign(const float v[16], int r0, int r1, std::uint8_t idx[16]) {
+// palette() with the quotients looked up: n / 7.0f and n / 5.0f for every numerator n the format
+// can form (at most 7 * 255), computed by the same float division, so the same bits.
+struct Quotients {
+    float by7[7 * 255 + 1], by5[5 * 255 + 1];
+};
+[[maybe_unused]] const Quotients& quotients() {
+    static const Quotients q = [] {
+        Quotients r{};
+        for (int n = 0; n <= 7 * 255; ++n) r.by7[n] = static_cast<float>(n) / 7.0f;
+        for (int n = 0; n <= 5 * 255; ++n) r.by5[n] = static_cast<float>(n) / 5.0f;
+        return r;
+    }();
+    return q;
+}
+[[maybe_unused]] void palette_fast(int r0, int r1, float pal[8]) {
+    const Quotients& q = quotients();
+    pal[0] = static_cast<float>(r0);
+    pal[1] = static_cast<float>(r1);
+    if (r0 > r1) {
+        for (int j = 1; j <= 6; ++j) pal[j + 1] = q.by7[(7 - j) * r0 + j * r1];
+    } else {
+        for (int j = 1; j <= 4; ++j) pal[j + 1] = q.by5[(5 - j) * r0 + j * r1];
+        pal[6] = 0.0f;
+        pal[7] = 255.0f;
+    }
+}
+
+// Best indices and squared error (255 units) for the endpoint pair: each texel's first palette entry
+// of least squared distance, the errors summed in texel order. assign_scalar is the obviously
+// correct form; assign_fast computes the same floats (the same subtractions and products, the
+// same strict comparisons in the same entry order, the same summation order) four texels at a
+// time, so both give the same bits.
+float assign_scalar(const float v[16], int r0, int r1, std::uint8_t idx[16]) {
     float pal[8];
     palette(r0, r1, pal);
     float err = 0;
@@ -40,6 +76,54 @@ float assign(const float v[16], int r0, int r1, std::uint8_t idx[16]) {
     return err;
 }
 
+#if defined(__SSE2__)
+// `bound`: the caller keeps the result only if it is below `bound`. When the four-lane sum of the
+// errors exceeds bound (1 + 1e-5), the texel-order sum exceeds bound too (two float sums of the same
+// 16 non-negative terms differ by at most about 20 ulp-units of the total, 1.2e-6 relative), so
+// the pair is dropped without the ordered sum and the index bytes (returns +inf). Otherwise the
+// result is assign_scalar's, bit for bit.
+float assign_fast(const float v[16], int r0, int r1, std::uint8_t idx[16], float bound) {
+    float pal[8];
+    palette_fast(r0, r1, pal);
+    __m128 x[4], be[4];
+    __m128i bi[4];
+    for (int q = 0; q < 4; ++q) {
+        x[q] = _mm_loadu_ps(v + 4 * q);
+        be[q] = _mm_set1_ps(1e30f);
+        bi[q] = _mm_setzero_si128();
+    }
+    for (int j = 0; j < 8; ++j) {
+        const __m128 p = _mm_set1_ps(pal[j]);
+        const __m128i jj = _mm_set1_epi32(j);
+        for (int q = 0; q < 4; ++q) {
+            const __m128 d = _mm_sub_ps(p, x[q]);
+            const __m128 dd = _mm_mul_ps(d, d);
+            const __m128 lt = _mm_cmplt_ps(dd, be[q]);
+            be[q] = _mm_or_ps(_mm_and_ps(lt, dd), _mm_andnot_ps(lt, be[q]));
+            const __m128i m = _mm_castps_si128(lt);
+            bi[q] = _mm_or_si128(_mm_and_si128(m, jj), _mm_andnot_si128(m, bi[q]));
+        }
+    }
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, _mm_add_ps(_mm_add_ps(be[0], be[1]), _mm_add_ps(be[2], be[3])));
+    if ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) > bound * (1 + 1e-5f)) return std::numeric_limits<float>::infinity();
+    alignas(16) float e[16];
+    alignas(16) std::int32_t k[16];
+    for (int q = 0; q < 4; ++q) {
+        _mm_store_ps(e + 4 * q, be[q]);
+        _mm_store_si128(reinterpret_cast<__m128i*>(k + 4 * q), bi[q]);
+    }
+    float err = 0;
+    for (int i = 0; i < 16; ++i) {
+        idx[i] = static_cast<std::uint8_t>(k[i]);
+        err += e[i];
+    }
+    return err;
+}
+#else
+float assign_fast(const float v[16], int r0, int r1, std::uint8_t idx[16], float) { return assign_scalar(v, r0, r1, idx); }
+#endif
+
 // Interpolation weight of endpoint 1 for index j (0 for r0, 1 for r1); -1 for the constants.
 float weight(bool eight, int j) {
     if (j == 0) return 0;
@@ -54,10 +138,11 @@ struct Best {
     float err = 1e30f;
     std::uint8_t idx[16] = {};
 };
+template <bool kFast>
 void consider(const float v[16], int r0, int r1, Best& b) {
     r0 = std::clamp(r0, 0, 255), r1 = std::clamp(r1, 0, 255);
     std::uint8_t idx[16];
-    const float e = assign(v, r0, r1, idx);
+    const float e = kFast ? assign_fast(v, r0, r1, idx, b.err) : assign_scalar(v, r0, r1, idx);
     if (e < b.err) {
         b.err = e, b.r0 = r0, b.r1 = r1;
         std::memcpy(b.idx, idx, 16);
@@ -65,6 +150,7 @@ void consider(const float v[16], int r0, int r1, Best& b) {
 }
 
 // Least-squares endpoints for fixed indices, then rounded; ordered for the palette kind.
+template <bool kFast>
 void refine(const float v[16], Best& b) {
     const bool eight = b.r0 > b.r1;
     float aa = 0, ab = 0, bb = 0, ra = 0, rb = 0;
@@ -79,8 +165,8 @@ void refine(const float v[16], Best& b) {
     const float e0 = (bb * ra - ab * rb) / det, e1 = (aa * rb - ab * ra) / det;
     const int a = std::clamp(static_cast<int>(std::lround(e0)), 0, 255);
     const int c = std::clamp(static_cast<int>(std::lround(e1)), 0, 255);
-    if (eight && a > c) consider(v, a, c, b);
-    if (!eight && a <= c) consider(v, a, c, b);
+    if (eight && a > c) consider<kFast>(v, a, c, b);
+    if (!eight && a <= c) consider<kFast>(v, a, c, b);
 }
 
 void write_block(const Best& b, std::uint8_t out[8]) {
@@ -91,9 +177,8 @@ void write_block(const Best& b, std::uint8_t out[8]) {
     for (int k = 0; k < 6; ++k) out[2 + k] = static_cast<std::uint8_t>(bits >> (8 * k));
 }
 
-}  // namespace
-
-void encode_bc4_block(const float in[16], Quality quality, std::uint8_t out[8]) {
+template <bool kFast>
+void encode_bc4(const float in[16], Quality quality, std::uint8_t out[8]) {
     float v[16];
     float lo = 255, hi = 0;
     for (int i = 0; i < 16; ++i) {
@@ -105,27 +190,45 @@ void encode_bc4_block(const float in[16], Quality quality, std::uint8_t out[8]) 
     const int l = static_cast<int>(std::floor(lo)), h = static_cast<int>(std::ceil(hi));
     // Eight-value palette (r0 > r1) spanning the range; and the six-value one (r0 <= r1) with the
     // range excluding exact 0 and 1 texels (those use the constant entries).
-    consider(v, std::max(h, l + 1), l, b);
+    consider<kFast>(v, std::max(h, l + 1), l, b);
     float lo6 = 255, hi6 = 0;
     for (int i = 0; i < 16; ++i)
         if (v[i] > 0 && v[i] < 255) lo6 = std::min(lo6, v[i]), hi6 = std::max(hi6, v[i]);
-    if (lo6 <= hi6) consider(v, static_cast<int>(std::floor(lo6)), static_cast<int>(std::ceil(hi6)), b);
-    if (h == l) consider(v, l, l, b);
+    if (lo6 <= hi6) consider<kFast>(v, static_cast<int>(std::floor(lo6)), static_cast<int>(std::ceil(hi6)), b);
+    if (h == l) consider<kFast>(v, l, l, b);
     const int rounds = quality == Quality::kFast ? 1 : 3;
-    for (int it = 0; it < rounds; ++it) refine(v, b);
+    for (int it = 0; it < rounds; ++it) refine<kFast>(v, b);
     if (quality == Quality::kDefault) {
         // Local search around the best pair (keeps its palette kind).
         const Best start = b;
+        // The fast path skips repeats: the start pair (b.err is its error already) and a pair that
+        // clamps to one already tried (it cannot beat it); the others in the same order.
+        int tried[25], n = 0;
         for (int d0 = -2; d0 <= 2; ++d0)
             for (int d1 = -2; d1 <= 2; ++d1) {
                 const int a = start.r0 + d0, c = start.r1 + d1;
                 if ((start.r0 > start.r1) != (a > c)) continue;
-                consider(v, a, c, b);
+                if constexpr (kFast) {
+                    const int key = std::clamp(a, 0, 255) * 256 + std::clamp(c, 0, 255);
+                    if (key == start.r0 * 256 + start.r1 || std::find(tried, tried + n, key) != tried + n) continue;
+                    tried[n++] = key;
+                }
+                consider<kFast>(v, a, c, b);
             }
-        refine(v, b);
+        refine<kFast>(v, b);
     }
     write_block(b, out);
 }
+
+}  // namespace
+
+void encode_bc4_block(const float in[16], Quality quality, std::uint8_t out[8]) { encode_bc4<true>(in, quality, out); }
+
+namespace detail {
+void encode_bc4_block_scalar(const float in[16], Quality quality, std::uint8_t out[8]) {
+    encode_bc4<false>(in, quality, out);
+}
+}  // namespace detail
 
 void decode_bc4_block(const std::uint8_t in[8], float out[16]) {
     float pal[8];

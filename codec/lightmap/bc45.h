@@ -25,6 +25,12 @@ void decode_bc4_block(const std::uint8_t in[8], float out[16]);
 void encode_bc5_block(const float rg[16][2], Quality quality, std::uint8_t out[16]);
 void decode_bc5_block(const std::uint8_t in[16], float out[16][2]);
 
+namespace detail {
+// encode_bc4_block's scalar twin: the same search with the plain per-texel index loop; the fast
+// path (SSE2, four texels at a time) gives the same bytes (tested bit for bit).
+void encode_bc4_block_scalar(const float v[16], Quality quality, std::uint8_t out[8]);
+}  // namespace detail
+
 // Whole images; `channels` interleaved floats per texel (1 for BC4, 2 for BC5); edge blocks
 // replicate the last row/column. Deterministic whatever `threads` is.
 std::vector<std::uint8_t> encode_image(const float* values, int channels, int width, int height, Quality quality,
