@@ -15,7 +15,7 @@ set(ZHC_PUBLIC_HEADERS_formats
   io/file_io.h envmap/envmap.h envmap/envmap_cube.h probes/probe_file.h probes/gltf_probes.h
   lightmap/ktx2.h lightmap/dds.h lightmap/lightmap_exr.h
   # experimental
-  lightmap/lightmap_stream.h scene/scene_json.h scene/scene_gltf.h)
+  lightmap/astc.h lightmap/lightmap_stream.h scene/scene_json.h scene/scene_gltf.h)
 
 # zhc_umbrella_header(part target): generates <build>/include/zhc/<part>.h including every public
 # header of the part, and puts it on the target's include path, so a consumer writes

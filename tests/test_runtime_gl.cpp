@@ -114,7 +114,7 @@ void main() {
         vec3 nn = vec3(normals[6u * i + 3u], normals[6u * i + 4u], normals[6u * i + 5u]);
         vec3 e = zhcVolumeIrradiance(ZhcVolume(uVolOrigin, uVolSpacing, uVolCounts), f, p, nn);
         outv[o] = e.x; outv[o + 1u] = e.y; outv[o + 2u] = e.z;
-    } else if (uMode == 5u) {  // the generated table: item i is encoding id i (ids past the end included)
+    } else if (uMode == 6u) {  // the generated table: item i is encoding id i (ids past the end included)
         outv[o] = float(zhcEncodingBytes(i));
         outv[o + 1u] = float(zhcEncodingFamily(i));
         outv[o + 2u] = float(zhcEncodingHallucination(i));
@@ -403,7 +403,7 @@ void check_generated_table() {
     const auto table = codecs();
     const std::size_t n = table.size() + 2;
     typename Fixture::Uniforms un;
-    un.mode = 5;
+    un.mode = 6;
     const std::vector<float> gpu = Fixture::run(un, {0u}, std::vector<float>(3 * n, 0.0f), n);
     const CodecOptions d;
     for (std::size_t e = 0; e < n; ++e) {

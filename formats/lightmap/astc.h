@@ -9,6 +9,10 @@
 // Determinism: astcenc compresses each block from its own texels only, whichever of the context's
 // threads takes it (the work is split by block index), so the bytes do not depend on the thread
 // count (tested: 1, 2 and 4 threads, and band by band against the whole image).
+//
+// Experimental: this API may change between minor versions (docs/api.md "Public headers").
+// Thread safety: decoding is reentrant; concurrent ENCODE calls are not promised (astcenc keeps
+// state between images in one process, docs/lightmap-formats.md): encode from one thread at a time.
 #pragma once
 
 #include <cstdint>
