@@ -12,9 +12,10 @@
 //    probe and probes per second of the sky/environment occlusion pass (whose rays also decide
 //    probe validity), the dilation, and the visibility-mask pass, each as a ratio of its rays/s to
 //    the shadow-ray throughput of the same mesh measured in the same run.
-// Medians over 5 runs (3 for the occlusion passes) in the thread's CPU time (one thread
-// throughout, so a loaded machine slows the run, not the numbers); the spread (min..max) is
-// printed. Numbers never gate tests.
+// Medians over 5 runs in the thread's CPU time (one thread throughout, so a loaded machine slows
+// the run, not the numbers); the spread (min..max) is printed. The occlusion passes: medians of 3
+// of the bake report's per-pass times, which are wall clock (steady_clock), so load shows there.
+// Numbers never gate tests.
 // --json FILE also writes the numbers as one JSON object (scripts/docs_numbers.py makes docs tables of it).
 #include <algorithm>
 #include <chrono>

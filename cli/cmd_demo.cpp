@@ -12,6 +12,7 @@
 // and zh3_q16 is the ZH3 paper's own 16-byte layout. The demo prints the 16-byte choice beside it,
 // where zh3_q16 ranks, and the commands that embed the choice instead.
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -68,7 +69,8 @@ std::string embedded_note(const ChoiceResult& choice, const std::string& dir) {
     for (const BudgetChoice& b : choice.budgets)
         if (b.budget == 16) b16 = &b;
     const ChoiceCandidate* best = b16 ? choice.chosen(*b16) : nullptr;
-    // zh3_q16's rank among the 16-byte representations, by the choice's order (error, then table order).
+    // zh3_q16's rank among the 16-byte representations, by the choice's order (error, then bytes,
+    // then the audit's order; a non-finite error ranks last).
     std::vector<const ChoiceCandidate*> fit;
     const ChoiceCandidate* embedded = nullptr;
     for (const ChoiceCandidate& k : choice.candidates) {
@@ -76,7 +78,12 @@ std::string embedded_note(const ChoiceResult& choice, const std::string& dir) {
         fit.push_back(&k);
         if (k.codec->name == kEmbedded) embedded = &k;
     }
-    std::stable_sort(fit.begin(), fit.end(), [](const ChoiceCandidate* a, const ChoiceCandidate* c) { return a->error < c->error; });
+    std::stable_sort(fit.begin(), fit.end(), [](const ChoiceCandidate* a, const ChoiceCandidate* c) {
+        const bool fa = std::isfinite(a->error), fc = std::isfinite(c->error);
+        if (fa != fc) return fa;
+        if (fa && a->error != c->error) return a->error < c->error;
+        return a->codec->size_bytes < c->codec->size_bytes;
+    });
     if (!best || !embedded) return std::string(kEmbedded) + " (probes_zh3_q16.zhp, probes.glb)";
     const std::size_t rank = static_cast<std::size_t>(std::find(fit.begin(), fit.end(), embedded) - fit.begin()) + 1;
     std::string s = std::string(kEmbedded) + " (probes_zh3_q16.zhp, probes.glb), relative rmse " + fmt(embedded->error, "%.4f");

@@ -617,6 +617,23 @@ TEST(SkyOcclusionCli, KeysFlagsReportAndErrors) {
     ASSERT_TRUE(back.ok());
     EXPECT_EQ(back->occlusion.sky_samples, 1024);
     EXPECT_EQ(back->occlusion.invalid_fraction, 0.25);
+    // The library's own checks (validate_scene), reached without the CLI or the JSON reader.
+    Scene api = at_positions({{0, 0, 0}});
+    api.occlusion.sky_samples = 65537;
+    auto r1 = bake_scene(api);
+    ASSERT_FALSE(r1.ok());
+    EXPECT_EQ(r1.error().code, ErrorCode::kInvalidValue);
+    api.occlusion.sky_samples = 16;
+    api.occlusion.invalid_fraction = std::nan("");
+    auto r2 = bake_scene(api);
+    ASSERT_FALSE(r2.ok());
+    EXPECT_EQ(r2.error().code, ErrorCode::kInvalidValue);
+    // A count above the limit in a scene file.
+    const std::string big = R"({"version": 1, "probes": {"positions": [[0, 0, 0]]}, "occlusion": {"sky_samples": 70000}})";
+    auto tb = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(big.data()), big.size()), "b.json", "");
+    ASSERT_FALSE(tb.ok());
+    EXPECT_EQ(tb.error().code, ErrorCode::kTooLarge);
+    EXPECT_NE(tb.error().message.find("sky_samples"), std::string::npos) << tb.error().message;
 }
 
 }  // namespace

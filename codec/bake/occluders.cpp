@@ -46,11 +46,12 @@ bool slab(const double lo[3], const double hi[3], Vec3 o, Vec3 d, double t0, dou
 // Moller-Trumbore (1997): solve o + t d = v0 + u e1 + v e2 by Cramer's rule with
 // det = e1 . (d x e2). Policy in occluders.h: det == 0 (parallel, or a degenerate triangle) misses;
 // inclusive barycentric bounds widened by 1e-10; t in the open interval (t_min, t_max); both faces.
-bool ray_hits_triangle(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 o, Vec3 d, double t_min, double t_max) {
+// Returns 0 (miss), 1 (front face) or 2 (back face), and the hit distance in *t_out.
+inline int ray_triangle_face(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 o, Vec3 d, double t_min, double t_max, double* t_out) {
     const Vec3 e1 = v1 - v0, e2 = v2 - v0;
     const Vec3 p = cross(d, e2);
     const double det = dot(e1, p);
-    if (det == 0.0 || !std::isfinite(det)) return false;
+    if (det == 0.0 || !std::isfinite(det)) return 0;
     const double inv = 1.0 / det;
     const Vec3 s = o - v0;
     // Barycentric tolerance: Moller-Trumbore computes u, v per triangle, so on a shared edge the
@@ -58,24 +59,6 @@ bool ray_hits_triangle(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 o, Vec3 d, double t_min, 
     // relative 1e-10 of its edges closes such cracks (rounding errors are ~1e-15 for well-posed
     // rays) while moving its boundary by far less than any scene feature.
     constexpr double kBary = 1e-10;
-    const double u = dot(s, p) * inv;
-    if (u < -kBary || u > 1.0 + kBary) return false;
-    const Vec3 q = cross(s, e1);
-    const double v = dot(d, q) * inv;
-    if (v < -kBary || u + v > 1.0 + kBary) return false;
-    const double t = dot(e2, q) * inv;
-    return t > t_min && t < t_max;
-}
-
-// ray_hits_triangle with the hit distance and the face: 0 miss, 1 front, 2 back.
-int ray_triangle_face(const Occluder& tri, Vec3 o, Vec3 d, double t_min, double t_max, double* t_out) {
-    const Vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
-    const Vec3 p = cross(d, e2);
-    const double det = dot(e1, p);
-    if (det == 0.0 || !std::isfinite(det)) return 0;
-    const double inv = 1.0 / det;
-    const Vec3 s = o - tri.v0;
-    constexpr double kBary = 1e-10;  // as ray_hits_triangle
     const double u = dot(s, p) * inv;
     if (u < -kBary || u > 1.0 + kBary) return 0;
     const Vec3 q = cross(s, e1);
@@ -86,6 +69,11 @@ int ray_triangle_face(const Occluder& tri, Vec3 o, Vec3 d, double t_min, double 
     *t_out = t;
     // det = e1 . (d x e2) = -d . (e1 x e2): det < 0 when d runs along the normal (a back face).
     return det < 0 ? 2 : 1;
+}
+
+bool ray_hits_triangle(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 o, Vec3 d, double t_min, double t_max) {
+    double t;
+    return ray_triangle_face(v0, v1, v2, o, d, t_min, t_max, &t) != 0;
 }
 
 }  // namespace
@@ -105,7 +93,7 @@ RayHit ray_nearest(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_m
     RayHit h;
     if (occ.kind == OccluderKind::kTriangle) {
         double t = 0;
-        const int face = ray_triangle_face(occ, o, d, t_min, t_max, &t);
+        const int face = ray_triangle_face(occ.v0, occ.v1, occ.v2, o, d, t_min, t_max, &t);
         if (face) h = {true, face == 2, t};
         return h;
     }
@@ -174,8 +162,8 @@ bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
 }
 
 // The compact form keeps only the doubles the primitive's kind uses (triangle: v0 v1 v2; sphere:
-// centre, radius; box: min, max), so the BVH holds 80 bytes per primitive instead of a copy of the
-// 160-byte Occluder; expand() gives back the same doubles, so every test computes what it did.
+// centre, radius; box: min, max), 80 bytes per primitive (an Occluder is 160). expand() gives back
+// the same doubles, so the ray tests see exactly the caller's occluders.
 OccluderBvh::Prim OccluderBvh::compact(const Occluder& o) {
     Prim p;
     p.kind = o.kind;
@@ -362,9 +350,8 @@ RayHit OccluderBvh::nearest(Vec3 o, Vec3 d, double t_min, double t_max) const {
         }
         if (n.count > 0) {
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
-                // Strictly nearer hits only (the interval's far end is the best so far, with the
-                // best's own t admitted through `<=` below): the first primitive wins a tie.
-                const RayHit h = ray_nearest(expand(prims_[i]), o, d, t_min, best.hit ? std::nextafter(far, far + 1.0) : far);
+                // Strictly nearer hits only (t < far, the best so far): the first primitive visited wins a tie.
+                const RayHit h = ray_nearest(expand(prims_[i]), o, d, t_min, far);
                 if (h.hit && (!best.hit || h.t < best.t)) {
                     best = h;
                     far = h.t;

@@ -82,12 +82,12 @@ public:
     // Any hit with t in (t_min, t_max)?
     bool occluded(Vec3 o, Vec3 d, double t_min, double t_max) const;
     // The nearest hit with t in (t_min, t_max) (ties between primitives at the same t: the first
-    // in the tree's leaf order, so the answer is the same on every run).
+    // visited, the nearer child on the split axis first, so the answer is the same on every run).
     RayHit nearest(Vec3 o, Vec3 d, double t_min, double t_max) const;
     // Is p inside (or on) any sphere or box occluder?
     bool inside_any_solid(Vec3 p) const;
     std::size_t node_count() const { return nodes_.size(); }
-    // Bytes the tree holds (primitives and nodes), for bench_bake's bytes per triangle.
+    // Bytes the tree holds (primitives and nodes), printed per primitive by test_scene_mesh.
     std::size_t memory_bytes() const { return prims_.capacity() * sizeof(Prim) + nodes_.capacity() * sizeof(Node); }
 
 private:

@@ -158,19 +158,7 @@ std::vector<Vec3> cone_sample_directions(Vec3 axis, double sigma, int count) {
     return out;
 }
 
-std::vector<Vec3> sphere_sample_directions(int count) {
-    std::vector<Vec3> out;
-    if (count <= 0) return out;
-    out.reserve(static_cast<size_t>(count));
-    const double golden = kPi * (3.0 - std::sqrt(5.0));
-    for (int k = 0; k < count; ++k) {
-        const double z = 1.0 - (2.0 * k + 1.0) / count;
-        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-        const double phi = golden * k;
-        out.push_back({r * std::cos(phi), r * std::sin(phi), z});
-    }
-    return out;
-}
+std::vector<Vec3> sphere_sample_directions(int count) { return fibonacci_sphere(count); }
 
 void sky_radiance(const SceneSky& sky, Vec3 d, double rgb[3]) {
     if (sky.kind == SkyKind::kConstant) {
@@ -734,8 +722,8 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
     if (validity) {
         const auto& g = layout.grid;
         const long nx = g.counts[0], ny = g.counts[1], nz = g.counts[2];
-        std::vector<Sh3Radiance> dil(count);
-        std::vector<std::uint8_t> has(count, 0);
+        // Written in place: only valid probes are read and only invalid ones written, so the
+        // order of the probes does not matter.
         for (size_t i = 0; i < count; ++i) {
             if (valid[i]) continue;
             ++invalid;
@@ -760,15 +748,12 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
                         }
                 if (wsum > 0) {
                     for (int c = 0; c < 9; ++c)
-                        for (int k = 0; k < 3; ++k) dil[i][c][k] = static_cast<float>(sum[c * 3 + k] / wsum);
-                    has[i] = 1;
+                        for (int k = 0; k < 3; ++k) out[i][c][k] = static_cast<float>(sum[c * 3 + k] / wsum);
                     ++dilated;
                     break;
                 }
             }
         }
-        for (size_t i = 0; i < count; ++i)
-            if (has[i]) out[i] = dil[i];
     }
     const double dil_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_dil).count();
 
@@ -803,7 +788,6 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
             report->occlusion_ms += ms[static_cast<size_t>(t)][effects.size()];
             report->occlusion_rays += rays[static_cast<size_t>(t)][effects.size()];
         }
-        report->occlusion_probes = tracing ? count : 0;
         for (size_t ei = 0; ei < effects.size(); ++ei) {
             BakeEffect& be = report->effects[ei];
             for (int t = 0; t < threads; ++t) {

@@ -156,7 +156,7 @@ struct BakeReport {
     double total_ms = 0;
     // Occlusion pass (sky/environment visibility and probe validity share its rays), validity
     // dilation and visibility masks; zero when not run.
-    std::uint64_t occlusion_rays = 0, occlusion_probes = 0;
+    std::uint64_t occlusion_rays = 0;
     double occlusion_ms = 0;
     bool validity_checked = false;  // grid with occluders and sky_samples > 0
     std::uint64_t invalid_probes = 0, dilated_probes = 0;

@@ -12,7 +12,8 @@
 //                     list does not qualify;
 //   max_encode_us     its mean encode time per probe (the audit's timing) is at most N us.
 // Among the qualifying representations the lowest error wins; ties go to fewer bytes, then to
-// the codec-table order (so the choice is deterministic). The runner-up is the next one in that
+// the audit's order (the codec table's unless --representations lists another), so the choice is
+// deterministic. The runner-up is the next one in that
 // order; the margin is the runner-up's error minus the choice's.
 //
 // Experimental: this API may change between minor versions (docs/api.md "Public headers").
