@@ -13,6 +13,7 @@
 #include "formats/envmap/envmap.h"
 #include "formats/io/file_io.h"
 #include "formats/probes/probe_file.h"
+#include "formats/report/audit_inputs.h"
 
 namespace zhc::cli {
 namespace cmd_convert {  // one namespace per verb file: the CLI is a unity build
@@ -98,8 +99,7 @@ Result<Loaded> load_input(const Options& o) {
         in.list = std::move(list).value();
         in.kind = "json";
     } else {
-        return make_error(ErrorCode::kBadFormat,
-                          o.input + ": not an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map), .zhp probe file or JSON probe list");
+        return unknown_probe_input(o.input, *bytes);
     }
     return in;
 }

@@ -13,12 +13,14 @@
 #include "codec/probe/quantize.h"
 #include "formats/envmap/envmap.h"
 #include "formats/envmap/envmap_cube.h"
+#include "formats/lightmap/astc.h"
 #include "formats/lightmap/dds.h"
 #include "formats/lightmap/ktx2.h"
 #include "formats/lightmap/lightmap_exr.h"
 #include "formats/io/file_io.h"
 #include "formats/probes/gltf_probes.h"
 #include "formats/probes/probe_file.h"
+#include "formats/report/audit_inputs.h"
 #include "formats/io/json_depth.h"
 #include "formats/scene/scene_gltf.h"
 #include "formats/scene/scene_json.h"
@@ -141,10 +143,21 @@ Status describe_2d_texture(const std::vector<std::uint8_t>& b, const std::string
     if (img) {
         const std::uint32_t vk = img->vk_format;
         j["type"] = "IrradZ lightmap texture (" + container + ", 2-D)";
-        j["format"] = vk == kVkFormatBc6hUfloat ? "BC6H_UFLOAT" : vk == kVkFormatBc5Unorm ? "BC5_UNORM" : "BC4_UNORM";
-        j["plane"] = vk == kVkFormatBc6hUfloat ? "I_z: linear RGB irradiance at the normal"
-                     : vk == kVkFormatBc5Unorm ? "d: direction, hemi-octahedral (u, v)"
-                                               : "w_a: weight in [0, 1]";
+        if (const auto a = astc::format_of_vk(vk)) {
+            // ASTC targets: I_z as HDR, or as LDR on the log2 range of its key; d and w_a in one LDR texture.
+            bool ldr_iz = false;
+            for (const auto& kv : img->key_values) ldr_iz = ldr_iz || kv.key == lightmap_astc::kRangeKey;
+            j["format"] = "ASTC_" + std::to_string(a->footprint.x) + "x" + std::to_string(a->footprint.y) +
+                          (a->hdr ? "_SFLOAT" : "_UNORM");
+            j["plane"] = a->hdr  ? "I_z: linear RGB irradiance at the normal"
+                         : ldr_iz ? "I_z: log2 of the irradiance on the range of key zhc.iz_log2_range (LDR)"
+                                  : "d and w_a: (u, v, w_a)";
+        } else {
+            j["format"] = vk == kVkFormatBc6hUfloat ? "BC6H_UFLOAT" : vk == kVkFormatBc5Unorm ? "BC5_UNORM" : "BC4_UNORM";
+            j["plane"] = vk == kVkFormatBc6hUfloat ? "I_z: linear RGB irradiance at the normal"
+                         : vk == kVkFormatBc5Unorm ? "d: direction, hemi-octahedral (u, v)"
+                                                   : "w_a: weight in [0, 1]";
+        }
         j["width"] = img->width;
         j["height"] = img->height;
         j["block_bytes"] = img->blocks.size();
@@ -347,9 +360,7 @@ int run(const Options& o) {
         j["layout"] = layout_json(list->layout);
         probe_stats(list->probes, j);
     } else {
-        return report(make_error(ErrorCode::kBadFormat,
-                                 o.path + ": not an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map), .zhp probe file or JSON probe list" +
-                                     git_lfs_hint(*bytes)));
+        return report(unknown_probe_input(o.path, *bytes));
     }
     print_json_or_text(j, o.json);
     return kExitOk;

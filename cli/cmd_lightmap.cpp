@@ -83,6 +83,12 @@ std::string inputs_text(const std::vector<std::string>& files) {
     for (const auto& f : files) s += (s.empty() ? "" : " + ") + f;
     return s;
 }
+// The inputs as a report names them: relative to --paths-relative-to when given.
+std::string shown_inputs(const std::vector<std::string>& files, const std::string& base) {
+    std::vector<std::string> shown;
+    for (const std::string& f : files) shown.push_back(shown_path(f, base));
+    return inputs_text(shown);
+}
 
 int run_encode(const Options& o) {
     const auto files = input_files(o.inputs);
@@ -214,7 +220,7 @@ int run_audit_targets(const Options& o, const std::vector<std::string>& files) {
         // The plain audit's object (the BC target), then the targets side by side.
         const auto& a = base.audit;
         nlohmann::ordered_json j;
-        j["input"] = input;
+        j["input"] = shown_inputs(files, o.paths_base);
         j["width"] = base.width;
         j["height"] = base.height;
         j["quality"] = o.quality;
@@ -286,9 +292,7 @@ int run_audit(const Options& o) {
     const std::string input = inputs_text(files);
     if (o.json) {
         nlohmann::ordered_json j;
-        std::vector<std::string> shown;
-        for (const std::string& f : files) shown.push_back(shown_path(f, o.paths_base));
-        j["input"] = inputs_text(shown);
+        j["input"] = shown_inputs(files, o.paths_base);
         j["width"] = r->width;
         j["height"] = r->height;
         j["quality"] = o.quality;
@@ -344,7 +348,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
         add_threads_option(s, o->threads, "output identical for any count");
     };
     auto band = [&](CLI::App* s) {
-        s->add_option("--band-rows", o->band_rows, "rows per streamed band (rounded up to a multiple of 4; default: about 2^18 texels; output identical for any value)")
+        s->add_option("--band-rows", o->band_rows, "rows per streamed band (rounded up to whole rows of blocks: 4, and the ASTC footprint height; default: about 2^18 texels; output identical for any value)")
             ->check(CLI::Range(1, 1 << 20));
         add_progress_flags(s, o->progress);
         add_depfile_option(s);

@@ -387,9 +387,10 @@ const std::map<std::string, Generator>& generators() {
              for (const char* p : {".iz.ktx2", ".d.ktx2", ".wa.ktx2"}) fs::remove(d + "/.gen_iz" + p);
          }},
         // Git LFS pointers (what a checkout holds when git lfs did not fetch the content) where an
-        // EXR, a glTF, a lightmap EXR / KTX2 triplet or a glTF's .bin belongs.
+        // EXR, a glTF, a .zhp, a lightmap EXR / KTX2 triplet or a glTF's .bin belongs.
         {"lfs.exr", file([](const std::string&) { return lfs_pointer(); })},
         {"lfs.gltf", file([](const std::string&) { return lfs_pointer(); })},
+        {"lfs.zhp", file([](const std::string&) { return lfs_pointer(); })},
         {"lfs_lm.exr", file([](const std::string&) { return lfs_pointer(); })},
         {"lfslm", [](const std::string& d, const std::string& n) {
              for (const char* p : {".iz.ktx2", ".d.ktx2", ".wa.ktx2"}) test::write_bytes(d + "/" + n + p, lfs_pointer());

@@ -208,6 +208,9 @@ TEST(DepfileCli, LightmapEncodeNamesEveryPartAndEveryOutput) {
     EXPECT_NE(r.out.find("\"input\": \"sh.exr\""), std::string::npos) << r.out;
     r = run_zhc({"lightmap", "audit", sh, "--json", "--quality", "fast"});
     EXPECT_NE(r.out.find("\"input\": \"" + sh + "\""), std::string::npos) << r.out;
+    r = run_zhc({"lightmap", "audit", sh, "--json", "--quality", "fast", "--targets", "bc", "--paths-relative-to", dir});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("\"input\": \"sh.exr\""), std::string::npos) << r.out;
 
     r = run_zhc({"lightmap", "encode", sh, "-o", dir + "/lm", "--quality", "fast", "--depfile", dir + "/enc.d"});
     ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -1,11 +1,10 @@
 // zhc/formats/io/file_io.h — bounded file reads and atomic file writes.
 //
 // Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
-// on different files and arguments. The only process-wide state touched is OpenEXR's own
-// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
-// guards it), which never changes the bytes read or written, and the FileRecorder that a
+// on different files and arguments. The one process-wide state is the FileRecorder that a
 // ScopedFileRecording installs (below): it observes which files are opened and written, under its
-// own lock, and never changes what a call does.
+// own lock, and never changes what a call does. There is one recorder per process, so run one
+// recording at a time: two concurrent recordings would each see the other's files.
 #pragma once
 
 #include <cstdint>

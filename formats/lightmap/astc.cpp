@@ -185,10 +185,14 @@ Result<Compressed> compress(const lightmap::IrradzPlanes& p, const Options& o, i
     c.height = p.height;
     c.options = o;
     const size_t n = p.wa.size();
-    std::vector<float> iz = p.iz;
-    if (o.ldr_iz)
-        for (float& v : iz) v = lightmap::iz_to_ldr(v, o.range);
-    auto iz_blocks = astc::encode(iz.data(), 3, p.width, p.height, o.footprint, !o.ldr_iz, o.effort, threads);
+    std::vector<float> ldr;  // the LDR range encoding of I_z; HDR encodes p.iz as it is
+    const float* iz = p.iz.data();
+    if (o.ldr_iz) {
+        ldr.resize(p.iz.size());
+        for (size_t i = 0; i < ldr.size(); ++i) ldr[i] = lightmap::iz_to_ldr(p.iz[i], o.range);
+        iz = ldr.data();
+    }
+    auto iz_blocks = astc::encode(iz, 3, p.width, p.height, o.footprint, !o.ldr_iz, o.effort, threads);
     if (!iz_blocks) return iz_blocks.error();
     c.iz = std::move(*iz_blocks);
     if (o.split_dwa) {

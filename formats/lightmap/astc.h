@@ -11,8 +11,11 @@
 // count (tested: 1, 2 and 4 threads, and band by band against the whole image).
 //
 // Experimental: this API may change between minor versions (docs/api.md "Public headers").
-// Thread safety: decoding is reentrant; concurrent ENCODE calls are not promised (astcenc keeps
-// state between images in one process, docs/lightmap-formats.md): encode from one thread at a time.
+// Thread safety: every function here is reentrant; astcenc contexts are pooled behind a mutex and
+// lent to one call at a time. Determinism: one `zhc lightmap encode` gives the same bytes for any
+// thread count and band height (tested), but astcenc 4.2 keeps some state between images inside a
+// process, so a process that encodes several footprints can see its later results move slightly
+// (docs/lightmap-formats.md "Determinism").
 #pragma once
 
 #include <cstdint>

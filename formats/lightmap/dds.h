@@ -17,9 +17,7 @@
 // 'ATI1' / 'BC4U' (as BC4_UNORM) and 'ATI2' / 'BC5U' (as BC5_UNORM), data at byte 128.
 //
 // Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
-// on different files and arguments. The only process-wide state touched is OpenEXR's own
-// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
-// guards it), which never changes the bytes read or written.
+// on different files and arguments.
 #pragma once
 
 #include <cstdint>

@@ -8,9 +8,7 @@
 // anything is allocated, and each kind of problem has its own error code and message.
 //
 // Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
-// on different files and arguments. The only process-wide state touched is OpenEXR's own
-// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
-// guards it), which never changes the bytes read or written.
+// on different files and arguments.
 #pragma once
 
 #include <array>

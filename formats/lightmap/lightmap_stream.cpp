@@ -19,6 +19,18 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// Decoded IrradZ planes -> the 7 floats per texel of the IrradZ EXR (I_z RGB, w_a, d xyz).
+void irradz_texels(const lightmap::IrradzPlanes& p, std::vector<float>& texels) {
+    const size_t n = p.wa.size();
+    texels.resize(n * 7);
+    for (size_t t = 0; t < n; ++t) {
+        const Vec3 d = lightmap::decode_hemioct(p.d[2 * t], p.d[2 * t + 1]);
+        const float v[7] = {p.iz[3 * t], p.iz[3 * t + 1], p.iz[3 * t + 2], p.wa[t],
+                            static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z)};
+        std::memcpy(&texels[t * 7], v, sizeof v);
+    }
+}
+
 constexpr std::uint32_t kFormats[3] = {kVkFormatBc6hUfloat, kVkFormatBc5Unorm, kVkFormatBc4Unorm};
 const char* const kSuffixes[3] = {".iz", ".d", ".wa"};
 
@@ -191,14 +203,7 @@ Result<DecodeResult> decode_astc(const std::string& prefix, const BlockFileLayou
         }
         auto p = lightmap_astc::decompress(c);
         if (!p) return p.error();
-        const size_t n = p->wa.size();
-        texels.resize(n * 7);
-        for (size_t t = 0; t < n; ++t) {
-            const Vec3 d = lightmap::decode_hemioct(p->d[2 * t], p->d[2 * t + 1]);
-            const float v[7] = {p->iz[3 * t], p->iz[3 * t + 1], p->iz[3 * t + 2], p->wa[t],
-                                static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z)};
-            std::memcpy(&texels[t * 7], v, sizeof v);
-        }
+        irradz_texels(*p, texels);
         if (Status s = (*writer)->write_rows(texels.data(), c.height); !s) return out_error(s.error());
         if (progress) progress(static_cast<std::uint64_t>(y1), static_cast<std::uint64_t>(r.height));
     }
@@ -326,14 +331,7 @@ Result<DecodeResult> decode(const std::string& prefix, bool dds, const std::stri
                 return s.error();
         }
         const auto p = lightmap::decompress(c);
-        const size_t n = p.wa.size();
-        texels.resize(n * 7);
-        for (size_t t = 0; t < n; ++t) {
-            const Vec3 d = lightmap::decode_hemioct(p.d[2 * t], p.d[2 * t + 1]);
-            const float v[7] = {p.iz[3 * t], p.iz[3 * t + 1], p.iz[3 * t + 2], p.wa[t],
-                                static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z)};
-            std::memcpy(&texels[t * 7], v, sizeof v);
-        }
+        irradz_texels(p, texels);
         if (Status s = (*writer)->write_rows(texels.data(), c.height); !s) return out_error(s.error());
         if (progress) progress(static_cast<std::uint64_t>(y1), static_cast<std::uint64_t>(r.height));
     }
@@ -341,31 +339,10 @@ Result<DecodeResult> decode(const std::string& prefix, bool dds, const std::stri
     return r;
 }
 
+// The plain audit is the BC target alone: audit_targets' base result with no targets listed.
 Result<AuditResult> audit(const std::vector<std::string>& inputs, const AuditOptions& o) {
-    auto src = open_source(inputs, o.threads);
-    if (!src) return src.error();
-    ShLightmapSource& in = **src;
     AuditResult r;
-    set_size(r, in);
-    lightmap::AuditAccumulator acc(o.stride);
-    const int rows = band_rows(r.width, o.threads, o.band_rows);
-    lightmap::ShLightmap band;
-    for (int y0 = 0; y0 < r.height; y0 += rows) {
-        const int y1 = std::min(r.height, y0 + rows);
-        auto t = Clock::now();
-        if (Status s = in.read_rows(y0, y1, band); !s) return s.error();
-        r.timing.read += since(t);
-        t = Clock::now();
-        const auto search = lightmap::fit_planes(band, Fit::kNewton, o.threads);  // irradz::EncodeOptions' default, as lightmap audit
-        r.timing.fit += since(t);
-        const auto old_way = lightmap::fit_planes(band, Fit::kOld, o.threads);
-        t = Clock::now();
-        const auto c = lightmap::compress(search, o.bc6h_quality, o.bc45_quality, o.threads);
-        r.timing.compress += since(t);
-        acc.add(band, search, old_way, lightmap::decompress(c));
-        if (o.progress) o.progress(static_cast<std::uint64_t>(y1), static_cast<std::uint64_t>(r.height));
-    }
-    r.audit = acc.result();
+    if (auto t = audit_targets(inputs, o, {}, &r); !t) return t.error();
     return r;
 }
 

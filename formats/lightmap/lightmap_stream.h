@@ -1,7 +1,8 @@
 // zhc/formats/lightmap/lightmap_stream.h — the lightmap verbs as streaming pipelines in bounded memory
-// (docs/lightmap-formats.md, "Streaming"): the SH lightmap EXR is read in bands of rows (a multiple
-// of 4, whole rows of 4x4 blocks), each band is fitted and block-compressed, and its blocks are
-// appended to the KTX2/DDS level data in temporary files renamed at the end (all three or none).
+// (docs/lightmap-formats.md, "Streaming"): the SH lightmap EXR is read in bands of rows (whole rows
+// of blocks: 4 rows for BC, the footprint's height as well for ASTC), each band is fitted and
+// block-compressed, and its blocks are appended to the KTX2/DDS level data in temporary files
+// renamed at the end (all of a target's files or none).
 // Peak memory is a few bands, whatever the image size. The bytes written do not depend on the band
 // height or the thread count: each 4x4 block depends only on its own texels (the last band holds the
 // image's partial bottom block row, whose missing rows repeat the last row as in the whole-image
@@ -9,7 +10,8 @@
 //
 // Experimental: this API may change between minor versions (docs/api.md "Public headers").
 // Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
-// on different files and arguments. The only process-wide state touched is OpenEXR's own
+// on different files and arguments (the ASTC encoder lends each astcenc context to one call at a
+// time, formats/lightmap/astc.cpp). The only process-wide state touched is OpenEXR's own
 // global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
 // guards it), which never changes the bytes read or written.
 #pragma once

@@ -253,7 +253,7 @@ Status precheck(const json& doc, const std::string& path, const GltfLimits& limi
 // "spot" object), checked before tinygltf so that a missing one is named by its glTF path
 // ("accessors[2].componentType") rather than by tinygltf's text ("'componentType' property is
 // missing in Accessor."). Only objects are looked into: a wrong type is reported by the readers
-// (or by tinygltf) as before.
+// (or by tinygltf).
 Status check_required(const json& doc, const std::string& path) {
     struct Need {
         const char* array;                 // top-level array (or extensions.KHR_lights_punctual.lights)
@@ -537,8 +537,7 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     }
     if (looks_like_git_lfs_pointer(bytes)) return fail(ErrorCode::kBadFormat, path, "not a glTF asset" + git_lfs_hint(bytes));
     if (Status depth = check_json_depth(text, path); !depth) return depth.error();
-    // Where the JSON breaks, as zhc's other JSON readers say it (line and column; in a GLB they
-    // count in its JSON chunk).
+    // Where the JSON breaks: line and column (in a GLB they count in its JSON chunk).
     try {
         out.doc = json::parse(text);
     } catch (const json::parse_error& e) {

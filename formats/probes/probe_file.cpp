@@ -158,7 +158,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
     // 1. Magic: a short file that is a prefix of the magic is truncated, anything else is not ours.
     const size_t magic_have = std::min(bytes.size(), sizeof kMagic);
     if (std::memcmp(h, kMagic, magic_have) != 0)
-        return err(ErrorCode::kBadFormat, name, "not a .zhp probe file (bad magic at byte 0)");
+        return err(ErrorCode::kBadFormat, name, "not a .zhp probe file (bad magic at byte 0)" + git_lfs_hint(bytes));
     if (bytes.size() < kOffVersion + 2)
         return err(ErrorCode::kTruncated, name, "file ends inside the header (" + std::to_string(bytes.size()) +
                                                     " of " + std::to_string(kProbeFileHeaderBytes) + " bytes)");
@@ -382,7 +382,7 @@ Result<ProbeList> parse_probe_json_impl(std::span<const std::uint8_t> bytes, con
     try {
         doc = json::parse(bytes.begin(), bytes.end());
     } catch (const json::parse_error& e) {
-        return err(ErrorCode::kBadFormat, name, std::string("not valid JSON (") + e.what() + ")");
+        return err(ErrorCode::kBadFormat, name, std::string("not valid JSON (") + e.what() + ")" + git_lfs_hint(bytes));
     }
     if (!doc.is_object()) return err(ErrorCode::kBadFormat, name, "top level must be an object");
     if (doc.contains("format") && doc["format"] != "zhc-probes")

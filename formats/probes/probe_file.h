@@ -20,9 +20,7 @@
 //    "probes": [{"position": [x,y,z], "sh3": [[r,g,b], ... 9 rows]}, ...]}
 //
 // Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
-// on different files and arguments. The only process-wide state touched is OpenEXR's own
-// global thread pool (grown, never shrunk, when a call asks for more threads; OpenEXR
-// guards it), which never changes the bytes read or written.
+// on different files and arguments.
 #pragma once
 
 #include <cstdint>

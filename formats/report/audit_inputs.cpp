@@ -97,9 +97,12 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
         in.reference = "the probes' SH3 irradiance (JSON float SH3)";
         return in;
     }
-    // The same code and words as convert and info for a file of no known format (exit 4).
-    return make_error(ErrorCode::kBadFormat,
-                      path + ": not an environment map (EXR/.hdr, KTX2/DDS cube map), .zhp probe file or JSON probe list");
+    return unknown_probe_input(path, *bytes);
+}
+
+Error unknown_probe_input(const std::string& path, std::span<const std::uint8_t> bytes) {
+    return Error{ErrorCode::kBadFormat, path + ": not an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map), .zhp probe file or JSON probe list" +
+                                            git_lfs_hint(bytes)};
 }
 
 Result<AuditedFiles> audit_files(const std::vector<std::string>& files, const std::vector<Vec3>& dirs,

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct AuditLoadOptions {
 // Files and folders -> the list of files to audit (folders: their .exr/.hdr/.zhp/.json files,
 // sorted by name, not recursive). Missing paths are an error.
 Result<std::vector<std::string>> expand_audit_inputs(const std::vector<std::string>& paths);
+// The error for a file of no format audit, convert and info read (exit 4, kBadFormat), with the
+// Git LFS hint when the bytes are an LFS pointer.
+Error unknown_probe_input(const std::string& path, std::span<const std::uint8_t> bytes);
 
 // Reads one file as an AuditInput (codec/report/audit_run.h): an environment map (.exr, .hdr; its
 // reference integrated at `dirs`), a probe container or a JSON probe list.

@@ -57,7 +57,7 @@ expect() {  # expect WHAT "room hall lm"
 later() { sleep 1; touch "$1"; }  # newer than the outputs whatever the clock granularity
 
 expect "first build" "room hall lm"
-for f in room.zhp room.zhp.d hall/lit.glb lm/room.iz.ktx2 lm/room.d.ktx2 lm/room.wa.ktx2; do
+for f in room.zhp room.zhp.d hall/lit.glb lm/room.iz.ktx2 lm/room.d.ktx2 lm/room.wa.ktx2 lm/phone.iz.ktx2 lm/phone.dwa.ktx2; do
   [ -s "$b/$f" ] || { echo "FAIL: $b/$f missing after the first build" >&2; exit 1; }
 done
 expect "nothing changed" ""

@@ -123,6 +123,15 @@ with open(W("bc7_2d.ktx2"), "wb") as f:
     f.write(relabelled)
 for name in ("lm.exr", "iz.exr", "lm.iz.ktx2", "lm.d.dds", "bc7_2d.ktx2"):
     check("info", "info", ["info", W(name), "--json"])
+# ASTC planes: info names the ASTC format and the plane (HDR I_z, LDR I_z with its range key, d + w_a).
+run("lightmap", "encode", W("lm.exr"), "-o", W("hdr"), "--target", "astc", "--footprint", "6x6", "--quiet")
+run("lightmap", "encode", W("lm.exr"), "-o", W("ldr"), "--target", "astc-ldr", "--quiet")
+for name, fmt, plane in (("hdr.iz.ktx2", "ASTC_6x6_SFLOAT", "I_z: linear"), ("ldr.iz.ktx2", "ASTC_4x4_UNORM", "I_z: log2"),
+                         ("hdr.dwa.ktx2", "ASTC_6x6_UNORM", "d and w_a")):
+    check("info", "info", ["info", W(name), "--json"])
+    doc = json.loads(run("info", W(name), "--json"))
+    if doc.get("format") != fmt or not doc.get("plane", "").startswith(plane):
+        failures.append("zhc info %s: format %r, plane %r (expected %s, %s...)" % (name, doc.get("format"), doc.get("plane"), fmt, plane))
 if GLTF_SCENE:
     run("gltf", "embed", GLTF_SCENE, W("q16.zhp"), "-o", W("lit.glb"))
     check("info", "info", ["info", W("lit.glb"), "--json"])
