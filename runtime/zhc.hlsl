@@ -182,7 +182,7 @@ struct ZhcFormat
     uint l2Bound;        // ZHC_L2_*
     uint dcFormat;       // ZHC_DC_* (half only fits sh2_q's 6-byte slot; elsewhere it means R11G11B10F)
     uint zonalMapping;   // ZHC_ZONAL_*
-    uint axisMode;       // ZHC_AXIS_*: zh3_q16 / zh3_solved_q16 / hall_curve_q (float layouts: by name)
+    uint axisMode;       // ZHC_AXIS_*: read by the encodings whose zhc_encoding_axis is ZHC_ENTRY_AXIS_FORMAT
     uint kind;           // ZHC_KIND_*
     float lumR, lumG, lumB;  // luminance weights of the shared zonal axis (Rec. 709 by default)
     float hallA, hallB;      // Eq. 21 curve, f20 = (a p^2 + b p) f0 (defaults 0.6, 0.08)

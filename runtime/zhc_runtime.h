@@ -224,7 +224,7 @@ struct zhc_probe_format {
     int l2_bound;      /* enum zhc_l2_bound: non-zonal L2 interval sqrt(15)/2 or sqrt(5) */
     int dc_format;     /* enum zhc_dc_format (half: sh2_q / hall_curve_q only) */
     int zonal_mapping; /* enum zhc_zonal_mapping: how [-sqrt(5)/2, sqrt(5)] maps to [-1, 1] */
-    int axis_mode;     /* enum zhc_axis_mode: zonal axis of zh3_q16, zh3_solved_q16, hall_curve_q */
+    int axis_mode;     /* enum zhc_axis_mode: zonal axis of the encodings whose info->axis is ZHC_ENTRY_AXIS_FORMAT */
     int kind;          /* enum zhc_stored_kind: the bytes hold radiance or irradiance SH */
     double luminance[3]; /* luminance weights of the luminance axis (default Rec. 709) */
     double hallucinate_a, hallucinate_b; /* Eq. 21 curve f20 = (a p^2 + b p) f0: 0.6, 0.08 */
@@ -242,7 +242,7 @@ static inline int zhc_encoding_from_name(const char* name) {
 /* 1 for the packed (quantised) encodings: layouts zh3_q16, sh3_q28 and sh2_q. */
 static inline int zhc_encoding_is_packed(int e) {
     const zhc_encoding_info* info = zhc_encoding_info_of(e);
-    return info && info->layout >= ZHC_LAYOUT_ZH3_Q16;
+    return info && (info->layout == ZHC_LAYOUT_ZH3_Q16 || info->layout == ZHC_LAYOUT_SH3_Q28 || info->layout == ZHC_LAYOUT_SH2_Q);
 }
 /* Layout of encoding e (enum zhc_layout; sh3_f32 for an unknown e, whose format validation fails). */
 static inline unsigned zhc__layout(int e) {
@@ -261,9 +261,7 @@ static inline int zhc__per_channel(const zhc_probe_format* f) {
     return axis == ZHC_ENTRY_AXIS_CHANNEL || (axis == ZHC_ENTRY_AXIS_FORMAT && f->axis_mode == ZHC_AXIS_PER_CHANNEL);
 }
 
-/* Defaults of `zhc convert --to ENCODING` (cli/cmd_convert.cpp, codec/probe/quantize.h CodecOptions):
- * 8 bits, no sqrt, tight bound, R11G11B10F DC, affine zonal mapping, luminance axis, radiance,
- * Rec. 709 weights (0.2126, 0.7152, 0.0722), Eq. 21 a = 0.6, b = 0.08.
+/* Defaults of `zhc convert --to ENCODING`: the generated ZHC_DEFAULT_* (codec/probe/codec.h CodecOptions).
  * Returns ZHC_OK, or ZHC_ERR_ARGUMENT for an unknown name (f then holds the defaults with
  * encoding -1). Safe for untrusted input (name may be any NUL-terminated string). */
 static inline int zhc_probe_format_init(zhc_probe_format* f, const char* encoding) {

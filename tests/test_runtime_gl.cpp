@@ -52,7 +52,7 @@ constexpr double kCFloat = 16, kCQuant = 32, kCDecode = 16, kCLightmap = 16;
 constexpr int kOutFloats = 30;  // per item: 27 SH3 radiance + 3 irradiance
 
 // The test main appended after zhc.glsl. Modes: 0 probe decode + irradiance, 1 IrradZ texel,
-// 2 DC unpacking, 3 HLSH, 4 probe volume, 5 the ASTC LDR fallback's I_z decode.
+// 2 DC unpacking, 3 HLSH, 4 probe volume, 5 the ASTC LDR fallback's I_z decode, 6 the generated table.
 // Before zhc.glsl: the probe words, bound for the volume functions (ZHC_VOLUME_WORD).
 const char* kTestPrelude = R"(
 layout(std430, binding = 0) readonly buffer Words { uint words[]; };
@@ -395,7 +395,6 @@ TEST_F(RuntimeGles, EveryCodecDecodesAndEvaluatesLikeTheCodec) {
                                      test::sample_count(30000));
 }
 
-// R11G11B10F, RGB9E5 and half unpacking are integer-exact: every code of every channel.
 // runtime/zhc.glsl's generated table functions and constants, run on the GPU, against the codec
 // table's runtime description: every id, and two ids past the end (bytes 0, family 0).
 template <class Fixture>
@@ -410,6 +409,7 @@ void check_generated_table() {
         const float* r = gpu.data() + e * kOutFloats;
         if (e >= table.size()) {
             EXPECT_EQ(r[0], 0.0f) << "id " << e << " past the table: 0 bytes";
+            EXPECT_EQ(r[1], 0.0f) << "id " << e << " past the table: family 0";
             continue;
         }
         const auto rt = runtime_entry(table[e]);
@@ -433,6 +433,7 @@ void check_generated_table() {
 TEST_F(RuntimeGl, GeneratedTableMatchesTheCodec) { check_generated_table<RuntimeGl>(); }
 TEST_F(RuntimeGles, GeneratedTableMatchesTheCodec) { check_generated_table<RuntimeGles>(); }
 
+// R11G11B10F, RGB9E5 and half unpacking are integer-exact: every code of every channel.
 TEST_F(RuntimeGl, DcUnpackingIsBitExact) {
     std::vector<std::uint32_t> w;
     for (std::uint32_t c = 0; c < 2048; ++c) w.push_back(c | (c << 11) | ((c & 0x3FF) << 22));  // R11G11B10F codes

@@ -107,5 +107,33 @@ TEST(RuntimeTable, SameStorageComparesExactlyTheStorageFields) {
     EXPECT_TRUE(same_storage(a, controls));
 }
 
+// Packed entries whose traits contradict their layout: each refusal of runtime_entry, by its reason.
+TEST(RuntimeTable, PackedEntriesWithContradictoryTraitsAreRefused) {
+    using H = ZonalHallucination;
+    const PackedCodec* by[3] = {};
+    for (const Codec& c : codecs())
+        if (c.packed) by[static_cast<int>(c.packed->layout)] = c.packed;
+    const PackedCodec *zh3q = by[static_cast<int>(PackedLayout::kZh3Q16)], *sh3q = by[static_cast<int>(PackedLayout::kSh3Q28)],
+                      *sh2q = by[static_cast<int>(PackedLayout::kSh2Q)];
+    ASSERT_TRUE(zh3q && sh3q && sh2q);
+    const struct {
+        Codec codec;
+        const char* reason;
+    } bad[] = {
+        {fake(20, ZonalAxis::kFromParams, H::kNone, zh3q), "size differs from its packed layout"},
+        {fake(16, ZonalAxis::kNone, H::kNone, zh3q), "zh3_q16 layout needs a zonal axis"},
+        {fake(28, ZonalAxis::kLuminance, H::kNone, sh3q), "layout without zonal term has no zonal axis"},
+        {fake(28, ZonalAxis::kFromParams, H::kCurve, sh3q), "needs linear SH bytes"},
+        {fake(16, ZonalAxis::kFromParams, H::kSphere, sh2q), "by the Eq. 21 curve only"},
+        {fake(16, ZonalAxis::kFromParams, H::kNone, sh2q), "layout without zonal term has no zonal axis"},
+    };
+    for (const auto& b : bad) {
+        const auto e = runtime_entry(b.codec);
+        ASSERT_FALSE(e.ok()) << b.reason;
+        EXPECT_EQ(e.error().code, ErrorCode::kUnsupported);
+        EXPECT_NE(e.error().message.find(b.reason), std::string::npos) << e.error().message;
+    }
+}
+
 }  // namespace
 }  // namespace zhc

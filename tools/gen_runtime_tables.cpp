@@ -351,8 +351,9 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "zhc_gen_tables: %s\n", e.error().message.c_str());
             return 5;
         }
-        if (e->summary.find("*/") != std::string_view::npos || e->size_bytes > 0xFFF) {
-            std::fprintf(stderr, "zhc_gen_tables: codec table entry '%s': summary holds \"*/\" or size over 4095 bytes\n",
+        if (e->summary.find("*/") != std::string_view::npos || e->summary.find_first_of("\r\n") != std::string_view::npos ||
+            e->size_bytes > 0xFFF) {
+            std::fprintf(stderr, "zhc_gen_tables: codec table entry '%s': summary holds \"*/\" or a line break, or size over 4095 bytes\n",
                          std::string(c.name).c_str());
             return 5;
         }

@@ -134,7 +134,8 @@ enum class ZonalHallucination : std::uint8_t {
 
 // What code outside an entry may ask about it instead of testing its name. Each field is a fact
 // about the entry's bytes or decoder; tests check every one of them against the entry's functions
-// (tests/test_codec_table.cpp; zonal_axis against the GLSL and HLSL runtimes).
+// (tests/test_codec_table.cpp; zonal_axis and hallucination through the runtimes' decoders:
+// test_runtime_c bit for bit, the GLSL and HLSL tests).
 struct CodecTraits {
     // decode(encode(x)) == x bit for bit for every finite hub (the entry stores the hub itself: sh3).
     // The first exact entry is the baseline of size and speed comparisons, and a round trip through
