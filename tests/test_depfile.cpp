@@ -154,9 +154,13 @@ TEST(DepfileCli, BakeNamesSceneAndEnvironmentMap) {
     ASSERT_EQ(info.exit_code, 0) << info.err;
     EXPECT_EQ(info.out, rule.prerequisites[0] + "\n" + rule.prerequisites[1] + "\n");
 
-    // A failing command writes no depfile, and leaves an earlier one alone.
-    fs::remove(dep);
+    // A failing command leaves an earlier depfile alone, and writes none where there was none.
+    const std::string before = text_of(dep);
     fs::remove(map);
+    r = run_zhc({"bake", scene, "-o", dir + "/other.zhp", "--depfile", dep, "--quiet"});
+    EXPECT_EQ(r.exit_code, 3);
+    EXPECT_EQ(text_of(dep), before);
+    fs::remove(dep);
     r = run_zhc({"bake", scene, "-o", dir + "/other.zhp", "--depfile", dep, "--quiet"});
     EXPECT_EQ(r.exit_code, 3);
     EXPECT_FALSE(fs::exists(dep));

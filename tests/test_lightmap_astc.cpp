@@ -281,6 +281,12 @@ TEST(LightmapAstc, CliRefusesDdsAndBrokenFiles) {
     r = test::run_zhc({"lightmap", "decode", dir + "/l", "-o", dir + "/l2.exr"});
     EXPECT_EQ(r.exit_code, 4);
     EXPECT_NE(r.err.find("zhc.iz_log2_range"), std::string::npos) << r.err;
+    // A range key whose value is not "lo hi" with lo < hi: exit 4.
+    iz->key_values.push_back({std::string(lightmap_astc::kRangeKey), {'2', ' ', '1', 0}});
+    ASSERT_TRUE(write_ktx2(dir + "/l.iz.ktx2", *iz).ok());
+    r = test::run_zhc({"lightmap", "decode", dir + "/l", "-o", dir + "/l3.exr"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("not two finite floats"), std::string::npos) << r.err;
     // Two processes, 1 and 3 threads, other band heights: the same files.
     for (const char* target : {"astc", "astc-ldr"}) {
         ASSERT_EQ(test::run_zhc({"lightmap", "encode", exr, "-o", dir + "/p1", "--target", target, "--threads", "1"}).exit_code, 0);
@@ -288,6 +294,12 @@ TEST(LightmapAstc, CliRefusesDdsAndBrokenFiles) {
         for (const char* part : {".iz.ktx2", ".dwa.ktx2"})
             EXPECT_EQ(test::read_bytes(dir + "/p1" + part), test::read_bytes(dir + "/p3" + part)) << target << part;
     }
+    // A 6x6 d/w_a texture beside a 4x4 I_z (the last p1: astc-ldr 4x4): exit 4, naming the expected vkFormat.
+    std::filesystem::copy_file(dir + "/p1.iz.ktx2", dir + "/m.iz.ktx2", std::filesystem::copy_options::overwrite_existing);
+    std::filesystem::copy_file(dir + "/l.dwa.ktx2", dir + "/m.dwa.ktx2", std::filesystem::copy_options::overwrite_existing);
+    r = test::run_zhc({"lightmap", "decode", dir + "/m", "-o", dir + "/m.exr"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("expected 157"), std::string::npos) << r.err;
     // --targets with --html: one summary row per target in the report.
     r = test::run_zhc({"lightmap", "audit", exr, "--targets", "bc,astc:6x6", "--html", dir + "/t.html"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
