@@ -11,6 +11,7 @@
 #include "formats/scene/scene_gltf.h"
 #include "formats/scene/scene_json.h"
 #include "support.h"
+#include "zhc_runtime.h"
 
 namespace zhc {
 namespace {
@@ -162,7 +163,9 @@ TEST(SkyOcclusion, ProbeAboveAPlaneSeesTheUpperHemisphereAndConverges) {
         s.occlusion.sky_samples = n;
         const double err = max_abs_diff(bake(s)[0], expected);
         std::printf("plane: %5d rays/probe: max |error| %.3g\n", n, err);
-        EXPECT_LT(err, 4.0 / std::sqrt(double(n))) << n;
+        // The spiral's directions are quasi-random: the error falls about as 1/n (0.073 at 64 rays,
+        // 3.1e-4 at 16384); the bound is 12/n, about 2.5x the measured error at every n.
+        EXPECT_LT(err, 12.0 / n) << n;
         EXPECT_LT(err, previous) << n;  // decreasing with the ray count
         previous = err;
     }
@@ -212,7 +215,9 @@ TEST(SkyOcclusion, ProbeAtTheBottomOfAShaftSeesTheCap) {
         const Sh3Radiance got = bake(s)[0];
         const double err = max_abs_diff(got, expected);
         std::printf("shaft: %5d rays/probe: max |error| %.3g (L00 %.4f, closed form %.4f)\n", n, err, got[0][0], expected[0][0]);
-        EXPECT_LT(err, 0.05 * expected[0][0] * std::sqrt(4096.0 / n)) << n;
+        // Measured: 3.8 % of L00 at 1024 rays, 0.08 % at 65536; the bound 10 % (1024 / n)^0.75 is
+        // 2.6 to 6 times the measured error.
+        EXPECT_LT(err, 0.1 * expected[0][0] * std::pow(1024.0 / n, 0.75)) << n;
         EXPECT_LT(err, previous * 1.05) << n;
         previous = err;
     }
@@ -436,23 +441,14 @@ TEST(VisibilityMasks, MatchTheSlowTwinOnTwoWalls) {
 // ---- the leak test ----------------------------------------------------------------------------
 
 // Reference volume sampling (the contract in codec/probe/probe_set.h): the cell containing p
-// (coordinates clamped to the grid, as runtime/zhc_runtime.h zhc__volume_axis), corner weights
+// (runtime/zhc_runtime.h's own zhc__volume_axis: coordinates clamped to the grid), corner weights
 // trilinear x valid(probe) x bit(7 - corner) of the probe's mask, renormalised; all eight zero:
 // the plain trilinear blend.
 Sh3Radiance sample_volume(const ProbeGrid& g, const std::vector<Sh3Radiance>& probes, const std::vector<std::uint8_t>* validity,
                           const std::vector<std::uint8_t>* visibility, Vec3 p) {
     std::uint32_t i0[3];
     double f[3];
-    for (int a = 0; a < 3; ++a) {
-        const std::uint32_t n = g.counts[static_cast<size_t>(a)];
-        double t = (p[a] - g.origin[a]) / g.spacing[a];
-        if (!(t >= 0)) t = 0;
-        if (t > n - 1.0) t = n - 1.0;
-        std::uint32_t i = static_cast<std::uint32_t>(std::floor(t));
-        if (n >= 2 && i > n - 2) i = n - 2;
-        i0[a] = i;
-        f[a] = n >= 2 ? t - i : 0.0;
-    }
+    for (int a = 0; a < 3; ++a) zhc__volume_axis(p[a], g.origin[a], g.spacing[a], g.counts[static_cast<size_t>(a)], &i0[a], &f[a]);
     double w[8], wsum = 0;
     size_t index[8];
     for (int c = 0; c < 8; ++c) {
