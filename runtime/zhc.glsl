@@ -68,6 +68,16 @@ const uint ZHC_LAYOUT_ZH3_F32 = 2u;  // 15 floats: DC, L1, zonal f20 per channel
 const uint ZHC_LAYOUT_ZH3_Q16 = 3u;  // 16 bytes: DC (4) + per channel [L1-1, L10, L11, zonal]
 const uint ZHC_LAYOUT_SH3_Q28 = 4u;  // 28 bytes: DC (4) + per channel [L1-1 .. L22]
 const uint ZHC_LAYOUT_SH2_Q = 5u;  // 16 bytes: DC slot (6) + per channel [L1-1, L10, L11] + byte 15
+// 32-bit words per probe of a layout family (0 for an unknown family).
+uint zhcFamilyWords(uint family) {
+    if (family == ZHC_LAYOUT_SH3_F32) return 27u;
+    if (family == ZHC_LAYOUT_SH2_F32) return 12u;
+    if (family == ZHC_LAYOUT_ZH3_F32) return 15u;
+    if (family == ZHC_LAYOUT_ZH3_Q16) return 4u;
+    if (family == ZHC_LAYOUT_SH3_Q28) return 7u;
+    if (family == ZHC_LAYOUT_SH2_Q) return 4u;
+    return 0u;
+}
 // Zonal L2 hallucinated at decode (ZH3 paper Sec. 3.4; codec zh3_hallucinate).
 const uint ZHC_HALL_NONE = 0u;  // no hallucination (L2 stored or absent)
 const uint ZHC_HALL_AMBDIR = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
@@ -704,22 +714,13 @@ vec3 zhcHlshIrradiance(vec3 iz, vec3 ca, vec3 cx, vec3 cy, vec3 m) {
 //   ...
 //   vec3 e = zhcVolumeIrradiance(uVolume, uFormat, worldPosition, worldNormal);
 //
-// Without ZHC_VOLUME_WORD the volume functions are not compiled (ZhcVolume and zhcFamilyWords are).
+// Without ZHC_VOLUME_WORD the volume functions are not compiled (ZhcVolume is; zhcFamilyWords is in the generated table).
 
 struct ZhcVolume {
     vec3 origin;   // position of probe (0, 0, 0)
     vec3 spacing;  // > 0 (the application checks, as zhc_volume_init)
     uvec3 counts;  // >= 1 each
 };
-
-// Words per probe of a layout family (27, 12, 15, 4, 7, 4).
-uint zhcFamilyWords(uint family) {
-    if (family == ZHC_LAYOUT_SH3_F32) return 27u;
-    if (family == ZHC_LAYOUT_SH2_F32) return 12u;
-    if (family == ZHC_LAYOUT_ZH3_F32) return 15u;
-    if (family == ZHC_LAYOUT_SH3_Q28) return 7u;
-    return 4u;
-}
 
 #ifdef ZHC_VOLUME_WORD
 // SH3 radiance of probe `probe` of the volume's buffer.

@@ -83,6 +83,16 @@ const ZHC_LAYOUT_ZH3_F32: u32 = 2u;  // 15 floats: DC, L1, zonal f20 per channel
 const ZHC_LAYOUT_ZH3_Q16: u32 = 3u;  // 16 bytes: DC (4) + per channel [L1-1, L10, L11, zonal]
 const ZHC_LAYOUT_SH3_Q28: u32 = 4u;  // 28 bytes: DC (4) + per channel [L1-1 .. L22]
 const ZHC_LAYOUT_SH2_Q: u32 = 5u;  // 16 bytes: DC slot (6) + per channel [L1-1, L10, L11] + byte 15
+// 32-bit words per probe of a layout family (0 for an unknown family).
+fn zhcFamilyWords(family: u32) -> u32 {
+    if (family == ZHC_LAYOUT_SH3_F32) { return 27u; }
+    if (family == ZHC_LAYOUT_SH2_F32) { return 12u; }
+    if (family == ZHC_LAYOUT_ZH3_F32) { return 15u; }
+    if (family == ZHC_LAYOUT_ZH3_Q16) { return 4u; }
+    if (family == ZHC_LAYOUT_SH3_Q28) { return 7u; }
+    if (family == ZHC_LAYOUT_SH2_Q) { return 4u; }
+    return 0u;
+}
 // Zonal L2 hallucinated at decode (ZH3 paper Sec. 3.4; codec zh3_hallucinate).
 const ZHC_HALL_NONE: u32 = 0u;  // no hallucination (L2 stored or absent)
 const ZHC_HALL_AMBDIR: u32 = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|

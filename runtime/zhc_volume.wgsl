@@ -31,15 +31,6 @@ struct ZhcVolume {
     counts: vec3<u32>,   // >= 1 each
 }
 
-// Words per probe of a layout family (27, 12, 15, 4, 7, 4).
-fn zhcFamilyWords(family: u32) -> u32 {
-    if (family == ZHC_LAYOUT_SH3_F32) { return 27u; }
-    if (family == ZHC_LAYOUT_SH2_F32) { return 12u; }
-    if (family == ZHC_LAYOUT_ZH3_F32) { return 15u; }
-    if (family == ZHC_LAYOUT_SH3_Q28) { return 7u; }
-    return 4u;
-}
-
 // SH3 radiance of probe `probe` of the volume's buffer.
 fn zhcVolumeProbe(probe: u32, f: ZhcFormat) -> ZhcSh3 {
     let stride = zhcFamilyWords(f.family);

@@ -246,6 +246,17 @@ std::string gen_shader(const Model& m, bool wgsl) {
     };
     o << "// Layout families: how a probe's words are laid out (codec/probe/runtime_table.h RuntimeLayout).\n";
     each_layout([&](RuntimeLayout l, int i) { decl("ZHC_LAYOUT_" + upper(zhc::runtime_layout_name(l)), i, layout_comment(l)); });
+    o << "// 32-bit words per probe of a layout family (0 for an unknown family).\n";
+    o << (wgsl ? "fn zhcFamilyWords(family: u32) -> u32 {\n" : "uint zhcFamilyWords(uint family) {\n");
+    each_layout([&](RuntimeLayout l, int) {
+        const std::string name = "ZHC_LAYOUT_" + upper(zhc::runtime_layout_name(l));
+        const std::size_t words = zhc::runtime_layout_bytes(l) / 4;
+        if (wgsl)
+            o << "    if (family == " << name << ") { return " << words << "u; }\n";
+        else
+            o << "    if (family == " << name << ") return " << words << "u;\n";
+    });
+    o << "    return 0u;\n}\n";
     o << "// Zonal L2 hallucinated at decode (ZH3 paper Sec. 3.4; codec zh3_hallucinate).\n";
     each_hall([&](ZonalHallucination h, int i) { decl("ZHC_HALL_" + upper(zhc::zonal_hallucination_name(h)), i, hall_comment(h)); });
     o << "// Where an encoding's zonal axis comes from (luminance / channel: set axisMode to it).\n";

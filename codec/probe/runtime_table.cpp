@@ -7,6 +7,18 @@
 
 namespace zhc {
 
+std::size_t runtime_layout_bytes(RuntimeLayout layout) {
+    switch (layout) {
+        case RuntimeLayout::kSh3F32: return 27 * 4;
+        case RuntimeLayout::kSh2F32: return 12 * 4;
+        case RuntimeLayout::kZh3F32: return 15 * 4;
+        case RuntimeLayout::kZh3Q16: return packed_size_bytes(PackedLayout::kZh3Q16);
+        case RuntimeLayout::kSh3Q28: return packed_size_bytes(PackedLayout::kSh3Q28);
+        case RuntimeLayout::kSh2Q: return packed_size_bytes(PackedLayout::kSh2Q);
+    }
+    return 0;
+}
+
 std::string_view runtime_layout_name(RuntimeLayout layout) {
     switch (layout) {
         case RuntimeLayout::kSh3F32: return "sh3_f32";
@@ -54,11 +66,11 @@ Result<RuntimeEntry> runtime_entry(const Codec& c) {
             case PackedLayout::kSh2Q: e.layout = RuntimeLayout::kSh2Q; break;
         }
         if (c.size_bytes != packed_size_bytes(c.packed->layout)) return refuse("size differs from its packed layout's");
-    } else if (c.size_bytes == 27 * 4 && e.axis == ZonalAxis::kNone) {
+    } else if (c.size_bytes == runtime_layout_bytes(RuntimeLayout::kSh3F32) && e.axis == ZonalAxis::kNone) {
         e.layout = RuntimeLayout::kSh3F32;
-    } else if (c.size_bytes == 12 * 4) {
+    } else if (c.size_bytes == runtime_layout_bytes(RuntimeLayout::kSh2F32)) {
         e.layout = RuntimeLayout::kSh2F32;
-    } else if (c.size_bytes == 15 * 4 && e.axis != ZonalAxis::kNone) {
+    } else if (c.size_bytes == runtime_layout_bytes(RuntimeLayout::kZh3F32) && e.axis != ZonalAxis::kNone) {
         e.layout = RuntimeLayout::kZh3F32;
     } else {
         return refuse("no runtime layout holds " + std::to_string(c.size_bytes) +

@@ -35,6 +35,8 @@ inline constexpr int kZonalAxisCount = 4;           // codec.h ZonalAxis
 
 // Lower-case names the generated tables use ("sh3_f32", "none", "curve_adaptive", "luminance").
 std::string_view runtime_layout_name(RuntimeLayout layout);
+// Stored bytes of one probe in a layout (108, 48, 60, then the packed layouts' 16, 28, 16).
+std::size_t runtime_layout_bytes(RuntimeLayout layout);
 std::string_view zonal_hallucination_name(ZonalHallucination h);
 std::string_view zonal_axis_name(ZonalAxis a);  // "none", "luminance", "channel", "format"
 
