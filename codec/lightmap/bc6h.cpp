@@ -1,5 +1,6 @@
 // zhc/codec/lightmap/bc6h.cpp — BC6H unsigned encoder and decoder (see bc6h.h, docs/lightmap-formats.md).
 #include "codec/lightmap/bc6h.h"
+#include "codec/lightmap/bptc_tables.h"
 
 #include <algorithm>
 #include <array>
@@ -149,16 +150,12 @@ const std::array<PackPlan, 14>& pack_plans() {
     return plans;
 }
 
-// Two-subset partitions (the first 32 of BC7's): bit t set = texel t belongs to subset 1.
-constexpr std::uint16_t kPartition[32] = {
-    0xcccc, 0x8888, 0xeeee, 0xecc8, 0xc880, 0xfeec, 0xfec8, 0xec80, 0xc800, 0xffec, 0xfe80,
-    0xe800, 0xffe8, 0xff00, 0xfff0, 0xf000, 0xf710, 0x008e, 0x7100, 0x08ce, 0x008c, 0x7310,
-    0x3100, 0x8cce, 0x088c, 0x3110, 0x6666, 0x366c, 0x17e8, 0x0ff0, 0x718e, 0x399c};
-// Anchor texel of subset 1 (subset 0's anchor is texel 0).
-constexpr std::uint8_t kAnchor2[32] = {15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15,
-                                       15, 2,  8,  2,  2,  8,  8,  15, 2,  8,  2,  2,  8,  8,  2,  2};
-constexpr int kWeights3[8] = {0, 9, 18, 27, 37, 46, 55, 64};
-constexpr int kWeights4[16] = {0, 4, 9, 13, 17, 21, 26, 30, 34, 38, 43, 47, 51, 55, 60, 64};
+// The BPTC tables (codec/lightmap/bptc_tables.h): BC6H's two-subset modes use the first 32
+// partitions and their anchors; 3- and 4-bit index weights.
+constexpr const std::uint16_t (&kPartition)[64] = bptc::kPartition2;
+constexpr const std::uint8_t (&kAnchor2)[64] = bptc::kAnchor2;
+constexpr const int (&kWeights3)[8] = bptc::kWeights3;
+constexpr const int (&kWeights4)[16] = bptc::kWeights4;
 // evaluate's vectorised search computes the weights as round(64 j / (n - 1)) in floats: checked
 // here against the tables, with the same float expression.
 template <int N>
