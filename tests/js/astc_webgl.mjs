@@ -5,7 +5,8 @@
 //     blocks at the right and bottom edges for every footprint) and `zhc lightmap encode` to
 //     astc-ldr 4x4, astc-ldr 6x6 and astc (HDR) 4x4;
 //  2. ktx-parse (the npm KTX 2.0 parser) reads every file: vkFormat, size, one level, the DFD's ASTC
-//     colour model (162) and footprint, the LDR range key (runtime/web's parseIzLog2Range);
+//     colour model (162) and footprint, the LDR range key (runtime/web's parseIzLog2Range); the
+//     files rewritten by ktx-parse's own writer decode in zhc to the same lightmap;
 //  3. tests/runtime_c/zhc_astc_texels decodes both textures with astcenc (the encoder's twin) and
 //     evaluates runtime/zhc_runtime.h's zhc_irradz_irradiance_astc at a random tangent normal per texel;
 //     runtime/web's irradzIrradianceAstc on the same texels must agree (V8's Math.pow / atan2 / sin /
@@ -26,8 +27,8 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { read } from 'ktx-parse';
-import { makeRand, checker } from './fixtures.mjs';
+import { read, write } from 'ktx-parse';
+import { makeRand, checker, ulpDiff } from './fixtures.mjs';
 import { chromiumPages } from './chromium_page.mjs';
 import { irradzIrradianceAstc, parseIzLog2Range, izFromLdr, decodeHemioct } from '../../runtime/web/zhc_runtime.mjs';
 
@@ -54,10 +55,6 @@ check(maps.length === 8, `eight sample maps in ${envmapDir} (found ${maps.length
 const variants = [{ target: 'astc-ldr', fp: '4x4' }, { target: 'astc-ldr', fp: '6x6' }, { target: 'astc', fp: '4x4' }];
 const textures = [], cases = [];
 let jsExact = 0, jsTotal = 0, jsWorstUlp = 0;
-const ulps = (a, b) => {
-  const fa = new Float32Array([a, b]), ia = new Int32Array(fa.buffer);
-  return Math.abs(ia[0] - ia[1]);
-};
 for (const map of maps) {
   const name = path.basename(map, '.exr');
   run('lightmap', 'synth', path.join(envmapDir, map), '-o', W(`${name}_lm.exr`), '--size', String(WIDTH), '--height', String(HEIGHT));
@@ -87,6 +84,14 @@ for (const map of maps) {
       fs.writeFileSync(W(file), k.levels[0].levelData);
       textures.push({ name: `${tag}.${part}`, file, width: WIDTH, height: HEIGHT, glFormat: GL_ASTC[v.fp], hdr });
     }
+    // 2b. The same textures as another writer lays them out (ktx-parse's write: its own key/value
+    // order, padding and level alignment): zhc reads them to the same decoded lightmap.
+    for (const part of ['iz', 'dwa'])
+      fs.writeFileSync(W(`${tag}_kp.${part}.ktx2`), write(read(new Uint8Array(fs.readFileSync(W(`${tag}.${part}.ktx2`))))));
+    run('lightmap', 'decode', W(tag), '-o', W(`${tag}_dec.exr`));
+    run('lightmap', 'decode', W(`${tag}_kp`), '-o', W(`${tag}_kp_dec.exr`));
+    check(Buffer.compare(fs.readFileSync(W(`${tag}_dec.exr`)), fs.readFileSync(W(`${tag}_kp_dec.exr`))) === 0,
+      `${tag}: the files as ktx-parse writes them decode to the same lightmap`);
     // 3. astcenc's texels and the C header's irradiance; the JS runtime on the same texels.
     const rand = makeRand(cases.length + 1);
     const normals = new Float64Array(3 * N);
@@ -106,7 +111,7 @@ for (const map of maps) {
         const got = irradzIrradianceAstc(Array.from(iz.subarray(4 * i, 4 * i + 3)), Array.from(dwa.subarray(4 * i, 4 * i + 3)), range, model,
           Array.from(normals.subarray(3 * i, 3 * i + 3)));
         for (let k = 0; k < 3; k++) {
-          const want = e[6 * i + 3 * model + k], u = ulps(got[k], want);
+          const want = e[6 * i + 3 * model + k], u = ulpDiff(got[k], want);
           jsTotal++;
           if (u === 0) jsExact++;
           jsWorstUlp = Math.max(jsWorstUlp, u);

@@ -104,3 +104,13 @@ export function checker() {
   };
   return { check, finish };
 }
+
+// Distance in units in the last place between two float32 values, on the ordered integer line
+// (+0 and -0 are 0 apart, a value and its neighbour across zero 1 apart).
+export function ulpDiff(a, b) {
+  const buf = new DataView(new ArrayBuffer(8));
+  buf.setFloat32(0, a, true);
+  buf.setFloat32(4, b, true);
+  const ia = buf.getInt32(0, true), ib = buf.getInt32(4, true);
+  return Math.abs((ia < 0 ? 0x80000000 - ia : ia) - (ib < 0 ? 0x80000000 - ib : ib));
+}

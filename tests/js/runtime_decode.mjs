@@ -18,7 +18,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { register } from 'node:module';
-import { randomProbes, triangleScene, makeRand, checker } from './fixtures.mjs';
+import { randomProbes, triangleScene, makeRand, checker, ulpDiff } from './fixtures.mjs';
 
 register('./three_resolver.mjs', import.meta.url);
 const runtime = await import('../../runtime/web/zhc_runtime.mjs');
@@ -48,13 +48,6 @@ fs.writeFileSync(W('grid.json'), JSON.stringify({ format: 'zhc-probes', version:
 fs.writeFileSync(W('scene.glb'), triangleScene());
 
 // --- decoded SH3 vs zhc -------------------------------------------------------------------------
-const ulpDiff = (a, b) => {
-  const buf = new DataView(new ArrayBuffer(8));
-  buf.setFloat32(0, a, true);
-  buf.setFloat32(4, b, true);
-  const ia = buf.getInt32(0, true), ib = buf.getInt32(4, true);
-  return Math.abs((ia < 0 ? 0x80000000 - ia : ia) - (ib < 0 ? 0x80000000 - ib : ib));
-};
 // Compares a Float32Array(count * 27) with zhc's JSON probe list; returns the number of
 // coefficients that differ in any bit (and logs the first few).
 function compareWithJson(what, sh, jsonFile, quiet = false) {
