@@ -80,9 +80,10 @@ Result<std::vector<std::uint8_t>> read_file_bytes(const std::string& path, std::
 }
 
 bool looks_like_git_lfs_pointer(std::span<const std::uint8_t> bytes) {
-    // The specification's first line; pointers are under 1024 bytes ("version" key first).
+    // The specification's first line ("version" key first). Decided from the first bytes alone, so
+    // a reader that sees only a file's head (the streaming KTX2/DDS/EXR layout readers) answers as
+    // one that sees the whole file.
     static constexpr std::string_view kPrefixes[] = {"version https://git-lfs.github.com/spec/", "version https://hawser.github.com/spec/"};
-    if (bytes.size() >= 1024) return false;
     const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     for (const std::string_view p : kPrefixes)
         if (text.substr(0, p.size()) == p) return true;

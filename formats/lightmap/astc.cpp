@@ -170,6 +170,17 @@ Result<std::vector<float>> decode_rgba(const std::uint8_t* blocks, std::size_t s
     const astcenc_swizzle swz{ASTCENC_SWZ_R, ASTCENC_SWZ_G, ASTCENC_SWZ_B, ASTCENC_SWZ_A};
     const astcenc_error e = astcenc_decompress_image((*ctx)->get(), blocks, size, &image, &swz, 0);
     if (e != ASTCENC_SUCCESS) return make_error(ErrorCode::kInternal, std::string("astcenc_decompress_image: ") + astcenc_get_error_string(e));
+    // An invalid block (reserved or out-of-range encodings) decodes to the error colour. With float
+    // output astcenc gives NaN there; for the LDR (UNORM) formats the specification's error colour is
+    // opaque magenta, which is what a GPU samples, so zhc decodes to that.
+    if (!hdr)
+        for (size_t i = 0; i < rgba.size(); i += 4)
+            if (std::isnan(rgba[i]) || std::isnan(rgba[i + 1]) || std::isnan(rgba[i + 2]) || std::isnan(rgba[i + 3])) {
+                rgba[i] = 1.0f;
+                rgba[i + 1] = 0.0f;
+                rgba[i + 2] = 1.0f;
+                rgba[i + 3] = 1.0f;
+            }
     return rgba;
 }
 
