@@ -11,6 +11,8 @@
 //  * `params` pass validate_quant_params for that representation;
 //  * layout kGrid: counts multiply to `count`, origin and spacing finite;
 //    layout kPositions: positions.size() == count, all finite; layout kNone: nothing.
+//  * validity: empty or `count` bytes, each 0 or 1; visibility: empty, or `count` bytes with a
+//    grid layout.
 #pragma once
 
 #include <array>
@@ -55,6 +57,14 @@ struct ProbeSet {
     ProbeLayout layout;
     std::uint64_t count = 0;
     std::vector<std::uint8_t> payload;  // count * size_bytes, probe-major
+    // Leak-avoidance data of a baked grid (docs/scene.md "Probes near geometry"), both optional:
+    // empty, or exactly `count` bytes. validity[i]: 1 = valid, 0 = inside geometry (its SH is a
+    // blend of valid neighbours). visibility[i] (grid layouts only): bit (cx + 2 cy + 4 cz) set =
+    // the probe is visible from the grid cell on its side (cx, cy, cz), c = 1 towards +axis, 0
+    // towards -axis. Sampling a cell with lower corner probe (i0, j0, k0), corner (dx, dy, dz)
+    // reads bit 7 - (dx + 2 dy + 4 dz) of that corner probe.
+    std::vector<std::uint8_t> validity;
+    std::vector<std::uint8_t> visibility;
 
     // nullptr when `representation` is not in the table.
     const Codec* codec() const { return find_codec(representation); }
@@ -62,6 +72,9 @@ struct ProbeSet {
 
 // Checks every invariant above; kInvalidArgument naming the first broken one.
 Status validate_probe_set(const ProbeSet& set);
+// The leak-data part of it: validity and visibility each empty or `count` bytes, validity values
+// 0/1, visibility only with a grid layout.
+Status validate_leak_data(const ProbeSet& set);
 
 // Probe i's stored bytes -> hub, and hub -> stored bytes. With params.kind == kIrradiance the
 // payload holds irradiance SH: the quantised layouts then use the irradiance-scaled ratio bounds
