@@ -99,6 +99,8 @@ function definition(vol) {
   const d = JSON.parse(JSON.stringify(vol));
   delete d.coefficients;
   delete d.positions;
+  delete d.validity;
+  delete d.visibility;
   if (d.draco) delete d.draco.bufferView;
   return JSON.stringify(d);
 }
