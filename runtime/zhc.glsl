@@ -715,6 +715,17 @@ vec3 zhcHlshIrradiance(vec3 iz, vec3 ca, vec3 cx, vec3 cy, vec3 m) {
 //   vec3 e = zhcVolumeIrradiance(uVolume, uFormat, worldPosition, worldNormal);
 //
 // Without ZHC_VOLUME_WORD the volume functions are not compiled (ZhcVolume is; zhcFamilyWords is in the generated table).
+//
+// Validity and visibility (docs/runtime.md "Validity and visibility"): define also
+// ZHC_VOLUME_MASK(probe) as an expression giving probe `probe`'s combined mask byte as a uint,
+// `valid ? visibility : 0` (absent validity: valid; absent visibility: 0xFF), e.g. from an R8UI 3D
+// texture or 4 masks per uint of a buffer:
+//
+//   #define ZHC_VOLUME_MASK(i) ((zhcMaskWords[(i) >> 2] >> (8u * ((i) & 3u))) & 0xFFu)
+//
+// Corner (dx, dy, dz) of the cell then weighs w times bit 7 - (dx + 2 dy + 4 dz) of its mask, the
+// weights are divided by their sum, and when all eight vanish the plain trilinear weights are
+// used. Without ZHC_VOLUME_MASK the blend is the plain trilinear one, as before.
 
 struct ZhcVolume {
     vec3 origin;   // position of probe (0, 0, 0)
@@ -741,11 +752,28 @@ ZhcSh3 zhcVolumeSh3(ZhcVolume v, ZhcFormat f, vec3 p) {
     t = min(t, vec3(n - 1u));
     uvec3 i0 = min(uvec3(t), max(n, uvec3(2u)) - 2u);
     vec3 fr = t - vec3(i0);
+#ifdef ZHC_VOLUME_MASK
+    // Masked weights (8 mask loads, ~8 selects + 8 adds + 8 divisions), then the blend below.
+    float wm[8];
+    float sum = 0.0;
+    for (uint c = 0u; c < 8u; ++c) {
+        uvec3 b = uvec3(c & 1u, (c >> 1) & 1u, c >> 2);
+        vec3 wv = mix(1.0 - fr, fr, notEqual(b, uvec3(0u)));
+        float w = wv.x * wv.y * wv.z;
+        uvec3 q = i0 + b;
+        uint bit = w == 0.0 ? 0u : (uint(ZHC_VOLUME_MASK(q.x + n.x * (q.y + n.y * q.z))) >> (7u - c)) & 1u;
+        wm[c] = bit != 0u ? w : 0.0;
+        sum += wm[c];
+    }
+#endif
     ZhcSh3 acc = zhcZeroSh3();
     for (uint c = 0u; c < 8u; ++c) {
         uvec3 b = uvec3(c & 1u, (c >> 1) & 1u, c >> 2);
         vec3 wv = mix(1.0 - fr, fr, notEqual(b, uvec3(0u)));
         float w = wv.x * wv.y * wv.z;
+#ifdef ZHC_VOLUME_MASK
+        if (sum > 0.0) w = wm[c] / sum;  // else: every corner masked, plain trilinear
+#endif
         if (w == 0.0) continue;
         uvec3 q = i0 + b;
         ZhcSh3 s = zhcVolumeProbe(q.x + n.x * (q.y + n.y * q.z), f);

@@ -833,6 +833,17 @@ float3 zhc_irradz_irradiance_astc(float3 iz, float3 dwa, uint model, float3 n)
 //   float3 e = zhc_volume_irradiance(gVolume, gFormat, worldPosition, worldNormal);
 //
 // Without ZHC_VOLUME_WORD only the ZhcVolume struct is declared.
+//
+// Validity and visibility (docs/runtime.md "Validity and visibility"): define also
+// ZHC_VOLUME_MASK(probe) as an expression giving probe `probe`'s combined mask byte as a uint,
+// `valid ? visibility : 0` (absent validity: valid; absent visibility: 0xFF), e.g.
+//
+//   ByteAddressBuffer probeMasks;  // 4 masks per word
+//   #define ZHC_VOLUME_MASK(i) ((probeMasks.Load(4u * ((i) >> 2)) >> (8u * ((i) & 3u))) & 0xFFu)
+//
+// Corner (dx, dy, dz) of the cell then weighs w times bit 7 - (dx + 2 dy + 4 dz) of its mask, the
+// weights are divided by their sum, and when all eight vanish the plain trilinear weights are
+// used. Without ZHC_VOLUME_MASK the blend is the plain trilinear one.
 struct ZhcVolume
 {
     float3 origin;   // position of probe (0, 0, 0)
@@ -860,6 +871,23 @@ ZhcSH3 zhc_volume_sh3(ZhcVolume v, ZhcFormat f, float3 p)
     t = min(t, float3(n - 1u));
     uint3 i0 = min(uint3(t), max(n, uint3(2u, 2u, 2u)) - 2u);
     float3 fr = t - float3(i0);
+#ifdef ZHC_VOLUME_MASK
+    // Masked weights (8 mask loads, ~8 selects + 8 adds + 8 divisions), then the blend below.
+    float wm[8];
+    float sum = 0.0f;
+    [unroll] for (uint m = 0u; m < 8u; ++m)
+    {
+        uint3 b = uint3(m & 1u, (m >> 1) & 1u, m >> 2);
+        float wx = b.x != 0u ? fr.x : 1.0f - fr.x;
+        float wy = b.y != 0u ? fr.y : 1.0f - fr.y;
+        float wz = b.z != 0u ? fr.z : 1.0f - fr.z;
+        float w = wx * wy * wz;
+        uint3 q = i0 + b;
+        uint bit = w == 0.0f ? 0u : (uint(ZHC_VOLUME_MASK(q.x + n.x * (q.y + n.y * q.z))) >> (7u - m)) & 1u;
+        wm[m] = bit != 0u ? w : 0.0f;
+        sum += wm[m];
+    }
+#endif
     ZhcSH3 acc;
     [unroll] for (int i = 0; i < 9; ++i) acc.c[i] = float3(0.0f, 0.0f, 0.0f);
     [loop] for (uint c = 0u; c < 8u; ++c)
@@ -869,6 +897,9 @@ ZhcSH3 zhc_volume_sh3(ZhcVolume v, ZhcFormat f, float3 p)
         float wy = b.y != 0u ? fr.y : 1.0f - fr.y;
         float wz = b.z != 0u ? fr.z : 1.0f - fr.z;
         float w = wx * wy * wz;
+#ifdef ZHC_VOLUME_MASK
+        if (sum > 0.0f) w = wm[c] / sum;  // else: every corner masked, plain trilinear
+#endif
         if (w == 0.0f) continue;
         uint3 q = i0 + b;
         ZhcSH3 s = zhc_volume_probe(q.x + n.x * (q.y + n.y * q.z), f);

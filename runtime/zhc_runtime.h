@@ -767,7 +767,7 @@ static inline void zhc_probe_irradiance(const zhc_probe_format* f, const void* b
     zhc_probe_irradiance_d(f, bytes, nd, rgb);
 }
 
-/* ---- .zhp container (docs/zhp-container.md, version 1) ------------------------------------- */
+/* ---- .zhp container (docs/zhp-container.md, versions 1 and 2) ------------------------------ */
 
 #define ZHC_ZHP_HEADER_BYTES 184
 
@@ -784,6 +784,8 @@ typedef struct zhc_zhp_info {
     uint64_t body_bytes;          /* uncompressed body size */
     uint64_t stored_body_bytes;   /* body size in the file */
     uint32_t body_crc32;
+    uint64_t validity_offset;     /* version 2: count bytes (0/1) after the payload; 0 = absent */
+    uint64_t visibility_offset;   /* version 2, grid only: count 8-bit cell masks; 0 = absent */
 } zhc_zhp_info;
 
 /* CRC-32, IEEE 802.3 (reflected 0xEDB88320, init and final XOR 0xFFFFFFFF); continue a running
@@ -802,14 +804,17 @@ static inline uint32_t zhc_crc32(uint32_t crc, const void* data, size_t size) {
 
 /* The header of a .zhp file: `header` holds `size` bytes (the whole file or at least its first
  * 184). Checks, in zhc's reader order (formats/probes/probe_file.cpp): magic (a short prefix of it:
- * TRUNCATED, else BAD_FORMAT), version 1 (UNSUPPORTED), 184 bytes present (TRUNCATED), header CRC-32
- * (CHECKSUM), header size 184, reserved bytes zero (BAD_FORMAT), enum ranges of kind, DC format, L2
+ * TRUNCATED, else BAD_FORMAT), version 1 or 2 (UNSUPPORTED), 184 bytes present (TRUNCATED), header
+ * CRC-32 (CHECKSUM), header size 184, reserved bytes zero (BAD_FORMAT; version 2: byte 21 holds the
+ * per-probe sections, bit 0 validity, bit 1 visibility: other bits UNSUPPORTED, none or visibility
+ * without a grid BAD_FORMAT), enum ranges of kind, DC format, L2
  * bound, zonal mapping, axis mode, compression, layout (UNSUPPORTED), sqrt 0/1 and bits 2..8
  * (BAD_FORMAT), representation name printable ASCII, zero padded (BAD_FORMAT) and known
  * (UNSUPPORTED), bytes per probe = the encoding's (BAD_FORMAT), luminance weights finite
  * (INVALID_VALUE), half DC only on sh2_q / hall_curve_q (BAD_FORMAT), probe count <= 2^26
  * (TOO_LARGE), grid values finite (INVALID_VALUE), grid counts multiply to the count or grid fields
- * all +0 without a grid (BAD_FORMAT), body bytes = count (12 [positions] + probe size) (BAD_FORMAT)
+ * all +0 without a grid (BAD_FORMAT), body bytes = count (12 [positions] + probe size + 1 per
+ * per-probe section) (BAD_FORMAT)
  * and <= 2 GiB (TOO_LARGE), stored body = body when uncompressed, <= ZSTD_compressBound when
  * compressed (BAD_FORMAT). Does not look at the body (see zhc_zhp_open).
  * On ZHC_OK fills f (format, a/b the codec's 0.6/0.08) and info (either may be NULL).
@@ -824,17 +829,23 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
     uint64_t count, raw_expected, raw, stored, pos_bytes;
     uint32_t counts[3];
     double grid[6];
-    int c;
+    int c, version, leak = 0;
     if (info) memset(info, 0, sizeof *info);
     if (size == 0) return ZHC_ERR_TRUNCATED;
     if (!h) return ZHC_ERR_ARGUMENT;
     if (memcmp(h, magic, size < 8 ? size : 8) != 0) return ZHC_ERR_BAD_FORMAT;
     if (size < 10) return ZHC_ERR_TRUNCATED;
-    if ((h[8] | (h[9] << 8)) != 1) return ZHC_ERR_UNSUPPORTED;
+    version = h[8] | (h[9] << 8);
+    if (version != 1 && version != 2) return ZHC_ERR_UNSUPPORTED;
     if (size < ZHC_ZHP_HEADER_BYTES) return ZHC_ERR_TRUNCATED;
     if (zhc_crc32(0, h, 180) != zhc__u32(h + 180)) return ZHC_ERR_CHECKSUM;
     if ((h[10] | (h[11] << 8)) != ZHC_ZHP_HEADER_BYTES) return ZHC_ERR_BAD_FORMAT;
-    if ((h[21] | h[22] | h[23]) || zhc__u32(h + 68) || zhc__u32(h + 156)) return ZHC_ERR_BAD_FORMAT;
+    if ((version == 1 && h[21]) || (h[22] | h[23]) || zhc__u32(h + 68) || zhc__u32(h + 156)) return ZHC_ERR_BAD_FORMAT;
+    if (version == 2) {
+        leak = h[21];
+        if (leak > 3) return ZHC_ERR_UNSUPPORTED;
+        if (leak == 0 || ((leak & 2) && h[20] != 1)) return ZHC_ERR_BAD_FORMAT;
+    }
     if (h[12] > 1 || h[14] > 2 || h[15] > 1 || h[17] > 2 || h[18] > 1 || h[19] > 1 || h[20] > 2)
         return ZHC_ERR_UNSUPPORTED;
     if (h[16] > 1) return ZHC_ERR_BAD_FORMAT;
@@ -892,7 +903,7 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
         if (counts[0] | counts[1] | counts[2]) return ZHC_ERR_BAD_FORMAT;
     }
     pos_bytes = inf.layout == 2 ? count * 12 : 0;
-    raw_expected = pos_bytes + count * inf.probe_size;
+    raw_expected = pos_bytes + count * inf.probe_size + count * (uint64_t)((leak & 1) + ((leak >> 1) & 1));
     raw = zhc__u64(h + 160);
     if (raw != raw_expected) return ZHC_ERR_BAD_FORMAT;
     if (raw > ((uint64_t)1 << 31)) return ZHC_ERR_TOO_LARGE;
@@ -906,6 +917,8 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
     inf.body_crc32 = zhc__u32(h + 176);
     inf.positions_offset = inf.layout == 2 ? ZHC_ZHP_HEADER_BYTES : 0;
     inf.payload_offset = ZHC_ZHP_HEADER_BYTES + pos_bytes;
+    if (leak & 1) inf.validity_offset = inf.payload_offset + count * inf.probe_size;
+    if (leak & 2) inf.visibility_offset = inf.payload_offset + count * inf.probe_size + ((leak & 1) ? count : 0);
     if (f) *f = fmt;
     if (info) *info = inf;
     return ZHC_OK;
@@ -914,7 +927,7 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
 /* A whole .zhp file in memory (`file`, `size` bytes): the header as zhc_zhp_parse_header, then
  * file size = 184 + stored body (TRUNCATED / TRAILING_BYTES), body CRC-32 (CHECKSUM), a compressed
  * body (ZHC_ERR_COMPRESSED: f and info are still filled, the payload offset is meaningless), finite
- * positions (INVALID_VALUE). On ZHC_OK probe i's bytes are at file + info->payload_offset +
+ * positions and validity bytes 0/1 (INVALID_VALUE). On ZHC_OK probe i's bytes are at file + info->payload_offset +
  * i * info->probe_size. Safe for untrusted input; accepts exactly the uncompressed files zhc's
  * reader accepts, with the same error class. */
 static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const void* file, size_t size) {
@@ -934,6 +947,9 @@ static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const vo
     if (inf.layout == 2)
         for (i = 0; i < inf.probe_count * 3; ++i)
             if (!isfinite(zhc__f32(p + ZHC_ZHP_HEADER_BYTES + 4 * i))) return ZHC_ERR_INVALID_VALUE;
+    if (inf.validity_offset)
+        for (i = 0; i < inf.probe_count; ++i)
+            if (p[inf.validity_offset + i] > 1) return ZHC_ERR_INVALID_VALUE;
     return ZHC_OK;
 }
 
@@ -948,7 +964,9 @@ static inline int zhc_probe_format_from_zhp(zhc_probe_format* f, const void* hea
 /* A grid of probes: probe (x, y, z) (x < counts[0], ...) is number x + counts[0] (y + counts[1] z),
  * at origin + (x spacing[0], y spacing[1], z spacing[2]), its stored bytes at
  * probes + number * probe_size. The volume REFERS to the caller's bytes (nothing is copied): they
- * must outlive it. Fill it with zhc_volume_from_zhp or zhc_volume_init (which validate), not by hand. */
+ * must outlive it. Fill it with zhc_volume_from_zhp or zhc_volume_init (which validate), not by hand;
+ * after zhc_volume_init a caller may point `validity` / `visibility` at its own per-probe bytes
+ * (count bytes each, same probe order; docs/runtime.md "Validity and visibility"). */
 typedef struct zhc_volume {
     zhc_probe_format format;
     const uint8_t* probes;  /* counts[0] counts[1] counts[2] probes of probe_size bytes */
@@ -956,6 +974,11 @@ typedef struct zhc_volume {
     double origin[3];       /* position of probe (0, 0, 0), the probe set's frame (zhc axes for .zhp) */
     double spacing[3];      /* > 0, finite */
     uint32_t counts[3];     /* >= 1 each, product <= 2^26 */
+    /* Optional leak-avoidance data (codec/probe/probe_set.h), NULL = absent. validity[i]: 0 = the
+     * probe is inside geometry (weight 0), else valid. visibility[i]: bit (cx + 2 cy + 4 cz) set =
+     * probe i is visible from its neighbouring cell on side (cx, cy, cz) (1 = towards +axis). */
+    const uint8_t* validity;
+    const uint8_t* visibility;
 } zhc_volume;
 
 /* A volume from its parts: format (validated: ZHC_ERR_ARGUMENT), the stored probes (`size` bytes,
@@ -998,7 +1021,8 @@ static inline int zhc_volume_init(zhc_volume* v, const zhc_probe_format* format,
  * ZHC_ERR_NOT_GRID for a valid file without a grid layout (none, or scattered `points`: see
  * docs/runtime.md for what to do with those), then the grid checks of zhc_volume_init (an empty
  * grid, spacing <= 0 or a far corner that overflows: ZHC_ERR_INVALID_VALUE). On error v is zeroed.
- * Safe for untrusted input (any bytes, any size). */
+ * A version 2 file's validity and visibility sections fill v->validity / v->visibility (pointing
+ * into `file`); without them both are NULL. Safe for untrusted input (any bytes, any size). */
 static inline int zhc_volume_from_zhp(zhc_volume* v, const void* file, size_t size) {
     zhc_probe_format f;
     zhc_zhp_info info;
@@ -1008,8 +1032,12 @@ static inline int zhc_volume_from_zhp(zhc_volume* v, const void* file, size_t si
     r = zhc_zhp_open(&f, &info, file, size);
     if (r != ZHC_OK) return r;
     if (info.layout != 1) return ZHC_ERR_NOT_GRID;
-    return zhc_volume_init(v, &f, (const uint8_t*)file + info.payload_offset, (size_t)(size - info.payload_offset),
-                           info.grid_origin, info.grid_spacing, info.grid_counts);
+    r = zhc_volume_init(v, &f, (const uint8_t*)file + info.payload_offset, (size_t)(size - info.payload_offset),
+                        info.grid_origin, info.grid_spacing, info.grid_counts);
+    if (r != ZHC_OK) return r;
+    if (info.validity_offset) v->validity = (const uint8_t*)file + info.validity_offset;
+    if (info.visibility_offset) v->visibility = (const uint8_t*)file + info.visibility_offset;
+    return ZHC_OK;
 }
 
 /* The grid coordinate along one axis: t = (p - origin) / spacing clamped to [0, n - 1] (NaN: 0),
@@ -1032,24 +1060,45 @@ static inline void zhc__volume_axis(double p, double origin, double spacing, uin
  * the box the value is that of the nearest point of the box), weights
  * w = prod_axes (f or 1 - f), accumulated in double in a fixed order. Probes of weight 0 are not
  * read (a probe that decodes to NaN affects only the cells around it). sh3[i*3+k] as
- * zhc_decode_probe. An invalid volume (zeroed, or not from zhc_volume_init/from_zhp) gives zeros. */
+ * zhc_decode_probe. An invalid volume (zeroed, or not from zhc_volume_init/from_zhp) gives zeros.
+ * With v->validity or v->visibility set, corner (dx, dy, dz)'s weight is w times (validity != 0)
+ * times bit 7 - (dx + 2 dy + 4 dz) of its visibility mask, and the weights are divided by their
+ * sum (summed over corners 0..7 in order); when every weight vanishes the plain trilinear weights
+ * are used (the documented fallback). Without either pointer the result is the plain blend, bit
+ * for bit. */
 static inline void zhc_volume_sh3(const zhc_volume* v, const double position[3], double sh3[27]) {
     uint32_t i0[3];
-    double f[3];
+    double f[3], w[8], sum = 0.0;
+    size_t index[8];
     int c, corner, j;
     memset(sh3, 0, 27 * sizeof(double));
     if (!v || !v->probes || v->probe_size == 0) return;
     for (c = 0; c < 3; ++c) zhc__volume_axis(position[c], v->origin[c], v->spacing[c], v->counts[c], &i0[c], &f[c]);
     for (corner = 0; corner < 8; ++corner) {
         const int bx = corner & 1, by = (corner >> 1) & 1, bz = (corner >> 2) & 1;
-        const double w = (bx ? f[0] : 1.0 - f[0]) * (by ? f[1] : 1.0 - f[1]) * (bz ? f[2] : 1.0 - f[2]);
-        size_t index;
+        w[corner] = (bx ? f[0] : 1.0 - f[0]) * (by ? f[1] : 1.0 - f[1]) * (bz ? f[2] : 1.0 - f[2]);
+        index[corner] = (size_t)(i0[0] + (uint32_t)bx) +
+                        (size_t)v->counts[0] *
+                            ((size_t)(i0[1] + (uint32_t)by) + (size_t)v->counts[1] * (size_t)(i0[2] + (uint32_t)bz));
+    }
+    if (v->validity || v->visibility) {
+        double m[8];
+        for (corner = 0; corner < 8; ++corner) {
+            m[corner] = 0.0;
+            if (w[corner] == 0.0) continue; /* a corner beyond a count-1 axis is not read */
+            if (v->validity && !v->validity[index[corner]]) continue;
+            if (v->visibility && !((v->visibility[index[corner]] >> (7 - corner)) & 1u)) continue;
+            m[corner] = w[corner];
+            sum += m[corner];
+        }
+        if (sum > 0.0)
+            for (corner = 0; corner < 8; ++corner) w[corner] = m[corner] / sum;
+    }
+    for (corner = 0; corner < 8; ++corner) {
         float probe[27];
-        if (w == 0.0) continue; /* also every corner beyond a count-1 axis (its f is 0) */
-        index = (size_t)(i0[0] + (uint32_t)bx) +
-                (size_t)v->counts[0] * ((size_t)(i0[1] + (uint32_t)by) + (size_t)v->counts[1] * (size_t)(i0[2] + (uint32_t)bz));
-        zhc_decode_probe(&v->format, v->probes + index * v->probe_size, probe);
-        for (j = 0; j < 27; ++j) sh3[j] += w * (double)probe[j];
+        if (w[corner] == 0.0) continue; /* also every corner beyond a count-1 axis (its f is 0) */
+        zhc_decode_probe(&v->format, v->probes + index[corner] * v->probe_size, probe);
+        for (j = 0; j < 27; ++j) sh3[j] += w[corner] * (double)probe[j];
     }
 }
 

@@ -212,7 +212,8 @@ TEST(ProbeFile, FieldChecksHaveDistinctErrors) {
         return r.ok() ? ErrorCode::kInternal : r.error().code;
     };
     EXPECT_EQ(code_of(good), ErrorCode::kInternal);  // i.e. it parses
-    EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 8, {2, 0})), ErrorCode::kUnsupported);       // version 2
+    EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 8, {3, 0})), ErrorCode::kUnsupported);       // version 3
+    EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 8, {2, 0})), ErrorCode::kBadFormat);  // 2 without sections
     EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 24, {'z', 'h', '9'})), ErrorCode::kUnsupported);  // unknown rep
     EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 14, {7})), ErrorCode::kUnsupported);         // DC format 7
     EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 19, {2})), ErrorCode::kUnsupported);         // compression 2

@@ -86,7 +86,16 @@ void expect_agreement(const std::vector<std::uint8_t>& file, const std::string& 
         EXPECT_TRUE(ref->payload.empty() ||
                     std::memcmp(file.data() + info.payload_offset, ref->payload.data(), ref->payload.size()) == 0)
             << what;
-        EXPECT_EQ(info.payload_offset + ref->payload.size(), file.size());
+        EXPECT_EQ(info.payload_offset + ref->payload.size() + ref->validity.size() + ref->visibility.size(), file.size());
+        // Version 2 sections: where the runtime says, the bytes zhc's reader returns.
+        EXPECT_EQ(info.validity_offset != 0, !ref->validity.empty()) << what;
+        EXPECT_EQ(info.visibility_offset != 0, !ref->visibility.empty()) << what;
+        if (!ref->validity.empty()) {
+            EXPECT_EQ(std::memcmp(file.data() + info.validity_offset, ref->validity.data(), ref->validity.size()), 0);
+        }
+        if (!ref->visibility.empty()) {
+            EXPECT_EQ(std::memcmp(file.data() + info.visibility_offset, ref->visibility.data(), ref->visibility.size()), 0);
+        }
         if (ref->layout.kind == ProbeLayoutKind::kGrid)
             for (int c = 0; c < 3; ++c) {
                 EXPECT_EQ(info.grid_counts[c], ref->layout.grid.counts[size_t(c)]);
@@ -125,12 +134,35 @@ std::vector<std::vector<std::uint8_t>> sample_files() {
             if (bytes) files.push_back(*bytes);
         }
     }
+    // Version 2 files (validity and/or visibility sections): grid with both, grid with
+    // visibility only, positions with validity only.
+    for (int variant = 0; variant < 3; ++variant) {
+        std::vector<Sh3Radiance> hub;
+        for (int i = 0; i < 6; ++i) hub.push_back(random_probe(rng, std::uint64_t(i)));
+        ProbeLayout layout;
+        if (variant < 2) {
+            layout.kind = ProbeLayoutKind::kGrid;
+            layout.grid.counts = {3, 2, 1};
+            layout.grid.spacing = {1, 1, 1};
+        } else {
+            layout.kind = ProbeLayoutKind::kPositions;
+            for (int i = 0; i < 6; ++i) layout.positions.push_back({float(i), 0.0f, 1.0f});
+        }
+        auto set = encode_probe_set(hub, "zh3_q16", CodecOptions{}, layout);
+        EXPECT_TRUE(bool(set));
+        if (!set) continue;
+        if (variant != 1) set->validity = {1, 0, 1, 1, 0, 1};
+        if (variant != 2) set->visibility = {0xFF, 0x0F, 0x80, 0x01, 0x00, 0x5A};
+        auto bytes = serialize_probe_set(*set);
+        EXPECT_TRUE(bool(bytes));
+        if (bytes) files.push_back(*bytes);
+    }
     return files;
 }
 
 TEST(RuntimeC, ZhpFilesFromZhcsWriterParseToTheSameParamsAndPayload) {
     const auto files = sample_files();
-    ASSERT_EQ(files.size(), size_t(3 * ZHC_ENC_COUNT));
+    ASSERT_EQ(files.size(), size_t(3 * ZHC_ENC_COUNT + 3));
     for (size_t i = 0; i < files.size(); ++i) {
         zhc_probe_format f;
         ASSERT_EQ(zhc_probe_format_from_zhp(&f, files[i].data(), files[i].size()), ZHC_OK) << i;

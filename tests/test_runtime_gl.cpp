@@ -58,6 +58,11 @@ const char* kTestPrelude = R"(
 layout(std430, binding = 0) readonly buffer Words { uint words[]; };
 #define ZHC_VOLUME_WORD(i) words[i]
 )";
+// The masked variant's extra prelude: per-probe combined masks, 4 per word (ZHC_VOLUME_MASK).
+const char* kTestMaskPrelude = R"(
+layout(std430, binding = 3) readonly buffer Masks { uint masks[]; };
+#define ZHC_VOLUME_MASK(i) ((masks[(i) >> 2] >> (8u * ((i) & 3u))) & 0xFFu)
+)";
 const char* kTestMain = R"(
 layout(local_size_x = 64) in;
 layout(std430, binding = 1) readonly buffer Normals { float normals[]; };
@@ -170,37 +175,42 @@ protected:
             why_ = std::string("cannot read ") + ZHC_RUNTIME_GLSL_PATH;
             return;
         }
-        const std::string source =
-            std::string(kEs ? "#version 310 es\n" : "#version 450\n") + kTestPrelude + library + kTestMain;
-        const char* src = source.c_str();
-        GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
-        glShaderSource(sh, 1, &src, nullptr);
-        glCompileShader(sh);
-        GLint ok = 0;
-        glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-        if (!ok) {
-            char log[8192] = {};
-            glGetShaderInfoLog(sh, sizeof log, nullptr, log);
-            why_ = std::string("compute shader does not compile: ") + log;
+        // Two programs: the plain one, and one with ZHC_VOLUME_MASK (validity and visibility).
+        for (int masked = 0; masked < 2; ++masked) {
+            const std::string source = std::string(kEs ? "#version 310 es\n" : "#version 450\n") + kTestPrelude +
+                                       (masked ? kTestMaskPrelude : "") + library + kTestMain;
+            const char* src = source.c_str();
+            GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
+            glShaderSource(sh, 1, &src, nullptr);
+            glCompileShader(sh);
+            GLint ok = 0;
+            glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+            if (!ok) {
+                char log[8192] = {};
+                glGetShaderInfoLog(sh, sizeof log, nullptr, log);
+                why_ = std::string("compute shader does not compile: ") + log;
+                glDeleteShader(sh);
+                return;
+            }
+            GLuint prog = glCreateProgram();
+            glAttachShader(prog, sh);
+            glLinkProgram(prog);
             glDeleteShader(sh);
-            return;
+            glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+            (masked ? masked_program_ : program_) = prog;
+            if (!ok) {
+                char log[8192] = {};
+                glGetProgramInfoLog(prog, sizeof log, nullptr, log);
+                why_ = std::string("program does not link: ") + log;
+                return;
+            }
         }
-        program_ = glCreateProgram();
-        glAttachShader(program_, sh);
-        glLinkProgram(program_);
-        glDeleteShader(sh);
-        glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char log[8192] = {};
-            glGetProgramInfoLog(program_, sizeof log, nullptr, log);
-            why_ = std::string("program does not link: ") + log;
-            return;
-        }
-        glGenBuffers(3, buffers_);
+        glGenBuffers(4, buffers_);
     }
     static void TearDownTestSuite() {
         if (program_) glDeleteProgram(program_);
-        if (buffers_[0]) glDeleteBuffers(3, buffers_);
+        if (masked_program_) glDeleteProgram(masked_program_);
+        if (buffers_[0]) glDeleteBuffers(4, buffers_);
         test::destroy_context(&egl_);
     }
     void SetUp() override {
@@ -218,14 +228,19 @@ public:
 
     // The grid of mode 4 (probe volume).
     static void set_volume(const float origin[3], const float spacing[3], const std::uint32_t counts[3]) {
-        glProgramUniform3f(program_, glGetUniformLocation(program_, "uVolOrigin"), origin[0], origin[1], origin[2]);
-        glProgramUniform3f(program_, glGetUniformLocation(program_, "uVolSpacing"), spacing[0], spacing[1], spacing[2]);
-        glProgramUniform3ui(program_, glGetUniformLocation(program_, "uVolCounts"), counts[0], counts[1], counts[2]);
+        for (GLuint prog : {program_, masked_program_}) {
+            glProgramUniform3f(prog, glGetUniformLocation(prog, "uVolOrigin"), origin[0], origin[1], origin[2]);
+            glProgramUniform3f(prog, glGetUniformLocation(prog, "uVolSpacing"), spacing[0], spacing[1], spacing[2]);
+            glProgramUniform3ui(prog, glGetUniformLocation(prog, "uVolCounts"), counts[0], counts[1], counts[2]);
+        }
     }
 
     // Runs the shader on `count` items; returns count * kOutFloats floats.
+    // With `masks` (4 combined mask bytes per word): the ZHC_VOLUME_MASK program.
     static std::vector<float> run(const Uniforms& un, const std::vector<std::uint32_t>& words,
-                                  const std::vector<float>& normals, std::size_t count) {
+                                  const std::vector<float>& normals, std::size_t count,
+                                  const std::vector<std::uint32_t>* masks = nullptr) {
+        const GLuint program = masks ? masked_program_ : program_;
         auto upload = [](GLuint buf, GLuint binding, const void* data, std::size_t bytes) {
             glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
             glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(std::max<std::size_t>(bytes, 16)), nullptr,
@@ -236,15 +251,16 @@ public:
         upload(buffers_[0], 0, words.data(), words.size() * 4);
         upload(buffers_[1], 1, normals.data(), normals.size() * 4);
         upload(buffers_[2], 2, nullptr, count * kOutFloats * 4);
-        glUseProgram(program_);
-        glUniform1ui(glGetUniformLocation(program_, "uCount"), static_cast<GLuint>(count));
-        glUniform1ui(glGetUniformLocation(program_, "uStride"), un.stride);
-        glUniform1ui(glGetUniformLocation(program_, "uMode"), un.mode);
-        glUniform4ui(glGetUniformLocation(program_, "uA"), un.a[0], un.a[1], un.a[2], un.a[3]);
-        glUniform4ui(glGetUniformLocation(program_, "uB"), un.b[0], un.b[1], un.b[2], un.b[3]);
-        glUniform1ui(glGetUniformLocation(program_, "uKind"), un.kind);
-        glUniform3f(glGetUniformLocation(program_, "uLum"), un.lum[0], un.lum[1], un.lum[2]);
-        glUniform2f(glGetUniformLocation(program_, "uCurve"), un.curve[0], un.curve[1]);
+        if (masks) upload(buffers_[3], 3, masks->data(), masks->size() * 4);
+        glUseProgram(program);
+        glUniform1ui(glGetUniformLocation(program, "uCount"), static_cast<GLuint>(count));
+        glUniform1ui(glGetUniformLocation(program, "uStride"), un.stride);
+        glUniform1ui(glGetUniformLocation(program, "uMode"), un.mode);
+        glUniform4ui(glGetUniformLocation(program, "uA"), un.a[0], un.a[1], un.a[2], un.a[3]);
+        glUniform4ui(glGetUniformLocation(program, "uB"), un.b[0], un.b[1], un.b[2], un.b[3]);
+        glUniform1ui(glGetUniformLocation(program, "uKind"), un.kind);
+        glUniform3f(glGetUniformLocation(program, "uLum"), un.lum[0], un.lum[1], un.lum[2]);
+        glUniform2f(glGetUniformLocation(program, "uCurve"), un.curve[0], un.curve[1]);
         glDispatchCompute(static_cast<GLuint>((count + 63) / 64), 1, 1);
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         std::vector<float> out(count * kOutFloats);
@@ -261,8 +277,8 @@ public:
 
 protected:
     static inline test::EglContext egl_;
-    static inline GLuint program_ = 0;
-    static inline GLuint buffers_[3] = {0, 0, 0};
+    static inline GLuint program_ = 0, masked_program_ = 0;
+    static inline GLuint buffers_[4] = {0, 0, 0, 0};
     static inline std::string why_, renderer_;
 };
 
@@ -724,7 +740,131 @@ void compare_volumes(int samples_per_grid) {
     }
 }
 
+// Masked probe volumes (ZHC_VOLUME_MASK: validity and visibility, docs/runtime.md "Validity and
+// visibility") against the C header with zhc_volume::validity / ::visibility set: a 6x5x4 grid per
+// entry, random validity (1 in 4 invalid) and masks (each bit set with p = 1/2), combined on upload
+// as valid ? visibility : 0, random points inside and around the box. Bound: compare_volumes' for
+// the weights, divided by the masked weight sum M (each renormalised weight m_b / M carries the
+// absolute errors of the m_b over M, twice), with the scales of the cell's corners. Where M is
+// below 1e-3 the masked blend is ill-conditioned (a few u of t move the cell's only visible corner
+// in or out of weight 0): such samples are counted, not compared, and must stay rare. Plus a grid
+// whose probes are all invalid: the fallback, the plain trilinear blend, within compare_volumes'
+// bound.
+template <class Fixture>
+void compare_masked_volumes(int samples) {
+    const std::vector<Sh3Radiance> maps = envmap_probes();
+    ASSERT_EQ(maps.size(), 8u);
+    std::printf("%-22s %8s %10s %8s\n", "masked volume", "samples", "max u S", "skipped");
+    for (const char* name : {"sh3", "zh3_q16", "sh3_q28", "hall_adaptive_q16"})
+        for (int all_invalid = 0; all_invalid < 2; ++all_invalid) {
+            const Codec* codec = find_codec(name);
+            ASSERT_NE(codec, nullptr);
+            const GlslEntry& e = glsl_entries().at(name);
+            std::mt19937_64 rng(0x3a5u + codec->size_bytes + unsigned(all_invalid));
+            std::uniform_real_distribution<double> u(0, 1);
+            const std::uint32_t counts[3] = {6, 5, 4};
+            const float origin_f[3] = {-1.5f, 2.0f, 0.25f}, spacing_f[3] = {0.75f, 0.5f, 1.25f};
+            const double origin[3] = {origin_f[0], origin_f[1], origin_f[2]};
+            const double spacing[3] = {spacing_f[0], spacing_f[1], spacing_f[2]};
+            const std::uint32_t count = counts[0] * counts[1] * counts[2];
+            const CodecOptions p{};
+            std::vector<std::uint8_t> bytes(count * codec->size_bytes), validity(count), visibility(count);
+            std::vector<Sh3Radiance> decoded;
+            std::vector<std::uint32_t> masks((count + 3) / 4, 0);
+            for (std::uint32_t i = 0; i < count; ++i) {
+                encode_probe(*codec, p, random_probe(rng, maps, int(i % 3)), bytes.data() + i * codec->size_bytes, nullptr);
+                decoded.push_back(decode_probe(*codec, p, bytes.data() + i * codec->size_bytes));
+                validity[i] = all_invalid ? 0 : (rng() % 4 == 0 ? 0 : 1);
+                visibility[i] = std::uint8_t(rng());
+                const std::uint32_t combined = validity[i] ? visibility[i] : 0u;
+                masks[i / 4] |= combined << (8 * (i % 4));
+            }
+            zhc_probe_format fmt;
+            ASSERT_TRUE(runtime_format(name, p, &fmt));
+            zhc_volume vol;
+            ASSERT_EQ(zhc_volume_init(&vol, &fmt, bytes.data(), bytes.size(), origin, spacing, counts), ZHC_OK);
+            vol.validity = validity.data();
+            vol.visibility = visibility.data();
+            std::vector<float> items;
+            for (int i = 0; i < samples; ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    const double size = (counts[c] - 1) * spacing[c];
+                    items.push_back(float(origin[c] - 0.25 * size + 1.5 * size * u(rng)));
+                }
+                const Vec3 n = test::uniform_direction(u(rng), u(rng));
+                items.push_back(float(n.x));
+                items.push_back(float(n.y));
+                items.push_back(float(n.z));
+            }
+            std::vector<std::uint32_t> w(bytes.size() / 4);
+            std::memcpy(w.data(), bytes.data(), bytes.size());
+            typename Fixture::Uniforms un;
+            un.mode = 4;
+            un.a[0] = e.family;
+            un.a[1] = e.hallucination;
+            un.a[2] = static_cast<std::uint32_t>(p.bits);
+            un.a[3] = p.sqrt_encoding ? 1u : 0u;
+            un.b[0] = static_cast<std::uint32_t>(p.l2_bound);
+            un.b[1] = static_cast<std::uint32_t>(p.dc_format);
+            un.b[2] = static_cast<std::uint32_t>(p.zonal_mapping);
+            un.b[3] = axis_mode(e, p);
+            un.kind = static_cast<std::uint32_t>(p.kind);
+            un.lum[0] = static_cast<float>(p.luminance.r);
+            un.lum[1] = static_cast<float>(p.luminance.g);
+            un.lum[2] = static_cast<float>(p.luminance.b);
+            un.curve[0] = static_cast<float>(p.hallucinate_a);
+            un.curve[1] = static_cast<float>(p.hallucinate_b);
+            Fixture::set_volume(origin_f, spacing_f, counts);
+            const std::vector<float> gpu = Fixture::run(un, w, items, std::size_t(samples), &masks);
+            Tally t;
+            long compared = 0, skipped = 0, renormalised = 0;
+            for (int i = 0; i < samples; ++i) {
+                const double pos[3] = {items[6 * size_t(i)], items[6 * size_t(i) + 1], items[6 * size_t(i) + 2]};
+                const double nrm[3] = {items[6 * size_t(i) + 3], items[6 * size_t(i) + 4], items[6 * size_t(i) + 5]};
+                double ref[3];
+                zhc_volume_irradiance_d(&vol, pos, nrm, ref);
+                std::uint32_t i0[3];
+                double f[3], extra = 0;
+                for (int c = 0; c < 3; ++c) {
+                    const double tt = std::min(std::max((pos[c] - origin[c]) / spacing[c], 0.0), double(counts[c] - 1));
+                    i0[c] = std::min(std::uint32_t(tt), counts[c] - 2);
+                    f[c] = tt - i0[c];
+                    extra += (std::fabs(pos[c]) + std::fabs(origin[c])) / spacing[c] + tt + 2;
+                }
+                double scale[3] = {0, 0, 0}, masked_sum = 0;
+                for (int b = 0; b < 8; ++b) {
+                    const std::uint32_t q[3] = {i0[0] + (b & 1), i0[1] + ((b >> 1) & 1), i0[2] + (b >> 2)};
+                    const std::uint32_t idx = q[0] + counts[0] * (q[1] + counts[1] * q[2]);
+                    const double wb = ((b & 1) ? f[0] : 1 - f[0]) * ((b >> 1 & 1) ? f[1] : 1 - f[1]) * ((b >> 2) ? f[2] : 1 - f[2]);
+                    if (validity[idx] && ((visibility[idx] >> (7 - b)) & 1)) masked_sum += wb;
+                    const Scale sc = probe_scale(e, p, decoded[idx]);
+                    for (int k = 0; k < 3; ++k) scale[k] += sc.irradiance[k];
+                }
+                double bound = 48 + 3 * extra;
+                if (masked_sum > 0) {
+                    if (masked_sum < 1e-3) {
+                        ++skipped;
+                        continue;
+                    }
+                    bound = 2 * bound / masked_sum;
+                    ++renormalised;
+                }
+                ++compared;
+                for (int k = 0; k < 3; ++k)
+                    check_value(t, &t.max_irr, ref[k], gpu[size_t(i) * kOutFloats + std::size_t(k)], scale[k], bound,
+                                std::string(name) + " sample " + std::to_string(i) + " channel " + std::to_string(k));
+            }
+            std::printf("%-22s %8ld %10.3f %8ld%s\n", name, compared, t.max_irr, skipped, all_invalid ? " (all invalid)" : "");
+            EXPECT_EQ(t.failures, 0) << name << ": " << t.first_failure;
+            EXPECT_EQ(t.compared, 3 * compared) << name;
+            EXPECT_LE(skipped, samples / 100) << name;
+            EXPECT_TRUE(all_invalid ? renormalised == 0 : renormalised > samples / 2) << name << ": " << renormalised;
+        }
+}
+
 TEST_F(RuntimeGl, ProbeVolumesMatchTheCHeader) { compare_volumes<RuntimeGl>(int(test::sample_count(10000))); }
+TEST_F(RuntimeGl, MaskedProbeVolumesMatchTheCHeader) { compare_masked_volumes<RuntimeGl>(int(test::sample_count(10000))); }
+TEST_F(RuntimeGles, MaskedProbeVolumesMatchTheCHeader) { compare_masked_volumes<RuntimeGles>(int(test::sample_count(2000))); }
 TEST_F(RuntimeGles, ProbeVolumesMatchTheCHeader) { compare_volumes<RuntimeGles>(int(test::sample_count(2000))); }
 
 }  // namespace

@@ -83,12 +83,14 @@ public:
     // failure). One pipeline and one set of buffers serve every call (pipeline creation is the slow part).
     static constexpr std::size_t kCapacity = 1u << 17;
     // params: 16 uints, or 32 for the probe-volume mode (grid in params 16..24).
+    // masked: the ZHC_VOLUME_MASK build (runtime_test_masked.spv; masks at word params[25]).
     std::vector<float> run(const std::uint32_t* params, const std::vector<std::uint32_t>& words,
-                           const std::vector<float>& normals4, std::size_t count) {
+                           const std::vector<float>& normals4, std::size_t count, bool masked = false) {
         std::string err;
+        std::unique_ptr<vk::Kernel>& kernel_ = masked ? masked_kernel_ : plain_kernel_;
         if (!kernel_) {
             const std::size_t sizes[4] = {32 * 4, kCapacity * 27 * 4, kCapacity * 16, kCapacity * kOutFloats * 4};
-            kernel_ = context_->make_kernel(spirv_, sizes, &err);
+            kernel_ = context_->make_kernel(masked ? masked_spirv_ : spirv_, sizes, &err);
             if (!kernel_) {
                 ADD_FAILURE() << err;
                 return {};
@@ -115,15 +117,16 @@ private:
     Gpu() {
         vk::force_icd(ZHC_LVP_ICD);
         spirv_ = vk::read_spirv(ZHC_RUNTIME_TEST_SPV);
-        if (spirv_.empty()) {
-            error_ = std::string("cannot read ") + ZHC_RUNTIME_TEST_SPV;
+        masked_spirv_ = vk::read_spirv(ZHC_RUNTIME_TEST_MASKED_SPV);
+        if (spirv_.empty() || masked_spirv_.empty()) {
+            error_ = std::string("cannot read ") + ZHC_RUNTIME_TEST_SPV + " or " + ZHC_RUNTIME_TEST_MASKED_SPV;
             return;
         }
         context_ = vk::Context::create(true, &error_);
     }
-    std::vector<std::uint32_t> spirv_;
+    std::vector<std::uint32_t> spirv_, masked_spirv_;
     std::unique_ptr<vk::Context> context_;
-    std::unique_ptr<vk::Kernel> kernel_;  // destroyed before context_ (declared after it)
+    std::unique_ptr<vk::Kernel> plain_kernel_, masked_kernel_;  // destroyed before context_ (declared after it)
     std::string error_;
 };
 
@@ -756,6 +759,138 @@ TEST_F(RuntimeVk, ProbeVolumesMatchTheCHeader) {
         std::printf("%-22s %8ld %12.3f\n", std::string(codec.name).c_str(), compared, max_rel);
         EXPECT_EQ(failures, 0) << first;
     }
+}
+
+// Masked probe volumes (ZHC_VOLUME_MASK, runtime_test_masked.spv) against the C header with
+// zhc_volume::validity / ::visibility: a 6x5x4 grid per entry with random validity (1 in 4 invalid)
+// and masks, uploaded combined (valid ? visibility : 0, 4 per word after the probe words), and an
+// all-invalid grid (the fallback). Bound: ProbeVolumesMatchTheCHeader's, with the weight part
+// divided by the masked weight sum M (renormalisation: m_b / M carries the m_b's absolute errors
+// over M, twice); samples with 0 < M < 1e-3 (ill-conditioned: a few u of t move the only visible
+// corner in or out of weight 0) are counted, not compared, and must stay under 1 %.
+TEST_F(RuntimeVk, MaskedProbeVolumesMatchTheCHeader) {
+    const int samples = int(test::sample_count(10000));
+    std::printf("%-22s %8s %12s %8s\n", "masked volume", "samples", "max err/eps T", "skipped");
+    for (const char* name : {"sh3", "zh3_q16", "sh3_q28", "hall_adaptive_q16"})
+        for (int all_invalid = 0; all_invalid < 2; ++all_invalid) {
+            const Codec* codec = find_codec(name);
+            ASSERT_NE(codec, nullptr);
+            const int id = hlsl_encoding(name);
+            ASSERT_GE(id, 0) << name;
+            std::mt19937_64 rng(0x6d61u + codec->size_bytes + unsigned(all_invalid));
+            std::uniform_real_distribution<double> u(0, 1);
+            const std::uint32_t counts[3] = {6, 5, 4};
+            const float origin_f[3] = {-1.5f, 2.0f, 0.25f}, spacing_f[3] = {0.75f, 0.5f, 1.25f};
+            const double origin[3] = {origin_f[0], origin_f[1], origin_f[2]};
+            const double spacing[3] = {spacing_f[0], spacing_f[1], spacing_f[2]};
+            const std::uint32_t count = counts[0] * counts[1] * counts[2];
+            const CodecOptions p;
+            std::vector<std::uint8_t> bytes(count * codec->size_bytes), validity(count), visibility(count);
+            std::vector<Sh3Radiance> decoded;
+            for (std::uint32_t i = 0; i < count; ++i) {
+                const Sh3Radiance hub = i % 3 == 0 ? random_lights(rng) : (i % 3 == 1 ? random_sh(rng) : random_envmap(rng));
+                encode_probe(*codec, p, hub, bytes.data() + i * codec->size_bytes, nullptr);
+                decoded.push_back(decode_probe(*codec, p, bytes.data() + i * codec->size_bytes));
+                validity[i] = all_invalid ? 0 : (rng() % 4 == 0 ? 0 : 1);
+                visibility[i] = std::uint8_t(rng());
+            }
+            zhc_probe_format fmt;
+            ASSERT_TRUE(runtime_format(name, p, &fmt));
+            zhc_volume vol;
+            ASSERT_EQ(zhc_volume_init(&vol, &fmt, bytes.data(), bytes.size(), origin, spacing, counts), ZHC_OK);
+            vol.validity = validity.data();
+            vol.visibility = visibility.data();
+            std::vector<float> items;  // position, 0, normal, 0
+            for (int i = 0; i < samples; ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    const double size = (counts[c] - 1) * spacing[c];
+                    items.push_back(float(origin[c] - 0.25 * size + 1.5 * size * u(rng)));
+                }
+                items.push_back(0.0f);
+                add_normal(rng, &items);
+            }
+            std::uint32_t params[32] = {static_cast<std::uint32_t>(id),
+                                        static_cast<std::uint32_t>(p.bits),
+                                        p.sqrt_encoding ? 1u : 0u,
+                                        static_cast<std::uint32_t>(p.l2_bound),
+                                        static_cast<std::uint32_t>(p.dc_format),
+                                        static_cast<std::uint32_t>(p.zonal_mapping),
+                                        static_cast<std::uint32_t>(p.axis_mode),
+                                        static_cast<std::uint32_t>(p.kind),
+                                        float_bits(static_cast<float>(p.luminance.r)),
+                                        float_bits(static_cast<float>(p.luminance.g)),
+                                        float_bits(static_cast<float>(p.luminance.b)),
+                                        float_bits(static_cast<float>(p.hallucinate_a)),
+                                        float_bits(static_cast<float>(p.hallucinate_b)),
+                                        static_cast<std::uint32_t>(samples),
+                                        static_cast<std::uint32_t>(codec->size_bytes / 4),
+                                        3u};
+            for (int c = 0; c < 3; ++c) {
+                params[16 + c] = float_bits(origin_f[c]);
+                params[19 + c] = float_bits(spacing_f[c]);
+                params[22 + c] = counts[c];
+            }
+            std::vector<std::uint32_t> words(bytes.size() / 4);
+            std::memcpy(words.data(), bytes.data(), bytes.size());
+            params[25] = static_cast<std::uint32_t>(words.size());
+            words.resize(words.size() + (count + 3) / 4, 0);
+            for (std::uint32_t i = 0; i < count; ++i)
+                words[params[25] + i / 4] |= std::uint32_t(validity[i] ? visibility[i] : 0) << (8 * (i % 4));
+            const std::vector<float> out = Gpu::get().run(params, words, items, std::size_t(samples), /*masked=*/true);
+            ASSERT_EQ(out.size(), std::size_t(samples) * kOutFloats);
+            double max_rel = 0;
+            long compared = 0, failures = 0, skipped = 0, renormalised = 0;
+            std::string first;
+            for (int i = 0; i < samples; ++i) {
+                const std::size_t at = 8 * std::size_t(i);
+                const double pos[3] = {items[at], items[at + 1], items[at + 2]};
+                const double nrm[3] = {items[at + 4], items[at + 5], items[at + 6]};
+                double ref[3];
+                zhc_volume_irradiance_d(&vol, pos, nrm, ref);
+                std::uint32_t i0[3];
+                double f[3], extra = 0;
+                for (int c = 0; c < 3; ++c) {
+                    const double tt = std::min(std::max((pos[c] - origin[c]) / spacing[c], 0.0), double(counts[c] - 1));
+                    i0[c] = std::min(std::uint32_t(tt), counts[c] - 2);
+                    f[c] = tt - i0[c];
+                    extra += (std::fabs(pos[c]) + std::fabs(origin[c])) / spacing[c] + tt + 2;
+                }
+                double t[3] = {0, 0, 0}, masked_sum = 0;
+                for (int b = 0; b < 8; ++b) {
+                    const std::uint32_t q[3] = {i0[0] + (b & 1), i0[1] + ((b >> 1) & 1), i0[2] + (b >> 2)};
+                    const std::uint32_t idx = q[0] + counts[0] * (q[1] + counts[1] * q[2]);
+                    const double wb = ((b & 1) ? f[0] : 1 - f[0]) * ((b >> 1 & 1) ? f[1] : 1 - f[1]) * ((b >> 2) ? f[2] : 1 - f[2]);
+                    if (validity[idx] && ((visibility[idx] >> (7 - b)) & 1)) masked_sum += wb;
+                    double tb[3], kappa;
+                    probe_scales(*codec, p, decoded[idx], tb, &kappa);
+                    for (int k = 0; k < 3; ++k) t[k] += tb[k];
+                }
+                double weight_part = 1.5 * extra;
+                if (masked_sum > 0) {
+                    if (masked_sum < 1e-3) {
+                        ++skipped;
+                        continue;
+                    }
+                    weight_part = 2 * weight_part / masked_sum;
+                    ++renormalised;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_TRUE(std::isfinite(t[k]) && std::isfinite(ref[k])) << name << " item " << i;
+                    const double got = out[std::size_t(i) * kOutFloats + 27 + std::size_t(k)];
+                    const double err = std::fabs(got - ref[k]);
+                    const double bound = (40 + weight_part) * FLT_EPSILON * t[k] + kFlushFloor;
+                    if (!(err <= bound) && failures++ == 0)
+                        first = std::string(name) + " item " + std::to_string(i) + " channel " + std::to_string(k) +
+                                ": shader " + std::to_string(got) + " C " + std::to_string(ref[k]);
+                    max_rel = std::max(max_rel, err / (FLT_EPSILON * t[k] + kFlushFloor));
+                }
+                ++compared;
+            }
+            std::printf("%-22s %8ld %12.3f %8ld%s\n", name, compared, max_rel, skipped, all_invalid ? " (all invalid)" : "");
+            EXPECT_EQ(failures, 0) << first;
+            EXPECT_LE(skipped, samples / 100) << name;
+            EXPECT_TRUE(all_invalid ? renormalised == 0 : renormalised > samples / 2) << name << ": " << renormalised;
+        }
 }
 
 }  // namespace

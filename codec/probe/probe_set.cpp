@@ -61,6 +61,26 @@ Sh3Radiance as_radiance_type(const Sh3Irradiance& e) {
 }
 }  // namespace
 
+Status validate_leak_data(const ProbeSet& set) {
+    if (!set.validity.empty()) {
+        if (set.validity.size() != set.count)
+            return make_error(ErrorCode::kInvalidArgument, "validity holds " + std::to_string(set.validity.size()) +
+                                                               " bytes, expected 0 or " + std::to_string(set.count));
+        for (size_t i = 0; i < set.validity.size(); ++i)
+            if (set.validity[i] > 1)
+                return make_error(ErrorCode::kInvalidArgument, "validity[" + std::to_string(i) + "] is " +
+                                                                   std::to_string(set.validity[i]) + ", expected 0 or 1");
+    }
+    if (!set.visibility.empty()) {
+        if (set.layout.kind != ProbeLayoutKind::kGrid)
+            return make_error(ErrorCode::kInvalidArgument, "visibility masks need a grid layout");
+        if (set.visibility.size() != set.count)
+            return make_error(ErrorCode::kInvalidArgument, "visibility holds " + std::to_string(set.visibility.size()) +
+                                                               " bytes, expected 0 or " + std::to_string(set.count));
+    }
+    return Ok{};
+}
+
 Status validate_probe_set(const ProbeSet& set) {
     const Codec* codec = set.codec();
     if (!codec) return make_error(ErrorCode::kInvalidArgument, "unknown representation '" + set.representation + "'");
@@ -70,7 +90,8 @@ Status validate_probe_set(const ProbeSet& set) {
         return make_error(ErrorCode::kInvalidArgument, "payload holds " + std::to_string(set.payload.size()) +
                                                            " bytes, expected " + std::to_string(set.count) + " x " +
                                                            std::to_string(codec->size_bytes));
-    return validate_layout(set.layout, set.count);
+    if (Status st = validate_layout(set.layout, set.count); !st) return st;
+    return validate_leak_data(set);
 }
 
 void encode_probe(const Codec& codec, const CodecOptions& params, const Sh3Radiance& hub, std::uint8_t* out,
@@ -126,7 +147,11 @@ Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view represe
                                    EncodeStats* stats) {
     auto hub = decode_probe_set(set);
     if (!hub) return hub.error();
-    return encode_probe_set(*hub, representation, params, set.layout, stats);
+    auto out = encode_probe_set(*hub, representation, params, set.layout, stats);
+    if (!out) return out;
+    out->validity = set.validity;  // per-probe leak data does not depend on the representation
+    out->visibility = set.visibility;
+    return out;
 }
 
 Vec3 probe_position(const ProbeSet& set, std::uint64_t i) {

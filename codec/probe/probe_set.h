@@ -11,6 +11,8 @@
 //  * `params` pass validate_quant_params for that representation;
 //  * layout kGrid: counts multiply to `count`, origin and spacing finite;
 //    layout kPositions: positions.size() == count, all finite; layout kNone: nothing.
+//  * validity: empty or `count` bytes, each 0 or 1; visibility: empty, or `count` bytes with a
+//    grid layout.
 //
 // Thread safety (docs/api.md): every function here is reentrant and keeps no state between
 // calls; calls may run concurrently on different arguments and on the same const ones.
@@ -73,6 +75,9 @@ struct ProbeSet {
 
 // Checks every invariant above; kInvalidArgument naming the first broken one.
 Status validate_probe_set(const ProbeSet& set);
+// The leak-data part of it: validity and visibility each empty or `count` bytes, validity values
+// 0/1, visibility only with a grid layout.
+Status validate_leak_data(const ProbeSet& set);
 
 // Probe i's stored bytes -> hub, and hub -> stored bytes. With params.kind == kIrradiance the
 // payload holds irradiance SH: the quantised layouts then use the irradiance-scaled ratio bounds

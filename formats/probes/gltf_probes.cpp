@@ -691,7 +691,31 @@ Result<ProbeSet> rotate_set(const ProbeSet& set, const Mat3& r) {
     auto hub = decode_probe_set(set);
     if (!hub) return hub.error();
     for (Sh3Radiance& sh : *hub) sh = rotate(sh, r);
-    return encode_probe_set(*hub, set.representation, set.params, set.layout);
+    auto out = encode_probe_set(*hub, set.representation, set.params, set.layout);
+    if (!out) return out;
+    out->validity = set.validity;  // per-probe data, independent of the SH axes
+    out->visibility = set.visibility;
+    return out;
+}
+
+std::uint8_t visibility_to_gltf(std::uint8_t mask) {
+    std::uint8_t out = 0;
+    for (int b = 0; b < 8; ++b) {
+        if (!((mask >> b) & 1)) continue;
+        const int cx = b & 1, cy = (b >> 1) & 1, cz = (b >> 2) & 1;  // zhc axes
+        out = static_cast<std::uint8_t>(out | (1u << (cy + 2 * cz + 4 * cx)));  // glTF (x, y, z) = zhc (y, z, x)
+    }
+    return out;
+}
+
+std::uint8_t visibility_from_gltf(std::uint8_t mask) {
+    std::uint8_t out = 0;
+    for (int b = 0; b < 8; ++b) {
+        if (!((mask >> b) & 1)) continue;
+        const int gx = b & 1, gy = (b >> 1) & 1, gz = (b >> 2) & 1;  // glTF axes
+        out = static_cast<std::uint8_t>(out | (1u << (gz + 2 * gx + 4 * gy)));  // zhc (x, y, z) = glTF (z, x, y)
+    }
+    return out;
 }
 
 // Grid probe order zhc (i fastest, zhc axes) <-> glTF (glTF x = zhc y fastest).

@@ -230,6 +230,29 @@ struct VolumeReader {
         } else if (layout != "none") {
             return bad(ErrorCode::kUnsupported, "layout must be grid, points or none");
         }
+        // Optional leak-avoidance data: UNSIGNED_BYTE SCALAR accessors of `count` elements.
+        for (const char* key : {"validity", "visibility"}) {
+            if (!v.contains(key)) continue;
+            auto a = index(v, key, m.accessors.size());
+            if (!a) return a.error();
+            auto b = accessor_bytes(*a, kUbyte, TINYGLTF_TYPE_SCALAR, set.count, key);
+            if (!b) return b.error();
+            std::vector<std::uint8_t> data(b->begin(), b->end());
+            const bool is_validity = std::string(key) == "validity";
+            if (!is_validity && set.layout.kind != ProbeLayoutKind::kGrid)
+                return bad(ErrorCode::kBadFormat, "visibility needs layout grid");
+            if (is_validity)
+                for (size_t i = 0; i < data.size(); ++i)
+                    if (data[i] > 1)
+                        return bad(ErrorCode::kInvalidValue, "validity of probe " + std::to_string(i) + " is " +
+                                                                 std::to_string(data[i]) + ", expected 0 or 1");
+            if (set.layout.kind == ProbeLayoutKind::kGrid)
+                data = reorder_grid(data, 1, set.layout.grid.counts, /*to_gltf_order=*/false);
+            if (!is_validity)
+                for (std::uint8_t& x : data) x = visibility_from_gltf(x);
+            out.stored_bytes += b->size();
+            (is_validity ? set.validity : set.visibility) = std::move(data);
+        }
         auto valid = validate_probe_set(set);
         if (!valid) return bad(ErrorCode::kBadFormat, valid.error().message);
         if (out.sh_axes == GltfShAxes::kGltf) {

@@ -292,6 +292,20 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
                                   ? add_accessor(view, kFloat, "VEC3", set.count * (size / 12), options.name + " coefficients")
                                   : add_accessor(view, kUbyte, "SCALAR", set.count * size, options.name + " coefficients");
     }
+    // Leak-avoidance data: one UNSIGNED_BYTE per probe in the volume's probe order; visibility
+    // masks in the glTF grid's axes.
+    if (!set.validity.empty()) {
+        std::vector<std::uint8_t> bytes = set.validity;
+        if (set.layout.kind == ProbeLayoutKind::kGrid) bytes = reorder_grid(bytes, 1, set.layout.grid.counts, /*to_gltf_order=*/true);
+        vol["validity"] = add_accessor(append_view(bytes, options.name + " validity"), kUbyte, "SCALAR", set.count,
+                                       options.name + " validity");
+    }
+    if (!set.visibility.empty()) {  // grid only (validate_probe_set)
+        std::vector<std::uint8_t> bytes = reorder_grid(set.visibility, 1, set.layout.grid.counts, /*to_gltf_order=*/true);
+        for (std::uint8_t& b : bytes) b = visibility_to_gltf(b);
+        vol["visibility"] = add_accessor(append_view(bytes, options.name + " visibility"), kUbyte, "SCALAR", set.count,
+                                         options.name + " visibility");
+    }
     if (!options.output_path.empty()) {
         auto st = relocate_images(doc, scene_path, options, limits, append_view);
         if (!st) return st.error();

@@ -57,7 +57,8 @@ enum : std::size_t {
     kOffAxisMode = 18,      // u8
     kOffCompression = 19,   // u8 0 none 1 zstd
     kOffLayoutKind = 20,    // u8
-    kOffReserved0 = 21,     // 3 bytes zero
+    kOffLeakFlags = 21,     // u8 version 2: bit 0 validity, bit 1 visibility (version 1: zero)
+    kOffReserved0 = 22,     // 2 bytes zero
     kOffName = 24,          // 32 bytes ASCII, zero padded
     kNameBytes = 32,
     kOffCount = 56,         // u64
@@ -83,6 +84,13 @@ std::uint64_t positions_bytes(const ProbeSet& set) {
     return set.layout.kind == ProbeLayoutKind::kPositions ? set.count * 12 : 0;
 }
 
+constexpr std::uint8_t kLeakValidity = 1, kLeakVisibility = 2;
+
+std::uint8_t leak_flags(const ProbeSet& set) {
+    return static_cast<std::uint8_t>((set.validity.empty() ? 0 : kLeakValidity) |
+                                     (set.visibility.empty() ? 0 : kLeakVisibility));
+}
+
 }  // namespace
 
 bool looks_like_probe_file(std::span<const std::uint8_t> bytes) {
@@ -98,11 +106,19 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
     if (options.zstd_level < 0 || options.zstd_level > ZSTD_maxCLevel())
         return make_error(ErrorCode::kInvalidArgument,
                           "zstd level must be 0 (none) .. " + std::to_string(ZSTD_maxCLevel()));
-    std::vector<std::uint8_t> body(positions_bytes(set) + set.payload.size());
+    const std::uint8_t leak = leak_flags(set);
+    std::vector<std::uint8_t> body(positions_bytes(set) + set.payload.size() + set.validity.size() +
+                                   set.visibility.size());
     if (set.layout.kind == ProbeLayoutKind::kPositions)
         for (size_t i = 0; i < set.count; ++i)
             for (size_t c = 0; c < 3; ++c) le::store_f32(body.data() + 12 * i + 4 * c, set.layout.positions[i][c]);
     if (!set.payload.empty()) std::memcpy(body.data() + positions_bytes(set), set.payload.data(), set.payload.size());
+    // Version 2 sections after the payload: validity then visibility, one byte per probe each.
+    std::size_t at = positions_bytes(set) + set.payload.size();
+    for (const std::vector<std::uint8_t>* v : {&set.validity, &set.visibility}) {
+        if (!v->empty()) std::memcpy(body.data() + at, v->data(), v->size());
+        at += v->size();
+    }
     const std::uint64_t raw_bytes = body.size();
     if (options.zstd_level > 0) {
         std::vector<std::uint8_t> packed(ZSTD_compressBound(body.size()));
@@ -115,7 +131,8 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
     std::vector<std::uint8_t> out(kProbeFileHeaderBytes + body.size(), 0);
     std::uint8_t* h = out.data();
     std::memcpy(h + kOffMagic, kMagic, sizeof kMagic);
-    le::store(h + kOffVersion, kProbeFileVersion, 2);
+    // A set without leak data is written as version 1, byte for byte as before version 2 existed.
+    le::store(h + kOffVersion, leak ? kProbeFileVersionLeak : kProbeFileVersion, 2);
     le::store(h + kOffHeaderBytes, kProbeFileHeaderBytes, 2);
     const CodecOptions& p = set.params;
     h[kOffKind] = static_cast<std::uint8_t>(p.kind);
@@ -127,6 +144,7 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
     h[kOffAxisMode] = static_cast<std::uint8_t>(p.axis_mode);
     h[kOffCompression] = options.zstd_level > 0 ? 1 : 0;
     h[kOffLayoutKind] = static_cast<std::uint8_t>(set.layout.kind);
+    h[kOffLeakFlags] = leak;
     std::memcpy(h + kOffName, set.representation.data(), set.representation.size());
     le::store(h + kOffCount, set.count, 8);
     le::store(h + kOffProbeBytes, set.codec()->size_bytes, 4);
@@ -164,10 +182,9 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
                                                     " of " + std::to_string(kProbeFileHeaderBytes) + " bytes)");
     // 2. Version before anything version-specific (a newer file may have another header size).
     const auto version = static_cast<std::uint16_t>(le::load(h + kOffVersion, 2));
-    if (version != kProbeFileVersion)
+    if (version != kProbeFileVersion && version != kProbeFileVersionLeak)
         return err(ErrorCode::kUnsupported, name, ".zhp version " + std::to_string(version) +
-                                                      " is not supported (this zhc reads version " +
-                                                      std::to_string(kProbeFileVersion) + ")");
+                                                      " is not supported (this zhc reads versions 1 and 2)");
     if (bytes.size() < kProbeFileHeaderBytes)
         return err(ErrorCode::kTruncated, name, "file ends inside the header (" + std::to_string(bytes.size()) +
                                                     " of " + std::to_string(kProbeFileHeaderBytes) + " bytes)");
@@ -178,10 +195,19 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
     // 4. Fields.
     if (le::load(h + kOffHeaderBytes, 2) != kProbeFileHeaderBytes)
         return err(ErrorCode::kBadFormat, name, "header size field is " + std::to_string(le::load(h + kOffHeaderBytes, 2)) +
-                                                    ", version 1 requires 184 (byte 10)");
-    if (h[kOffReserved0] | h[kOffReserved0 + 1] | h[kOffReserved0 + 2] || le::load(h + kOffReserved1, 4) ||
-        le::load(h + kOffReserved2, 4))
+                                                    ", versions 1 and 2 require 184 (byte 10)");
+    if ((version == kProbeFileVersion && h[kOffLeakFlags]) || h[kOffReserved0] | h[kOffReserved0 + 1] ||
+        le::load(h + kOffReserved1, 4) || le::load(h + kOffReserved2, 4))
         return err(ErrorCode::kBadFormat, name, "reserved header bytes are not zero (bytes 21-23, 68-71, 156-159)");
+    const std::uint8_t leak = h[kOffLeakFlags];
+    if (version == kProbeFileVersionLeak) {
+        if (leak > (kLeakValidity | kLeakVisibility))
+            return err(ErrorCode::kUnsupported, name, "unknown per-probe sections " + std::to_string(leak) + " (byte 21)");
+        if (leak == 0)
+            return err(ErrorCode::kBadFormat, name, "version 2 without per-probe sections (byte 21 is 0; such a file is version 1)");
+        if ((leak & kLeakVisibility) && h[kOffLayoutKind] != static_cast<std::uint8_t>(ProbeLayoutKind::kGrid))
+            return err(ErrorCode::kBadFormat, name, "visibility masks without a grid layout (bytes 20-21)");
+    }
     auto enum_field = [&](std::size_t off, int max, const char* what) -> Status {
         if (h[off] > max)
             return err(ErrorCode::kUnsupported, name, std::string("unknown ") + what + " " + std::to_string(h[off]) +
@@ -264,7 +290,8 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
     }
     // Body sizes: count <= 2^26 and size_bytes < 2^8 keep these products far from overflow.
     const std::uint64_t pos_bytes = layout_kind == ProbeLayoutKind::kPositions ? count * 12 : 0;
-    const std::uint64_t raw_expected = pos_bytes + count * probe_bytes;
+    const std::uint64_t leak_sections = ((leak & kLeakValidity) ? 1u : 0u) + ((leak & kLeakVisibility) ? 1u : 0u);
+    const std::uint64_t raw_expected = pos_bytes + count * probe_bytes + count * leak_sections;
     const std::uint64_t raw_bytes = le::load(h + kOffRawBody, 8);
     if (raw_bytes != raw_expected)
         return err(ErrorCode::kBadFormat, name, "body size " + std::to_string(raw_bytes) + " does not match " +
@@ -318,7 +345,22 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
                 set.layout.positions[i][static_cast<size_t>(c)] = v;
             }
     }
-    set.payload.assign(body.begin() + static_cast<std::ptrdiff_t>(pos_bytes), body.end());
+    const std::size_t payload_end = pos_bytes + count * probe_bytes;
+    set.payload.assign(body.begin() + static_cast<std::ptrdiff_t>(pos_bytes),
+                       body.begin() + static_cast<std::ptrdiff_t>(payload_end));
+    std::size_t at = payload_end;
+    if (leak & kLeakValidity) {
+        set.validity.assign(body.begin() + static_cast<std::ptrdiff_t>(at),
+                            body.begin() + static_cast<std::ptrdiff_t>(at + count));
+        for (size_t i = 0; i < count; ++i)
+            if (set.validity[i] > 1)
+                return err(ErrorCode::kInvalidValue, name, "validity of probe " + std::to_string(i) + " is " +
+                                                               std::to_string(set.validity[i]) + ", expected 0 or 1");
+        at += count;
+    }
+    if (leak & kLeakVisibility)
+        set.visibility.assign(body.begin() + static_cast<std::ptrdiff_t>(at),
+                              body.begin() + static_cast<std::ptrdiff_t>(at + count));
     if (info) {
         info->version = version;
         info->compressed = compressed;

@@ -33,9 +33,9 @@ export const ZHC_LIGHT_PROBES = 'ZHC_light_probes';
 // that holds no index and is carried verbatim, except that a key this module does not know is
 // only carried when its value is a string or a boolean (a number or an object could be an index
 // of something this module cannot renumber, so such a file is refused rather than written wrong).
-const KNOWN_KEYS = new Set(['name', 'encoding', 'kind', 'count', 'shAxes', 'layout', 'grid', 'positions', 'coefficients',
+const KNOWN_KEYS = new Set(['name', 'encoding', 'kind', 'count', 'shAxes', 'layout', 'grid', 'positions', 'coefficients', 'validity', 'visibility',
   'quantization', 'luminanceWeights', 'draco', 'extras']);
-const ACCESSOR_KEYS = ['positions', 'coefficients'];
+const ACCESSOR_KEYS = ['positions', 'coefficients', 'validity', 'visibility'];
 
 const COMPONENT_BYTES = { 5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4 };
 const TYPE_SIZE = { SCALAR: 1, VEC2: 2, VEC3: 3, VEC4: 4, MAT2: 4, MAT3: 9, MAT4: 16 };

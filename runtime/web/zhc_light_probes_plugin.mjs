@@ -57,12 +57,14 @@ export class ZhcProbeVolume {
   // Irradiance at any point of a GRID volume: the trilinear blend of the 8 surrounding probes'
   // decoded SH3 (the point clamped to the grid's box), evaluated at `normal`; position and normal in
   // glTF / three.js axes, node-local (docs/runtime.md "Probe volumes"). The normal is normalised
-  // (zero: +Y). Throws for points / none layouts (scattered probes: see the docs) and for a grid
+  // (zero: +Y). With validity / visibility accessors the weights are masked and renormalised
+  // (docs/runtime.md "Validity and visibility"). Throws for points / none layouts (scattered probes: see the docs) and for a grid
   // whose spacing is not > 0.
   irradianceAt(position, normal) {
     if (this.layout !== 'grid') throw new Error(`zhc: volume '${this.name}' has layout ${this.layout}: irradianceAt needs a grid`);
     if (!this.sh) this.#check(0);
-    if (!this.#volume) this.#volume = makeVolume({ sh: this.sh, ...this.grid });
+    if (!this.#volume)
+      this.#volume = makeVolume({ sh: this.sh, ...this.grid, validity: this.validity ?? null, visibility: this.visibility ?? null });
     const d = normalizeOr([normal[0], normal[1], normal[2]], [0, 1, 0]);
     return volumeIrradiance(this.#volume, position, this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
   }
@@ -203,7 +205,9 @@ export function lightProbeGridAtlas(volume, half = false) {
 
 // Parses one volume's JSON (and the accessor arrays already loaded) into a ZhcProbeVolume.
 // Throws Error naming the problem on malformed input.
-export function buildVolume(v, coefficientsArray, positionsArray) {
+// validityArray / visibilityArray: the optional `validity` / `visibility` accessors (count bytes,
+// glTF probe order, masks in glTF grid axes: docs/gltf-extension.md), or null.
+export function buildVolume(v, coefficientsArray, positionsArray, validityArray = null, visibilityArray = null) {
   if (typeof v.encoding !== 'string') throw new Error('ZHC_light_probes: missing encoding');
   const enc = encodingInfo(v.encoding);
   const count = v.count;
@@ -243,9 +247,19 @@ export function buildVolume(v, coefficientsArray, positionsArray) {
   } else {
     positions = new Float32Array(count * 3);  // layout none: every probe at the node origin
   }
+  const perProbe = (a, what) => {
+    if (!a) return null;
+    if (a.length !== count) throw new Error(`ZHC_light_probes: ${what} accessor size`);
+    const b = Uint8Array.from(a);
+    if (what === 'validity' && b.some((x) => x > 1)) throw new Error('ZHC_light_probes: validity byte other than 0 or 1');
+    return b;
+  };
+  const validity = perProbe(validityArray, 'validity'), visibility = perProbe(visibilityArray, 'visibility');
+  if (visibility && v.layout !== 'grid') throw new Error('ZHC_light_probes: visibility needs layout grid');
   return new ZhcProbeVolume({
     name: v.name, encoding: v.encoding, kind: params.kind, count, shAxes, layout: v.layout, grid: v.grid,
     params, bytesPerProbe: enc.bytes, bytes, positions, sh: decodeAll(v.encoding, bytes, count, params),
+    validity, visibility,
   });
 }
 
@@ -280,7 +294,8 @@ export class ZhcLightProbesPlugin {
       }
       const coeffs = (await this.parser.getDependency('accessor', v.coefficients)).array;
       const pos = v.positions !== undefined ? (await this.parser.getDependency('accessor', v.positions)).array : null;
-      volumes.push(buildVolume(v, coeffs, pos));
+      const acc = async (key) => (v[key] !== undefined ? (await this.parser.getDependency('accessor', v[key])).array : null);
+      volumes.push(buildVolume(v, coeffs, pos, await acc('validity'), await acc('visibility')));
     }
     for (const v of volumes) v.nodes = [];
     for (const anchor of this.anchors) {

@@ -520,8 +520,13 @@ export function parseZhp(bytes) {
   if (bytes.length < 184 || magic.some((m, i) => bytes[i] !== m)) throw new Error('zhp: not a .zhp file');
   const dv = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   if (crc32(bytes, 0, 180) !== dv.getUint32(180, true)) throw new Error('zhp: header CRC mismatch');
-  if (dv.getUint16(8, true) !== 1) throw new Error('zhp: unsupported version');
+  const version = dv.getUint16(8, true);
+  if (version !== 1 && version !== 2) throw new Error('zhp: unsupported version');
   if (dv.getUint16(10, true) !== 184) throw new Error('zhp: bad header size');
+  // Version 2: byte 21 lists the per-probe sections after the payload (bit 0 validity, bit 1
+  // visibility); version 1: zero.
+  const sections = bytes[21];
+  if (version === 1 ? sections !== 0 : sections === 0 || sections > 3) throw new Error('zhp: bad per-probe sections (byte 21)');
   const enumOf = (off, names) => {
     const v = bytes[off];
     if (v >= names.length) throw new Error(`zhp: unknown enum value ${v} at byte ${off}`);
@@ -546,7 +551,9 @@ export function parseZhp(bytes) {
   if (bpp !== enc.bytes) throw new Error('zhp: bytes per probe does not match the encoding');
   const body = Number(dv.getBigUint64(160, true));
   const posBytes = layout === 'positions' ? count * 12 : 0;
-  if (body !== posBytes + count * bpp || 184 + body > bytes.length) throw new Error('zhp: body size mismatch');
+  if ((sections & 2) && layout !== 'grid') throw new Error('zhp: visibility masks without a grid layout');
+  const sectionBytes = count * ((sections & 1) + ((sections >> 1) & 1));
+  if (body !== posBytes + count * bpp + sectionBytes || 184 + body > bytes.length) throw new Error('zhp: body size mismatch');
   if (crc32(bytes, 184, 184 + body) !== dv.getUint32(176, true)) throw new Error('zhp: body CRC mismatch');
   const grid = layout === 'grid' ? {
     origin: [0, 1, 2].map((j) => dv.getFloat64(96 + 8 * j, true)),
@@ -558,8 +565,12 @@ export function parseZhp(bytes) {
     positions = new Float32Array(count * 3);
     for (let j = 0; j < count * 3; j++) positions[j] = dv.getFloat32(184 + 4 * j, true);
   }
-  const payload = bytes.subarray(184 + posBytes, 184 + body);
-  return { encoding: name, params, count, bytesPerProbe: bpp, layout, grid, positions, payload };
+  const payloadEnd = 184 + posBytes + count * bpp;
+  const payload = bytes.subarray(184 + posBytes, payloadEnd);
+  const validity = (sections & 1) ? bytes.subarray(payloadEnd, payloadEnd + count) : null;
+  const visibility = (sections & 2) ? bytes.subarray(184 + body - count, 184 + body) : null;
+  if (validity && validity.some((v) => v > 1)) throw new Error('zhp: validity byte other than 0 or 1');
+  return { encoding: name, params, count, bytesPerProbe: bpp, layout, grid, positions, payload, validity, visibility };
 }
 
 // Decodes every probe of a payload: Float32Array(count * 27), probe p at p * 27.
@@ -581,9 +592,11 @@ export function decodeAll(encoding, payload, count, params = DEFAULT_PARAMS) {
 // A volume from its parts: { encoding, params (makeParams), bytes (Uint8Array: count x bytes per
 // probe, at least), origin, spacing, counts } (the grid as in .zhp / glTF: probe (x, y, z) is number
 // x + nx (y + ny z) at origin + (x sx, y sy, z sz)), or { sh (Float32Array(count x 27), decoded
-// radiance), origin, spacing, counts }. Throws Error naming the problem: counts integers >= 1,
-// origin and spacing finite, spacing > 0, far corner finite (zhc_volume_init's rules).
-export function makeVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, origin, spacing, counts }) {
+// radiance), origin, spacing, counts }; optional validity / visibility (Uint8Array, one byte per
+// probe, docs/runtime.md "Validity and visibility"; null = absent). Throws Error naming the
+// problem: counts integers >= 1, origin and spacing finite, spacing > 0, far corner finite
+// (zhc_volume_init's rules), validity / visibility shorter than the probe count.
+export function makeVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, origin, spacing, counts, validity = null, visibility = null }) {
   const arr3 = (a, what) => {
     if (!a || a.length !== 3) throw new Error(`zhc volume: ${what} must have 3 entries`);
     return [Number(a[0]), Number(a[1]), Number(a[2])];
@@ -606,7 +619,9 @@ export function makeVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, origi
   } else if (decoded.length < count * 27) {
     throw new Error(`zhc volume: ${count} probes need ${count * 27} SH3 floats`);
   }
-  return Object.freeze({ origin: o, spacing: s, counts: n, count, sh: decoded });
+  for (const [what, a] of [['validity', validity], ['visibility', visibility]])
+    if (a && a.length < count) throw new Error(`zhc volume: ${what} has ${a.length} bytes for ${count} probes`);
+  return Object.freeze({ origin: o, spacing: s, counts: n, count, sh: decoded, validity, visibility });
 }
 
 // A volume from a whole .zhp file (Uint8Array): parseZhp's checks, then a grid layout (throws
@@ -614,7 +629,8 @@ export function makeVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, origi
 export function volumeFromZhp(bytes) {
   const z = parseZhp(bytes);
   if (z.layout !== 'grid') throw new Error(`zhc volume: the .zhp layout is ${z.layout}, not a grid`);
-  return makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid });
+  return makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid,
+                      validity: z.validity, visibility: z.visibility });
 }
 
 // Grid coordinate along one axis: [first probe of the cell, weight of the next] (zhc__volume_axis).
@@ -629,19 +645,37 @@ function volumeAxis(p, origin, spacing, n) {
 }
 
 // Blended SH3 radiance at `position` (the volume's frame): Float64Array(27), index i*3+k
-// (zhc_volume_sh3). Probes of weight 0 are skipped.
+// (zhc_volume_sh3). Probes of weight 0 are skipped. With validity / visibility: corner (dx, dy, dz)
+// weighs w x valid x bit 7 - (dx + 2 dy + 4 dz) of its mask, weights divided by their sum (corner
+// order), all eight vanishing: the plain trilinear weights (zhc_volume_sh3, the same doubles).
 export function volumeSH3(vol, position) {
   const out = new Float64Array(27);
   const [ix, fx] = volumeAxis(position[0], vol.origin[0], vol.spacing[0], vol.counts[0]);
   const [iy, fy] = volumeAxis(position[1], vol.origin[1], vol.spacing[1], vol.counts[1]);
   const [iz, fz] = volumeAxis(position[2], vol.origin[2], vol.spacing[2], vol.counts[2]);
   const nx = vol.counts[0], ny = vol.counts[1], sh = vol.sh;
+  const w = new Float64Array(8), index = new Array(8);
   for (let corner = 0; corner < 8; corner++) {
     const bx = corner & 1, by = (corner >> 1) & 1, bz = (corner >> 2) & 1;
-    const w = (bx ? fx : 1.0 - fx) * (by ? fy : 1.0 - fy) * (bz ? fz : 1.0 - fz);
-    if (w === 0.0) continue;
-    const base = ((ix + bx) + nx * ((iy + by) + ny * (iz + bz))) * 27;
-    for (let j = 0; j < 27; j++) out[j] += w * sh[base + j];
+    w[corner] = (bx ? fx : 1.0 - fx) * (by ? fy : 1.0 - fy) * (bz ? fz : 1.0 - fz);
+    index[corner] = (ix + bx) + nx * ((iy + by) + ny * (iz + bz));
+  }
+  if (vol.validity || vol.visibility) {
+    const m = new Float64Array(8);
+    let sum = 0.0;
+    for (let corner = 0; corner < 8; corner++) {
+      if (w[corner] === 0.0) continue;
+      if (vol.validity && !vol.validity[index[corner]]) continue;
+      if (vol.visibility && !((vol.visibility[index[corner]] >> (7 - corner)) & 1)) continue;
+      m[corner] = w[corner];
+      sum += m[corner];
+    }
+    if (sum > 0.0) for (let corner = 0; corner < 8; corner++) w[corner] = m[corner] / sum;
+  }
+  for (let corner = 0; corner < 8; corner++) {
+    if (w[corner] === 0.0) continue;
+    const base = index[corner] * 27;
+    for (let j = 0; j < 27; j++) out[j] += w[corner] * sh[base + j];
   }
   return out;
 }

@@ -114,3 +114,23 @@ export function ulpDiff(a, b) {
   const ia = buf.getInt32(0, true), ib = buf.getInt32(4, true);
   return Math.abs((ia < 0 ? 0x80000000 - ia : ia) - (ib < 0 ? 0x80000000 - ib : ib));
 }
+
+// A version 1 .zhp (Uint8Array) rewritten as version 2 with validity and/or visibility sections
+// (Uint8Array of count bytes each, or null): docs/zhp-container.md "Per-probe sections". `crc32`:
+// runtime/web's (bytes, start, end).
+export function zhpWithSections(bytes, validity, visibility, crc32) {
+  const extra = (validity ? validity.length : 0) + (visibility ? visibility.length : 0);
+  const out = new Uint8Array(bytes.length + extra);
+  out.set(bytes);
+  if (validity) out.set(validity, bytes.length);
+  if (visibility) out.set(visibility, bytes.length + (validity ? validity.length : 0));
+  const dv = new DataView(out.buffer);
+  dv.setUint16(8, 2, true);
+  out[21] = (validity ? 1 : 0) | (visibility ? 2 : 0);
+  const body = BigInt(out.length - 184);
+  dv.setBigUint64(160, body, true);
+  dv.setBigUint64(168, body, true);
+  dv.setUint32(176, crc32(out, 184, out.length), true);
+  dv.setUint32(180, crc32(out, 0, 180), true);
+  return out;
+}

@@ -21,7 +21,8 @@ import validator from 'gltf-validator';
 import * as core from '@gltf-transform/core';
 import { ALL_EXTENSIONS } from '@gltf-transform/extensions';
 import { cloneDocument } from '@gltf-transform/functions';
-import { glb, triangleSceneParts, randomProbes, checker } from './fixtures.mjs';
+import { glb, triangleSceneParts, randomProbes, checker, zhpWithSections } from './fixtures.mjs';
+import { crc32 } from '../../runtime/web/zhc_runtime.mjs';
 import { defineZhcLightProbes } from '../../runtime/web/zhc_gltf_transform.mjs';
 
 const [zhc, work, corpus] = process.argv.slice(2);
@@ -98,6 +99,8 @@ function definition(vol) {
   const d = JSON.parse(JSON.stringify(vol));
   delete d.coefficients;
   delete d.positions;
+  delete d.validity;
+  delete d.visibility;
   if (d.draco) delete d.draco.bufferView;
   return JSON.stringify(d);
 }
@@ -156,6 +159,17 @@ inputs.push({ name: 'two_volumes_draco14.glb', file: W('two_volumes_draco14.glb'
 inputs.push({ name: 'three_volumes_draco_lossless.glb', file: W('three_volumes_draco_lossless.glb') });
 inputs.push({ name: 'points_sh3_gltf_axes.glb', file: W('points_sh3_gltf_axes.glb') });
 inputs.push({ name: 'grid_sh2_q.gltf', file: W('grid_sh2_q.gltf') });
+// A grid with validity and visibility accessors: a version 2 .zhp embedded.
+{
+  run(['convert', W('grid.json'), '-o', W('grid_q16.zhp'), '--to', 'zh3_q16']);
+  const validity = Uint8Array.from({ length: 24 }, (_, i) => (i % 5 === 2 ? 0 : 1));
+  const visibility = Uint8Array.from({ length: 24 }, (_, i) => (i * 37 + 11) & 0xff);
+  fs.writeFileSync(W('grid_leak.zhp'), zhpWithSections(new Uint8Array(fs.readFileSync(W('grid_q16.zhp'))), validity, visibility, crc32));
+  run(['gltf', 'embed', W('tri.glb'), W('grid_leak.zhp'), '-o', W('grid_leak.glb')]);
+  const vol = readJson(W('grid_leak.glb')).json.extensions.ZHC_light_probes.volumes[0];
+  check(Number.isInteger(vol.validity) && Number.isInteger(vol.visibility), 'grid_leak.glb: validity and visibility accessors');
+  inputs.push({ name: 'grid_leak.glb', file: W('grid_leak.glb'), leak: true });
+}
 
 // Node placement that a transform could get wrong: the probe nodes of the two-volume file under a
 // translated, rotated, scaled parent, the first with its own offset, the second volume placed twice.
@@ -182,6 +196,11 @@ for (const inp of inputs) {
   inp.placements = placements(inp.json);
   inp.extracted = extractAll(inp.file, inp.volumes.length, `in_${inp.name}`);
   console.log(`input ${inp.name}: ${inp.volumes.map((v) => `${v.encoding}/${v.layout}${v.draco ? '/draco' : ''}`).join(', ')}`);
+  if (inp.leak) {  // the extraction is a version 2 .zhp with the embedded sections (last 48 bytes)
+    const z = inp.extracted[0].zhp, src = fs.readFileSync(W('grid_leak.zhp'));
+    check(z[8] === 2 && z[21] === 3 && z.subarray(z.length - 48).equals(src.subarray(src.length - 48)),
+      'grid_leak.glb: zhc gltf extract gives the validity and visibility it was embedded with');
+  }
 }
 
 // --- 2./3. the CLI with the config ----------------------------------------------------------------

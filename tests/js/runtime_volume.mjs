@@ -11,12 +11,13 @@
 //  3. the GLTFLoader plugin's ZhcProbeVolume.irradianceAt on the demo's probes.glb (glTF axes)
 //     against the C sampler on probes_zh3_q16.zhp at the same points in zhc axes: within 1e-6 of the
 //     mean irradiance (the plugin blends in glTF probe order: a different order of the same sums);
+//  3b. the same with validity and visibility sections (version 2 files), fallback included;
 //  4. volumeFromZhp refuses a points file and a spacing <= 0 grid; irradianceAt refuses non-grids.
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { register } from 'node:module';
-import { makeRand, checker } from './fixtures.mjs';
+import { makeRand, checker, zhpWithSections, triangleScene } from './fixtures.mjs';
 
 register('./three_resolver.mjs', import.meta.url);
 const runtime = await import('../../runtime/web/zhc_runtime.mjs');
@@ -35,6 +36,7 @@ const W = (f) => path.join(work, f);
 const { check, finish } = checker();
 const run = (...args) => execFileSync(zhc, args, { maxBuffer: 1 << 28 }).toString();
 const f32 = Math.fround;
+const throwsWith = (f, re) => { try { f(); return false; } catch (e) { return e instanceof Error && re.test(e.message); } };
 
 run('demo', '-o', W('demo'), '--directions', '16');
 const sh3File = W('demo/probes_sh3.zhp');
@@ -127,11 +129,74 @@ async function loadThree(file) {
   check(mean > 0 && worst <= 1e-6, 'plugin irradianceAt agrees with the C header within 1e-6 of the mean');
 }
 
+// --- 3b: validity and visibility (a version 2 .zhp) ---------------------------------------------------
+// The demo's files rewritten as version 2 with random validity (1 in 4 invalid) and visibility masks
+// (each bit set with p = 1/2), plus an all-invalid one (the fallback): JS and the C sampler
+// (zhc_volume_from_zhp fills zhc_volume::validity / ::visibility) give the same float32 values.
+const withSections = (bytes, validity, visibility) => zhpWithSections(bytes, validity, visibility, runtime.crc32);
+{
+  const rand = makeRand(27);
+  let masked = 0, differ = 0;
+  for (const [name, mode] of [['probes_sh3.zhp', 3], ['probes_zh3_q16.zhp', 3], ['probes_zh3_q16.zhp', 1], ['probes_sh3.zhp', 2], ['probes_zh3_q16.zhp', 0]]) {
+    const v1 = new Uint8Array(fs.readFileSync(W('demo/' + name)));
+    const count = runtime.parseZhp(v1).count;
+    const validity = mode & 1 ? Uint8Array.from({ length: count }, () => (rand() < 0.25 ? 0 : 1))
+      : mode === 0 ? new Uint8Array(count) : null;  // mode 0: every probe invalid
+    const visibility = mode & 2 ? Uint8Array.from({ length: count }, () => Math.floor(rand() * 256)) : null;
+    const file = W(`leak_${mode}_${name}`);
+    fs.writeFileSync(file, withSections(v1, validity, visibility));
+    const vol = runtime.volumeFromZhp(new Uint8Array(fs.readFileSync(file)));
+    const plain = runtime.volumeFromZhp(v1);
+    check((vol.validity !== null) === Boolean(validity) && (vol.visibility !== null) === Boolean(visibility), `${file}: sections read`);
+    const pts = randomPoints(vol, 5000, 300 + mode);
+    const want = sampleC(file, pts);
+    let same = 0, diff = 0;
+    pts.forEach(({ p, n }, i) => {
+      const got = runtime.volumeIrradiance(vol, p, n);
+      if (want[i] && got.every((g, k) => Object.is(g, want[i][k]))) same++;
+      const base = runtime.volumeIrradiance(plain, p, n);
+      if (!got.every((g, k) => Object.is(g, base[k]))) diff++;
+    });
+    console.log(`volume with sections ${mode} (${name}): ${same}/${pts.length} bit-identical to the C header, ${diff} differ from the plain blend`);
+    check(same === pts.length, `${name} sections ${mode}: masked volumeIrradiance equals the C header bit for bit`);
+    if (mode === 0) check(diff === 0, 'every probe invalid: the fallback is the plain trilinear blend, bit for bit');
+    else check(diff > pts.length / 4, `${name} sections ${mode}: the masks change the result`);
+    masked += same;
+    differ += diff;
+  }
+  // Refusals: validity 2, visibility without a grid is refused by parseZhp (checked via the flags).
+  const v1 = new Uint8Array(fs.readFileSync(W('demo/probes_zh3_q16.zhp')));
+  const count = runtime.parseZhp(v1).count;
+  const bad = new Uint8Array(count).fill(1);
+  bad[count >> 1] = 2;
+  check(throwsWith(() => runtime.parseZhp(withSections(v1, bad, null)), /validity/), 'parseZhp refuses a validity byte 2');
+  console.log(`masked volumes: ${masked} samples bit-identical between JS and C`);
+  // The glTF plugin on the masked zh3_q16 grid embedded by `zhc gltf embed` (validity and
+  // visibility accessors, glTF probe order and mask axes) against the C sampler on the .zhp.
+  fs.writeFileSync(W('tri.glb'), triangleScene());
+  const leakZhp = W('leak_3_probes_zh3_q16.zhp');
+  run('gltf', 'embed', W('tri.glb'), leakZhp, '-o', W('leak.glb'));
+  const gltf = await loadThree(W('leak.glb'));
+  const v = gltf.userData.zhcLightProbes[0];
+  check(v.validity && v.visibility, 'leak.glb: the plugin reads validity and visibility');
+  const zvol = runtime.volumeFromZhp(new Uint8Array(fs.readFileSync(leakZhp)));
+  const pts = randomPoints(zvol, 5000, 8);
+  const want = sampleC(leakZhp, pts);
+  let mean = 0, worst = 0;
+  for (const e of want) mean += (Math.abs(e[0]) + Math.abs(e[1]) + Math.abs(e[2])) / 3;
+  mean /= want.length;
+  pts.forEach(({ p, n }, i) => {
+    const got = v.irradianceAt(runtime.zhcToGltfDir(p), runtime.zhcToGltfDir(n));
+    for (let k = 0; k < 3; k++) worst = Math.max(worst, Math.abs(got[k] - want[i][k]) / mean);
+  });
+  console.log(`plugin irradianceAt with masks (leak.glb) vs C (the .zhp): max error / mean ${worst.toExponential(2)}`);
+  check(mean > 0 && worst <= 1e-6, 'masked plugin irradianceAt agrees with the C header within 1e-6 of the mean');
+}
+
 // --- 4: refusals ----------------------------------------------------------------------------------------
 fs.writeFileSync(W('points.json'), JSON.stringify({ format: 'zhc-probes', version: 1, layout: { type: 'positions' },
   probes: [{ position: [0, 0, 0], sh3: Array.from({ length: 9 }, () => [1, 1, 1]) }] }));
 run('convert', W('points.json'), '-o', W('points.zhp'), '--to', 'zh3_q16');
-const throwsWith = (f, re) => { try { f(); return false; } catch (e) { return e instanceof Error && re.test(e.message); } };
 check(throwsWith(() => runtime.volumeFromZhp(new Uint8Array(fs.readFileSync(W('points.zhp')))), /not a grid/),
   'volumeFromZhp refuses a positions layout');
 {

@@ -90,7 +90,8 @@ runtime.ENCODING_TABLE.forEach((row, id) => {
 // the documented functions exist, and a broken copy is rejected (the check can fail).
 {
   const { WgslReflect } = await import('wgsl_reflect/wgsl_reflect.module.js');  // (its package "main" does not load as ESM)
-  const volumeText = fs.readFileSync(path.join(repo, 'runtime', 'zhc_volume.wgsl'), 'utf8');
+  const volumeText = fs.readFileSync(path.join(repo, 'runtime', 'zhc_volume.wgsl'), 'utf8') + '\n' +
+    fs.readFileSync(path.join(repo, 'runtime', 'zhc_volume_mask.wgsl'), 'utf8');
   const kernelText = fs.readFileSync(path.join(here, 'browser', 'wgsl_kernel.wgsl'), 'utf8');
   const parse = (code) => {
     try {
@@ -285,11 +286,11 @@ function formatBytes(e, p) {
 }
 // A job for the page (wgsl_page.mjs): header, the kernel's Job uniform (stride, count, grid), the
 // format uniform, the probe words, the item inputs.
-function jobBytes(kernel, count, outFloats, itemFloats, stride, grid, fmt, words, itemData) {
+function jobBytes(kernel, count, outFloats, itemFloats, stride, grid, fmt, words, itemData, maskOffset = 0) {
   const head = new Uint32Array(16);
   head.set([kernel, count, outFloats, itemFloats, words.length]);
   const job = new ArrayBuffer(64);
-  new Uint32Array(job, 0, 4).set([stride, count, 0, 0]);
+  new Uint32Array(job, 0, 4).set([stride, count, maskOffset, 0]);
   if (grid) {
     new Float32Array(job, 16, 8).set([...grid.origin, 0, ...grid.spacing, 0]);
     new Uint32Array(job, 48, 4).set([...grid.counts, 0]);
@@ -437,7 +438,12 @@ function volumeJob(c) {
   c.p = z.params;
   c.bytes = z.payload.slice(0, count * c.e.bytes);
   c.decoded = Array.from({ length: count }, (_, q) => runtime.decodeProbe(c.e.name, c.bytes, q * c.e.bytes, c.p));
-  c.vol = runtime.makeVolume({ encoding: c.e.name, params: c.p, bytes: c.bytes, origin: volumeOrigin, spacing: volumeSpacing, counts });
+  if (c.masked) {  // validity (1 in 4 invalid, or all invalid) and random visibility masks
+    c.validity = Uint8Array.from({ length: count }, () => (c.masked === 'all invalid' || caseRand() < 0.25 ? 0 : 1));
+    c.visibility = Uint8Array.from({ length: count }, () => Math.floor(caseRand() * 256));
+  }
+  c.vol = runtime.makeVolume({ encoding: c.e.name, params: c.p, bytes: c.bytes, origin: volumeOrigin, spacing: volumeSpacing, counts,
+    validity: c.validity ?? null, visibility: c.visibility ?? null });
   const n = kVolumeSamples + count;
   c.items = new Float32Array(6 * n);
   for (let i = 0; i < n; i++) {
@@ -453,6 +459,13 @@ function volumeJob(c) {
   }
   c.samples = n;
   c.outFloats = 3 * n;
+  if (c.masked) {  // combined masks valid ? visibility : 0, 4 per word, after the probe words
+    const probeWords = wordsOf(c.bytes), words = new Uint32Array(probeWords.length + Math.ceil(count / 4));
+    words.set(probeWords);
+    for (let q = 0; q < count; q++) words[probeWords.length + (q >> 2)] |= (c.validity[q] ? c.visibility[q] : 0) << (8 * (q & 3));
+    return jobBytes(2, n, 3, 6, c.e.bytes / 4, { origin: volumeOrigin, spacing: volumeSpacing, counts }, formatBytes(c.e, c.p),
+      words, c.items, probeWords.length);
+  }
   return jobBytes(1, n, 3, 6, c.e.bytes / 4, { origin: volumeOrigin, spacing: volumeSpacing, counts }, formatBytes(c.e, c.p),
     wordsOf(c.bytes), c.items);
 }
@@ -499,7 +512,47 @@ function volumeIrradianceD(c, pos, nrm) {
 // Bound (test_runtime_gl compare_volumes): u times the summed probe scales S of the cell's corners,
 // times 48 (decode and evaluation 32, blending 16) + 3 sum_axes ((|p| + |o|) / s + t + 2) (the
 // float error of t = (p - o) / s moves each weight by at most 3 times it).
+// Masked cases (zhc_volume_mask.wgsl): the reference is the runtime's masked volumeIrradianceD (bit
+// for bit the C header's, js.runtime_volume); bound as test_runtime_gl's compare_masked_volumes: the
+// weight part divided by the masked weight sum M, twice; samples with 0 < M < 1e-3 (ill-conditioned)
+// and the probe positions (f = 0 exactly in double, not always in float) are counted, not compared.
+const maskedTallies = new Map(encodings.map((e) => [e.name, { ...tally(), samples: 0, skipped: 0, renormalised: 0 }]));
+function compareMaskedVolume(c, gpu) {
+  const t = maskedTallies.get(c.e.name + (c.masked === 'all invalid' ? ' all invalid' : ''));
+  const counts = c.grid.counts;
+  for (let i = 0; i < kVolumeSamples; i++) {
+    const pos = [c.items[6 * i], c.items[6 * i + 1], c.items[6 * i + 2]];
+    const nrm = [c.items[6 * i + 3], c.items[6 * i + 4], c.items[6 * i + 5]];
+    const { corners, ax } = volumeIrradianceD(c, pos, nrm);
+    const rgb = runtime.volumeIrradianceD(c.vol, pos, nrm);
+    let extra = 0, masked = 0;
+    for (let a = 0; a < 3; a++) extra += (Math.abs(pos[a]) + Math.abs(volumeOrigin[a])) / volumeSpacing[a] + ax[a].t + 2;
+    for (let corner = 0; corner < 8; corner++) {
+      const b = [corner & 1, (corner >> 1) & 1, corner >> 2];
+      const w = (b[0] ? ax[0].f : 1 - ax[0].f) * (b[1] ? ax[1].f : 1 - ax[1].f) * (b[2] ? ax[2].f : 1 - ax[2].f);
+      const q = (ax[0].i0 + b[0]) + counts[0] * ((ax[1].i0 + b[1]) + counts[1] * (ax[2].i0 + b[2]));
+      if (w !== 0 && c.validity[q] && (c.visibility[q] >> (7 - corner)) & 1) masked += w;
+    }
+    let weightPart = 3 * extra;
+    if (masked > 0) {
+      if (masked < 1e-3) { t.skipped++; continue; }
+      weightPart = 2 * weightPart / masked;
+      t.renormalised++;
+    }
+    const scale = [0, 0, 0];
+    for (const q of corners) {
+      const sc = probeScale(c.e, c.p, c.decoded[q]);
+      for (let k = 0; k < 3; k++) scale[k] += sc.irradiance[k];
+    }
+    t.samples++;
+    for (let k = 0; k < 3; k++)
+      checkValue(t, 'maxIrr', rgb[k], gpu[3 * i + k], scale[k], 48 + weightPart,
+        () => `${c.e.name} masked sample ${i} (position ${pos.join(',')}) channel ${k}`);
+  }
+}
+for (const e of encodings) maskedTallies.set(e.name + ' all invalid', { ...tally(), samples: 0, skipped: 0, renormalised: 0 });
 function compareVolume(c, gpu) {
+  if (c.masked) return compareMaskedVolume(c, gpu);
   const t = volumeTallies.get(c.e.name);
   for (let i = 0; i < c.samples; i++) {
     const pos = [c.items[6 * i], c.items[6 * i + 1], c.items[6 * i + 2]];
@@ -531,6 +584,9 @@ function compareVolume(c, gpu) {
 }
 for (const e of encodings)
   for (const grid of volumeGrids) cases.push({ e, volume: true, grid, zhp: W(`${e.name}_${grid.batch}.zhp`) });
+for (const e of encodings)
+  for (const masked of ['random', 'all invalid'])
+    cases.push({ e, volume: true, masked, grid: volumeGrids[0], zhp: W(`${e.name}_${volumeGrids[0].batch}.zhp`) });
 
 // --- 3. server + Chromium ---------------------------------------------------------------------
 const roots = { '/runtime/': path.join(repo, 'runtime'), '/test/': path.join(here, 'browser') };
@@ -557,7 +613,7 @@ const routes = {
       const tc = Date.now();
       (current.volume ? compareVolume : compareCase)(current, gpu);
       compareMs += Date.now() - tc;
-      current.bytes = current.normals = current.items = current.decoded = current.vol = null;
+      current.bytes = current.normals = current.items = current.decoded = current.vol = current.validity = current.visibility = null;
       jobsDone++;
     }
     res.end('ok');
@@ -603,6 +659,14 @@ for (const e of encodings) {
   check(t.failures === 0, `${e.name} volume: ${t.failures} values out of bound; first: ${t.firstFailure}`);
   check(t.twinMismatch === 0, `${e.name} volume: the test's twin equals runtime volumeIrradianceD (${t.twinMismatch} values differ)`);
   check(t.skipped === 0 && t.samples === volumeGrids.reduce((acc, g) => acc + kVolumeSamples + g.counts[0] * g.counts[1] * g.counts[2], 0) && t.compared === 3 * t.samples, `${e.name} volume: every sample compared (${t.samples})`);
+}
+console.log('masked probe volumes (zhc_volume_mask.wgsl): max error in u S of zhcVolumeIrradianceMasked vs the masked volumeIrradianceD:');
+for (const [name, t] of maskedTallies) {
+  console.log(`${name.padEnd(34)} ${String(t.samples).padStart(7)} samples ${t.maxIrr.toFixed(3).padStart(8)} u S, renormalised ${t.renormalised}, skipped ${t.skipped}`);
+  check(t.failures === 0, `${name} masked volume: ${t.failures} values out of bound; first: ${t.firstFailure}`);
+  check(t.samples + t.skipped === kVolumeSamples && t.skipped <= kVolumeSamples / 100 && t.compared === 3 * t.samples,
+    `${name} masked volume: every sample compared or counted (${t.samples} + ${t.skipped} skipped)`);
+  check(name.endsWith('all invalid') ? t.renormalised === 0 : t.renormalised > kVolumeSamples / 2, `${name}: the masks act (${t.renormalised} renormalised)`);
 }
 console.log(`wall time: encoding ${((tEncoded - t0) / 1000).toFixed(1)} s, browser + comparison ${((tBrowser - tEncoded) / 1000).toFixed(1)} s ` +
   `(of which JS reference + comparison ${(compareMs / 1000).toFixed(1)} s), total ${((Date.now() - t0) / 1000).toFixed(1)} s`);

@@ -8,12 +8,19 @@
 // (params 16..24: grid origin, spacing (float bits), counts; binding 2 holds position, normal as two
 // float4 per item; irradiance in floats 27..29); 4: the ASTC LDR fallback's I_z decode
 // (zhc_irradz_iz_from_ldr; per item 5 floats t rgb, lo, hi; result in floats 27..29).
+// Compiled twice: plain, and with -DZHC_TEST_MASKED (ZHC_VOLUME_MASK: validity and visibility masks
+// at word params[25] of binding 1).
 [[vk::binding(0, 0)]] StructuredBuffer<uint> params;
 [[vk::binding(1, 0)]] ByteAddressBuffer words;
 [[vk::binding(2, 0)]] StructuredBuffer<float4> normals;
 [[vk::binding(3, 0)]] RWStructuredBuffer<float> results;
 
 #define ZHC_VOLUME_WORD(i) words.Load(4u * (i))
+#ifdef ZHC_TEST_MASKED
+// The masked build (runtime_test_masked.spv): combined masks, 4 per word, after the probe words at
+// word params[25].
+#define ZHC_VOLUME_MASK(i) ((words.Load(4u * (params[25] + ((i) >> 2))) >> (8u * ((i) & 3u))) & 0xFFu)
+#endif
 #include "zhc.hlsl"
 
 [numthreads(64, 1, 1)]

@@ -1,10 +1,12 @@
 // Compute kernels of tests/js/wgsl_test.mjs, appended to runtime/zhc.wgsl + runtime/zhc_volume.wgsl
-// by the page.
+// + runtime/zhc_volume_mask.wgsl by the page.
 // decode_kernel: item i = the probe words words[i * stride .. + stride) (stride <= 27) and the unit
 // normal items[3 i .. 3 i + 2]; writes zhcDecode (27 floats, SH3 radiance) and zhcIrradiance
 // (3 floats) at out[30 i ..].
 // volume_kernel: item i = position items[6 i ..], normal items[6 i + 3 ..]; the grid's probe words
 // in words[]; writes zhcVolumeIrradiance (3 floats) at out[3 i ..].
+// masked_volume_kernel: the same with zhcVolumeIrradianceMasked; the combined masks (4 per word) in
+// words[] from word job.pad0 on.
 
 struct Job {
     stride: u32,
@@ -30,8 +32,9 @@ fn zhcMyFormat() -> ZhcFormat {
                      vec3f(0.2126, 0.7152, 0.0722), vec2f(0.6, 0.08));
 }
 
-// The probe words of zhc_volume.wgsl's functions.
+// The probe words of zhc_volume.wgsl's functions, and the masks of zhc_volume_mask.wgsl's.
 fn zhcVolumeWord(i: u32) -> u32 { return words[i]; }
+fn zhcVolumeMask(i: u32) -> u32 { return (words[job.pad0 + (i >> 2u)] >> (8u * (i & 3u))) & 0xFFu; }
 
 @compute @workgroup_size(64)
 fn decode_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -60,6 +63,18 @@ fn volume_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
     let p = vec3<f32>(items[6u * i], items[6u * i + 1u], items[6u * i + 2u]);
     let n = vec3<f32>(items[6u * i + 3u], items[6u * i + 4u], items[6u * i + 5u]);
     let e = zhcVolumeIrradiance(ZhcVolume(job.origin.xyz, job.spacing.xyz, job.counts.xyz), fmt, p, n);
+    outv[3u * i] = e.x;
+    outv[3u * i + 1u] = e.y;
+    outv[3u * i + 2u] = e.z;
+}
+
+@compute @workgroup_size(64)
+fn masked_volume_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= job.count) { return; }
+    let p = vec3<f32>(items[6u * i], items[6u * i + 1u], items[6u * i + 2u]);
+    let n = vec3<f32>(items[6u * i + 3u], items[6u * i + 4u], items[6u * i + 5u]);
+    let e = zhcVolumeIrradianceMasked(ZhcVolume(job.origin.xyz, job.spacing.xyz, job.counts.xyz), fmt, p, n);
     outv[3u * i] = e.x;
     outv[3u * i + 1u] = e.y;
     outv[3u * i + 2u] = e.z;
