@@ -94,7 +94,9 @@ export class ZhcProbeVolume {
   // axes, radiance), with a copy of its first / last slice on either side; probe (x, y, z) sits at its
   // texel centre, so the hardware trilinear filter blends the same 8 probes with the same weights as
   // zhc's volume. three.js samples at `position + normal * spacing / 2` (its offset against
-  // self-shadowing) and shades BRDF_Lambert * pi E, i.e. albedo * zhc's E there.
+  // self-shadowing) and shades BRDF_Lambert * pi E, i.e. albedo * zhc's E there. The volume's
+  // validity / visibility masks are not applied (a filtered texture cannot drop corners): the grid
+  // shows the plain trilinear blend (docs/runtime.md, three.js section).
   lightProbeGrid(GridClass, { matrixWorld, type } = {}) {
     if (typeof GridClass !== 'function') throw new TypeError('zhc: lightProbeGrid needs three.js\'s LightProbeGridWebGL or LightProbeGrid class');
     if (this.layout !== 'grid') throw new Error(`zhc: volume '${this.name}' has layout ${this.layout}: lightProbeGrid needs a grid`);

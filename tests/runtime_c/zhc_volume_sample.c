@@ -1,11 +1,14 @@
-/* zhc_volume_sample FILE.zhp POINTS.txt: builds a probe volume from a grid .zhp with
+/* zhc_volume_sample FILE.zhp POINTS.txt [--plain]: builds a probe volume from a grid .zhp with
  * runtime/zhc_runtime.h alone (zhc_volume_from_zhp) and prints, for every line
  * "px py pz nx ny nz" of POINTS.txt (floats), the irradiance zhc_volume_irradiance gives at that
- * position and normal: "%.9g %.9g %.9g" (enough digits to read back the same float).
+ * position and normal: "%.9g %.9g %.9g" (enough digits to read back the same float). --plain drops
+ * the file's validity and visibility masks (plain trilinear blending: what a sampler that cannot
+ * read them, such as three.js's LightProbeGrid texture, computes).
  * Exit codes: 0 ok, 1 usage/IO, 2 + zhc_error when the file is not a volume. Built as strict C99
  * (tests/runtime_c); tests/test_runtime_c_volume.cpp runs it. */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "zhc_runtime.h"
 
@@ -36,8 +39,8 @@ int main(int argc, char** argv) {
     FILE* points;
     float p[3], n[3], rgb[3];
     int r;
-    if (argc != 3) {
-        fprintf(stderr, "usage: %s FILE.zhp POINTS.txt\n", argv[0]);
+    if (argc != 3 && !(argc == 4 && strcmp(argv[3], "--plain") == 0)) {
+        fprintf(stderr, "usage: %s FILE.zhp POINTS.txt [--plain]\n", argv[0]);
         return 1;
     }
     data = read_all(argv[1], &size);
@@ -51,6 +54,7 @@ int main(int argc, char** argv) {
         free(data);
         return 2 + r;
     }
+    if (argc == 4) volume.validity = volume.visibility = NULL;
     points = fopen(argv[2], "r");
     if (!points) {
         fprintf(stderr, "%s: cannot open\n", argv[2]);
