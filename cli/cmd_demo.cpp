@@ -125,7 +125,8 @@ int run(const Options& o) {
     BakeOptions bo;
     bo.threads = threads;
     BakeReport rep;
-    auto baked = bake_scene(scene, bo, &rep);
+    ProbeLeakData leak;  // validity and visibility masks: the demo's containers equal `zhc bake`'s
+    auto baked = bake_scene(scene, bo, &rep, &leak);
     if (!baked) return report(baked.error());
     const std::vector<Sh3Radiance>& probes = *baked;
     std::printf("\nbake: %llu probes in %.1f ms (CPU time per effect, summed over %d threads):\n",
@@ -139,6 +140,8 @@ int run(const Options& o) {
     for (const char* rep_name : {"sh3", "zh3_q16"}) {
         auto set = encode_probe_set(probes, rep_name, CodecOptions{}, layout);
         if (!set) return report(set.error());
+        set->validity = leak.validity;
+        set->visibility = leak.visibility;
         if (std::string(rep_name) == "zh3_q16") q16_set = *set;
         if (Status s = write_probe_file(path(std::string("probes_") + rep_name + ".zhp"), *set); !s)
             return report_output(s.error());

@@ -127,6 +127,48 @@ TEST(RuntimeCVolumeLeak, RandomMasksMatchTheTwinBitForBit) {
 // A 2x1x1 grid, probe 0 constant a, probe 1 constant b; probe 1 hidden from the cell between them
 // (its bit 7 - 1 = 6, the cell on its -x side): anywhere in the cell, except exactly at probe 1
 // (where probe 0's weight is 0 and the fallback applies), the sample is exactly probe 0.
+// Real data: the masks `zhc demo` bakes for its scene (walls and boxes through the grid), in its
+// zh3_q16 and sh3 containers, against the twin at random points of the box.
+TEST(RuntimeCVolumeLeak, DemoBakeMasksMatchTheTwinBitForBit) {
+    const std::string dir = test::fresh_dir("runtime_c_volume_leak_demo");
+    const auto demo = test::run_zhc({"demo", "-o", dir, "--directions", "16"});
+    ASSERT_EQ(demo.exit_code, 0) << demo.err;
+    for (const char* name : {"probes_zh3_q16.zhp", "probes_sh3.zhp"}) {
+        const std::vector<std::uint8_t> bytes = test::read_bytes(dir + "/" + name);
+        auto set = parse_probe_set(bytes, name);
+        ASSERT_TRUE(bool(set)) << name;
+        ASSERT_EQ(set->validity.size(), set->count) << name;
+        ASSERT_EQ(set->visibility.size(), set->count) << name;
+        size_t hidden_bits = 0, invalid = 0;
+        for (size_t i = 0; i < set->count; ++i) {
+            invalid += set->validity[i] == 0;
+            for (int b = 0; b < 8; ++b) hidden_bits += ((set->visibility[i] >> b) & 1) == 0;
+        }
+        EXPECT_GT(hidden_bits, 0u) << name << ": the demo's occluders cut the grid";
+        const auto decoded = *decode_probe_set(*set);
+        zhc_volume v;
+        ASSERT_EQ(zhc_volume_from_zhp(&v, bytes.data(), bytes.size()), ZHC_OK) << name;
+        zhc_volume plain = v;
+        plain.validity = plain.visibility = nullptr;
+        const ProbeGrid& g = set->layout.grid;
+        std::mt19937 rng(7);
+        std::uniform_real_distribution<double> u(0.0, 1.0);
+        int differ = 0;
+        const int samples = int(test::scaled_count(4000, 400));  // Release: 4000
+        for (int s = 0; s < samples; ++s) {
+            double p[3];
+            for (int c = 0; c < 3; ++c) p[c] = g.origin[c] + u(rng) * (g.counts[size_t(c)] - 1) * g.spacing[c];
+            const Sh27 got = runtime_sh3(v, p), want = twin_sh3(*set, decoded, p);
+            ASSERT_EQ(std::memcmp(got.data(), want.data(), sizeof got), 0) << name << " sample " << s;
+            const Sh27 base = runtime_sh3(plain, p);
+            differ += std::memcmp(got.data(), base.data(), sizeof got) != 0;
+        }
+        std::printf("demo %s: %zu probes, %zu invalid, %zu hidden mask bits; %d of %d samples bit for bit, %d differ from the plain blend\n",
+                    name, size_t(set->count), invalid, hidden_bits, samples, samples, differ);
+        EXPECT_GT(differ, 0) << name;
+    }
+}
+
 TEST(RuntimeCVolumeLeak, TwoConstantsSeparatedByAMaskBitGiveTheVisibleOne) {
     std::vector<float> bytes(54, 0.0f);
     const float a[3] = {3.0f, 0.5f, 0.25f}, b[3] = {100.0f, 200.0f, 300.0f};
