@@ -83,7 +83,7 @@
 #define ZHC_ZH3_DERING_Q16 21u   // zh3_q16's 16 bytes
 #define ZHC_ZH3_CHANNEL_Q16 22u  // zh3_q16's 16 bytes, each channel's own axis (f.axisMode unused)
 #define ZHC_ZH3_SOLVED_CHANNEL_Q16 23u  // zh3_channel_q16's 16 bytes
-#define ZHC_HALL_SOLVED 24u      // hall_curve's 12 floats (the L1 is solved at encode: codec/probe/zh3_hall.cpp)
+#define ZHC_HALL_SOLVED 24u      // hall_curve's 12 floats (the L1 is solved at encode: codec/probe/zh3_hall_solve.cpp)
 #define ZHC_HALL_SOLVED_Q16 25u  // hall_curve_q's 16 bytes
 #define ZHC_HALL_ADAPTIVE_Q16 26u  // sh2_q's 16 bytes, byte 15 = scale code: Eq. 21 times 0.5 min(code, 7)
 #define ZHC_ENCODING_COUNT 27u
@@ -562,7 +562,7 @@ float3 zhc_irradiance_sh2_q(uint4 p, ZhcFormat f, float3 n)
     return kZhcY00 * c[0] + (w1 * kZhcY1) * (-c[1] * n.y + c[2] * n.z - c[3] * n.x);
 }
 
-// hall_adaptive_q16: the curve's a and b times s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall.cpp); 1 for
+// hall_adaptive_q16: the curve's a and b times s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall_solve.cpp); 1 for
 // hall_curve_q / hall_solved_q16.
 ZhcFormat zhc_hall_scaled(uint4 p, ZhcFormat f)
 {

@@ -75,8 +75,8 @@ enum zhc_encoding {
     ZHC_ENC_HALL_AMBDIR_CHANNEL = 9,  /* the same three on per-channel axes */
     ZHC_ENC_HALL_SPHERE_CHANNEL = 10,
     ZHC_ENC_HALL_CURVE_CHANNEL = 11,
-    ZHC_ENC_ZH3_LUM_DERING = 12,        /* 15 floats: decoded as zh3_lum */
-    ZHC_ENC_ZH3_LUM_DERING_SPHERE = 13, /* 15 floats: decoded as zh3_lum */
+    ZHC_ENC_ZH3_LUM_AXIS_CLAMP = 12,    /* 15 floats: decoded as zh3_lum */
+    ZHC_ENC_ZH3_LUM_SPHERE_CLAMP = 13,  /* 15 floats: decoded as zh3_lum */
     ZHC_ENC_SH3_DERING = 14,            /* 27 floats: decoded as sh3 */
     ZHC_ENC_ZH3_Q16 = 15,             /* 16 bytes: DC (4) + per channel [L1-1, L10, L11, zonal] */
     ZHC_ENC_ZH3_SOLVED_Q16 = 16,      /* zh3_q16 bytes */
@@ -136,16 +136,33 @@ static inline const char* zhc_encoding_name(int e) {
     static const char* const names[ZHC_ENC_COUNT] = {
         "sh3", "sh2", "zh3_lum", "zh3_channel", "zh3_solved_lum", "zh3_solved_channel", "hall_ambdir",
         "hall_sphere", "hall_curve", "hall_ambdir_channel", "hall_sphere_channel", "hall_curve_channel",
-        "zh3_lum_dering", "zh3_lum_dering_sphere", "sh3_dering", "zh3_q16", "zh3_solved_q16", "sh3_q28",
+        "zh3_lum_axis_clamp", "zh3_lum_sphere_clamp", "sh3_dering", "zh3_q16", "zh3_solved_q16", "sh3_q28",
         "sh2_q", "hall_curve_q", "zh3_dering", "zh3_dering_q16", "zh3_channel_q16", "zh3_solved_channel_q16",
         "hall_solved", "hall_solved_q16", "hall_adaptive_q16"};
     return (e >= 0 && e < ZHC_ENC_COUNT) ? names[e] : NULL;
 }
 
-/* Encoding from a NUL-terminated name; -1 when unknown (or NULL). */
+/* The other names an encoding answers to when read (codec/probe/codec_table.cpp codec_aliases():
+ * App. B's zonal clamps leave irradiance negative where no zonal value helps, so only entries that
+ * keep it >= 0 carry "dering" in their names). The entry's own name when `name` is an alias, else
+ * `name` itself. */
+#define ZHC_ENC_ZH3_LUM_DERING ZHC_ENC_ZH3_LUM_AXIS_CLAMP
+#define ZHC_ENC_ZH3_LUM_DERING_SPHERE ZHC_ENC_ZH3_LUM_SPHERE_CLAMP
+static inline const char* zhc__encoding_alias(const char* name) {
+    static const char* const aliases[][2] = {{"zh3_lum_dering", "zh3_lum_axis_clamp"},
+                                             {"zh3_lum_dering_sphere", "zh3_lum_sphere_clamp"}};
+    size_t i;
+    for (i = 0; i < sizeof aliases / sizeof aliases[0]; ++i)
+        if (strcmp(name, aliases[i][0]) == 0) return aliases[i][1];
+    return name;
+}
+
+/* Encoding from a NUL-terminated name or an alias of one (zhc__encoding_alias); -1 when unknown
+ * (or NULL). */
 static inline int zhc_encoding_from_name(const char* name) {
     int e;
     if (!name) return -1;
+    name = zhc__encoding_alias(name);
     for (e = 0; e < ZHC_ENC_COUNT; ++e)
         if (strcmp(name, zhc_encoding_name(e)) == 0) return e;
     return -1;
@@ -616,7 +633,7 @@ static inline int zhc_decode_probe(const zhc_probe_format* f, const void* bytes,
             zhc__decode_packed(f, in, radiance_sh3);
             if (zhc__sh2q_layout(f->encoding) && f->encoding != ZHC_ENC_SH2_Q) {
                 /* ZH3 paper Sec. 3.4.3, Eq. 21 on the decoder's axis (quantize.cpp hallucinate_curve);
-                 * hall_adaptive_q16 scales a and b by s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall.cpp). */
+                 * hall_adaptive_q16 scales a and b by s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall_solve.cpp). */
                 const double s = f->encoding == ZHC_ENC_HALL_ADAPTIVE_Q16 ? 0.5 * (in[15] < 7 ? in[15] : 7) : 1.0;
                 per_channel = f->axis_mode == ZHC_AXIS_PER_CHANNEL;
                 for (i = 0; i < 12; ++i) lin[i] = (float)zhc__f32_round(radiance_sh3[i]);

@@ -236,7 +236,7 @@ export function hallucinateZonal(model, f0, f1Zonal, a = HALLUCINATE_CURVE_A, b 
   return (a * p * p + b * p) * f0;
 }
 // zh3_hallucinate then zh3_expand: linear (>= 12 float32 values) -> SH3 radiance.
-// `scale` multiplies the curve's a and b (hall_adaptive_q16; codec/probe/zh3_hall.cpp hall_scaled_expand).
+// `scale` multiplies the curve's a and b (hall_adaptive_q16; codec/probe/zh3_hall_solve.cpp hall_scaled_expand).
 function hallucinateExpand(linear, model, axisMode, w, scale = 1) {
   const axes = zh3Axes(linear, axisMode, w);
   const zonal = [0, 0, 0];
@@ -328,8 +328,8 @@ export const ENCODINGS = Object.freeze({
   hall_ambdir_channel: { bytes: 48, decode: hallFloat('ambdir', 'channel') },
   hall_sphere_channel: { bytes: 48, decode: hallFloat('sphere', 'channel') },
   hall_curve_channel: { bytes: 48, decode: hallFloat('curve', 'channel') },
-  zh3_lum_dering: { bytes: 60, decode: zh3Float('luminance') },
-  zh3_lum_dering_sphere: { bytes: 60, decode: zh3Float('luminance') },
+  zh3_lum_axis_clamp: { bytes: 60, decode: zh3Float('luminance') },
+  zh3_lum_sphere_clamp: { bytes: 60, decode: zh3Float('luminance') },
   zh3_dering: { bytes: 60, decode: zh3Float('luminance') },
   sh3_dering: { bytes: 108, decode: (b, o) => loadFloats(b, o, 27) },
   zh3_q16: { bytes: 16, packed: true, decode: packed('zh3_q16') },
@@ -348,7 +348,21 @@ export const ENCODINGS = Object.freeze({
   hall_adaptive_q16: { bytes: 16, packed: true, decode: (b, o, p) => hallucinateExpand(decodePacked('sh2_q', b, o, p), 'curve', p.axisMode, p.luminanceWeights, 0.5 * Math.min(b[o + 15], 7)) },
 });
 
+// Other names an encoding answers to in files (codec/probe/codec_table.cpp codec_aliases(): App. B's
+// zonal clamps leave irradiance negative where no zonal value helps, so only entries that keep it
+// >= 0 carry "dering" in their names): alias -> the entry's own name.
+export const ENCODING_ALIASES = Object.freeze({
+  zh3_lum_dering: 'zh3_lum_axis_clamp',
+  zh3_lum_dering_sphere: 'zh3_lum_sphere_clamp',
+});
+
+// The entry's own name for a name or an alias of one (anything else is returned unchanged).
+export function encodingName(name) {
+  return Object.prototype.hasOwnProperty.call(ENCODING_ALIASES, name) ? ENCODING_ALIASES[name] : name;
+}
+
 export function encodingInfo(name) {
+  name = encodingName(name);
   const e = Object.prototype.hasOwnProperty.call(ENCODINGS, name) ? ENCODINGS[name] : null;
   if (!e) throw new Error(`zhc: unknown encoding '${name}' (known: ${Object.keys(ENCODINGS).join(', ')})`);
   return e;
