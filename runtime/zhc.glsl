@@ -55,34 +55,34 @@ precision highp int;
 // out), the zonal L2 hallucinated at decode, and the zonal axis: luminance / channel = fixed by the
 // entry (set axisMode to it), header = the .zhp header's axis mode, none = no zonal term. One line
 // per entry; tests/test_runtime_gl.cpp reads these lines (an entry missing here fails it).
-//   name                   family              hallucination            axis
-//   sh3                    ZHC_LAYOUT_SH3_F32  ZHC_HALL_NONE            none
-//   sh2                    ZHC_LAYOUT_SH2_F32  ZHC_HALL_NONE            none
-//   zh3_lum                ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   zh3_channel            ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            channel
-//   zh3_solved_lum         ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   zh3_solved_channel     ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            channel
-//   hall_ambdir            ZHC_LAYOUT_SH2_F32  ZHC_HALL_AMBDIR          luminance
-//   hall_sphere            ZHC_LAYOUT_SH2_F32  ZHC_HALL_SPHERE          luminance
-//   hall_curve             ZHC_LAYOUT_SH2_F32  ZHC_HALL_CURVE           luminance
-//   hall_ambdir_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_AMBDIR          channel
-//   hall_sphere_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_SPHERE          channel
-//   hall_curve_channel     ZHC_LAYOUT_SH2_F32  ZHC_HALL_CURVE           channel
-//   zh3_lum_dering         ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   zh3_lum_dering_sphere  ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   sh3_dering             ZHC_LAYOUT_SH3_F32  ZHC_HALL_NONE            none
-//   zh3_q16                ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            header
-//   zh3_solved_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            header
-//   sh3_q28                ZHC_LAYOUT_SH3_Q28  ZHC_HALL_NONE            none
-//   sh2_q                  ZHC_LAYOUT_SH2_Q    ZHC_HALL_NONE            none
-//   hall_curve_q           ZHC_LAYOUT_SH2_Q    ZHC_HALL_CURVE           header
-//   zh3_dering             ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   zh3_dering_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            header
-//   zh3_channel_q16        ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            channel
-//   zh3_solved_channel_q16 ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            channel
-//   hall_solved            ZHC_LAYOUT_SH2_F32  ZHC_HALL_CURVE           luminance
-//   hall_solved_q16        ZHC_LAYOUT_SH2_Q    ZHC_HALL_CURVE           header
-//   hall_adaptive_q16      ZHC_LAYOUT_SH2_Q    ZHC_HALL_CURVE_ADAPTIVE  header
+//   name                   family              hallucination                 axis
+//   sh3                    ZHC_LAYOUT_SH3_F32  ZHC_HALL_MODE_NONE            none
+//   sh2                    ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_NONE            none
+//   zh3_lum                ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   zh3_channel            ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            channel
+//   zh3_solved_lum         ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   zh3_solved_channel     ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            channel
+//   hall_ambdir            ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_AMBDIR          luminance
+//   hall_sphere            ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_SPHERE          luminance
+//   hall_curve             ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_CURVE           luminance
+//   hall_ambdir_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_AMBDIR          channel
+//   hall_sphere_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_SPHERE          channel
+//   hall_curve_channel     ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_CURVE           channel
+//   zh3_lum_axis_clamp     ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   zh3_lum_sphere_clamp   ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   sh3_dering             ZHC_LAYOUT_SH3_F32  ZHC_HALL_MODE_NONE            none
+//   zh3_q16                ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            header
+//   zh3_solved_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            header
+//   sh3_q28                ZHC_LAYOUT_SH3_Q28  ZHC_HALL_MODE_NONE            none
+//   sh2_q                  ZHC_LAYOUT_SH2_Q    ZHC_HALL_MODE_NONE            none
+//   hall_curve_q           ZHC_LAYOUT_SH2_Q    ZHC_HALL_MODE_CURVE           header
+//   zh3_dering             ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   zh3_dering_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            header
+//   zh3_channel_q16        ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            channel
+//   zh3_solved_channel_q16 ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            channel
+//   hall_solved            ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_CURVE           luminance
+//   hall_solved_q16        ZHC_LAYOUT_SH2_Q    ZHC_HALL_MODE_CURVE           header
+//   hall_adaptive_q16      ZHC_LAYOUT_SH2_Q    ZHC_HALL_MODE_CURVE_ADAPTIVE  header
 // (sh3 27 words, sh2 12, the ZH3 floats 15, sh3_q28 seven uints, the other quantised layouts uvec4.)
 const uint ZHC_LAYOUT_SH3_F32 = 0u;
 const uint ZHC_LAYOUT_SH2_F32 = 1u;
@@ -92,12 +92,12 @@ const uint ZHC_LAYOUT_SH3_Q28 = 4u;
 const uint ZHC_LAYOUT_SH2_Q = 5u;
 
 // Zonal L2 hallucinated at decode (ZH3 paper Sec. 3.4; codec zh3_hallucinate).
-const uint ZHC_HALL_NONE = 0u;
-const uint ZHC_HALL_AMBDIR = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
-const uint ZHC_HALL_SPHERE = 2u;  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
-const uint ZHC_HALL_CURVE = 3u;   // Eq. 21: f20 = (a p^2 + b p) f0
+const uint ZHC_HALL_MODE_NONE = 0u;
+const uint ZHC_HALL_MODE_AMBDIR = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
+const uint ZHC_HALL_MODE_SPHERE = 2u;  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
+const uint ZHC_HALL_MODE_CURVE = 3u;   // Eq. 21: f20 = (a p^2 + b p) f0
 // hall_adaptive_q16 (ZHC_LAYOUT_SH2_Q only): Eq. 21 with a, b times s = 0.5 min(byte 15, 7).
-const uint ZHC_HALL_CURVE_ADAPTIVE = 4u;
+const uint ZHC_HALL_MODE_CURVE_ADAPTIVE = 4u;
 
 // .zhp header enums (codec/probe/quantize.h, same numeric values as the file).
 const uint ZHC_DC_R11G11B10F = 0u;
@@ -117,7 +117,7 @@ const uint ZHC_KIND_IRRADIANCE = 1u;  // stored SH are irradiance (band scales a
 // and, for the hall_* entries, the hallucination model). All uint/vec so it fits a UBO (std140).
 struct ZhcFormat {
     uint family;         // ZHC_LAYOUT_* (the layout family)
-    uint hallucination;  // ZHC_HALL_*
+    uint hallucination;  // ZHC_HALL_MODE_*
     uint bits;           // 2..8 bits per ratio (quantised layouts)
     uint sqrtEncoding;   // 1: sign-preserving square-root encoding of the ratios
     uint l2Bound;        // ZHC_L2_*
@@ -308,13 +308,13 @@ vec3 zhcIrradianceZh3(ZhcSh3 linear, vec3 zonal, vec3 axis[3], vec3 n, vec3 s) {
 // ~15 flops + 3 divisions.
 vec3 zhcHallucinateZonal(ZhcSh3 linear, vec3 axis[3], ZhcFormat f) {
     vec3 zonal = vec3(0.0);
-    vec2 ab = f.hallucination == ZHC_HALL_SPHERE ? vec2(2.0 * ZHC_SQRT5 / 3.0, -sqrt(5.0 / 3.0)) : f.curve;
+    vec2 ab = f.hallucination == ZHC_HALL_MODE_SPHERE ? vec2(2.0 * ZHC_SQRT5 / 3.0, -sqrt(5.0 / 3.0)) : f.curve;
     for (int k = 0; k < 3; ++k) {
         float f1 = abs(dot(zhcL1Vector(linear, k), axis[k]));
         float f0 = linear.c[0][k];
-        if (f.hallucination == ZHC_HALL_AMBDIR) {
+        if (f.hallucination == ZHC_HALL_MODE_AMBDIR) {
             zonal[k] = (ZHC_SQRT15 / 3.0) * f1;
-        } else if (f.hallucination != ZHC_HALL_NONE && zhcIsFinite(f0) && f0 > 0.0) {
+        } else if (f.hallucination != ZHC_HALL_MODE_NONE && zhcIsFinite(f0) && f0 > 0.0) {
             float p = f1 / f0;  // >= 0, +Inf or NaN (NaN only from NaN inputs: stays NaN)
             zonal[k] = p >= ZHC_SQRT3 ? (ab.x * 3.0 + ab.y * ZHC_SQRT3) * f0 : (ab.x * p + ab.y) * f1;
         }
@@ -432,7 +432,7 @@ ZhcSh3 zhcDecodeSh3F32(uint w[27], ZhcFormat f) { return zhcStoredToRadiance(zhc
 // axis of f.axisMode, in the stored domain. ~120 flops with hallucination.
 ZhcSh3 zhcDecodeSh2F32(uint w[12], ZhcFormat f) {
     ZhcSh3 s = zhcLoadSh2F32(w);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         vec3 axis[3];
         zhcZonalAxes(s, f, axis);
         zhcExpandZonal(s, zhcHallucinateZonal(s, axis, f), axis);
@@ -469,9 +469,9 @@ ZhcSh3 zhcDecodeSh3Q28(uint w[7], ZhcFormat f) { return zhcStoredToRadiance(zhcL
 // hallucinate_curve after decode_packed), whatever the stored kind. ~100 / ~200 flops.
 // hall_adaptive_q16's per-probe scale of the curve (byte 15), as plain Eq. 21 afterwards.
 ZhcFormat zhcHallAdaptive(uvec4 w, ZhcFormat f) {
-    if (f.hallucination == ZHC_HALL_CURVE_ADAPTIVE) {
+    if (f.hallucination == ZHC_HALL_MODE_CURVE_ADAPTIVE) {
         f.curve *= 0.5 * float(min(w.w >> 24u, 7u));
-        f.hallucination = ZHC_HALL_CURVE;
+        f.hallucination = ZHC_HALL_MODE_CURVE;
     }
     return f;
 }
@@ -479,7 +479,7 @@ ZhcFormat zhcHallAdaptive(uvec4 w, ZhcFormat f) {
 ZhcSh3 zhcDecodeSh2Q(uvec4 w, ZhcFormat f) {
     f = zhcHallAdaptive(w, f);
     ZhcSh3 s = zhcStoredToRadiance(zhcLoadSh2Q(w, f), f);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         vec3 axis[3];
         zhcZonalAxes(s, f, axis);
         zhcExpandZonal(s, zhcHallucinateZonal(s, axis, f), axis);
@@ -501,7 +501,7 @@ vec3 zhcIrradianceSh2F32(uint w[12], ZhcFormat f, vec3 n) {
     vec3 zonal = vec3(0.0);
     vec3 axis[3];
     axis[0] = axis[1] = axis[2] = vec3(0.0, 0.0, 1.0);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         zhcZonalAxes(s, f, axis);
         zonal = zhcHallucinateZonal(s, axis, f);
     }
@@ -537,7 +537,7 @@ vec3 zhcIrradianceSh2Q(uvec4 w, ZhcFormat f, vec3 n) {
     vec3 zonal = vec3(0.0);
     vec3 axis[3];
     axis[0] = axis[1] = axis[2] = vec3(0.0, 0.0, 1.0);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         zhcZonalAxes(s, f, axis);
         zonal = zhcHallucinateZonal(s, axis, f);
     }

@@ -71,8 +71,8 @@
 #define ZHC_HALL_AMBDIR_CHANNEL 9u
 #define ZHC_HALL_SPHERE_CHANNEL 10u
 #define ZHC_HALL_CURVE_CHANNEL 11u
-#define ZHC_ZH3_LUM_DERING 12u
-#define ZHC_ZH3_LUM_DERING_SPHERE 13u
+#define ZHC_ZH3_LUM_AXIS_CLAMP 12u
+#define ZHC_ZH3_LUM_SPHERE_CLAMP 13u
 #define ZHC_SH3_DERING 14u
 #define ZHC_ZH3_Q16 15u
 #define ZHC_ZH3_SOLVED_Q16 16u
@@ -87,6 +87,10 @@
 #define ZHC_HALL_SOLVED_Q16 25u  // hall_curve_q's 16 bytes
 #define ZHC_HALL_ADAPTIVE_Q16 26u  // sh2_q's 16 bytes, byte 15 = scale code: Eq. 21 times 0.5 min(code, 7)
 #define ZHC_ENCODING_COUNT 27u
+// Other names of encodings (zhc::codec_aliases(): only entries that keep irradiance >= 0 carry
+// "dering" in their names; .zhp and glTF files may name these two by their aliases).
+#define ZHC_ZH3_LUM_DERING ZHC_ZH3_LUM_AXIS_CLAMP
+#define ZHC_ZH3_LUM_DERING_SPHERE ZHC_ZH3_LUM_SPHERE_CLAMP
 
 // Stored bytes per probe of each encoding (all multiples of 4).
 uint zhc_encoding_bytes(uint encoding)

@@ -24,7 +24,7 @@
 //
 //   override ZHC_BITS: u32 = 8u;
 //   fn zhcMyFormat() -> ZhcFormat {
-//       return ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_BITS, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
+//       return ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_MODE_NONE, ZHC_BITS, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
 //                        ZHC_ZONAL_AFFINE, ZHC_AXIS_LUMINANCE, ZHC_KIND_RADIANCE,
 //                        vec3f(0.2126, 0.7152, 0.0722), vec2f(0.6, 0.08));
 //   }
@@ -71,34 +71,34 @@
 // entry (set axisMode to it), header = the .zhp header's axis mode, none = no zonal term. One line
 // per entry; tests/js/wgsl_test.mjs reads these lines (an entry of the runtime's table missing here
 // fails it).
-//   name                   family              hallucination            axis
-//   sh3                    ZHC_LAYOUT_SH3_F32  ZHC_HALL_NONE            none
-//   sh2                    ZHC_LAYOUT_SH2_F32  ZHC_HALL_NONE            none
-//   zh3_lum                ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   zh3_channel            ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            channel
-//   zh3_solved_lum         ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   zh3_solved_channel     ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            channel
-//   hall_ambdir            ZHC_LAYOUT_SH2_F32  ZHC_HALL_AMBDIR          luminance
-//   hall_sphere            ZHC_LAYOUT_SH2_F32  ZHC_HALL_SPHERE          luminance
-//   hall_curve             ZHC_LAYOUT_SH2_F32  ZHC_HALL_CURVE           luminance
-//   hall_ambdir_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_AMBDIR          channel
-//   hall_sphere_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_SPHERE          channel
-//   hall_curve_channel     ZHC_LAYOUT_SH2_F32  ZHC_HALL_CURVE           channel
-//   zh3_lum_dering         ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   zh3_lum_dering_sphere  ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   sh3_dering             ZHC_LAYOUT_SH3_F32  ZHC_HALL_NONE            none
-//   zh3_q16                ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            header
-//   zh3_solved_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            header
-//   sh3_q28                ZHC_LAYOUT_SH3_Q28  ZHC_HALL_NONE            none
-//   sh2_q                  ZHC_LAYOUT_SH2_Q    ZHC_HALL_NONE            none
-//   hall_curve_q           ZHC_LAYOUT_SH2_Q    ZHC_HALL_CURVE           header
-//   zh3_dering             ZHC_LAYOUT_ZH3_F32  ZHC_HALL_NONE            luminance
-//   zh3_dering_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            header
-//   zh3_channel_q16        ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            channel
-//   zh3_solved_channel_q16 ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_NONE            channel
-//   hall_solved            ZHC_LAYOUT_SH2_F32  ZHC_HALL_CURVE           luminance
-//   hall_solved_q16        ZHC_LAYOUT_SH2_Q    ZHC_HALL_CURVE           header
-//   hall_adaptive_q16      ZHC_LAYOUT_SH2_Q    ZHC_HALL_CURVE_ADAPTIVE  header
+//   name                   family              hallucination                 axis
+//   sh3                    ZHC_LAYOUT_SH3_F32  ZHC_HALL_MODE_NONE            none
+//   sh2                    ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_NONE            none
+//   zh3_lum                ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   zh3_channel            ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            channel
+//   zh3_solved_lum         ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   zh3_solved_channel     ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            channel
+//   hall_ambdir            ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_AMBDIR          luminance
+//   hall_sphere            ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_SPHERE          luminance
+//   hall_curve             ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_CURVE           luminance
+//   hall_ambdir_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_AMBDIR          channel
+//   hall_sphere_channel    ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_SPHERE          channel
+//   hall_curve_channel     ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_CURVE           channel
+//   zh3_lum_axis_clamp     ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   zh3_lum_sphere_clamp   ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   sh3_dering             ZHC_LAYOUT_SH3_F32  ZHC_HALL_MODE_NONE            none
+//   zh3_q16                ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            header
+//   zh3_solved_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            header
+//   sh3_q28                ZHC_LAYOUT_SH3_Q28  ZHC_HALL_MODE_NONE            none
+//   sh2_q                  ZHC_LAYOUT_SH2_Q    ZHC_HALL_MODE_NONE            none
+//   hall_curve_q           ZHC_LAYOUT_SH2_Q    ZHC_HALL_MODE_CURVE           header
+//   zh3_dering             ZHC_LAYOUT_ZH3_F32  ZHC_HALL_MODE_NONE            luminance
+//   zh3_dering_q16         ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            header
+//   zh3_channel_q16        ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            channel
+//   zh3_solved_channel_q16 ZHC_LAYOUT_ZH3_Q16  ZHC_HALL_MODE_NONE            channel
+//   hall_solved            ZHC_LAYOUT_SH2_F32  ZHC_HALL_MODE_CURVE           luminance
+//   hall_solved_q16        ZHC_LAYOUT_SH2_Q    ZHC_HALL_MODE_CURVE           header
+//   hall_adaptive_q16      ZHC_LAYOUT_SH2_Q    ZHC_HALL_MODE_CURVE_ADAPTIVE  header
 // (sh3 27 words, sh2 12, the ZH3 floats 15, sh3_q28 seven u32, the other quantised layouts vec4<u32>.)
 const ZHC_LAYOUT_SH3_F32: u32 = 0u;
 const ZHC_LAYOUT_SH2_F32: u32 = 1u;
@@ -108,12 +108,12 @@ const ZHC_LAYOUT_SH3_Q28: u32 = 4u;
 const ZHC_LAYOUT_SH2_Q: u32 = 5u;
 
 // Zonal L2 hallucinated at decode (ZH3 paper Sec. 3.4; codec zh3_hallucinate).
-const ZHC_HALL_NONE: u32 = 0u;
-const ZHC_HALL_AMBDIR: u32 = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
-const ZHC_HALL_SPHERE: u32 = 2u;  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
-const ZHC_HALL_CURVE: u32 = 3u;   // Eq. 21: f20 = (a p^2 + b p) f0
+const ZHC_HALL_MODE_NONE: u32 = 0u;
+const ZHC_HALL_MODE_AMBDIR: u32 = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
+const ZHC_HALL_MODE_SPHERE: u32 = 2u;  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
+const ZHC_HALL_MODE_CURVE: u32 = 3u;   // Eq. 21: f20 = (a p^2 + b p) f0
 // hall_adaptive_q16 (ZHC_LAYOUT_SH2_Q only): Eq. 21 with a, b times s = 0.5 min(byte 15, 7).
-const ZHC_HALL_CURVE_ADAPTIVE: u32 = 4u;
+const ZHC_HALL_MODE_CURVE_ADAPTIVE: u32 = 4u;
 
 // .zhp header enums (codec/probe/quantize.h, same numeric values as the file).
 const ZHC_DC_R11G11B10F: u32 = 0u;
@@ -134,7 +134,7 @@ const ZHC_KIND_IRRADIANCE: u32 = 1u;  // stored SH are irradiance (band scales a
 // 0..32, luminance at 48 (vec3 alignment 16), curve at 64; 80 bytes.
 struct ZhcFormat {
     family: u32,         // ZHC_LAYOUT_* (the layout family)
-    hallucination: u32,  // ZHC_HALL_*
+    hallucination: u32,  // ZHC_HALL_MODE_*
     bits: u32,           // 2..8 bits per ratio (quantised layouts)
     sqrtEncoding: u32,   // 1: sign-preserving square-root encoding of the ratios
     l2Bound: u32,        // ZHC_L2_*
@@ -361,13 +361,13 @@ fn zhcIrradianceZh3(linear: ZhcSh3, zonal: vec3<f32>, axis: array<vec3<f32>, 3>,
 fn zhcHallucinateZonal(linear: ZhcSh3, axis: array<vec3<f32>, 3>, f: ZhcFormat) -> vec3<f32> {
     var zonal = vec3<f32>(0.0);
     var ax = axis;
-    let ab = select(f.curve, vec2<f32>(2.0 * ZHC_SQRT5 / 3.0, -ZHC_SQRT5_3), f.hallucination == ZHC_HALL_SPHERE);
+    let ab = select(f.curve, vec2<f32>(2.0 * ZHC_SQRT5 / 3.0, -ZHC_SQRT5_3), f.hallucination == ZHC_HALL_MODE_SPHERE);
     for (var k = 0; k < 3; k++) {
         let f1 = abs(dot(zhcL1Vector(linear, k), ax[k]));
         let f0 = linear.c[0][k];
-        if (f.hallucination == ZHC_HALL_AMBDIR) {
+        if (f.hallucination == ZHC_HALL_MODE_AMBDIR) {
             zonal[k] = (ZHC_SQRT15 / 3.0) * f1;
-        } else if (f.hallucination != ZHC_HALL_NONE && zhcIsFinite(f0) && f0 > 0.0) {
+        } else if (f.hallucination != ZHC_HALL_MODE_NONE && zhcIsFinite(f0) && f0 > 0.0) {
             let p = f1 / f0;  // >= 0, +Inf or NaN (NaN only from NaN inputs: stays NaN)
             zonal[k] = select((ab.x * p + ab.y) * f1, (ab.x * 3.0 + ab.y * ZHC_SQRT3) * f0, p >= ZHC_SQRT3);
         }
@@ -499,7 +499,7 @@ fn zhcDecodeSh3F32(w: array<u32, 27>, f: ZhcFormat) -> ZhcSh3 { return zhcStored
 // axis of f.axisMode, in the stored domain. ~120 flops with hallucination.
 fn zhcDecodeSh2F32(w: array<u32, 12>, f: ZhcFormat) -> ZhcSh3 {
     var s = zhcLoadSh2F32(w);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         let axis = zhcZonalAxes(s, f);
         s = zhcExpandZonal(s, zhcHallucinateZonal(s, axis, f), axis);
     }
@@ -524,9 +524,9 @@ fn zhcDecodeSh3Q28(w: array<u32, 7>, f: ZhcFormat) -> ZhcSh3 { return zhcStoredT
 // hall_adaptive_q16's per-probe scale of the curve (byte 15), as plain Eq. 21 afterwards.
 fn zhcHallAdaptive(w: vec4<u32>, f: ZhcFormat) -> ZhcFormat {
     var g = f;
-    if (f.hallucination == ZHC_HALL_CURVE_ADAPTIVE) {
+    if (f.hallucination == ZHC_HALL_MODE_CURVE_ADAPTIVE) {
         g.curve = g.curve * (0.5 * f32(min(w.w >> 24u, 7u)));
-        g.hallucination = ZHC_HALL_CURVE;
+        g.hallucination = ZHC_HALL_MODE_CURVE;
     }
     return g;
 }
@@ -536,7 +536,7 @@ fn zhcHallAdaptive(w: vec4<u32>, f: ZhcFormat) -> ZhcFormat {
 fn zhcDecodeSh2Q(w: vec4<u32>, format: ZhcFormat) -> ZhcSh3 {
     let f = zhcHallAdaptive(w, format);
     var s = zhcStoredToRadiance(zhcLoadSh2Q(w, f), f);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         let axis = zhcZonalAxes(s, f);
         s = zhcExpandZonal(s, zhcHallucinateZonal(s, axis, f), axis);
     }
@@ -557,7 +557,7 @@ fn zhcIrradianceSh2F32(w: array<u32, 12>, f: ZhcFormat, n: vec3<f32>) -> vec3<f3
     var zonal = vec3<f32>(0.0);
     let up = vec3<f32>(0.0, 0.0, 1.0);
     var axis = array<vec3<f32>, 3>(up, up, up);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         axis = zhcZonalAxes(s, f);
         zonal = zhcHallucinateZonal(s, axis, f);
     }
@@ -585,7 +585,7 @@ fn zhcIrradianceSh2Q(w: vec4<u32>, format: ZhcFormat, n: vec3<f32>) -> vec3<f32>
     var zonal = vec3<f32>(0.0);
     let up = vec3<f32>(0.0, 0.0, 1.0);
     var axis = array<vec3<f32>, 3>(up, up, up);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         axis = zhcZonalAxes(s, f);
         zonal = zhcHallucinateZonal(s, axis, f);
     }

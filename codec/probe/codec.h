@@ -142,7 +142,7 @@ const Codec* find_codec(std::string_view name);
 
 // Names accepted for an entry besides its own: readers of .zhp and glTF files and the command line
 // take them, writers never write them. An entry's name says "dering" only when its encoder
-// guarantees irradiance >= 0 everywhere (tests/test_codec_table.cpp, DeringNamesAreNonNegative),
+// guarantees irradiance >= 0 everywhere (tests/test_codec_names.cpp, DeringNamesAreNonNegative),
 // so App. B's clamps, which leave irradiance negative where no zonal value helps, are named for
 // what they do and answer to their "dering" names here.
 struct CodecAlias {

@@ -75,8 +75,8 @@ const std::map<std::string, GlslEntry, std::less<>>& glsl_entries() {
         const std::pair<const char*, std::uint32_t> mine[] = {
             {"ZHC_LAYOUT_SH3_F32", kSh3F32}, {"ZHC_LAYOUT_SH2_F32", kSh2F32},   {"ZHC_LAYOUT_ZH3_F32", kZh3F32},
             {"ZHC_LAYOUT_ZH3_Q16", kZh3Q16}, {"ZHC_LAYOUT_SH3_Q28", kSh3Q28},   {"ZHC_LAYOUT_SH2_Q", kSh2Q},
-            {"ZHC_HALL_NONE", kHallNone},    {"ZHC_HALL_AMBDIR", kHallAmbdir},  {"ZHC_HALL_SPHERE", kHallSphere},
-            {"ZHC_HALL_CURVE", kHallCurve},  {"ZHC_HALL_CURVE_ADAPTIVE", kHallCurveAdaptive}};
+            {"ZHC_HALL_MODE_NONE", kHallNone},    {"ZHC_HALL_MODE_AMBDIR", kHallAmbdir},  {"ZHC_HALL_MODE_SPHERE", kHallSphere},
+            {"ZHC_HALL_MODE_CURVE", kHallCurve},  {"ZHC_HALL_MODE_CURVE_ADAPTIVE", kHallCurveAdaptive}};
         for (const auto& [name, value] : mine)
             EXPECT_TRUE(constants.count(name) && constants[name] == value) << name << " in runtime/zhc.glsl";
         return out;

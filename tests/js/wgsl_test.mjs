@@ -70,7 +70,7 @@ for (const m of wgslText.matchAll(/^\/\/\s+(\w+)\s+(ZHC_LAYOUT_\w+)\s+(ZHC_HALL_
 const F = { SH3_F32: 0, SH2_F32: 1, ZH3_F32: 2, ZH3_Q16: 3, SH3_Q28: 4, SH2_Q: 5 };
 const H = { NONE: 0, AMBDIR: 1, SPHERE: 2, CURVE: 3, CURVE_ADAPTIVE: 4 };
 for (const [k, v] of Object.entries(F)) check(constants[`ZHC_LAYOUT_${k}`] === v, `zhc.wgsl: ZHC_LAYOUT_${k} = ${v}u`);
-for (const [k, v] of Object.entries(H)) check(constants[`ZHC_HALL_${k}`] === v, `zhc.wgsl: ZHC_HALL_${k} = ${v}u`);
+for (const [k, v] of Object.entries(H)) check(constants[`ZHC_HALL_MODE_${k}`] === v, `zhc.wgsl: ZHC_HALL_MODE_${k} = ${v}u`);
 const familyBytes = [108, 48, 60, 16, 28, 16];
 const encodings = [];
 for (const name of Object.keys(runtime.ENCODINGS)) {
