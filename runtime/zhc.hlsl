@@ -76,8 +76,8 @@
 #define ZHC_HALL_AMBDIR_CHANNEL 9u  // linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), channel axes
 #define ZHC_HALL_SPHERE_CHANNEL 10u  // linear SH + zonal L2 hallucinated, sphere light (Eq. 20), channel axes
 #define ZHC_HALL_CURVE_CHANNEL 11u  // linear SH + zonal L2 hallucinated, curve fit (Eq. 21), channel axes
-#define ZHC_ZH3_LUM_DERING 12u  // zh3_lum with the zonal L2 clamped for non-negative irradiance (App. B)
-#define ZHC_ZH3_LUM_DERING_SPHERE 13u  // zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere
+#define ZHC_ZH3_LUM_AXIS_CLAMP 12u  // zh3_lum with the zonal L2 clamped for irradiance >= 0 along the axis (App. B)
+#define ZHC_ZH3_LUM_SPHERE_CLAMP 13u  // zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere if one exists
 #define ZHC_SH3_DERING 14u  // quadratic SH windowed to non-negative irradiance (Sloan 2017), 27 floats
 #define ZHC_ZH3_Q16 15u  // ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)
 #define ZHC_ZH3_SOLVED_Q16 16u  // zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted
@@ -92,6 +92,11 @@
 #define ZHC_HALL_SOLVED_Q16 25u  // hall_curve_q's bytes and decoder; encoder solves the L1 (quantised, checked)
 #define ZHC_HALL_ADAPTIVE_Q16 26u  // sh2_q bytes + per-probe hallucination scale code (byte 15), L1 solved for it
 #define ZHC_ENCODING_COUNT 27u
+// Names an entry answers to besides its own (codec/probe/codec_table.cpp codec_aliases()): read,
+// never written. Only entries that keep irradiance >= 0 everywhere carry "dering" in their names, so
+// App. B's zonal clamps are named for what they do and read files that name them by these.
+#define ZHC_ZH3_LUM_DERING ZHC_ZH3_LUM_AXIS_CLAMP
+#define ZHC_ZH3_LUM_DERING_SPHERE ZHC_ZH3_LUM_SPHERE_CLAMP
 
 // Layouts of the stored words (codec/probe/runtime_table.h RuntimeLayout).
 #define ZHC_LAYOUT_SH3_F32 0u  // 27 floats
@@ -136,8 +141,8 @@ static const uint kZhcEncodingTable[27] = {
     0x211030u,  // hall_ambdir_channel
     0x221030u,  // hall_sphere_channel
     0x231030u,  // hall_curve_channel
-    0x10203cu,  // zh3_lum_dering
-    0x10203cu,  // zh3_lum_dering_sphere
+    0x10203cu,  // zh3_lum_axis_clamp
+    0x10203cu,  // zh3_lum_sphere_clamp
     0x6cu,  // sh3_dering
     0x303010u,  // zh3_q16
     0x303010u,  // zh3_solved_q16
@@ -623,7 +628,7 @@ float3 zhc_irradiance_sh2_q(uint4 p, ZhcFormat f, float3 n)
     return kZhcY00 * c[0] + (w1 * kZhcY1) * (-c[1] * n.y + c[2] * n.z - c[3] * n.x);
 }
 
-// hall_adaptive_q16: the curve's a and b times s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall.cpp); 1 for
+// hall_adaptive_q16: the curve's a and b times s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall_solve.cpp); 1 for
 // hall_curve_q / hall_solved_q16.
 ZhcFormat zhc_hall_scaled(uint4 p, ZhcFormat f)
 {

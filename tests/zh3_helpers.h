@@ -1,4 +1,4 @@
-// Helpers shared by the ZH3 tests (test_zh3, test_zh3_solve, test_zh3_dering): codec lookup and round
+// Helpers shared by the ZH3 tests (test_zh3, test_zh3_solve, test_zh3_clamp): codec lookup and round
 // trip, coefficient distances, random lightings and rotations, the eight real maps.
 #pragma once
 
