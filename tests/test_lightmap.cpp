@@ -60,7 +60,7 @@ TEST(Lightmap, CompressedPlanesKeepTheHemisphericalError) {
     // irradiance from below, so the SH irradiance at -Z is small compared to +Z on average.
     const IrradzPlanes search = encode_planes(lm, {}, 2);
     irradz::EncodeOptions old;
-    old.solve = irradz::Solve::kOld;
+    old.solve = irradz::Solve::kTalkBaseline;
     const IrradzPlanes old_way = encode_planes(lm, old, 1);
     EXPECT_EQ(encode_planes(lm, {}, 1).wa, search.wa);  // thread count does not matter
     const Compressed c = compress(search, bc6h::Quality::kDefault, bc45::Quality::kDefault, 2);
@@ -127,7 +127,7 @@ TEST(LightmapTables, FitsAndPresetsAreWhatTheirNamesSay) {
     const Sh3Radiance world = project_default_lighting();
     const ShLightmap lm = synthesize_sphere(world, 8, 8, 1);
     const std::pair<Fit, irradz::Solve> solves[] = {
-        {Fit::kNewton, irradz::Solve::kNewton}, {Fit::kSearch, irradz::Solve::kSearch}, {Fit::kOld, irradz::Solve::kOld}};
+        {Fit::kNewton, irradz::Solve::kNewton}, {Fit::kSearch, irradz::Solve::kSearch}, {Fit::kTalkBaseline, irradz::Solve::kTalkBaseline}};
     for (auto [fit, solve] : solves) {
         irradz::EncodeOptions eo;
         eo.solve = solve;
