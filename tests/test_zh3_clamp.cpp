@@ -1,4 +1,4 @@
-// ZH3 deringing (App. B; codec/probe/zh3.h): the non-negativity interval by dense sampling, the clamp
+// ZH3 App. B zonal clamps (codec/probe/zh3_clamp.cpp): the non-negativity interval by dense sampling, the clamp
 // along the axis and the sphere variant everywhere (helpers: zh3_helpers.h).
 #include <algorithm>
 #include <cmath>
@@ -19,7 +19,7 @@ namespace {
 
 using namespace zh3_test;
 
-// ---- ZH3 deringing (App. B) ---------------------------------------------------------------------
+// ---- ZH3 zonal clamp (App. B) ---------------------------------------------------------------------
 
 double min_along(double f0, double f1, double f20) {
     double m = 1e300;
@@ -90,13 +90,13 @@ TEST(Zh3Dering, ClampedResultIsNonNegativeAlongTheAxisAndValidInputsAreUnchanged
     const auto coarse = fibonacci_directions(4000);
     int clamped = 0, unchanged = 0, negative_before = 0, negative_after = 0, nonneg_inputs = 0, infeasible = 0,
         negative_after_feasible = 0;
-    const Codec& dering = codec("zh3_lum_dering");
+    const Codec& clamp = codec("zh3_lum_axis_clamp");
     const Codec& plain = codec("zh3_lum");
     for (size_t idx = 0; idx < inputs.size(); ++idx) {
         const Sh3Radiance& in = inputs[idx];
         std::vector<std::uint8_t> a(60), b(60);
         EncodeStats st;
-        dering.encode(in, {}, a.data(), &st);
+        clamp.encode(in, {}, a.data(), &st);
         plain.encode(in, {}, b.data(), nullptr);
         const bool was_valid = [&] {
             const Zh3 z = zh3_fit(in, ZonalAxisMode::kLuminance, {});
@@ -117,7 +117,7 @@ TEST(Zh3Dering, ClampedResultIsNonNegativeAlongTheAxisAndValidInputsAreUnchanged
         }
         // Dense check along the axis: circle averages of irradiance (the perpendicular L1 averages
         // out) and the two poles, for every channel with positive DC.
-        const Sh3Radiance dec = dering.decode(a.data(), {});
+        const Sh3Radiance dec = clamp.decode(a.data(), {});
         if (idx < 300 || idx >= inputs.size() - 108) {  // non-negative lighting (random lights, maps, mono)
             const Sh3Radiance before = plain.decode(b.data(), {});
             bool neg_b = false, neg_a = false;
@@ -165,8 +165,8 @@ TEST(Zh3Dering, ClampedResultIsNonNegativeAlongTheAxisAndValidInputsAreUnchanged
             }
         }
     }
-    std::printf("zh3_lum_dering: %d inputs clamped, %d unchanged; of %d non-negative lightings %d had negative"
-                " irradiance somewhere with zh3_lum, %d with zh3_lum_dering (4000 directions); %d have a channel with"
+    std::printf("zh3_lum_axis_clamp: %d inputs clamped, %d unchanged; of %d non-negative lightings %d had negative"
+                " irradiance somewhere with zh3_lum, %d with zh3_lum_axis_clamp (4000 directions); %d have a channel with"
                 " a > sqrt(3) (no safe zonal value); %d of the others stay negative off the axis\n",
                 clamped, unchanged, nonneg_inputs, negative_before, negative_after, infeasible, negative_after_feasible);
     EXPECT_LE(negative_after, negative_before);
@@ -184,7 +184,7 @@ TEST(Zh3Dering, SphereVariantIsNonNegativeEverywhereWhenAnyZonalValueIs) {
     for (const RealMap& m : real_maps()) inputs.push_back(m.sh);
     const auto sphere = fibonacci_directions(20000);
     const auto coarse = fibonacci_directions(3000);
-    const Codec& strict = codec("zh3_lum_dering_sphere");
+    const Codec& strict = codec("zh3_lum_sphere_clamp");
     const Codec& plain = codec("zh3_lum");
     int clamped = 0, infeasible = 0, negative_before = 0;
     for (size_t idx = 0; idx < inputs.size(); ++idx) {
@@ -235,7 +235,7 @@ TEST(Zh3Dering, SphereVariantIsNonNegativeEverywhereWhenAnyZonalValueIs) {
             EXPECT_GE(mn, best - 5e-3 * dc - 1e-9) << "input " << idx << " channel " << k;
         }
     }
-    std::printf("zh3_lum_dering_sphere: %zu inputs, %d clamped, %d channels negative with zh3_lum, %d channels with no"
+    std::printf("zh3_lum_sphere_clamp: %zu inputs, %d clamped, %d channels negative with zh3_lum, %d channels with no"
                 " non-negative zonal value\n",
                 inputs.size(), clamped, negative_before, infeasible);
     EXPECT_GT(clamped, 0);
