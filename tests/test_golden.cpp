@@ -38,7 +38,7 @@
 #include <sstream>
 #include <tuple>
 
-#include "codec/report/audit.h"
+#include "codec/audit/audit.h"
 #include "codec/lightmap/bc45.h"
 #include "codec/lightmap/bc6h.h"
 #include "codec/probe/codec.h"

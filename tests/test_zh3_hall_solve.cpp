@@ -10,7 +10,7 @@
 #include <map>
 #include <random>
 
-#include "codec/report/audit.h"
+#include "codec/audit/audit.h"
 #include "codec/probe/codec.h"
 #include "codec/probe/probe_set.h"
 #include "codec/probe/quantize.h"
