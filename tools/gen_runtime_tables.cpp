@@ -237,9 +237,9 @@ std::string gen_hlsl(const Model& m) {
     each_layout([&](RuntimeLayout l, int i) {
         o << "#define ZHC_LAYOUT_" << upper(zhc::runtime_layout_name(l)) << " " << i << "u  // " << layout_comment(l) << "\n";
     });
-    o << "// The zonal L2 term the decoder hallucinates (ZHC_HALL_* names are encodings here, hence DECODE_HALL).\n";
+    o << "// The zonal L2 term the decoder hallucinates (ZHC_HALL_<NAME> above are encodings; these are modes).\n";
     each_hall([&](ZonalHallucination h, int i) {
-        o << "#define ZHC_DECODE_HALL_" << upper(zhc::zonal_hallucination_name(h)) << " " << i << "u  // " << hall_comment(h) << "\n";
+        o << "#define ZHC_HALL_MODE_" << upper(zhc::zonal_hallucination_name(h)) << " " << i << "u  // " << hall_comment(h) << "\n";
     });
     o << "// Where an encoding's zonal axis comes from.\n";
     each_axis([&](ZonalAxis a, int i) {
