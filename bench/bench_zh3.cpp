@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
 
     std::vector<const Codec*> rows = {find_codec("sh3"), find_codec("sh2")};
     for (const Codec& c : zh3_codecs()) rows.push_back(&c);
-    // The hallucinated and solved 16-byte entries (codec/probe/zh3_hall.cpp, quantize.cpp): their
+    // The hallucinated and solved 16-byte entries (codec/probe/zh3_hall_solve.cpp, quantize.cpp): their
     // solves are the costliest encodes in the table.
     for (const char* name : {"hall_curve", "hall_curve_q", "hall_solved", "hall_solved_q16", "hall_adaptive_q16", "zh3_solved_q16"})
         rows.push_back(find_codec(name));

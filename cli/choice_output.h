@@ -1,4 +1,4 @@
-// zhc/cli/choice_output.h — the choice section (codec/report/choice.h) as JSON and as an HTML
+// zhc/cli/choice_output.h — the choice section (codec/audit/choice.h) as JSON and as an HTML
 // table, shared by `zhc audit` and `zhc demo`. Header-only like json_output.h: the verb files are
 // compiled together (cli/CMakeLists.txt, unity build).
 #pragma once
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "codec/report/choice.h"
+#include "codec/audit/choice.h"
 #include "formats/report/html_report.h"
 #include "formats/report/runtime_cost.h"
 

@@ -12,12 +12,12 @@
 #include "json_output.h"
 #include "progress.h"
 #include "table.h"
-#include "codec/report/audit_run.h"
-#include "codec/report/choice.h"
+#include "codec/audit/audit_run.h"
+#include "codec/audit/choice.h"
 #include "formats/io/file_io.h"
 #include "formats/report/html_report.h"
 #include "formats/report/runtime_cost.h"
-#include "codec/report/benchmark.h"
+#include "codec/audit/benchmark.h"
 
 namespace zhc::cli {
 namespace cmd_audit {  // one namespace per verb file: the CLI is a unity build
@@ -42,7 +42,7 @@ struct Options {
     LdrDecoding ldr;
     std::string runtime_cost;  // bench_runtime --json output: GPU cost per encoding
     std::string paths_base;    // --paths-relative-to
-    // The choice section (codec/report/choice.h): extra budgets and the constraints.
+    // The choice section (codec/audit/choice.h): extra budgets and the constraints.
     std::vector<std::size_t> budgets;
     std::vector<std::string> require;  // "nonnegative"
     long long max_instructions = -1;

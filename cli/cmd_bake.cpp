@@ -139,7 +139,7 @@ int run(const Options& o) {
         if (!out) return report(out.error());
         if (Status st = write_file_atomic(o.output, *out); !st) return report_output(st.error());
         std::printf("%s: %llu probes as %s embedded in %s (%zu bytes)\n", o.output.c_str(),
-                    static_cast<unsigned long long>(set->count), o.to.c_str(),
+                    static_cast<unsigned long long>(set->count), set->representation.c_str(),
                     gltf_in ? "a copy of the input asset" : "a minimal glTF", out->size());
         return kExitOk;
     }
@@ -149,7 +149,7 @@ int run(const Options& o) {
     if (!bytes) return report(bytes.error());
     if (Status st = write_file_atomic(o.output, *bytes); !st) return report_output(st.error());
     std::printf("%s: %llu probes as %s (%zu bytes/probe), %zu bytes\n", o.output.c_str(),
-                static_cast<unsigned long long>(set->count), o.to.c_str(), codec->size_bytes, bytes->size());
+                static_cast<unsigned long long>(set->count), set->representation.c_str(), codec->size_bytes, bytes->size());
     return kExitOk;
 }
 

@@ -9,7 +9,7 @@
 
 #include "cli.h"
 #include "json_output.h"
-#include "codec/report/benchmark.h"
+#include "codec/audit/benchmark.h"
 #include "formats/report/audit_inputs.h"
 #include "formats/report/html_report.h"
 #include "formats/report/plot.h"

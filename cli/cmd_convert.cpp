@@ -131,6 +131,7 @@ int run(const Options& o) {
     if (!in) return report(in.error());
 
     std::string rep = o.to;
+    if (const Codec* named = rep.empty() ? nullptr : find_codec(rep)) rep = std::string(named->name);  // an alias: its entry
     if (rep.empty() && ext == ".zhp") {
         if (!in->set) {
             std::fprintf(stderr, "zhc: error: -r/--representations NAME is required to write a .zhp from %s input\n",

@@ -4,7 +4,7 @@
 // occluder that shadow the sun and lamps and occlude the sky; codec/bake/scene.h default_scene)
 // into a probe grid, encodes it with every representation
 // of the codec table, writes the probe containers, the scene, the audit table (reference: each
-// probe's baked SH3 irradiance) with its choice per byte budget (codec/report/choice.h) and
+// probe's baked SH3 irradiance) with its choice per byte budget (codec/audit/choice.h) and
 // pictures of a few probes, and prints where everything is.
 //
 // The containers and the glTF hold zh3_q16 whatever the choice: the demo's outputs are a fixed
@@ -22,14 +22,14 @@
 #include "choice_output.h"
 #include "cli.h"
 #include "table.h"
-#include "codec/report/audit_run.h"
-#include "codec/report/choice.h"
+#include "codec/audit/audit_run.h"
+#include "codec/audit/choice.h"
 #include "codec/bake/scene.h"
 #include "formats/report/audit_inputs.h"
 #include "formats/io/file_io.h"
 #include "formats/probes/gltf_probes.h"
 #include "formats/report/html_report.h"
-#include "codec/report/benchmark.h"
+#include "codec/audit/benchmark.h"
 #include "formats/probes/probe_file.h"
 #include "formats/report/runtime_cost.h"
 #include "formats/scene/scene_json.h"

@@ -168,7 +168,7 @@ int run_audit_html(const Options& o, const std::string& input, const std::vector
     if (!lm) return report(lm.error());
     irradz::EncodeOptions eo;
     const auto search = lightmap::encode_planes(*lm, eo, o.threads);
-    eo.solve = irradz::Solve::kOld;
+    eo.solve = irradz::Solve::kTalkBaseline;
     const auto old_way = lightmap::encode_planes(*lm, eo, o.threads);
     const auto c = lightmap::compress(search, bc6h_quality(o.quality), bc45_quality(o.quality), o.threads);
     const auto after = lightmap::decompress(c);
@@ -368,8 +368,13 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
         ->check(CLI::IsMember({"bc", "astc", "astc-ldr"}));
     enc->add_option("--footprint", o->footprint, "ASTC block footprint: 4x4 (default, 2 B/texel), 5x5, 6x6 (0.89 B/texel), 8x8")
         ->check(CLI::IsMember({"4x4", "5x5", "6x6", "8x8"}));
-    enc->add_option("--solve", o->solve, "IrradZ fit: " + choices_help(lightmap::fits()))
-        ->check(CLI::IsMember(choice_names(lightmap::fits())));
+    std::string solve_help = "IrradZ fit: " + choices_help(lightmap::fits());
+    std::vector<std::string> solve_names = choice_names(lightmap::fits());
+    for (const lightmap::FitAlias& a : lightmap::fit_aliases()) {
+        solve_help += "; " + std::string(a.alias) + ": alias of " + std::string(a.name);
+        solve_names.emplace_back(a.alias);
+    }
+    enc->add_option("--solve", o->solve, solve_help)->check(CLI::IsMember(solve_names));
     quality(enc);
     band(enc);
     CLI::App* dec = lm->add_subcommand("decode", "PREFIX.{iz,d,wa}.ktx2 or .dds -> IrradZ EXR (Iz.R Iz.G Iz.B wa d.X d.Y d.Z)");

@@ -79,11 +79,11 @@ uint zhcFamilyWords(uint family) {
     return 0u;
 }
 // Zonal L2 hallucinated at decode (ZH3 paper Sec. 3.4; codec zh3_hallucinate).
-const uint ZHC_HALL_NONE = 0u;  // no hallucination (L2 stored or absent)
-const uint ZHC_HALL_AMBDIR = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
-const uint ZHC_HALL_SPHERE = 2u;  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
-const uint ZHC_HALL_CURVE = 3u;  // Eq. 21: f20 = (a p^2 + b p) f0
-const uint ZHC_HALL_CURVE_ADAPTIVE = 4u;  // Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout)
+const uint ZHC_HALL_MODE_NONE = 0u;  // no hallucination (L2 stored or absent)
+const uint ZHC_HALL_MODE_AMBDIR = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
+const uint ZHC_HALL_MODE_SPHERE = 2u;  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
+const uint ZHC_HALL_MODE_CURVE = 3u;  // Eq. 21: f20 = (a p^2 + b p) f0
+const uint ZHC_HALL_MODE_CURVE_ADAPTIVE = 4u;  // Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout)
 // Where an encoding's zonal axis comes from (luminance / channel: set axisMode to it).
 const uint ZHC_ENTRY_AXIS_NONE = 0u;  // no zonal term
 const uint ZHC_ENTRY_AXIS_LUMINANCE = 1u;  // the luminance-weighted L1 axis, fixed by the encoding
@@ -102,8 +102,8 @@ const uint ZHC_ENC_HALL_CURVE = 8u;  // linear SH + zonal L2 hallucinated, curve
 const uint ZHC_ENC_HALL_AMBDIR_CHANNEL = 9u;  // linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), channel axes
 const uint ZHC_ENC_HALL_SPHERE_CHANNEL = 10u;  // linear SH + zonal L2 hallucinated, sphere light (Eq. 20), channel axes
 const uint ZHC_ENC_HALL_CURVE_CHANNEL = 11u;  // linear SH + zonal L2 hallucinated, curve fit (Eq. 21), channel axes
-const uint ZHC_ENC_ZH3_LUM_DERING = 12u;  // zh3_lum with the zonal L2 clamped for non-negative irradiance (App. B)
-const uint ZHC_ENC_ZH3_LUM_DERING_SPHERE = 13u;  // zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere
+const uint ZHC_ENC_ZH3_LUM_AXIS_CLAMP = 12u;  // zh3_lum with the zonal L2 clamped for irradiance >= 0 along the axis (App. B)
+const uint ZHC_ENC_ZH3_LUM_SPHERE_CLAMP = 13u;  // zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere if one exists
 const uint ZHC_ENC_SH3_DERING = 14u;  // quadratic SH windowed to non-negative irradiance (Sloan 2017), 27 floats
 const uint ZHC_ENC_ZH3_Q16 = 15u;  // ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)
 const uint ZHC_ENC_ZH3_SOLVED_Q16 = 16u;  // zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted
@@ -143,8 +143,8 @@ const uint ZHC_ENCODING_ROWS[27] = uint[27](
         0x211030u,  // hall_ambdir_channel
         0x221030u,  // hall_sphere_channel
         0x231030u,  // hall_curve_channel
-        0x10203cu,  // zh3_lum_dering
-        0x10203cu,  // zh3_lum_dering_sphere
+        0x10203cu,  // zh3_lum_axis_clamp
+        0x10203cu,  // zh3_lum_sphere_clamp
         0x6cu,  // sh3_dering
         0x303010u,  // zh3_q16
         0x303010u,  // zh3_solved_q16
@@ -185,7 +185,7 @@ const uint ZHC_KIND_IRRADIANCE = 1u;  // stored SH are irradiance (band scales a
 // and, for the hall_* entries, the hallucination model). All uint/vec so it fits a UBO (std140).
 struct ZhcFormat {
     uint family;         // ZHC_LAYOUT_* (the layout family)
-    uint hallucination;  // ZHC_HALL_*
+    uint hallucination;  // ZHC_HALL_MODE_*
     uint bits;           // 2..8 bits per ratio (quantised layouts)
     uint sqrtEncoding;   // 1: sign-preserving square-root encoding of the ratios
     uint l2Bound;        // ZHC_L2_*
@@ -376,13 +376,13 @@ vec3 zhcIrradianceZh3(ZhcSh3 linear, vec3 zonal, vec3 axis[3], vec3 n, vec3 s) {
 // ~15 flops + 3 divisions.
 vec3 zhcHallucinateZonal(ZhcSh3 linear, vec3 axis[3], ZhcFormat f) {
     vec3 zonal = vec3(0.0);
-    vec2 ab = f.hallucination == ZHC_HALL_SPHERE ? vec2(2.0 * ZHC_SQRT5 / 3.0, -sqrt(5.0 / 3.0)) : f.curve;
+    vec2 ab = f.hallucination == ZHC_HALL_MODE_SPHERE ? vec2(2.0 * ZHC_SQRT5 / 3.0, -sqrt(5.0 / 3.0)) : f.curve;
     for (int k = 0; k < 3; ++k) {
         float f1 = abs(dot(zhcL1Vector(linear, k), axis[k]));
         float f0 = linear.c[0][k];
-        if (f.hallucination == ZHC_HALL_AMBDIR) {
+        if (f.hallucination == ZHC_HALL_MODE_AMBDIR) {
             zonal[k] = (ZHC_SQRT15 / 3.0) * f1;
-        } else if (f.hallucination != ZHC_HALL_NONE && zhcIsFinite(f0) && f0 > 0.0) {
+        } else if (f.hallucination != ZHC_HALL_MODE_NONE && zhcIsFinite(f0) && f0 > 0.0) {
             float p = f1 / f0;  // >= 0, +Inf or NaN (NaN only from NaN inputs: stays NaN)
             zonal[k] = p >= ZHC_SQRT3 ? (ab.x * 3.0 + ab.y * ZHC_SQRT3) * f0 : (ab.x * p + ab.y) * f1;
         }
@@ -500,7 +500,7 @@ ZhcSh3 zhcDecodeSh3F32(uint w[27], ZhcFormat f) { return zhcStoredToRadiance(zhc
 // axis of f.axisMode, in the stored domain. ~120 flops with hallucination.
 ZhcSh3 zhcDecodeSh2F32(uint w[12], ZhcFormat f) {
     ZhcSh3 s = zhcLoadSh2F32(w);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         vec3 axis[3];
         zhcZonalAxes(s, f, axis);
         zhcExpandZonal(s, zhcHallucinateZonal(s, axis, f), axis);
@@ -537,9 +537,9 @@ ZhcSh3 zhcDecodeSh3Q28(uint w[7], ZhcFormat f) { return zhcStoredToRadiance(zhcL
 // hallucinate_curve after decode_packed), whatever the stored kind. ~100 / ~200 flops.
 // hall_adaptive_q16's per-probe scale of the curve (byte 15), as plain Eq. 21 afterwards.
 ZhcFormat zhcHallAdaptive(uvec4 w, ZhcFormat f) {
-    if (f.hallucination == ZHC_HALL_CURVE_ADAPTIVE) {
+    if (f.hallucination == ZHC_HALL_MODE_CURVE_ADAPTIVE) {
         f.curve *= 0.5 * float(min(w.w >> 24u, 7u));
-        f.hallucination = ZHC_HALL_CURVE;
+        f.hallucination = ZHC_HALL_MODE_CURVE;
     }
     return f;
 }
@@ -547,7 +547,7 @@ ZhcFormat zhcHallAdaptive(uvec4 w, ZhcFormat f) {
 ZhcSh3 zhcDecodeSh2Q(uvec4 w, ZhcFormat f) {
     f = zhcHallAdaptive(w, f);
     ZhcSh3 s = zhcStoredToRadiance(zhcLoadSh2Q(w, f), f);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         vec3 axis[3];
         zhcZonalAxes(s, f, axis);
         zhcExpandZonal(s, zhcHallucinateZonal(s, axis, f), axis);
@@ -569,7 +569,7 @@ vec3 zhcIrradianceSh2F32(uint w[12], ZhcFormat f, vec3 n) {
     vec3 zonal = vec3(0.0);
     vec3 axis[3];
     axis[0] = axis[1] = axis[2] = vec3(0.0, 0.0, 1.0);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         zhcZonalAxes(s, f, axis);
         zonal = zhcHallucinateZonal(s, axis, f);
     }
@@ -605,7 +605,7 @@ vec3 zhcIrradianceSh2Q(uvec4 w, ZhcFormat f, vec3 n) {
     vec3 zonal = vec3(0.0);
     vec3 axis[3];
     axis[0] = axis[1] = axis[2] = vec3(0.0, 0.0, 1.0);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         zhcZonalAxes(s, f, axis);
         zonal = zhcHallucinateZonal(s, axis, f);
     }

@@ -76,8 +76,8 @@
 #define ZHC_HALL_AMBDIR_CHANNEL 9u  // linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), channel axes
 #define ZHC_HALL_SPHERE_CHANNEL 10u  // linear SH + zonal L2 hallucinated, sphere light (Eq. 20), channel axes
 #define ZHC_HALL_CURVE_CHANNEL 11u  // linear SH + zonal L2 hallucinated, curve fit (Eq. 21), channel axes
-#define ZHC_ZH3_LUM_DERING 12u  // zh3_lum with the zonal L2 clamped for non-negative irradiance (App. B)
-#define ZHC_ZH3_LUM_DERING_SPHERE 13u  // zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere
+#define ZHC_ZH3_LUM_AXIS_CLAMP 12u  // zh3_lum with the zonal L2 clamped for irradiance >= 0 along the axis (App. B)
+#define ZHC_ZH3_LUM_SPHERE_CLAMP 13u  // zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere if one exists
 #define ZHC_SH3_DERING 14u  // quadratic SH windowed to non-negative irradiance (Sloan 2017), 27 floats
 #define ZHC_ZH3_Q16 15u  // ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)
 #define ZHC_ZH3_SOLVED_Q16 16u  // zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted
@@ -92,6 +92,11 @@
 #define ZHC_HALL_SOLVED_Q16 25u  // hall_curve_q's bytes and decoder; encoder solves the L1 (quantised, checked)
 #define ZHC_HALL_ADAPTIVE_Q16 26u  // sh2_q bytes + per-probe hallucination scale code (byte 15), L1 solved for it
 #define ZHC_ENCODING_COUNT 27u
+// Names an entry answers to besides its own (codec/probe/codec_table.cpp codec_aliases()): read,
+// never written. Only entries that keep irradiance >= 0 everywhere carry "dering" in their names, so
+// App. B's zonal clamps are named for what they do and read files that name them by these.
+#define ZHC_ZH3_LUM_DERING ZHC_ZH3_LUM_AXIS_CLAMP
+#define ZHC_ZH3_LUM_DERING_SPHERE ZHC_ZH3_LUM_SPHERE_CLAMP
 
 // Layouts of the stored words (codec/probe/runtime_table.h RuntimeLayout).
 #define ZHC_LAYOUT_SH3_F32 0u  // 27 floats
@@ -100,12 +105,12 @@
 #define ZHC_LAYOUT_ZH3_Q16 3u  // 16 bytes: DC (4) + per channel [L1-1, L10, L11, zonal]
 #define ZHC_LAYOUT_SH3_Q28 4u  // 28 bytes: DC (4) + per channel [L1-1 .. L22]
 #define ZHC_LAYOUT_SH2_Q 5u  // 16 bytes: DC slot (6) + per channel [L1-1, L10, L11] + byte 15
-// The zonal L2 term the decoder hallucinates (ZHC_HALL_* names are encodings here, hence DECODE_HALL).
-#define ZHC_DECODE_HALL_NONE 0u  // no hallucination (L2 stored or absent)
-#define ZHC_DECODE_HALL_AMBDIR 1u  // Eq. 14: f20 = sqrt(15)/3 |f1|
-#define ZHC_DECODE_HALL_SPHERE 2u  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
-#define ZHC_DECODE_HALL_CURVE 3u  // Eq. 21: f20 = (a p^2 + b p) f0
-#define ZHC_DECODE_HALL_CURVE_ADAPTIVE 4u  // Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout)
+// The zonal L2 term the decoder hallucinates (ZHC_HALL_<NAME> above are encodings; these are modes).
+#define ZHC_HALL_MODE_NONE 0u  // no hallucination (L2 stored or absent)
+#define ZHC_HALL_MODE_AMBDIR 1u  // Eq. 14: f20 = sqrt(15)/3 |f1|
+#define ZHC_HALL_MODE_SPHERE 2u  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
+#define ZHC_HALL_MODE_CURVE 3u  // Eq. 21: f20 = (a p^2 + b p) f0
+#define ZHC_HALL_MODE_CURVE_ADAPTIVE 4u  // Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout)
 // Where an encoding's zonal axis comes from.
 #define ZHC_ENTRY_AXIS_NONE 0u  // no zonal term
 #define ZHC_ENTRY_AXIS_LUMINANCE 1u  // the luminance-weighted L1 axis, fixed by the encoding
@@ -136,8 +141,8 @@ static const uint kZhcEncodingTable[27] = {
     0x211030u,  // hall_ambdir_channel
     0x221030u,  // hall_sphere_channel
     0x231030u,  // hall_curve_channel
-    0x10203cu,  // zh3_lum_dering
-    0x10203cu,  // zh3_lum_dering_sphere
+    0x10203cu,  // zh3_lum_axis_clamp
+    0x10203cu,  // zh3_lum_sphere_clamp
     0x6cu,  // sh3_dering
     0x303010u,  // zh3_q16
     0x303010u,  // zh3_solved_q16
@@ -461,27 +466,25 @@ void zhc_expand_zonal(inout ZhcSH3 sh, float3 f20, float3 a[3])
 }
 
 // ---- hallucination (ZH3 paper Sec. 3.4, Listing 1; codec/probe/zh3.cpp hallucinate_zonal) ---------------
-#define ZHC_HALL_MODEL_AMBDIR 0u   // Eq. 14: f20 = sqrt(15)/3 |f1|
-#define ZHC_HALL_MODEL_SPHERE 1u   // Eq. 20: f20 = (2 sqrt5/3 p^2 - sqrt(5/3) p) f0
-#define ZHC_HALL_MODEL_CURVE 2u    // Eq. 21: f20 = (a p^2 + b p) f0
-
+// mode: ZHC_HALL_MODE_AMBDIR (Eq. 14), _SPHERE (Eq. 20), _CURVE or _CURVE_ADAPTIVE (Eq. 21 with
+// curveA, curveB; the adaptive scale is already in them: zhc_hall_scaled).
 // f1 = the channel's L1 projected on its zonal axis; p = |f1| / f0 clamped to [0, sqrt3];
 // f0 <= 0 or not finite gives 0 (except Eq. 14, which does not use f0).
-float zhc_hallucinate_zonal(uint model, float f0, float f1, float curveA, float curveB)
+float zhc_hallucinate_zonal(uint mode, float f0, float f1, float curveA, float curveB)
 {
     float af1 = abs(f1);
-    if (model == ZHC_HALL_MODEL_AMBDIR) return kZhcSqrt15Over3 * af1;
+    if (mode == ZHC_HALL_MODE_AMBDIR) return kZhcSqrt15Over3 * af1;
     if (!(f0 > 0.0f) || !(f0 <= 3.402823466e38f)) return 0.0f;
     float p = min(af1 / f0, kZhcSqrt3);
-    if (model == ZHC_HALL_MODEL_SPHERE) return (kZhcTwoSqrt5Over3 * p * p - kZhcSqrt5Over3 * p) * f0;
+    if (mode == ZHC_HALL_MODE_SPHERE) return (kZhcTwoSqrt5Over3 * p * p - kZhcSqrt5Over3 * p) * f0;
     return (curveA * p * p + curveB * p) * f0;
 }
 
-float3 zhc_hallucinate(uint model, float3 c0, float3 c1m1, float3 c10, float3 c11, float3 a[3], ZhcFormat f)
+float3 zhc_hallucinate(uint mode, float3 c0, float3 c1m1, float3 c10, float3 c11, float3 a[3], ZhcFormat f)
 {
     float3 r;
     [unroll] for (uint k = 0u; k < 3u; ++k)
-        r[k] = zhc_hallucinate_zonal(model, c0[k], dot(zhc_l1_vector(c1m1, c10, c11, k), a[k]), f.hallA, f.hallB);
+        r[k] = zhc_hallucinate_zonal(mode, c0[k], dot(zhc_l1_vector(c1m1, c10, c11, k), a[k]), f.hallA, f.hallB);
     return r;
 }
 
@@ -494,14 +497,6 @@ uint zhc_axis_mode_of(uint encoding, ZhcFormat f)
     if (axis == ZHC_ENTRY_AXIS_CHANNEL) return ZHC_AXIS_PER_CHANNEL;
     if (axis == ZHC_ENTRY_AXIS_FORMAT) return f.axisMode;
     return ZHC_AXIS_LUMINANCE;
-}
-// zhc_hallucinate_zonal's model of an encoding (both curves: ZHC_HALL_MODEL_CURVE).
-uint zhc_hall_model_of(uint encoding)
-{
-    uint h = zhc_encoding_hallucination(encoding);
-    if (h == ZHC_DECODE_HALL_AMBDIR) return ZHC_HALL_MODEL_AMBDIR;
-    if (h == ZHC_DECODE_HALL_SPHERE) return ZHC_HALL_MODEL_SPHERE;
-    return ZHC_HALL_MODEL_CURVE;
 }
 
 float3 zhc_word3(uint w[27], uint i) { return asfloat(uint3(w[3u * i], w[3u * i + 1u], w[3u * i + 2u])); }
@@ -520,8 +515,8 @@ void zhc_zh3_floats(uint w[27], uint encoding, ZhcFormat f, out float3 c[4], out
     [unroll] for (uint i = 0u; i < 4u; ++i) c[i] = zhc_word3(w, i);
     float3 lum = float3(f.lumR, f.lumG, f.lumB);
     zhc_zonal_axes(c[1], c[2], c[3], zhc_axis_mode_of(encoding, f), lum, a);
-    if (zhc_encoding_hallucination(encoding) != ZHC_DECODE_HALL_NONE)
-        f20 = zhc_hallucinate(zhc_hall_model_of(encoding), c[0], c[1], c[2], c[3], a, f);
+    if (zhc_encoding_hallucination(encoding) != ZHC_HALL_MODE_NONE)
+        f20 = zhc_hallucinate(zhc_encoding_hallucination(encoding), c[0], c[1], c[2], c[3], a, f);
     else
         f20 = zhc_word3(w, 4u);
 }
@@ -595,7 +590,7 @@ float3 zhc_irradiance_floats(uint w[27], ZhcFormat f, float3 n)
 {
     bool irr = f.kind == ZHC_KIND_IRRADIANCE;
     uint fam = zhc_encoding_layout(f.encoding);
-    if (fam == ZHC_LAYOUT_SH3_F32 || (fam == ZHC_LAYOUT_SH2_F32 && zhc_encoding_hallucination(f.encoding) == ZHC_DECODE_HALL_NONE))
+    if (fam == ZHC_LAYOUT_SH3_F32 || (fam == ZHC_LAYOUT_SH2_F32 && zhc_encoding_hallucination(f.encoding) == ZHC_HALL_MODE_NONE))
     {
         ZhcSH3 s = zhc_stored_sh3_floats(w, fam == ZHC_LAYOUT_SH2_F32 ? 4u : 9u);
         return irr ? zhc_sh3_evaluate(s, n) : zhc_sh3_irradiance(s, n);
@@ -623,11 +618,11 @@ float3 zhc_irradiance_sh2_q(uint4 p, ZhcFormat f, float3 n)
     return kZhcY00 * c[0] + (w1 * kZhcY1) * (-c[1] * n.y + c[2] * n.z - c[3] * n.x);
 }
 
-// hall_adaptive_q16: the curve's a and b times s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall.cpp); 1 for
+// hall_adaptive_q16: the curve's a and b times s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall_solve.cpp); 1 for
 // hall_curve_q / hall_solved_q16.
 ZhcFormat zhc_hall_scaled(uint4 p, ZhcFormat f)
 {
-    float s = zhc_encoding_hallucination(f.encoding) == ZHC_DECODE_HALL_CURVE_ADAPTIVE ? 0.5f * float(min(zhc_byte(p.w, 3u), 7u)) : 1.0f;
+    float s = zhc_encoding_hallucination(f.encoding) == ZHC_HALL_MODE_CURVE_ADAPTIVE ? 0.5f * float(min(zhc_byte(p.w, 3u), 7u)) : 1.0f;
     f.hallA *= s;
     f.hallB *= s;
     return f;
@@ -643,7 +638,7 @@ float3 zhc_irradiance_hall_curve_q(uint4 p, ZhcFormat f, float3 n)
     float s1 = f.kind == ZHC_KIND_IRRADIANCE ? 1.5f : 1.0f;  // stored -> radiance L1
     c[1] *= s1; c[2] *= s1; c[3] *= s1;
     zhc_zonal_axes(c[1], c[2], c[3], zhc_axis_mode_of(f.encoding, f), float3(f.lumR, f.lumG, f.lumB), a);
-    float3 f20 = zhc_hallucinate(ZHC_HALL_MODEL_CURVE, c[0], c[1], c[2], c[3], a, f);
+    float3 f20 = zhc_hallucinate(ZHC_HALL_MODE_CURVE, c[0], c[1], c[2], c[3], a, f);
     return zhc_zh3_evaluate(c[0], c[1], c[2], c[3], f20, a, n, 2.0f / 3.0f, 0.25f);
 }
 
@@ -659,7 +654,7 @@ float3 zhc_irradiance_sh3_q28(uint w[7], ZhcFormat f, float3 n)
 float3 zhc_irradiance(uint w[27], ZhcFormat f, float3 n)
 {
     uint fam = zhc_encoding_layout(f.encoding);
-    bool hall = zhc_encoding_hallucination(f.encoding) != ZHC_DECODE_HALL_NONE;
+    bool hall = zhc_encoding_hallucination(f.encoding) != ZHC_HALL_MODE_NONE;
     if (fam == ZHC_LAYOUT_ZH3_Q16)
         return zhc_irradiance_zh3_q16(uint4(w[0], w[1], w[2], w[3]), f, n);
     if (fam == ZHC_LAYOUT_SH2_Q && !hall) return zhc_irradiance_sh2_q(uint4(w[0], w[1], w[2], w[3]), f, n);
@@ -708,7 +703,7 @@ ZhcSH3 zhc_decode_hall_curve_q(uint4 p, ZhcFormat f)
     float s1 = f.kind == ZHC_KIND_IRRADIANCE ? 1.5f : 1.0f;
     c[1] *= s1; c[2] *= s1; c[3] *= s1;
     zhc_zonal_axes(c[1], c[2], c[3], zhc_axis_mode_of(f.encoding, f), float3(f.lumR, f.lumG, f.lumB), a);
-    float3 f20 = zhc_hallucinate(ZHC_HALL_MODEL_CURVE, c[0], c[1], c[2], c[3], a, f);
+    float3 f20 = zhc_hallucinate(ZHC_HALL_MODE_CURVE, c[0], c[1], c[2], c[3], a, f);
     return zhc_sh3_from_zh3(c, f20, a, ZHC_KIND_RADIANCE);  // already radiance
 }
 
@@ -719,7 +714,7 @@ ZhcSH3 zhc_decode_floats(uint w[27], ZhcFormat f)
 {
     uint e = f.encoding;
     uint fam = zhc_encoding_layout(e);
-    if (fam == ZHC_LAYOUT_SH3_F32 || (fam == ZHC_LAYOUT_SH2_F32 && zhc_encoding_hallucination(e) == ZHC_DECODE_HALL_NONE))
+    if (fam == ZHC_LAYOUT_SH3_F32 || (fam == ZHC_LAYOUT_SH2_F32 && zhc_encoding_hallucination(e) == ZHC_HALL_MODE_NONE))
         return zhc_radiance_from_stored(zhc_stored_sh3_floats(w, fam == ZHC_LAYOUT_SH2_F32 ? 4u : 9u), f.kind);
     float3 c[4], f20, a[3];
     zhc_zh3_floats(w, e, f, c, f20, a);
@@ -732,7 +727,7 @@ ZhcSH3 zhc_decode_sh3(uint w[27], ZhcFormat f)
     uint e = f.encoding;
     uint4 p = uint4(w[0], w[1], w[2], w[3]);
     uint fam = zhc_encoding_layout(e);
-    bool hall = zhc_encoding_hallucination(e) != ZHC_DECODE_HALL_NONE;
+    bool hall = zhc_encoding_hallucination(e) != ZHC_HALL_MODE_NONE;
     if (fam == ZHC_LAYOUT_ZH3_Q16) return zhc_decode_zh3_q16(p, f);
     if (fam == ZHC_LAYOUT_SH2_Q && !hall) return zhc_decode_sh2_q(p, f);
     if (fam == ZHC_LAYOUT_SH2_Q) return zhc_decode_hall_curve_q(p, f);

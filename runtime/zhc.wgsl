@@ -24,7 +24,7 @@
 //
 //   override ZHC_BITS: u32 = 8u;
 //   fn zhcMyFormat() -> ZhcFormat {
-//       return ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_BITS, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
+//       return ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_MODE_NONE, ZHC_BITS, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
 //                        ZHC_ZONAL_AFFINE, ZHC_AXIS_LUMINANCE, ZHC_KIND_RADIANCE,
 //                        vec3f(0.2126, 0.7152, 0.0722), vec2f(0.6, 0.08));
 //   }
@@ -94,11 +94,11 @@ fn zhcFamilyWords(family: u32) -> u32 {
     return 0u;
 }
 // Zonal L2 hallucinated at decode (ZH3 paper Sec. 3.4; codec zh3_hallucinate).
-const ZHC_HALL_NONE: u32 = 0u;  // no hallucination (L2 stored or absent)
-const ZHC_HALL_AMBDIR: u32 = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
-const ZHC_HALL_SPHERE: u32 = 2u;  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
-const ZHC_HALL_CURVE: u32 = 3u;  // Eq. 21: f20 = (a p^2 + b p) f0
-const ZHC_HALL_CURVE_ADAPTIVE: u32 = 4u;  // Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout)
+const ZHC_HALL_MODE_NONE: u32 = 0u;  // no hallucination (L2 stored or absent)
+const ZHC_HALL_MODE_AMBDIR: u32 = 1u;  // Eq. 14: f20 = sqrt(15)/3 |f1|
+const ZHC_HALL_MODE_SPHERE: u32 = 2u;  // Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0
+const ZHC_HALL_MODE_CURVE: u32 = 3u;  // Eq. 21: f20 = (a p^2 + b p) f0
+const ZHC_HALL_MODE_CURVE_ADAPTIVE: u32 = 4u;  // Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout)
 // Where an encoding's zonal axis comes from (luminance / channel: set axisMode to it).
 const ZHC_ENTRY_AXIS_NONE: u32 = 0u;  // no zonal term
 const ZHC_ENTRY_AXIS_LUMINANCE: u32 = 1u;  // the luminance-weighted L1 axis, fixed by the encoding
@@ -117,8 +117,8 @@ const ZHC_ENC_HALL_CURVE: u32 = 8u;  // linear SH + zonal L2 hallucinated, curve
 const ZHC_ENC_HALL_AMBDIR_CHANNEL: u32 = 9u;  // linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), channel axes
 const ZHC_ENC_HALL_SPHERE_CHANNEL: u32 = 10u;  // linear SH + zonal L2 hallucinated, sphere light (Eq. 20), channel axes
 const ZHC_ENC_HALL_CURVE_CHANNEL: u32 = 11u;  // linear SH + zonal L2 hallucinated, curve fit (Eq. 21), channel axes
-const ZHC_ENC_ZH3_LUM_DERING: u32 = 12u;  // zh3_lum with the zonal L2 clamped for non-negative irradiance (App. B)
-const ZHC_ENC_ZH3_LUM_DERING_SPHERE: u32 = 13u;  // zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere
+const ZHC_ENC_ZH3_LUM_AXIS_CLAMP: u32 = 12u;  // zh3_lum with the zonal L2 clamped for irradiance >= 0 along the axis (App. B)
+const ZHC_ENC_ZH3_LUM_SPHERE_CLAMP: u32 = 13u;  // zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere if one exists
 const ZHC_ENC_SH3_DERING: u32 = 14u;  // quadratic SH windowed to non-negative irradiance (Sloan 2017), 27 floats
 const ZHC_ENC_ZH3_Q16: u32 = 15u;  // ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1)
 const ZHC_ENC_ZH3_SOLVED_Q16: u32 = 16u;  // zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted
@@ -159,8 +159,8 @@ fn zhcEncodingRow(e: u32) -> u32 {
         0x211030u,  // hall_ambdir_channel
         0x221030u,  // hall_sphere_channel
         0x231030u,  // hall_curve_channel
-        0x10203cu,  // zh3_lum_dering
-        0x10203cu,  // zh3_lum_dering_sphere
+        0x10203cu,  // zh3_lum_axis_clamp
+        0x10203cu,  // zh3_lum_sphere_clamp
         0x6cu,  // sh3_dering
         0x303010u,  // zh3_q16
         0x303010u,  // zh3_solved_q16
@@ -203,7 +203,7 @@ const ZHC_KIND_IRRADIANCE: u32 = 1u;  // stored SH are irradiance (band scales a
 // 0..32, luminance at 48 (vec3 alignment 16), curve at 64; 80 bytes.
 struct ZhcFormat {
     family: u32,         // ZHC_LAYOUT_* (the layout family)
-    hallucination: u32,  // ZHC_HALL_*
+    hallucination: u32,  // ZHC_HALL_MODE_*
     bits: u32,           // 2..8 bits per ratio (quantised layouts)
     sqrtEncoding: u32,   // 1: sign-preserving square-root encoding of the ratios
     l2Bound: u32,        // ZHC_L2_*
@@ -430,13 +430,13 @@ fn zhcIrradianceZh3(linear: ZhcSh3, zonal: vec3<f32>, axis: array<vec3<f32>, 3>,
 fn zhcHallucinateZonal(linear: ZhcSh3, axis: array<vec3<f32>, 3>, f: ZhcFormat) -> vec3<f32> {
     var zonal = vec3<f32>(0.0);
     var ax = axis;
-    let ab = select(f.curve, vec2<f32>(2.0 * ZHC_SQRT5 / 3.0, -ZHC_SQRT5_3), f.hallucination == ZHC_HALL_SPHERE);
+    let ab = select(f.curve, vec2<f32>(2.0 * ZHC_SQRT5 / 3.0, -ZHC_SQRT5_3), f.hallucination == ZHC_HALL_MODE_SPHERE);
     for (var k = 0; k < 3; k++) {
         let f1 = abs(dot(zhcL1Vector(linear, k), ax[k]));
         let f0 = linear.c[0][k];
-        if (f.hallucination == ZHC_HALL_AMBDIR) {
+        if (f.hallucination == ZHC_HALL_MODE_AMBDIR) {
             zonal[k] = (ZHC_SQRT15 / 3.0) * f1;
-        } else if (f.hallucination != ZHC_HALL_NONE && zhcIsFinite(f0) && f0 > 0.0) {
+        } else if (f.hallucination != ZHC_HALL_MODE_NONE && zhcIsFinite(f0) && f0 > 0.0) {
             let p = f1 / f0;  // >= 0, +Inf or NaN (NaN only from NaN inputs: stays NaN)
             zonal[k] = select((ab.x * p + ab.y) * f1, (ab.x * 3.0 + ab.y * ZHC_SQRT3) * f0, p >= ZHC_SQRT3);
         }
@@ -568,7 +568,7 @@ fn zhcDecodeSh3F32(w: array<u32, 27>, f: ZhcFormat) -> ZhcSh3 { return zhcStored
 // axis of f.axisMode, in the stored domain. ~120 flops with hallucination.
 fn zhcDecodeSh2F32(w: array<u32, 12>, f: ZhcFormat) -> ZhcSh3 {
     var s = zhcLoadSh2F32(w);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         let axis = zhcZonalAxes(s, f);
         s = zhcExpandZonal(s, zhcHallucinateZonal(s, axis, f), axis);
     }
@@ -593,9 +593,9 @@ fn zhcDecodeSh3Q28(w: array<u32, 7>, f: ZhcFormat) -> ZhcSh3 { return zhcStoredT
 // hall_adaptive_q16's per-probe scale of the curve (byte 15), as plain Eq. 21 afterwards.
 fn zhcHallAdaptive(w: vec4<u32>, f: ZhcFormat) -> ZhcFormat {
     var g = f;
-    if (f.hallucination == ZHC_HALL_CURVE_ADAPTIVE) {
+    if (f.hallucination == ZHC_HALL_MODE_CURVE_ADAPTIVE) {
         g.curve = g.curve * (0.5 * f32(min(w.w >> 24u, 7u)));
-        g.hallucination = ZHC_HALL_CURVE;
+        g.hallucination = ZHC_HALL_MODE_CURVE;
     }
     return g;
 }
@@ -605,7 +605,7 @@ fn zhcHallAdaptive(w: vec4<u32>, f: ZhcFormat) -> ZhcFormat {
 fn zhcDecodeSh2Q(w: vec4<u32>, format: ZhcFormat) -> ZhcSh3 {
     let f = zhcHallAdaptive(w, format);
     var s = zhcStoredToRadiance(zhcLoadSh2Q(w, f), f);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         let axis = zhcZonalAxes(s, f);
         s = zhcExpandZonal(s, zhcHallucinateZonal(s, axis, f), axis);
     }
@@ -626,7 +626,7 @@ fn zhcIrradianceSh2F32(w: array<u32, 12>, f: ZhcFormat, n: vec3<f32>) -> vec3<f3
     var zonal = vec3<f32>(0.0);
     let up = vec3<f32>(0.0, 0.0, 1.0);
     var axis = array<vec3<f32>, 3>(up, up, up);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         axis = zhcZonalAxes(s, f);
         zonal = zhcHallucinateZonal(s, axis, f);
     }
@@ -654,7 +654,7 @@ fn zhcIrradianceSh2Q(w: vec4<u32>, format: ZhcFormat, n: vec3<f32>) -> vec3<f32>
     var zonal = vec3<f32>(0.0);
     let up = vec3<f32>(0.0, 0.0, 1.0);
     var axis = array<vec3<f32>, 3>(up, up, up);
-    if (f.hallucination != ZHC_HALL_NONE) {
+    if (f.hallucination != ZHC_HALL_MODE_NONE) {
         axis = zhcZonalAxes(s, f);
         zonal = zhcHallucinateZonal(s, axis, f);
     }

@@ -80,8 +80,8 @@ enum zhc_encoding {
     ZHC_ENC_HALL_AMBDIR_CHANNEL = 9, /* linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), channel axes */
     ZHC_ENC_HALL_SPHERE_CHANNEL = 10, /* linear SH + zonal L2 hallucinated, sphere light (Eq. 20), channel axes */
     ZHC_ENC_HALL_CURVE_CHANNEL = 11, /* linear SH + zonal L2 hallucinated, curve fit (Eq. 21), channel axes */
-    ZHC_ENC_ZH3_LUM_DERING = 12, /* zh3_lum with the zonal L2 clamped for non-negative irradiance (App. B) */
-    ZHC_ENC_ZH3_LUM_DERING_SPHERE = 13, /* zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere */
+    ZHC_ENC_ZH3_LUM_AXIS_CLAMP = 12, /* zh3_lum with the zonal L2 clamped for irradiance >= 0 along the axis (App. B) */
+    ZHC_ENC_ZH3_LUM_SPHERE_CLAMP = 13, /* zh3_lum, zonal L2 nearest to the fit with irradiance >= 0 on the whole sphere if one exists */
     ZHC_ENC_SH3_DERING = 14, /* quadratic SH windowed to non-negative irradiance (Sloan 2017), 27 floats */
     ZHC_ENC_ZH3_Q16 = 15, /* ZH3 (luminance axis), 16 bytes: R11G11B10F DC + 8-bit L1/zonal ratios (App. A.1) */
     ZHC_ENC_ZH3_SOLVED_Q16 = 16, /* zh3_q16 bytes; encoder quantises the BFGS-solved L1 (Eq. 11), zonal refitted */
@@ -97,6 +97,11 @@ enum zhc_encoding {
     ZHC_ENC_HALL_ADAPTIVE_Q16 = 26, /* sh2_q bytes + per-probe hallucination scale code (byte 15), L1 solved for it */
     ZHC_ENC_COUNT = 27
 };
+/* Names an entry answers to besides its own (codec/probe/codec_table.cpp codec_aliases()): read,
+ * never written. Only entries that keep irradiance >= 0 everywhere carry "dering" in their names, so
+ * App. B's zonal clamps are named for what they do and read files that name them by these. */
+#define ZHC_ENC_ZH3_LUM_DERING ZHC_ENC_ZH3_LUM_AXIS_CLAMP
+#define ZHC_ENC_ZH3_LUM_DERING_SPHERE ZHC_ENC_ZH3_LUM_SPHERE_CLAMP
 /* How an encoding's bytes are laid out (codec/probe/runtime_table.h RuntimeLayout). */
 enum zhc_layout {
     ZHC_LAYOUT_SH3_F32 = 0, /* 27 floats */
@@ -108,11 +113,11 @@ enum zhc_layout {
 };
 /* The zonal L2 term the decoder hallucinates from the linear SH (ZH3 paper Sec. 3.4). */
 enum zhc_hallucination {
-    ZHC_HALL_NONE = 0, /* no hallucination (L2 stored or absent) */
-    ZHC_HALL_AMBDIR = 1, /* Eq. 14: f20 = sqrt(15)/3 |f1| */
-    ZHC_HALL_SPHERE = 2, /* Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0 */
-    ZHC_HALL_CURVE = 3, /* Eq. 21: f20 = (a p^2 + b p) f0 */
-    ZHC_HALL_CURVE_ADAPTIVE = 4 /* Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout) */
+    ZHC_HALL_MODE_NONE = 0, /* no hallucination (L2 stored or absent) */
+    ZHC_HALL_MODE_AMBDIR = 1, /* Eq. 14: f20 = sqrt(15)/3 |f1| */
+    ZHC_HALL_MODE_SPHERE = 2, /* Eq. 20: f20 = (2 sqrt(5)/3 p^2 - sqrt(5/3) p) f0 */
+    ZHC_HALL_MODE_CURVE = 3, /* Eq. 21: f20 = (a p^2 + b p) f0 */
+    ZHC_HALL_MODE_CURVE_ADAPTIVE = 4 /* Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout) */
 };
 /* Where an encoding's zonal axis comes from. */
 enum zhc_entry_axis {
@@ -148,33 +153,33 @@ struct zhc_encoding_info {
 /* The row of encoding e, or NULL when e is out of range. */
 static inline const zhc_encoding_info* zhc_encoding_info_of(int e) {
     static const zhc_encoding_info table[ZHC_ENC_COUNT] = {
-        {"sh3", 108, ZHC_LAYOUT_SH3_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_NONE},
-        {"sh2", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_NONE},
-        {"zh3_lum", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
-        {"zh3_channel", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_CHANNEL},
-        {"zh3_solved_lum", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
-        {"zh3_solved_channel", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_CHANNEL},
-        {"hall_ambdir", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_AMBDIR, ZHC_ENTRY_AXIS_LUMINANCE},
-        {"hall_sphere", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_SPHERE, ZHC_ENTRY_AXIS_LUMINANCE},
-        {"hall_curve", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_CURVE, ZHC_ENTRY_AXIS_LUMINANCE},
-        {"hall_ambdir_channel", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_AMBDIR, ZHC_ENTRY_AXIS_CHANNEL},
-        {"hall_sphere_channel", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_SPHERE, ZHC_ENTRY_AXIS_CHANNEL},
-        {"hall_curve_channel", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_CURVE, ZHC_ENTRY_AXIS_CHANNEL},
-        {"zh3_lum_dering", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
-        {"zh3_lum_dering_sphere", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
-        {"sh3_dering", 108, ZHC_LAYOUT_SH3_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_NONE},
-        {"zh3_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_FORMAT},
-        {"zh3_solved_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_FORMAT},
-        {"sh3_q28", 28, ZHC_LAYOUT_SH3_Q28, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_NONE},
-        {"sh2_q", 16, ZHC_LAYOUT_SH2_Q, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_NONE},
-        {"hall_curve_q", 16, ZHC_LAYOUT_SH2_Q, ZHC_HALL_CURVE, ZHC_ENTRY_AXIS_FORMAT},
-        {"zh3_dering", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
-        {"zh3_dering_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_FORMAT},
-        {"zh3_channel_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_CHANNEL},
-        {"zh3_solved_channel_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_ENTRY_AXIS_CHANNEL},
-        {"hall_solved", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_CURVE, ZHC_ENTRY_AXIS_LUMINANCE},
-        {"hall_solved_q16", 16, ZHC_LAYOUT_SH2_Q, ZHC_HALL_CURVE, ZHC_ENTRY_AXIS_FORMAT},
-        {"hall_adaptive_q16", 16, ZHC_LAYOUT_SH2_Q, ZHC_HALL_CURVE_ADAPTIVE, ZHC_ENTRY_AXIS_FORMAT},
+        {"sh3", 108, ZHC_LAYOUT_SH3_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_NONE},
+        {"sh2", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_NONE},
+        {"zh3_lum", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
+        {"zh3_channel", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_CHANNEL},
+        {"zh3_solved_lum", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
+        {"zh3_solved_channel", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_CHANNEL},
+        {"hall_ambdir", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_MODE_AMBDIR, ZHC_ENTRY_AXIS_LUMINANCE},
+        {"hall_sphere", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_MODE_SPHERE, ZHC_ENTRY_AXIS_LUMINANCE},
+        {"hall_curve", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_MODE_CURVE, ZHC_ENTRY_AXIS_LUMINANCE},
+        {"hall_ambdir_channel", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_MODE_AMBDIR, ZHC_ENTRY_AXIS_CHANNEL},
+        {"hall_sphere_channel", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_MODE_SPHERE, ZHC_ENTRY_AXIS_CHANNEL},
+        {"hall_curve_channel", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_MODE_CURVE, ZHC_ENTRY_AXIS_CHANNEL},
+        {"zh3_lum_axis_clamp", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
+        {"zh3_lum_sphere_clamp", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
+        {"sh3_dering", 108, ZHC_LAYOUT_SH3_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_NONE},
+        {"zh3_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_FORMAT},
+        {"zh3_solved_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_FORMAT},
+        {"sh3_q28", 28, ZHC_LAYOUT_SH3_Q28, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_NONE},
+        {"sh2_q", 16, ZHC_LAYOUT_SH2_Q, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_NONE},
+        {"hall_curve_q", 16, ZHC_LAYOUT_SH2_Q, ZHC_HALL_MODE_CURVE, ZHC_ENTRY_AXIS_FORMAT},
+        {"zh3_dering", 60, ZHC_LAYOUT_ZH3_F32, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_LUMINANCE},
+        {"zh3_dering_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_FORMAT},
+        {"zh3_channel_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_CHANNEL},
+        {"zh3_solved_channel_q16", 16, ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_MODE_NONE, ZHC_ENTRY_AXIS_CHANNEL},
+        {"hall_solved", 48, ZHC_LAYOUT_SH2_F32, ZHC_HALL_MODE_CURVE, ZHC_ENTRY_AXIS_LUMINANCE},
+        {"hall_solved_q16", 16, ZHC_LAYOUT_SH2_Q, ZHC_HALL_MODE_CURVE, ZHC_ENTRY_AXIS_FORMAT},
+        {"hall_adaptive_q16", 16, ZHC_LAYOUT_SH2_Q, ZHC_HALL_MODE_CURVE_ADAPTIVE, ZHC_ENTRY_AXIS_FORMAT},
     };
     return (e >= 0 && e < ZHC_ENC_COUNT) ? &table[e] : NULL;
 }
@@ -189,6 +194,18 @@ static inline const char* zhc_encoding_name(int e) {
 static inline size_t zhc_encoding_size(int e) {
     const zhc_encoding_info* info = zhc_encoding_info_of(e);
     return info ? info->bytes : 0;
+}
+
+/* The entry's own name when `name` is an alias of one (ZHC_ENC_ aliases above), else `name`. */
+static inline const char* zhc__encoding_alias(const char* name) {
+    static const char* const aliases[][2] = {
+        {"zh3_lum_dering", "zh3_lum_axis_clamp"},
+        {"zh3_lum_dering_sphere", "zh3_lum_sphere_clamp"},
+    };
+    size_t i;
+    for (i = 0; i < sizeof aliases / sizeof aliases[0]; ++i)
+        if (strcmp(name, aliases[i][0]) == 0) return aliases[i][1];
+    return name;
 }
 /* END GENERATED by zhc_gen_tables */
 enum zhc_stored_kind { ZHC_KIND_RADIANCE = 0, ZHC_KIND_IRRADIANCE = 1 };
@@ -230,10 +247,12 @@ struct zhc_probe_format {
     double hallucinate_a, hallucinate_b; /* Eq. 21 curve f20 = (a p^2 + b p) f0: 0.6, 0.08 */
 };
 
-/* Encoding from a NUL-terminated name; -1 when unknown (or NULL). */
+/* Encoding from a NUL-terminated name or an alias of one (zhc__encoding_alias); -1 when unknown
+ * (or NULL). */
 static inline int zhc_encoding_from_name(const char* name) {
     int e;
     if (!name) return -1;
+    name = zhc__encoding_alias(name);
     for (e = 0; e < ZHC_ENC_COUNT; ++e)
         if (strcmp(name, zhc_encoding_name(e)) == 0) return e;
     return -1;
@@ -251,7 +270,7 @@ static inline unsigned zhc__layout(int e) {
 }
 static inline unsigned zhc__hallucination(int e) {
     const zhc_encoding_info* info = zhc_encoding_info_of(e);
-    return info ? info->hallucination : (unsigned)ZHC_HALL_NONE;
+    return info ? info->hallucination : (unsigned)ZHC_HALL_MODE_NONE;
 }
 /* 1 when f's zonal axes are each channel's own: fixed by the encoding, or f->axis_mode for the
  * encodings whose axis is the format's. */
@@ -644,14 +663,14 @@ enum { ZHC__D_SH3, ZHC__D_SH2, ZHC__D_ZH3, ZHC__D_HALL, ZHC__D_PACKED };
 static inline int zhc__decoder(int e) {
     const unsigned layout = zhc__layout(e);
     if (layout == ZHC_LAYOUT_SH3_F32) return ZHC__D_SH3;
-    if (layout == ZHC_LAYOUT_SH2_F32) return zhc__hallucination(e) == ZHC_HALL_NONE ? ZHC__D_SH2 : ZHC__D_HALL;
+    if (layout == ZHC_LAYOUT_SH2_F32) return zhc__hallucination(e) == ZHC_HALL_MODE_NONE ? ZHC__D_SH2 : ZHC__D_HALL;
     if (layout == ZHC_LAYOUT_ZH3_F32) return ZHC__D_ZH3;
     return ZHC__D_PACKED;
 }
 /* Hallucination model of zhc__hallucinate (0 Eq. 14, 1 Eq. 20, 2 Eq. 21, both curves). */
 static inline int zhc__hall_model(int e) {
     const unsigned h = zhc__hallucination(e);
-    return h == ZHC_HALL_AMBDIR ? 0 : (h == ZHC_HALL_SPHERE ? 1 : 2);
+    return h == ZHC_HALL_MODE_AMBDIR ? 0 : (h == ZHC_HALL_MODE_SPHERE ? 1 : 2);
 }
 
 /* Decodes one probe: `bytes` holds zhc_probe_size(f) bytes (any values: safe for untrusted
@@ -694,11 +713,11 @@ static inline int zhc_decode_probe(const zhc_probe_format* f, const void* bytes,
             break;
         default:
             zhc__decode_packed(f, in, radiance_sh3);
-            if (zhc__hallucination(f->encoding) != ZHC_HALL_NONE) {
+            if (zhc__hallucination(f->encoding) != ZHC_HALL_MODE_NONE) {
                 /* ZH3 paper Sec. 3.4.3, Eq. 21 on the decoder's axis (quantize.cpp hallucinate_curve);
-                 * hall_adaptive_q16 scales a and b by s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall.cpp). */
+                 * hall_adaptive_q16 scales a and b by s = 0.5 min(byte 15, 7) (codec/probe/zh3_hall_solve.cpp). */
                 const double s =
-                    zhc__hallucination(f->encoding) == ZHC_HALL_CURVE_ADAPTIVE ? 0.5 * (in[15] < 7 ? in[15] : 7) : 1.0;
+                    zhc__hallucination(f->encoding) == ZHC_HALL_MODE_CURVE_ADAPTIVE ? 0.5 * (in[15] < 7 ? in[15] : 7) : 1.0;
                 per_channel = zhc__per_channel(f);
                 for (i = 0; i < 12; ++i) lin[i] = (float)zhc__f32_round(radiance_sh3[i]);
                 zhc__hallucinate(lin, 2, per_channel, f->luminance, s * f->hallucinate_a, s * f->hallucinate_b, zonal);

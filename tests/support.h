@@ -51,7 +51,7 @@ struct Rng {
     }
 };
 
-// The four probes of the golden-bytes tests (test_quantize, test_zh3_hall), given as literal floats
+// The four probes of the golden-bytes tests (test_quantize, test_zh3_hall_solve), given as literal floats
 // (not computed with libm) so the golden inputs are bit-identical on every machine; the last one
 // is out of range (a negative lobe) to exercise clamping.
 std::vector<Sh3Radiance> golden_probes();

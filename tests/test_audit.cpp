@@ -5,8 +5,8 @@
 #include <filesystem>
 
 #include "cli/cli.h"
-#include "codec/report/audit.h"
-#include "codec/report/benchmark.h"
+#include "codec/audit/audit.h"
+#include "codec/audit/benchmark.h"
 #include "support.h"
 
 namespace zhc {

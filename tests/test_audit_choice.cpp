@@ -1,4 +1,4 @@
-// The audit's choice (codec/report/choice.h): per byte budget, the lowest relative rmse among the
+// The audit's choice (codec/audit/choice.h): per byte budget, the lowest relative rmse among the
 // representations that fit and meet the constraints. An analytic case with hand-made rows and a
 // known answer; the sample maps audited for real, the choice compared with a slow twin that
 // recomputes it from the per-input rows; --require nonnegative holds on every input; budgets below
@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "codec/bake/scene.h"
-#include "codec/report/choice.h"
+#include "codec/audit/choice.h"
 #include "formats/report/audit_inputs.h"
 #include "support.h"
 

@@ -1,4 +1,4 @@
-// The audit run (codec/report/audit_run.h, formats audit_files): gates on analytic cases with known
+// The audit run (codec/audit/audit_run.h, formats audit_files): gates on analytic cases with known
 // answers, per-input pooling against a slow twin over the concatenated directions, the
 // cross-input aggregate, determinism across thread counts, files against in-memory inputs.
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <random>
 
-#include "codec/report/audit_run.h"
+#include "codec/audit/audit_run.h"
 #include "formats/report/audit_inputs.h"
 #include "support.h"
 

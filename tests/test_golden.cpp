@@ -9,7 +9,7 @@
 //           on the I_z plane of a 16x16 synthetic lightmap lit by that map: log2-PSNR.
 //   bc5/bc4 every BC5/BC4 quality on the crop (tone-mapped R,G / luminance) and on the
 //           lightmap's d / w_a planes: PSNR (20 log10(1 / RMSE)).
-//   irradz  the three IrradZ solves (search, old, newton = the default) on the synthetic lightmap:
+//   irradz  the three IrradZ solves (search, talk_baseline, newton = the default) on the synthetic lightmap:
 //           hemispherical irradiance RMSE against its SH3 (lightmap::audit), hash of the planes;
 //           "search_bc" / "newton_bc" = that solve, then BC6H + BC5 + BC4 at default quality
 //           ("newton_bc" is the `zhc lightmap encode` output).
@@ -38,7 +38,7 @@
 #include <sstream>
 #include <tuple>
 
-#include "codec/report/audit.h"
+#include "codec/audit/audit.h"
 #include "codec/lightmap/bc45.h"
 #include "codec/lightmap/bc6h.h"
 #include "codec/probe/codec.h"
@@ -220,7 +220,7 @@ std::vector<Row> compute_rows() {
         irradz::EncodeOptions eo;
         eo.solve = irradz::Solve::kSearch;
         const lightmap::IrradzPlanes search = lightmap::encode_planes(lm, eo, 1);
-        eo.solve = irradz::Solve::kOld;
+        eo.solve = irradz::Solve::kTalkBaseline;
         const lightmap::IrradzPlanes old_way = lightmap::encode_planes(lm, eo, 1);
         const lightmap::Compressed c = lightmap::compress(search, bc6h::Quality::kDefault, bc45::Quality::kDefault, 1);
         const lightmap::IrradzPlanes after = lightmap::decompress(c);
@@ -235,7 +235,7 @@ std::vector<Row> compute_rows() {
         };
         const std::uint64_t plane_bytes = 4 * (search.iz.size() + search.wa.size() + search.d.size());
         rows.push_back(make_row("irradz", "search", lmname, plane_bytes, "hemi_rmse", a.rmse_search, planes_hash(search)));
-        rows.push_back(make_row("irradz", "old", lmname, plane_bytes, "hemi_rmse", a.rmse_old, planes_hash(old_way)));
+        rows.push_back(make_row("irradz", "talk_baseline", lmname, plane_bytes, "hemi_rmse", a.rmse_old, planes_hash(old_way)));
         auto blocks_hash = [](const lightmap::Compressed& k) {
             Hash h;
             h.bytes(k.bc6h);

@@ -172,7 +172,7 @@ TEST(IrradzEncode, RecoversAmbientPlusDirectionalExactly) {
         const IrradZ q = encode(rad, o, &err_sh_iz);
         EXPECT_GT(dot(q.d, d), std::cos(3 * kPi / 180)) << t;
         EXPECT_NEAR(q.w_a, p.w_a, 0.06) << t;
-        o.solve = Solve::kOld;
+        o.solve = Solve::kTalkBaseline;
         encode(rad, o, &err_old, &iz);
         EXPECT_NEAR(dot(p.d, d), 1.0, 1e-9) << t;
         // I_z = C_a + C_d d_z, C_d = intensity / pi.
@@ -223,7 +223,7 @@ TEST(IrradzEncode, GoldenSectionIsCloseToABruteForceDirectionGrid) {
         encode(texels[t], o, &e_newton);
         o.solve = Solve::kSearch;
         encode(texels[t], o, &e_search);
-        o.solve = Solve::kOld;
+        o.solve = Solve::kTalkBaseline;
         const IrradZ old = encode(texels[t], o, &e_old);
         e_old = sh_hemispherical_error(target, old, Model::kHhd);
         double best = 1e300;
@@ -263,7 +263,7 @@ TEST(IrradzEncode, SearchBeatsTheOldWayOnRealMaps) {
         o.model = Model::kAhd;
         mse_ahd += hemispherical_mse(target, encode(tx, o), Model::kAhd);
         o.model = Model::kHhd;
-        o.solve = Solve::kOld;
+        o.solve = Solve::kTalkBaseline;
         mse_old += hemispherical_mse(target, encode(tx, o), Model::kHhd);
     }
     const double n = static_cast<double>(texels.size());

@@ -72,7 +72,7 @@ TEST(IrradzNewton, GradientAndHessianMatchFiniteDifferences) {
             for (int j = 0; j < 6; ++j) {
                 const double qx = 4 * u(rng), qy = 4 * u(rng);
                 const ReducedError r = reduced_error(irr, model, qx, qy);
-                IrradZ p = encode(texels[t], newton::with(Solve::kOld, model));  // I_z
+                IrradZ p = encode(texels[t], newton::with(Solve::kTalkBaseline, model));  // I_z
                 p.w_a = 1 - r.s;
                 p.d = normalize_or(Vec3{qx, qy, 1}, {0, 0, 1});
                 const double c = sh_hemispherical_error(irr, p, model) - iz2 * r.psi;

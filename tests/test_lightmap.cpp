@@ -60,7 +60,7 @@ TEST(Lightmap, CompressedPlanesKeepTheHemisphericalError) {
     // irradiance from below, so the SH irradiance at -Z is small compared to +Z on average.
     const IrradzPlanes search = encode_planes(lm, {}, 2);
     irradz::EncodeOptions old;
-    old.solve = irradz::Solve::kOld;
+    old.solve = irradz::Solve::kTalkBaseline;
     const IrradzPlanes old_way = encode_planes(lm, old, 1);
     EXPECT_EQ(encode_planes(lm, {}, 1).wa, search.wa);  // thread count does not matter
     const Compressed c = compress(search, bc6h::Quality::kDefault, bc45::Quality::kDefault, 2);
@@ -115,6 +115,15 @@ TEST(LightmapTables, FitsAndPresetsAreWhatTheirNamesSay) {
     }
     EXPECT_EQ(find_fit("nope"), nullptr);
     EXPECT_EQ(fits().front().fit, Fit::kNewton);  // the default comes first
+    // Aliases find the entry they name and never shadow a name: "old" is the talk's baseline.
+    ASSERT_FALSE(fit_aliases().empty());
+    for (const FitAlias& a : fit_aliases()) {
+        EXPECT_TRUE(names.count(a.alias) == 0) << a.alias;
+        ASSERT_NE(find_fit(a.alias), nullptr) << a.alias;
+        EXPECT_EQ(find_fit(a.alias), find_fit(a.name));
+    }
+    ASSERT_NE(find_fit("old"), nullptr);
+    EXPECT_EQ(find_fit("old")->fit, Fit::kTalkBaseline);
     names.clear();
     for (const QualityPreset& q : quality_presets()) {
         EXPECT_TRUE(names.insert(q.name).second) << q.name;
@@ -127,7 +136,7 @@ TEST(LightmapTables, FitsAndPresetsAreWhatTheirNamesSay) {
     const Sh3Radiance world = project_default_lighting();
     const ShLightmap lm = synthesize_sphere(world, 8, 8, 1);
     const std::pair<Fit, irradz::Solve> solves[] = {
-        {Fit::kNewton, irradz::Solve::kNewton}, {Fit::kSearch, irradz::Solve::kSearch}, {Fit::kOld, irradz::Solve::kOld}};
+        {Fit::kNewton, irradz::Solve::kNewton}, {Fit::kSearch, irradz::Solve::kSearch}, {Fit::kTalkBaseline, irradz::Solve::kTalkBaseline}};
     for (auto [fit, solve] : solves) {
         irradz::EncodeOptions eo;
         eo.solve = solve;
@@ -151,6 +160,15 @@ TEST(LightmapTables, FitsAndPresetsAreWhatTheirNamesSay) {
     }
     r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/f", "--solve", "nope"});
     EXPECT_EQ(r.exit_code, 2);
+    // The CLI takes an alias and writes what its entry writes.
+    for (const FitAlias& a : fit_aliases()) {
+        r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/named", "--solve", std::string(a.name), "--quality", "fast"});
+        ASSERT_EQ(r.exit_code, 0) << a.name << ": " << r.err;
+        r = test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/alias", "--solve", std::string(a.alias), "--quality", "fast"});
+        ASSERT_EQ(r.exit_code, 0) << a.alias << ": " << r.err;
+        for (const char* plane : {".iz.ktx2", ".d.ktx2", ".wa.ktx2"})
+            EXPECT_EQ(test::read_bytes(dir + "/named" + plane), test::read_bytes(dir + "/alias" + plane)) << a.alias << plane;
+    }
 }
 
 TEST(LightmapCli, EncodeDecodeAuditAndBadInput) {

@@ -104,7 +104,7 @@ TEST(LightmapStream, EncodeBytesDoNotDependOnBandsOrThreads) {
     }
     // The default quality and the other solves too (one band size that does not divide the height).
     const std::string exr = dir + "/lm37x23.exr";
-    for (auto fit : {lightmap_stream::Fit::kNewton, lightmap_stream::Fit::kSearch, lightmap_stream::Fit::kOld}) {
+    for (auto fit : {lightmap_stream::Fit::kNewton, lightmap_stream::Fit::kSearch, lightmap_stream::Fit::kTalkBaseline}) {
         lightmap_stream::EncodeOptions o;
         o.fit = fit;
         o.band_rows = 8;
@@ -197,7 +197,7 @@ TEST(LightmapStream, DecodeAuditSynthMatchWholeImage) {
     // audit: the same numbers as lightmap::audit on the whole image, for any band height.
     irradz::EncodeOptions so;
     const auto search = lightmap::encode_planes(lm, so, 1);
-    so.solve = irradz::Solve::kOld;
+    so.solve = irradz::Solve::kTalkBaseline;
     const auto old_way = lightmap::encode_planes(lm, so, 1);
     const auto after = lightmap::decompress(lightmap::compress(search, bc6h::Quality::kFast, bc45::Quality::kFast, 1));
     const auto ref = lightmap::audit(lm, search, old_way, after, 7);

@@ -144,6 +144,19 @@ TEST(RuntimeC, EveryCodecTableEntryIsKnownWithItsSizeInOrder) {
             EXPECT_EQ(zhc_probe_format_validate(&f) == ZHC_OK, bool(validate_quant_params(p, name))) << name << dc;
         }
     }
+    // The codec table's aliases name their entries here too (a .zhp or glTF volume may carry one),
+    // as the generated defines do.
+    for (const CodecAlias& a : codec_aliases()) {
+        const std::string alias(a.alias), name(a.name);
+        EXPECT_GE(zhc_encoding_from_name(name.c_str()), 0) << name;
+        EXPECT_EQ(zhc_encoding_from_name(alias.c_str()), zhc_encoding_from_name(name.c_str())) << alias;
+        zhc_probe_format fa;
+        ASSERT_EQ(zhc_probe_format_init(&fa, alias.c_str()), ZHC_OK) << alias;
+        EXPECT_STREQ(zhc_encoding_name(fa.encoding), name.c_str());
+    }
+    EXPECT_EQ(int(ZHC_ENC_ZH3_LUM_DERING), int(ZHC_ENC_ZH3_LUM_AXIS_CLAMP));
+    EXPECT_EQ(int(ZHC_ENC_ZH3_LUM_DERING_SPHERE), int(ZHC_ENC_ZH3_LUM_SPHERE_CLAMP));
+    EXPECT_EQ(zhc_encoding_from_name("zh3_lum_dering_"), -1);
     zhc_probe_format f;
     EXPECT_NE(zhc_probe_format_init(&f, "sh4"), ZHC_OK);
     EXPECT_NE(zhc_probe_format_init(&f, ""), ZHC_OK);

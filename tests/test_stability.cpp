@@ -3,7 +3,7 @@
 #include <cfloat>
 #include <random>
 
-#include "codec/report/audit.h"
+#include "codec/audit/audit.h"
 #include "codec/probe/codec.h"
 #include "support.h"
 

@@ -1,6 +1,6 @@
 // Properties of the ZH3 representations (codec/probe/zh3.h, codec/probe/zh3.cpp): fit, luminance axis,
 // hallucination and the irradiance table on the eight real maps. The axis solve is tested in
-// test_zh3_solve.cpp, ZH3 deringing in test_zh3_dering.cpp (helpers: zh3_helpers.h).
+// test_zh3_solve.cpp, ZH3 deringing in test_zh3_clamp.cpp (helpers: zh3_helpers.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

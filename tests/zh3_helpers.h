@@ -1,4 +1,4 @@
-// Helpers shared by the ZH3 tests (test_zh3, test_zh3_solve, test_zh3_dering): codec lookup and round
+// Helpers shared by the ZH3 tests (test_zh3, test_zh3_solve, test_zh3_clamp): codec lookup and round
 // trip, coefficient distances, random lightings and rotations, the eight real maps.
 #pragma once
 
@@ -22,7 +22,7 @@ using test::fibonacci_directions;
 inline constexpr const char* kZh3Names[] = {
     "zh3_lum",     "zh3_channel",         "zh3_solved_lum",      "zh3_solved_channel",
     "hall_ambdir", "hall_sphere",         "hall_curve",          "hall_ambdir_channel",
-    "hall_sphere_channel", "hall_curve_channel", "zh3_lum_dering", "zh3_lum_dering_sphere"};
+    "hall_sphere_channel", "hall_curve_channel", "zh3_lum_axis_clamp", "zh3_lum_sphere_clamp"};
 
 inline const Codec& codec(const char* name) {
     const Codec* c = find_codec(name);

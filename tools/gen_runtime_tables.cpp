@@ -71,8 +71,22 @@ unsigned packed_row(const RuntimeEntry& e) {
 
 struct Model {
     std::vector<RuntimeEntry> entries;
+    std::vector<zhc::CodecAlias> aliases;  // zhc::codec_aliases(): other names an entry is read by
     zhc::CodecOptions defaults;
 };
+
+const char* const kAliasComment =
+    "Names an entry answers to besides its own (codec/probe/codec_table.cpp codec_aliases()): read,\n"
+    "never written. Only entries that keep irradiance >= 0 everywhere carry \"dering\" in their names, so\n"
+    "App. B's zonal clamps are named for what they do and read files that name them by these.";
+
+// kAliasComment as a comment: `first` before its first line, `next` before the others, `close`
+// after the last.
+std::string alias_comment(const std::string& first, const std::string& next, const std::string& close) {
+    std::string out = first;
+    for (const char* c = kAliasComment; *c; ++c) out += *c == '\n' ? "\n" + next : std::string(1, *c);
+    return out + close + "\n";
+}
 
 std::string layout_comment(RuntimeLayout l) {
     switch (l) {
@@ -139,6 +153,9 @@ std::string gen_c(const Model& m) {
     for (size_t i = 0; i < n; ++i)
         o << "    ZHC_ENC_" << upper(m.entries[i].name) << " = " << i << ", /* " << row_comment(m.entries[i]) << " */\n";
     o << "    ZHC_ENC_COUNT = " << n << "\n};\n";
+    o << alias_comment("/* ", " * ", " */");
+    for (const zhc::CodecAlias& a : m.aliases)
+        o << "#define ZHC_ENC_" << upper(a.alias) << " ZHC_ENC_" << upper(a.name) << "\n";
     o << "/* How an encoding's bytes are laid out (codec/probe/runtime_table.h RuntimeLayout). */\nenum zhc_layout {\n";
     each_layout([&](RuntimeLayout l, int i) {
         o << "    ZHC_LAYOUT_" << upper(zhc::runtime_layout_name(l)) << " = " << i << (i + 1 < zhc::kRuntimeLayoutCount ? "," : "")
@@ -146,7 +163,7 @@ std::string gen_c(const Model& m) {
     });
     o << "};\n/* The zonal L2 term the decoder hallucinates from the linear SH (ZH3 paper Sec. 3.4). */\nenum zhc_hallucination {\n";
     each_hall([&](ZonalHallucination h, int i) {
-        o << "    ZHC_HALL_" << upper(zhc::zonal_hallucination_name(h)) << " = " << i
+        o << "    ZHC_HALL_MODE_" << upper(zhc::zonal_hallucination_name(h)) << " = " << i
           << (i + 1 < zhc::kZonalHallucinationCount ? "," : "") << " /* " << hall_comment(h) << " */\n";
     });
     o << "};\n/* Where an encoding's zonal axis comes from. */\nenum zhc_entry_axis {\n";
@@ -174,7 +191,7 @@ std::string gen_c(const Model& m) {
          "    static const zhc_encoding_info table[ZHC_ENC_COUNT] = {\n";
     for (const RuntimeEntry& e : m.entries)
         o << "        {\"" << e.name << "\", " << e.size_bytes << ", ZHC_LAYOUT_" << upper(zhc::runtime_layout_name(e.layout))
-          << ", ZHC_HALL_" << upper(zhc::zonal_hallucination_name(e.hallucination)) << ", ZHC_ENTRY_AXIS_"
+          << ", ZHC_HALL_MODE_" << upper(zhc::zonal_hallucination_name(e.hallucination)) << ", ZHC_ENTRY_AXIS_"
           << upper(zhc::zonal_axis_name(e.axis)) << "},\n";
     o << "    };\n"
          "    return (e >= 0 && e < ZHC_ENC_COUNT) ? &table[e] : NULL;\n"
@@ -188,6 +205,20 @@ std::string gen_c(const Model& m) {
          "static inline size_t zhc_encoding_size(int e) {\n"
          "    const zhc_encoding_info* info = zhc_encoding_info_of(e);\n"
          "    return info ? info->bytes : 0;\n"
+         "}\n\n"
+         "/* The entry's own name when `name` is an alias of one (ZHC_ENC_ aliases above), else `name`. */\n"
+         "static inline const char* zhc__encoding_alias(const char* name) {\n";
+    if (m.aliases.empty()) {
+        o << "    return name;\n}\n";
+        return o.str();
+    }
+    o << "    static const char* const aliases[][2] = {\n";
+    for (const zhc::CodecAlias& a : m.aliases) o << "        {\"" << a.alias << "\", \"" << a.name << "\"},\n";
+    o << "    };\n"
+         "    size_t i;\n"
+         "    for (i = 0; i < sizeof aliases / sizeof aliases[0]; ++i)\n"
+         "        if (strcmp(name, aliases[i][0]) == 0) return aliases[i][1];\n"
+         "    return name;\n"
          "}\n";
     return o.str();
 }
@@ -200,13 +231,15 @@ std::string gen_hlsl(const Model& m) {
     o << "// One \"#define ZHC_<entry name in upper case> <place in the codec table>u\" per codec table entry.\n";
     for (size_t i = 0; i < n; ++i)
         o << "#define ZHC_" << upper(m.entries[i].name) << " " << i << "u  // " << row_comment(m.entries[i]) << "\n";
-    o << "#define ZHC_ENCODING_COUNT " << n << "u\n\n// Layouts of the stored words (codec/probe/runtime_table.h RuntimeLayout).\n";
+    o << "#define ZHC_ENCODING_COUNT " << n << "u\n" << alias_comment("// ", "// ", "");
+    for (const zhc::CodecAlias& a : m.aliases) o << "#define ZHC_" << upper(a.alias) << " ZHC_" << upper(a.name) << "\n";
+    o << "\n// Layouts of the stored words (codec/probe/runtime_table.h RuntimeLayout).\n";
     each_layout([&](RuntimeLayout l, int i) {
         o << "#define ZHC_LAYOUT_" << upper(zhc::runtime_layout_name(l)) << " " << i << "u  // " << layout_comment(l) << "\n";
     });
-    o << "// The zonal L2 term the decoder hallucinates (ZHC_HALL_* names are encodings here, hence DECODE_HALL).\n";
+    o << "// The zonal L2 term the decoder hallucinates (ZHC_HALL_<NAME> above are encodings; these are modes).\n";
     each_hall([&](ZonalHallucination h, int i) {
-        o << "#define ZHC_DECODE_HALL_" << upper(zhc::zonal_hallucination_name(h)) << " " << i << "u  // " << hall_comment(h) << "\n";
+        o << "#define ZHC_HALL_MODE_" << upper(zhc::zonal_hallucination_name(h)) << " " << i << "u  // " << hall_comment(h) << "\n";
     });
     o << "// Where an encoding's zonal axis comes from.\n";
     each_axis([&](ZonalAxis a, int i) {
@@ -258,7 +291,7 @@ std::string gen_shader(const Model& m, bool wgsl) {
     });
     o << "    return 0u;\n}\n";
     o << "// Zonal L2 hallucinated at decode (ZH3 paper Sec. 3.4; codec zh3_hallucinate).\n";
-    each_hall([&](ZonalHallucination h, int i) { decl("ZHC_HALL_" + upper(zhc::zonal_hallucination_name(h)), i, hall_comment(h)); });
+    each_hall([&](ZonalHallucination h, int i) { decl("ZHC_HALL_MODE_" + upper(zhc::zonal_hallucination_name(h)), i, hall_comment(h)); });
     o << "// Where an encoding's zonal axis comes from (luminance / channel: set axisMode to it).\n";
     each_axis([&](ZonalAxis a, int i) { decl("ZHC_ENTRY_AXIS_" + upper(zhc::zonal_axis_name(a)), i, axis_comment(a)); });
     o << "// Every codec table entry (zhc::codecs(); the id is the place in the table).\n";
@@ -314,7 +347,9 @@ std::string gen_js(const Model& m) {
         o << "  Object.freeze({ name: '" << e.name << "', bytes: " << e.size_bytes << ", layout: '"
           << zhc::runtime_layout_name(e.layout) << "', hallucination: '" << zhc::zonal_hallucination_name(e.hallucination)
           << "', axis: '" << zhc::zonal_axis_name(e.axis) << "' }),\n";
-    o << "]);\n// Defaults of the format (codec/probe/codec.h CodecOptions), enum fields as their numeric values.\n"
+    o << "]);\n" << alias_comment("// ", "// ", "") << "export const ENCODING_ALIASES = Object.freeze({\n";
+    for (const zhc::CodecAlias& a : m.aliases) o << "  " << a.alias << ": '" << a.name << "',\n";
+    o << "});\n// Defaults of the format (codec/probe/codec.h CodecOptions), enum fields as their numeric values.\n"
          "export const CODEC_DEFAULTS = Object.freeze({\n";
     each_storage_default(m.defaults, [&](const char* f, long v) { o << "  " << camel(f) << ": " << v << ",\n"; });
     o << "  luminanceWeights: Object.freeze([" << num(m.defaults.luminance.r) << ", " << num(m.defaults.luminance.g) << ", "
@@ -370,6 +405,7 @@ int main(int argc, char** argv) {
         }
         model.entries.push_back(*e);
     }
+    model.aliases.assign(zhc::codec_aliases().begin(), zhc::codec_aliases().end());
     const Target targets[] = {
         {"runtime/zhc_runtime.h", gen_c},
         {"runtime/zhc.hlsl", gen_hlsl},

@@ -65,7 +65,7 @@ const std::array<double, 81>& hemisphere_gram();
 enum class Solve {
     kNewton,  // the same least squares, d by Newton on the analytic reduced error (default)
     kSearch,  // talk: w_a by least squares with the hemispherical Gram matrix, d by golden-section
-    kOld,     // the talk's baseline ("old way"): optimal linear direction + spherical Gram matrix (identity)
+    kTalkBaseline,  // the talk's baseline, its "old way": optimal linear direction + spherical Gram matrix (identity)
 };
 
 struct EncodeOptions {

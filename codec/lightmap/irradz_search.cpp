@@ -174,7 +174,7 @@ IrradZ encode(const Sh3Radiance& tangent_radiance, const EncodeOptions& options,
         optimal_linear_direction(luminance(irr[1], lw), luminance(irr[2], lw), luminance(irr[3], lw), &old_dir);
     if (!has_dir) old_dir = {0, 0, 1};
 
-    if (options.solve == Solve::kOld) {
+    if (options.solve == Solve::kTalkBaseline) {
         const Target tg = make_target(irr, tb.g_sphere, sampled_iz);
         const Vec3 d = clamp_to_hemisphere(old_dir);
         const IrradZ p = make(tg, fit_direction(tg, d, options.model, tb.g_sphere).w, d);

@@ -277,7 +277,8 @@ namespace {
 constexpr FitEntry kFits[] = {
     {"newton", "hemispherical Gram matrix, d by Newton on the analytic reduced error, the default", Fit::kNewton},
     {"search", "the same least squares, d by golden-section search, the reference", Fit::kSearch},
-    {"old", "the old way: optimal linear direction, spherical Gram matrix", Fit::kOld},
+    {"talk_baseline", "the talk's baseline (its \"old way\"): optimal linear direction, spherical Gram matrix",
+     Fit::kTalkBaseline},
     {"linear", "closed form from L0 + L1 for linear-SH lightmaps, L2 ignored", Fit::kLinear},
 };
 constexpr QualityPreset kQualityPresets[] = {
@@ -286,11 +287,18 @@ constexpr QualityPreset kQualityPresets[] = {
     {"slow", "BC6H exhaustive over all modes and partitions, BC4/BC5 default", bc6h::Quality::kExhaustive,
      bc45::Quality::kDefault},
 };
+
+constexpr FitAlias kFitAliases[] = {
+    {"old", "talk_baseline"},
+};
 }  // namespace
 
 std::span<const FitEntry> fits() { return kFits; }
+std::span<const FitAlias> fit_aliases() { return kFitAliases; }
 
 const FitEntry* find_fit(std::string_view name) {
+    for (const FitAlias& a : kFitAliases)
+        if (a.alias == name) name = a.name;
     for (const FitEntry& f : kFits)
         if (f.name == name) return &f;
     return nullptr;
@@ -299,7 +307,9 @@ const FitEntry* find_fit(std::string_view name) {
 IrradzPlanes fit_planes(const ShLightmap& lm, Fit fit, int threads) {
     if (fit == Fit::kLinear) return encode_planes_linear_sh(lm, threads);
     irradz::EncodeOptions eo;
-    eo.solve = fit == Fit::kOld ? irradz::Solve::kOld : (fit == Fit::kSearch ? irradz::Solve::kSearch : irradz::Solve::kNewton);
+    eo.solve = fit == Fit::kTalkBaseline ? irradz::Solve::kTalkBaseline
+               : fit == Fit::kSearch      ? irradz::Solve::kSearch
+                                          : irradz::Solve::kNewton;
     return encode_planes(lm, eo, threads);
 }
 

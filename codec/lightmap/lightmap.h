@@ -59,7 +59,7 @@ IrradzPlanes encode_planes_linear_sh(const ShLightmap& lm, int threads = 1);
 enum class Fit {
     kNewton,  // irradz Solve::kNewton (the default)
     kSearch,  // irradz Solve::kSearch (golden-section reference)
-    kOld,     // irradz Solve::kOld (the talk's "old way")
+    kTalkBaseline,  // irradz Solve::kTalkBaseline (the talk's baseline, its "old way")
     kLinear,  // encode_planes_linear_sh (closed form from L0 + L1)
 };
 struct FitEntry {
@@ -67,8 +67,15 @@ struct FitEntry {
     std::string_view summary;
     Fit fit;
 };
-std::span<const FitEntry> fits();  // newton (default), search, old, linear
-const FitEntry* find_fit(std::string_view name);  // nullptr when unknown
+std::span<const FitEntry> fits();  // newton (default), search, talk_baseline, linear
+// Names a fit answers to besides its own: "old" (the talk's words for its baseline) stands for
+// talk_baseline. The command line accepts them; nothing writes them.
+struct FitAlias {
+    std::string_view alias;
+    std::string_view name;  // the FitEntry it stands for
+};
+std::span<const FitAlias> fit_aliases();
+const FitEntry* find_fit(std::string_view name);  // a name or an alias; nullptr when unknown
 // encode_planes with the fit's solve, or encode_planes_linear_sh for kLinear.
 IrradzPlanes fit_planes(const ShLightmap& lm, Fit fit, int threads = 1);
 

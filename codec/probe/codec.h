@@ -168,8 +168,21 @@ struct Codec {
 
 // The whole table, in a stable order (audit and benchmark rows follow it).
 std::span<const Codec> codecs();
-// nullptr when no entry has that name.
+// The entry named `name`, or the entry an alias (codec_aliases below) stands for; nullptr when
+// neither names one. Code that stores or prints a name takes the entry's own (Codec::name), so an
+// alias is read and never written.
 const Codec* find_codec(std::string_view name);
+
+// Names accepted for an entry besides its own: readers of .zhp and glTF files and the command line
+// take them, writers never write them. An entry's name says "dering" only when its encoder
+// guarantees irradiance >= 0 everywhere (tests/test_codec_names.cpp, DeringNamesAreNonNegative),
+// so App. B's clamps, which leave irradiance negative where no zonal value helps, are named for
+// what they do and answer to their "dering" names here.
+struct CodecAlias {
+    std::string_view alias;  // accepted on input
+    std::string_view name;   // the entry it stands for
+};
+std::span<const CodecAlias> codec_aliases();
 // A comma-separated list of names ("sh3,zh3_lum") -> entries in that order; empty -> the whole
 // table. An unknown name is kInvalidArgument naming it and listing the known ones.
 Result<std::vector<const Codec*>> select_codecs(std::string_view comma_separated_names);

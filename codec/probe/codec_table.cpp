@@ -9,19 +9,22 @@
 // The parts of the table: one line per codec module, X(the module's part function), in table order.
 // The table's order is the runtime encoding ids (the runtimes' generated tables, written by
 // `cmake --build build --target update_runtime_tables`, docs/runtime.md "Generated tables"), so a
-// new module's line goes last and no line ever moves or goes (the runtime tests fail otherwise).
-// This list is the only edit outside a new module's own files (plus its source line in
-// codec/CMakeLists.txt) and the regenerated runtime tables. Static self-registration would need no
-// list, but objects of a static library that nothing references are dropped by the linker, and the
-// order would follow the link order.
+// new module's line goes last and no line ever moves or goes (the runtime tests fail otherwise; a
+// module split in two keeps its entries' order with two adjacent lines, as zh3,
+// zh3_hallucinated and zh3_clamp do). This list is the only edit outside a new module's own files
+// (plus its source line in codec/CMakeLists.txt) and the regenerated runtime tables. Static
+// self-registration would need no list, but objects of a static library that nothing references
+// are dropped by the linker, and the order would follow the link order.
 #define ZHC_CODEC_PARTS(X)      \
     X(core_codecs)             \
     X(zh3_codecs)              \
+    X(zh3_hallucinated_codecs) \
+    X(zh3_clamp_codecs)        \
     X(dering_codecs)           \
     X(quantized_codecs)        \
-    X(zh3_window_codecs)       \
+    X(zh3_dering_codecs)       \
     X(zh3_channel_q16_codecs)  \
-    X(hall_codecs)             \
+    X(hall_solve_codecs)       \
     /* a new module's line goes here, last */
 
 namespace zhc {
@@ -42,9 +45,21 @@ std::span<const Codec> codecs() {
     return table;
 }
 
+std::span<const CodecAlias> codec_aliases() {
+    static constexpr CodecAlias kAliases[] = {
+        {"zh3_lum_dering", "zh3_lum_axis_clamp"},
+        {"zh3_lum_dering_sphere", "zh3_lum_sphere_clamp"},
+    };
+    return kAliases;
+}
+
 const Codec* find_codec(std::string_view name) {
     for (const Codec& c : codecs())
         if (c.name == name) return &c;
+    for (const CodecAlias& a : codec_aliases())
+        if (a.alias == name)
+            for (const Codec& c : codecs())
+                if (c.name == a.name) return &c;
     return nullptr;
 }
 

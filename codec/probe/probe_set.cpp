@@ -117,7 +117,7 @@ Result<ProbeSet> encode_probe_set(std::span<const Sh3Radiance> hub, std::string_
     if (Status st = validate_quant_params(params, representation); !st) return st.error();
     if (Status st = validate_layout(layout, hub.size()); !st) return st.error();
     ProbeSet set;
-    set.representation = std::string(representation);
+    set.representation = std::string(codec->name);  // an alias (codec_aliases) is never written
     set.params = params;
     set.layout = std::move(layout);
     set.count = hub.size();

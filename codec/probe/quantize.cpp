@@ -7,7 +7,7 @@
 // Byte layouts: docs/quantization.md.
 #include "codec/probe/quantize.h"
 
-#include "codec/probe/zh3_window.h"
+#include "codec/probe/zh3_dering.h"
 
 #include <algorithm>
 #include <cmath>
@@ -437,7 +437,7 @@ bool decoded_non_negative(const std::uint8_t* bytes, const CodecOptions& p) {
     return true;
 }
 
-// zh3_dering_q16 (codec/probe/zh3_window.h): window, quantise, decode, check; window further while the
+// zh3_dering_q16 (codec/probe/zh3_dering.h): window, quantise, decode, check; window further while the
 // decoded probe goes negative (the DC's rounding, the L1 codes and the decoder's axis all move
 // it). The caps after the float window s: s (1 - 2^-12), s (1 - 2^-8), s (1 - 2^-4), then halving
 // down to 0, where only the DC and the zonal code nearest 0 are left (always non-negative: the

@@ -130,7 +130,7 @@ struct QuantEncodeControls {
     // bytes decode with the ordinary zh3_q16 decoder (entry "zh3_solved_q16"). Slower encode; the
     // solve's iterations and tolerance are the params' encoder controls.
     bool solve_axis = false;
-    // zh3_q16: whole-sphere deringing (entry "zh3_dering_q16", codec/probe/zh3_window.h): the probe is
+    // zh3_q16: whole-sphere deringing (entry "zh3_dering_q16", codec/probe/zh3_dering.h): the probe is
     // windowed, quantised, decoded, and windowed further while the DECODED irradiance has a
     // negative certified minimum anywhere on the sphere.
     bool dering = false;

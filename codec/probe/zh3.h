@@ -6,9 +6,10 @@
 // the stored L1 (the luminance L1's optimal linear direction, shared by all channels, or each
 // channel's own), so the decoder needs nothing else.
 //
-// Codec-table entries (codec/probe/zh3.cpp, zh3_codecs() below): zh3_lum, zh3_channel, zh3_solved_lum,
-// zh3_solved_channel, hall_{ambdir,sphere,curve}[_channel], zh3_lum_dering (App. B;
-// defined here), zh3_lum_dering_sphere. Derivations and choices: docs/zh3.md.
+// Codec-table entries, each with the algorithm it stores: zh3_lum, zh3_channel, zh3_solved_lum,
+// zh3_solved_channel (zh3.cpp, zh3_codecs()), hall_{ambdir,sphere,curve}[_channel]
+// (zh3_hallucinate.cpp, zh3_hallucinated_codecs()), zh3_lum_axis_clamp (App. B) and
+// zh3_lum_sphere_clamp (zh3_clamp.cpp, zh3_clamp_codecs()). Derivations and choices: docs/zh3.md.
 //
 // Thread safety (docs/api.md): every function here is reentrant and keeps no state between
 // calls; calls may run concurrently on different arguments and on the same const ones.
@@ -84,7 +85,7 @@ double hallucinate_zonal(Hallucination model, double f0, double f1_zonal, double
 Zh3 zh3_hallucinate(const Sh2Radiance& linear, Hallucination model, ZonalAxisMode mode,
                     const CodecOptions& options);
 
-// ---- ZH3 deringing (App. B) --------------------------------------------------------------------
+// ---- zonal clamps (App. B; zh3_clamp.cpp) -----------------------------------------------------
 
 // The interval of RADIANCE zonal coefficients f20 for which
 //   Y00 f0 + (2/3) kY1 f1_zonal z + (1/4) kY20 f20 (3 z^2 - 1) >= 0  for all z in [-1, 1]
@@ -95,10 +96,10 @@ struct ZonalInterval {
     double lo = 0, hi = 0;
     bool feasible = false;
 };
-ZonalInterval zh3_dering_interval(double f0, double f1_zonal);
+ZonalInterval zh3_axis_clamp_interval(double f0, double f1_zonal);
 // Clamps each channel's zonal coefficient into its interval (f1_zonal = the channel's L1 projected
 // on its zonal axis). Returns true when a coefficient changed.
-bool zh3_dering(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
+bool zh3_axis_clamp(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
 
 // Whole-sphere variant (zhc's extension, docs/zh3.md): with the channel's L1 split into f1_zonal
 // along the zonal axis and f1_perp (length) across it, the channel's minimum irradiance over the
@@ -106,11 +107,13 @@ bool zh3_dering(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
 //   1 + a cos(theta) - c sin(theta) + b (3 cos^2(theta) - 1),  c = 2 f1_perp / (sqrt(3) f0)
 // (the worst azimuth is analytic). Returns the radiance f20 nearest to `f20` that makes it >= 0, or,
 // when none does, the one that maximises it; *clamped tells whether it changed. f0 <= 0 gives 0.
-double zh3_dering_sphere_zonal(double f0, double f1_zonal, double f1_perp, double f20, bool* clamped);
+double zh3_sphere_clamp_zonal(double f0, double f1_zonal, double f1_perp, double f20, bool* clamped);
 // Applies it to every channel of a ZH3 (axis from `mode`). Returns true when a coefficient changed.
-bool zh3_dering_sphere(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
+bool zh3_sphere_clamp(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w);
 
-// The codec table part of this module (its entries in table order).
+// The codec table parts of these files (their entries in table order).
 std::span<const Codec> zh3_codecs();
+std::span<const Codec> zh3_hallucinated_codecs();
+std::span<const Codec> zh3_clamp_codecs();
 
 }  // namespace zhc

@@ -1,6 +1,9 @@
 // zhc/codec/probe/zh3_hallucinate.cpp — ZH3 hallucination: the zonal L2 coefficient guessed from
 // the linear SH alone (Sec. 3.4, Listing 1), with three models of the lighting: ambient plus one
-// directional light (Eq. 14), a sphere light (Eq. 15-20) and the fitted curve (Eq. 21).
+// directional light (Eq. 14), a sphere light (Eq. 15-20) and the fitted curve (Eq. 21), and the
+// codec-table entries that decode with them from sh2's 12 floats (hall_{ambdir,sphere,curve}[_channel],
+// zh3_hallucinated_codecs()). The encoders that solve the stored L1 for these decoders are in
+// zh3_hall_solve.cpp.
 //
 // Source: Roughton, Sloan, Silvennoinen, Iwanicki, Shirley, "ZH3: Quadratic Zonal Harmonics",
 // I3D 2024. Derivations redone in docs/zh3.md (Eq. 20).
@@ -42,5 +45,52 @@ Zh3 zh3_hallucinate(const Sh2Radiance& linear, Hallucination model, ZonalAxisMod
     }
     return z;
 }
+
+namespace {
+
+// Hallucinated: the stored bytes are exactly sh2's (DC + L1, 12 floats).
+void encode_linear(const Sh3Radiance& in, const CodecOptions&, std::uint8_t* out, EncodeStats*) {
+    store_linear(in, out);
+}
+template <Hallucination Model, ZonalAxisMode Mode>
+Sh3Radiance decode_hall(const std::uint8_t* in, const CodecOptions& o) {
+    return zh3_expand(zh3_hallucinate(load_linear(in), Model, Mode, o), Mode, o.luminance);
+}
+template <Hallucination Model, ZonalAxisMode Mode>
+Rgb irradiance_hall(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
+    return zh3_irradiance(zh3_hallucinate(load_linear(in), Model, Mode, o), Mode, o.luminance, n);
+}
+
+constexpr auto kLum = ZonalAxisMode::kLuminance;
+constexpr auto kChan = ZonalAxisMode::kPerChannel;
+constexpr auto kAmbDir = Hallucination::kAmbientDirectional;
+constexpr auto kSphere = Hallucination::kSphere;
+constexpr auto kCurve = Hallucination::kCurve;
+
+// The hall_* entries' traits: axis and the hallucination their decoder applies.
+template <Hallucination H, ZonalAxisMode M>
+constexpr CodecTraits kHall{.zonal_axis = M == kLum ? ZonalAxis::kLuminance : ZonalAxis::kPerChannel,
+                            .hallucination = H == kAmbDir   ? ZonalHallucination::kAmbientDirectional
+                                             : H == kSphere ? ZonalHallucination::kSphere
+                                                            : ZonalHallucination::kCurve};
+
+const Codec kHallucinatedCodecs[] = {
+    {"hall_ambdir", "linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), luminance axis",
+     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kLum>, irradiance_hall<kAmbDir, kLum>, kHall<kAmbDir, kLum>},
+    {"hall_sphere", "linear SH + zonal L2 hallucinated, sphere light (Eq. 20), luminance axis", kLinearFloats * 4,
+     encode_linear, decode_hall<kSphere, kLum>, irradiance_hall<kSphere, kLum>, kHall<kSphere, kLum>},
+    {"hall_curve", "linear SH + zonal L2 hallucinated, curve fit (Eq. 21), luminance axis", kLinearFloats * 4,
+     encode_linear, decode_hall<kCurve, kLum>, irradiance_hall<kCurve, kLum>, kHall<kCurve, kLum>},
+    {"hall_ambdir_channel", "linear SH + zonal L2 hallucinated, ambient+directional (Eq. 14), channel axes",
+     kLinearFloats * 4, encode_linear, decode_hall<kAmbDir, kChan>, irradiance_hall<kAmbDir, kChan>, kHall<kAmbDir, kChan>},
+    {"hall_sphere_channel", "linear SH + zonal L2 hallucinated, sphere light (Eq. 20), channel axes",
+     kLinearFloats * 4, encode_linear, decode_hall<kSphere, kChan>, irradiance_hall<kSphere, kChan>, kHall<kSphere, kChan>},
+    {"hall_curve_channel", "linear SH + zonal L2 hallucinated, curve fit (Eq. 21), channel axes",
+     kLinearFloats * 4, encode_linear, decode_hall<kCurve, kChan>, irradiance_hall<kCurve, kChan>, kHall<kCurve, kChan>},
+};
+
+}  // namespace
+
+std::span<const Codec> zh3_hallucinated_codecs() { return kHallucinatedCodecs; }
 
 }  // namespace zhc

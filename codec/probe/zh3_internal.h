@@ -1,7 +1,8 @@
 // zhc/codec/probe/zh3_internal.h — internal to codec/: the ZH3 helpers shared by the fit
-// (zh3_fit.cpp), the solve (zh3_solve.cpp), hallucination (zh3_hallucinate.cpp) and deringing
-// (zh3_dering.cpp): the L2 basis at an axis, the zonal axes derived from a stored L1 (Sec. 3.1/3.2)
-// and the least-squares zonal coefficient along an axis (Eq. 9/10).
+// (zh3_fit.cpp), the solve (zh3_solve.cpp), hallucination (zh3_hallucinate.cpp) and the zonal clamps
+// (zh3_clamp.cpp): the L2 basis at an axis, the zonal axes derived from a stored L1 (Sec. 3.1/3.2),
+// the least-squares zonal coefficient along an axis (Eq. 9/10), and the 15-float ZH3 layout the
+// codec-table entries of those files share (zh3.cpp).
 //
 // Source: Roughton, Sloan, Silvennoinen, Iwanicki, Shirley, "ZH3: Quadratic Zonal Harmonics",
 // I3D 2024. Derivations redone in docs/zh3.md.
@@ -14,6 +15,8 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 
 #include "codec/probe/zh3.h"
 #include "codec/sh/sh_l1.h"
@@ -56,6 +59,22 @@ inline double fit_zonal(const Sh3Radiance& sh, int k, Vec3 a) {
     double f2[5];
     for (int m = 0; m < 5; ++m) f2[m] = sh[4 + m][k];
     return kSqrtFourPiOverFive * dot5(q, f2);
+}
+
+// The 15-float ZH3 layout: DC and L1 as [coefficient][R, G, B], then the three zonal coefficients
+// (defined in zh3.cpp).
+inline constexpr std::size_t kZh3Floats = 15;
+inline constexpr std::size_t kLinearFloats = 12;  // the hallucinated entries store sh2's 12 floats
+void store_zh3(const Zh3& z, std::uint8_t* out);
+Zh3 load_zh3(const std::uint8_t* in);
+
+template <ZonalAxisMode Mode>
+Sh3Radiance decode_zh3(const std::uint8_t* in, const CodecOptions& o) {
+    return zh3_expand(load_zh3(in), Mode, o.luminance);
+}
+template <ZonalAxisMode Mode>
+Rgb irradiance_zh3(const std::uint8_t* in, const CodecOptions& o, Vec3 n) {
+    return zh3_irradiance(load_zh3(in), Mode, o.luminance, n);
 }
 
 }  // namespace zhc::detail

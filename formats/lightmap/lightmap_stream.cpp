@@ -412,7 +412,7 @@ Result<std::vector<TargetAudit>> audit_targets(const std::vector<std::string>& i
         t = Clock::now();
         const auto search = lightmap::fit_planes(band, Fit::kNewton, o.threads);
         r.timing.fit += since(t);
-        const auto old_way = lightmap::fit_planes(band, Fit::kOld, o.threads);
+        const auto old_way = lightmap::fit_planes(band, Fit::kTalkBaseline, o.threads);
         // The BC target (also the plain audit's numbers, *base): compressed once per band.
         std::optional<lightmap::IrradzPlanes> bc_after;
         double bc_seconds = 0;

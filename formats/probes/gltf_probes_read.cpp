@@ -89,6 +89,7 @@ struct VolumeReader {
         set.representation = v["encoding"].get<std::string>();
         const Codec* codec = set.codec();
         if (!codec) return bad(ErrorCode::kUnsupported, "unknown encoding '" + set.representation + "'");
+        set.representation = std::string(codec->name);  // an alias (codec_aliases) reads as its entry
         if (!v.contains("count") || !v["count"].is_number_unsigned() || v["count"].get<std::uint64_t>() == 0)
             return bad(ErrorCode::kBadFormat, "count is not a positive integer");
         set.count = v["count"].get<std::uint64_t>();

@@ -189,7 +189,7 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
     }
     json vol = json::object();
     vol["name"] = options.name;
-    vol["encoding"] = set.representation;
+    vol["encoding"] = std::string(codec->name);  // the entry's own name, never an alias
     vol["kind"] = set.params.kind == StoredKind::kIrradiance ? "irradiance" : "radiance";
     vol["count"] = set.count;
     vol["shAxes"] = options.sh_axes == GltfShAxes::kZhc ? "zhc" : "gltf";

@@ -101,7 +101,8 @@ bool looks_like_probe_file(std::span<const std::uint8_t> bytes) {
 
 Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const ProbeFileWriteOptions& options) {
     if (Status st = validate_probe_set(set); !st) return st.error();
-    if (set.representation.size() >= kNameBytes)
+    const std::string_view rep_name = set.codec()->name;  // the entry's own name, never an alias
+    if (rep_name.size() >= kNameBytes)
         return make_error(ErrorCode::kInvalidArgument, "representation name longer than 31 bytes");
     if (options.zstd_level < 0 || options.zstd_level > ZSTD_maxCLevel())
         return make_error(ErrorCode::kInvalidArgument,
@@ -145,7 +146,7 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
     h[kOffCompression] = options.zstd_level > 0 ? 1 : 0;
     h[kOffLayoutKind] = static_cast<std::uint8_t>(set.layout.kind);
     h[kOffLeakFlags] = leak;
-    std::memcpy(h + kOffName, set.representation.data(), set.representation.size());
+    std::memcpy(h + kOffName, rep_name.data(), rep_name.size());
     le::store(h + kOffCount, set.count, 8);
     le::store(h + kOffProbeBytes, set.codec()->size_bytes, 4);
     le::store_f64(h + kOffLuminance, p.luminance.r);
@@ -243,7 +244,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
         return err(ErrorCode::kBadFormat, name, "'" + rep + "' probes are " + std::to_string(codec->size_bytes) +
                                                     " bytes, header says " + std::to_string(probe_bytes) + " (byte 64)");
     ProbeSet set;
-    set.representation = rep;
+    set.representation = std::string(codec->name);  // an alias (codec_aliases) reads as its entry
     CodecOptions& p = set.params;
     p.kind = static_cast<StoredKind>(h[kOffKind]);
     p.bits = h[kOffBits];

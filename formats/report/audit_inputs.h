@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "codec/report/audit_run.h"
+#include "codec/audit/audit_run.h"
 #include "codec/status.h"
 #include "formats/envmap/envmap.h"
 
@@ -28,7 +28,7 @@ Result<std::vector<std::string>> expand_audit_inputs(const std::vector<std::stri
 // Git LFS hint when the bytes are an LFS pointer.
 Error unknown_probe_input(const std::string& path, std::span<const std::uint8_t> bytes);
 
-// Reads one file as an AuditInput (codec/report/audit_run.h): an environment map (.exr, .hdr; its
+// Reads one file as an AuditInput (codec/audit/audit_run.h): an environment map (.exr, .hdr; its
 // reference integrated at `dirs`), a probe container or a JSON probe list.
 Result<AuditInput> load_audit_input(const std::string& path, const std::vector<Vec3>& dirs,
                                     const AuditLoadOptions& options);

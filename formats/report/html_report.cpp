@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "codec/report/benchmark.h"
+#include "codec/audit/benchmark.h"
 #include "formats/io/file_io.h"
 #include "formats/report/raster.h"
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "formats/report/audit_inputs.h"
-#include "codec/report/audit.h"
+#include "codec/audit/audit.h"
 #include "codec/status.h"
 #include "formats/report/plot.h"
 #include "formats/report/raster.h"

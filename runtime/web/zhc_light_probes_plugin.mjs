@@ -18,7 +18,7 @@
 // world directions by the inverse of the anchor's world rotation before a lookup.
 import * as THREE from 'three';
 import {
-  PACKED_LAYOUTS, decodeAll, encodingInfo, gltfToZhcDir, irradiance as shIrradiance, makeParams, normalizeOr,
+  PACKED_LAYOUTS, decodeAll, encodingInfo, encodingName, gltfToZhcDir, irradiance as shIrradiance, makeParams, normalizeOr,
   makeVolume, rotateZhcToGltf, toThreeConvention, volumeIrradiance,
 } from './zhc_runtime.mjs';
 import { compactVolume } from './zhc_volume.glsl.mjs';
@@ -259,7 +259,7 @@ export function buildVolume(v, coefficientsArray, positionsArray, validityArray 
   const validity = perProbe(validityArray, 'validity'), visibility = perProbe(visibilityArray, 'visibility');
   if (visibility && v.layout !== 'grid') throw new Error('ZHC_light_probes: visibility needs layout grid');
   return new ZhcProbeVolume({
-    name: v.name, encoding: v.encoding, kind: params.kind, count, shAxes, layout: v.layout, grid: v.grid,
+    name: v.name, encoding: encodingName(v.encoding), kind: params.kind, count, shAxes, layout: v.layout, grid: v.grid,
     params, bytesPerProbe: enc.bytes, bytes, positions, sh: decodeAll(v.encoding, bytes, count, params),
     validity, visibility,
   });
@@ -290,7 +290,7 @@ export class ZhcLightProbesPlugin {
     for (const v of root.volumes ?? []) {
       if (v.draco) {
         // Draco point clouds need the Draco decoder (KHR_draco_mesh_compression's); not decoded here.
-        volumes.push(new ZhcProbeVolume({ name: v.name, encoding: v.encoding, kind: v.kind ?? 'radiance', count: v.count,
+        volumes.push(new ZhcProbeVolume({ name: v.name, encoding: encodingName(v.encoding), kind: v.kind ?? 'radiance', count: v.count,
           shAxes: v.shAxes ?? 'gltf', layout: v.layout, grid: v.grid, draco: true }));
         continue;
       }

@@ -56,8 +56,8 @@ export const ENCODING_TABLE = Object.freeze([
   Object.freeze({ name: 'hall_ambdir_channel', bytes: 48, layout: 'sh2_f32', hallucination: 'ambdir', axis: 'channel' }),
   Object.freeze({ name: 'hall_sphere_channel', bytes: 48, layout: 'sh2_f32', hallucination: 'sphere', axis: 'channel' }),
   Object.freeze({ name: 'hall_curve_channel', bytes: 48, layout: 'sh2_f32', hallucination: 'curve', axis: 'channel' }),
-  Object.freeze({ name: 'zh3_lum_dering', bytes: 60, layout: 'zh3_f32', hallucination: 'none', axis: 'luminance' }),
-  Object.freeze({ name: 'zh3_lum_dering_sphere', bytes: 60, layout: 'zh3_f32', hallucination: 'none', axis: 'luminance' }),
+  Object.freeze({ name: 'zh3_lum_axis_clamp', bytes: 60, layout: 'zh3_f32', hallucination: 'none', axis: 'luminance' }),
+  Object.freeze({ name: 'zh3_lum_sphere_clamp', bytes: 60, layout: 'zh3_f32', hallucination: 'none', axis: 'luminance' }),
   Object.freeze({ name: 'sh3_dering', bytes: 108, layout: 'sh3_f32', hallucination: 'none', axis: 'none' }),
   Object.freeze({ name: 'zh3_q16', bytes: 16, layout: 'zh3_q16', hallucination: 'none', axis: 'format' }),
   Object.freeze({ name: 'zh3_solved_q16', bytes: 16, layout: 'zh3_q16', hallucination: 'none', axis: 'format' }),
@@ -72,6 +72,13 @@ export const ENCODING_TABLE = Object.freeze([
   Object.freeze({ name: 'hall_solved_q16', bytes: 16, layout: 'sh2_q', hallucination: 'curve', axis: 'format' }),
   Object.freeze({ name: 'hall_adaptive_q16', bytes: 16, layout: 'sh2_q', hallucination: 'curve_adaptive', axis: 'format' }),
 ]);
+// Names an entry answers to besides its own (codec/probe/codec_table.cpp codec_aliases()): read,
+// never written. Only entries that keep irradiance >= 0 everywhere carry "dering" in their names, so
+// App. B's zonal clamps are named for what they do and read files that name them by these.
+export const ENCODING_ALIASES = Object.freeze({
+  zh3_lum_dering: 'zh3_lum_axis_clamp',
+  zh3_lum_dering_sphere: 'zh3_lum_sphere_clamp',
+});
 // Defaults of the format (codec/probe/codec.h CodecOptions), enum fields as their numeric values.
 export const CODEC_DEFAULTS = Object.freeze({
   bits: 8,
@@ -293,7 +300,7 @@ export function hallucinateZonal(model, f0, f1Zonal, a = HALLUCINATE_CURVE_A, b 
   return (a * p * p + b * p) * f0;
 }
 // zh3_hallucinate then zh3_expand: linear (>= 12 float32 values) -> SH3 radiance.
-// `scale` multiplies the curve's a and b (hall_adaptive_q16; codec/probe/zh3_hall.cpp hall_scaled_expand).
+// `scale` multiplies the curve's a and b (hall_adaptive_q16; codec/probe/zh3_hall_solve.cpp hall_scaled_expand).
 function hallucinateExpand(linear, model, axisMode, w, scale = 1) {
   const axes = zh3Axes(linear, axisMode, w);
   const zonal = [0, 0, 0];
@@ -369,7 +376,7 @@ const zh3Float = (mode) => (b, o, p) => {
 const hallFloat = (model, mode) => (b, o, p) => hallucinateExpand(loadFloats(b, o, 12), model, mode, p.luminanceWeights);
 // The axis mode a decoder uses: the entry's fixed one, else the params'.
 const axisOf = (row, p) => (row.axis === 'luminance' || row.axis === 'channel' ? row.axis : p.axisMode);
-// sh2_q bytes, then the Eq. 21 curve (times 0.5 min(byte 15, 7) for the adaptive curve, codec/probe/zh3_hall.cpp).
+// sh2_q bytes, then the Eq. 21 curve (times 0.5 min(byte 15, 7) for the adaptive curve, codec/probe/zh3_hall_solve.cpp).
 const hallPacked = (row) => (b, o, p) => hallucinateExpand(decodePacked('sh2_q', b, o, p), 'curve', axisOf(row, p),
   p.luminanceWeights, row.hallucination === 'curve_adaptive' ? 0.5 * Math.min(b[o + 15], 7) : 1);
 
@@ -398,7 +405,13 @@ export const ENCODINGS = Object.freeze(Object.fromEntries(ENCODING_TABLE.map((ro
   decode: decoderOf(row),
 })])));
 
+// The entry's own name for a name or an alias of one (ENCODING_ALIASES); anything else unchanged.
+export function encodingName(name) {
+  return Object.prototype.hasOwnProperty.call(ENCODING_ALIASES, name) ? ENCODING_ALIASES[name] : name;
+}
+
 export function encodingInfo(name) {
+  name = encodingName(name);
   const e = Object.prototype.hasOwnProperty.call(ENCODINGS, name) ? ENCODINGS[name] : null;
   if (!e) throw new Error(`zhc: unknown encoding '${name}' (known: ${Object.keys(ENCODINGS).join(', ')})`);
   return e;

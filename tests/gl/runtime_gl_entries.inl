@@ -34,14 +34,14 @@
 // ---- codec table -> GLSL format ----------------------------------------------------------------------
 
 // The layout families and hallucination models, as the runtimes number them (runtime/zhc.glsl's
-// ZHC_LAYOUT_* / ZHC_HALL_*, generated like zhc_runtime.h's from codec/probe/runtime_table.h).
+// ZHC_LAYOUT_* / ZHC_HALL_MODE_*, generated like zhc_runtime.h's from codec/probe/runtime_table.h).
 enum : std::uint32_t {
     kSh3F32 = ZHC_LAYOUT_SH3_F32, kSh2F32 = ZHC_LAYOUT_SH2_F32, kZh3F32 = ZHC_LAYOUT_ZH3_F32,
     kZh3Q16 = ZHC_LAYOUT_ZH3_Q16, kSh3Q28 = ZHC_LAYOUT_SH3_Q28, kSh2Q = ZHC_LAYOUT_SH2_Q
 };
 enum : std::uint32_t {
-    kHallNone = ZHC_HALL_NONE, kHallAmbdir = ZHC_HALL_AMBDIR, kHallSphere = ZHC_HALL_SPHERE,
-    kHallCurve = ZHC_HALL_CURVE, kHallCurveAdaptive = ZHC_HALL_CURVE_ADAPTIVE
+    kHallNone = ZHC_HALL_MODE_NONE, kHallAmbdir = ZHC_HALL_MODE_AMBDIR, kHallSphere = ZHC_HALL_MODE_SPHERE,
+    kHallCurve = ZHC_HALL_MODE_CURVE, kHallCurveAdaptive = ZHC_HALL_MODE_CURVE_ADAPTIVE
 };
 
 struct GlslEntry {

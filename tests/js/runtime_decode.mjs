@@ -80,6 +80,19 @@ for (const name of tableNames)
   check(Object.prototype.hasOwnProperty.call(runtime.ENCODINGS, name) && runtime.ENCODINGS[name].bytes === table[name].bytes_per_probe,
     `codec table entry ${name} (${table[name].bytes_per_probe} bytes): runtime/web ENCODINGS has no entry of that size`);
 for (const name of Object.keys(runtime.ENCODINGS)) check(name in table, `runtime/web ENCODINGS.${name} is not a codec table entry`);
+// Aliases (ENCODING_ALIASES, generated from the codec's codec_aliases()): zhc takes each on the
+// command line as the entry it names, and the runtime decodes it as that entry.
+check(Object.keys(runtime.ENCODING_ALIASES).length > 0, 'runtime/web ENCODING_ALIASES lists the aliases');
+for (const [alias, name] of Object.entries(runtime.ENCODING_ALIASES)) {
+  check(!(alias in table) && name in table, `alias ${alias} -> ${name}: not an entry, names one`);
+  const named = Object.keys(JSON.parse(run('audit', W('two.json'), '-r', alias, '--json', '--no-timing')).aggregate.representations);
+  check(named.length === 1 && named[0] === name, `zhc audit -r ${alias} audits ${name} (got ${named.join()})`);
+  check(runtime.encodingName(alias) === name && runtime.encodingInfo(alias) === runtime.encodingInfo(name), `encodingInfo('${alias}')`);
+  const bytes = new Uint8Array(runtime.encodingInfo(name).bytes).map((_, i) => (i * 37 + 11) & 255);
+  const a = runtime.decodeProbe(alias, bytes), b = runtime.decodeProbe(name, bytes);
+  check(a.length === 27 && a.every((x, i) => Object.is(x, b[i])), `decodeProbe('${alias}') = decodeProbe('${name}')`);
+}
+check(runtime.encodingName('zh3_lum_dering_') === 'zh3_lum_dering_', 'encodingName leaves other names alone');
 
 // Every entry with the defaults, the float ones also as irradiance; then parameter sets chosen
 // for some of the quantised entries (an entry not named below still gets its defaults and one

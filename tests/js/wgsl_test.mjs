@@ -65,7 +65,7 @@ for (const m of wgslText.matchAll(/^const (ZHC_\w+): u32 = (\d+)u;/gm)) constant
 const F = { SH3_F32: 0, SH2_F32: 1, ZH3_F32: 2, ZH3_Q16: 3, SH3_Q28: 4, SH2_Q: 5 };
 const H = { NONE: 0, AMBDIR: 1, SPHERE: 2, CURVE: 3, CURVE_ADAPTIVE: 4 };
 for (const [k, v] of Object.entries(F)) check(constants[`ZHC_LAYOUT_${k}`] === v, `zhc.wgsl: ZHC_LAYOUT_${k} = ${v}u`);
-for (const [k, v] of Object.entries(H)) check(constants[`ZHC_HALL_${k}`] === v, `zhc.wgsl: ZHC_HALL_${k} = ${v}u`);
+for (const [k, v] of Object.entries(H)) check(constants[`ZHC_HALL_MODE_${k}`] === v, `zhc.wgsl: ZHC_HALL_MODE_${k} = ${v}u`);
 // Every entry's WGSL format comes from the runtime's generated table (ENCODING_TABLE of
 // zhc_runtime.mjs: layout, hallucination, axis), whose rows zhc.wgsl's generated table holds too
 // (runtime_tables.check compares both files with the codec table); the file's ids must be the rows'.
@@ -75,7 +75,7 @@ check(constants.ZHC_ENCODING_COUNT === runtime.ENCODING_TABLE.length, `zhc.wgsl:
 runtime.ENCODING_TABLE.forEach((row, id) => {
   const name = row.name;
   check(constants[`ZHC_ENC_${name.toUpperCase()}`] === id, `zhc.wgsl: ZHC_ENC_${name.toUpperCase()} = ${id}u`);
-  const e = { family: constants[`ZHC_LAYOUT_${row.layout.toUpperCase()}`], hallucination: constants[`ZHC_HALL_${row.hallucination.toUpperCase()}`], axis: row.axis };
+  const e = { family: constants[`ZHC_LAYOUT_${row.layout.toUpperCase()}`], hallucination: constants[`ZHC_HALL_MODE_${row.hallucination.toUpperCase()}`], axis: row.axis };
   check(e.family !== undefined && e.hallucination !== undefined, `${name}: zhc.wgsl defines its family and hallucination`);
   const info = runtime.ENCODINGS[name];
   check(familyBytes[e.family] === info.bytes, `${name}: zhc.wgsl's family has the entry's ${info.bytes} bytes`);

@@ -132,7 +132,7 @@ def main():
     if len(inputs) < 4:
         sys.exit("FAILED: no sample maps in %s" % envmaps)
     all_names = PACKED + ["sh3", "sh2", "zh3_lum", "zh3_channel", "hall_curve", "hall_sphere_channel",
-                          "zh3_lum_dering", "sh3_dering"]
+                          "zh3_lum_axis_clamp", "sh3_dering"]
     checked = probes_total = inexact = 0
     worst = 0.0
     for inp in inputs:

@@ -27,7 +27,7 @@ struct Job {
 // The specialised-format example of zhc.wgsl's header, compiled as written (not called).
 override ZHC_BITS: u32 = 8u;
 fn zhcMyFormat() -> ZhcFormat {
-    return ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_NONE, ZHC_BITS, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
+    return ZhcFormat(ZHC_LAYOUT_ZH3_Q16, ZHC_HALL_MODE_NONE, ZHC_BITS, 0u, ZHC_L2_TIGHT, ZHC_DC_R11G11B10F,
                      ZHC_ZONAL_AFFINE, ZHC_AXIS_LUMINANCE, ZHC_KIND_RADIANCE,
                      vec3f(0.2126, 0.7152, 0.0722), vec2f(0.6, 0.08));
 }

@@ -1,4 +1,4 @@
-#include "codec/report/choice.h"
+#include "codec/audit/choice.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// zhc/codec/report/audit_run.h — the audit of a set of inputs: every representation on every probe of
+// zhc/codec/audit/audit_run.h — the audit of a set of inputs: every representation on every probe of
 // every input, pooled per input and across inputs, timed, and checked against pass/fail gates.
 //
 // What `zhc audit` computes (the CLI only parses options, prints and maps to exit codes); reading
@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "codec/report/audit.h"
+#include "codec/audit/audit.h"
 
 namespace zhc {
 

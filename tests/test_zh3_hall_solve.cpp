@@ -1,5 +1,5 @@
 // Hallucinate-solve (hall_solved, hall_solved_q16) and the adaptive hallucination scale
-// (hall_adaptive_q16): codec/probe/zh3_hall.h, docs/zh3.md.
+// (hall_adaptive_q16): codec/probe/zh3_hall_solve.h, docs/zh3.md.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,12 +10,12 @@
 #include <map>
 #include <random>
 
-#include "codec/report/audit.h"
+#include "codec/audit/audit.h"
 #include "codec/probe/codec.h"
 #include "codec/probe/probe_set.h"
 #include "codec/probe/quantize.h"
 #include "codec/probe/zh3.h"
-#include "codec/probe/zh3_hall.h"
+#include "codec/probe/zh3_hall_solve.h"
 #include "tests/support.h"
 
 namespace zhc {

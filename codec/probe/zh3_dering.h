@@ -1,4 +1,4 @@
-// zhc/codec/probe/zh3_window.h — ZH3 deringing that keeps irradiance non-negative on the WHOLE sphere
+// zhc/codec/probe/zh3_dering.h — ZH3 deringing that keeps irradiance non-negative on the WHOLE sphere
 // (zhc's extension; docs/zh3.md "Whole-sphere windowing").
 //
 // The ZH3 paper's App. B (zh3_dering) only bounds the zonal coefficient along the axis; when the
@@ -50,6 +50,6 @@ double zh3_dering_window_scale(const Zh3& zh3, ZonalAxisMode mode, const Luminan
 double zh3_dering_window(Zh3* zh3, ZonalAxisMode mode, const LuminanceWeights& w, double max_scale = 1.0);
 
 // Codec-table entries: zh3_dering (15 floats, as zh3_lum) and zh3_dering_q16 (zh3_q16 bytes).
-std::span<const Codec> zh3_window_codecs();
+std::span<const Codec> zh3_dering_codecs();
 
 }  // namespace zhc

@@ -1,4 +1,4 @@
-// zhc/codec/report/benchmark.h — what accuracy costs in time: per representation, bytes per probe,
+// zhc/codec/audit/benchmark.h — what accuracy costs in time: per representation, bytes per probe,
 // encode ns/probe, irradiance evaluation ns/sample and error, over a set of probes.
 //
 // Experimental: this API may change between minor versions (docs/api.md "Public headers").
@@ -8,7 +8,7 @@
 
 #include <vector>
 
-#include "codec/report/audit.h"
+#include "codec/audit/audit.h"
 #include "codec/probe/codec.h"
 
 namespace zhc {

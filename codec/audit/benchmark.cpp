@@ -1,4 +1,4 @@
-#include "codec/report/benchmark.h"
+#include "codec/audit/benchmark.h"
 
 #include <algorithm>
 #include <chrono>

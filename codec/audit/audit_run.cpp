@@ -1,4 +1,4 @@
-#include "codec/report/audit_run.h"
+#include "codec/audit/audit_run.h"
 
 #include <algorithm>
 #include <chrono>

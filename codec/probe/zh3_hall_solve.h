@@ -1,4 +1,4 @@
-// zhc/codec/probe/zh3_hall.h — hallucinate-solve and the adaptive hallucination scale.
+// zhc/codec/probe/zh3_hall_solve.h — hallucinate-solve and the adaptive hallucination scale.
 //
 // The decoders are the curve hallucination of the ZH3 paper (Roughton et al. 2024, Sec. 3.4.3,
 // Eq. 21, Listing 1): from stored linear SH (DC f0, L1) the decoder derives the zonal axis a (the
@@ -11,7 +11,7 @@
 // profile, the component along a the minimiser of a quartic in one variable), so the solve is a
 // search over the axis only: candidate axes, then BFGS on the sphere.
 //
-// Codec-table entries (codec/probe/zh3_hall.cpp, hall_codecs()):
+// Codec-table entries (codec/probe/zh3_hall_solve.cpp, hall_solve_codecs()):
 //   hall_solved        48 bytes, sh2's float layout; decodes exactly as hall_curve
 //   hall_solved_q16    16 bytes, sh2_q's layout; decodes exactly as hall_curve_q
 //   hall_adaptive_q16  16 bytes, sh2_q's layout with byte 15 = scale code (docs/quantization.md)

@@ -1,4 +1,4 @@
-#include "codec/report/audit.h"
+#include "codec/audit/audit.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-// zhc/codec/report/choice.h — which representation to use: per byte budget, the audited
+// zhc/codec/audit/choice.h — which representation to use: per byte budget, the audited
 // representation with the lowest error that fits the budget and meets the user's constraints.
 //
 // The error is the audit's main metric, the relative irradiance rmse (rmse over the mean
@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "codec/report/audit_run.h"
+#include "codec/audit/audit_run.h"
 
 namespace zhc {
 

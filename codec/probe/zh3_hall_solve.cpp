@@ -1,4 +1,4 @@
-// Hallucinate-solve and the adaptive hallucination scale (codec/probe/zh3_hall.h; derivation in docs/zh3.md).
+// Hallucinate-solve and the adaptive hallucination scale (codec/probe/zh3_hall_solve.h; derivation in docs/zh3.md).
 //
 // Vector form as codec/probe/zh3_internal.h: channel k's radiance L1 (f1-1, f10, f11) is v = (-f11, -f1-1, f10).
 // Error in irradiance SH (band scales 1, 2/3, 1/4), per channel, with u the target's L1 vector, T2
@@ -13,7 +13,7 @@
 // F' on [0, sqrt 3] is the cubic (A'^2/4) x^3 + (3 A'B'/8) x^2 + (B'^2/8 - A' eta/4 + 8/9) x
 // - (B' eta/8 + 8 gamma/9) (A' = s A, B' = s B); above sqrt 3, G is constant and F is least at
 // max(gamma, sqrt 3). The minimum is among x = 0, the cubic's roots in [0, sqrt 3] and that point.
-#include "codec/probe/zh3_hall.h"
+#include "codec/probe/zh3_hall_solve.h"
 
 #include <algorithm>
 #include <array>
@@ -549,7 +549,7 @@ Sh3Radiance decode_q(const std::uint8_t* in, const CodecOptions& params) {
 constexpr PackedCodec kHallSolvedQ16{PackedLayout::kSh2Q, encode_q<false>, decode_q<false>};
 constexpr PackedCodec kHallAdaptiveQ16{PackedLayout::kSh2Q, encode_q<true>, decode_q<true>};
 
-const Codec kHallCodecs[] = {
+const Codec kHallSolveCodecs[] = {
     {"hall_solved", "hall_curve's bytes and decoder; encoder solves the L1 for the error after hallucination", 48,
      encode_solved, decode_solved, irradiance_solved,
      {.zonal_axis = ZonalAxis::kLuminance, .hallucination = ZonalHallucination::kCurve}},
@@ -562,6 +562,6 @@ const Codec kHallCodecs[] = {
 };
 }  // namespace
 
-std::span<const Codec> hall_codecs() { return kHallCodecs; }
+std::span<const Codec> hall_solve_codecs() { return kHallSolveCodecs; }
 
 }  // namespace zhc

@@ -1,4 +1,4 @@
-// zhc/codec/report/audit.h — error metrics of every representation against a reference irradiance.
+// zhc/codec/audit/audit.h — error metrics of every representation against a reference irradiance.
 //
 // The reference for an environment map is the true irradiance E(n) = (1/pi) int L(w) max(0, n.w) dw
 // by direct integration of the map (after a flux-preserving box downsample to no less than
