@@ -115,10 +115,16 @@ export function ulpDiff(a, b) {
   return Math.abs((ia < 0 ? 0x80000000 - ia : ia) - (ib < 0 ? 0x80000000 - ib : ib));
 }
 
-// A version 1 .zhp (Uint8Array) rewritten as version 2 with validity and/or visibility sections
-// (Uint8Array of count bytes each, or null): docs/zhp-container.md "Per-probe sections". `crc32`:
-// runtime/web's (bytes, start, end).
+// An uncompressed .zhp (Uint8Array; version 1, or version 2 whose sections are replaced) rewritten
+// as version 2 with validity and/or visibility sections (Uint8Array of count bytes each, or null):
+// docs/zhp-container.md "Per-probe sections". `crc32`: runtime/web's (bytes, start, end).
 export function zhpWithSections(bytes, validity, visibility, crc32) {
+  if (bytes[8] === 2) {  // drop the sections it has (they follow the payload)
+    const hv = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+    const count = Number(hv.getBigUint64(56, true));
+    const had = (bytes[21] & 1) + ((bytes[21] >> 1) & 1);
+    bytes = bytes.slice(0, 184 + Number(hv.getBigUint64(160, true)) - had * count);
+  }
   const extra = (validity ? validity.length : 0) + (visibility ? visibility.length : 0);
   const out = new Uint8Array(bytes.length + extra);
   out.set(bytes);
