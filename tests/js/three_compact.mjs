@@ -6,6 +6,9 @@
 //     zh3_channel_q16 with non-default parameters (6 bits, sqrt, RGB9E5 DC); `zhc bake` of a small
 //     scene whose 4x4x3 grid a wall cuts between two probe columns (visibility masks) and a box
 //     encloses one probe (invalid): zh3_q16 (.glb and .zhp) and sh3_q28 (.zhp), the masked ones;
+//     and the demo's zh3_q16 .zhp with synthetic masks handed to compactVolume (random invalid
+//     probes and cleared bits; the bottom two probe layers fully masked, so that their cells take
+//     the all-masked fallback, the plain weights);
 //  2. 24 samples per volume: 20 points q random inside the grid's box, 4 outside it (clamped),
 //     random unit directions d, in the volume's frame (glb: node-local glTF axes; .zhp: zhc axes);
 //     on the masked grids no coordinate within 1e-3 of a cell face (a masked blend is not
@@ -17,7 +20,9 @@
 //  4. the C header (tests/runtime_c/zhc_volume_sample: zhc_volume_from_zhp + zhc_volume_irradiance)
 //     gives E(q, d) from the .zhp (the glb's samples converted to zhc axes), with the masks (the
 //     masked volumes) or without them (`--plain`: the demo's grids, which have none, and the baked
-//     .zhp built with `masks: false`);
+//     .zhp built with `masks: false`); for the synthetic masks the JS runtime's volumeIrradiance
+//     with them (the C header's doubles in the same order, bit for bit: js.runtime_volume), and in
+//     the fully masked cells the plain C header, bit for bit;
 //  5. masks: compactVolume's combined mask texture against a twin (glb: the .zhp's masks with axes
 //     and bits permuted to glTF), the masked C header differs from the plain one by more than the
 //     tolerance at >= 4 samples of each masked grid (ignoring the masks would fail), and in Node
@@ -43,7 +48,7 @@ import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { makeRand, checker } from './fixtures.mjs';
 import { chromiumPages } from './chromium_page.mjs';
-import { parseZhp, decodeAll, kY00, kY1, kY20 } from '../../runtime/web/zhc_runtime.mjs';
+import { parseZhp, decodeAll, makeVolume, volumeIrradiance, kY00, kY1, kY20 } from '../../runtime/web/zhc_runtime.mjs';
 import { zhcVolumeGlsl, compactVolume, compactVolumeMask } from '../../runtime/web/zhc_volume.glsl.mjs';
 
 const [zhc, sampler, workArg, chromiumArg] = process.argv.slice(2);
@@ -91,6 +96,7 @@ const volumes = [
   { name: 'demo sh3_q28 (.zhp)', zhp: 'demo_sh3_q28.zhp', ref: W('demo_sh3_q28.zhp'), gltf: false, rootTranslation: [-1, 0.5, 2], rootScale: 0.8, seed: 22 },
   { name: 'demo sh2_q (.zhp)', zhp: 'demo_sh2_q.zhp', ref: W('demo_sh2_q.zhp'), gltf: false, rootTranslation: [0.3, 1.5, -0.5], rootScale: 1.5, seed: 23 },
   { name: 'demo zh3_channel_q16 6 bits sqrt rgb9e5 (.zhp)', zhp: 'demo_zh3_channel.zhp', ref: W('demo_zh3_channel.zhp'), gltf: false, rootTranslation: [2, -1, 0.5], rootScale: 1.1, seed: 24 },
+  { name: 'demo zh3_q16 synthetic masks (.zhp)', zhp: 'demo/probes_zh3_q16.zhp', ref: W('demo/probes_zh3_q16.zhp'), gltf: false, masked: true, synthetic: 31, rootTranslation: [-0.5, 0.3, 0.9], rootScale: 0.7, seed: 28 },
   { name: 'baked masked zh3_q16 (glb)', glb: 'baked_masked.glb', ref: W('baked_masked.zhp'), gltf: true, masked: true, rootTranslation: [-0.6, 0.9, 0.4], rootScale: 1.3, seed: 25 },
   { name: 'baked masked zh3_q16 (.zhp)', zhp: 'baked_masked.zhp', ref: W('baked_masked.zhp'), gltf: false, masked: true, rootTranslation: [1.2, 0.2, -0.7], rootScale: 0.9, seed: 26 },
   { name: 'baked masked sh3_q28 (.zhp)', zhp: 'baked_masked_sh3_q28.zhp', ref: W('baked_masked_sh3_q28.zhp'), gltf: false, masked: true, rootTranslation: [0.4, -0.8, 1.1], rootScale: 1.2, seed: 27 },
@@ -100,7 +106,21 @@ const volumes = [
 const toZhc = (v) => [v[2], v[0], v[1]];  // glTF (x, y, z) = zhc (y, z, x)
 const SAMPLES = 24, OUTSIDE = 4;
 for (const v of volumes) {
-  const z = parseZhp(new Uint8Array(fs.readFileSync(v.ref)));
+  let z = parseZhp(new Uint8Array(fs.readFileSync(v.ref)));
+  if (v.synthetic) {
+    // ~15 % invalid probes, each visibility bit cleared with probability 0.3; probes of the two
+    // lowest z layers (zhc axes) fully masked: every corner of a cell with i0_z = 0 is dropped.
+    const mr = makeRand(v.synthetic), [nx, ny] = z.grid.counts;
+    const validity = new Uint8Array(z.count), visibility = new Uint8Array(z.count);
+    for (let p = 0; p < z.count; p++) {
+      validity[p] = mr() < 0.15 ? 0 : 1;
+      for (let j = 0; j < 8; j++) if (mr() >= 0.3) visibility[p] |= 1 << j;
+      if (Math.floor(p / (nx * ny)) < 2) visibility[p] = 0;
+    }
+    z = { ...z, validity, visibility };
+    v.validity = Array.from(validity);
+    v.visibility = Array.from(visibility);
+  }
   v.zhpInfo = z;
   v.sh = decodeAll(z.encoding, z.payload, z.count, z.params);
   // The grid in the sample frame: zhc axes permuted to glTF for the glb (its grid is glTF's).
@@ -132,7 +152,8 @@ for (const v of volumes) {
   }
 }
 fs.writeFileSync(W('three_compact_spec.json'), JSON.stringify({
-  volumes: volumes.map(({ name, glb, zhp, masksOff, rootTranslation, rootScale, samples }) => ({ name, glb, zhp, masks: !masksOff, rootTranslation, rootScale, samples })),
+  volumes: volumes.map(({ name, glb, zhp, masksOff, validity, visibility, rootTranslation, rootScale, samples }) =>
+    ({ name, glb, zhp, masks: !masksOff, validity, visibility, rootTranslation, rootScale, samples })),
 }));
 
 // The C header at the samples (zhc axes): masked (its default) for the masked volumes, plain
@@ -144,6 +165,24 @@ for (const v of volumes) {
   fs.writeFileSync(file, pts.map((p) => p.map((x) => x.toPrecision(9)).join(' ')).join('\n') + '\n');
   const sample = (plain) => execFileSync(sampler, [v.ref, file, ...(plain ? ['--plain'] : [])]).toString().trim().split('\n')
     .map((l) => l.trim().split(/\s+/).map((x) => f32(Number(x))));
+  if (v.synthetic) {
+    // No .zhp holds these masks: the JS runtime's twin of zhc_volume_irradiance applies them.
+    const z = v.zhpInfo;
+    const vol = makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, validity: z.validity, visibility: z.visibility });
+    v.expected = pts.map((p) => volumeIrradiance(vol, p.slice(0, 3), p.slice(3)));
+    v.expectedMasked = v.expected;
+    v.expectedPlain = sample(true);
+    // Cells with i0_z = 0 (t_z < 1, clamped) have every corner masked: the plain blend, bit for bit.
+    let fallback = 0, same = 0;
+    pts.forEach((p, i) => {
+      if ((p[2] - z.grid.origin[2]) / z.grid.spacing[2] >= 1) return;
+      fallback++;
+      if (v.expected[i].every((x, k) => x === v.expectedPlain[i][k])) same++;
+    });
+    console.log(`${v.name}: ${fallback} samples in fully masked cells, ${same} equal to the plain C header bit for bit`);
+    check(fallback >= 4 && same === fallback, `${v.name}: ${same} of ${fallback} samples in fully masked cells equal the plain C header bit for bit (>= 4)`);
+    continue;
+  }
   v.expected = sample(!v.masked);
   if (v.masked || v.masksOff) {
     v.expectedMasked = v.masked ? v.expected : sample(false);

@@ -11,7 +11,8 @@
 //  (C) a patched MeshStandardMaterial (roughness 1, metalness 0) and, as its twin, the same material
 //      lit by a THREE.LightProbe holding zhc's blended SH3 at q (JS volumeSH3, three.js's basis).
 // A volume with validity / visibility masks gets the masked chunk and the R8UI mask texture (spec
-// `masks: false`: compactVolume's opt-out); the ShaderMaterial passes the mask sampler when the
+// `masks: false`: compactVolume's opt-out; spec `validity` / `visibility`: synthetic masks handed to
+// compactVolume with the parsed .zhp); the ShaderMaterial passes the mask sampler when the
 // chunk defines ZHC_VOLUME_MASKED, and the LightProbe twin blends with the same masks (volumeSH3).
 // Reported: the pixels, GPU bytes per probe of the compact texture and of three.js's own grid
 // (LightProbeGridWebGL atlas via the plugin's lightProbeGrid, float and binary16), the mask
@@ -76,9 +77,16 @@ async function main() {
       const bytes = new Uint8Array(await (await fetch(`/work/${f.zhp}`)).arrayBuffer());
       root.updateMatrixWorld(true);
       matrixWorld = root.matrixWorld.clone().multiply(ZHC_TO_GLTF);
-      compact = compactVolumeFromZhp(bytes, { THREE, matrixWorld, masks: f.masks });
       const z = parseZhp(bytes);
-      r.shVolume = f.masks ? volumeFromZhp(bytes) : makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid });
+      if (f.validity) {
+        // Synthetic masks (the spec's arrays) on a .zhp without any: the source object carries them.
+        const masks = { validity: Uint8Array.from(f.validity), visibility: Uint8Array.from(f.visibility) };
+        compact = compactVolume({ ...z, ...masks }, { THREE, matrixWorld });
+        r.shVolume = makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, ...masks });
+      } else {
+        compact = compactVolumeFromZhp(bytes, { THREE, matrixWorld, masks: f.masks });
+        r.shVolume = f.masks ? volumeFromZhp(bytes) : makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid });
+      }
       r.count = parseZhp(bytes).count;
     }
     r.encoding = compact.encoding;
