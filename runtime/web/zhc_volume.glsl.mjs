@@ -10,15 +10,19 @@
 // (runtime/zhc.glsl), docs/runtime.md "Probe volumes". Exact to the decode: no filtering of stored
 // bytes (which would be wrong: ratios times a per-probe DC, a per-probe zonal axis), no float
 // transcode; the only differences from the C header are float32 rounding in the shader.
+// A grid with validity / visibility masks (a baked one) also gets its combined mask bytes
+// (valid ? visibility : 0) in an R8UI 3D texture, one texel per probe, and the masked, renormalised
+// weights of zhc_volume_sh3 (docs/runtime.md "Validity and visibility"); `masks: false` drops them.
 //
-//   zhcVolumeGlsl({ encoding, params, normalAxes })   GLSL ES 3.00 chunk (zhc_irradiance's included):
+//   zhcVolumeGlsl({ encoding, params, normalAxes, masked })   GLSL ES 3.00 chunk (zhc_irradiance's included):
 //     struct ZhcVolume { vec3 origin; vec3 spacing; vec3 counts; };
 //     vec3 zhcVolumeIrradiance(highp usampler3D tex, ZhcVolume v, vec3 position, vec3 normal)
 //       position in the grid's frame (a glTF volume: its node's local glTF axes; a .zhp: zhc axes),
 //       normal in the same frame (normalised in the shader; zero: +Z of the coefficients' axes); for
 //       shAxes "zhc" volumes in glTF axes the chunk maps the normal to zhc axes (normalAxes 'gltf').
 //     void zhcVolumeSh3(highp usampler3D tex, ZhcVolume v, vec3 position, out vec3 c[9])  blended SH3
-//   compactVolume(source, { THREE, matrixWorld })      texture payload + uniforms (+ a Data3DTexture
+//     masked: both take `highp usampler3D maskTex` after tex, and ZHC_VOLUME_MASKED is defined
+//   compactVolume(source, { THREE, matrixWorld, masks })   texture payloads + uniforms (+ Data3DTextures
 //     when THREE is given) from a ZhcProbeVolume (the GLTFLoader plugin) or parseZhp(bytes)
 //   patchMaterialWithVolume(material, compact, THREE)  onBeforeCompile: a stock three.js material
 //     (MeshLambertMaterial, MeshStandardMaterial, MeshPhysicalMaterial, ...) gets the volume's
@@ -44,7 +48,11 @@ function compactLayout(encoding) {
 // The volume chunk for one encoding and parameter set. normalAxes: 'gltf' when the shader's
 // normals are in glTF axes and the coefficients in zhc axes (a glTF volume with shAxes "zhc", what
 // zhc writes), 'same' when both share the grid's frame (a .zhp, or shAxes "gltf").
-export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same' } = {}) {
+// masked: the chunk applies a grid's validity and visibility masks (docs/runtime.md "Validity and
+// visibility"): it defines ZHC_VOLUME_MASKED, and zhcVolumeSh3 / zhcVolumeIrradiance take a second
+// sampler, the combined mask bytes as an R8UI 3D texture (n_x x n_y x n_z, one texel per probe),
+// right after the probe texture. Unmasked (the default) the chunk has neither.
+export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same', masked = false } = {}) {
   const layout = compactLayout(encoding);
   // The *_channel_q16 encodings imply per-channel axes whatever the params say (a .zhp header's
   // axisMode field is the one of the luminance variants).
@@ -56,11 +64,37 @@ export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same' } = {
     sh3_q28: 'zhcSh3Sh3Q28(w0, texelFetch(tex, t + ivec3(1, 0, 0), 0), c);',
     sh2_q: 'zhcSh3Sh2Q(w0, c);',
   }[layout];
+  if (typeof masked !== 'boolean') throw new Error('zhcVolumeGlsl: masked must be true or false');
+  // The masked chunk's additions; each is empty without masks, so the unmasked text stays as it is.
+  const maskDefine = masked ? '#define ZHC_VOLUME_MASKED 1\n' : '';
+  const maskParam = masked ? 'highp usampler3D maskTex, ' : '';
+  const maskArg = masked ? 'maskTex, ' : '';
+  const maskDoc = masked ? `
+// Masked (ZHC_VOLUME_MASKED): maskTex holds each probe's combined mask byte m = valid ? visibility
+// : 0 at texel (x, y, z); corner b = (bx, by, bz) keeps its weight w_b when bit 7 - (bx + 2 by +
+// 4 bz) of its m is set, else 0; the kept weights are divided by their sum (summed over corners
+// 0..7 in order); when every corner is dropped the plain weights stay (zhc_volume_sh3's fallback).` : '';
+  const maskWeights = masked ? `
+  // Masked weights first (8 mask fetches), then the blend below with w_b = m_b / sum.
+  float wm[8];
+  float sum = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    ivec3 b = ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
+    vec3 wv = mix(1.0 - fr, fr, notEqual(b, ivec3(0)));
+    float w = wv.x * wv.y * wv.z;
+    wm[corner] = 0.0;
+    if (w == 0.0) continue;  // also every corner beyond a count-1 axis: not fetched
+    uint m = texelFetch(maskTex, i0 + b, 0).r;
+    if (((m >> uint(7 - corner)) & 1u) != 0u) wm[corner] = w;
+    sum += wm[corner];
+  }` : '';
+  const maskUse = masked ? `
+    if (sum > 0.0) w = wm[corner] / sum;  // else: every corner dropped, the plain weights` : '';
   return `${zhcIrradianceGlsl(params)}
 // ---- zhc compact volume (runtime/web/zhc_volume.glsl.mjs): ${encoding}, ${texels} RGBA32UI texel(s) per probe ----
 #define ZHC_VOLUME_TEXELS ${texels}
 #define ZHC_VOLUME_NORMAL_FROM_GLTF ${normalAxes === 'gltf' ? 1 : 0}
-const float ZHC_SQRT3 = ${Math.fround(Math.sqrt(3)).toPrecision(9)};
+${maskDefine}const float ZHC_SQRT3 = ${Math.fround(Math.sqrt(3)).toPrecision(9)};
 struct ZhcVolume {
   vec3 origin;   // position of probe (0, 0, 0)
   vec3 spacing;  // > 0
@@ -131,19 +165,19 @@ void zhcVolumeProbe(highp usampler3D tex, ivec3 q, out vec3 c[9]) {
 }
 
 // Blended SH3 radiance at p: t = clamp((p - origin) / spacing, 0, counts - 1) (NaN: 0), cell
-// i0 = min(floor(t), counts - 2), weights prod (f or 1 - f), f = t - i0; probes of weight 0 skipped.
-void zhcVolumeSh3(highp usampler3D tex, ZhcVolume v, vec3 p, out vec3 acc[9]) {
+// i0 = min(floor(t), counts - 2), weights prod (f or 1 - f), f = t - i0; probes of weight 0 skipped.${maskDoc}
+void zhcVolumeSh3(highp usampler3D tex, ${maskParam}ZhcVolume v, vec3 p, out vec3 acc[9]) {
   ivec3 n = max(ivec3(v.counts), ivec3(1));
   vec3 t = (p - v.origin) / v.spacing;
   t = mix(vec3(0.0), t, greaterThanEqual(t, vec3(0.0)));  // below the box, or NaN: 0
   t = min(t, vec3(n - 1));
   ivec3 i0 = min(ivec3(t), max(n, ivec3(2)) - 2);
-  vec3 fr = t - vec3(i0);
+  vec3 fr = t - vec3(i0);${maskWeights}
   for (int i = 0; i < 9; ++i) acc[i] = vec3(0.0);
   for (int corner = 0; corner < 8; ++corner) {
     ivec3 b = ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
     vec3 wv = mix(1.0 - fr, fr, notEqual(b, ivec3(0)));
-    float w = wv.x * wv.y * wv.z;
+    float w = wv.x * wv.y * wv.z;${maskUse}
     if (w == 0.0) continue;
     vec3 c[9];
     zhcVolumeProbe(tex, i0 + b, c);
@@ -153,9 +187,9 @@ void zhcVolumeSh3(highp usampler3D tex, ZhcVolume v, vec3 p, out vec3 acc[9]) {
 
 // Irradiance (zhc's normalised kernel: constant radiance 1 gives 1) at position p for the surface
 // normal n (normalised here; zero or not finite: the frame's up), both in the grid's frame.
-vec3 zhcVolumeIrradiance(highp usampler3D tex, ZhcVolume v, vec3 p, vec3 n) {
+vec3 zhcVolumeIrradiance(highp usampler3D tex, ${maskParam}ZhcVolume v, vec3 p, vec3 n) {
   vec3 c[9];
-  zhcVolumeSh3(tex, v, p, c);
+  zhcVolumeSh3(tex, ${maskArg}v, p, c);
 #if ZHC_VOLUME_NORMAL_FROM_GLTF
   n = n.zxy;
 #endif
@@ -180,6 +214,19 @@ export function compactVolumeWords(bytes, bytesPerProbe, counts, texels) {
   return out;
 }
 
+// The combined mask bytes of a grid (docs/runtime.md "Validity and visibility": what reaches the
+// GPU): Uint8Array(count), probe p's byte validity[p] ? visibility[p] : 0, absent validity = valid,
+// absent visibility = 0xFF; null when both are absent. Probe order = texel order of the R8UI mask
+// texture (x fastest).
+export function compactVolumeMask(validity, visibility, count) {
+  if (!validity && !visibility) return null;
+  for (const [what, a] of [['validity', validity], ['visibility', visibility]])
+    if (a && a.length < count) throw new Error(`zhc compact volume: ${what} has ${a.length} bytes for ${count} probes`);
+  const out = new Uint8Array(count);
+  for (let p = 0; p < count; p++) out[p] = validity && !validity[p] ? 0 : visibility ? visibility[p] : 0xFF;
+  return out;
+}
+
 // Column-major 4x4 helpers (three.js Matrix4.elements order), no three.js needed.
 function invertAffine(m) {
   const a = [m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]];  // columns
@@ -201,10 +248,18 @@ function invertAffine(m) {
 // node's local glTF axes) or parseZhp(bytes) of a .zhp (grid in zhc axes). Options: THREE (the
 // three.js module: adds `texture`, a Data3DTexture, and three.js `uniforms`), matrixWorld (the
 // grid frame -> world, column-major 16 numbers or a Matrix4; any invertible affine map, rotations
-// included; default: a ZhcProbeVolume's single node's matrixWorld, else identity).
-// Returns { encoding, layout, texelsPerProbe, gpuBytesPerProbe, gpuBytes, size: [w, h, d], data,
-// grid: { origin, spacing, counts }, glsl (zhcVolumeGlsl for it), texture?, uniforms? }.
-export function compactVolume(source, { THREE, matrixWorld } = {}) {
+// included; default: a ZhcProbeVolume's single node's matrixWorld, else identity), masks (default
+// true: a source with validity or visibility bytes, a ZhcProbeVolume's or parseZhp's, gets the
+// masked chunk and an R8UI mask texture of its combined bytes; false: the plain trilinear blend,
+// 8 texel fetches per sample fewer and 1 byte per probe less, for grids whose masks do not matter
+// where they are sampled or to match three.js's own grid, which cannot apply them). A source whose
+// combined bytes are all 0xFF (nothing masked) gets the plain chunk: its masked weights are the
+// plain ones divided by their sum, 1 up to rounding.
+// Returns { encoding, layout, texelsPerProbe, gpuBytesPerProbe (probe texels, plus 1 with masks),
+// gpuBytes (both textures), size: [w, h, d], data, masked, mask (the combined bytes or null),
+// maskBytes, grid: { origin, spacing, counts }, glsl (zhcVolumeGlsl for it), texture?, maskTexture?,
+// uniforms? }.
+export function compactVolume(source, { THREE, matrixWorld, masks = true } = {}) {
   const isZhp = source.payload !== undefined;
   if ((source.layout ?? 'grid') !== 'grid' || !source.grid) throw new Error(`zhc compact volume: needs a grid (layout ${source.layout})`);
   const layout = compactLayout(source.encoding);
@@ -220,10 +275,17 @@ export function compactVolume(source, { THREE, matrixWorld } = {}) {
   if (counts[0] * texels > 2048 || counts[1] > 2048 || counts[2] > 2048) throw new Error('zhc compact volume: grid larger than a 3D texture (2048)');
   const data = compactVolumeWords(bytes, bytesPerProbe, counts, texels);
   const normalAxes = !isZhp && source.shAxes === 'zhc' ? 'gltf' : 'same';
+  if (typeof masks !== 'boolean') throw new Error('zhc compact volume: masks must be true or false');
+  const count = counts[0] * counts[1] * counts[2];
+  let mask = masks ? compactVolumeMask(source.validity ?? null, source.visibility ?? null, count) : null;
+  if (mask && mask.every((m) => m === 0xFF)) mask = null;
+  const masked = mask !== null;
   const out = {
-    encoding: source.encoding, layout, texelsPerProbe: texels, gpuBytesPerProbe: 16 * texels, gpuBytes: data.byteLength,
-    size: [counts[0] * texels, counts[1], counts[2]], data, grid: { origin: [...origin], spacing: [...spacing], counts: [...counts] },
-    normalAxes, glsl: zhcVolumeGlsl({ encoding: source.encoding, params: source.params, normalAxes }),
+    encoding: source.encoding, layout, texelsPerProbe: texels, gpuBytesPerProbe: 16 * texels + (masked ? 1 : 0),
+    gpuBytes: data.byteLength + (masked ? mask.byteLength : 0),
+    size: [counts[0] * texels, counts[1], counts[2]], data, masked, mask, maskBytes: masked ? mask.byteLength : 0,
+    grid: { origin: [...origin], spacing: [...spacing], counts: [...counts] },
+    normalAxes, glsl: zhcVolumeGlsl({ encoding: source.encoding, params: source.params, normalAxes, masked }),
   };
   let m = matrixWorld?.elements ?? matrixWorld;
   if (!m && !isZhp && source.nodes?.length === 1) {
@@ -250,6 +312,19 @@ export function compactVolume(source, { THREE, matrixWorld } = {}) {
       zhcWorldToVolume: { value: new THREE.Matrix4().fromArray(out.worldToGrid) },
       zhcWorldNormalToVolume: { value: new THREE.Matrix3().setFromMatrix4(new THREE.Matrix4().fromArray(m)).transpose() },
     };
+    if (masked) {
+      // The combined mask bytes: one R8UI texel per probe, (x, y, z) at texel (x, y, z).
+      const mtex = new THREE.Data3DTexture(mask, counts[0], counts[1], counts[2]);
+      mtex.format = THREE.RedIntegerFormat;
+      mtex.type = THREE.UnsignedByteType;
+      mtex.internalFormat = 'R8UI';
+      mtex.minFilter = mtex.magFilter = THREE.NearestFilter;
+      mtex.generateMipmaps = false;
+      mtex.unpackAlignment = 1;
+      mtex.needsUpdate = true;
+      out.maskTexture = mtex;
+      out.uniforms.zhcVolumeMaskTex = { value: mtex };
+    }
   }
   return out;
 }
@@ -266,7 +341,7 @@ export function patchMaterialWithVolume(material, compact, THREE) {
   const decl = `precision highp usampler3D;
 ${compact.glsl}
 uniform highp usampler3D zhcVolumeTex;
-uniform ZhcVolume zhcVolume;
+${compact.masked ? 'uniform highp usampler3D zhcVolumeMaskTex;\n' : ''}uniform ZhcVolume zhcVolume;
 uniform mat4 zhcWorldToVolume;
 uniform mat3 zhcWorldNormalToVolume;
 `;
@@ -274,7 +349,7 @@ uniform mat3 zhcWorldNormalToVolume;
 	{
 		vec3 zhcWorldPos = ( ( vec4( geometryPosition, 1.0 ) - viewMatrix[ 3 ] ) * viewMatrix ).xyz;
 		vec3 zhcWorldNormal = transformNormalByInverseViewMatrix( geometryNormal, viewMatrix );
-		irradiance += PI * zhcVolumeIrradiance( zhcVolumeTex, zhcVolume, ( zhcWorldToVolume * vec4( zhcWorldPos, 1.0 ) ).xyz,
+		irradiance += PI * zhcVolumeIrradiance( zhcVolumeTex, ${compact.masked ? 'zhcVolumeMaskTex, ' : ''}zhcVolume, ( zhcWorldToVolume * vec4( zhcWorldPos, 1.0 ) ).xyz,
 			zhcWorldNormalToVolume * zhcWorldNormal );
 	}`;
   const previous = material.onBeforeCompile;

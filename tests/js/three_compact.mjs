@@ -3,21 +3,38 @@
 //
 //  1. zhc writes the grids: `zhc demo` (probes.glb: the 8x8x4 zh3_q16 grid, glTF; probes_sh3.zhp,
 //     probes_zh3_q16.zhp: the same probes) and `zhc convert probes_sh3.zhp` to sh3_q28, sh2_q and
-//     zh3_channel_q16 with non-default parameters (6 bits, sqrt, RGB9E5 DC);
+//     zh3_channel_q16 with non-default parameters (6 bits, sqrt, RGB9E5 DC); `zhc bake` of a small
+//     scene whose 4x4x3 grid a wall cuts between two probe columns (visibility masks) and a box
+//     encloses one probe (invalid): zh3_q16 (.glb and .zhp) and sh3_q28 (.zhp), the masked ones;
+//     and the demo's zh3_q16 .zhp with synthetic masks handed to compactVolume (random invalid
+//     probes and cleared bits; the bottom two probe layers fully masked, so that their cells take
+//     the all-masked fallback, the plain weights);
 //  2. 24 samples per volume: 20 points q random inside the grid's box, 4 outside it (clamped),
 //     random unit directions d, in the volume's frame (glb: node-local glTF axes; .zhp: zhc axes);
+//     on the masked grids no coordinate within 1e-3 of a cell face (a masked blend is not
+//     continuous across cell faces, so float32 and double could pick different cells there);
 //  3. headless Chromium (SwiftShader WebGL2) runs tests/js/browser/three_compact_page.mjs: the stored
 //     bytes in an RGBA32UI Data3DTexture (compactVolume), (A) a ShaderMaterial writing
 //     zhcVolumeIrradiance per sample, (B) white spheres with a MeshLambertMaterial patched by
 //     patchMaterialWithVolume (pole at q in world space, normal d), both to RGBA32F targets;
 //  4. the C header (tests/runtime_c/zhc_volume_sample: zhc_volume_from_zhp + zhc_volume_irradiance)
-//     gives E(q, d) from the .zhp (the glb's samples converted to zhc axes).
+//     gives E(q, d) from the .zhp (the glb's samples converted to zhc axes), with the masks (the
+//     masked volumes) or without them (`--plain`: the demo's grids, which have none, and the baked
+//     .zhp built with `masks: false`); for the synthetic masks the JS runtime's volumeIrradiance
+//     with them (the C header's doubles in the same order, bit for bit: js.runtime_volume), and in
+//     the fully masked cells the plain C header, bit for bit;
+//  5. masks: compactVolume's combined mask texture against a twin (glb: the .zhp's masks with axes
+//     and bits permuted to glTF), the masked C header differs from the plain one by more than the
+//     tolerance at >= 4 samples of each masked grid (ignoring the masks would fail), and in Node
+//     (no browser) the chunk's text: unchanged without masks, `masks: false` = no masks.
 //
 // Tolerance: the error model of the GLSL volume test (tests/test_runtime_gl.cpp, compare_volumes):
 // |pixel - E| <= (48 + 3 X) u S per channel, u = 2^-24, S = the sum over the cell's corners of
 // each probe's irradiance scale (kY00 m0 + 2/3 kY1 (m1 + m2 + m3) + L2 part, m_i the coefficient
 // magnitude or its ratio bound times the DC; ZH3's zonal part grows with the axis' condition
 // number), X = sum over axes of (|p| + |o|) / s + t + 2 (the float grid coordinate's error).
+// Masked: the kept weights are divided by their sum M (<= 1), which scales their errors by up to
+// 1 / M: X / M (the division's own rounding is a few u, inside the 48).
 // (C) patched MeshStandardMaterial against its LightProbe twin: 2e-5 k T, T = sum_i s_l |c_i Y_i(n)|
 // of the blended SH3 (>= |E|), k the material's pixel per unit E (fitted per channel over the
 // samples): three.js's 6-digit irradiance constants (relative <= 2.0e-6) and float32 shading, as
@@ -31,7 +48,8 @@ import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { makeRand, checker } from './fixtures.mjs';
 import { chromiumPages } from './chromium_page.mjs';
-import { parseZhp, decodeAll, kY00, kY1, kY20 } from '../../runtime/web/zhc_runtime.mjs';
+import { parseZhp, decodeAll, makeVolume, volumeIrradiance, kY00, kY1, kY20 } from '../../runtime/web/zhc_runtime.mjs';
+import { zhcVolumeGlsl, compactVolume, compactVolumeMask } from '../../runtime/web/zhc_volume.glsl.mjs';
 
 const [zhc, sampler, workArg, chromiumArg] = process.argv.slice(2);
 if (!zhc || !sampler || !workArg) {
@@ -56,17 +74,53 @@ fs.copyFileSync(W('demo/probes.glb'), W('demo_probes.glb'));
 run('convert', W('demo/probes_sh3.zhp'), '-o', W('demo_sh3_q28.zhp'), '-r', 'sh3_q28');
 run('convert', W('demo/probes_sh3.zhp'), '-o', W('demo_sh2_q.zhp'), '-r', 'sh2_q');
 run('convert', W('demo/probes_sh3.zhp'), '-o', W('demo_zh3_channel.zhp'), '-r', 'zh3_channel_q16', '--bits', '6', '--sqrt', '--dc', 'rgb9e5');
+// A baked grid with masks: probes at x = -1, -1/3, 1/3, 1; a double-sided wall at x = 0.2 cuts the
+// middle column of cells (the x = 1/3 probes are hidden from them: visibility bits cleared), the
+// point light sits on the wall's +x side, the blue sphere light on its -x side; the box encloses
+// probe (1, -1, 0) (invalid). invalid_fraction 0.6: the single-sided wall's back face (at most half
+// a probe's rays) invalidates no probe, only the box does.
+fs.writeFileSync(W('masked_scene.json'), JSON.stringify({
+  version: 1, probes: { grid: { min: [-1, -1, 0], max: [1, 1, 1.5], counts: [4, 4, 3] } }, sky: { type: 'gradient' },
+  occlusion: { invalid_fraction: 0.6 },
+  lights: [{ type: 'point', position: [0.7, 0.1, 0.8], intensity: [8, 6.4, 4.8], shadows: true },
+    { type: 'sphere', center: [-0.7, 0.8, 1.2], radius: 0.15, radiance: [3, 6, 40], shadows: true }],
+  occluders: [{ type: 'mesh', positions: [0.2, -2, -1, 0.2, 2, -1, 0.2, 2, 3, 0.2, -2, 3], indices: [0, 1, 2, 0, 2, 3] },
+    { type: 'box', min: [0.8, -1.2, -0.2], max: [1.2, -0.8, 0.2] }],
+}));
+run('bake', W('masked_scene.json'), '-o', W('baked_masked.glb'), '--to', 'zh3_q16', '--quiet');
+run('bake', W('masked_scene.json'), '-o', W('baked_masked.zhp'), '--to', 'zh3_q16', '--quiet');
+run('bake', W('masked_scene.json'), '-o', W('baked_masked_sh3_q28.zhp'), '--to', 'sh3_q28', '--quiet');
 
 const volumes = [
   { name: 'demo zh3_q16 (glb)', glb: 'demo_probes.glb', ref: W('demo/probes_zh3_q16.zhp'), gltf: true, rootTranslation: [0.7, -0.4, 1.3], rootScale: 1.25, seed: 21 },
   { name: 'demo sh3_q28 (.zhp)', zhp: 'demo_sh3_q28.zhp', ref: W('demo_sh3_q28.zhp'), gltf: false, rootTranslation: [-1, 0.5, 2], rootScale: 0.8, seed: 22 },
   { name: 'demo sh2_q (.zhp)', zhp: 'demo_sh2_q.zhp', ref: W('demo_sh2_q.zhp'), gltf: false, rootTranslation: [0.3, 1.5, -0.5], rootScale: 1.5, seed: 23 },
   { name: 'demo zh3_channel_q16 6 bits sqrt rgb9e5 (.zhp)', zhp: 'demo_zh3_channel.zhp', ref: W('demo_zh3_channel.zhp'), gltf: false, rootTranslation: [2, -1, 0.5], rootScale: 1.1, seed: 24 },
+  { name: 'demo zh3_q16 synthetic masks (.zhp)', zhp: 'demo/probes_zh3_q16.zhp', ref: W('demo/probes_zh3_q16.zhp'), gltf: false, masked: true, synthetic: 31, rootTranslation: [-0.5, 0.3, 0.9], rootScale: 0.7, seed: 28 },
+  { name: 'baked masked zh3_q16 (glb)', glb: 'baked_masked.glb', ref: W('baked_masked.zhp'), gltf: true, masked: true, rootTranslation: [-0.6, 0.9, 0.4], rootScale: 1.3, seed: 25 },
+  { name: 'baked masked zh3_q16 (.zhp)', zhp: 'baked_masked.zhp', ref: W('baked_masked.zhp'), gltf: false, masked: true, rootTranslation: [1.2, 0.2, -0.7], rootScale: 0.9, seed: 26 },
+  { name: 'baked masked sh3_q28 (.zhp)', zhp: 'baked_masked_sh3_q28.zhp', ref: W('baked_masked_sh3_q28.zhp'), gltf: false, masked: true, rootTranslation: [0.4, -0.8, 1.1], rootScale: 1.2, seed: 27 },
+  // The same baked .zhp with compactVolume(..., { masks: false }): the plain blend.
+  { name: 'baked zh3_q16 masks: false (.zhp)', zhp: 'baked_masked.zhp', ref: W('baked_masked.zhp'), gltf: false, masked: false, masksOff: true, rootTranslation: [1.2, 0.2, -0.7], rootScale: 0.9, seed: 26 },
 ];
 const toZhc = (v) => [v[2], v[0], v[1]];  // glTF (x, y, z) = zhc (y, z, x)
 const SAMPLES = 24, OUTSIDE = 4;
 for (const v of volumes) {
-  const z = parseZhp(new Uint8Array(fs.readFileSync(v.ref)));
+  let z = parseZhp(new Uint8Array(fs.readFileSync(v.ref)));
+  if (v.synthetic) {
+    // ~15 % invalid probes, each visibility bit cleared with probability 0.3; probes of the two
+    // lowest z layers (zhc axes) fully masked: every corner of a cell with i0_z = 0 is dropped.
+    const mr = makeRand(v.synthetic), [nx, ny] = z.grid.counts;
+    const validity = new Uint8Array(z.count), visibility = new Uint8Array(z.count);
+    for (let p = 0; p < z.count; p++) {
+      validity[p] = mr() < 0.15 ? 0 : 1;
+      for (let j = 0; j < 8; j++) if (mr() >= 0.3) visibility[p] |= 1 << j;
+      if (Math.floor(p / (nx * ny)) < 2) visibility[p] = 0;
+    }
+    z = { ...z, validity, visibility };
+    v.validity = Array.from(validity);
+    v.visibility = Array.from(visibility);
+  }
   v.zhpInfo = z;
   v.sh = decodeAll(z.encoding, z.payload, z.count, z.params);
   // The grid in the sample frame: zhc axes permuted to glTF for the glb (its grid is glTF's).
@@ -75,14 +129,22 @@ for (const v of volumes) {
   const frame = { origin: perm(g.origin), spacing: perm(g.spacing), counts: perm(g.counts) };
   const rand = makeRand(v.seed);
   v.samples = [];
+  // Grid coordinate of q along axis c strictly inside the box and within 1e-3 of a cell face.
+  const nearFace = (q) => q.some((x, c) => {
+    const t = (x - frame.origin[c]) / frame.spacing[c];
+    return t > 0 && t < frame.counts[c] - 1 && Math.abs(t - Math.round(t)) < 1e-3;
+  });
   for (let i = 0; i < SAMPLES; i++) {
     const out = i >= SAMPLES - OUTSIDE;
-    const q = [0, 1, 2].map((c) => {
-      const size = (frame.counts[c] - 1) * frame.spacing[c];
-      const t = out ? -0.2 + 1.4 * rand() : 0.02 + 0.96 * rand();
-      return f32(frame.origin[c] + size * t);
-    });
-    if (out) q[i % 3] = f32(frame.origin[i % 3] + (i % 2 ? -0.3 : 1.3) * (frame.counts[i % 3] - 1) * frame.spacing[i % 3]);
+    let q;
+    do {
+      q = [0, 1, 2].map((c) => {
+        const size = (frame.counts[c] - 1) * frame.spacing[c];
+        const t = out ? -0.2 + 1.4 * rand() : 0.02 + 0.96 * rand();
+        return f32(frame.origin[c] + size * t);
+      });
+      if (out) q[i % 3] = f32(frame.origin[i % 3] + (i % 2 ? -0.3 : 1.3) * (frame.counts[i % 3] - 1) * frame.spacing[i % 3]);
+    } while ((v.masked || v.masksOff) && nearFace(q));
     const zz = 2 * rand() - 1, phi = 2 * Math.PI * rand(), r = Math.sqrt(Math.max(0, 1 - zz * zz));
     const d = [r * Math.cos(phi), r * Math.sin(phi), zz];
     const len = Math.hypot(...d);
@@ -90,16 +152,83 @@ for (const v of volumes) {
   }
 }
 fs.writeFileSync(W('three_compact_spec.json'), JSON.stringify({
-  volumes: volumes.map(({ name, glb, zhp, rootTranslation, rootScale, samples }) => ({ name, glb, zhp, rootTranslation, rootScale, samples })),
+  volumes: volumes.map(({ name, glb, zhp, masksOff, validity, visibility, rootTranslation, rootScale, samples }) =>
+    ({ name, glb, zhp, masks: !masksOff, validity, visibility, rootTranslation, rootScale, samples })),
 }));
 
-// The C header at the samples (zhc axes).
+// The C header at the samples (zhc axes): masked (its default) for the masked volumes, plain
+// (--plain) for the others; both for the baked grid.
 for (const v of volumes) {
   const file = W('points.txt');
   const pts = v.samples.map(({ q, d }) => (v.gltf ? [...toZhc(q), ...toZhc(d)] : [...q, ...d]));
   v.zhcPoints = pts;
   fs.writeFileSync(file, pts.map((p) => p.map((x) => x.toPrecision(9)).join(' ')).join('\n') + '\n');
-  v.expected = execFileSync(sampler, [v.ref, file]).toString().trim().split('\n').map((l) => l.trim().split(/\s+/).map((x) => f32(Number(x))));
+  const sample = (plain) => execFileSync(sampler, [v.ref, file, ...(plain ? ['--plain'] : [])]).toString().trim().split('\n')
+    .map((l) => l.trim().split(/\s+/).map((x) => f32(Number(x))));
+  if (v.synthetic) {
+    // No .zhp holds these masks: the JS runtime's twin of zhc_volume_irradiance applies them.
+    const z = v.zhpInfo;
+    const vol = makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, validity: z.validity, visibility: z.visibility });
+    v.expected = pts.map((p) => volumeIrradiance(vol, p.slice(0, 3), p.slice(3)));
+    v.expectedMasked = v.expected;
+    v.expectedPlain = sample(true);
+    // Cells with i0_z = 0 (t_z < 1, clamped) have every corner masked: the plain blend, bit for bit.
+    let fallback = 0, same = 0;
+    pts.forEach((p, i) => {
+      if ((p[2] - z.grid.origin[2]) / z.grid.spacing[2] >= 1) return;
+      fallback++;
+      if (v.expected[i].every((x, k) => x === v.expectedPlain[i][k])) same++;
+    });
+    console.log(`${v.name}: ${fallback} samples in fully masked cells, ${same} equal to the plain C header bit for bit`);
+    check(fallback >= 4 && same === fallback, `${v.name}: ${same} of ${fallback} samples in fully masked cells equal the plain C header bit for bit (>= 4)`);
+    continue;
+  }
+  v.expected = sample(!v.masked);
+  if (v.masked || v.masksOff) {
+    v.expectedMasked = v.masked ? v.expected : sample(false);
+    v.expectedPlain = v.masked ? sample(true) : v.expected;
+  }
+}
+
+// --- 1b. Node (no browser): the chunk's text and the combined mask bytes ----------------------------
+{
+  const z = volumes.find((x) => x.name === 'baked masked zh3_q16 (.zhp)').zhpInfo;
+  check(!!z.validity && !!z.visibility && z.validity.some((x) => x === 0) && z.visibility.some((x) => x !== 0xFF),
+    'the baked grid has an invalid probe and visibility masks other than 0xFF');
+  const invalid = Array.from(z.validity).filter((x) => x === 0).length;
+  const cut = Array.from(z.visibility).filter((x) => x !== 0xFF).length;
+  console.log(`baked grid ${z.grid.counts.join('x')}: ${invalid} invalid probe(s), ${cut} probes with visibility bits cleared`);
+  for (const encoding of ['zh3_q16', 'sh3_q28', 'sh2_q', 'zh3_channel_q16'])
+    for (const normalAxes of ['same', 'gltf']) {
+      const plain = zhcVolumeGlsl({ encoding, params: z.params, normalAxes });
+      const off = zhcVolumeGlsl({ encoding, params: z.params, normalAxes, masked: false });
+      const on = zhcVolumeGlsl({ encoding, params: z.params, normalAxes, masked: true });
+      check(plain === off && !/MASK|maskTex/.test(plain), `${encoding} ${normalAxes}: the unmasked chunk has no mask code`);
+      check(on.includes('#define ZHC_VOLUME_MASKED 1') && on.includes('zhcVolumeSh3(highp usampler3D tex, highp usampler3D maskTex, ZhcVolume v')
+        && on.includes('zhcVolumeIrradiance(highp usampler3D tex, highp usampler3D maskTex, ZhcVolume v'), `${encoding} ${normalAxes}: the masked chunk takes the mask sampler`);
+      // The masked chunk is the unmasked one plus lines: removing the added lines gives it back.
+      const a = plain.split('\n'), b = on.split('\n');
+      let j = 0;
+      for (const line of b) if (j < a.length && (line === a[j] || line.replace('highp usampler3D maskTex, ', '').replace('maskTex, ', '') === a[j])) j++;
+      check(j === a.length, `${encoding} ${normalAxes}: the masked chunk keeps every line of the plain one in order`);
+    }
+  const cm = compactVolume(z), cmOff = compactVolume(z, { masks: false });
+  const cmNone = compactVolume({ ...z, validity: null, visibility: null });
+  const cmFF = compactVolume({ ...z, validity: new Uint8Array(z.count).fill(1), visibility: new Uint8Array(z.count).fill(0xFF) });
+  check(cm.masked === true && cm.glsl.includes('ZHC_VOLUME_MASKED') && cm.maskBytes === z.count && cm.gpuBytes === 17 * z.count && cm.gpuBytesPerProbe === 17,
+    `compactVolume of the baked .zhp is masked, ${cm.gpuBytes} GPU bytes (${cm.gpuBytesPerProbe} per probe)`);
+  check(!cmOff.masked && cmOff.mask === null && cmOff.glsl === cmNone.glsl && cmOff.gpuBytes === 16 * z.count && cmOff.gpuBytesPerProbe === 16,
+    'masks: false gives the chunk and bytes of a grid without masks');
+  check(!cmFF.masked && cmFF.glsl === cmNone.glsl, 'all-valid, all-0xFF masks give the plain chunk');
+  const twin = Array.from({ length: z.count }, (_, p) => (z.validity[p] === 0 ? 0 : z.visibility[p]));
+  check(Array.from(cm.mask).every((m, p) => m === twin[p]), 'the combined mask bytes are valid ? visibility : 0 probe by probe');
+  check(Array.from(compactVolumeMask(null, z.visibility, z.count)).every((m, p) => m === z.visibility[p]) &&
+    Array.from(compactVolumeMask(z.validity, null, z.count)).every((m, p) => m === (z.validity[p] ? 0xFF : 0)) &&
+    compactVolumeMask(null, null, z.count) === null, 'absent validity counts as valid, absent visibility as 0xFF');
+  const throws = (fn, re) => { try { fn(); return false; } catch (e) { return re.test(e.message); } };
+  check(throws(() => compactVolume(z, { masks: 'no' }), /masks must be/) &&
+    throws(() => compactVolume({ ...z, visibility: z.visibility.subarray(0, 5) }), /visibility has 5 bytes/),
+    'compactVolume refuses a non-boolean masks option and short mask bytes');
 }
 
 // Irradiance scale of one decoded probe (tests/gl/runtime_gl_entries.inl probe_scale, packed
@@ -140,7 +269,8 @@ function probeScale(z, sh, p) {
     return kY00 * m[0][k] + (2 / 3) * kY1 * (m[1][k] + m[2][k] + m[3][k]) + 0.25 * l2;
   });
 }
-// S (sum over the cell's corners) and X (the weight-error factor) of a point in zhc axes.
+// S (sum over the cell's corners) and X (the weight-error factor) of a point in zhc axes; M the sum
+// of the masked weights (1 without masks, or when every corner is masked: the plain weights).
 function errorModel(v, pz) {
   const g = v.zhpInfo.grid, i0 = [], extra = [0];
   for (let c = 0; c < 3; c++) {
@@ -149,13 +279,24 @@ function errorModel(v, pz) {
     extra[0] += (Math.abs(pz[c]) + Math.abs(g.origin[c])) / g.spacing[c] + tt + 2;
   }
   const S = [0, 0, 0];
+  let M = 0;
+  const z = v.zhpInfo;
   for (let b = 0; b < 8; b++) {
     const q = [i0[0] + (b & 1), i0[1] + ((b >> 1) & 1), i0[2] + (b >> 2)];
     if (q.some((x, c) => x >= g.counts[c])) continue;
-    const s = probeScale(v.zhpInfo, v.sh, q[0] + g.counts[0] * (q[1] + g.counts[1] * q[2]));
+    const p = q[0] + g.counts[0] * (q[1] + g.counts[1] * q[2]);
+    const s = probeScale(z, v.sh, p);
     for (let k = 0; k < 3; k++) S[k] += s[k];
+    let w = 1;
+    for (let c = 0; c < 3; c++) {
+      const tt = Math.min(Math.max((pz[c] - g.origin[c]) / g.spacing[c], 0), g.counts[c] - 1), f = g.counts[c] >= 2 ? tt - i0[c] : 0;
+      w *= (q[c] - i0[c]) ? f : 1 - f;
+    }
+    const keep = (!z.validity || z.validity[p]) && (!z.visibility || ((z.visibility[p] >> (7 - b)) & 1));
+    if (keep) M += w;
   }
-  return { S, X: extra[0] };
+  if (!v.masked || !(M > 0)) M = 1;
+  return { S, X: extra[0] / M, M };
 }
 
 // --- 3. Chromium ---------------------------------------------------------------------------------
@@ -179,10 +320,29 @@ for (const r of report.volumes ?? []) {
   const v = volumes.find((x) => x.name === r.name);
   const z = v.zhpInfo;
   const texels = z.encoding === 'sh3_q28' ? 2 : 1;
-  check(r.count === z.count && r.gpuBytes === 16 * texels * z.count && r.textureBytes === r.gpuBytes,
-    `${r.name}: the texture holds ${16 * texels} bytes per probe (${r.gpuBytes} for ${r.count} probes)`);
+  const maskBytes = v.masked ? z.count : 0;
+  check(r.count === z.count && r.textureBytes === 16 * texels * z.count && r.gpuBytes === r.textureBytes + maskBytes &&
+    r.maskTextureBytes === maskBytes && r.maskBytes === maskBytes && r.gpuBytesPerProbe === 16 * texels + (v.masked ? 1 : 0),
+    `${r.name}: the texture holds ${16 * texels} bytes per probe, the mask texture ${v.masked ? 1 : 0} (${r.gpuBytes} for ${r.count} probes)`);
   const [nx, ny, nz] = v.gltf ? [z.grid.counts[1], z.grid.counts[2], z.grid.counts[0]] : z.grid.counts;
   check(r.size[0] === texels * nx && r.size[1] === ny && r.size[2] === nz, `${r.name}: texture ${r.size.join('x')} = (${texels} nx) x ny x nz`);
+  check(r.masked === !!v.masked && r.glslMasked === !!v.masked, `${r.name}: masked chunk and mask texture exactly when the volume has masks and keeps them (${r.masked})`);
+  if (v.masked) {
+    check(r.maskSize[0] === nx && r.maskSize[1] === ny && r.maskSize[2] === nz, `${r.name}: mask texture ${r.maskSize.join('x')} = nx x ny x nz`);
+    // Twin of the combined bytes from the .zhp (zhc axes); the glb's grid is glTF's: glTF probe
+    // (gx, gy, gz) is zhc probe (gz, gx, gy), and glTF side (cx, cy, cz) is zhc side (cz, cx, cy).
+    const [NX, NY] = z.grid.counts;
+    const combined = (p) => (z.validity && !z.validity[p] ? 0 : z.visibility ? z.visibility[p] : 0xFF);
+    const want = [];
+    for (let gz = 0; gz < nz; gz++) for (let gy = 0; gy < ny; gy++) for (let gx = 0; gx < nx; gx++) {
+      if (!v.gltf) { want.push(combined(gx + nx * (gy + ny * gz))); continue; }
+      const m = combined(gz + NX * (gx + NY * gy));
+      let g = 0;
+      for (let j = 0; j < 8; j++) if ((m >> ((j >> 2) + 2 * (j & 1) + 4 * ((j >> 1) & 1))) & 1) g |= 1 << j;
+      want.push(g);
+    }
+    check(r.mask.length === want.length && r.mask.every((m, i) => m === want[i]), `${r.name}: the mask texture holds valid ? visibility : 0 per probe${v.gltf ? ' (glTF axes and bits)' : ''}`);
+  }
   check(r.normalAxes === (v.gltf ? 'gltf' : 'same'), `${r.name}: normals mapped to zhc axes only for the glTF volume (${r.normalAxes})`);
   if (v.gltf) {
     check(r.defaultMatrix === true, `${r.name}: compactVolume's default placement is the volume node's matrixWorld`);
@@ -201,11 +361,24 @@ for (const r of report.volumes ?? []) {
   check(r.unpatched.every((x) => x === 0), `${r.name}: the unpatched material renders black (only the volume lights the sphere)`);
   const st = () => ({ maxUnits: 0, maxRel: 0, sumRel: 0, n: 0, fails: 0 });
   const A = st(), B = st();
-  let meanE = 0, lit = 0;
+  let meanE = 0, lit = 0, moved = 0, movedMax = 0, movedRel = 0;
   v.samples.forEach((s, i) => {
     const E = v.expected[i];
     const { S, X } = errorModel(v, v.zhcPoints[i]);
     const boundA = 48 + 3 * X;
+    // The masks' effect: masked against plain C header, in the units of the comparison (the
+    // masked volume's bound: its X / M is the larger).
+    if (v.expectedMasked) {
+      const bound = 48 + 3 * errorModel({ ...v, masked: true }, v.zhcPoints[i]).X;
+      let over = false;
+      for (let k = 0; k < 3; k++) {
+        const d = Math.abs(v.expectedMasked[i][k] - v.expectedPlain[i][k]);
+        movedMax = Math.max(movedMax, d / (U * S[k]));
+        movedRel = Math.max(movedRel, d / Math.abs(v.expectedPlain[i][k]));
+        if (d > bound * U * S[k]) over = true;
+      }
+      if (over) moved++;
+    }
     let worldX = 0;
     const g = v.zhpInfo.grid;
     for (let c = 0; c < 3; c++) worldX += (r.worldMax + r.translationMax) / (r.scale * g.spacing[c]);
@@ -230,6 +403,10 @@ for (const r of report.volumes ?? []) {
   });
   // sh2_q (L1 only) rings below 0 on some back-facing normals; the others are lit everywhere.
   check(lit >= (z.encoding === 'sh2_q' ? 16 : SAMPLES), `${r.name}: ${lit} of ${SAMPLES} samples lit in every channel`);
+  if (v.expectedMasked) {
+    check(moved >= 4, `${r.name}: the masks move E beyond the tolerance at ${moved} of ${SAMPLES} samples (>= 4)`);
+    console.log(`  masks move the C header's E at ${moved} of ${SAMPLES} samples beyond the bound: max ${movedMax.toExponential(3)} u S (${(movedMax * U).toExponential(2)} S), relative ${movedRel.toExponential(2)}`);
+  }
   // (C) Standard: fitted pixel-per-E k and the twin comparison.
   let worstC = 0;
   for (let k = 0; k < 3; k++) {

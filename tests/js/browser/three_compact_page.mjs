@@ -10,8 +10,13 @@
 //      volumes, the zhc -> glTF axis rotation); the centre pixel of a 33 x 33 target shades the pole.
 //  (C) a patched MeshStandardMaterial (roughness 1, metalness 0) and, as its twin, the same material
 //      lit by a THREE.LightProbe holding zhc's blended SH3 at q (JS volumeSH3, three.js's basis).
+// A volume with validity / visibility masks gets the masked chunk and the R8UI mask texture (spec
+// `masks: false`: compactVolume's opt-out; spec `validity` / `visibility`: synthetic masks handed to
+// compactVolume with the parsed .zhp); the ShaderMaterial passes the mask sampler when the
+// chunk defines ZHC_VOLUME_MASKED, and the LightProbe twin blends with the same masks (volumeSH3).
 // Reported: the pixels, GPU bytes per probe of the compact texture and of three.js's own grid
-// (LightProbeGridWebGL atlas via the plugin's lightProbeGrid, float and binary16), refusals.
+// (LightProbeGridWebGL atlas via the plugin's lightProbeGrid, float and binary16), the mask
+// texture's bytes, refusals.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { LightProbeGridWebGL } from 'three/addons/lighting/LightProbeGridWebGL.js';
@@ -47,7 +52,7 @@ async function main() {
       root.add(gltf.scene);
       root.updateMatrixWorld(true);
       matrixWorld = v.nodes[0].matrixWorld.clone();
-      r.shVolume = makeVolume({ sh: v.sh, ...v.grid });
+      r.shVolume = makeVolume({ sh: v.sh, ...v.grid, validity: v.validity, visibility: v.visibility });
       compact = v.compactVolume();  // the plugin's method; default placement: the node's matrixWorld
       r.defaultMatrix = compact.matrixWorld.every((x, i) => x === matrixWorld.elements[i]);
       const gridF = v.lightProbeGrid(LightProbeGridWebGL);
@@ -72,8 +77,16 @@ async function main() {
       const bytes = new Uint8Array(await (await fetch(`/work/${f.zhp}`)).arrayBuffer());
       root.updateMatrixWorld(true);
       matrixWorld = root.matrixWorld.clone().multiply(ZHC_TO_GLTF);
-      compact = compactVolumeFromZhp(bytes, { THREE, matrixWorld });
-      r.shVolume = volumeFromZhp(bytes);
+      const z = parseZhp(bytes);
+      if (f.validity) {
+        // Synthetic masks (the spec's arrays) on a .zhp without any: the source object carries them.
+        const masks = { validity: Uint8Array.from(f.validity), visibility: Uint8Array.from(f.visibility) };
+        compact = compactVolume({ ...z, ...masks }, { THREE, matrixWorld });
+        r.shVolume = makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, ...masks });
+      } else {
+        compact = compactVolumeFromZhp(bytes, { THREE, matrixWorld, masks: f.masks });
+        r.shVolume = f.masks ? volumeFromZhp(bytes) : makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid });
+      }
       r.count = parseZhp(bytes).count;
     }
     r.encoding = compact.encoding;
@@ -82,6 +95,12 @@ async function main() {
     r.textureBytes = compact.texture.image.data.byteLength;
     r.size = compact.size;
     r.normalAxes = compact.normalAxes;
+    r.masked = compact.masked;
+    r.glslMasked = compact.glsl.includes('#define ZHC_VOLUME_MASKED 1');
+    r.maskBytes = compact.maskBytes;
+    r.maskTextureBytes = compact.maskTexture ? compact.maskTexture.image.data.byteLength : 0;
+    r.maskSize = compact.maskTexture ? [compact.maskTexture.image.width, compact.maskTexture.image.height, compact.maskTexture.image.depth] : null;
+    r.mask = compact.mask ? Array.from(compact.mask) : null;
 
     // (A) ShaderMaterial, one pixel per sample.
     const N = f.samples.length;
@@ -97,13 +116,19 @@ async function main() {
 ${compact.glsl}
 uniform highp sampler2D uSamples;
 uniform highp usampler3D zhcVolumeTex;
+#ifdef ZHC_VOLUME_MASKED
+uniform highp usampler3D zhcVolumeMaskTex;
+#define ZHC_MASK_ARG zhcVolumeMaskTex,
+#else
+#define ZHC_MASK_ARG
+#endif
 uniform ZhcVolume zhcVolume;
 out highp vec4 zhcOut;
 void main() {
   int i = int(gl_FragCoord.x);
   vec3 q = texelFetch(uSamples, ivec2(0, i), 0).xyz;
   vec3 d = texelFetch(uSamples, ivec2(1, i), 0).xyz;
-  zhcOut = vec4(zhcVolumeIrradiance(zhcVolumeTex, zhcVolume, q, d), 1.0);
+  zhcOut = vec4(zhcVolumeIrradiance(zhcVolumeTex, ZHC_MASK_ARG zhcVolume, q, d), 1.0);
 }`,
     });
     const quad = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
