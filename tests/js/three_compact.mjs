@@ -91,11 +91,13 @@ run('bake', W('masked_scene.json'), '-o', W('baked_masked.glb'), '--to', 'zh3_q1
 run('bake', W('masked_scene.json'), '-o', W('baked_masked.zhp'), '--to', 'zh3_q16', '--quiet');
 run('bake', W('masked_scene.json'), '-o', W('baked_masked_sh3_q28.zhp'), '--to', 'sh3_q28', '--quiet');
 
+// The demo's grids carry the bake's own masks (a few hidden bits near its occluders: `fewMasks`,
+// so the masks need not move E at 4 of the samples there).
 const volumes = [
-  { name: 'demo zh3_q16 (glb)', glb: 'demo_probes.glb', ref: W('demo/probes_zh3_q16.zhp'), gltf: true, rootTranslation: [0.7, -0.4, 1.3], rootScale: 1.25, seed: 21 },
-  { name: 'demo sh3_q28 (.zhp)', zhp: 'demo_sh3_q28.zhp', ref: W('demo_sh3_q28.zhp'), gltf: false, rootTranslation: [-1, 0.5, 2], rootScale: 0.8, seed: 22 },
-  { name: 'demo sh2_q (.zhp)', zhp: 'demo_sh2_q.zhp', ref: W('demo_sh2_q.zhp'), gltf: false, rootTranslation: [0.3, 1.5, -0.5], rootScale: 1.5, seed: 23 },
-  { name: 'demo zh3_channel_q16 6 bits sqrt rgb9e5 (.zhp)', zhp: 'demo_zh3_channel.zhp', ref: W('demo_zh3_channel.zhp'), gltf: false, rootTranslation: [2, -1, 0.5], rootScale: 1.1, seed: 24 },
+  { name: 'demo zh3_q16 (glb)', masked: true, fewMasks: true, glb: 'demo_probes.glb', ref: W('demo/probes_zh3_q16.zhp'), gltf: true, rootTranslation: [0.7, -0.4, 1.3], rootScale: 1.25, seed: 21 },
+  { name: 'demo sh3_q28 (.zhp)', masked: true, fewMasks: true, zhp: 'demo_sh3_q28.zhp', ref: W('demo_sh3_q28.zhp'), gltf: false, rootTranslation: [-1, 0.5, 2], rootScale: 0.8, seed: 22 },
+  { name: 'demo sh2_q (.zhp)', masked: true, fewMasks: true, zhp: 'demo_sh2_q.zhp', ref: W('demo_sh2_q.zhp'), gltf: false, rootTranslation: [0.3, 1.5, -0.5], rootScale: 1.5, seed: 23 },
+  { name: 'demo zh3_channel_q16 6 bits sqrt rgb9e5 (.zhp)', masked: true, fewMasks: true, zhp: 'demo_zh3_channel.zhp', ref: W('demo_zh3_channel.zhp'), gltf: false, rootTranslation: [2, -1, 0.5], rootScale: 1.1, seed: 24 },
   { name: 'demo zh3_q16 synthetic masks (.zhp)', zhp: 'demo/probes_zh3_q16.zhp', ref: W('demo/probes_zh3_q16.zhp'), gltf: false, masked: true, synthetic: 31, rootTranslation: [-0.5, 0.3, 0.9], rootScale: 0.7, seed: 28 },
   { name: 'baked masked zh3_q16 (glb)', glb: 'baked_masked.glb', ref: W('baked_masked.zhp'), gltf: true, masked: true, rootTranslation: [-0.6, 0.9, 0.4], rootScale: 1.3, seed: 25 },
   { name: 'baked masked zh3_q16 (.zhp)', zhp: 'baked_masked.zhp', ref: W('baked_masked.zhp'), gltf: false, masked: true, rootTranslation: [1.2, 0.2, -0.7], rootScale: 0.9, seed: 26 },
@@ -404,7 +406,7 @@ for (const r of report.volumes ?? []) {
   // sh2_q (L1 only) rings below 0 on some back-facing normals; the others are lit everywhere.
   check(lit >= (z.encoding === 'sh2_q' ? 16 : SAMPLES), `${r.name}: ${lit} of ${SAMPLES} samples lit in every channel`);
   if (v.expectedMasked) {
-    check(moved >= 4, `${r.name}: the masks move E beyond the tolerance at ${moved} of ${SAMPLES} samples (>= 4)`);
+    if (!v.fewMasks) check(moved >= 4, `${r.name}: the masks move E beyond the tolerance at ${moved} of ${SAMPLES} samples (>= 4)`);
     console.log(`  masks move the C header's E at ${moved} of ${SAMPLES} samples beyond the bound: max ${movedMax.toExponential(3)} u S (${(movedMax * U).toExponential(2)} S), relative ${movedRel.toExponential(2)}`);
   }
   // (C) Standard: fitted pixel-per-E k and the twin comparison.
