@@ -9,6 +9,7 @@
 #include "codec/bake/occluders.h"
 #include "codec/bake/scene.h"
 #include "formats/scene/scene_gltf.h"
+#include "formats/probes/probe_file.h"
 #include "formats/scene/scene_json.h"
 #include "support.h"
 #include "zhc_runtime.h"
@@ -440,43 +441,40 @@ TEST(VisibilityMasks, MatchTheSlowTwinOnTwoWalls) {
 
 // ---- the leak test ----------------------------------------------------------------------------
 
-// Reference volume sampling (the contract in codec/probe/probe_set.h): the cell containing p
-// (runtime/zhc_runtime.h's own zhc__volume_axis: coordinates clamped to the grid), corner weights
-// trilinear x valid(probe) x bit(7 - corner) of the probe's mask, renormalised; all eight zero:
-// the plain trilinear blend.
-Sh3Radiance sample_volume(const ProbeGrid& g, const std::vector<Sh3Radiance>& probes, const std::vector<std::uint8_t>* validity,
-                          const std::vector<std::uint8_t>* visibility, Vec3 p) {
-    std::uint32_t i0[3];
-    double f[3];
-    for (int a = 0; a < 3; ++a) zhc__volume_axis(p[a], g.origin[a], g.spacing[a], g.counts[static_cast<size_t>(a)], &i0[a], &f[a]);
-    double w[8], wsum = 0;
-    size_t index[8];
-    for (int c = 0; c < 8; ++c) {
-        const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
-        const double tri = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
-        index[c] = (i0[0] + dx) + size_t(g.counts[0]) * ((i0[1] + dy) + size_t(g.counts[1]) * (i0[2] + dz));
-        double wc = tri;
-        if (validity && !(*validity)[index[c]]) wc = 0;
-        if (visibility && !(((*visibility)[index[c]] >> (7 - c)) & 1)) wc = 0;
-        w[c] = wc;
-        wsum += wc;
+
+// The volume samples at `points` through the shipped data path: the grid's probes as an sh3 .zhp
+// with the given sections (version 2, serialize_probe_set), opened by runtime/zhc_runtime.h
+// (zhc_volume_from_zhp) and sampled with zhc_volume_sh3, which applies validity and masks
+// (docs/runtime.md "Validity and visibility"; its own twin: test_runtime_c_volume_leak.cpp).
+std::vector<Sh3Radiance> sample_volume(const ProbeGrid& g, const std::vector<Sh3Radiance>& probes,
+                                       const std::vector<std::uint8_t>* validity, const std::vector<std::uint8_t>* visibility,
+                                       const std::vector<Vec3>& points) {
+    ProbeLayout layout;
+    layout.kind = ProbeLayoutKind::kGrid;
+    layout.grid = g;
+    auto set = encode_probe_set(probes, "sh3", CodecOptions{}, layout);
+    EXPECT_TRUE(bool(set));
+    if (!set) return {};
+    if (validity) set->validity = *validity;
+    if (visibility) set->visibility = *visibility;
+    auto bytes = serialize_probe_set(*set);
+    EXPECT_TRUE(bool(bytes));
+    if (!bytes) return {};
+    zhc_volume v;
+    EXPECT_EQ(zhc_volume_from_zhp(&v, bytes->data(), bytes->size()), ZHC_OK);
+    EXPECT_EQ(v.validity != nullptr, validity != nullptr);
+    EXPECT_EQ(v.visibility != nullptr, visibility != nullptr);
+    std::vector<Sh3Radiance> out;
+    for (const Vec3& p : points) {
+        const double pos[3] = {p[0], p[1], p[2]};
+        double sh[27];
+        zhc_volume_sh3(&v, pos, sh);
+        Sh3Radiance r;
+        for (int i = 0; i < 9; ++i)
+            for (int k = 0; k < 3; ++k) r[i][k] = static_cast<float>(sh[i * 3 + k]);
+        out.push_back(r);
     }
-    if (wsum == 0) {  // fallback: plain trilinear
-        for (int c = 0; c < 8; ++c) {
-            const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
-            w[c] = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
-        }
-        wsum = 1;
-    }
-    double acc[27] = {};
-    for (int c = 0; c < 8; ++c)
-        if (w[c] != 0)
-            for (int i = 0; i < 9; ++i)
-                for (int k = 0; k < 3; ++k) acc[i * 3 + k] += w[c] / wsum * probes[index[c]][i][k];
-    Sh3Radiance r;
-    for (int i = 0; i < 9; ++i)
-        for (int k = 0; k < 3; ++k) r[i][k] = static_cast<float>(acc[i * 3 + k]);
-    return r;
+    return out;
 }
 
 struct LeakStats {
@@ -544,12 +542,11 @@ LeakResult measure_leak(const Scene& scene, const char* label) {
     const auto truth = bake(truth_scene, 2);
     EXPECT_EQ(truth.size(), points.size());
     if (truth.size() != points.size()) return {};
-    std::vector<Sh3Radiance> plain, valid_only, masked;
-    for (const Vec3& p : points) {
-        plain.push_back(sample_volume(g, probes, nullptr, nullptr, p));
-        valid_only.push_back(sample_volume(g, probes, &leak.validity, nullptr, p));
-        masked.push_back(sample_volume(g, probes, &leak.validity, &leak.visibility, p));
-    }
+    const std::vector<Sh3Radiance> plain = sample_volume(g, probes, nullptr, nullptr, points);
+    const std::vector<Sh3Radiance> valid_only = sample_volume(g, probes, &leak.validity, nullptr, points);
+    const std::vector<Sh3Radiance> masked = sample_volume(g, probes, &leak.validity, &leak.visibility, points);
+    EXPECT_EQ(masked.size(), points.size());
+    if (masked.size() != points.size()) return {};
     const LeakResult r{leak_stats(plain, truth), leak_stats(valid_only, truth), leak_stats(masked, truth)};
     std::printf("%s, %zu dark-side points: relative SH error mean / p95, leaked energy (excess L00 / true L00)\n", label, points.size());
     std::printf("  (a) plain trilinear   %8.3f  %8.3f  %8.3f\n", r.plain.mean, r.plain.p95, r.plain.leaked);
