@@ -53,10 +53,11 @@ Sh27 twin_sh3(const ProbeSet& set, const std::vector<Sh3Radiance>& hub, const do
         for (int c = 0; c < 3; ++c) w[corner] *= d[c] ? f[c] : 1 - f[c];
         idx[corner] = (i0[0] + std::uint32_t(d[0])) +
                       size_t(g.counts[0]) * ((i0[1] + std::uint32_t(d[1])) + size_t(g.counts[1]) * (i0[2] + std::uint32_t(d[2])));
-        const bool valid = set.validity.empty() || set.validity[idx[corner]] == 1;
+        // A corner of weight 0 is never read: on an axis of one probe its index lies past the grid.
         const int bit = 7 - (d[0] + 2 * d[1] + 4 * d[2]);
-        const bool seen = set.visibility.empty() || ((set.visibility[idx[corner]] >> bit) & 1);
-        m[corner] = w[corner] != 0 && valid && seen ? w[corner] : 0.0;
+        const bool valid = w[corner] != 0 && (set.validity.empty() || set.validity[idx[corner]] == 1);
+        const bool seen = w[corner] != 0 && (set.visibility.empty() || ((set.visibility[idx[corner]] >> bit) & 1));
+        m[corner] = valid && seen ? w[corner] : 0.0;
         sum += m[corner];
     }
     Sh27 sh{};
