@@ -229,8 +229,9 @@ for (const v of volumes) {
     compactVolumeMask(null, null, z.count) === null, 'absent validity counts as valid, absent visibility as 0xFF');
   const throws = (fn, re) => { try { fn(); return false; } catch (e) { return re.test(e.message); } };
   check(throws(() => compactVolume(z, { masks: 'no' }), /masks must be/) &&
-    throws(() => compactVolume({ ...z, visibility: z.visibility.subarray(0, 5) }), /visibility has 5 bytes/),
-    'compactVolume refuses a non-boolean masks option and short mask bytes');
+    throws(() => compactVolume({ ...z, visibility: z.visibility.subarray(0, 5) }), /visibility has 5 bytes/) &&
+    throws(() => zhcVolumeGlsl({ encoding: 'zh3_q16', masked: 'yes' }), /masked must be true or false/),
+    'compactVolume refuses a non-boolean masks option and short mask bytes, zhcVolumeGlsl a non-boolean masked');
 }
 
 // Irradiance scale of one decoded probe (tests/gl/runtime_gl_entries.inl probe_scale, packed
