@@ -24,6 +24,7 @@
 #include <stdexcept>
 
 #include "formats/io/exr_memory.h"
+#include "formats/io/exr_scanlines.h"
 #include "formats/io/file_io.h"
 
 namespace zhc {
@@ -92,63 +93,6 @@ Result<LightmapExrSummary> describe_lightmap_exr(std::span<const std::uint8_t> b
         std::string what = e.what();
         if (const auto nl = what.find('\n'); nl != std::string::npos) what.resize(nl);
         return make_error(ErrorCode::kBadFormat, name + ": cannot read OpenEXR (" + what + ")");
-    }
-}
-
-Result<lightmap::ShLightmap> read_sh_lightmap_exr(const std::string& path, const LightmapReadOptions& o) {
-    auto bytes = read_file_bytes(path, o.max_file_bytes);
-    if (!bytes) return bytes.error();
-    const auto& b = *bytes;
-    ExrLayout layout;
-    // Every chunk inside the file before the texels are allocated; nothing after the last one.
-    if (Status s = check_exr_file(b, path, o.max_texels, &layout); !s) return s.error();
-    try {
-        Imf::Header::setMaxImageSize(1 << 20, 1 << 20);
-        ExrMemoryStream stream(b, path);
-        const int threads = std::max(1, o.threads);
-        if (threads > 1 && IlmThread::ThreadPool::globalThreadPool().numThreads() < threads)
-            IlmThread::ThreadPool::globalThreadPool().setNumThreads(threads);
-        Imf::InputFile file(stream, threads > 1 ? threads : 0);
-        const Imath::Box2i dw = file.header().dataWindow();
-        const std::int64_t w = std::int64_t(dw.max.x) - dw.min.x + 1, h = std::int64_t(dw.max.y) - dw.min.y + 1;
-        if (w <= 0 || h <= 0) return make_error(ErrorCode::kBadFormat, path + ": empty data window");
-        if (static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h) > o.max_texels)
-            return make_error(ErrorCode::kTooLarge, path + ": " + std::to_string(w) + "x" + std::to_string(h) +
-                                                        " texels exceed the limit " + std::to_string(o.max_texels));
-        for (int i = 0; i < 9; ++i)
-            for (int k = 0; k < 3; ++k)
-                if (!file.header().channels().findChannel(sh_channel(i, k)))
-                    return make_error(ErrorCode::kBadFormat, path + ": missing channel \"" + sh_channel(i, k) +
-                                                                 "\" (an SH lightmap has sh0.R .. sh8.B)");
-        lightmap::ShLightmap lm;
-        lm.width = static_cast<int>(w);
-        lm.height = static_cast<int>(h);
-        std::vector<float> buf(static_cast<size_t>(w) * static_cast<size_t>(h) * 27);
-        Imf::FrameBuffer fb;
-        const size_t xs = 27 * sizeof(float), ys = xs * static_cast<size_t>(w);
-        char* base = reinterpret_cast<char*>(buf.data()) - (static_cast<std::ptrdiff_t>(dw.min.x) * static_cast<std::ptrdiff_t>(xs) +
-                                                             static_cast<std::ptrdiff_t>(dw.min.y) * static_cast<std::ptrdiff_t>(ys));
-        for (int i = 0; i < 9; ++i)
-            for (int k = 0; k < 3; ++k)
-                fb.insert(sh_channel(i, k), Imf::Slice(Imf::FLOAT, base + (i * 3 + k) * sizeof(float), xs, ys));
-        file.setFrameBuffer(fb);
-        file.readPixels(dw.min.y, dw.max.y);
-        lm.texels.resize(static_cast<size_t>(w) * static_cast<size_t>(h));
-        for (size_t t = 0; t < lm.texels.size(); ++t)
-            for (int i = 0; i < 9; ++i)
-                for (int k = 0; k < 3; ++k) {
-                    const float v = buf[t * 27 + static_cast<size_t>(i * 3 + k)];
-                    if (!std::isfinite(v))
-                        return make_error(ErrorCode::kInvalidValue, path + ": non-finite value in channel " + sh_channel(i, k) +
-                                                                        " at texel (" + std::to_string(t % static_cast<size_t>(w)) +
-                                                                        ", " + std::to_string(t / static_cast<size_t>(w)) + ")");
-                    lm.texels[t][i][k] = v;
-                }
-        return lm;
-    } catch (const std::exception& e) {
-        std::string what = e.what();
-        if (const auto nl = what.find('\n'); nl != std::string::npos) what.resize(nl);
-        return make_error(ErrorCode::kBadFormat, path + ": cannot read OpenEXR (" + what + ")");
     }
 }
 
@@ -268,6 +212,7 @@ struct ExrInput {
     std::unique_ptr<ExrMemoryStream> stream;
     std::unique_ptr<Imf::InputFile> exr;
     Imath::Box2i dw;
+    bool fast = false;  // ZIP / ZIPS / uncompressed scanlines: decode_exr_scanlines, else readPixels
 };
 
 class ExrSource final : public ShLightmapSource {
@@ -281,6 +226,7 @@ public:
             return make_error(ErrorCode::kInvalidArgument, std::to_string(paths.size()) +
                                                                " input files: give one SH lightmap EXR, or 4 (linear SH) or 9 (SH3) EXRs, one per coefficient");
         const int threads = std::max(1, o.threads);
+        threads_ = threads;
         if (threads > 1 && IlmThread::ThreadPool::globalThreadPool().numThreads() < threads)
             IlmThread::ThreadPool::globalThreadPool().setNumThreads(threads);
         for (const auto& path : paths) {
@@ -295,6 +241,7 @@ public:
                 in->stream = std::make_unique<ExrMemoryStream>(b, path);
                 in->exr = std::make_unique<Imf::InputFile>(*in->stream, threads > 1 ? threads : 0);
                 in->dw = in->exr->header().dataWindow();
+                in->fast = exr_scanlines_supported(*in->exr);
             } catch (const std::exception& e) {
                 return exr_error(path, e);
             }
@@ -350,6 +297,15 @@ public:
         const size_t xs = sizeof(Sh3Radiance), ys = xs * static_cast<size_t>(width_);
         for (size_t f = 0; f < inputs_.size(); ++f) {
             ExrInput& in = *inputs_[f];
+            if (in.fast) {
+                std::vector<ExrFloatSlice> slices;
+                for (const Slot& s : slots_)
+                    if (s.file == f)
+                        slices.push_back({s.channel, reinterpret_cast<char*>(band.texels.data()) + static_cast<size_t>(s.offset) * sizeof(float), xs, ys});
+                if (Status st = decode_exr_scanlines(*in.exr, in.path, y0, y1, slices, threads_); !st) return st;
+                in.file.release();
+                continue;
+            }
             try {
                 Imf::FrameBuffer fb;
                 char* base = reinterpret_cast<char*>(band.texels.data()) -
@@ -392,7 +348,7 @@ private:
     };
     std::vector<std::unique_ptr<ExrInput>> inputs_;
     std::vector<Slot> slots_;
-    int width_ = 0, height_ = 0, coefficients_ = 9;
+    int width_ = 0, height_ = 0, coefficients_ = 9, threads_ = 1;
 };
 
 class ExrWriter final : public ExrBandWriter {
@@ -483,6 +439,21 @@ Result<std::unique_ptr<ShLightmapSource>> ShLightmapSource::open(const std::vect
     auto s = std::make_unique<ExrSource>();
     if (Status st = s->open_all(paths, options); !st) return st.error();
     return std::unique_ptr<ShLightmapSource>(std::move(s));
+}
+
+Result<lightmap::ShLightmap> read_sh_lightmap_exr(const std::string& path, const LightmapReadOptions& o) {
+    // The streaming source read in one band: the same checks, decoders and messages.
+    LightmapStreamOptions so;
+    so.max_texels = o.max_texels;
+    so.max_file_bytes = o.max_file_bytes;
+    so.threads = o.threads;
+    ExrSource src;
+    if (Status s = src.open_all({path}, so); !s) return s.error();
+    if (src.coefficients() != 9)
+        return make_error(ErrorCode::kBadFormat, path + ": missing channel \"sh4.R\" (an SH lightmap has sh0.R .. sh8.B)");
+    lightmap::ShLightmap lm;
+    if (Status s = src.read_rows(0, src.height(), lm); !s) return s.error();
+    return lm;
 }
 
 Result<std::unique_ptr<ExrBandWriter>> ExrBandWriter::open(const std::string& path, int width, int height,
