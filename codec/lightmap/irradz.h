@@ -14,6 +14,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <span>
 
 #include "codec/sh/sh.h"
@@ -98,6 +99,9 @@ double hemispherical_mse(const Sh3Irradiance& target, const IrradZ& p, Model mod
 // baker sampled it directly (`sampled_iz`, the talk's "directly sample I_z in the bake").
 IrradZ encode(const Sh3Radiance& tangent_radiance, const EncodeOptions& options = {},
               double* error = nullptr, const Rgb* sampled_iz = nullptr);
+// encode() of n texels into out[0 .. n), the same results bit for bit; with Solve::kNewton the
+// texels' evaluations run four at a time in vector lanes (give it a few dozen texels at once).
+void encode_many(const Sh3Radiance* tangent_radiance, std::size_t n, const EncodeOptions& options, IrradZ* out);
 
 // The reduced error the Newton solve minimises, at the gnomonic direction q = (d_x, d_y) / d_z:
 // psi(q) = min over s = 1 - w_a in [0, 1] of |m - u|_G^2 (u the I_z-weighted colour average of the

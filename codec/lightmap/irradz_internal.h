@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "codec/lightmap/irradz.h"
@@ -75,5 +76,10 @@ inline Vec3 clamp_to_hemisphere(Vec3 d) {
 // SH-space hemispherical error in `error` (optional).
 IrradZ fit_newton(const Sh3Irradiance& irr, Model model, const EncodeOptions& options, double* error,
                   const Rgb* sampled_iz);
+// fit_newton of n texels (no sampled I_z, no error), the same results bit for bit: their evaluations
+// of psi run four at a time in the lanes of a vector, in the AVX2 build where the CPU has AVX2 and
+// `allow_avx2` (false: the baseline build, for the tests).
+void fit_newton_many(const Sh3Irradiance* irr, std::size_t n, Model model, const EncodeOptions& options, IrradZ* out,
+                     bool allow_avx2 = true);
 
 }  // namespace zhc::irradz::detail

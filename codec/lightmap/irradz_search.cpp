@@ -162,6 +162,20 @@ IrradZ solve_w_a(const Sh3Irradiance& target, Vec3 d, Model model, const std::ar
     return make(tg, fit_direction(tg, d, model, gram).w, d);
 }
 
+void encode_many(const Sh3Radiance* tangent_radiance, std::size_t n, const EncodeOptions& options, IrradZ* out) {
+    if (options.solve != Solve::kNewton) {
+        for (std::size_t i = 0; i < n; ++i) out[i] = encode(tangent_radiance[i], options);
+        return;
+    }
+    constexpr std::size_t kChunk = 64;
+    Sh3Irradiance irr[kChunk];
+    for (std::size_t i0 = 0; i0 < n; i0 += kChunk) {
+        const std::size_t m = std::min(kChunk, n - i0);
+        for (std::size_t i = 0; i < m; ++i) irr[i] = to_irradiance(tangent_radiance[i0 + i]);
+        detail::fit_newton_many(irr, m, options.model, options, out + i0);
+    }
+}
+
 IrradZ encode(const Sh3Radiance& tangent_radiance, const EncodeOptions& options, double* error,
               const Rgb* sampled_iz) {
     const Sh3Irradiance irr = to_irradiance(tangent_radiance);

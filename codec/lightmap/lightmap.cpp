@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <thread>
+#include <vector>
 
 namespace zhc::lightmap {
 namespace {
@@ -113,6 +114,15 @@ ShLightmap synthesize_sphere_rows(const Sh3Radiance& world, int width, int heigh
 
 namespace {
 
+// Texel i of the planes.
+void store(IrradzPlanes& p, size_t i, const irradz::IrradZ& t) {
+    for (int k = 0; k < 3; ++k) p.iz[3 * i + static_cast<size_t>(k)] = t.i_z[k];
+    p.wa[i] = static_cast<float>(t.w_a);
+    const auto uv = encode_hemioct(t.d);
+    p.d[2 * i] = uv[0];
+    p.d[2 * i + 1] = uv[1];
+}
+
 // Fills the planes of lm, texel i from to_irradz(lm.texels[i]), rows split over threads.
 template <class ToIrradz>
 IrradzPlanes encode_planes_with(const ShLightmap& lm, int threads, ToIrradz&& to_irradz) {
@@ -126,12 +136,7 @@ IrradzPlanes encode_planes_with(const ShLightmap& lm, int threads, ToIrradz&& to
     parallel_rows(lm.height, threads, [&](int y0, int y1) {
         for (size_t i = static_cast<size_t>(y0) * static_cast<size_t>(lm.width);
              i < static_cast<size_t>(y1) * static_cast<size_t>(lm.width); ++i) {
-            const irradz::IrradZ t = to_irradz(lm.texels[i]);
-            for (int k = 0; k < 3; ++k) p.iz[3 * i + static_cast<size_t>(k)] = t.i_z[k];
-            p.wa[i] = static_cast<float>(t.w_a);
-            const auto uv = encode_hemioct(t.d);
-            p.d[2 * i] = uv[0];
-            p.d[2 * i + 1] = uv[1];
+            store(p, i, to_irradz(lm.texels[i]));
         }
     });
     return p;
@@ -140,7 +145,24 @@ IrradzPlanes encode_planes_with(const ShLightmap& lm, int threads, ToIrradz&& to
 }  // namespace
 
 IrradzPlanes encode_planes(const ShLightmap& lm, const irradz::EncodeOptions& options, int threads) {
-    return encode_planes_with(lm, threads, [&](const auto& texel) { return irradz::encode(texel, options); });
+    // A row at a time through encode_many (vector lanes across texels), then stored like
+    // encode_planes_with does.
+    IrradzPlanes p;
+    p.width = lm.width;
+    p.height = lm.height;
+    const size_t n = lm.texels.size(), w = static_cast<size_t>(std::max(0, lm.width));
+    p.iz.resize(3 * n);
+    p.wa.resize(n);
+    p.d.resize(2 * n);
+    parallel_rows(lm.height, threads, [&](int y0, int y1) {
+        std::vector<irradz::IrradZ> row(w);
+        for (int y = y0; y < y1; ++y) {
+            const size_t i0 = static_cast<size_t>(y) * w;
+            irradz::encode_many(lm.texels.data() + i0, w, options, row.data());
+            for (size_t x = 0; x < w; ++x) store(p, i0 + x, row[x]);
+        }
+    });
+    return p;
 }
 
 IrradzPlanes encode_planes_linear_sh(const ShLightmap& lm, int threads) {
