@@ -156,26 +156,34 @@ Status decode_exr_scanlines(Imf::InputFile& file, const std::string& path, int y
             const int row0 = chunk * L.lines_per_chunk;
             const int rows = std::min(L.lines_per_chunk, L.height - row0);
             const std::size_t n = static_cast<std::size_t>(rows) * L.row_bytes;
+            // One worker reads the chunk where OpenEXR leaves it; several copy it out under the lock.
+            std::span<const std::uint8_t> chunk_bytes;
             try {
-                std::lock_guard<std::mutex> lock(file_mutex);
+                std::unique_lock<std::mutex> lock(file_mutex, std::defer_lock);
+                if (workers > 1) lock.lock();
                 const char* data = nullptr;
                 int size = 0;
                 file.rawPixelData(L.min_y + row0, data, size);
                 if (size < 0 || (data == nullptr && size > 0)) throw std::runtime_error("bad chunk size");
-                packed.assign(data, data + size);
+                if (workers > 1) {
+                    packed.assign(data, data + size);
+                    chunk_bytes = packed;
+                } else {
+                    chunk_bytes = {reinterpret_cast<const std::uint8_t*>(data), static_cast<size_t>(size)};
+                }
             } catch (const std::exception& e) {
                 std::string what = e.what();
                 if (const auto nl = what.find('\n'); nl != std::string::npos) what.resize(nl);
                 st = make_error(ErrorCode::kBadFormat, path + ": cannot read OpenEXR (" + what + ")");
                 return;
             }
-            const std::uint8_t* src = packed.data();
-            if (packed.size() != n) {
+            const std::uint8_t* src = chunk_bytes.data();
+            if (chunk_bytes.size() != n) {
                 // Compressed: ZIP or ZIPS (a NONE chunk or a stored one has exactly the raw size).
                 std::size_t got = 0;
                 raw.resize(n);
-                if (h.compression() == Imf::NO_COMPRESSION || packed.size() > n ||
-                    libdeflate_zlib_decompress(inflater.get(), packed.data(), packed.size(), raw.data(), n, &got) !=
+                if (h.compression() == Imf::NO_COMPRESSION || chunk_bytes.size() > n ||
+                    libdeflate_zlib_decompress(inflater.get(), chunk_bytes.data(), chunk_bytes.size(), raw.data(), n, &got) !=
                         LIBDEFLATE_SUCCESS ||
                     got != n) {
                     st = make_error(ErrorCode::kBadFormat, path + ": corrupt OpenEXR chunk at row " + std::to_string(L.min_y + row0) +

@@ -320,9 +320,17 @@ public:
             }
             in.file.release();
         }
+        for (size_t t = 0; t < n; ++t)
+            for (int i = coefficients_; i < 9; ++i) band.texels[t][i] = Rgb{};
+        // Every float of the band finite (exponent bits not all ones), in one pass the compiler
+        // vectorises; only where one is not does the loop below find the first to name it.
+        static_assert(sizeof(Sh3Radiance) == 27 * sizeof(float));
+        const std::uint32_t* bits = reinterpret_cast<const std::uint32_t*>(band.texels.data());
+        std::uint32_t bad = 0;
+        for (size_t i = 0; i < n * 27; ++i) bad |= static_cast<std::uint32_t>((bits[i] & 0x7f800000u) == 0x7f800000u);
+        if (!bad) return Ok{};
         for (size_t t = 0; t < n; ++t) {
             Sh3Radiance& r = band.texels[t];
-            for (int i = coefficients_; i < 9; ++i) r[i] = Rgb{};
             for (const Slot& s : slots_) {
                 const float v = r[s.offset / 3][s.offset % 3];
                 if (!std::isfinite(v))
