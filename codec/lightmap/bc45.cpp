@@ -10,6 +10,13 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+// The AVX2 index search: x86-64 GCC and clang (target attribute, __builtin_cpu_supports).
+#if defined(__SSE2__) && (defined(__x86_64__) || defined(__i386__)) && (defined(__GNUC__) || defined(__clang__))
+#define ZHC_BC45_AVX2 1
+#include <immintrin.h>
+#else
+#define ZHC_BC45_AVX2 0
+#endif
 
 namespace zhc::bc45 {
 namespace {
@@ -124,6 +131,61 @@ float assign_fast(const float v[16], int r0, int r1, std::uint8_t idx[16], float
 float assign_fast(const float v[16], int r0, int r1, std::uint8_t idx[16], float) { return assign_scalar(v, r0, r1, idx); }
 #endif
 
+#if ZHC_BC45_AVX2
+// assign_fast eight texels at a time (AVX2): per texel the same subtraction, product and strict
+// comparison in the same entry order, the texel-order sum; only the early-out's sum runs in another
+// order, which the bound's margin covers (see assign_fast).
+__attribute__((target("avx2"))) float assign_avx2(const float v[16], int r0, int r1, std::uint8_t idx[16], float bound) {
+    float pal[8];
+    palette_fast(r0, r1, pal);
+    __m256 x[2], be[2];
+    __m256i bi[2];
+    for (int q = 0; q < 2; ++q) {
+        x[q] = _mm256_loadu_ps(v + 8 * q);
+        be[q] = _mm256_set1_ps(1e30f);
+        bi[q] = _mm256_setzero_si256();
+    }
+    for (int j = 0; j < 8; ++j) {
+        const __m256 p = _mm256_set1_ps(pal[j]);
+        const __m256i jj = _mm256_set1_epi32(j);
+        for (int q = 0; q < 2; ++q) {
+            const __m256 d = _mm256_sub_ps(p, x[q]);
+            const __m256 dd = _mm256_mul_ps(d, d);
+            const __m256 lt = _mm256_cmp_ps(dd, be[q], _CMP_LT_OQ);
+            be[q] = _mm256_blendv_ps(be[q], dd, lt);
+            bi[q] = _mm256_blendv_epi8(bi[q], jj, _mm256_castps_si256(lt));
+        }
+    }
+    const __m256 s8 = _mm256_add_ps(be[0], be[1]);
+    const __m128 s4 = _mm_add_ps(_mm256_castps256_ps128(s8), _mm256_extractf128_ps(s8, 1));
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, s4);
+    if ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) > bound * (1 + 1e-5f)) return std::numeric_limits<float>::infinity();
+    alignas(32) float e[16];
+    alignas(32) std::int32_t k[16];
+    for (int q = 0; q < 2; ++q) {
+        _mm256_store_ps(e + 8 * q, be[q]);
+        _mm256_store_si256(reinterpret_cast<__m256i*>(k + 8 * q), bi[q]);
+    }
+    float err = 0;
+    for (int i = 0; i < 16; ++i) {
+        idx[i] = static_cast<std::uint8_t>(k[i]);
+        err += e[i];
+    }
+    return err;
+}
+bool have_avx2() {
+    static const bool a = __builtin_cpu_supports("avx2");
+    return a;
+}
+#else
+float assign_avx2(const float v[16], int r0, int r1, std::uint8_t idx[16], float bound) { return assign_fast(v, r0, r1, idx, bound); }
+bool have_avx2() { return false; }
+#endif
+
+// The index search paths: the scalar twin, SSE2 (four texels a vector), AVX2 (eight).
+enum Path { kScalar = 0, kSse2 = 1, kAvx2 = 2 };
+
 // Interpolation weight of endpoint 1 for index j (0 for r0, 1 for r1); -1 for the constants.
 float weight(bool eight, int j) {
     if (j == 0) return 0;
@@ -138,11 +200,13 @@ struct Best {
     float err = 1e30f;
     std::uint8_t idx[16] = {};
 };
-template <bool kFast>
+template <int kPath>
 void consider(const float v[16], int r0, int r1, Best& b) {
     r0 = std::clamp(r0, 0, 255), r1 = std::clamp(r1, 0, 255);
     std::uint8_t idx[16];
-    const float e = kFast ? assign_fast(v, r0, r1, idx, b.err) : assign_scalar(v, r0, r1, idx);
+    const float e = kPath == kAvx2   ? assign_avx2(v, r0, r1, idx, b.err)
+                    : kPath == kSse2 ? assign_fast(v, r0, r1, idx, b.err)
+                                     : assign_scalar(v, r0, r1, idx);
     if (e < b.err) {
         b.err = e, b.r0 = r0, b.r1 = r1;
         std::memcpy(b.idx, idx, 16);
@@ -150,7 +214,7 @@ void consider(const float v[16], int r0, int r1, Best& b) {
 }
 
 // Least-squares endpoints for fixed indices, then rounded; ordered for the palette kind.
-template <bool kFast>
+template <int kPath>
 void refine(const float v[16], Best& b) {
     const bool eight = b.r0 > b.r1;
     float aa = 0, ab = 0, bb = 0, ra = 0, rb = 0;
@@ -165,8 +229,8 @@ void refine(const float v[16], Best& b) {
     const float e0 = (bb * ra - ab * rb) / det, e1 = (aa * rb - ab * ra) / det;
     const int a = std::clamp(static_cast<int>(std::lround(e0)), 0, 255);
     const int c = std::clamp(static_cast<int>(std::lround(e1)), 0, 255);
-    if (eight && a > c) consider<kFast>(v, a, c, b);
-    if (!eight && a <= c) consider<kFast>(v, a, c, b);
+    if (eight && a > c) consider<kPath>(v, a, c, b);
+    if (!eight && a <= c) consider<kPath>(v, a, c, b);
 }
 
 void write_block(const Best& b, std::uint8_t out[8]) {
@@ -177,7 +241,7 @@ void write_block(const Best& b, std::uint8_t out[8]) {
     for (int k = 0; k < 6; ++k) out[2 + k] = static_cast<std::uint8_t>(bits >> (8 * k));
 }
 
-template <bool kFast>
+template <int kPath>
 void encode_bc4(const float in[16], Quality quality, std::uint8_t out[8]) {
     float v[16];
     float lo = 255, hi = 0;
@@ -190,14 +254,14 @@ void encode_bc4(const float in[16], Quality quality, std::uint8_t out[8]) {
     const int l = static_cast<int>(std::floor(lo)), h = static_cast<int>(std::ceil(hi));
     // Eight-value palette (r0 > r1) spanning the range; and the six-value one (r0 <= r1) with the
     // range excluding exact 0 and 1 texels (those use the constant entries).
-    consider<kFast>(v, std::max(h, l + 1), l, b);
+    consider<kPath>(v, std::max(h, l + 1), l, b);
     float lo6 = 255, hi6 = 0;
     for (int i = 0; i < 16; ++i)
         if (v[i] > 0 && v[i] < 255) lo6 = std::min(lo6, v[i]), hi6 = std::max(hi6, v[i]);
-    if (lo6 <= hi6) consider<kFast>(v, static_cast<int>(std::floor(lo6)), static_cast<int>(std::ceil(hi6)), b);
-    if (h == l) consider<kFast>(v, l, l, b);
+    if (lo6 <= hi6) consider<kPath>(v, static_cast<int>(std::floor(lo6)), static_cast<int>(std::ceil(hi6)), b);
+    if (h == l) consider<kPath>(v, l, l, b);
     const int rounds = quality == Quality::kFast ? 1 : 3;
-    for (int it = 0; it < rounds; ++it) refine<kFast>(v, b);
+    for (int it = 0; it < rounds; ++it) refine<kPath>(v, b);
     if (quality == Quality::kDefault) {
         // Local search around the best pair (keeps its palette kind).
         const Best start = b;
@@ -208,26 +272,30 @@ void encode_bc4(const float in[16], Quality quality, std::uint8_t out[8]) {
             for (int d1 = -2; d1 <= 2; ++d1) {
                 const int a = start.r0 + d0, c = start.r1 + d1;
                 if ((start.r0 > start.r1) != (a > c)) continue;
-                if constexpr (kFast) {
+                if constexpr (kPath != kScalar) {
                     const int key = std::clamp(a, 0, 255) * 256 + std::clamp(c, 0, 255);
                     if (key == start.r0 * 256 + start.r1 || std::find(tried, tried + n, key) != tried + n) continue;
                     tried[n++] = key;
                 }
-                consider<kFast>(v, a, c, b);
+                consider<kPath>(v, a, c, b);
             }
-        refine<kFast>(v, b);
+        refine<kPath>(v, b);
     }
     write_block(b, out);
 }
 
 }  // namespace
 
-void encode_bc4_block(const float in[16], Quality quality, std::uint8_t out[8]) { encode_bc4<true>(in, quality, out); }
+void encode_bc4_block(const float in[16], Quality quality, std::uint8_t out[8]) {
+    if (have_avx2()) return encode_bc4<kAvx2>(in, quality, out);
+    encode_bc4<kSse2>(in, quality, out);
+}
 
 namespace detail {
 void encode_bc4_block_scalar(const float in[16], Quality quality, std::uint8_t out[8]) {
-    encode_bc4<false>(in, quality, out);
+    encode_bc4<kScalar>(in, quality, out);
 }
+void encode_bc4_block_sse2(const float in[16], Quality quality, std::uint8_t out[8]) { encode_bc4<kSse2>(in, quality, out); }
 }  // namespace detail
 
 void decode_bc4_block(const std::uint8_t in[8], float out[16]) {

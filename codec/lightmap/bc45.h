@@ -29,6 +29,8 @@ namespace detail {
 // encode_bc4_block's scalar twin: the same search with the plain per-texel index loop; the fast
 // path (SSE2, four texels at a time) gives the same bytes (tested bit for bit).
 void encode_bc4_block_scalar(const float v[16], Quality quality, std::uint8_t out[8]);
+// The SSE2 path (four texels at a time), which encode_bc4_block takes where the CPU lacks AVX2 (eight).
+void encode_bc4_block_sse2(const float v[16], Quality quality, std::uint8_t out[8]);
 }  // namespace detail
 
 // Whole images; `channels` interleaved floats per texel (1 for BC4, 2 for BC5); edge blocks
