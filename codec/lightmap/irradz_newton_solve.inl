@@ -437,8 +437,7 @@ struct Prepared {
     double sx[4] = {}, sy[4] = {};  // the start points, the closed form first
 };
 
-Prepared prepare(const Sh3Irradiance& irr, Model model, const Rgb* sampled_iz) {
-    Prepared p;
+void prepare(Prepared& p, const Sh3Irradiance& irr, Model model, const Rgb* sampled_iz) {
     p.x = make_texel(irr, sampled_iz);
     p.rd = make_reduced(p.x, model);
     p.s2 = p.x.iz[0] * p.x.iz[0] + p.x.iz[1] * p.x.iz[1] + p.x.iz[2] * p.x.iz[2];
@@ -450,7 +449,6 @@ Prepared prepare(const Sh3Irradiance& irr, Model model, const Rgb* sampled_iz) {
         const double pts[4][2] = {{px, py}, {0, 0}, {rx, ry}, {-rx, -ry}};
         for (int i = 0; i < 4; ++i) p.sx[i] = pts[i][0], p.sy[i] = pts[i][1];
     }
-    return p;
 }
 
 // The best of the four starts from psi and s there (e[0] the closed form). A start where psi is flat
@@ -524,8 +522,8 @@ ReducedT<V4> broadcast(const Reduced& rd) {
     r.hgh = V4{} + rd.hgh;
     return r;
 }
-ReducedT<V4> gather(const Reduced* const lanes[4]) {
-    ReducedT<V4> r = broadcast(*lanes[0]);
+void gather(const Reduced* const lanes[4], ReducedT<V4>& r) {
+    r = broadcast(*lanes[0]);
     for (int l = 1; l < 4; ++l) {
         const Reduced& x = *lanes[l];
         for (size_t i = 0; i < 9; ++i) {
@@ -537,7 +535,6 @@ ReducedT<V4> gather(const Reduced* const lanes[4]) {
         r.hgv[l] = x.hgv;
         r.hgh[l] = x.hgh;
     }
-    return r;
 }
 PsiEval lane(const PsiEvalT<V4>& e, int l) {
     PsiEval o;
@@ -552,7 +549,8 @@ PsiEval lane(const PsiEvalT<V4>& e, int l) {
 }
 
 [[maybe_unused]] IrradZ fit_one(const Sh3Irradiance& irr, Model model, const EncodeOptions& options, double* error, const Rgb* sampled_iz) {
-    const Prepared p = prepare(irr, model, sampled_iz);
+    Prepared p;
+    prepare(p, irr, model, sampled_iz);
     double px = 0, py = 0;
     if (p.s2 > 0) {
         double psi[4], s[4];
@@ -568,11 +566,14 @@ PsiEval lane(const PsiEvalT<V4>& e, int l) {
 }
 
 void fit_many(const Sh3Irradiance* irr, std::size_t n, Model model, const EncodeOptions& options, IrradZ* out) {
-    std::vector<Prepared> prep(n);
-    std::vector<NewtonState> st(n);
+    // Per-thread workspaces, grown once (a row of texels comes in chunks of the same size).
+    thread_local std::vector<Prepared> prep;
+    thread_local std::vector<NewtonState> st;
+    thread_local std::vector<size_t> want;
+    if (prep.size() < n) prep.resize(n), st.resize(n);
     for (size_t i = 0; i < n; ++i) {
         Prepared& p = prep[i];
-        p = prepare(irr[i], model, nullptr);
+        prepare(p, irr[i], model, nullptr);
         st[i].want = false;
         if (!(p.s2 > 0)) continue;
         // The four starts of one texel in the four lanes.
@@ -584,7 +585,7 @@ void fit_many(const Sh3Irradiance* irr, std::size_t n, Model model, const Encode
         newton_begin(st[i], px, py);
     }
     // Newton rounds: every texel that wants an evaluation gets one, four per vector, until none does.
-    std::vector<size_t> want;
+    ReducedT<V4> packed;
     for (;;) {
         want.clear();
         for (size_t i = 0; i < n; ++i)
@@ -600,7 +601,8 @@ void fit_many(const Sh3Irradiance* irr, std::size_t n, Model model, const Encode
                 px[l] = st[i].nx;
                 py[l] = st[i].ny;
             }
-            const PsiEvalT<V4> e = eval_psi_p<true, V4>(gather(lanes), px, py);
+            gather(lanes, packed);
+            const PsiEvalT<V4> e = eval_psi_p<true, V4>(packed, px, py);
             for (int l = 0; l < m; ++l)
                 newton_result(st[want[k + static_cast<size_t>(l)]], lane(e, l), options.newton_iterations, options.newton_tolerance);
         }
