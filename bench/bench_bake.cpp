@@ -25,6 +25,8 @@
 #include <random>
 #include <string>
 
+#include <unistd.h>
+
 #include "codec/bake/occluders.h"
 #include "codec/bake/scene.h"
 #include "timing.h"
@@ -59,6 +61,66 @@ SceneLight light_of(LightKind kind, int i) {
     return l;
 }
 
+// Resident set (VmRSS) and its high-water mark (VmHWM) in bytes, and the mark's reset (Linux >= 4.0:
+// 5 to /proc/self/clear_refs); -1 where /proc does not tell.
+double proc_status_bytes(const char* key) {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind(key, 0) == 0) return std::atof(line.c_str() + std::string(key).size()) * 1024.0;
+    return -1;
+}
+bool reset_peak() {
+    std::ofstream out("/proc/self/clear_refs");
+    out << "5";
+    out.flush();
+    return bool(out);
+}
+
+// A sphere of radius 1.5 hovering over the middle of the probe grid, lit by a sun with a
+// 3-degree radius and 64 samples: a mix of blocked rays (under it) and misses.
+Scene mesh_scene(std::uint32_t n, int res) {
+    Scene s = grid_scene(n);
+    s.occlusion.sky_samples = 0;
+    s.occluders = uv_sphere_triangles({0.3, -0.2, 4.5}, 1.5, res, res);
+    SceneLight sun = light_of(LightKind::kDirectional, 0);
+    sun.direction = {0.2, 0.1, 1};
+    sun.angular_radius_rad = 3 * kPi / 180;
+    sun.shadows = true;
+    sun.shadow_samples = 64;
+    s.lights = {sun};
+    return s;
+}
+
+
+// In a fresh process (this program run as `--peak-child N RES`, so that no memory an earlier
+// measurement freed is reused and uncounted): the resident set before the mesh scene is made, then
+// the high-water mark of making it and baking it given up (bake_scene(Scene&&), as `zhc bake`
+// runs it), per triangle. -1 where /proc or the child fails.
+double bake_peak_bytes_per_triangle(std::uint32_t n, int res) {
+    char exe[4096];
+    const ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);  // in the shell it names sh
+    if (len <= 0) return -1;
+    exe[len] = 0;
+    char cmd[4200];
+    std::snprintf(cmd, sizeof cmd, "'%s' --peak-child %u %d", exe, n, res);
+    FILE* f = popen(cmd, "r");
+    if (!f) return -1;
+    double v = -1;
+    if (std::fscanf(f, "%lf", &v) != 1) v = -1;
+    return pclose(f) == 0 ? v : -1;
+}
+int peak_child(std::uint32_t n, int res) {
+    const double rss0 = proc_status_bytes("VmRSS:");
+    if (rss0 <= 0 || !reset_peak()) return std::printf("-1\n"), 0;
+    Scene s = mesh_scene(n, res);
+    const double tris = double(s.occluders.size());
+    bench::keep(bake_scene(std::move(s)));
+    const double hwm = proc_status_bytes("VmHWM:");
+    std::printf("%.6g\n", hwm > 0 ? (hwm - rss0) / tris : -1.0);
+    return 0;
+}
+
 double probe_count(const Scene& s) {
     return double(s.probes.counts[0]) * s.probes.counts[1] * s.probes.counts[2];
 }
@@ -80,6 +142,8 @@ std::string join(const std::vector<std::string>& rows) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    if (argc == 4 && std::string(argv[1]) == "--peak-child")
+        return peak_child(static_cast<std::uint32_t>(std::atoi(argv[2])), std::atoi(argv[3]));
     std::uint32_t n = 64;
     std::string json;
     for (int i = 1; i < argc; ++i) {
@@ -164,13 +228,10 @@ int main(int argc, char** argv) {
         Scene s = grid_scene(n / 2);
         s.occlusion.sky_samples = 0;
         for (int i = 0; i < 1000; ++i) {
-            Occluder o;
-            o.kind = i % 2 ? OccluderKind::kSphere : OccluderKind::kBox;
-            o.center = {u(rng), u(rng), 4 + 0.5 * u(rng)};
-            o.radius = 0.1 + 0.2 * u01(rng);
-            o.min = o.center;
-            o.max = o.center + Vec3{0.4 * u01(rng), 0.4 * u01(rng), 0.1};
-            s.occluders.push_back(o);
+            const Vec3 c{u(rng), u(rng), 4 + 0.5 * u(rng)};
+            const double r = 0.1 + 0.2 * u01(rng);
+            const Vec3 hi = c + Vec3{0.4 * u01(rng), 0.4 * u01(rng), 0.1};
+            s.occluders.push_back(i % 2 ? sphere_occluder(c, r) : box_occluder(c, hi));
         }
         SceneLight sun = light_of(LightKind::kDirectional, 0);
         sun.direction = {0.2, 0.1, 1};
@@ -206,17 +267,8 @@ int main(int argc, char** argv) {
     }
     std::printf("\n%-40s %12s %12s %10s\n", "triangle-mesh occluder", "rays/s", "ns per ray", "ms");
     for (const int res : {100, 316}) {
-        // A sphere of radius 1.5 hovering over the middle of the probe grid, lit by a sun with a
-        // 3-degree radius and 64 samples: a mix of blocked rays (under it) and misses.
-        Scene s = grid_scene(n / 2);
-        s.occlusion.sky_samples = 0;
-        s.occluders = uv_sphere_triangles({0.3, -0.2, 4.5}, 1.5, res, res);
-        SceneLight sun = light_of(LightKind::kDirectional, 0);
-        sun.direction = {0.2, 0.1, 1};
-        sun.angular_radius_rad = 3 * kPi / 180;
-        sun.shadows = true;
-        sun.shadow_samples = 64;
-        s.lights = {sun};
+        const Scene s = mesh_scene(n / 2, res);
+        const SceneLight& sun = s.lights[0];
         const size_t tris = s.occluders.size();
         const auto tb0 = bench::time_repeats_cpu(3, [&] { bench::keep(OccluderBvh(s.occluders)); });
         BakeReport rep;
@@ -257,10 +309,19 @@ int main(int argc, char** argv) {
         const double brute_rate = double(probes) * dirs.size() / tbf.median_s;
         std::printf("%-40s %12.3g %12.1f %10s  (BVH query %.0fx faster)\n", "  brute force (early exit)", brute_rate,
                     1e9 / brute_rate, "", query_rate / brute_rate);
+        // Memory per triangle: the tree (its primitives, 80 bytes each, and nodes), and the peak of a
+        // bake of the scene given up (bake_scene(Scene&&), as `zhc bake` runs it): the high-water
+        // mark above the resident set before the scene's copy was made, per triangle.
+        const double bvh_per_tri = double(bvh.memory_bytes()) / double(tris);
+        const double bake_peak_per_tri = bake_peak_bytes_per_triangle(n / 2, res);
+        std::printf("%-40s BVH %.1f bytes per triangle (%zu-byte primitives, %zu nodes); bake peak %.1f bytes per triangle\n",
+                    "  memory", bvh_per_tri, sizeof(Occluder), bvh.node_count(), bake_peak_per_tri);
         mesh_rows.push_back(format("{\"triangles\": %zu, \"bvh_build_ms\": %.4g, \"rays\": %llu, \"bake_rays_per_s\": %.6g, "
-                                   "\"query_rays_per_s\": %.6g, \"blocked_fraction\": %.4f, \"brute_force_rays_per_s\": %.6g}",
+                                   "\"query_rays_per_s\": %.6g, \"blocked_fraction\": %.4f, \"brute_force_rays_per_s\": %.6g, "
+                                   "\"bvh_bytes_per_triangle\": %.4g, \"bake_peak_bytes_per_triangle\": %.4g}",
                                    tris, tb0.median_s * 1e3, static_cast<unsigned long long>(rep.rays), rep.rays / t.median_s,
-                                   query_rate, double(hits) / repeats / (double(pos.size()) * dirs.size()), brute_rate));
+                                   query_rate, double(hits) / repeats / (double(pos.size()) * dirs.size()), brute_rate,
+                                   bvh_per_tri, bake_peak_per_tri));
     }
     
     // Occlusion passes on the 200k-triangle mesh, against its shadow rays in the same run.

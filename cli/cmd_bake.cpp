@@ -88,15 +88,15 @@ int run(const Options& o) {
     ProbeLeakData leak;
     Progress progress("zhc bake", "probes", o.progress);
     if (progress.enabled()) bo.progress = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
-    auto probes = bake_scene(*scene, bo, &rep, &leak);
+    size_t occluders = scene->occluders.size(), triangles = 0;
+    for (const Occluder& oc : scene->occluders) triangles += oc.kind == OccluderKind::kTriangle;
+    // The bake takes the occluders over (its BVH holds the only copy of the mesh).
+    auto probes = bake_scene(std::move(*scene), bo, &rep, &leak);
     progress.finish();
     if (!probes) return report(probes.error());
     if (!o.progress.quiet) {
         print_report(rep);
-        size_t triangles = 0;
-        for (const Occluder& oc : scene->occluders) triangles += oc.kind == OccluderKind::kTriangle;
-        if (!scene->occluders.empty())
-            std::printf("occluders: %zu (%zu mesh triangles)\n", scene->occluders.size(), triangles);
+        if (occluders > 0) std::printf("occluders: %zu (%zu mesh triangles)\n", occluders, triangles);
     }
 
     const ProbeLayout layout = probe_layout(scene->probes);

@@ -72,17 +72,20 @@ def sig(x, digits=2):
 def gen_bench_bake(ctx):
     d = run_json(os.path.join(ctx["build"], "bench", "bench_bake"), [], ctx["tmp"])
     n = d["probes_per_axis"] // 2
-    rows = ["| occluder | BVH build | BVH rays/s (query) | rays/s (whole bake) | brute force rays/s | BVH / brute force | rays blocked |",
-            "|---|---:|---:|---:|---:|---:|---:|"]
+    rows = ["| occluder | BVH build | BVH rays/s (query) | rays/s (whole bake) | brute force rays/s | BVH / brute force | rays blocked "
+            "| BVH bytes/triangle | bake peak bytes/triangle |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for m in d["meshes"]:
-        rows.append("| %s triangles | %.0f ms | %s | %s | %s | ~%s x | %.1f%% |" % (
+        rows.append("| %s triangles | %.0f ms | %s | %s | %s | ~%s x | %.1f%% | %.0f | %.0f |" % (
             format(m["triangles"], ","), m["bvh_build_ms"], sig(m["query_rays_per_s"]), sig(m["bake_rays_per_s"]),
             sig(m["brute_force_rays_per_s"]), format(int(float("%.2g" % (m["query_rays_per_s"] / m["brute_force_rays_per_s"]))), ","),
-            100 * m["blocked_fraction"]))
+            100 * m["blocked_fraction"], m["bvh_bytes_per_triangle"], m["bake_peak_bytes_per_triangle"]))
     rays = d["meshes"][0]["rays"] if d["meshes"] else 0
     return "\n".join([header("build/bench/bench_bake --json FILE"),
                       "One thread, %dx%dx%d probes, a sun with 64 samples over a tessellated sphere (%s rays), "
-                      "median of %d runs in thread CPU time; brute force on a subset of the same rays." % (n, n, max(1, n // 4), format(rays, ","), d["repeats"]),
+                      "median of %d runs in thread CPU time; brute force on a subset of the same rays. Memory: the tree's bytes per triangle, "
+                      "and the peak resident memory of making the scene and baking it given up (`bake_scene(Scene&&)`, as `zhc bake` does) "
+                      "in a fresh process, per triangle." % (n, n, max(1, n // 4), format(rays, ","), d["repeats"]),
                       ""] + rows)
 
 

@@ -248,10 +248,7 @@ TEST(SceneBake, BoxOccluderRemovesOnlyTheShadowedLight) {
     SceneLight c = sphere_light({0, 0, 6}, 0.5, {1, 1, 8});  // also behind the wall but unshadowed
     c.name = "C";
     s.lights = {a, b, c};
-    Occluder wall;
-    wall.kind = OccluderKind::kBox;
-    wall.min = {-1, -1, 2};
-    wall.max = {1, 1, 2.05};
+    Occluder wall = box_occluder({-1, -1, 2}, {1, 1, 2.05});
     s.occluders = {wall};
     // About the lights' shadows: the sky stays unoccluded here (occlusion.sky_samples 0), so the
     // references without occluders differ only by the lights (sky occlusion: test_scene_occlusion).
@@ -290,10 +287,7 @@ TEST(SceneBake, PartialShadowMatchesDenseVisibleProjection) {
     l.shadows = true;
     l.shadow_samples = 4096;
     s.lights = {l};
-    Occluder half;
-    half.kind = OccluderKind::kBox;
-    half.min = {0.0, -3, 2};
-    half.max = {3, 3, 2.1};
+    Occluder half = box_occluder({0.0, -3, 2}, {3, 3, 2.1});
     s.occluders = {half};
     const Sh3Radiance baked = bake_one(s);
     const Sh3Radiance dense = dense_projection(1000000, [&](Vec3 w) {
@@ -319,10 +313,7 @@ TEST(SceneBake, ShadowedProbeInsideSphereLight) {
     l.shadows = true;
     l.shadow_samples = 4096;
     s.lights = {l};
-    Occluder slab;
-    slab.kind = OccluderKind::kBox;
-    slab.min = {-3, -3, 0.05};
-    slab.max = {3, 3, 0.1};
+    Occluder slab = box_occluder({-3, -3, 0.05}, {3, 3, 0.1});
     s.occluders = {slab};
     const Sh3Radiance baked = bake_one(s);
     // Slow twin: dense directions, visible unless the slab is hit before the ray leaves the sphere
@@ -344,14 +335,11 @@ TEST(Occluders, BvhAgreesWithBruteForce) {
     for (int i = 0; i < 300; ++i) {
         Occluder o;
         if (i % 2) {
-            o.kind = OccluderKind::kSphere;
-            o.center = {u(rng), u(rng), u(rng)};
-            o.radius = 0.05 + 0.3 * u01(rng);
+            const Vec3 c{u(rng), u(rng), u(rng)};
+            o = sphere_occluder(c, 0.05 + 0.3 * u01(rng));
         } else {
-            o.kind = OccluderKind::kBox;
             const Vec3 a{u(rng), u(rng), u(rng)};
-            o.min = a;
-            o.max = a + Vec3{0.5 * u01(rng), 0.5 * u01(rng), 0.5 * u01(rng)};
+            o = box_occluder(a, a + Vec3{0.5 * u01(rng), 0.5 * u01(rng), 0.5 * u01(rng)});
         }
         occ.push_back(o);
     }
@@ -369,17 +357,11 @@ TEST(Occluders, BvhAgreesWithBruteForce) {
     EXPECT_GT(hits, 1000);
     EXPECT_LT(hits, 19000);
     // Analytic cases: a sphere straight ahead, behind, beyond t_max; a box from inside.
-    Occluder sph;
-    sph.kind = OccluderKind::kSphere;
-    sph.center = {0, 0, 5};
-    sph.radius = 1;
+    Occluder sph = sphere_occluder({0, 0, 5}, 1);
     EXPECT_TRUE(ray_hits(sph, {0, 0, 0}, {0, 0, 1}, 1e-9, 1e30));
     EXPECT_FALSE(ray_hits(sph, {0, 0, 0}, {0, 0, -1}, 1e-9, 1e30));
     EXPECT_FALSE(ray_hits(sph, {0, 0, 0}, {0, 0, 1}, 1e-9, 3.9));
-    Occluder box;
-    box.kind = OccluderKind::kBox;
-    box.min = {-1, -1, -1};
-    box.max = {1, 1, 1};
+    Occluder box = box_occluder({-1, -1, -1}, {1, 1, 1});
     EXPECT_TRUE(ray_hits(box, {0, 0, 0}, {1, 0, 0}, 1e-9, 1e30));
     EXPECT_TRUE(ray_hits(box, {-3, 0.5, 0}, {1, 0, 0}, 1e-9, 1e30));
     EXPECT_FALSE(ray_hits(box, {-3, 0.5, 0}, {1, 0, 0}, 1e-9, 1.9));
@@ -422,10 +404,7 @@ TEST(SceneBake, ReportListsExactlyTheSceneEffects) {
     for (const BakeEffect& e : rep.effects) EXPECT_EQ(e.method, "closed form");
     EXPECT_EQ(rep.rays, 0u);
     // An occluder: only the shadowed light traces.
-    Occluder o;
-    o.kind = OccluderKind::kSphere;
-    o.center = {5, 5, 5};
-    o.radius = 1;
+    Occluder o = sphere_occluder({5, 5, 5}, 1);
     s.occluders = {o};
     bake_one(s, &rep);
     EXPECT_EQ(rep.effects[1].method, "closed form");

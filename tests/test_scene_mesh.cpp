@@ -89,15 +89,9 @@ TEST(TriangleOccluder, BvhAgreesWithBruteForceOnMeshes) {
         const Vec3 a{u(rng), u(rng), u(rng)};
         occ.push_back(triangle_occluder(a, a + Vec3{0.3 * u01(rng), 0.3 * u01(rng), 0}, a + Vec3{0, 0.2 * u01(rng), 0.3 * u01(rng)}));
     }
-    Occluder s;
-    s.kind = OccluderKind::kSphere;
-    s.center = {3, 3, 3};
-    s.radius = 0.4;
+    Occluder s = sphere_occluder({3, 3, 3}, 0.4);
     occ.push_back(s);
-    Occluder b;
-    b.kind = OccluderKind::kBox;
-    b.min = {-3.5, 2, -1};
-    b.max = {-3, 2.5, 1};
+    Occluder b = box_occluder({-3.5, 2, -1}, {-3, 2.5, 1});
     occ.push_back(b);
     ASSERT_GT(occ.size(), 22000u);
     const OccluderBvh bvh(occ);
@@ -209,10 +203,7 @@ TEST(TriangleOccluder, QuadRemovesExactlyTheLightItHides) {
     EXPECT_GT(rep.rays, 0u);
     // The same quad as a box of zero thickness gives the same bake (two twins of one plane).
     Scene as_box = s;
-    Occluder box;
-    box.kind = OccluderKind::kBox;
-    box.min = {-1, -1, 2};
-    box.max = {1, 1, 2};
+    Occluder box = box_occluder({-1, -1, 2}, {1, 1, 2});
     as_box.occluders = {box};
     auto boxed = bake_scene(as_box);
     ASSERT_TRUE(boxed.ok());

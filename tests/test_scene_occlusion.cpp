@@ -33,10 +33,7 @@ std::vector<Sh3Radiance> bake(const Scene& s, int threads = 1, BakeReport* rep =
 }
 
 Occluder box(Vec3 lo, Vec3 hi) {
-    Occluder o;
-    o.kind = OccluderKind::kBox;
-    o.min = lo;
-    o.max = hi;
+    Occluder o = box_occluder(lo, hi);
     return o;
 }
 
@@ -297,7 +294,7 @@ TEST(ProbeValidity, ProbesInsideABoxOrAClosedMeshAreInvalidAndDilated) {
     };
     const std::vector<Case> cases = {
         {"box", {box({1.8, -0.2, -0.2}, {2.2, 0.2, 0.2})}, true},
-        {"sphere", {[] { Occluder o; o.center = {2, 0, 0}; o.radius = 0.3; return o; }()}, true},
+        {"sphere", {sphere_occluder({2, 0, 0}, 0.3)}, true},
         {"closed mesh", cube_mesh({1.8, -0.2, -0.2}, {2.2, 0.2, 0.2}), true},
         // The same mesh wound inwards: its inside is the outside of a room, probes there valid.
         {"inward mesh", cube_mesh({1.8, -0.2, -0.2}, {2.2, 0.2, 0.2}, true), false},

@@ -10,14 +10,14 @@ namespace {
 void bounds_of(const Occluder& o, double lo[3], double hi[3]) {
     for (int a = 0; a < 3; ++a) {
         if (o.kind == OccluderKind::kSphere) {
-            lo[a] = o.center[a] - o.radius;
-            hi[a] = o.center[a] + o.radius;
+            lo[a] = o.center()[a] - o.radius();
+            hi[a] = o.center()[a] + o.radius();
         } else if (o.kind == OccluderKind::kTriangle) {
             lo[a] = std::min({o.v0[a], o.v1[a], o.v2[a]});
             hi[a] = std::max({o.v0[a], o.v1[a], o.v2[a]});
         } else {
-            lo[a] = o.min[a];
-            hi[a] = o.max[a];
+            lo[a] = o.min()[a];
+            hi[a] = o.max()[a];
         }
     }
 }
@@ -80,12 +80,12 @@ bool ray_hits_triangle(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 o, Vec3 d, double t_min, 
 
 bool inside_solid(const Occluder& occ, Vec3 p) {
     if (occ.kind == OccluderKind::kSphere) {
-        const Vec3 v = p - occ.center;
-        return dot(v, v) <= occ.radius * occ.radius;
+        const Vec3 v = p - occ.center();
+        return dot(v, v) <= occ.radius() * occ.radius();
     }
     if (occ.kind == OccluderKind::kBox)
-        return p.x >= occ.min.x && p.x <= occ.max.x && p.y >= occ.min.y && p.y <= occ.max.y && p.z >= occ.min.z &&
-               p.z <= occ.max.z;
+        return p.x >= occ.min().x && p.x <= occ.max().x && p.y >= occ.min().y && p.y <= occ.max().y && p.z >= occ.min().z &&
+               p.z <= occ.max().z;
     return false;
 }
 
@@ -99,15 +99,15 @@ RayHit ray_nearest(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_m
     }
     if (inside_solid(occ, o)) return {true, true, t_min};
     if (occ.kind == OccluderKind::kSphere) {
-        const Vec3 oc = o - occ.center;
-        const double b = dot(d, oc), c = dot(oc, oc) - occ.radius * occ.radius;
+        const Vec3 oc = o - occ.center();
+        const double b = dot(d, oc), c = dot(oc, oc) - occ.radius() * occ.radius();
         const double disc = b * b - c;
         if (disc < 0.0) return h;
         const double t_near = -b - std::sqrt(disc);
         if (t_near > t_min && t_near < t_max) h = {true, false, t_near};
         return h;
     }
-    double lo[3] = {occ.min.x, occ.min.y, occ.min.z}, hi[3] = {occ.max.x, occ.max.y, occ.max.z};
+    double lo[3] = {occ.min().x, occ.min().y, occ.min().z}, hi[3] = {occ.max().x, occ.max().y, occ.max().z};
     double enter = 0;
     if (slab(lo, hi, o, d, t_min, t_max, &enter) && enter < t_max) h = {true, false, enter};
     return h;
@@ -119,6 +119,22 @@ Occluder triangle_occluder(Vec3 a, Vec3 b, Vec3 c) {
     o.v0 = a;
     o.v1 = b;
     o.v2 = c;
+    return o;
+}
+
+Occluder sphere_occluder(Vec3 c, double r) {
+    Occluder o;
+    o.kind = OccluderKind::kSphere;
+    o.v0 = c;
+    o.v1 = {r, 0, 0};
+    return o;
+}
+
+Occluder box_occluder(Vec3 lo, Vec3 hi) {
+    Occluder o;
+    o.kind = OccluderKind::kBox;
+    o.v0 = lo;
+    o.v1 = hi;
     return o;
 }
 
@@ -141,8 +157,8 @@ bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
     if (occ.kind == OccluderKind::kTriangle) return ray_hits_triangle(occ.v0, occ.v1, occ.v2, o, d, t_min, t_max);
     if (occ.kind == OccluderKind::kSphere) {
         // |o + t d - c|^2 = r^2 with |d| = 1: t^2 + 2 b t + c = 0, b = d.(o - c), c = |o - c|^2 - r^2.
-        const Vec3 oc = o - occ.center;
-        const double b = dot(d, oc), c = dot(oc, oc) - occ.radius * occ.radius;
+        const Vec3 oc = o - occ.center();
+        const double b = dot(d, oc), c = dot(oc, oc) - occ.radius() * occ.radius();
         if (c <= 0.0) return true;  // origin inside (or on) the sphere
         const double disc = b * b - c;
         if (disc < 0.0) return false;
@@ -151,7 +167,7 @@ bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
         // Any t of [t_near, t_far] inside (t_min, t_max)?
         return t_far > t_min && t_near < t_max;
     }
-    double lo[3] = {occ.min.x, occ.min.y, occ.min.z}, hi[3] = {occ.max.x, occ.max.y, occ.max.z};
+    double lo[3] = {occ.min().x, occ.min().y, occ.min().z}, hi[3] = {occ.max().x, occ.max().y, occ.max().z};
     bool inside = true;
     for (int a = 0; a < 3; ++a) inside = inside && o[a] >= lo[a] && o[a] <= hi[a];
     if (inside) return true;
@@ -161,47 +177,45 @@ bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
     return enter < t_max;
 }
 
-// The compact form keeps only the doubles the primitive's kind uses (triangle: v0 v1 v2; sphere:
-// centre, radius; box: min, max), 80 bytes per primitive (an Occluder is 160). expand() gives back
-// the same doubles, so the ray tests see exactly the caller's occluders.
-OccluderBvh::Prim OccluderBvh::compact(const Occluder& o) {
-    Prim p;
-    p.kind = o.kind;
-    const Vec3 a = o.kind == OccluderKind::kTriangle ? o.v0 : o.kind == OccluderKind::kSphere ? o.center : o.min;
-    const Vec3 b = o.kind == OccluderKind::kTriangle ? o.v1 : o.kind == OccluderKind::kSphere ? Vec3{o.radius, 0, 0} : o.max;
-    const Vec3 c = o.kind == OccluderKind::kTriangle ? o.v2 : Vec3{};
-    const double v[9] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z};
-    std::copy(v, v + 9, p.p);
-    return p;
+OccluderBvh::OccluderBvh(const std::vector<Occluder>& occluders) : prims_(occluders) { build_tree(); }
+
+OccluderBvh::OccluderBvh(std::vector<Occluder>&& occluders) : prims_(std::move(occluders)) {
+    occluders.clear();
+    occluders.shrink_to_fit();
+    build_tree();
 }
 
-Occluder OccluderBvh::expand(const Prim& p) {
-    Occluder o;
-    o.kind = p.kind;
-    const Vec3 a{p.p[0], p.p[1], p.p[2]}, b{p.p[3], p.p[4], p.p[5]}, c{p.p[6], p.p[7], p.p[8]};
-    if (p.kind == OccluderKind::kTriangle) o.v0 = a, o.v1 = b, o.v2 = c;
-    else if (p.kind == OccluderKind::kSphere) o.center = a, o.radius = b.x;
-    else o.min = a, o.max = b;
-    return o;
-}
-
-OccluderBvh::OccluderBvh(const std::vector<Occluder>& occluders) {
-    if (occluders.empty()) return;
-    // Boxes and centroids once; the build permutes indices, then the primitives are stored in
-    // leaf order (each leaf a contiguous range).
-    std::vector<Bounds> bounds(occluders.size());
-    for (size_t i = 0; i < occluders.size(); ++i) {
-        bounds_of(occluders[i], bounds[i].lo, bounds[i].hi);
-        for (int a = 0; a < 3; ++a) bounds[i].centroid[a] = 0.5 * (bounds[i].lo[a] + bounds[i].hi[a]);
+void OccluderBvh::build_tree() {
+    if (prims_.empty()) return;
+    prims_.shrink_to_fit();
+    // Boxes once (a centroid is computed from its box where needed: the same doubles as storing it,
+    // 24 bytes per primitive less at the build's peak); the build permutes indices, then the
+    // primitives are put in leaf order (each leaf a contiguous range) in place, following the
+    // permutation's cycles.
+    std::vector<Bounds> bounds(prims_.size());
+    for (size_t i = 0; i < prims_.size(); ++i) {
+        bounds_of(prims_[i], bounds[i].lo, bounds[i].hi);
     }
-    std::vector<std::uint32_t> order(occluders.size());
+    std::vector<std::uint32_t> order(prims_.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
-    nodes_.reserve(occluders.size() + 1);  // leaves of 2..4 primitives: < n nodes
+    nodes_.reserve(prims_.size() + 1);  // leaves of 2..4 primitives: < n nodes
     build(order, bounds, 0, static_cast<std::uint32_t>(order.size()), 0);
     std::vector<Bounds>().swap(bounds);
     nodes_.shrink_to_fit();  // the reservation was the bound n + 1; leaves hold 2..4 primitives
-    prims_.reserve(occluders.size());
-    for (std::uint32_t i : order) prims_.push_back(compact(occluders[i]));
+    // prims_[i] becomes what prims_[order[i]] held: each cycle of the permutation rotated once.
+    for (size_t start = 0; start < order.size(); ++start) {
+        if (order[start] == start) continue;
+        const Occluder first = prims_[start];
+        size_t i = start;
+        while (order[i] != start) {
+            const size_t next = order[i];
+            prims_[i] = prims_[next];
+            order[i] = static_cast<std::uint32_t>(i);
+            i = next;
+        }
+        prims_[i] = first;
+        order[i] = static_cast<std::uint32_t>(i);
+    }
 }
 
 std::uint32_t OccluderBvh::build(std::vector<std::uint32_t>& order, const std::vector<Bounds>& bounds,
@@ -219,8 +233,8 @@ std::uint32_t OccluderBvh::build(std::vector<std::uint32_t>& order, const std::v
         for (int a = 0; a < 3; ++a) {
             n.lo[a] = std::min(n.lo[a], b.lo[a]);
             n.hi[a] = std::max(n.hi[a], b.hi[a]);
-            clo[a] = std::min(clo[a], b.centroid[a]);
-            chi[a] = std::max(chi[a], b.centroid[a]);
+            clo[a] = std::min(clo[a], b.centroid(a));
+            chi[a] = std::max(chi[a], b.centroid(a));
         }
     }
     // Conservative node boxes: widened by a relative 1e-9 so rounding in the slab test never
@@ -247,7 +261,7 @@ std::uint32_t OccluderBvh::build(std::vector<std::uint32_t>& order, const std::v
     // partition (and the whole tree) is the same for the same input on every run.
     std::nth_element(order.begin() + first, order.begin() + mid, order.begin() + first + count,
                      [&bounds, axis](std::uint32_t a, std::uint32_t b) {
-                         const double ca = bounds[a].centroid[axis], cb = bounds[b].centroid[axis];
+                         const double ca = bounds[a].centroid(axis), cb = bounds[b].centroid(axis);
                          return ca < cb || (ca == cb && a < b);
                      });
     n.count = 0;
@@ -293,11 +307,10 @@ bool OccluderBvh::occluded(Vec3 o, Vec3 d, double t_min, double t_max) const {
         }
         if (n.count > 0) {
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
-                const Prim& p = prims_[i];
+                const Occluder& p = prims_[i];
                 const bool hit = p.kind == OccluderKind::kTriangle
-                                     ? ray_hits_triangle({p.p[0], p.p[1], p.p[2]}, {p.p[3], p.p[4], p.p[5]}, {p.p[6], p.p[7], p.p[8]}, o,
-                                                         d, t_min, t_max)
-                                     : ray_hits(expand(p), o, d, t_min, t_max);
+                                     ? ray_hits_triangle(p.v0, p.v1, p.v2, o, d, t_min, t_max)
+                                     : ray_hits(p, o, d, t_min, t_max);
                 if (hit) return true;
             }
         } else if (top + 2 <= 128) {
@@ -351,7 +364,7 @@ RayHit OccluderBvh::nearest(Vec3 o, Vec3 d, double t_min, double t_max) const {
         if (n.count > 0) {
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
                 // Strictly nearer hits only (t < far, the best so far): the first primitive visited wins a tie.
-                const RayHit h = ray_nearest(expand(prims_[i]), o, d, t_min, far);
+                const RayHit h = ray_nearest(prims_[i], o, d, t_min, far);
                 if (h.hit && (!best.hit || h.t < best.t)) {
                     best = h;
                     far = h.t;
@@ -383,7 +396,7 @@ bool OccluderBvh::inside_any_solid(Vec3 p) const {
         if (!in) continue;
         if (n.count > 0) {
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i)
-                if (inside_solid(expand(prims_[i]), p)) return true;
+                if (inside_solid(prims_[i], p)) return true;
         } else if (top + 2 <= 128) {
             stack[top++] = n.left;
             stack[top++] = n.right;

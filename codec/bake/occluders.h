@@ -2,31 +2,14 @@
 //
 // std-only (codec/ may not use Embree). The BVH is a binary tree over the occluders' bounding
 // boxes, split at the median centroid along the longest centroid axis (leaves of <= 4
-// primitives), built deterministically from precomputed boxes and centroids in O(n log n);
-// `occluded` is an any-hit query with an explicit stack that visits the nearer child first.
-// Triangle meshes of 10^5..10^6 triangles are one triangle primitive each in the same tree;
-// bench/bench_bake reports rays per second against brute force. The tree reads the caller's
-// occluders without copying them and keeps each primitive in 80 bytes (its nine doubles and its
-// kind) plus about 0.7 nodes of 72 bytes: 132 bytes per triangle on a 22,800-triangle mesh
-// (test_scene_mesh prints it; memory_bytes()).
-//
-// Ray/triangle (Moller & Trumbore 1997, "Fast, minimum storage ray/triangle intersection"), in
-// double, epsilon policy (docs/scene.md "Triangle meshes"):
-//  * both faces block (no back-face culling: an occluder is a surface, not a closed solid);
-//  * a ray exactly parallel to the triangle's plane (determinant == 0, bit-exact) misses: it sees
-//    the triangle edge-on, zero solid angle; no other epsilon on the determinant;
-//  * barycentric bounds are inclusive and widened by 1e-10 (u >= -1e-10, v >= -1e-10,
-//    u + v <= 1 + 1e-10): Moller-Trumbore is not watertight (neighbours compute their own u, v and
-//    may both reject a ray through their shared edge by a few ulps); the widening, far above
-//    rounding (~1e-15) and far below any scene feature, closes those cracks: no leaks along the
-//    seams of a closed mesh ("watertight enough" for shadow rays);
-//  * the hit distance must lie in the open interval (t_min, t_max), like the other primitives;
-//  * a degenerate (zero-area) triangle never blocks.
-//
-// Experimental: this API may change between minor versions (docs/api.md "Public headers").
-// Thread safety (docs/api.md): every function here is reentrant and keeps no state between
-// calls; calls may run concurrently on different arguments and on the same const ones.
-// An occluder set (and its BVH) is immutable once built: rays may be cast from many threads at once.
+// primitives), built deterministically from precomputed boxes in O(n log n); `occluded` is an
+// any-hit query with an explicit stack that visits the nearer child first. Triangle meshes of
+// 10^5..10^6 triangles are one triangle primitive each in the same tree; bench/bench_bake reports
+// rays per second against brute force and bytes per triangle. The tree keeps the occluders
+// themselves (80 bytes each) in leaf order plus about 0.7 nodes of 72 bytes: 127 to 135 bytes per
+// triangle (memory_bytes(); test_scene_mesh prints it). Built from a const vector it copies the
+// occluders; from an rvalue it takes them over and reorders them in place, so a baked scene's mesh
+// is held once (bake_scene(Scene&&)).
 #pragma once
 
 #include <cstdint>
@@ -38,19 +21,27 @@
 namespace zhc {
 
 enum class OccluderKind : std::uint8_t { kSphere, kBox, kTriangle };
+// Three points' worth of doubles whatever the kind (80 bytes: meshes bring hundreds of thousands of
+// triangles, and the BVH keeps these as its primitives): a triangle's vertices v0, v1, v2 (either
+// winding; both faces block); a sphere's centre in v0 and radius in v1.x; a box's corners min in v0
+// and max in v1 (axis-aligned, min <= max per axis). Make them with the functions below; read a
+// sphere or box through its accessors.
 struct Occluder {
     OccluderKind kind = OccluderKind::kSphere;
+    Vec3 v0, v1, v2;
     std::string_view name() const {
         return kind == OccluderKind::kSphere ? "sphere" : kind == OccluderKind::kBox ? "box" : "triangle";
     }
-    Vec3 center;        // sphere
-    double radius = 0;  // sphere
-    Vec3 min, max;      // box (axis-aligned, min <= max per axis)
-    Vec3 v0, v1, v2;    // triangle (either winding; both faces block)
+    Vec3 center() const { return v0; }    // sphere
+    double radius() const { return v1.x; }  // sphere
+    Vec3 min() const { return v0; }       // box
+    Vec3 max() const { return v1; }       // box
 };
 
-// A triangle occluder with vertices a, b, c.
+// A triangle occluder with vertices a, b, c; a sphere (centre c, radius r); a box (corners lo, hi).
 Occluder triangle_occluder(Vec3 a, Vec3 b, Vec3 c);
+Occluder sphere_occluder(Vec3 c, double r);
+Occluder box_occluder(Vec3 lo, Vec3 hi);
 // Triangles of a UV sphere (centre c, radius r) with n_lat x n_lon quads of two triangles each
 // (one at the poles): 2 n_lat n_lon - 2 n_lon triangles. A closed mesh occluder for scenes,
 // tests and benchmarks.
@@ -78,6 +69,9 @@ class OccluderBvh {
 public:
     OccluderBvh() = default;
     explicit OccluderBvh(const std::vector<Occluder>& occluders);
+    // Takes the occluders over (no copy: they are reordered in place into the tree's leaf order and
+    // their vector is left empty), so a scene's mesh is held once.
+    explicit OccluderBvh(std::vector<Occluder>&& occluders);
     bool empty() const { return prims_.empty(); }
     // Any hit with t in (t_min, t_max)?
     bool occluded(Vec3 o, Vec3 d, double t_min, double t_max) const;
@@ -88,7 +82,7 @@ public:
     bool inside_any_solid(Vec3 p) const;
     std::size_t node_count() const { return nodes_.size(); }
     // Bytes the tree holds (primitives and nodes), printed per primitive by test_scene_mesh.
-    std::size_t memory_bytes() const { return prims_.capacity() * sizeof(Prim) + nodes_.capacity() * sizeof(Node); }
+    std::size_t memory_bytes() const { return prims_.capacity() * sizeof(Occluder) + nodes_.capacity() * sizeof(Node); }
 
 private:
     struct Node {
@@ -98,20 +92,15 @@ private:
         std::uint8_t axis = 0;               // inner node: split axis (nearer child first)
     };
     struct Bounds {
-        double lo[3], hi[3], centroid[3];
+        double lo[3], hi[3];
+        double centroid(int a) const { return 0.5 * (lo[a] + hi[a]); }
     };
-    // A primitive in leaf order, compactly: nine doubles (the kind's vertices / centre and radius /
-    // corners) and the kind, 80 bytes (an Occluder is 160).
-    struct Prim {
-        double p[9];
-        OccluderKind kind;
-    };
-    static Prim compact(const Occluder& o);
-    static Occluder expand(const Prim& p);
-    std::vector<Prim> prims_;
+    std::vector<Occluder> prims_;  // in leaf order
     std::vector<Node> nodes_;
     std::uint32_t build(std::vector<std::uint32_t>& order, const std::vector<Bounds>& bounds, std::uint32_t first,
                         std::uint32_t count, int depth);
+    // The tree over prims_ (in input order), which it then reorders into leaf order.
+    void build_tree();
 };
 
 }  // namespace zhc

@@ -205,16 +205,8 @@ Scene default_scene() {
     sphere("green", {2.2, -2.4, 0.8}, 0.3, {4, 30, 6}, false);
     sphere("blue", {1.2, 2.3, 2.7}, 0.4, {4, 10, 36}, true);
     // A roof over one corner (shades the sun there) and a pillar-like sphere between lights.
-    Occluder roof;
-    roof.kind = OccluderKind::kBox;
-    roof.min = {-4.5, -4.5, 3.6};
-    roof.max = {0.5, 0.5, 3.8};
-    s.occluders.push_back(roof);
-    Occluder ball;
-    ball.kind = OccluderKind::kSphere;
-    ball.center = {-1.0, 0.6, 1.6};
-    ball.radius = 0.55;
-    s.occluders.push_back(ball);
+    s.occluders.push_back(box_occluder({-4.5, -4.5, 3.6}, {0.5, 0.5, 3.8}));
+    s.occluders.push_back(sphere_occluder({-1.0, 0.6, 1.6}, 0.55));
     return s;
 }
 
@@ -313,14 +305,14 @@ Status validate_scene(const Scene& s) {
         const Occluder& o = s.occluders[i];
         const std::string at = "occluders[" + std::to_string(i) + "]";
         if (o.kind == OccluderKind::kSphere) {
-            if (!finite3(o.center) || !(o.radius > 0) || !std::isfinite(o.radius))
+            if (!finite3(o.center()) || !(o.radius() > 0) || !std::isfinite(o.radius()))
                 return bad(at + ": sphere needs a finite centre and radius > 0");
         } else if (o.kind == OccluderKind::kTriangle) {
             if (!finite3(o.v0) || !finite3(o.v1) || !finite3(o.v2)) return bad(at + ": triangle vertex is not finite");
         } else {
-            if (!finite3(o.min) || !finite3(o.max)) return bad(at + ": box bounds are not finite");
+            if (!finite3(o.min()) || !finite3(o.max())) return bad(at + ": box bounds are not finite");
             for (int a = 0; a < 3; ++a)
-                if (o.min[a] > o.max[a]) return bad(at + ": box min > max on axis " + std::to_string(a));
+                if (o.min()[a] > o.max()[a]) return bad(at + ": box min > max on axis " + std::to_string(a));
         }
     }
     return Ok{};
@@ -523,18 +515,40 @@ std::uint8_t grid_visibility_mask(const OccluderBvh& bvh, const ProbeGrid& g, st
 
 }  // namespace
 
+namespace {
+Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh& bvh, double bvh_ms, Clock::time_point t_start,
+                                           const BakeOptions& options, BakeReport* report, ProbeLeakData* leak);
+}  // namespace
+
 Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOptions& options, BakeReport* report,
                                             ProbeLeakData* leak) {
     const auto t_start = Clock::now();
     if (Status s = validate_scene(scene); !s) return s.error();
+    const auto t_bvh = Clock::now();
+    const OccluderBvh bvh(scene.occluders);
+    const double bvh_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_bvh).count();
+    return bake_with(scene, bvh, bvh_ms, t_start, options, report, leak);
+}
+
+Result<std::vector<Sh3Radiance>> bake_scene(Scene&& scene, const BakeOptions& options, BakeReport* report,
+                                            ProbeLeakData* leak) {
+    const auto t_start = Clock::now();
+    if (Status s = validate_scene(scene); !s) return s.error();
+    const auto t_bvh = Clock::now();
+    const OccluderBvh bvh(std::move(scene.occluders));
+    const double bvh_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_bvh).count();
+    return bake_with(scene, bvh, bvh_ms, t_start, options, report, leak);
+}
+
+namespace {
+
+// The bake of a validated scene whose occluders are in `bvh` (scene.occluders is not read).
+Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh& bvh, double bvh_ms, Clock::time_point t_start,
+                                           const BakeOptions& options, BakeReport* report, ProbeLeakData* leak) {
     if (leak) *leak = {};
     const std::vector<Vec3> positions = probe_positions(scene.probes);
     const size_t count = positions.size();
     const bool grid = scene.probes.kind == ProbePlacementKind::kGrid;
-
-    const auto t_bvh = Clock::now();
-    const OccluderBvh bvh(scene.occluders);
-    const double bvh_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_bvh).count();
     const int n_occ = bvh.empty() ? 0 : scene.occlusion.sky_samples;
     const bool occlude_distant = n_occ > 0 && (scene.environment || scene.sky);
     const bool validity = n_occ > 0 && grid;
@@ -815,5 +829,7 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
     }
     return out;
 }
+
+}  // namespace
 
 }  // namespace zhc

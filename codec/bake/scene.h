@@ -185,6 +185,11 @@ struct ProbeLeakData {
 // masks are traced only when it is asked for. The probes do not depend on `leak`.
 Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOptions& options = {},
                                             BakeReport* report = nullptr, ProbeLeakData* leak = nullptr);
+// The same bake of a scene given up: its occluders move into the bake's BVH instead of being
+// copied, so a mesh of n triangles is held once (80 bytes per triangle plus the tree's nodes) rather
+// than twice; `scene.occluders` is left empty.
+Result<std::vector<Sh3Radiance>> bake_scene(Scene&& scene, const BakeOptions& options = {},
+                                            BakeReport* report = nullptr, ProbeLeakData* leak = nullptr);
 
 // One light's radiance SH at probe position p, closed form, no shadows (the building block,
 // exposed for tests and benchmarks): accumulates into acc (27 doubles, coefficient-major RGB).

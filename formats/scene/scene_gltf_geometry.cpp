@@ -212,6 +212,12 @@ void Reader::add_triangles(const std::vector<Vec3>& verts, const std::vector<std
 // triangle occluders themselves and nothing per instance besides.
 void Reader::add_instances(const std::vector<Vec3>& local, const std::vector<std::uint32_t>& idx, std::uint64_t mode,
                            const Instancing& inst, const std::string& where) {
+    // Room for every triangle of every instance at once (the count was checked against the limit):
+    // a mesh of n triangles then costs n occluders, not up to twice that while the vector grows.
+    const std::uint64_t per = mode == 4 ? idx.size() / 3 : idx.size() > 2 ? idx.size() - 2 : 0;
+    const std::uint64_t need = per * inst.count;
+    if (occluders_.capacity() - occluders_.size() < need)
+        occluders_.reserve(std::max<std::uint64_t>(occluders_.size() + need, 2 * occluders_.capacity()));
     std::vector<Vec3> verts(local.size());
     for (std::uint64_t k = 0; k < inst.count; ++k) {
         const Mat4 world = instance_world(inst, k);

@@ -295,16 +295,14 @@ void read_occluder(const Reader& r, const json& j, const std::string& p, const S
     Occluder o;
     if (type == "sphere") {
         r.object(j, p, {"type", "name", "center", "radius"});
-        o.kind = OccluderKind::kSphere;
-        o.center = r.vec3(r.field(j, p, "center"), p + ".center");
-        o.radius = r.positive(r.field(j, p, "radius"), p + ".radius");
+        const Vec3 c = r.vec3(r.field(j, p, "center"), p + ".center");
+        o = sphere_occluder(c, r.positive(r.field(j, p, "radius"), p + ".radius"));
     } else if (type == "box") {
         r.object(j, p, {"type", "name", "min", "max"});
-        o.kind = OccluderKind::kBox;
-        o.min = r.vec3(r.field(j, p, "min"), p + ".min");
-        o.max = r.vec3(r.field(j, p, "max"), p + ".max");
+        const Vec3 lo = r.vec3(r.field(j, p, "min"), p + ".min");
+        o = box_occluder(lo, r.vec3(r.field(j, p, "max"), p + ".max"));
         for (int a = 0; a < 3; ++a)
-            if (o.min[a] > o.max[a]) r.fail(ErrorCode::kInvalidValue, p, "min must be <= max on every axis");
+            if (o.min()[a] > o.max()[a]) r.fail(ErrorCode::kInvalidValue, p, "min must be <= max on every axis");
     } else if (type == "mesh") {
         // Flat vertex list [x0, y0, z0, x1, ...] and optional flat triangle list [i0, i1, i2, ...]
         // (without indices, consecutive vertex triples are the triangles).
@@ -578,9 +576,9 @@ std::string scene_json(const Scene& s) {
     for (size_t i = 0; i < s.occluders.size(); ++i) {
         const Occluder& o = s.occluders[i];
         if (o.kind == OccluderKind::kSphere) {
-            occ.push_back({{"type", "sphere"}, {"center", vec_json(o.center)}, {"radius", o.radius}});
+            occ.push_back({{"type", "sphere"}, {"center", vec_json(o.center())}, {"radius", o.radius()}});
         } else if (o.kind == OccluderKind::kBox) {
-            occ.push_back({{"type", "box"}, {"min", vec_json(o.min)}, {"max", vec_json(o.max)}});
+            occ.push_back({{"type", "box"}, {"min", vec_json(o.min())}, {"max", vec_json(o.max())}});
         } else {
             json pos = json::array();
             for (; i < s.occluders.size() && s.occluders[i].kind == OccluderKind::kTriangle; ++i)
