@@ -90,13 +90,16 @@ int run(const Options& o) {
     if (progress.enabled()) bo.progress = [&](std::uint64_t d, std::uint64_t t) { progress.update(d, t); };
     size_t occluders = scene->occluders.size(), triangles = 0;
     for (const Occluder& oc : scene->occluders) triangles += oc.kind == OccluderKind::kTriangle;
+    const bool traced = bake_traces_occluders(*scene);
     // The bake takes the occluders over (its BVH holds the only copy of the mesh).
     auto probes = bake_scene(std::move(*scene), bo, &rep, &leak);
     progress.finish();
     if (!probes) return report(probes.error());
     if (!o.progress.quiet) {
         print_report(rep);
-        if (occluders > 0) std::printf("occluders: %zu (%zu mesh triangles)\n", occluders, triangles);
+        if (occluders > 0)
+            std::printf("occluders: %zu (%zu mesh triangles)%s\n", occluders, triangles,
+                        traced ? "" : "; not traced: no shadowed light, and sky samples 0 or nothing they would occlude");
     }
 
     const ProbeLayout layout = probe_layout(scene->probes);

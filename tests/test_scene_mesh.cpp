@@ -3,6 +3,7 @@
 // brute-force loop over every triangle, seams without leaks, and a quad of two triangles removing
 // exactly the light it hides.
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -158,6 +159,58 @@ Scene two_probes() {
     return s;
 }
 
+
+// Occluders that no effect traces (no shadowed light; sky samples 0, or sky samples but neither
+// distant lighting nor a grid): the bake builds no tree, the probes are those of the scene without
+// occluders bit for bit, through both bake_scene overloads; each effect that traces turns the tree on.
+TEST(TriangleOccluder, UntracedOccludersBuildNoTreeAndChangeNothing) {
+    Scene s = two_probes();
+    SceneLight l;
+    l.kind = LightKind::kPoint;
+    l.position = {0, 0, 4};
+    l.color = {6, 5, 4};
+    l.shadows = false;
+    s.lights = {l};
+    s.occluders = uv_sphere_triangles({0, 0, 2}, 0.5, 20, 20);  // between the light and probe 0
+    Scene bare = s;
+    bare.occluders.clear();
+    auto ref = bake_scene(bare);
+    ASSERT_TRUE(ref.ok());
+    for (int sky_samples : {0, 64}) {  // positions, no sky or environment: sky samples trace nothing
+        s.occlusion.sky_samples = sky_samples;
+        EXPECT_FALSE(bake_traces_occluders(s));
+        auto a = bake_scene(s);
+        Scene given = s;
+        auto b = bake_scene(std::move(given));
+        ASSERT_TRUE(a.ok() && b.ok());
+        EXPECT_TRUE(given.occluders.empty());
+        for (size_t p = 0; p < ref->size(); ++p) {
+            EXPECT_EQ(std::memcmp(&(*a)[p], &(*ref)[p], sizeof(Sh3Radiance)), 0) << p;
+            EXPECT_EQ(std::memcmp(&(*b)[p], &(*ref)[p], sizeof(Sh3Radiance)), 0) << p;
+        }
+    }
+    Scene shadowed = s;
+    shadowed.lights[0].shadows = true;
+    EXPECT_TRUE(bake_traces_occluders(shadowed));
+    auto sh = bake_scene(shadowed);
+    ASSERT_TRUE(sh.ok());
+    EXPECT_GT(test::max_abs_diff((*sh)[0], (*ref)[0]), 0.1);  // the sphere shadows probe 0 then
+    Scene grid = s;
+    grid.probes.kind = ProbePlacementKind::kGrid;
+    grid.probes.min = {-1, -1, 0};
+    grid.probes.max = {1, 1, 1};
+    grid.probes.counts = {2, 2, 2};
+    grid.occlusion.sky_samples = 16;  // validity and masks trace on a grid
+    EXPECT_TRUE(bake_traces_occluders(grid));
+    grid.occlusion.sky_samples = 0;
+    EXPECT_FALSE(bake_traces_occluders(grid));
+    Scene sky = s;
+    SceneSky gradient;
+    gradient.kind = SkyKind::kGradient;
+    sky.sky = gradient;
+    sky.occlusion.sky_samples = 16;
+    EXPECT_TRUE(bake_traces_occluders(sky));
+}
 
 TEST(TriangleOccluder, QuadRemovesExactlyTheLightItHides) {
     Scene s = two_probes();

@@ -520,12 +520,23 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
                                            const BakeOptions& options, BakeReport* report, ProbeLeakData* leak);
 }  // namespace
 
+bool bake_traces_occluders(const Scene& scene) {
+    if (scene.occluders.empty()) return false;
+    // Sky occlusion of the distant lighting, probe validity and visibility masks (grids), shadows.
+    const bool grid = scene.probes.kind == ProbePlacementKind::kGrid;
+    if (scene.occlusion.sky_samples > 0 && (scene.environment || scene.sky || grid)) return true;
+    for (const SceneLight& l : scene.lights)
+        if (l.shadows) return true;
+    return false;
+}
+
 Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOptions& options, BakeReport* report,
                                             ProbeLeakData* leak) {
     const auto t_start = Clock::now();
     if (Status s = validate_scene(scene); !s) return s.error();
     const auto t_bvh = Clock::now();
-    const OccluderBvh bvh(scene.occluders);
+    // No tree when no effect traces (the bake is the same: every effect sees no occluders then).
+    const OccluderBvh bvh = bake_traces_occluders(scene) ? OccluderBvh(scene.occluders) : OccluderBvh();
     const double bvh_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_bvh).count();
     return bake_with(scene, bvh, bvh_ms, t_start, options, report, leak);
 }
@@ -535,7 +546,9 @@ Result<std::vector<Sh3Radiance>> bake_scene(Scene&& scene, const BakeOptions& op
     const auto t_start = Clock::now();
     if (Status s = validate_scene(scene); !s) return s.error();
     const auto t_bvh = Clock::now();
-    const OccluderBvh bvh(std::move(scene.occluders));
+    const bool traced = bake_traces_occluders(scene);
+    const OccluderBvh bvh = traced ? OccluderBvh(std::move(scene.occluders)) : OccluderBvh();
+    std::vector<Occluder>().swap(scene.occluders);
     const double bvh_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_bvh).count();
     return bake_with(scene, bvh, bvh_ms, t_start, options, report, leak);
 }

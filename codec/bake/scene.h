@@ -185,6 +185,11 @@ struct ProbeLeakData {
 // masks are traced only when it is asked for. The probes do not depend on `leak`.
 Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOptions& options = {},
                                             BakeReport* report = nullptr, ProbeLeakData* leak = nullptr);
+// Whether a bake of `scene` traces rays against its occluders: it has some, and sky_samples > 0
+// with distant lighting or a probe grid (sky occlusion, validity and visibility masks), or a light
+// casts shadows. Otherwise the bake builds no tree and its occluders change nothing.
+bool bake_traces_occluders(const Scene& scene);
+
 // The same bake of a scene given up: its occluders move into the bake's BVH instead of being
 // copied, so a mesh of n triangles is held once (80 bytes per triangle plus the tree's nodes) rather
 // than twice; `scene.occluders` is left empty.
