@@ -3,6 +3,7 @@
 // any thread count and band height, the LDR range encoding against a long-double twin, analytic
 // constant images, the streaming encode / decode against the whole-image functions, the CLI's
 // refusals, and the side-by-side audit's ordering on a sample map's lightmap.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -300,6 +301,19 @@ TEST(LightmapAstc, CliRefusesDdsAndBrokenFiles) {
     r = test::run_zhc({"lightmap", "decode", dir + "/m", "-o", dir + "/m.exr"});
     EXPECT_EQ(r.exit_code, 4);
     EXPECT_NE(r.err.find("expected 157"), std::string::npos) << r.err;
+    // An HDR I_z block with a reserved encoding (all zero bits: block mode 0) decodes to the error
+    // colour, NaN in HDR: exit 4 naming the file and the block, no output.
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", exr, "-o", dir + "/h", "--target", "astc"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "decode", dir + "/h", "-o", dir + "/h_ok.exr"}).exit_code, 0);
+    auto hiz = read_ktx2(dir + "/h.iz.ktx2");
+    ASSERT_TRUE(hiz.ok());
+    ASSERT_EQ(hiz->blocks.size(), 16u * 16u);  // 16 x 16 texels, 4 x 4 blocks
+    std::fill(hiz->blocks.begin() + 16 * 6, hiz->blocks.begin() + 16 * 7, std::uint8_t{0});  // block (2, 1)
+    ASSERT_TRUE(write_ktx2(dir + "/h.iz.ktx2", *hiz).ok());
+    r = test::run_zhc({"lightmap", "decode", dir + "/h", "-o", dir + "/h_bad.exr"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("h.iz.ktx2: invalid ASTC HDR block at block column 2, row 1"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/h_bad.exr"));
     // --targets with --html: one summary row per target in the report.
     r = test::run_zhc({"lightmap", "audit", exr, "--targets", "bc,astc:6x6", "--html", dir + "/t.html"});
     ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -157,7 +157,8 @@ Result<std::vector<std::uint8_t>> encode(const float* values, int channels, int 
     return out;
 }
 
-Result<std::vector<float>> decode_rgba(const std::uint8_t* blocks, std::size_t size, int width, int height, Footprint f, bool hdr) {
+Result<std::vector<float>> decode_rgba(const std::uint8_t* blocks, std::size_t size, int width, int height, Footprint f, bool hdr,
+                                       int first_row) {
     if (!footprint_supported(f)) return make_error(ErrorCode::kUnsupported, "astc: unsupported footprint");
     if (width <= 0 || height <= 0 || size != 16 * block_count(f, width, height))
         return make_error(ErrorCode::kInvalidArgument, "astc: block data does not match the image size");
@@ -171,8 +172,20 @@ Result<std::vector<float>> decode_rgba(const std::uint8_t* blocks, std::size_t s
     const astcenc_error e = astcenc_decompress_image((*ctx)->get(), blocks, size, &image, &swz, 0);
     if (e != ASTCENC_SUCCESS) return make_error(ErrorCode::kInternal, std::string("astcenc_decompress_image: ") + astcenc_get_error_string(e));
     // An invalid block (reserved or out-of-range encodings) decodes to the error colour. With float
-    // output astcenc gives NaN there; for the LDR (UNORM) formats the specification's error colour is
-    // opaque magenta, which is what a GPU samples, so zhc decodes to that.
+    // output astcenc gives NaN there. For the LDR (UNORM) formats the specification's error colour is
+    // opaque magenta, which is what a GPU samples, so zhc decodes to that. For HDR (SFLOAT) it is NaN,
+    // which no lightmap value may be (an EXR written with it would poison what reads it): refused,
+    // naming the first such block.
+    if (hdr) {
+        for (size_t i = 0; i < rgba.size(); i += 4)
+            if (std::isnan(rgba[i]) || std::isnan(rgba[i + 1]) || std::isnan(rgba[i + 2]) || std::isnan(rgba[i + 3])) {
+                const size_t x = (i / 4) % static_cast<size_t>(width), y = (i / 4) / static_cast<size_t>(width);
+                return make_error(ErrorCode::kBadFormat,
+                                  "invalid ASTC HDR block at block column " + std::to_string(x / static_cast<size_t>(f.x)) + ", row " +
+                                      std::to_string((static_cast<size_t>(first_row) + y) / static_cast<size_t>(f.y)) +
+                                      " (reserved or out-of-range encoding: it decodes to the error colour, NaN)");
+            }
+    }
     if (!hdr)
         for (size_t i = 0; i < rgba.size(); i += 4)
             if (std::isnan(rgba[i]) || std::isnan(rgba[i + 1]) || std::isnan(rgba[i + 2]) || std::isnan(rgba[i + 3])) {
@@ -227,9 +240,9 @@ Result<Compressed> compress(const lightmap::IrradzPlanes& p, const Options& o, i
     return c;
 }
 
-Result<lightmap::IrradzPlanes> decompress(const Compressed& c) {
+Result<lightmap::IrradzPlanes> decompress(const Compressed& c, int first_row) {
     const Options& o = c.options;
-    auto iz = astc::decode_rgba(c.iz.data(), c.iz.size(), c.width, c.height, o.footprint, !o.ldr_iz);
+    auto iz = astc::decode_rgba(c.iz.data(), c.iz.size(), c.width, c.height, o.footprint, !o.ldr_iz, first_row);
     if (!iz) return iz.error();
     auto dwa = astc::decode_rgba(c.dwa.data(), c.dwa.size(), c.width, c.height, o.footprint, false);
     if (!dwa) return dwa.error();

@@ -55,7 +55,11 @@ Result<std::vector<std::uint8_t>> encode(const float* values, int channels, int 
                                          Effort effort, int threads = 1);
 // astcenc's decompressor: RGBA float per texel (HDR: the block's float16 values; LDR: the
 // unorm16 / 65535 value rounded to float16, as the ASTC specification decodes without decode_unorm8).
-Result<std::vector<float>> decode_rgba(const std::uint8_t* blocks, std::size_t size, int width, int height, Footprint f, bool hdr);
+// An invalid block decodes to the specification's error colour: opaque magenta in LDR (what a GPU
+// samples); in HDR, where that colour is NaN, kBadFormat naming the block (its row counted from
+// `first_row`, the texel row the blocks start at in the whole image).
+Result<std::vector<float>> decode_rgba(const std::uint8_t* blocks, std::size_t size, int width, int height, Footprint f, bool hdr,
+                                       int first_row = 0);
 
 }  // namespace zhc::astc
 
@@ -82,7 +86,7 @@ struct Compressed {
 Result<Compressed> compress(const lightmap::IrradzPlanes& p, const Options& o, int threads = 1);
 // The texture values (astcenc's decoder) turned into planes: I_z as decoded (HDR) or iz_from_ldr
 // of the decoded value (LDR); (u, v, w_a) as decoded.
-Result<lightmap::IrradzPlanes> decompress(const Compressed& c);
+Result<lightmap::IrradzPlanes> decompress(const Compressed& c, int first_row = 0);
 
 // The KTX2 key of the LDR range and its value: "lo hi" as two decimal floats (%.9g, exact), NUL-terminated.
 inline constexpr const char* kRangeKey = "zhc.iz_log2_range";

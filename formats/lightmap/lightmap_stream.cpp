@@ -201,8 +201,8 @@ Result<DecodeResult> decode_astc(const std::string& prefix, const BlockFileLayou
             blocks[f]->resize(static_cast<size_t>(block_rows * bw * 16));
             if (Status s = readers[f].read(offsets[f] + first * bw * 16, blocks[f]->data(), blocks[f]->size()); !s) return s.error();
         }
-        auto p = lightmap_astc::decompress(c);
-        if (!p) return p.error();
+        auto p = lightmap_astc::decompress(c, y0);
+        if (!p) return make_error(p.error().code, paths[0] + ": " + p.error().message);
         irradz_texels(*p, texels);
         if (Status s = (*writer)->write_rows(texels.data(), c.height); !s) return out_error(s.error());
         if (progress) progress(static_cast<std::uint64_t>(y1), static_cast<std::uint64_t>(r.height));
