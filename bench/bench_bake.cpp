@@ -61,22 +61,6 @@ SceneLight light_of(LightKind kind, int i) {
     return l;
 }
 
-// Resident set (VmRSS) and its high-water mark (VmHWM) in bytes, and the mark's reset (Linux >= 4.0:
-// 5 to /proc/self/clear_refs); -1 where /proc does not tell.
-double proc_status_bytes(const char* key) {
-    std::ifstream in("/proc/self/status");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind(key, 0) == 0) return std::atof(line.c_str() + std::string(key).size()) * 1024.0;
-    return -1;
-}
-bool reset_peak() {
-    std::ofstream out("/proc/self/clear_refs");
-    out << "5";
-    out.flush();
-    return bool(out);
-}
-
 // A sphere of radius 1.5 hovering over the middle of the probe grid, lit by a sun with a
 // 3-degree radius and 64 samples: a mix of blocked rays (under it) and misses.
 Scene mesh_scene(std::uint32_t n, int res) {
@@ -111,12 +95,12 @@ double bake_peak_bytes_per_triangle(std::uint32_t n, int res) {
     return pclose(f) == 0 ? v : -1;
 }
 int peak_child(std::uint32_t n, int res) {
-    const double rss0 = proc_status_bytes("VmRSS:");
-    if (rss0 <= 0 || !reset_peak()) return std::printf("-1\n"), 0;
+    const double rss0 = bench::proc_status_bytes("VmRSS:");
+    if (rss0 <= 0 || !bench::reset_peak()) return std::printf("-1\n"), 0;
     Scene s = mesh_scene(n, res);
     const double tris = double(s.occluders.size());
     bench::keep(bake_scene(std::move(s)));
-    const double hwm = proc_status_bytes("VmHWM:");
+    const double hwm = bench::proc_status_bytes("VmHWM:");
     std::printf("%.6g\n", hwm > 0 ? (hwm - rss0) / tris : -1.0);
     return 0;
 }
@@ -327,19 +311,13 @@ int main(int argc, char** argv) {
     // Occlusion passes on the 200k-triangle mesh, against its shadow rays in the same run.
     std::string occlusion_json = "null";
     {
-        Scene s = grid_scene(n / 2);
-        // ~200k triangles: a sphere over the grid (shadows the sun) and one the probes sit around
-        // and inside (validity and masks have work).
-        s.occluders = uv_sphere_triangles({0.3, -0.2, 4.5}, 1.5, 224, 224);
+        // ~200k triangles: the mesh scene's sphere over the grid (shadows the sun) and one the probes
+        // sit around and inside (validity and masks have work), under a sky, occlusion on.
+        Scene s = mesh_scene(n / 2, 224);
+        s.occlusion = SceneOcclusion{};
         const auto low = uv_sphere_triangles({-1.5, 1.0, 1.5}, 1.2, 224, 224);
         s.occluders.insert(s.occluders.end(), low.begin(), low.end());
         s.sky = SceneSky{};
-        SceneLight sun = light_of(LightKind::kDirectional, 0);
-        sun.direction = {0.2, 0.1, 1};
-        sun.angular_radius_rad = 3 * kPi / 180;
-        sun.shadows = true;
-        sun.shadow_samples = 64;
-        s.lights = {sun};
         const double probes = probe_count(s);
         std::printf("\nocclusion passes, %zu triangles, %.0f probes, 1 thread (median of 3)\n", s.occluders.size(), probes);
         // Shadow rays alone (no sky occlusion): the reference throughput.

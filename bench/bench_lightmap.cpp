@@ -56,19 +56,10 @@ double thread_seconds() {
 }
 double wall_seconds() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
-// VmHWM (peak resident set) in MB, and its reset.
+// VmHWM (peak resident set) in MB, -1 where /proc does not tell.
 double peak_mb() {
-    std::ifstream in("/proc/self/status");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("VmHWM:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
-    return -1;
-}
-bool reset_peak() {
-    std::ofstream out("/proc/self/clear_refs");
-    out << "5";
-    out.flush();
-    return bool(out);
+    const double b = bench::proc_status_bytes("VmHWM:");
+    return b < 0 ? -1 : b / (1024.0 * 1024.0);
 }
 
 constexpr int kStages = 9;
@@ -110,7 +101,7 @@ StageResult run_stage(bool* reset_ok, double texels, int reps, F&& fn) {
     StageResult r;
     r.texels = texels;
     std::vector<double> cpu, wall;
-    *reset_ok = reset_peak() && *reset_ok;
+    *reset_ok = bench::reset_peak() && *reset_ok;
     for (int i = 0; i < reps; ++i) {
         const double w0 = wall_seconds(), c0 = thread_seconds();
         fn();

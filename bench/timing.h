@@ -1,9 +1,12 @@
-// Tiny timing helpers for the plain-main benchmarks: medians over repeats with the spread.
+// Tiny timing helpers for the plain-main benchmarks: medians over repeats with the spread; the
+// process's resident memory from /proc.
 #pragma once
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -11,6 +14,24 @@
 #include <time.h>
 
 namespace zhc::bench {
+
+// A "Vm...:" line of /proc/self/status in bytes (VmRSS: the resident set, VmHWM: its high-water
+// mark); -1 where /proc does not tell.
+inline double proc_status_bytes(const char* key) {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    const std::string k = key;
+    while (std::getline(in, line))
+        if (line.rfind(k, 0) == 0) return std::atof(line.c_str() + k.size()) * 1024.0;
+    return -1;
+}
+// Resets VmHWM to the current resident set (Linux >= 4.0: 5 to /proc/self/clear_refs).
+inline bool reset_peak() {
+    std::ofstream out("/proc/self/clear_refs");
+    out << "5";
+    out.flush();
+    return bool(out);
+}
 
 struct Timing {
     double median_s = 0, min_s = 0, max_s = 0;

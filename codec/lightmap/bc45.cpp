@@ -10,8 +10,8 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
-// The AVX2 index search: x86-64 GCC and clang (target attribute, __builtin_cpu_supports).
-#if defined(__SSE2__) && (defined(__x86_64__) || defined(__i386__)) && (defined(__GNUC__) || defined(__clang__))
+#include "codec/isa.h"  // the AVX2 index search
+#if ZHC_AVX2_TWIN && defined(__SSE2__)
 #define ZHC_BC45_AVX2 1
 #include <immintrin.h>
 #else
@@ -174,10 +174,7 @@ __attribute__((target("avx2"))) float assign_avx2(const float v[16], int r0, int
     }
     return err;
 }
-bool have_avx2() {
-    static const bool a = __builtin_cpu_supports("avx2");
-    return a;
-}
+bool have_avx2() { return cpu_has_avx2(); }
 #else
 float assign_avx2(const float v[16], int r0, int r1, std::uint8_t idx[16], float bound) { return assign_fast(v, r0, r1, idx, bound); }
 bool have_avx2() { return false; }

@@ -11,12 +11,7 @@
 #include <string_view>
 #include <thread>
 
-// The AVX2 twin of the encoder: x86-64 only (GCC and clang: target pragmas, __builtin_cpu_supports).
-#if (defined(__x86_64__) || defined(__i386__)) && (defined(__GNUC__) || defined(__clang__))
-#define ZHC_BC6H_AVX2 1
-#else
-#define ZHC_BC6H_AVX2 0
-#endif
+#include "codec/isa.h"  // the AVX2 twin of the encoder
 
 namespace zhc::bc6h {
 namespace {
@@ -382,23 +377,14 @@ namespace {
 }  // namespace
 }  // namespace isa_baseline
 
-#if ZHC_BC6H_AVX2
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+#if ZHC_AVX2_TWIN
+ZHC_AVX2_BEGIN
 namespace isa_avx2 {
 namespace {
 #include "codec/lightmap/bc6h_encoder.inl"
 }  // namespace
 }  // namespace isa_avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+ZHC_AVX2_END
 #endif
 
 bool isa_supported(Isa isa) {
@@ -406,11 +392,7 @@ bool isa_supported(Isa isa) {
         case Isa::kBaseline:
             return true;
         case Isa::kAvx2:
-#if ZHC_BC6H_AVX2
-            return __builtin_cpu_supports("avx2");
-#else
-            return false;
-#endif
+            return cpu_has_avx2();
     }
     return false;
 }
@@ -425,7 +407,7 @@ const char* isa_name(Isa isa) { return isa == Isa::kAvx2 ? "avx2" : "baseline"; 
 namespace {
 using EncodeFn = void (*)(const float rgb[16][3], Quality quality, std::uint8_t out[16]);
 EncodeFn encoder_for(Isa isa) {
-#if ZHC_BC6H_AVX2
+#if ZHC_AVX2_TWIN
     if (isa == Isa::kAvx2 && isa_supported(Isa::kAvx2)) return isa_avx2::encode_block_impl;
 #endif
     (void)isa;

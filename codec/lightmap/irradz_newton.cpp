@@ -13,6 +13,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "codec/isa.h"
 #include "codec/lightmap/irradz_internal.h"
 
 namespace zhc::irradz {
@@ -49,34 +50,20 @@ const SparseGram& sparse_gram() {
 }
 }  // namespace
 
-// The solve, twice (see irradz_newton_solve.inl); x86-64 GCC and clang get the AVX2 twin.
-#if (defined(__x86_64__) || defined(__i386__)) && (defined(__GNUC__) || defined(__clang__))
-#define ZHC_IRRADZ_AVX2 1
-#else
-#define ZHC_IRRADZ_AVX2 0
-#endif
+// The solve, twice (see irradz_newton_solve.inl and codec/isa.h).
 namespace isa_baseline {
 namespace {
 #include "codec/lightmap/irradz_newton_solve.inl"
 }  // namespace
 }  // namespace isa_baseline
-#if ZHC_IRRADZ_AVX2
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+#if ZHC_AVX2_TWIN
+ZHC_AVX2_BEGIN
 namespace isa_avx2 {
 namespace {
 #include "codec/lightmap/irradz_newton_solve.inl"
 }  // namespace
 }  // namespace isa_avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+ZHC_AVX2_END
 #endif
 
 
@@ -104,9 +91,8 @@ IrradZ detail::fit_newton(const Sh3Irradiance& irr, Model model, const EncodeOpt
 
 void detail::fit_newton_many(const Sh3Irradiance* irr, std::size_t n, Model model, const EncodeOptions& options, IrradZ* out,
                              bool allow_avx2) {
-#if ZHC_IRRADZ_AVX2
-    static const bool avx2 = __builtin_cpu_supports("avx2");
-    if (avx2 && allow_avx2) return isa_avx2::fit_many(irr, n, model, options, out);
+#if ZHC_AVX2_TWIN
+    if (cpu_has_avx2() && allow_avx2) return isa_avx2::fit_many(irr, n, model, options, out);
 #endif
     (void)allow_avx2;
     isa_baseline::fit_many(irr, n, model, options, out);
