@@ -100,7 +100,8 @@ double hemispherical_mse(const Sh3Irradiance& target, const IrradZ& p, Model mod
 IrradZ encode(const Sh3Radiance& tangent_radiance, const EncodeOptions& options = {},
               double* error = nullptr, const Rgb* sampled_iz = nullptr);
 // encode() of n texels into out[0 .. n), the same results bit for bit; with Solve::kNewton the
-// texels' evaluations run four at a time in vector lanes (give it a few dozen texels at once).
+// texels' evaluations run four at a time in vector lanes (give it a few dozen texels at once). Its
+// workspace is per thread: threads may call it concurrently.
 void encode_many(const Sh3Radiance* tangent_radiance, std::size_t n, const EncodeOptions& options, IrradZ* out);
 
 // The reduced error the Newton solve minimises, at the gnomonic direction q = (d_x, d_y) / d_z:
