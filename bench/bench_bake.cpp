@@ -293,9 +293,8 @@ int main(int argc, char** argv) {
         const double brute_rate = double(probes) * dirs.size() / tbf.median_s;
         std::printf("%-40s %12.3g %12.1f %10s  (BVH query %.0fx faster)\n", "  brute force (early exit)", brute_rate,
                     1e9 / brute_rate, "", query_rate / brute_rate);
-        // Memory per triangle: the tree (its primitives, 80 bytes each, and nodes), and the peak of a
-        // bake of the scene given up (bake_scene(Scene&&), as `zhc bake` runs it): the high-water
-        // mark above the resident set before the scene's copy was made, per triangle.
+        // Memory per triangle: the tree (its primitives, 80 bytes each, and nodes), and the peak of
+        // making the scene and baking it given up, in a fresh process (bake_peak_bytes_per_triangle).
         const double bvh_per_tri = double(bvh.memory_bytes()) / double(tris);
         const double bake_peak_per_tri = bake_peak_bytes_per_triangle(n / 2, res);
         std::printf("%-40s BVH %.1f bytes per triangle (%zu-byte primitives, %zu nodes); bake peak %.1f bytes per triangle\n",

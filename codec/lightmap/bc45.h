@@ -26,8 +26,8 @@ void encode_bc5_block(const float rg[16][2], Quality quality, std::uint8_t out[1
 void decode_bc5_block(const std::uint8_t in[16], float out[16][2]);
 
 namespace detail {
-// encode_bc4_block's scalar twin: the same search with the plain per-texel index loop; the fast
-// path (SSE2, four texels at a time) gives the same bytes (tested bit for bit).
+// encode_bc4_block's scalar twin: the same search with the plain per-texel index loop; the vector
+// paths (AVX2, eight texels at a time; SSE2, four) give the same bytes (tested bit for bit).
 void encode_bc4_block_scalar(const float v[16], Quality quality, std::uint8_t out[8]);
 // The SSE2 path (four texels at a time), which encode_bc4_block takes where the CPU lacks AVX2 (eight).
 void encode_bc4_block_sse2(const float v[16], Quality quality, std::uint8_t out[8]);
