@@ -5,6 +5,7 @@
 #include <limits>
 
 namespace zhc {
+static_assert(sizeof(Occluder) == 80, "Occluder: the material index lives in the padding after kind");
 namespace {
 
 void bounds_of(const Occluder& o, double lo[3], double hi[3]) {
@@ -111,6 +112,28 @@ RayHit ray_nearest(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_m
     double enter = 0;
     if (slab(lo, hi, o, d, t_min, t_max, &enter) && enter < t_max) h = {true, false, enter};
     return h;
+}
+
+Vec3 surface_normal(const Occluder& occ, Vec3 x, Vec3 d) {
+    Vec3 n{0, 0, 1};
+    if (occ.kind == OccluderKind::kTriangle) {
+        n = normalize_or(cross(occ.v1 - occ.v0, occ.v2 - occ.v0), {0, 0, 1});
+    } else if (occ.kind == OccluderKind::kSphere) {
+        n = normalize_or(x - occ.center(), {0, 0, 1});
+    } else {
+        // The face whose plane is nearest to x.
+        double best = std::numeric_limits<double>::infinity();
+        for (int a = 0; a < 3; ++a)
+            for (int side = 0; side < 2; ++side) {
+                const double dist = std::fabs(x[a] - (side ? occ.max()[a] : occ.min()[a]));
+                if (dist < best) {
+                    best = dist;
+                    n = {0, 0, 0};
+                    (a == 0 ? n.x : a == 1 ? n.y : n.z) = side ? 1.0 : -1.0;
+                }
+            }
+    }
+    return dot(n, d) > 0 ? -1.0 * n : n;
 }
 
 Occluder triangle_occluder(Vec3 a, Vec3 b, Vec3 c) {
@@ -367,6 +390,7 @@ RayHit OccluderBvh::nearest(Vec3 o, Vec3 d, double t_min, double t_max) const {
                 const RayHit h = ray_nearest(prims_[i], o, d, t_min, far);
                 if (h.hit && (!best.hit || h.t < best.t)) {
                     best = h;
+                    best.prim = i;
                     far = h.t;
                 }
             }

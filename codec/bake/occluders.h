@@ -26,8 +26,12 @@ enum class OccluderKind : std::uint8_t { kSphere, kBox, kTriangle };
 // winding; both faces block); a sphere's centre in v0 and radius in v1.x; a box's corners min in v0
 // and max in v1 (axis-aligned, min <= max per axis). Make them with the functions below; read a
 // sphere or box through its accessors.
+// `material` indexes the scene's materials (codec/bake/transport.h SceneMaterial); kNoMaterial (the
+// default) absorbs all light and emits none. It sits in the padding after `kind`: still 80 bytes.
+constexpr std::uint32_t kNoMaterial = 0xFFFFFFFFu;
 struct Occluder {
     OccluderKind kind = OccluderKind::kSphere;
+    std::uint32_t material = kNoMaterial;
     Vec3 v0, v1, v2;
     std::string_view name() const {
         return kind == OccluderKind::kSphere ? "sphere" : kind == OccluderKind::kBox ? "box" : "triangle";
@@ -60,10 +64,15 @@ struct RayHit {
     bool hit = false;
     bool back = false;
     double t = 0;
+    std::uint32_t prim = 0;  // OccluderBvh::nearest: the primitive hit (OccluderBvh::primitive)
 };
 RayHit ray_nearest(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max);
 // Is p inside (or on) a sphere or box occluder? (Triangles bound no volume.)
 bool inside_solid(const Occluder& occ, Vec3 p);
+// The unit surface normal of `occ` at a point x on its surface, turned to face against the ray
+// direction d (surfaces are two-sided): a triangle's geometric normal, a sphere's radial direction,
+// a box's face normal (the face x is nearest to).
+Vec3 surface_normal(const Occluder& occ, Vec3 x, Vec3 d);
 
 class OccluderBvh {
 public:
@@ -80,7 +89,14 @@ public:
     RayHit nearest(Vec3 o, Vec3 d, double t_min, double t_max) const;
     // Is p inside (or on) any sphere or box occluder?
     bool inside_any_solid(Vec3 p) const;
+    // The primitive a nearest() hit names (leaf order; RayHit::prim).
+    const Occluder& primitive(std::uint32_t i) const { return prims_[i]; }
     std::size_t node_count() const { return nodes_.size(); }
+    // The box around every occluder (the root node's); not called on an empty tree.
+    void root_bounds(Vec3* lo, Vec3* hi) const {
+        *lo = {nodes_[0].lo[0], nodes_[0].lo[1], nodes_[0].lo[2]};
+        *hi = {nodes_[0].hi[0], nodes_[0].hi[1], nodes_[0].hi[2]};
+    }
     // Bytes the tree holds (primitives and nodes), printed per primitive by test_scene_mesh.
     std::size_t memory_bytes() const { return prims_.capacity() * sizeof(Occluder) + nodes_.capacity() * sizeof(Node); }
 

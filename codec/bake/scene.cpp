@@ -301,9 +301,23 @@ Status validate_scene(const Scene& s) {
             case LightKind::kPoint: break;
         }
     }
+    for (size_t i = 0; i < s.materials.size(); ++i) {
+        const SceneMaterial& m = s.materials[i];
+        const std::string at = "materials[" + std::to_string(i) + "]";
+        for (int k = 0; k < 3; ++k) {
+            if (!(m.albedo[k] >= 0 && m.albedo[k] <= 1)) return bad(at + ": albedo must be in [0, 1]");
+            if (!(m.emission[k] >= 0) || !std::isfinite(m.emission[k])) return bad(at + ": emission must be finite and >= 0");
+        }
+    }
+    if (s.transport.max_bounces < 0 || s.transport.max_bounces > 1024) return bad("transport.bounces must be in [0, 1024]");
+    if (!(s.transport.max_noise > 0 && s.transport.max_noise <= 1)) return bad("transport.max_noise must be in (0, 1]");
+    if (s.transport.min_rays < 1 || s.transport.max_rays < s.transport.min_rays || s.transport.max_rays > (1 << 20))
+        return bad("transport: need 1 <= min_rays <= max_rays <= 1048576");
     for (size_t i = 0; i < s.occluders.size(); ++i) {
         const Occluder& o = s.occluders[i];
         const std::string at = "occluders[" + std::to_string(i) + "]";
+        if (o.material != kNoMaterial && o.material >= s.materials.size())
+            return bad(at + ": material " + std::to_string(o.material) + " is not in materials");
         if (o.kind == OccluderKind::kSphere) {
             if (!finite3(o.center()) || !(o.radius() > 0) || !std::isfinite(o.radius()))
                 return bad(at + ": sphere needs a finite centre and radius > 0");
@@ -516,12 +530,14 @@ std::uint8_t grid_visibility_mask(const OccluderBvh& bvh, const ProbeGrid& g, st
 }  // namespace
 
 namespace {
-Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh& bvh, double bvh_ms, Clock::time_point t_start,
-                                           const BakeOptions& options, BakeReport* report, ProbeLeakData* leak);
+Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh& bvh, bool transport, double bvh_ms,
+                                           Clock::time_point t_start, const BakeOptions& options, BakeReport* report,
+                                           ProbeLeakData* leak);
 }  // namespace
 
 bool bake_traces_occluders(const Scene& scene) {
     if (scene.occluders.empty()) return false;
+    if (scene_has_transport(scene)) return true;
     // Sky occlusion of the distant lighting, probe validity and visibility masks (grids), shadows.
     const bool grid = scene.probes.kind == ProbePlacementKind::kGrid;
     if (scene.occlusion.sky_samples > 0 && (scene.environment || scene.sky || grid)) return true;
@@ -538,7 +554,7 @@ Result<std::vector<Sh3Radiance>> bake_scene(const Scene& scene, const BakeOption
     // No tree when no effect traces (the bake is the same: every effect sees no occluders then).
     const OccluderBvh bvh = bake_traces_occluders(scene) ? OccluderBvh(scene.occluders) : OccluderBvh();
     const double bvh_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_bvh).count();
-    return bake_with(scene, bvh, bvh_ms, t_start, options, report, leak);
+    return bake_with(scene, bvh, scene_has_transport(scene), bvh_ms, t_start, options, report, leak);
 }
 
 Result<std::vector<Sh3Radiance>> bake_scene(Scene&& scene, const BakeOptions& options, BakeReport* report,
@@ -547,17 +563,19 @@ Result<std::vector<Sh3Radiance>> bake_scene(Scene&& scene, const BakeOptions& op
     if (Status s = validate_scene(scene); !s) return s.error();
     const auto t_bvh = Clock::now();
     const bool traced = bake_traces_occluders(scene);
+    const bool transport = scene_has_transport(scene);
     const OccluderBvh bvh = traced ? OccluderBvh(std::move(scene.occluders)) : OccluderBvh();
     std::vector<Occluder>().swap(scene.occluders);
     const double bvh_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_bvh).count();
-    return bake_with(scene, bvh, bvh_ms, t_start, options, report, leak);
+    return bake_with(scene, bvh, transport, bvh_ms, t_start, options, report, leak);
 }
 
 namespace {
 
 // The bake of a validated scene whose occluders are in `bvh` (scene.occluders is not read).
-Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh& bvh, double bvh_ms, Clock::time_point t_start,
-                                           const BakeOptions& options, BakeReport* report, ProbeLeakData* leak) {
+Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh& bvh, bool transport, double bvh_ms,
+                                           Clock::time_point t_start, const BakeOptions& options, BakeReport* report,
+                                           ProbeLeakData* leak) {
     if (leak) *leak = {};
     const std::vector<Vec3> positions = probe_positions(scene.probes);
     const size_t count = positions.size();
@@ -663,12 +681,20 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
 
     // Probes in blocks; each block runs the occlusion pass, then the effects in order into a
     // double accumulator. Blocks are independent, so any thread count gives the same bytes.
-    constexpr size_t kBlock = 1024;
+    // Reflected light: a path tracer over the same tree; its probes are costly, so blocks are small.
+    std::optional<PathTracer> tracer;
+    if (transport && !bvh.empty()) {
+        tracer.emplace(scene, bvh);
+        info.push_back({"reflected light", "path traced", 0, 0});
+    }
+    const size_t kBlock = tracer ? 16 : 1024;
     const size_t blocks = (count + kBlock - 1) / kBlock;
     const int threads = std::max(1, std::min<int>(options.threads, static_cast<int>(std::max<size_t>(blocks, 1))));
     std::vector<Sh3Radiance> out(count);
     std::vector<std::uint8_t> valid(validity ? count : 0, 1);
     std::vector<std::vector<double>> ms(static_cast<size_t>(threads), std::vector<double>(effects.size() + 1, 0.0));
+    std::vector<PathTracer::ProbeStats> tstats(tracer ? count : 0);
+    std::vector<double> tms(static_cast<size_t>(threads), 0.0);
     std::vector<std::vector<std::uint64_t>> rays(static_cast<size_t>(threads),
                                                  std::vector<std::uint64_t>(effects.size() + 1, 0));
     std::mutex progress_mutex;
@@ -727,6 +753,13 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
                 rays[tz][ei] += r;
             }
             ms[tz][ei] += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        }
+        if (tracer) {
+            const auto t0 = Clock::now();
+            // Invalid probes are dilated from their valid neighbours below: not traced.
+            for (size_t p = lo; p < hi; ++p)
+                if (!validity || valid[p]) tstats[p] = tracer->trace_probe(positions[p], p, &acc[(p - lo) * 27], &acc[(p - lo) * 27]);
+            tms[tz] += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         }
         for (size_t p = lo; p < hi; ++p)
             for (int i = 0; i < 9; ++i)
@@ -838,6 +871,36 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
         report->validity_checked = validity;
         report->mask_ms = mask_ms;
         report->rays += mask_rays;
+        if (tracer) {
+            TransportReport& tr = report->transport;
+            tr.traced = true;
+            tr.max_bounces = scene.transport.max_bounces;
+            tr.energy_left = tracer->energy_left();
+            std::vector<double> noise;
+            for (size_t p = 0; p < count; ++p) {
+                const PathTracer::ProbeStats& st = tstats[p];
+                if (st.paths == 0) continue;
+                ++tr.probes;
+                tr.paths += st.paths;
+                tr.rays += st.rays;
+                tr.vertices += st.vertices;
+                tr.cut += st.cut;
+                tr.max_depth = std::max(tr.max_depth, st.max_depth);
+                noise.push_back(st.noise);
+                if (st.noise > scene.transport.max_noise) ++tr.probes_over_noise;
+            }
+            if (!noise.empty()) {
+                std::sort(noise.begin(), noise.end());
+                tr.noise_median = noise[noise.size() / 2];
+                tr.noise_max = noise.back();
+            }
+            for (double t : tms) tr.milliseconds += t;
+            BakeEffect& be = report->effects.back();
+            be.rays = tr.rays;
+            be.milliseconds = tr.milliseconds;
+            be.method = "path traced: " + std::to_string(tr.rays) + " rays";
+            report->rays += tr.rays;
+        }
         report->total_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_start).count();
     }
     return out;

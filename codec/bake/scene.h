@@ -59,6 +59,7 @@
 #include "codec/probe/probe_set.h"
 #include "codec/sh/sh.h"
 #include "codec/bake/sky.h"
+#include "codec/bake/transport.h"
 #include "codec/status.h"
 
 namespace zhc {
@@ -128,6 +129,10 @@ struct Scene {
     std::optional<SceneSky> sky;
     std::vector<SceneLight> lights;
     std::vector<Occluder> occluders;
+    // Surfaces' reflectance and emission (Occluder::material indexes them) and the limits of the
+    // reflected-light pass (codec/bake/transport.h).
+    std::vector<SceneMaterial> materials;
+    SceneTransport transport;
 };
 
 // The built-in default scene of `zhc demo`: the default gradient sky and sun (codec/bake/sky.h), three
@@ -163,6 +168,8 @@ struct BakeReport {
     double dilation_ms = 0;
     std::uint64_t mask_rays = 0, mask_probes = 0;
     double mask_ms = 0;
+    // Reflected and emitted light (codec/bake/transport.h); traced == false when not run.
+    TransportReport transport;
     // "sky (closed form): 0.3 ms; sun 'key' (closed form, shadowed: 4096 rays): 1.2 ms"
     std::string summary() const;
 };

@@ -134,7 +134,7 @@ void Reader::walk() {
 // one probe at the origin.
 json default_probes(const Reader& r) {
     double lo[3], hi[3];
-    bool any = !r.occluders_.empty();
+    bool any = r.lo_[0] <= r.hi_[0];  // some mesh vertex (triangles, lines or points)
     for (int a = 0; a < 3; ++a) {
         lo[a] = r.lo_[a];
         hi[a] = r.hi_[a];
@@ -200,7 +200,13 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
             ibl.reset();
         }
         if (!extras.contains("version")) extras["version"] = 1;
-        if (!extras.contains("probes")) extras["probes"] = default_probes(r);
+        if (!extras.contains("probes")) {
+            extras["probes"] = default_probes(r);
+            const json& g = extras["probes"];
+            if (g.contains("positions") || (g["grid"]["counts"] == json::array({1, 1, 1})))
+                r.notes_.push_back("the default probe grid is a single probe: the meshes and point/spot lights span no volume "
+                                   "(give extras.zhc.probes for a useful grid)");
+        }
         const std::string text = extras.dump();
         std::string dir = fs::path(path).parent_path().string();
         // A glTF scene's environment map is in the glTF ecosystem's lat-long orientation unless
@@ -217,6 +223,11 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
             l.shadows = shadows;
             s.lights.push_back(std::move(l));
         }
+        // The glTF materials follow extras.zhc's: their occluders' indices shift by that many.
+        if (!s.materials.empty())
+            for (Occluder& o : r.occluders_)
+                if (o.material != kNoMaterial) o.material += static_cast<std::uint32_t>(s.materials.size());
+        s.materials.insert(s.materials.end(), r.materials_.begin(), r.materials_.end());
         // Moved, not copied, when extras.zhc adds none: the mesh triangles are the bulk of the memory.
         if (s.occluders.empty()) s.occluders = std::move(r.occluders_);
         else s.occluders.insert(s.occluders.end(), r.occluders_.begin(), r.occluders_.end());

@@ -193,6 +193,7 @@ void Reader::add_triangles(const std::vector<Vec3>& verts, const std::vector<std
     auto add = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
         if (mode != 4 && (a == b || b == c || a == c)) return;
         occluders_.push_back(triangle_occluder(verts[a], verts[b], verts[c]));
+        occluders_.back().material = current_material_;
     };
     const size_t n = idx.size();
     if (mode == 4) {
@@ -362,6 +363,74 @@ void Reader::add_draco(const json& prim, const json& ext, const std::string& pp,
     add_instances(verts, idx, 4, inst, ep);
 }
 
+void Reader::add_point_bounds(const json& prim, const std::string& pp, const Instancing& inst) {
+    if (!prim.contains("attributes") || !prim["attributes"].is_object() || !prim["attributes"].contains("POSITION")) return;
+    if (prim.contains("extensions") && prim["extensions"].is_object() && prim["extensions"].contains("KHR_draco_mesh_compression")) return;
+    const size_t n_acc = array_of(doc_, "accessors").size();
+    const size_t pa = index(prim["attributes"]["POSITION"], pp + ".attributes.POSITION", n_acc, "accessors");
+    const std::string pap = at("accessors", pa);
+    const std::uint64_t nv = count(accessor(pa, pap), "count", pap, true, 0);
+    if (nv == 0 || inst.count == 0) return;
+    // Bounded like triangles: the vertices times the instances count against the triangle limit.
+    count_triangles((nv + 2) / 3, inst.count, pp);
+    const std::vector<Vec3> verts = read_positions(pa, nv);
+    for (std::uint64_t k = 0; k < inst.count; ++k) {
+        const Mat4 world = instance_world(inst, k);
+        for (size_t i = 0; i < verts.size(); ++i) (void)transformed(world, verts[i], pap, i);
+    }
+}
+
+// The zhc material of a primitive's glTF material (glTF 2.0 spec 3.9): Lambertian albedo = base
+// colour factor x (1 - metallic factor), the diffuse part of the metal-rough model; emission =
+// emissive factor x KHR_materials_emissive_strength. No material (the spec's default: white,
+// fully metallic) and a material that neither reflects diffusely nor emits: kNoMaterial. Textures
+// are not sampled: a textured material uses its factors (noted once per material).
+std::uint32_t Reader::material_of(const json& prim, const std::string& pp) {
+    if (!prim.contains("material")) return kNoMaterial;
+    const json& mats = array_of(doc_, "materials");
+    const size_t mi = index(prim["material"], pp + ".material", mats.size(), "materials");
+    if (auto it = material_ids_.find(mi); it != material_ids_.end()) return it->second;
+    const std::string mp = at("materials", mi);
+    const json& m = mats[mi];
+    if (!m.is_object()) fail(ErrorCode::kInvalidValue, mp, "must be an object");
+    double base[4] = {1, 1, 1, 1}, metallic = 1, emissive[3] = {0, 0, 0}, strength = 1;
+    bool textured = false;
+    if (m.contains("pbrMetallicRoughness")) {
+        const json& pbr = m["pbrMetallicRoughness"];
+        if (!pbr.is_object()) fail(ErrorCode::kInvalidValue, mp + ".pbrMetallicRoughness", "must be an object");
+        if (pbr.contains("baseColorFactor")) {
+            const std::vector<double> f = numbers(pbr["baseColorFactor"], mp + ".pbrMetallicRoughness.baseColorFactor", 4);
+            for (int k = 0; k < 4; ++k) base[k] = f[static_cast<size_t>(k)];
+        }
+        if (pbr.contains("metallicFactor")) metallic = number(pbr["metallicFactor"], mp + ".pbrMetallicRoughness.metallicFactor");
+        textured = pbr.contains("baseColorTexture") || pbr.contains("metallicRoughnessTexture");
+    }
+    if (m.contains("emissiveFactor")) {
+        const std::vector<double> f = numbers(m["emissiveFactor"], mp + ".emissiveFactor", 3);
+        for (int k = 0; k < 3; ++k) emissive[k] = f[static_cast<size_t>(k)];
+    }
+    textured = textured || m.contains("emissiveTexture");
+    if (m.contains("extensions") && m["extensions"].is_object() && m["extensions"].contains("KHR_materials_emissive_strength")) {
+        const json& e = m["extensions"]["KHR_materials_emissive_strength"];
+        if (e.is_object() && e.contains("emissiveStrength"))
+            strength = number(e["emissiveStrength"], mp + ".extensions.KHR_materials_emissive_strength.emissiveStrength");
+    }
+    SceneMaterial sm;
+    sm.name = m.contains("name") && m["name"].is_string() ? m["name"].get<std::string>() : mp;
+    for (int k = 0; k < 3; ++k) {
+        sm.albedo[k] = static_cast<float>(std::clamp(base[k], 0.0, 1.0) * (1.0 - std::clamp(metallic, 0.0, 1.0)));
+        sm.emission[k] = static_cast<float>(std::clamp(emissive[k], 0.0, 1.0) * std::max(0.0, strength));
+    }
+    std::uint32_t id = kNoMaterial;
+    if (sm.albedo.r > 0 || sm.albedo.g > 0 || sm.albedo.b > 0 || sm.emission.r > 0 || sm.emission.g > 0 || sm.emission.b > 0) {
+        id = static_cast<std::uint32_t>(materials_.size());
+        materials_.push_back(sm);
+        if (textured) notes_.push_back(mp + ": textures are not sampled for reflected light (its factors are used)");
+    }
+    material_ids_[mi] = id;
+    return id;
+}
+
 void Reader::add_mesh(size_t mi, const Instancing& inst) {
     const std::string mp = at("meshes", mi);
     const json& mesh = array_of(doc_, "meshes")[mi];
@@ -374,8 +443,14 @@ void Reader::add_mesh(size_t mi, const Instancing& inst) {
         const json& prim = prims[pi];
         if (!prim.is_object()) fail(ErrorCode::kInvalidValue, pp, "must be an object");
         const std::uint64_t mode = count(prim, "mode", pp, false, 4);
-        if (mode <= 3) continue;  // POINTS, LINES, LINE_LOOP, LINE_STRIP: no area, block nothing
         if (mode > 6) fail(ErrorCode::kInvalidValue, pp + ".mode", "unknown primitive mode " + std::to_string(mode));
+        if (mode <= 3) {
+            // POINTS, LINES, LINE_LOOP, LINE_STRIP: no area, so they block nothing, but their
+            // vertices are part of the scene the default probe grid spans.
+            add_point_bounds(prim, pp, inst);
+            continue;
+        }
+        current_material_ = material_of(prim, pp);
         if (!prim.contains("attributes") || !prim["attributes"].is_object() || !prim["attributes"].contains("POSITION"))
             fail(ErrorCode::kInvalidValue, pp + ".attributes.POSITION", "missing");
         if (prim.contains("extensions") && prim["extensions"].is_object() && prim["extensions"].contains("KHR_draco_mesh_compression")) {

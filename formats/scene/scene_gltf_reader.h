@@ -162,6 +162,10 @@ public:
     void count_triangles(std::uint64_t t, std::uint64_t instances, const std::string& pp);
     void add_draco(const json& prim, const json& ext, const std::string& pp, std::uint64_t mode, const Instancing& inst);
     void add_mesh(size_t mi, const Instancing& inst);
+    // POINTS/LINES primitives: their vertices widen the bounds (default probes), nothing occludes.
+    void add_point_bounds(const json& prim, const std::string& pp, const Instancing& inst);
+    // The primitive's material as a zhc SceneMaterial index (materials_), or kNoMaterial.
+    std::uint32_t material_of(const json& prim, const std::string& pp);
 
     // EXT_mesh_gpu_instancing (scene_gltf_geometry.cpp)
     Instancing read_instancing(const json& e, const Mat4& world, const std::string& ep);
@@ -169,6 +173,7 @@ public:
 
     std::vector<SceneLight> lights_;
     std::vector<Occluder> occluders_;
+    std::vector<SceneMaterial> materials_;  // Occluder::material of occluders_ indexes these
     std::vector<std::string> notes_;  // what was read but is not baked, for the report
     std::optional<size_t> scene_;     // the scene walked (none: an asset without scenes)
     double lo_[3] = {INFINITY, INFINITY, INFINITY}, hi_[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -181,6 +186,8 @@ private:
     const GltfLimits& gltf_limits_;
     std::vector<LightDef> defs_;
     std::uint64_t triangles_ = 0;
+    std::map<size_t, std::uint32_t> material_ids_;  // glTF material -> materials_ index or kNoMaterial
+    std::uint32_t current_material_ = kNoMaterial;  // of the primitive being added
     std::map<size_t, std::vector<std::uint8_t>> decoded_;  // meshopt-compressed views, decoded once
     std::uint64_t decoded_total_ = 0;
 };

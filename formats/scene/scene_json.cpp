@@ -287,18 +287,64 @@ SceneLight read_light(const Reader& r, const json& j, const std::string& p, cons
     return l;
 }
 
+// The material of an occluder entry: "albedo" (diffuse reflectance in [0, 1], [r, g, b] or one
+// number) and "emission" (radiance); neither: kNoMaterial (absorbs, emits nothing). Equal materials
+// share one entry.
+std::uint32_t read_material(const Reader& r, const json& j, const std::string& p, std::vector<SceneMaterial>& materials) {
+    if (!j.contains("albedo") && !j.contains("emission")) return kNoMaterial;
+    SceneMaterial m;
+    if (j.contains("albedo")) {
+        m.albedo = r.colour(j["albedo"], p + ".albedo");
+        for (int k = 0; k < 3; ++k)
+            if (m.albedo[k] > 1) r.fail(ErrorCode::kInvalidValue, p + ".albedo", "must be in [0, 1] (got " + j["albedo"].dump() + ")");
+    }
+    if (j.contains("emission")) m.emission = r.colour(j["emission"], p + ".emission");
+    for (size_t i = 0; i < materials.size(); ++i) {
+        const SceneMaterial& q = materials[i];
+        bool same = true;
+        for (int k = 0; k < 3; ++k) same = same && q.albedo[k] == m.albedo[k] && q.emission[k] == m.emission[k];
+        if (same) return static_cast<std::uint32_t>(i);
+    }
+    materials.push_back(m);
+    return static_cast<std::uint32_t>(materials.size() - 1);
+}
+
+SceneTransport read_transport(const Reader& r, const json& j) {
+    const std::string p = "transport";
+    r.object(j, p, {"bounces", "max_noise", "min_rays", "max_rays"});
+    SceneTransport t;
+    auto integer = [&](const char* key, int lo, int hi, int fallback) {
+        if (!j.contains(key)) return fallback;
+        const json& v = j[key];
+        const std::string kp = p + "." + key;
+        if (!v.is_number_integer()) r.fail(ErrorCode::kInvalidValue, kp, "must be an integer (got " + Reader::type_of(v) + ")");
+        if (v.is_number_unsigned() ? v.get<std::uint64_t>() > std::uint64_t(hi) : (v.get<std::int64_t>() < lo || v.get<std::int64_t>() > hi))
+            r.fail(ErrorCode::kInvalidValue, kp, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + v.dump() + ")");
+        return static_cast<int>(v.get<std::int64_t>());
+    };
+    t.max_bounces = integer("bounces", 0, 1024, t.max_bounces);
+    t.min_rays = integer("min_rays", 1, 1 << 20, t.min_rays);
+    t.max_rays = integer("max_rays", 1, 1 << 20, std::max(t.max_rays, t.min_rays));
+    if (t.max_rays < t.min_rays) r.fail(ErrorCode::kInvalidValue, p + ".max_rays", "must be >= min_rays");
+    if (j.contains("max_noise")) {
+        t.max_noise = r.positive(j["max_noise"], p + ".max_noise");
+        if (t.max_noise > 1) r.fail(ErrorCode::kInvalidValue, p + ".max_noise", "must be in (0, 1] (got " + j["max_noise"].dump() + ")");
+    }
+    return t;
+}
+
 // Appends the occluder(s) of one "occluders" entry; `triangles` counts mesh triangles so far.
 void read_occluder(const Reader& r, const json& j, const std::string& p, const SceneJsonLimits& limits,
-                   std::vector<Occluder>& out, std::uint64_t& triangles) {
+                   std::vector<Occluder>& out, std::uint64_t& triangles, std::vector<SceneMaterial>& materials) {
     if (!j.is_object()) r.object(j, p, {});
     const std::string type = r.string(r.field(j, p, "type"), p + ".type");
     Occluder o;
     if (type == "sphere") {
-        r.object(j, p, {"type", "name", "center", "radius"});
+        r.object(j, p, {"type", "name", "center", "radius", "albedo", "emission"});
         const Vec3 c = r.vec3(r.field(j, p, "center"), p + ".center");
         o = sphere_occluder(c, r.positive(r.field(j, p, "radius"), p + ".radius"));
     } else if (type == "box") {
-        r.object(j, p, {"type", "name", "min", "max"});
+        r.object(j, p, {"type", "name", "min", "max", "albedo", "emission"});
         const Vec3 lo = r.vec3(r.field(j, p, "min"), p + ".min");
         o = box_occluder(lo, r.vec3(r.field(j, p, "max"), p + ".max"));
         for (int a = 0; a < 3; ++a)
@@ -306,7 +352,8 @@ void read_occluder(const Reader& r, const json& j, const std::string& p, const S
     } else if (type == "mesh") {
         // Flat vertex list [x0, y0, z0, x1, ...] and optional flat triangle list [i0, i1, i2, ...]
         // (without indices, consecutive vertex triples are the triangles).
-        r.object(j, p, {"type", "name", "positions", "indices"});
+        r.object(j, p, {"type", "name", "positions", "indices", "albedo", "emission"});
+        const std::uint32_t material = read_material(r, j, p, materials);
         const std::string pp = p + ".positions";
         const json& pos = r.array(r.field(j, p, "positions"), pp, 9 * limits.max_triangles, "numbers");
         if (pos.size() % 3 != 0 || pos.empty())
@@ -338,20 +385,24 @@ void read_occluder(const Reader& r, const json& j, const std::string& p, const S
         triangles += idx.size() / 3;
         if (triangles > limits.max_triangles)
             r.fail(ErrorCode::kTooLarge, p, "mesh triangles exceed the limit of " + std::to_string(limits.max_triangles) + " in all");
-        for (size_t t = 0; t + 2 < idx.size(); t += 3) out.push_back(triangle_occluder(v[idx[t]], v[idx[t + 1]], v[idx[t + 2]]));
+        for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+            out.push_back(triangle_occluder(v[idx[t]], v[idx[t + 1]], v[idx[t + 2]]));
+            out.back().material = material;
+        }
         if (j.contains("name")) (void)r.string(j["name"], p + ".name");
         return;
     } else {
         r.fail(ErrorCode::kUnsupported, p + ".type", "unknown occluder type \"" + type + "\" (known: sphere, box, mesh)");
     }
     if (j.contains("name")) (void)r.string(j["name"], p + ".name");
+    o.material = read_material(r, j, p, materials);
     out.push_back(o);
 }
 
 Scene parse(const Reader& r, const json& doc, const std::string& name, const std::string& base_dir,
             const SceneLoadOptions& options) {
     const SceneJsonLimits& limits = options.limits;
-    r.object(doc, "", {"format", "version", "description", "probes", "environment", "sky", "lights", "occluders", "occlusion"});
+    r.object(doc, "", {"format", "version", "description", "probes", "environment", "sky", "lights", "occluders", "occlusion", "transport"});
     if (doc.contains("format") && r.string(doc["format"], "format") != "zhc-scene")
         r.fail(ErrorCode::kBadFormat, "format", "must be \"zhc-scene\"");
     const json& version = r.field(doc, "", "version");
@@ -406,8 +457,10 @@ Scene parse(const Reader& r, const json& doc, const std::string& name, const std
     if (doc.contains("occluders")) {
         const json& a = r.array(doc["occluders"], "occluders", limits.max_occluders, "occluders");
         std::uint64_t triangles = 0;
-        for (size_t i = 0; i < a.size(); ++i) read_occluder(r, a[i], Reader::index("occluders", i), limits, s.occluders, triangles);
+        for (size_t i = 0; i < a.size(); ++i)
+            read_occluder(r, a[i], Reader::index("occluders", i), limits, s.occluders, triangles, s.materials);
     }
+    if (doc.contains("transport")) s.transport = read_transport(r, doc["transport"]);
     if (Status budget = check_ray_budget(s, limits, ""); !budget) throw Fail{make_error(budget.error().code, name + ": " + budget.error().message)};
     return s;
 }
@@ -573,22 +626,34 @@ std::string scene_json(const Scene& s) {
     }
     if (!lights.empty()) doc["lights"] = lights;
     json occ = json::array();
+    auto with_material = [&](json j, std::uint32_t material) {
+        if (material < s.materials.size()) {
+            j["albedo"] = rgb_json(s.materials[material].albedo);
+            j["emission"] = rgb_json(s.materials[material].emission);
+        }
+        return j;
+    };
     for (size_t i = 0; i < s.occluders.size(); ++i) {
         const Occluder& o = s.occluders[i];
         if (o.kind == OccluderKind::kSphere) {
-            occ.push_back({{"type", "sphere"}, {"center", vec_json(o.center())}, {"radius", o.radius()}});
+            occ.push_back(with_material({{"type", "sphere"}, {"center", vec_json(o.center())}, {"radius", o.radius()}}, o.material));
         } else if (o.kind == OccluderKind::kBox) {
-            occ.push_back({{"type", "box"}, {"min", vec_json(o.min())}, {"max", vec_json(o.max())}});
+            occ.push_back(with_material({{"type", "box"}, {"min", vec_json(o.min())}, {"max", vec_json(o.max())}}, o.material));
         } else {
+            // Consecutive triangles of one material are one mesh entry.
             json pos = json::array();
-            for (; i < s.occluders.size() && s.occluders[i].kind == OccluderKind::kTriangle; ++i)
+            for (; i < s.occluders.size() && s.occluders[i].kind == OccluderKind::kTriangle && s.occluders[i].material == o.material; ++i)
                 for (const Vec3& v : {s.occluders[i].v0, s.occluders[i].v1, s.occluders[i].v2})
                     for (int a = 0; a < 3; ++a) pos.push_back(v[a]);
             --i;
-            occ.push_back({{"type", "mesh"}, {"positions", pos}});
+            occ.push_back(with_material({{"type", "mesh"}, {"positions", pos}}, o.material));
         }
     }
     if (!occ.empty()) doc["occluders"] = occ;
+    const SceneTransport dt;
+    const SceneTransport& t = s.transport;
+    if (t.max_bounces != dt.max_bounces || t.max_noise != dt.max_noise || t.min_rays != dt.min_rays || t.max_rays != dt.max_rays)
+        doc["transport"] = {{"bounces", t.max_bounces}, {"max_noise", t.max_noise}, {"min_rays", t.min_rays}, {"max_rays", t.max_rays}};
     return doc.dump(2) + "\n";
 }
 

@@ -1,0 +1,352 @@
+// Reflected and emitted light (codec/bake/transport.h, docs/scene.md "Reflected light"): the
+// furnace (a closed surface of albedo a emitting L_e: every probe inside sees L_e / (1 - a)), one
+// bounce off an infinite plane lit by a sun (closed form) and by a point light (a slow quadrature
+// twin), a two-room house (the dark room stays dark, the lit room gains its reflected light),
+// determinism across threads, noise that falls with rays, scenes that reflect nothing baking the
+// same bytes as without materials, and the JSON and glTF material readers.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "codec/bake/occluders.h"
+#include "codec/bake/scene.h"
+#include "formats/scene/scene_gltf.h"
+#include "formats/scene/scene_json.h"
+#include "support.h"
+
+namespace zhc {
+namespace {
+
+std::vector<Sh3Radiance> bake(const Scene& s, int threads = 1, BakeReport* rep = nullptr) {
+    BakeOptions o;
+    o.threads = threads;
+    auto r = bake_scene(s, o, rep);
+    EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
+    return r.ok() ? *r : std::vector<Sh3Radiance>{};
+}
+
+// Normalised irradiance (constant radiance 1 -> 1) of channel k for unit normal n.
+double irradiance(const Sh3Radiance& sh, Vec3 n, int k) {
+    const auto y = sh3_basis(n);
+    double e = 0;
+    for (int i = 0; i < 9; ++i) e += (i == 0 ? 1.0 : i < 4 ? 2.0 / 3.0 : 0.25) * y[static_cast<size_t>(i)] * sh[i][k];
+    return e;
+}
+
+const Vec3 kAxes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+
+// Closed cube of 12 triangles, all of material m.
+std::vector<Occluder> cube(Vec3 lo, Vec3 hi, std::uint32_t m) {
+    auto v = [&](int i) { return Vec3{(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z}; };
+    const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    std::vector<Occluder> out;
+    for (const auto& q : quads) {
+        out.push_back(triangle_occluder(v(q[0]), v(q[1]), v(q[2])));
+        out.push_back(triangle_occluder(v(q[0]), v(q[2]), v(q[3])));
+    }
+    for (Occluder& o : out) o.material = m;
+    return out;
+}
+
+Scene at_positions(std::vector<Vec3> ps) {
+    Scene s;
+    s.probes.kind = ProbePlacementKind::kPositions;
+    s.probes.positions = std::move(ps);
+    s.occlusion.sky_samples = 0;
+    return s;
+}
+
+// The furnace: inside a closed surface of uniform albedo a and emission L_e, radiance is
+// L_e (1 + a + a^2 + ...) = L_e / (1 - a) in every direction, so each axis irradiance is that too.
+void furnace(std::vector<Occluder> shell, double a, Rgb le, double tolerance) {
+    Scene s = at_positions({{0, 0, 0}, {0.3, -0.2, 0.1}, {-0.4, 0.35, -0.3}});
+    SceneMaterial m;
+    m.albedo = {float(a), float(a), float(a)};
+    m.emission = le;
+    s.materials.push_back(m);
+    s.occluders = std::move(shell);
+    s.transport.min_rays = s.transport.max_rays = 16384;
+    BakeReport rep;
+    const auto probes = bake(s, 1, &rep);
+    ASSERT_EQ(probes.size(), 3u);
+    EXPECT_TRUE(rep.transport.traced);
+    std::printf("furnace a=%.2f: %llu paths, %llu rays, mean path %.2f vertices (deepest %d), noise median %.4f\n", a,
+                (unsigned long long)rep.transport.paths, (unsigned long long)rep.transport.rays,
+                double(rep.transport.vertices) / double(rep.transport.paths), rep.transport.max_depth, rep.transport.noise_median);
+    for (const Sh3Radiance& p : probes)
+        for (int k = 0; k < 3; ++k) {
+            const double want = le[k] / (1 - a);
+            for (const Vec3& n : kAxes) EXPECT_NEAR(irradiance(p, n, k), want, tolerance * want);
+        }
+    // Every path is 3 vertices long at least (Russian roulette starts at the third); there the
+    // throughput is a^3, the survival probability, after which each vertex continues with
+    // probability a: 3 + a^3 / (1 - a) vertices on average in a closed room.
+    const double mean_vertices = 3 + a * a * a / (1 - a);
+    EXPECT_NEAR(double(rep.transport.vertices) / double(rep.transport.paths), mean_vertices, 0.03 * mean_vertices);
+}
+
+TEST(Transport, FurnaceCube) { furnace(cube({-1, -1, -1}, {1, 1, 1}, 0), 0.8, {1.0f, 0.5f, 0.25f}, 0.03); }
+TEST(Transport, FurnaceSphereMesh) {
+    std::vector<Occluder> shell = uv_sphere_triangles({0, 0, 0}, 1.2, 24, 48);
+    for (Occluder& o : shell) o.material = 0;
+    furnace(std::move(shell), 0.5, {2.0f, 2.0f, 2.0f}, 0.02);
+}
+
+// One bounce with a closed form: a sun of normalised irradiance E0 at elevation theta over a plane
+// of albedo rho lights it with E = pi E0 cos theta, so the plane's radiance is rho E0 cos theta
+// everywhere; a probe above it sees that radiance over the lower hemisphere (a hemisphere light)
+// plus the sun itself.
+TEST(Transport, SunOverInfinitePlane) {
+    Scene s = at_positions({{0, 0, 1}, {3, -2, 0.5}});
+    const double R = 1e5, rho = 0.6;
+    SceneMaterial m;
+    m.albedo = {float(rho), float(rho), float(rho)};
+    s.materials.push_back(m);
+    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, -R, 0}, {R, R, 0}));
+    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, R, 0}, {-R, R, 0}));
+    for (Occluder& o : s.occluders) o.material = 0;
+    SceneLight sun;
+    sun.kind = LightKind::kDirectional;
+    sun.direction = normalize_or({0.3, 0.2, 1.0}, {0, 0, 1});
+    sun.color = {1.0f, 0.5f, 0.25f};
+    s.lights.push_back(sun);
+    s.transport.min_rays = s.transport.max_rays = 4096;
+    const auto probes = bake(s);
+    ASSERT_EQ(probes.size(), 2u);
+    SceneLight below;
+    below.kind = LightKind::kHemisphere;
+    below.direction = {0, 0, -1};
+    const double c = sun.direction.z;
+    below.color = {float(rho * c * 1.0), float(rho * c * 0.5), float(rho * c * 0.25)};
+    for (const Sh3Radiance& p : probes) {
+        double want[27] = {};
+        add_light_closed_form(sun, {0, 0, 0}, want);
+        add_light_closed_form(below, {0, 0, 0}, want);
+        Sh3Radiance w;
+        for (int i = 0; i < 9; ++i)
+            for (int k = 0; k < 3; ++k) w[i][k] = float(want[i * 3 + k]);
+        for (int k = 0; k < 3; ++k)
+            for (const Vec3& n : kAxes) {
+                const double e = irradiance(w, n, k);
+                EXPECT_NEAR(irradiance(p, n, k), e, 0.01 * irradiance(w, {0, 0, 1}, k) + 1e-6) << "axis " << n.x << n.y << n.z;
+            }
+    }
+}
+
+// A point light of intensity I at height hl over the plane z = 0 (albedo rho): the plane's radiance
+// at r is rho / pi * I hl / d^3 (d the distance from the light). The slow twin integrates what the
+// probe sees over the lower hemisphere with a fine midpoint rule in (theta, phi).
+TEST(Transport, PointLightOverPlaneAgainstQuadrature) {
+    const Vec3 probe{0.4, -0.3, 1.0}, light{0, 0, 2.0};
+    const double rho = 0.7, I = 5.0, R = 1e4;
+    Scene s = at_positions({probe});
+    SceneMaterial m;
+    m.albedo = {float(rho), float(rho), float(rho)};
+    s.materials.push_back(m);
+    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, -R, 0}, {R, R, 0}));
+    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, R, 0}, {-R, R, 0}));
+    for (Occluder& o : s.occluders) o.material = 0;
+    SceneLight l;
+    l.kind = LightKind::kPoint;
+    l.position = light;
+    l.color = {float(I), float(I), float(I)};
+    l.shadows = true;
+    s.lights.push_back(l);
+    s.transport.min_rays = s.transport.max_rays = 16384;
+    const auto probes = bake(s);
+    ASSERT_EQ(probes.size(), 1u);
+    // Slow twin: sum over the lower hemisphere of L(hit) Y(w) dw, plus the light's closed form.
+    double want[27] = {};
+    add_light_closed_form(l, probe, want);
+    const int nt = 600, np = 1200;
+    for (int i = 0; i < nt; ++i) {
+        const double th = kPi / 2 + (i + 0.5) * (kPi / 2) / nt;
+        for (int j = 0; j < np; ++j) {
+            const double ph = (j + 0.5) * 2 * kPi / np;
+            const Vec3 w{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
+            const double t = -probe.z / w.z;
+            const Vec3 x = probe + t * w;
+            const Vec3 v = light - x;
+            const double d = length(v);
+            const double L = rho / kPi * I * light.z / (d * d * d);
+            const double dw = std::sin(th) * (kPi / 2 / nt) * (2 * kPi / np);
+            const auto y = sh3_basis(w);
+            for (int c = 0; c < 9; ++c)
+                for (int k = 0; k < 3; ++k) want[c * 3 + k] += L * y[static_cast<size_t>(c)] * dw;
+        }
+    }
+    Sh3Radiance w;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) w[i][k] = float(want[i * 3 + k]);
+    for (const Vec3& n : kAxes) {
+        const double e = irradiance(w, n, 0), got = irradiance(probes[0], n, 0);
+        std::printf("point over plane, normal (%g %g %g): twin %.6f, bake %.6f\n", n.x, n.y, n.z, e, got);
+        EXPECT_NEAR(got, e, 0.01 * irradiance(w, {0, 0, -1}, 0));
+    }
+}
+
+// Two rooms split by a solid wall, a point light in the west room: the east room's probes see
+// nothing (no leak through the wall), the west room's gain reflected light on every side, most
+// of all on the sides that do not face the lamp.
+Scene house() {
+    Scene s;
+    s.probes.kind = ProbePlacementKind::kPositions;
+    s.probes.positions = {{-3, 0.5, 1.5}, {-1, -1.5, 1.0}, {3, 0.5, 1.5}, {1.2, 1, 2}};
+    SceneMaterial grey;
+    grey.albedo = {0.8f, 0.8f, 0.8f};
+    s.materials.push_back(grey);
+    // Outer box of the house (inside faces matter; both faces of every triangle reflect).
+    auto add = [&](std::vector<Occluder> t) { s.occluders.insert(s.occluders.end(), t.begin(), t.end()); };
+    add(cube({-5.1, -3, 0}, {5.1, 3, 3}, 0));
+    add(cube({-0.1, -3, 0}, {0.1, 3, 3}, 0));  // the dividing wall
+    SceneLight l;
+    l.kind = LightKind::kPoint;
+    l.position = {-2.5, 0, 2.2};
+    l.color = {8, 8, 8};
+    l.shadows = true;
+    s.lights.push_back(l);
+    s.occlusion.sky_samples = 0;
+    s.transport.max_noise = 0.02;
+    return s;
+}
+
+TEST(Transport, HouseLitRoomAndDarkRoom) {
+    Scene s = house();
+    BakeReport rep;
+    const auto lit = bake(s, 2, &rep);
+    ASSERT_EQ(lit.size(), 4u);
+    std::printf("house: %s\n", rep.summary().c_str());
+    std::printf("house: %llu paths, %llu rays, deepest %d, noise median %.4f max %.4f, energy left <= %.2e\n",
+                (unsigned long long)rep.transport.paths, (unsigned long long)rep.transport.rays, rep.transport.max_depth,
+                rep.transport.noise_median, rep.transport.noise_max, rep.transport.energy_left);
+    Scene direct_only = house();
+    direct_only.transport.max_bounces = 0;
+    const auto direct = bake(direct_only);
+    // East room: exactly dark, with or without reflected light.
+    for (size_t p : {size_t(2), size_t(3)})
+        for (int i = 0; i < 9; ++i) {
+            EXPECT_EQ(direct[p][i][0], 0.0f);
+            EXPECT_EQ(lit[p][i][0], 0.0f) << "probe " << p << " coefficient " << i;
+        }
+    // West room: every axis gains light; an axis facing away from the lamp gets only reflected light.
+    for (size_t p : {size_t(0), size_t(1)})
+        for (const Vec3& n : kAxes) {
+            const double d = irradiance(direct[p], n, 0), t = irradiance(lit[p], n, 0);
+            EXPECT_GT(t, d + 0.02 * std::max(d, 0.05)) << "probe " << p;
+        }
+    EXPECT_LE(rep.transport.noise_max, s.transport.max_noise + 1e-12);
+    EXPECT_LT(rep.transport.energy_left, 1e-5);
+}
+
+TEST(Transport, SameBytesForAnyThreadCount) {
+    Scene s = house();
+    s.transport.min_rays = s.transport.max_rays = 512;
+    const auto a = bake(s, 1), b = bake(s, 2), c = bake(s, 3);
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Sh3Radiance)), 0);
+    EXPECT_EQ(std::memcmp(a.data(), c.data(), a.size() * sizeof(Sh3Radiance)), 0);
+}
+
+// Standard error falls as 1 / sqrt(rays): the reported noise at 4x the rays is about half.
+TEST(Transport, NoiseFallsWithRays) {
+    Scene s = house();
+    s.transport.max_noise = 1e-9;  // never reached: every probe takes max_rays
+    double noise[2];
+    int i = 0;
+    for (int rays : {2048, 8192}) {
+        s.transport.min_rays = s.transport.max_rays = rays;
+        BakeReport rep;
+        (void)bake(s, 2, &rep);
+        noise[i++] = rep.transport.noise_median;
+        std::printf("house at %d rays/probe: noise median %.4f, %.1f ms\n", rays, rep.transport.noise_median, rep.transport.milliseconds);
+    }
+    EXPECT_GT(noise[0] / noise[1], 1.4);
+    EXPECT_LT(noise[0] / noise[1], 2.9);
+}
+
+// A scene whose surfaces reflect and emit nothing traces nothing and bakes the bytes of the same
+// scene without materials.
+TEST(Transport, BlackMaterialsBakeAsNoMaterials) {
+    Scene a = house();
+    a.materials[0].albedo = {0, 0, 0};
+    Scene b = house();
+    b.materials.clear();
+    for (Occluder& o : b.occluders) o.material = kNoMaterial;
+    BakeReport ra, rb;
+    const auto pa = bake(a, 1, &ra), pb = bake(b, 1, &rb);
+    EXPECT_FALSE(ra.transport.traced);
+    EXPECT_FALSE(rb.transport.traced);
+    EXPECT_FALSE(scene_has_transport(a));
+    ASSERT_EQ(pa.size(), pb.size());
+    EXPECT_EQ(std::memcmp(pa.data(), pb.data(), pa.size() * sizeof(Sh3Radiance)), 0);
+}
+
+// Emission alone lights a scene with no listed light: a glowing sphere mesh seen from outside
+// within its cone, L00 = closed form of a sphere light of that radiance (the bake's own closed form).
+TEST(Transport, EmissiveSphereMatchesSphereLight) {
+    Scene s = at_positions({{0, 0, 3}});
+    std::vector<Occluder> ball = uv_sphere_triangles({0, 0, 0}, 1.0, 64, 128);
+    for (Occluder& o : ball) o.material = 0;
+    s.occluders = std::move(ball);
+    SceneMaterial m;
+    m.emission = {3, 2, 1};
+    s.materials.push_back(m);
+    s.transport.min_rays = s.transport.max_rays = 65536;
+    const auto probes = bake(s);
+    ASSERT_EQ(probes.size(), 1u);
+    SceneLight sl;
+    sl.kind = LightKind::kSphere;
+    sl.center = {0, 0, 0};
+    sl.radius = 1.0;
+    sl.color = m.emission;
+    double want[27] = {};
+    add_light_closed_form(sl, {0, 0, 3}, want);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(probes[0][0][k], want[k], 0.02 * want[k]);
+    // Facing the sphere (-z), the irradiance is the sphere light's within the mesh's faceting.
+    Sh3Radiance w;
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 3; ++k) w[i][k] = float(want[i * 3 + k]);
+    EXPECT_NEAR(irradiance(probes[0], {0, 0, -1}, 0), irradiance(w, {0, 0, -1}, 0), 0.02 * irradiance(w, {0, 0, -1}, 0));
+}
+
+TEST(Transport, JsonMaterialsAndLimits) {
+    const std::string text = R"({"format":"zhc-scene","version":1,
+        "probes":{"positions":[[0,0,1]]},
+        "lights":[{"type":"point","position":[0,0,2],"intensity":[1,1,1],"shadows":true}],
+        "occluders":[{"type":"mesh","positions":[-5,-5,0, 5,-5,0, 5,5,0],"albedo":0.5},
+                     {"type":"mesh","positions":[-5,-5,0, 5,5,0, -5,5,0],"albedo":[0.5,0.5,0.5]},
+                     {"type":"box","min":[3,3,0],"max":[4,4,1],"emission":[1,0,0]}],
+        "transport":{"bounces":8,"max_noise":0.05,"min_rays":256,"max_rays":1024}})";
+    auto s = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()), "t.json", "", SceneLoadOptions{});
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    ASSERT_EQ(s->materials.size(), 2u);  // equal materials are shared
+    EXPECT_EQ(s->occluders[0].material, 0u);
+    EXPECT_EQ(s->occluders[1].material, 0u);
+    EXPECT_EQ(s->occluders[2].material, 1u);
+    EXPECT_FLOAT_EQ(s->materials[1].emission.r, 1.0f);
+    EXPECT_EQ(s->transport.max_bounces, 8);
+    EXPECT_EQ(s->transport.max_rays, 1024);
+    // Round trip through the writer.
+    const std::string back = scene_json(*s);
+    auto s2 = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(back.data()), back.size()), "t2.json", "", SceneLoadOptions{});
+    ASSERT_TRUE(s2.ok()) << s2.error().message;
+    EXPECT_EQ(s2->materials.size(), 2u);
+    EXPECT_EQ(s2->transport.max_noise, 0.05);
+    for (const char* bad : {R"("albedo":1.5)", R"("albedo":-1)", R"("emission":[1,2])"}) {
+        std::string t = R"({"format":"zhc-scene","version":1,"probes":{"positions":[[0,0,1]]},"occluders":[{"type":"sphere","center":[0,0,0],"radius":1,)" +
+                        std::string(bad) + "}]}";
+        auto r = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(t.data()), t.size()), "bad.json", "", SceneLoadOptions{});
+        ASSERT_FALSE(r.ok()) << bad;
+        EXPECT_NE(r.error().message.find("occluders[0]"), std::string::npos) << r.error().message;
+    }
+    for (const char* bad : {R"({"bounces":-1})", R"({"max_noise":0})", R"({"min_rays":100,"max_rays":10})", R"({"rays":5})"}) {
+        std::string t = R"({"format":"zhc-scene","version":1,"probes":{"positions":[[0,0,1]]},"transport":)" + std::string(bad) + "}";
+        auto r = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(t.data()), t.size()), "bad.json", "", SceneLoadOptions{});
+        ASSERT_FALSE(r.ok()) << bad;
+        EXPECT_NE(r.error().message.find("transport"), std::string::npos) << r.error().message;
+    }
+}
+
+}  // namespace
+}  // namespace zhc
