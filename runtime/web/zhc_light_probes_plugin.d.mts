@@ -1,0 +1,130 @@
+// Type declarations of zhc_light_probes_plugin.mjs (`@zhc/runtime/three`): the three.js GLTFLoader
+// plugin for ZHC_light_probes and the decoded volumes it attaches (three.js types: @types/three).
+import type { HalfFloatType, FloatType, LightProbe, Matrix4, Object3D, SphericalHarmonics3 } from 'three';
+import type { GLTF, GLTFLoaderPlugin, GLTFParser } from 'three/addons/loaders/GLTFLoader.js';
+import type { Vec3, Vec3Like, ZhcEncodingName, ZhcGrid, ZhcKind, ZhcParams } from './zhc_runtime.mjs';
+import type { ZhcCompactOptions, ZhcCompactVolume } from './zhc_volume.glsl.mjs';
+
+export declare const EXTENSION: 'ZHC_light_probes';
+
+/** The fields of a decoded volume (Draco-compressed volumes carry only the first group and `draco: true`). */
+export interface ZhcProbeVolumeFields {
+  name?: string;
+  encoding: ZhcEncodingName | string;
+  kind: ZhcKind;
+  count: number;
+  /** 'zhc': coefficients kept in zhc axes (what zhc writes); 'gltf': in glTF axes. */
+  shAxes: 'zhc' | 'gltf';
+  layout: 'grid' | 'points' | 'none';
+  /** The grid (layout 'grid'), in the node's local glTF axes. */
+  grid?: ZhcGrid;
+  draco?: boolean;
+  params?: ZhcParams;
+  bytesPerProbe?: number;
+  /** The stored probe bytes (count x bytesPerProbe). */
+  bytes?: Uint8Array;
+  /** Probe positions, node-local glTF axes, count x 3. */
+  positions?: Float32Array;
+  /** Decoded SH3 radiance, count x 27, in the stored axes (shAxes). */
+  sh?: Float32Array;
+  validity?: Uint8Array | null;
+  visibility?: Uint8Array | null;
+  /** The Object3Ds that place the volume (one per referencing node), set by the plugin. */
+  nodes?: Object3D[];
+}
+
+/** One decoded ZHC_light_probes volume: gltf.userData.zhcLightProbes[i]. */
+export declare class ZhcProbeVolume implements ZhcProbeVolumeFields {
+  constructor(desc: ZhcProbeVolumeFields);
+  name?: string;
+  encoding: ZhcEncodingName | string;
+  kind: ZhcKind;
+  count: number;
+  shAxes: 'zhc' | 'gltf';
+  layout: 'grid' | 'points' | 'none';
+  grid?: ZhcGrid;
+  draco?: boolean;
+  params?: ZhcParams;
+  bytesPerProbe?: number;
+  bytes?: Uint8Array;
+  positions?: Float32Array;
+  sh?: Float32Array;
+  validity?: Uint8Array | null;
+  visibility?: Uint8Array | null;
+  nodes?: Object3D[];
+  /** SH3 radiance of probe p in the stored axes, bit exact with zhc (a view). Throws RangeError for a bad index. */
+  probeSH(p: number): Float32Array;
+  /** SH3 radiance of probe p in glTF axes. */
+  probeSHGltf(p: number): Float32Array;
+  /** Irradiance of probe p at a direction in glTF / three.js axes (node-local). */
+  irradiance(p: number, dir: Vec3Like): Vec3;
+  /** Irradiance at any point of a grid volume (node-local glTF axes), 8 probes blended (masks applied). */
+  irradianceAt(position: Vec3Like, normal: Vec3Like): Vec3;
+  /** The compact path: stored bytes in an RGBA32UI Data3DTexture, uniforms and GLSL (three.js passed in). */
+  compactVolume(options?: Omit<ZhcCompactOptions, 'THREE'>): ZhcCompactVolume;
+  /** three.js's own probe grid (r187+ LightProbeGridWebGL or LightProbeGrid) filled from the decoded probes. */
+  lightProbeGrid<T extends Object3D>(
+    GridClass: new (width: number, height: number, depth: number, widthProbes: number, heightProbes: number, depthProbes: number) => T,
+    options?: { matrixWorld?: Matrix4; type?: typeof FloatType | typeof HalfFloatType },
+  ): T;
+  /** Position of probe p, node-local glTF axes. */
+  position(p: number): Vec3;
+  /** three.js SphericalHarmonics3 of probe p (three.js's signs, glTF axes, radiance). */
+  threeSH(p: number, target?: SphericalHarmonics3): SphericalHarmonics3;
+  /** A THREE.LightProbe of probe p at its node-local position. */
+  lightProbe(p: number, intensity?: number): LightProbe;
+  /** Index of the probe nearest to a node-local point; -1 for an empty volume. */
+  nearestProbe(pos: Vec3Like): number;
+}
+
+/** three.js's LightProbeGrid atlas of a grid volume: RGBA texels, x fastest, then y, then slice. */
+export declare function lightProbeGridAtlas(volume: ZhcProbeVolume, half?: boolean): {
+  data: Float32Array | Uint16Array;
+  width: number;
+  height: number;
+  depth: number;
+};
+
+/** One volume's JSON definition as in the glTF file. */
+export interface ZhcVolumeDefinition {
+  name?: string;
+  encoding: string;
+  count: number;
+  kind?: ZhcKind;
+  shAxes?: 'zhc' | 'gltf';
+  layout: 'grid' | 'points' | 'none';
+  grid?: ZhcGrid;
+  quantization?: {
+    bits?: number;
+    sqrt?: boolean;
+    l2Bound?: 'tight' | 'loose';
+    dcFormat?: 'r11g11b10f' | 'rgb9e5' | 'half';
+    zonalMapping?: 'affine' | 'zero' | 'symmetric';
+    axisMode?: 'luminance' | 'channel';
+  };
+  luminanceWeights?: number[];
+  [key: string]: unknown;
+}
+/** A volume's JSON and its accessor arrays -> a decoded ZhcProbeVolume (throws Error on malformed input). */
+export declare function buildVolume(
+  definition: ZhcVolumeDefinition,
+  coefficientsArray: ArrayBufferView,
+  positionsArray: ArrayLike<number> | null,
+  validityArray?: ArrayLike<number> | null,
+  visibilityArray?: ArrayLike<number> | null,
+): ZhcProbeVolume;
+
+/** What the plugin puts in gltf.userData. */
+export interface ZhcGltfUserData {
+  zhcLightProbes: ZhcProbeVolume[];
+}
+
+/** The GLTFLoader plugin: loader.register((parser) => new ZhcLightProbesPlugin(parser)). */
+export declare class ZhcLightProbesPlugin implements GLTFLoaderPlugin {
+  constructor(parser: GLTFParser);
+  readonly name: 'ZHC_light_probes';
+  parser: GLTFParser;
+  anchors: Object3D[];
+  createNodeAttachment(nodeIndex: number): Promise<Object3D> | null;
+  afterRoot(result: GLTF): Promise<void>;
+}
