@@ -138,6 +138,7 @@ int run(const Options& o) {
         GltfEmbedOptions eo;
         eo.binary = ext == ".glb";
         eo.output_path = o.output;
+        eo.replace = true;  // an asset baked before: its zhc_probes volume is this bake's
         auto out = embed_probes_gltf(host, host_path, *set, eo);
         if (!out) return report(out.error());
         if (Status st = write_file_atomic(o.output, *out); !st) return report_output(st.error());

@@ -41,11 +41,77 @@ TEST(CubeContainers, EveryPrefixIsRefusedCleanly) {
             EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
         }
         auto more = good;
-        more.push_back(0);
+        more.push_back(std::string(c.container) == "dds" ? 7 : 0);  // DDS: zero padding is read (below)
         auto r = read(more);
         ASSERT_FALSE(r);
         EXPECT_EQ(r.error().code, ErrorCode::kTrailingBytes) << r.error().message;
     }
+}
+
+// Bytes after a DDS cube's six faces: DirectXTex's loader (DirectXTexDDS.cpp CopyImage) needs the
+// bytes the header describes and ignores any after them. zhc ignores them when they are all zero
+// (padding) and refuses any other (kTrailingBytes naming the first non-zero byte, exit 4): data
+// the header does not describe could mean the faces sit elsewhere (an undeclared mip chain).
+// Constructed: every DDS case with 1 byte and a mip level's worth of zeros reads bit for bit as
+// without. Real: derkreature/IBLBaker's paperMillDiffuseMDR.dds (32-pixel RGBA8 faces, 6,144 zero
+// bytes after them) reads, and every texel is the file's bytes at the offset the header gives.
+TEST(CubeContainers, DdsZeroPaddingIgnoredOtherTrailingBytesRefused) {
+    const Image cube = render_cube(8, [](Vec3 d) { return Rgb{float(d.x + 2), 1.0f, float(d.z + 1.5)}; });
+    for (const Case& c : kCases) {
+        if (std::string(c.container) != "dds") continue;
+        SCOPED_TRACE(std::to_string(static_cast<int>(c.fmt)) + (c.legacy ? " legacy" : " dx10"));
+        const auto good = write(c, cube);
+        auto plain = read(good);
+        ASSERT_TRUE(plain) << plain.error().message;
+        const size_t level1 = write(c, cube, 2).size() - good.size();  // one mip level of the six faces
+        for (size_t pad : {size_t(1), level1}) {
+            auto padded = good;
+            padded.resize(good.size() + pad, 0);
+            auto r = read(padded);
+            ASSERT_TRUE(r) << pad << ": " << r.error().message;
+            EXPECT_EQ(r->rgb, plain->rgb);
+            padded[good.size() + pad / 2] = 1;
+            r = read(padded);
+            ASSERT_FALSE(r);
+            EXPECT_EQ(r.error().code, ErrorCode::kTrailingBytes) << r.error().message;
+            EXPECT_NE(r.error().message.find("(byte " + std::to_string(good.size() + pad / 2) + " is not)"), std::string::npos)
+                << r.error().message;
+        }
+    }
+    const std::string file = std::string(ZHC_TEST_DATA_DIR) + "/cube/iblbaker_paperMillDiffuseMDR.dds";
+    const std::vector<std::uint8_t> b = test::read_bytes(file);
+    constexpr size_t kFace = 32 * 32 * 4, kData = 128 + 6 * kFace;
+    ASSERT_EQ(b.size(), kData + 6144);
+    EXPECT_EQ(std::count(b.begin() + kData, b.end(), 0), 6144);
+    EnvmapInfo info;
+    auto img = read_envmap_memory(b, file, {}, &info);
+    ASSERT_TRUE(img) << img.error().message;
+    EXPECT_EQ(info.format, "dds");
+    EXPECT_EQ(info.channels, "RGBA8 UNORM");  // masks R 000000ff, G 0000ff00, B 00ff0000, A ff000000
+    ASSERT_EQ(img->width, 32);
+    ASSERT_EQ(img->height, 6 * 32);
+    size_t differ = 0;
+    for (size_t f = 0; f < 6; ++f)
+        for (size_t t = 0; t < 32 * 32; ++t) {
+            const std::uint8_t* p = b.data() + 128 + f * kFace + t * 4;  // R, G, B, A
+            const float* q = img->rgb.data() + (f * 32 * 32 + t) * 3;
+            for (int k = 0; k < 3; ++k) differ += std::abs(q[k] - p[k] / 255.0f) > 1e-6f;  // UNORM read as linear
+        }
+    EXPECT_EQ(differ, 0u);
+    // Without its padding: the same image.
+    auto cut = read_envmap_memory(std::vector<std::uint8_t>(b.begin(), b.begin() + kData), file, {}, nullptr);
+    ASSERT_TRUE(cut) << cut.error().message;
+    EXPECT_EQ(cut->rgb, img->rgb);
+    // The CLI: exit 0; a non-zero byte in the padding: exit 4 naming it.
+    const std::string dir = test::fresh_dir("cube_dds_padding");
+    EXPECT_EQ(test::run_zhc({"project", file, "--json"}).exit_code, 0);
+    auto bad = b;
+    bad[kData + 100] = 0x40;
+    test::write_bytes(dir + "/bad.dds", bad);
+    const auto r = test::run_zhc({"project", dir + "/bad.dds", "--json"});
+    EXPECT_EQ(r.exit_code, 4) << r.err;
+    EXPECT_NE(r.err.find("6144 trailing bytes after the DDS data (which ends at byte 24704), not all zero (byte 24804 is not)"),
+              std::string::npos) << r.err;
 }
 
 struct Hostile {

@@ -88,13 +88,16 @@ TEST(GltfProbes, VolumesAppendAndNodesReference) {
     const Bytes scene = write_model(make_scene(false), true);
     auto once = embed_probes_gltf(scene, "s.glb", grid_set("zh3_q16"));
     ASSERT_TRUE(once);
-    auto twice = embed_probes_gltf(*once, "s.glb", scattered_set(10, "sh3"));
-    ASSERT_TRUE(twice);
+    GltfEmbedOptions second;
+    second.name = "second";  // a volume of the name already there is refused (GltfInputs.EmbedOntoAnExistingVolumeRefusedOrReplaced)
+    auto twice = embed_probes_gltf(*once, "s.glb", scattered_set(10, "sh3"), second);
+    ASSERT_TRUE(twice) << twice.error().message;
     auto s = read_gltf_probes(*twice, "t.glb");
     ASSERT_TRUE(s) << s.error().message;
     ASSERT_EQ(s->volumes.size(), 2u);
     EXPECT_EQ(s->volumes[0].set.representation, "zh3_q16");
     EXPECT_EQ(s->volumes[1].set.representation, "sh3");
+    EXPECT_EQ(s->volumes[1].name, "second");
     ASSERT_EQ(s->volumes[1].nodes.size(), 1u);
     const json doc = gltf_json(*twice);
     EXPECT_EQ(doc["nodes"][s->volumes[1].nodes[0]]["extensions"][kGltfProbeExtension]["volume"], 1);

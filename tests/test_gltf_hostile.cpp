@@ -149,10 +149,22 @@ TEST(GltfProbes, HostileUrisRejectedBeforeReading) {
         doc["buffers"][0]["byteLength"] = 36;
         expect_rejected(text_bytes(doc), dir + "/inner/scene.gltf", ErrorCode::kBadFormat, "outside the input's directory");
     }
-    // Images: the URI is checked too, and images are never decoded (garbage PNG bytes are fine).
+    // Images are never read nor decoded by the reader (garbage PNG bytes are fine, and a URI that
+    // leaves the folder is not followed); embedding into another folder, which reads or
+    // re-references them, checks the URI like a buffer's.
     json doc = base;
-    doc["images"] = json::array({json{{"uri", "../x.png"}}});
-    expect_rejected(text_bytes(doc), dir + "/inner/scene.gltf", ErrorCode::kBadFormat, "images[0]: uri rejected");
+    doc["images"] = json::array({json{{"uri", "../secret.bin"}}});
+    EXPECT_TRUE(read_gltf_probes(text_bytes(doc), dir + "/inner/scene.gltf"));
+    for (const std::string uri : {"../secret.bin", "%2e%2e/secret.bin", "/etc/passwd", "file:///etc/passwd", "..\\secret.bin"}) {
+        doc["images"][0]["uri"] = uri;
+        GltfEmbedOptions eo;
+        eo.output_path = dir + "/out.glb";  // not inner/
+        auto r = embed_probes_gltf(text_bytes(doc), dir + "/inner/scene.gltf", scattered_set(4, "sh3"), eo);
+        ASSERT_FALSE(r) << uri;
+        EXPECT_EQ(r.error().code, ErrorCode::kBadFormat) << r.error().message;
+        EXPECT_NE(r.error().message.find("images[0].uri"), std::string::npos) << r.error().message;
+        EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
+    }
     doc["images"] = json::array({json{{"uri", "data:image/png;base64,AAAAAAAA"}}});
     EXPECT_TRUE(read_gltf_probes(text_bytes(doc), dir + "/inner/scene.gltf"));
 }

@@ -57,6 +57,13 @@ Scene scene_of(const std::string& file) {
     return s.ok() ? std::move(s).value() : Scene{};
 }
 
+// The number of nodes of a .glb or .gltf file.
+size_t gltf_node_count(const std::string& file) {
+    const std::vector<std::uint8_t> b = test::read_bytes(file);
+    const json j = test::get32(b, 0) == 0x46546C67 ? json::parse(b.begin() + 20, b.begin() + 20 + test::get32(b, 12)) : json::parse(b);
+    return j["nodes"].size();
+}
+
 // A triangle as its vertex set (rotation and winding ignored), rounded to `grid` for matching.
 using Tri = std::array<std::array<long long, 3>, 3>;
 std::vector<Tri> triangles(const Scene& s, double grid) {
@@ -252,6 +259,44 @@ TEST(GltfInputs, UrisResolveAgainstTheFileNotTheWorkingDirectory) {
     expect_refused("../other/lonely.gltf", 3, "'gt_list.bin' not found");
 }
 
+// An image URI that leaves the asset's folder ('..') is refused only where the image is read or
+// embedded (an output in another folder), never by commands that do not read images: info, bake
+// to .zhp/.json, and bake or embed into the input's own folder (the URI copied as it is).
+TEST(GltfInputs, ImageUriOutsideTheFolderRefusedOnlyWhereRead) {
+    const std::string root = test::fresh_dir("gltf_inputs_image_uri");
+    fs::create_directories(root + "/asset");
+    fs::create_directories(root + "/other");
+    json doc = json::parse(test::read_bytes(data("gt_list.gltf")));
+    ASSERT_TRUE(doc.contains("images"));
+    doc["images"][0]["uri"] = "../tex.png";
+    const std::string text = doc.dump();
+    const std::string in = root + "/asset/scene.gltf";
+    test::write_bytes(in, std::vector<std::uint8_t>(text.begin(), text.end()));
+    fs::copy_file(data("gt_list.bin"), root + "/asset/gt_list.bin");
+    fs::copy_file(data("tex.png"), root + "/tex.png");
+    const auto info = test::run_zhc({"info", in});
+    EXPECT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_EQ(max_diff(bake(in, "image_uri_up"), bake(data("gt_list.gltf"), "image_uri_reference")), 0.0);
+    const auto zhp = test::run_zhc({"bake", in, "-o", root + "/out.zhp", "--quiet"});
+    EXPECT_EQ(zhp.exit_code, 0) << zhp.err;
+    // Into the input's folder: the reference is kept as written.
+    const auto same = test::run_zhc({"bake", in, "-o", root + "/asset/same.gltf", "--quiet"});
+    ASSERT_EQ(same.exit_code, 0) << same.err;
+    EXPECT_EQ(json::parse(test::read_bytes(root + "/asset/same.gltf"))["images"][0]["uri"], "../tex.png");
+    // Elsewhere the image would have to be read or re-referenced: refused (exit 4), naming it.
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"bake", in, "-o", root + "/other/out.glb", "--quiet"},
+          std::vector<std::string>{"gltf", "embed", in, root + "/out.zhp", "-o", root + "/other/out.gltf"}}) {
+        const auto r = test::run_zhc(args);
+        EXPECT_EQ(r.exit_code, 4) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_NE(r.err.find("image '../tex.png'"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("images[0].uri"), std::string::npos) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(root + "/other/out.glb"));
+    EXPECT_FALSE(fs::exists(root + "/other/out.gltf"));
+}
+
 // GLB edits for hostile variants: the JSON chunk replaced, the BIN chunk kept.
 std::vector<std::uint8_t> edit_glb(const std::string& file, const std::function<void(json&, std::vector<std::uint8_t>&)>& edit) {
     std::vector<std::uint8_t> b = test::read_bytes(file);
@@ -347,6 +392,95 @@ TEST(GltfInputs, KhrMeshoptNameReadLikeExt) {
     EXPECT_EQ(max_diff(bake(file, "khr_meshopt"), bake(data("gt_list.glb"), "gt_list_khr")), 0.0);
 }
 
+// gltf-pipeline's meshopt assets (tests/data/gltf/gltf-pipeline, written by gltfpack 0.16):
+// meshopt-no-fallback's buffers[1] has neither a uri nor `"fallback": true` (both extensions make
+// the flag optional). Every view of it carries the extension, so it needs no bytes: bake, info
+// and gltf embed read it, and the bake is byte for byte that of the sibling meshopt-fallback,
+// whose fallback file holds the uncompressed views. Independent check: that sibling with the
+// compression extension removed from its views reads the fallback file's plain bytes, and gives
+// the same triangles as the decoded views. The assets have no lights: the lit copies add a
+// constant sky (extras.zhc), occluded by the two meshes, so the probes depend on the geometry.
+TEST(GltfInputs, MeshoptPlaceholderWithoutFallbackFlag) {
+    const std::string dir = test::fresh_dir("gltf_inputs_placeholder");
+    for (const std::string ext : {"EXT", "KHR"}) {
+        SCOPED_TRACE(ext);
+        const std::string name = ext + "_meshopt_compression";
+        const std::string src = data("gltf-pipeline/" + name + "/");
+        const std::string no_fb = src + "meshopt-no-fallback/meshopt-no-fallback.gltf";
+        const std::string fb = src + "meshopt-fallback/meshopt-fallback.gltf";
+        const json doc = json::parse(test::read_bytes(no_fb));
+        ASSERT_FALSE(doc["buffers"][1].contains("uri"));
+        ASSERT_FALSE(doc["buffers"][1].contains("extensions"));  // no "fallback" flag
+        const auto tris = triangles(scene_of(fb), 1e-9);
+        EXPECT_EQ(tris.size(), 60u);  // a box (36 indices) and a 26-vertex solid above it (144)
+        EXPECT_EQ(triangles(scene_of(no_fb), 1e-9), tris);
+        // The fallback file's plain bytes (views without the extension) are the same triangles.
+        const std::string plain_dir = dir + "/" + ext + "_plain";
+        fs::create_directories(plain_dir);
+        json plain = json::parse(test::read_bytes(fb));
+        for (json& v : plain["bufferViews"]) v.erase("extensions");
+        plain.erase("extensionsRequired");
+        const std::string plain_text = plain.dump();
+        test::write_bytes(plain_dir + "/plain.gltf", std::vector<std::uint8_t>(plain_text.begin(), plain_text.end()));
+        for (const char* f : {"meshopt-fallback.bin", "meshopt-fallback.fallback.bin"})
+            fs::copy_file(src + "meshopt-fallback/" + f, plain_dir + "/" + f, fs::copy_options::overwrite_existing);
+        EXPECT_EQ(triangles(scene_of(plain_dir + "/plain.gltf"), 1e-9), tris);
+        // Bake outputs byte for byte, as given (no lights) and lit by an occluded sky.
+        auto out_bytes = [&](const std::string& in, const std::string& out) {
+            const auto r = test::run_zhc({"bake", in, "-o", out, "--threads", "2", "--quiet"});
+            EXPECT_EQ(r.exit_code, 0) << in << ": " << r.err;
+            return test::read_bytes(out);
+        };
+        for (const char* o : {".zhp", ".json"})
+            EXPECT_EQ(out_bytes(no_fb, dir + "/" + ext + "_nofb" + o), out_bytes(fb, dir + "/" + ext + "_fb" + o)) << o;
+        std::vector<std::string> lit;
+        for (const std::string variant : {"meshopt-no-fallback", "meshopt-fallback"}) {
+            const std::string lit_dir = dir + "/" + ext + "_lit_" + variant;
+            fs::create_directories(lit_dir);
+            for (const auto& e : fs::directory_iterator(src + variant))
+                fs::copy_file(e.path(), lit_dir + "/" + e.path().filename().string(), fs::copy_options::overwrite_existing);
+            json j = json::parse(test::read_bytes(src + variant + "/" + variant + ".gltf"));
+            j["extras"]["zhc"] = {{"sky", {{"type", "constant"}, {"radiance", 1.0}}}};
+            const std::string text = j.dump();
+            lit.push_back(lit_dir + "/" + variant + ".gltf");
+            test::write_bytes(lit.back(), std::vector<std::uint8_t>(text.begin(), text.end()));
+        }
+        const auto lit_no_fb = bake(lit[0], ext + "_lit_nofb");
+        EXPECT_EQ(out_bytes(lit[0], dir + "/" + ext + "_lit_nofb.zhp"), out_bytes(lit[1], dir + "/" + ext + "_lit_fb.zhp"));
+        EXPECT_EQ(max_diff(lit_no_fb, bake(lit[1], ext + "_lit_fb")), 0.0);
+        // Occlusion shaped the probes: an open sky of radiance 1 has L00 = 2 sqrt(pi) everywhere.
+        double lo = INFINITY, hi = 0;
+        for (const Sh3Radiance& p : lit_no_fb) {
+            lo = std::min(lo, static_cast<double>(p.c[0].r));
+            hi = std::max(hi, static_cast<double>(p.c[0].r));
+        }
+        EXPECT_GT(hi, 0.5);
+        EXPECT_LT(lo, hi - 0.1);
+        // info reads it; gltf embed writes it into .gltf and .glb, the placeholder staying uri-less.
+        const auto info = test::run_zhc({"info", no_fb});
+        EXPECT_EQ(info.exit_code, 0) << info.err;
+        for (const char* o : {".gltf", ".glb"}) {
+            SCOPED_TRACE(o);
+            const std::string out = dir + "/" + ext + "_embedded" + o;
+            const auto r = test::run_zhc({"gltf", "embed", no_fb, dir + "/" + ext + "_nofb.zhp", "-o", out});
+            ASSERT_EQ(r.exit_code, 0) << r.err;
+            auto s = read_gltf_probes_file(out);
+            ASSERT_TRUE(s.ok()) << s.error().message;
+            EXPECT_EQ(s->volumes.size(), 1u);
+            EXPECT_EQ(triangles(scene_of(out), 1e-9), tris);
+        }
+    }
+    // A uri-less buffer that a plain view reads still needs its bytes: refused, naming it.
+    json bad = json::parse(test::read_bytes(data("gltf-pipeline/EXT_meshopt_compression/meshopt-no-fallback/meshopt-no-fallback.gltf")));
+    bad["bufferViews"][2].erase("extensions");
+    const std::string bad_dir = dir + "/plain_view";
+    fs::create_directories(bad_dir);
+    fs::copy_file(data("gltf-pipeline/EXT_meshopt_compression/meshopt-no-fallback/meshopt-no-fallback.bin"), bad_dir + "/meshopt-no-fallback.bin");
+    const std::string bad_text = bad.dump();
+    test::write_bytes(bad_dir + "/bad.gltf", std::vector<std::uint8_t>(bad_text.begin(), bad_text.end()));
+    expect_refused(bad_dir + "/bad.gltf", 4, "buffers[1]: no uri");
+}
+
 // Probes baked into a copy of a compressed asset: the fallback buffer stays uri-less, the copy
 // reads back (its own probes and, baked again, the same probes).
 TEST(GltfInputs, BakeIntoCompressedAssetsRoundTrips) {
@@ -363,6 +497,55 @@ TEST(GltfInputs, BakeIntoCompressedAssetsRoundTrips) {
             EXPECT_EQ(s->volumes[0].set.count, reference.size());
             EXPECT_EQ(max_diff(bake(out, std::string(name) + ext), reference), 0.0);
         }
+}
+
+// gltf embed onto an asset that already has a volume of the name it writes (zhc_probes): refused
+// (exit 2, naming the volume, nothing written) unless --replace, which replaces that volume in
+// place: still one volume, the same node referencing it, and extract returns the new probes.
+// A bake of an already baked asset replaces its volume the same way.
+TEST(GltfInputs, EmbedOntoAnExistingVolumeRefusedOrReplaced) {
+    const std::string dir = test::fresh_dir("gltf_inputs_replace");
+    ASSERT_EQ(test::run_zhc({"bake", data("gt_list.glb"), "-o", dir + "/lit.glb", "--quiet"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"bake", data("gt_list.glb"), "-o", dir + "/baked.zhp", "--quiet"}).exit_code, 0);
+    // A second probe set: the same grid as zh3_q16.
+    const auto conv = test::run_zhc({"convert", dir + "/baked.zhp", "-o", dir + "/other.zhp", "--to", "zh3_q16"});
+    ASSERT_EQ(conv.exit_code, 0) << conv.err;
+    const size_t nodes_before = gltf_node_count(dir + "/lit.glb");
+    for (const char* out : {"/twice.glb", "/twice.gltf"}) {
+        const auto r = test::run_zhc({"gltf", "embed", dir + "/lit.glb", dir + "/other.zhp", "-o", dir + out});
+        EXPECT_EQ(r.exit_code, 2) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_NE(r.err.find("volume named 'zhc_probes' (extensions.ZHC_light_probes.volumes[0])"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("--replace"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir + out));
+    }
+    auto other = read_probe_file(dir + "/other.zhp");
+    ASSERT_TRUE(other.ok());
+    for (const char* out : {"/replaced.glb", "/replaced.gltf"}) {
+        SCOPED_TRACE(out);
+        const auto r = test::run_zhc({"gltf", "embed", dir + "/lit.glb", dir + "/other.zhp", "-o", dir + out, "--replace"});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        auto s = read_gltf_probes_file(dir + out);
+        ASSERT_TRUE(s.ok()) << s.error().message;
+        ASSERT_EQ(s->volumes.size(), 1u);
+        EXPECT_EQ(s->volumes[0].name, "zhc_probes");
+        EXPECT_EQ(s->volumes[0].set.representation, "zh3_q16");
+        EXPECT_EQ(s->volumes[0].nodes.size(), 1u);
+        const auto x = test::run_zhc({"gltf", "extract", dir + out, "-o", dir + out + ".zhp"});
+        ASSERT_EQ(x.exit_code, 0) << x.err;
+        auto back = read_probe_file(dir + out + ".zhp");
+        ASSERT_TRUE(back.ok());
+        EXPECT_EQ(back->representation, "zh3_q16");
+        EXPECT_EQ(back->payload, other->payload);
+        // The node count of the asset did not grow (the existing node references the new volume).
+        EXPECT_EQ(gltf_node_count(dir + out), nodes_before);
+    }
+    // Re-baking a baked asset: one volume, the bake's.
+    ASSERT_EQ(test::run_zhc({"bake", dir + "/lit.glb", "-o", dir + "/relit.glb", "--quiet"}).exit_code, 0);
+    auto relit = read_gltf_probes_file(dir + "/relit.glb");
+    ASSERT_TRUE(relit.ok()) << relit.error().message;
+    EXPECT_EQ(relit->volumes.size(), 1u);
+    EXPECT_EQ(max_diff(bake(dir + "/relit.glb", "relit"), bake(data("gt_list.glb"), "relit_reference")), 0.0);
 }
 
 // zhc bake IN.gltf -o OTHER/out.gltf|.glb: the output's image references resolve from its folder.

@@ -4,15 +4,16 @@
 // share: gltf_probes_internal.h.
 //
 // tinygltf (Debian libtinygltf-dev, implementation in the shared library) parses and writes the
-// asset; everything untrusted is checked by us first: the GLB framing, every URI (no absolute
-// paths, schemes, `..` or backslashes, also percent-encoded), declared buffer sizes and data-URI
-// lengths (before tinygltf allocates), and file reads go through FsCallbacks that refuse paths
-// outside the input's directory. External buffers resolve in the input's directory only (a
-// missing one is kIoError naming it; tinygltf's extra search of the working directory always
-// finds nothing). Images are never read nor decoded: they are removed from the JSON tinygltf
-// sees (their URIs are still checked). glTF 2.x only (asset.version / minVersion). Uri-less
-// meshopt fallback buffers load no bytes (formats/scene/scene_gltf_geometry.cpp decodes the compressed views). The extension itself is read from our own nlohmann parse of the same JSON, so every
-// index it holds is bound-checked against the arrays tinygltf loaded.
+// asset; everything untrusted is checked by us first (gltf_probes_check.cpp: the GLB framing,
+// every buffer URI, declared buffer sizes and data-URI lengths before tinygltf allocates), and
+// file reads go through FsCallbacks that refuse paths outside the input's directory. External
+// buffers resolve in the input's directory only (a missing one is kIoError naming it; tinygltf's
+// extra search of the working directory always finds nothing). Images are never read nor decoded
+// here: they are removed from the JSON tinygltf sees, and their URIs are checked only where an
+// image is read or embedded (gltf_probes_write.cpp). Uri-less meshopt placeholder buffers load no
+// bytes (formats/scene/scene_gltf_geometry.cpp decodes the compressed views). The extension
+// itself is read from our own nlohmann parse of the same JSON, so every index it holds is
+// bound-checked against the arrays tinygltf loaded.
 #include "formats/probes/gltf_probes_internal.h"
 
 #include <algorithm>
@@ -31,302 +32,11 @@ namespace gltf_detail {
 
 using le::put32;
 
-constexpr std::uint32_t kGlbMagic = 0x46546C67;     // "glTF"
-constexpr std::uint32_t kChunkJson = 0x4E4F534A;    // "JSON"
-constexpr std::uint32_t kChunkBin = 0x004E4942;     // "BIN\0"
-
 Error fail(ErrorCode code, const std::string& path, const std::string& what) {
     return make_error(code, path + ": " + what);
 }
 
 namespace {
-
-// ---- untrusted input: framing, URIs, sizes -------------------------------------------------
-
-struct GlbParts {
-    std::string json_text;
-    bool has_bin = false;
-    std::uint64_t bin_offset = 0;
-    std::uint64_t bin_bytes = 0;
-};
-
-Result<GlbParts> split_glb(std::span<const std::uint8_t> b, const std::string& path) {
-    if (b.size() < 20) return fail(ErrorCode::kTruncated, path, "GLB shorter than its 12-byte header and first chunk header");
-    if (le32(b.data()) != kGlbMagic) return fail(ErrorCode::kBadFormat, path, "not a GLB (bad magic)");
-    if (le32(b.data() + 4) != 2) return fail(ErrorCode::kUnsupported, path, "GLB version " + std::to_string(le32(b.data() + 4)) + " (only 2)");
-    const std::uint64_t total = le32(b.data() + 8);
-    if (total > b.size()) return fail(ErrorCode::kTruncated, path, "GLB header declares " + std::to_string(total) + " bytes, file has " + std::to_string(b.size()));
-    if (total < b.size()) return fail(ErrorCode::kTrailingBytes, path, "bytes after the GLB's declared length " + std::to_string(total));
-    const std::uint64_t json_len = le32(b.data() + 12);
-    if (le32(b.data() + 16) != kChunkJson) return fail(ErrorCode::kBadFormat, path, "first GLB chunk is not JSON");
-    if (20 + json_len > total) return fail(ErrorCode::kTruncated, path, "GLB JSON chunk (" + std::to_string(json_len) + " bytes) runs past the end");
-    GlbParts parts;
-    parts.json_text.assign(reinterpret_cast<const char*>(b.data() + 20), static_cast<size_t>(json_len));
-    std::uint64_t at = 20 + json_len;
-    if (at + 8 <= total) {
-        const std::uint64_t bin_len = le32(b.data() + at);
-        if (le32(b.data() + at + 4) == kChunkBin) {
-            if (at + 8 + bin_len > total) return fail(ErrorCode::kTruncated, path, "GLB BIN chunk (" + std::to_string(bin_len) + " bytes) runs past the end");
-            parts.has_bin = true;
-            parts.bin_offset = at + 8;
-            parts.bin_bytes = bin_len;
-        }
-    } else if (at != total) {
-        return fail(ErrorCode::kBadFormat, path, "GLB: partial chunk header after the JSON chunk");
-    }
-    return parts;
-}
-
-// A buffer marked as the fallback of EXT_meshopt_compression / KHR_meshopt_compression.
-bool is_meshopt_fallback(const json& buffer) {
-    if (!buffer.is_object() || !buffer.contains("extensions") || !buffer["extensions"].is_object()) return false;
-    for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
-        const json& e = buffer["extensions"].contains(name) ? buffer["extensions"][name] : json();
-        if (e.is_object() && e.contains("fallback") && e["fallback"].is_boolean() && e["fallback"].get<bool>()) return true;
-    }
-    return false;
-}
-
-int hex_value(char c) {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
-}
-
-// "" when the URI is an acceptable relative reference inside the input's directory (or a data
-// URI), else why not. Percent escapes are decoded first (tinygltf decodes them too).
-std::string uri_problem(const std::string& uri) {
-    if (uri.rfind("data:", 0) == 0) return "";
-    std::string d;
-    for (size_t i = 0; i < uri.size(); ++i) {
-        if (uri[i] == '%') {
-            if (i + 2 >= uri.size()) return "truncated percent escape";
-            const int h = hex_value(uri[i + 1]), l = hex_value(uri[i + 2]);
-            if (h < 0 || l < 0) return "bad percent escape";
-            d.push_back(static_cast<char>(h * 16 + l));
-            i += 2;
-        } else {
-            d.push_back(uri[i]);
-        }
-    }
-    if (d.empty()) return "empty URI";
-    if (d.find('\0') != std::string::npos) return "NUL in URI";
-    if (d.find('\\') != std::string::npos) return "backslash in URI";
-    if (d.find(':') != std::string::npos) return "absolute URI or scheme (only relative paths and data: URIs)";
-    if (d[0] == '/') return "absolute path";
-    size_t start = 0;
-    while (start <= d.size()) {
-        const size_t end = std::min(d.find('/', start), d.size());
-        if (d.compare(start, end - start, "..") == 0) return "'..' escapes the input's directory";
-        start = end + 1;
-    }
-    return "";
-}
-
-}  // namespace
-
-// The path a relative URI names (percent escapes decoded; call after uri_problem accepted it).
-std::string uri_path(const std::string& uri) {
-    std::string d;
-    for (size_t i = 0; i < uri.size(); ++i) {
-        if (uri[i] == '%' && i + 2 < uri.size() && hex_value(uri[i + 1]) >= 0 && hex_value(uri[i + 2]) >= 0) {
-            d.push_back(static_cast<char>(hex_value(uri[i + 1]) * 16 + hex_value(uri[i + 2])));
-            i += 2;
-        } else {
-            d.push_back(uri[i]);
-        }
-    }
-    return d;
-}
-
-namespace {
-
-Result<std::uint64_t> json_size(const json& j, const char* key, const std::string& path, const std::string& where) {
-    if (!j.contains(key)) return fail(ErrorCode::kBadFormat, path, where + ": missing " + key);
-    const json& v = j[key];
-    if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<std::int64_t>() >= 0))
-        return fail(ErrorCode::kBadFormat, path, where + ": " + key + " is not a non-negative integer");
-    return v.get<std::uint64_t>();
-}
-
-// glTF 2.x only (asset.version "2.<minor>"; asset.minVersion, when given, at most "2.0").
-Status check_version(const json& asset, const std::string& path) {
-    auto parse = [](const json& v, int* major, int* minor) {
-        if (!v.is_string()) return false;
-        const std::string s = v.get<std::string>();
-        const size_t dot = s.find('.');
-        if (dot == std::string::npos || dot == 0 || dot + 1 == s.size() || dot > 4 || s.size() - dot - 1 > 4) return false;
-        for (size_t i = 0; i < s.size(); ++i)
-            if (i != dot && (s[i] < '0' || s[i] > '9')) return false;
-        *major = std::stoi(s.substr(0, dot));
-        *minor = std::stoi(s.substr(dot + 1));
-        return true;
-    };
-    int major = 0, minor = 0;
-    if (!asset.contains("version")) return fail(ErrorCode::kBadFormat, path, "asset.version missing (asset.version)");
-    if (!parse(asset["version"], &major, &minor))
-        return fail(ErrorCode::kBadFormat, path, "asset.version is not \"<major>.<minor>\" (asset.version)");
-    if (major != 2)
-        return fail(ErrorCode::kUnsupported, path, "glTF version " + asset["version"].get<std::string>() + " (zhc reads glTF 2.x) (asset.version)");
-    if (asset.contains("minVersion")) {
-        int min_major = 0, min_minor = 0;
-        if (!parse(asset["minVersion"], &min_major, &min_minor))
-            return fail(ErrorCode::kBadFormat, path, "asset.minVersion is not \"<major>.<minor>\" (asset.minVersion)");
-        if (min_major != 2 || min_minor > 0)
-            return fail(ErrorCode::kUnsupported, path, "the asset needs a glTF " + asset["minVersion"].get<std::string>() +
-                                                           " reader (zhc reads 2.0) (asset.minVersion)");
-    }
-    return Ok{};
-}
-
-// Checks every declared size and URI before tinygltf allocates anything.
-Status precheck(const json& doc, const std::string& path, const GltfLimits& limits, const GlbParts* glb) {
-    if (!doc.is_object()) return fail(ErrorCode::kBadFormat, path, "glTF JSON is not an object");
-    if (!doc.contains("asset") || !doc["asset"].is_object())
-        return fail(ErrorCode::kBadFormat, path, "not a glTF asset (no \"asset\" object)");
-    if (Status v = check_version(doc["asset"], path); !v) return v;
-    std::uint64_t total = 0;
-    if (doc.contains("buffers")) {
-        const json& bufs = doc["buffers"];
-        if (!bufs.is_array()) return fail(ErrorCode::kBadFormat, path, "\"buffers\" is not an array");
-        for (size_t i = 0; i < bufs.size(); ++i) {
-            const std::string where = "buffers[" + std::to_string(i) + "]";
-            if (!bufs[i].is_object()) return fail(ErrorCode::kBadFormat, path, where + " is not an object");
-            auto len = json_size(bufs[i], "byteLength", path, where);
-            if (!len) return len.error();
-            if (*len > limits.max_buffer_bytes)
-                return fail(ErrorCode::kTooLarge, path, where + ": byteLength " + std::to_string(*len) + " above the limit " + std::to_string(limits.max_buffer_bytes));
-            total += *len;
-            if (total > limits.max_total_bytes)
-                return fail(ErrorCode::kTooLarge, path, "buffers total above the limit " + std::to_string(limits.max_total_bytes));
-            if (bufs[i].contains("uri")) {
-                if (!bufs[i]["uri"].is_string()) return fail(ErrorCode::kBadFormat, path, where + ": uri is not a string");
-                const std::string uri = bufs[i]["uri"].get<std::string>();
-                const std::string why = uri_problem(uri);
-                if (!why.empty()) return fail(ErrorCode::kBadFormat, path, where + ": uri rejected: " + why);
-                if (uri.rfind("data:", 0) == 0 && uri.size() > limits.max_buffer_bytes / 3 * 4 + 256)
-                    return fail(ErrorCode::kTooLarge, path, where + ": data URI above the size limit");
-                if (uri.rfind("data:", 0) == 0) {
-                    // Named here rather than by tinygltf's "Failed to decode 'uri'".
-                    const size_t comma = uri.find(',');
-                    if (comma == std::string::npos || comma < 12 || uri.compare(comma - 7, 7, ";base64") != 0)
-                        return fail(ErrorCode::kBadFormat, path, where + ".uri: a data: URI that is not base64 (';base64,' is what glTF buffers use)");
-                    const size_t n = uri.size() - comma - 1;
-                    for (size_t k = comma + 1; k < uri.size(); ++k) {
-                        const char c = uri[k];
-                        const bool pad = c == '=' && k + 2 >= uri.size() && (k + 1 == uri.size() || uri[k + 1] == '=');
-                        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '/' || pad))
-                            return fail(ErrorCode::kBadFormat, path, where + ".uri: the data: URI's base64 has a character that is not base64 at offset " +
-                                                                     std::to_string(k - comma - 1) + " of its data");
-                    }
-                    if (n % 4 != 0)
-                        return fail(ErrorCode::kBadFormat, path, where + ".uri: the data: URI's base64 is " + std::to_string(n) +
-                                                                 " characters, not a multiple of 4");
-                }
-            } else if (is_meshopt_fallback(bufs[i]) && !(i == 0 && glb && glb->has_bin)) {
-                // EXT/KHR_meshopt_compression: a fallback buffer needs no bytes (every view of it
-                // is decoded from a compressed buffer); nothing is loaded for it.
-            } else if (i == 0 && glb) {
-                if (!glb->has_bin) return fail(ErrorCode::kBadFormat, path, where + ": no uri and the GLB has no BIN chunk");
-                if (*len > glb->bin_bytes) return fail(ErrorCode::kTruncated, path, where + ": byteLength " + std::to_string(*len) + " larger than the BIN chunk (" + std::to_string(glb->bin_bytes) + ")");
-            } else {
-                return fail(ErrorCode::kBadFormat, path, where + ": no uri");
-            }
-        }
-    }
-    if (doc.contains("images")) {
-        const json& imgs = doc["images"];
-        if (!imgs.is_array()) return fail(ErrorCode::kBadFormat, path, "\"images\" is not an array");
-        for (size_t i = 0; i < imgs.size(); ++i) {
-            if (!imgs[i].is_object() || !imgs[i].contains("uri")) continue;
-            const std::string where = "images[" + std::to_string(i) + "]";
-            if (!imgs[i]["uri"].is_string()) return fail(ErrorCode::kBadFormat, path, where + ": uri is not a string");
-            const std::string why = uri_problem(imgs[i]["uri"].get<std::string>());
-            if (!why.empty()) return fail(ErrorCode::kBadFormat, path, where + ": uri rejected: " + why);
-        }
-    }
-    return Ok{};
-}
-
-// The glTF 2.0 schema's required properties (and KHR_lights_punctual's, with its spot light's
-// "spot" object), checked before tinygltf so that a missing one is named by its glTF path
-// ("accessors[2].componentType") rather than by tinygltf's text ("'componentType' property is
-// missing in Accessor."). Only objects are looked into: a wrong type is reported by the readers
-// (or by tinygltf).
-Status check_required(const json& doc, const std::string& path) {
-    struct Need {
-        const char* array;                 // top-level array (or extensions.KHR_lights_punctual.lights)
-        const char* child;                 // "" or a member array/object of each element
-        std::vector<const char*> required;
-    };
-    auto missing = [&](const std::string& where, const char* prop) {
-        return fail(ErrorCode::kBadFormat, path, where + "." + prop + ": required property is missing");
-    };
-    auto check_object = [&](const json& o, const std::string& where, const std::vector<const char*>& props) -> Status {
-        if (!o.is_object()) return Ok{};
-        for (const char* p : props)
-            if (!o.contains(p)) return missing(where, p);
-        return Ok{};
-    };
-    auto each = [&](const json& parent, const char* key, const std::string& where,
-                    const std::function<Status(const json&, const std::string&)>& f) -> Status {
-        if (!parent.is_object() || !parent.contains(key) || !parent[key].is_array()) return Ok{};
-        const json& a = parent[key];
-        for (size_t i = 0; i < a.size(); ++i)
-            if (Status s = f(a[i], where + (where.empty() ? "" : ".") + key + "[" + std::to_string(i) + "]"); !s) return s;
-        return Ok{};
-    };
-    auto member = [&](const json& o, const char* key, const std::string& where, const std::vector<const char*>& props) -> Status {
-        if (!o.is_object() || !o.contains(key)) return Ok{};
-        return check_object(o[key], where + "." + key, props);
-    };
-    Status s = each(doc, "accessors", "", [&](const json& a, const std::string& w) -> Status {
-        if (Status t = check_object(a, w, {"componentType", "count", "type"}); !t) return t;
-        if (Status t = member(a, "sparse", w, {"count", "indices", "values"}); !t) return t;
-        if (a.is_object() && a.contains("sparse") && a["sparse"].is_object()) {
-            if (Status t = member(a["sparse"], "indices", w + ".sparse", {"bufferView", "componentType"}); !t) return t;
-            if (Status t = member(a["sparse"], "values", w + ".sparse", {"bufferView"}); !t) return t;
-        }
-        return Ok{};
-    });
-    if (!s) return s;
-    s = each(doc, "animations", "", [&](const json& a, const std::string& w) -> Status {
-        if (Status t = check_object(a, w, {"channels", "samplers"}); !t) return t;
-        if (Status t = each(a, "channels", w, [&](const json& c, const std::string& cw) -> Status {
-                if (Status u = check_object(c, cw, {"sampler", "target"}); !u) return u;
-                return member(c, "target", cw, {"path"});
-            });
-            !t)
-            return t;
-        return each(a, "samplers", w, [&](const json& c, const std::string& cw) { return check_object(c, cw, {"input", "output"}); });
-    });
-    if (!s) return s;
-    s = each(doc, "bufferViews", "", [&](const json& b, const std::string& w) { return check_object(b, w, {"buffer", "byteLength"}); });
-    if (!s) return s;
-    s = each(doc, "cameras", "", [&](const json& c, const std::string& w) -> Status {
-        if (Status t = check_object(c, w, {"type"}); !t) return t;
-        if (Status t = member(c, "perspective", w, {"yfov", "znear"}); !t) return t;
-        return member(c, "orthographic", w, {"xmag", "ymag", "zfar", "znear"});
-    });
-    if (!s) return s;
-    s = each(doc, "meshes", "", [&](const json& m, const std::string& w) -> Status {
-        if (Status t = check_object(m, w, {"primitives"}); !t) return t;
-        return each(m, "primitives", w, [&](const json& p, const std::string& pw) { return check_object(p, pw, {"attributes"}); });
-    });
-    if (!s) return s;
-    s = each(doc, "skins", "", [&](const json& k, const std::string& w) { return check_object(k, w, {"joints"}); });
-    if (!s) return s;
-    if (doc.contains("extensions") && doc["extensions"].is_object() && doc["extensions"].contains("KHR_lights_punctual"))
-        s = each(doc["extensions"]["KHR_lights_punctual"], "lights", "extensions.KHR_lights_punctual",
-                 [&](const json& l, const std::string& w) -> Status {
-                     if (Status t = check_object(l, w, {"type"}); !t) return t;
-                     if (l.is_object() && l["type"] == "spot" && !l.contains("spot"))
-                         return fail(ErrorCode::kBadFormat, path, w + ".spot: required for a spot light, missing");
-                     return Ok{};
-                 });
-    return s;
-}
 
 // File access for tinygltf: only regular files inside `base`, at most `max_bytes` each.
 struct FsGuard {
@@ -581,16 +291,16 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     // such accessors a placeholder bufferView (appended last, so no index of the asset moves)
     // for tinygltf's eyes only; the model is used for buffer bytes, never written back.
     // Two more changes for tinygltf's eyes only: images are dropped (never decoded nor needed;
-    // their URIs were checked above, and a data: URI of any MIME type is data, not a path), and a
-    // uri-less meshopt fallback buffer gets a 4-byte stand-in (its bytes are never read: every
-    // view of it is decoded from the compressed buffer, formats/scene/scene_gltf_geometry.cpp).
+    // a data: URI of any MIME type is data, not a path), and a uri-less meshopt placeholder
+    // buffer gets a 4-byte stand-in (its bytes are never read: every view of it is decoded from
+    // the compressed buffer, formats/scene/scene_gltf_geometry.cpp).
     std::vector<std::uint8_t> patched_glb;
     std::string patched_text;
-    std::vector<size_t> fallback_buffers;
+    std::vector<size_t> placeholder_buffers;
     if (out.doc.contains("buffers"))
         for (size_t i = 0; i < out.doc["buffers"].size(); ++i)
-            if (!out.doc["buffers"][i].contains("uri") && is_meshopt_fallback(out.doc["buffers"][i]) && !(i == 0 && out.binary && glb.has_bin))
-                fallback_buffers.push_back(i);
+            if (!out.doc["buffers"][i].contains("uri") && is_meshopt_placeholder(out.doc, i) && !(i == 0 && out.binary && glb.has_bin))
+                placeholder_buffers.push_back(i);
     // A base64 data: URI holding more bytes than its buffer's byteLength is valid glTF (as a
     // longer .bin file is): tinygltf is shown the decoded length and the buffer is cut back to
     // byteLength after loading. One holding fewer is refused here, naming the buffer.
@@ -612,10 +322,10 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
             if (decoded > declared) long_data_uris.push_back({i, declared});
         }
     const bool draco_patch = needs_draco_index_patch(out.doc);
-    if (draco_patch || out.doc.contains("images") || !fallback_buffers.empty() || !long_data_uris.empty()) {
+    if (draco_patch || out.doc.contains("images") || !placeholder_buffers.empty() || !long_data_uris.empty()) {
         json patched = out.doc;
         patched.erase("images");
-        for (size_t i : fallback_buffers) patched["buffers"][i] = json{{"byteLength", 4}, {"uri", "data:application/octet-stream;base64,AAAAAA=="}};
+        for (size_t i : placeholder_buffers) patched["buffers"][i] = json{{"byteLength", 4}, {"uri", "data:application/octet-stream;base64,AAAAAA=="}};
         for (const auto& [i, declared] : long_data_uris) {
             const std::string& uri = patched["buffers"][i]["uri"].get_ref<const std::string&>();
             const std::uint64_t chars = uri.size() - uri.find(',') - 1;
@@ -665,11 +375,11 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
         if (first.empty()) first = "tinygltf could not load the asset";
         return fail(ErrorCode::kBadFormat, path, first);
     }
-    for (size_t i : fallback_buffers)
+    for (size_t i : placeholder_buffers)
         if (i < out.model.buffers.size()) out.model.buffers[i].data.clear();
     for (const auto& [i, declared] : long_data_uris)
         if (i < out.model.buffers.size() && out.model.buffers[i].data.size() > declared) out.model.buffers[i].data.resize(static_cast<size_t>(declared));
-    out.fallback_buffers = fallback_buffers;
+    out.placeholder_buffers = placeholder_buffers;
     return out;
 }
 

@@ -46,6 +46,11 @@ struct GltfEmbedOptions {
     GltfShAxes sh_axes = GltfShAxes::kZhc;
     bool add_node = true;                // add a node referencing the volume to every scene
     std::string name = "zhc_probes";     // volume (and node) name
+    // A volume of the same name already in the asset: false refuses the embedding
+    // (kInvalidArgument naming the volume); true replaces it in place (same index, the nodes that
+    // referenced it reference the new one, no node added). The replaced volume's accessors and
+    // bytes stay in the asset, unreferenced.
+    bool replace = false;
     bool draco = false;                  // Draco point cloud (points layout, float sh3/sh2 only)
     int draco_bits = 0;                  // Draco quantisation bits, 0 = lossless
     // Where the output will be written. Images the input references by a relative URI keep it

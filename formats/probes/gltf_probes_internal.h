@@ -1,7 +1,8 @@
 // zhc/formats/probes/gltf_probes_internal.h — internal to formats/: what the three files of the
 // ZHC_light_probes implementation (docs/gltf-extension.md, glTF 2.0) share: the guarded tinygltf
 // load of an untrusted asset, GLB / data-URI writing, and the zhc <-> glTF frames.
-//   gltf_probes.cpp        untrusted input (GLB framing, URIs, sizes, file access), tinygltf load, frames
+//   gltf_probes.cpp        file access confined to the input's folder, the tinygltf load, GLB writing, frames
+//   gltf_probes_check.cpp  untrusted input checked before tinygltf: GLB framing, version, sizes, URIs
 //   gltf_probes_read.cpp   reading and validating the extension (volumes, accessors, Draco payloads)
 //   gltf_probes_write.cpp  embedding a probe set into an asset (buffers, accessors, images, GLB)
 #pragma once
@@ -32,8 +33,37 @@ inline constexpr auto le32 = le::load32;
 inline constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
 inline constexpr int kUbyte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
 
+inline constexpr std::uint32_t kGlbMagic = 0x46546C67;   // "glTF"
+inline constexpr std::uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
+inline constexpr std::uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
+
 // "<path>: <what>" as an error of `code`.
 Error fail(ErrorCode code, const std::string& path, const std::string& what);
+
+// ---- untrusted input, checked before tinygltf sees it (gltf_probes_check.cpp) ----
+
+// A GLB split into its JSON text and the place of its BIN chunk.
+struct GlbParts {
+    std::string json_text;
+    bool has_bin = false;
+    std::uint64_t bin_offset = 0;
+    std::uint64_t bin_bytes = 0;
+};
+// The GLB framing: header, length, JSON chunk, optional BIN chunk (nothing after the declared length).
+Result<GlbParts> split_glb(std::span<const std::uint8_t> b, const std::string& path);
+// "" when the URI is an acceptable relative reference inside the input's directory (or a data
+// URI), else why not (percent escapes decoded first).
+std::string uri_problem(const std::string& uri);
+// Whether buffers[buffer] needs no bytes under EXT_/KHR_meshopt_compression: marked
+// `"fallback": true`, or referenced by at least one bufferView and only by views that carry the
+// extension (each decoded from its compressed source, never from this buffer) and never the
+// source of a compressed view.
+bool is_meshopt_placeholder(const json& doc, size_t buffer);
+// Every declared size and buffer URI, glTF 2.x only (asset.version / minVersion), before
+// tinygltf allocates anything; `glb` is null for a .gltf file.
+Status precheck(const json& doc, const std::string& path, const GltfLimits& limits, const GlbParts* glb);
+// The glTF 2.0 schema's required properties (and KHR_lights_punctual's), named by glTF path.
+Status check_required(const json& doc, const std::string& path);
 
 // The path a relative URI names (percent escapes decoded; call after the URI was accepted).
 std::string uri_path(const std::string& uri);
@@ -55,7 +85,7 @@ struct Loaded {
     json doc;
     tinygltf::Model model;
     bool binary = false;
-    std::vector<size_t> fallback_buffers;  // uri-less meshopt fallback buffers (no bytes loaded)
+    std::vector<size_t> placeholder_buffers;  // uri-less meshopt placeholder buffers (no bytes loaded)
 };
 
 // Checks the framing, every URI and declared size, then loads the asset with tinygltf reading

@@ -2,13 +2,14 @@
 // ZHC_light_probes extension (docs/gltf-extension.md): the input's own JSON kept (order and values),
 // the probe data appended to the GLB binary buffer or a new data-URI buffer, accessors or a Draco
 // point cloud (gltf_draco.cpp), images the output could no longer reach relocated or embedded, and
-// the volume, extensionsUsed and a node added.
+// the volume, extensionsUsed and a node added (or a volume of the same name replaced in place).
 #include "formats/probes/gltf_probes_internal.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include "formats/io/file_io.h"
 #include "formats/probes/gltf_draco.h"
@@ -104,6 +105,8 @@ Status relocate_images(json& doc, const std::string& scene_path, const GltfEmbed
         const std::string uri = image["uri"].get<std::string>();
         if (uri.rfind("data:", 0) == 0) continue;
         const std::string where = "images[" + std::to_string(i) + "].uri";
+        if (const std::string why = uri_problem(uri); !why.empty())
+            return fail(ErrorCode::kBadFormat, scene_path, "image '" + uri + "' cannot be carried to the output's folder: " + why + " (" + where + ")");
         const fs::path file = fs::weakly_canonical(in_base / uri_path(uri), ec);
         if (ec || !inside(in_base, file)) return fail(ErrorCode::kBadFormat, scene_path, "image '" + uri + "' resolves outside the input's directory (" + where + ")");
         if (!fs::is_regular_file(file, ec))
@@ -173,6 +176,19 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
     auto loaded = load(scene_bytes, scene_path, limits);
     if (!loaded) return loaded.error();
     if (Status fields = check_embed_fields(loaded->doc, scene_path); !fields) return fields.error();
+    // A volume of the same name already in the asset: refused, or replaced in place (options.replace).
+    std::optional<std::size_t> replaced;
+    if (loaded->doc.contains("extensions") && loaded->doc["extensions"].contains(kGltfProbeExtension) &&
+        loaded->doc["extensions"][kGltfProbeExtension].contains("volumes")) {
+        const json& volumes = loaded->doc["extensions"][kGltfProbeExtension]["volumes"];  // checked: an array
+        for (std::size_t i = 0; i < volumes.size() && !replaced; ++i)
+            if (volumes[i].is_object() && volumes[i].contains("name") && volumes[i]["name"] == options.name) replaced = i;
+        if (replaced && !options.replace)
+            return make_error(ErrorCode::kInvalidArgument, scene_path + ": already has a " + kGltfProbeExtension + " volume named '" +
+                                                               options.name + "' (extensions." + kGltfProbeExtension + ".volumes[" +
+                                                               std::to_string(*replaced) + "]): refusing to add a second one of that name "
+                                                               "(zhc gltf embed --replace replaces it)");
+    }
     // The output is the input's own JSON (order and values kept by ordered_json) with our
     // additions; tinygltf's model only supplies the bytes of each buffer.
     json doc = loaded->doc;
@@ -246,12 +262,12 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
         target_index = buffers.size();
         buffers.push_back(json{{"name", options.name}});
     }
-    const auto& fallback = loaded->fallback_buffers;
-    if (options.binary && !fallback.empty() && fallback[0] == 0)
-        return fail(ErrorCode::kUnsupported, scene_path, "buffer 0 is a meshopt fallback buffer without bytes: embed into a .gltf output (buffers[0])");
+    const auto& placeholders = loaded->placeholder_buffers;
+    if (options.binary && !placeholders.empty() && placeholders[0] == 0)
+        return fail(ErrorCode::kUnsupported, scene_path, "buffer 0 is a meshopt placeholder buffer without bytes: embed into a .gltf output (buffers[0])");
     for (std::size_t i = 0; i < m.buffers.size(); ++i) {
         if (options.binary && i == 0) continue;
-        if (std::find(fallback.begin(), fallback.end(), i) != fallback.end()) continue;  // stays uri-less
+        if (std::find(placeholders.begin(), placeholders.end(), i) != placeholders.end()) continue;  // stays uri-less
         json& b = buffers[i];
         const bool data = b.contains("uri") && b["uri"].get<std::string>().rfind("data:", 0) == 0;
         if (!data) b["uri"] = data_uri(m.buffers[i].data);
@@ -316,17 +332,19 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
     if (options.binary) tb.erase("uri");
     else tb["uri"] = data_uri(target);
 
-    // The extension object (volumes appended to any existing ones), extensionsUsed, the node.
+    // The extension object (the volume appended to any existing ones, or replacing the one of its
+    // name), extensionsUsed, the node.
     if (!doc.contains("extensions")) doc["extensions"] = json::object();
     json& ext = doc["extensions"][kGltfProbeExtension];  // checked: absent (null) or an object
     if (ext.is_null()) ext = json::object();
     if (!ext.contains("volumes")) ext["volumes"] = json::array();
-    const std::size_t volume_index = ext["volumes"].size();
-    ext["volumes"].push_back(vol);
+    const std::size_t volume_index = replaced ? *replaced : ext["volumes"].size();
+    if (replaced) ext["volumes"][volume_index] = vol;  // the nodes that referenced the old volume reference this one
+    else ext["volumes"].push_back(vol);
     if (!doc.contains("extensionsUsed")) doc["extensionsUsed"] = json::array();
     json& used = doc["extensionsUsed"];
     if (std::find(used.begin(), used.end(), json(kGltfProbeExtension)) == used.end()) used.push_back(kGltfProbeExtension);
-    if (options.add_node) {
+    if (options.add_node && !replaced) {
         if (!doc.contains("nodes")) doc["nodes"] = json::array();
         doc["nodes"].push_back(json{{"name", options.name}, {"extensions", {{kGltfProbeExtension, {{"volume", volume_index}}}}}});
         const std::size_t node = doc["nodes"].size() - 1;
