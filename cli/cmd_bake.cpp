@@ -28,8 +28,27 @@ struct Options {
     int zstd = 0;
     int sky_samples = -1;        // -1: the scene's occlusion.sky_samples
     double invalid_fraction = -1;  // < 0: the scene's occlusion.invalid_fraction
+    int bounces = -1;              // -1: the scene's transport.bounces
+    double max_noise = -1;         // < 0: the scene's transport.max_noise
+    std::string rays;              // "MIN[:MAX]": the scene's transport.min_rays/max_rays
     ProgressFlags progress;  // --quiet also drops the effects report
 };
+
+// "MIN" or "MIN:MAX", decimal, 1 <= MIN <= MAX <= 2^20.
+bool parse_ray_range(const std::string& text, int* lo, int* hi) {
+    auto number = [](const std::string& t, int* v) {
+        if (t.empty() || t.size() > 7 || t.find_first_not_of("0123456789") != std::string::npos) return false;
+        *v = std::stoi(t);
+        return *v >= 1 && *v <= (1 << 20);
+    };
+    const size_t colon = text.find(':');
+    if (colon == std::string::npos) {
+        if (!number(text, lo)) return false;
+        *hi = std::max(*lo, SceneTransport{}.max_rays);
+        return true;
+    }
+    return number(text.substr(0, colon), lo) && number(text.substr(colon + 1), hi) && *lo <= *hi;
+}
 
 void print_report(const BakeReport& r) {
     std::printf("simulated effects (%llu probes; times are CPU time summed over threads):\n",
@@ -43,6 +62,20 @@ void print_report(const BakeReport& r) {
     if (r.mask_probes > 0)
         std::printf("  visibility masks: %llu rays (%.1f rays/probe) %.3f ms\n", static_cast<unsigned long long>(r.mask_rays),
                     double(r.mask_rays) / double(r.mask_probes), r.mask_ms);
+    if (r.transport.traced) {
+        const TransportReport& t = r.transport;
+        std::printf("  reflected light: %llu probes, %llu paths (%.0f per probe), %llu rays, %.2f bounces per path (deepest %d of at most %d)\n",
+                    static_cast<unsigned long long>(t.probes), static_cast<unsigned long long>(t.paths),
+                    t.probes ? double(t.paths) / double(t.probes) : 0.0, static_cast<unsigned long long>(t.rays),
+                    t.paths ? double(t.vertices) / double(t.paths) : 0.0, t.max_depth, t.max_bounces);
+        std::printf("  reflected light: noise (relative standard error of a probe's irradiance) median %.2f %%, max %.2f %%%s; energy left by the bounce limit <= %.1e\n",
+                    100 * t.noise_median, 100 * t.noise_max,
+                    t.probes_over_noise ? (" (" + std::to_string(t.probes_over_noise) + " probes stopped at the ray limit above the target)").c_str() : "",
+                    t.energy_left);
+        if (t.milliseconds > 0 && t.rays > 0)
+            std::printf("  reflected light: %.3f ms per probe, %.1f ms per million rays\n", t.milliseconds / double(std::max<std::uint64_t>(t.probes, 1)),
+                        t.milliseconds / (double(t.rays) * 1e-6));
+    }
     if (r.rays > 0)
         std::printf("  occluder BVH built in %.3f ms; %llu rays in total\n", r.occluder_build_ms,
                     static_cast<unsigned long long>(r.rays));
@@ -81,6 +114,17 @@ int run(const Options& o) {
     for (const std::string& n : notes) std::fprintf(stderr, "zhc: note: %s: %s\n", o.scene.c_str(), n.c_str());
     if (o.sky_samples >= 0) scene->occlusion.sky_samples = o.sky_samples;
     if (o.invalid_fraction >= 0) scene->occlusion.invalid_fraction = o.invalid_fraction;
+    if (o.bounces >= 0) scene->transport.max_bounces = o.bounces;
+    if (o.max_noise > 0) scene->transport.max_noise = o.max_noise;
+    if (!o.rays.empty()) {
+        int lo = 0, hi = 0;
+        if (!parse_ray_range(o.rays, &lo, &hi)) {
+            std::fprintf(stderr, "zhc: error: --rays %s: expected MIN or MIN:MAX, integers with 1 <= MIN <= MAX <= 1048576\n", o.rays.c_str());
+            return kExitUsage;
+        }
+        scene->transport.min_rays = lo;
+        scene->transport.max_rays = hi;
+    }
     if (Status b = check_ray_budget(*scene, SceneJsonLimits{}, o.scene); !b) return report(b.error());
     BakeOptions bo;
     bo.threads = threads;
@@ -95,6 +139,14 @@ int run(const Options& o) {
     auto probes = bake_scene(std::move(*scene), bo, &rep, &leak);
     progress.finish();
     if (!probes) return report(probes.error());
+    {
+        bool all_zero = true;
+        for (const Sh3Radiance& p : *probes)
+            for (int i = 0; i < 9 && all_zero; ++i) all_zero = p[i][0] == 0 && p[i][1] == 0 && p[i][2] == 0;
+        if (all_zero)
+            std::fprintf(stderr, "zhc: warning: %s: every probe is zero: no light of the scene reaches a probe (lights, sky, environment or emitting surfaces; docs/scene.md)\n",
+                         o.scene.c_str());
+    }
     if (!o.progress.quiet) {
         print_report(rep);
         if (occluders > 0)
@@ -166,6 +218,9 @@ const VerbRegistration registration(15, [](CLI::App& app) -> std::function<int()
     add_representations_option(sub, o->to, RepresentationCount::kOne, "stored in the .zhp/glTF (default sh3)", "--to")->capture_default_str();
     sub->add_option("--sky-samples", o->sky_samples, "occlusion rays per probe for the sky/environment, probe validity (default: the scene's occlusion.sky_samples, 256; 0 = no occlusion)")->check(CLI::Range(0, 65536));
     sub->add_option("--invalid-fraction", o->invalid_fraction, "a probe is invalid (dilated) when more than this fraction of its rays start inside geometry (default: the scene's occlusion.invalid_fraction, 0.25)")->check(CLI::Range(0.0, 1.0));
+    sub->add_option("--bounces", o->bounces, "reflected light: at most this many surface bounces per path (default: the scene's transport.bounces, 64; 0 = no reflected or emitted light)")->check(CLI::Range(0, 1024));
+    sub->add_option("--max-noise", o->max_noise, "reflected light: rays are added to a probe until the relative standard error of its irradiance is at most this (default: the scene's transport.max_noise, 0.02)")->check(CLI::Range(1e-6, 1.0));
+    sub->add_option("--rays", o->rays, "reflected light: rays per probe, MIN or MIN:MAX (default: the scene's transport.min_rays:max_rays, 512:8192)");
     sub->add_option("--zstd", o->zstd, "zstd-compress the .zhp body at this level (1..22; 0 = none)")->check(CLI::Range(0, 22));
     sub->add_flag("--progress", o->progress.force, "progress on stderr even when it is not a terminal (one line per 10 %)");
     sub->add_flag("--quiet", o->progress.quiet, "do not print the effects report nor progress");
