@@ -41,6 +41,12 @@ const repo = path.resolve(here, '..', '..');
 const webDir = path.join(repo, 'runtime', 'web');
 const modules = path.join(here, 'node_modules');
 const { check, finish } = checker();
+for (const dep of ['typescript', '@types/three', 'three', '@gltf-transform/core', '@gltf-transform/extensions']) {
+  if (!fs.existsSync(path.join(modules, dep, 'package.json'))) {
+    console.error(`web_package.mjs: ${dep} is not in tests/js/node_modules (npm ci in tests/js, with its devDependencies)`);
+    process.exit(1);
+  }
+}
 const ts = createRequire(import.meta.url)('typescript');
 const tsc = path.join(modules, 'typescript', 'bin', 'tsc');
 
