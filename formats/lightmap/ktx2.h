@@ -38,6 +38,12 @@ struct Ktx2Image {
     std::vector<Ktx2KeyValue> key_values;  // written in this order; read: every entry of the file
 };
 
+// The Vulkan name of a vkFormat value ("VK_FORMAT_ASTC_4x4_SRGB_BLOCK" for 158): the core formats
+// 0-184 and the ASTC HDR formats 1000066000-1000066013; "" for any other value. vk_format_label:
+// "VK_FORMAT_ASTC_4x4_SRGB_BLOCK (vkFormat 158)", or "vkFormat N" for a value with no name here.
+std::string vk_format_name(std::uint32_t vk_format);
+std::string vk_format_label(std::uint32_t vk_format);
+
 // Bytes per block of a supported format (8 or 16); 0 if unsupported.
 std::size_t ktx2_block_bytes(std::uint32_t vk_format);
 // The block footprint in texels: 4x4 for BC, the ASTC footprint for ASTC.
