@@ -13,9 +13,10 @@
 //  4. every export of every entry point, as Node imports it through the `exports` map, is declared
 //     (TypeScript's own resolution of the same specifiers through the `types` conditions) and the
 //     declarations export no value the module lacks; web_package/consumer.ts imports every one;
-//  5. `tsc --strict --noEmit` on the consumer (tests/js/web_package: consumer.ts and its tsconfig)
-//     passes, @ts-expect-error misuses included; with one parameter of the installed declarations
-//     widened to `any`, tsc fails on that misuse (so the check can fail);
+//  5. `tsc --strict --noEmit` on the consumer (tests/js/web_package: consumer.ts and its tsconfig,
+//     moduleResolution nodenext, then bundler) passes, @ts-expect-error misuses included; with one
+//     parameter of the installed declarations widened to `any`, tsc fails on that misuse (so the
+//     check can fail);
 //  6. the consumer compiled by tsc runs under Node on a glTF and a .zhp baked by zhc from
 //     examples/hall.gltf (`-r zh3_q16`): volume, lights hidden, the plugin's irradianceAt = the .zhp
 //     volume's irradiance (1e-6 of the mean, js.runtime_volume's bound), compact volume, three.js's
@@ -178,6 +179,10 @@ const strict = runTsc('--noEmit');
 const strictOut = strict.stdout.toString() + strict.stderr.toString();
 if (strict.status !== 0) console.log(strictOut);
 check(strict.status === 0, 'tsc --strict --noEmit: the consumer compiles against the installed declarations (@ts-expect-error misuses rejected)');
+// A bundler project (Vite, esbuild, webpack): the same consumer under moduleResolution bundler.
+const bundler = runTsc('--noEmit', '--module', 'esnext', '--moduleResolution', 'bundler');
+if (bundler.status !== 0) console.log(bundler.stdout.toString());
+check(bundler.status === 0, 'tsc --strict --noEmit --moduleResolution bundler: the consumer compiles too');
 const expectErrors = (fs.readFileSync(path.join(consumer, 'consumer.ts'), 'utf8').match(/^\s*\/\/ @ts-expect-error/gm) ?? []).length;
 console.log(`tsc --strict --noEmit: 0 errors, ${expectErrors} misuses rejected as expected`);
 // Mutation: widen irradiance's normal to `any`; the misuse `irradiance(one, 'up')` then compiles and
