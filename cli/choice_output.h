@@ -35,7 +35,8 @@ inline nlohmann::ordered_json choice_json(const ChoiceResult& r) {
         J j{{"representation", std::string(k->codec->name)},
             {"bytes_per_probe", k->codec->size_bytes},
             {"relative_rmse", k->error},
-            {"max_negative_fraction", k->max_negative_fraction}};
+            {"max_negative_fraction", k->max_negative_fraction},
+            {"min_irradiance", k->min_irradiance}};
         j["spirv_instructions"] = k->spirv_instructions >= 0 ? J(k->spirv_instructions) : J(nullptr);
         j["encode_ns"] = k->encode_ns >= 0 ? J(k->encode_ns) : J(nullptr);
         return j;
@@ -44,6 +45,7 @@ inline nlohmann::ordered_json choice_json(const ChoiceResult& r) {
     J j;
     j["metric"] = "relative_rmse";
     j["pooling"] = r.inputs > 1 ? "mean over inputs" : "one input";
+    j["cheaper_within"] = kCheaperWithin;
     j["constraints"] = {{"nonnegative", c.nonnegative},
                         {"max_instructions", c.max_instructions >= 0 ? J(c.max_instructions) : J(nullptr)},
                         {"max_encode_us", c.max_encode_us >= 0 ? J(c.max_encode_us) : J(nullptr)}};
@@ -56,6 +58,8 @@ inline nlohmann::ordered_json choice_json(const ChoiceResult& r) {
         e["choice"] = candidate(r.chosen(b));
         e["runner_up"] = candidate(r.second(b));
         e["margin"] = b.runner_up >= 0 ? J(b.margin) : J(nullptr);
+        e["cheaper"] = candidate(r.cheaper(b));
+        e["cheaper_increase"] = b.cheaper >= 0 ? J(b.cheaper_increase) : J(nullptr);
         e["reason"] = b.reason;
         j["budgets"].push_back(e);
     }
@@ -76,12 +80,16 @@ inline HtmlTable choice_html(const ChoiceResult& r) {
         const ChoiceCandidate* s = r.second(b);
         std::vector<HtmlCell> row;
         for (std::size_t k = 0; k < rows[i].size(); ++k) row.push_back({rows[i][k], 0});
+        const ChoiceCandidate* k = r.cheaper(b);
         row[2].sort = c ? double(c->codec->size_bytes) : -1;
         row[3].sort = c ? c->error : -1;
-        row[5].sort = s ? double(s->codec->size_bytes) : -1;
-        row[6].sort = s ? s->error : -1;
-        row[7].sort = s ? b.margin : -1;
-        row[8].sort = double(b.qualifying);
+        row[4].sort = c ? c->max_negative_fraction : -1;
+        row[5].sort = c ? c->min_irradiance : 0;
+        row[7].sort = s ? double(s->codec->size_bytes) : -1;
+        row[8].sort = s ? s->error : -1;
+        row[9].sort = s ? b.margin : -1;
+        row[10].sort = k ? double(k->codec->size_bytes) : -1;
+        row[11].sort = double(b.qualifying);
         t.rows.push_back(std::move(row));
     }
     t.notes = choice_notes(r);

@@ -165,7 +165,7 @@ HtmlReport html_of(const Options& o, const AuditGates& gates, const AuditedFiles
     h.title = "zhc audit";
     h.version = ZHC_VERSION;
     h.intro = "Irradiance error, size and speed of every representation. Reference: environment maps are integrated "
-              "directly (box-downsampled to at least 512x256); probe files use their probes' SH3 irradiance. Errors at " +
+              "over each pixel's exact footprint (box-downsampled to at least 512x256); probe files use their probes' SH3 irradiance. Errors at " +
               std::to_string(o.directions) + " Fibonacci-lattice directions per probe.";
     std::string given;
     for (const std::string& i : o.inputs) given += (given.empty() ? "" : " ") + shown_path(i, o.paths_base);
@@ -235,9 +235,16 @@ int run(const Options& o) {
         gpu_table = std::move(*t);
     }
     const RuntimeCostTable* gpu = o.runtime_cost.empty() ? nullptr : &gpu_table;
-    auto files = expand_audit_inputs(o.inputs);
+    std::vector<std::string> skipped;
+    auto files = expand_audit_inputs(o.inputs, &skipped);
     if (!files) return report(files.error());
-    if (files->empty()) return report(make_error(ErrorCode::kInvalidArgument, "no audit inputs found"));
+    if (files->empty())
+        return report(make_error(ErrorCode::kInvalidArgument,
+                                 "no audit inputs found" + (skipped.empty() ? std::string()
+                                                                            : " (skipped " + skipped[0] +
+                                                                                  (skipped.size() > 1 ? ", and " + std::to_string(skipped.size() - 1) + " more" : "") + ")")));
+    // A folder's JSON files that are not probe lists (a scene beside its maps): one note each.
+    for (const std::string& n : skipped) std::fprintf(stderr, "zhc: note: skipped %s\n", n.c_str());
     for (const auto& [option, path] : {std::pair<std::string, std::string>{"--markdown", o.markdown}, {"--html", o.html}})
         if (!path.empty())
             if (int rc = refuse_output_over_input(option, path, *files); rc != kExitOk) return rc;
@@ -287,7 +294,7 @@ int run(const Options& o) {
     if (o.json) {
         nlohmann::ordered_json j;
         j["directions"] = o.directions;
-        j["reference"] = "environment maps: direct integration of the map (box-downsampled to >= 512x256); "
+        j["reference"] = "environment maps: the map's irradiance over each pixel's exact footprint (box-downsampled to >= 512x256); "
                          "probe files: the probes' SH3 irradiance";
         j["files"] = nlohmann::ordered_json::array();
         for (size_t i = 0; i < inputs.size(); ++i) {
@@ -332,7 +339,7 @@ int run(const Options& o) {
     if (!o.markdown.empty()) {
         std::ostringstream md;
         md << "# zhc audit\n\nIrradiance error against the reference at " << o.directions
-           << " directions (environment maps: direct integration of the map; probe files: their SH3).\n\n";
+           << " directions (environment maps: the map's irradiance over each pixel's exact footprint; probe files: their SH3).\n\n";
         for (size_t i = 0; i < inputs.size(); ++i) {
             md << "## " << inputs[i].path << "\n\n" << inputs[i].description << "\n\nReference: " << inputs[i].reference << ".\n\n";
             std::vector<std::vector<std::string>> rows{columns(timed)};
@@ -390,7 +397,10 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
                     "GPU cost per encoding from build/bench/bench_runtime --json FILE: SPIR-V instructions and lavapipe ns/eval "
                     "columns (text, Markdown, HTML) and an error-vs-runtime-cost plot in the HTML report");
     sub->add_option("--budget", o->budgets,
-                    "choice section: one more byte budget per probe (repeatable; 16, 28, 48, 60 and 108 are always there)")
+                    "choice section: one more byte budget per probe (repeatable; 16, 28, 48, 60 and 108 are always there). "
+                    "Each budget's pick shows its negativity (neg_frac, min_irr) and, as cheaper_" +
+                        fmt(100.0 * kCheaperWithin, "%.0f%%") + ", the smallest representation with fewer bytes within " +
+                        fmt(100.0 * kCheaperWithin, "%.0f%%") + " of its relative rmse")
         ->check(CLI::Range(std::size_t(1), std::size_t(1) << 20));
     sub->add_option("--require", o->require,
                     "choice section: only representations with negative_fraction 0 on every input (nonnegative)")

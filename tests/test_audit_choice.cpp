@@ -21,7 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// One hand-made row: codec, relative rmse, negative fraction.
+// One hand-made row: codec, relative rmse, negative fraction (and a minimum irradiance of -10 times
+// it when negative, else 0.5).
 RepresentationResult row(const char* name, double relative_rmse, double negative_fraction = 0, double encode_ns = 0) {
     RepresentationResult r;
     r.codec = find_codec(name);
@@ -29,6 +30,7 @@ RepresentationResult row(const char* name, double relative_rmse, double negative
     r.metrics.relative_rmse = relative_rmse;
     r.metrics.rmse = relative_rmse;
     r.metrics.negative_fraction = negative_fraction;
+    r.metrics.min_irradiance = negative_fraction > 0 ? -10 * negative_fraction : 0.5;
     r.encode_ns = encode_ns;
     return r;
 }
@@ -157,14 +159,107 @@ TEST(AuditChoice, TableAndNotesSayWhatTheResultSays) {
     const auto table = choice_table(r);
     ASSERT_EQ(table.size(), r.budgets.size() + 1);
     EXPECT_EQ(table[0][0], "budget");
-    EXPECT_EQ(table[1], (std::vector<std::string>{"8", "none", "-", "-", "-", "-", "-", "-", "0 of 0"}));
-    // 28 bytes: sh3_q28 0.06, runner-up zh3_q16 0.14: margin 0.08 = 133.3% of 0.06.
-    EXPECT_EQ(table[3], (std::vector<std::string>{"28", "sh3_q28", "28", "0.0600", "zh3_q16", "16", "0.1400",
-                                                  "+0.0800 (+133.3%)", "4 of 4"}));
+    EXPECT_EQ(table[0], (std::vector<std::string>{"budget", "choice", "bytes", "rel_rmse", "neg_frac", "min_irr", "runner_up",
+                                                  "bytes", "rel_rmse", "margin", "cheaper_5%", "qualifying"}));
+    EXPECT_EQ(table[1], (std::vector<std::string>{"8", "none", "-", "-", "-", "-", "-", "-", "-", "-", "-", "0 of 0"}));
+    // 28 bytes: sh3_q28 0.06 (negative on 0.2 % of input 1's directions, down to -0.02),
+    // runner-up zh3_q16 0.14: margin 0.08 = 133.3% of 0.06; nothing smaller within 5 %.
+    EXPECT_EQ(table[3], (std::vector<std::string>{"28", "sh3_q28", "28", "0.0600", "0.0020", "-0.02", "zh3_q16", "16",
+                                                  "0.1400", "+0.0800 (+133.3%)", "-", "4 of 4"}));
+    // 108 bytes: sh3, never negative (its smallest irradiance 0.5).
+    EXPECT_EQ(table[6][1], "sh3");
+    EXPECT_EQ(table[6][4], "0.0000");
+    EXPECT_EQ(table[6][5], "0.5");
     const auto notes = choice_notes(r);
     ASSERT_EQ(notes.size(), 1u);
     EXPECT_EQ(notes[0].rfind("8 bytes: none: ", 0), 0u) << notes[0];
     EXPECT_NE(choice_intro(r).find("constraints (none)"), std::string::npos);
+}
+
+// The cheaper representation: the fewest bytes below the choice's within 5 % of its error, among
+// the qualifying ones. sh3 0.050 (108 B), sh3_q28 0.051 (28 B), zh3_q16 0.0524 (16 B, negative on
+// input 0), zh3_dering_q16 0.0530 (16 B: 6 % above sh3, 3.9 % above sh3_q28), sh2 0.049 (48 B).
+TEST(AuditChoice, CheaperWithinFivePercentIsNamed) {
+    EXPECT_EQ(kCheaperWithin, 0.05);
+    const Rows rows = two_inputs({row("sh3", 0.050), row("sh3_q28", 0.051), row("zh3_q16", 0.0524, 0.01),
+                                  row("zh3_dering_q16", 0.053), row("sh2", 0.1)},
+                                 {row("sh3", 0.050), row("sh3_q28", 0.051), row("zh3_q16", 0.0524),
+                                  row("zh3_dering_q16", 0.053), row("sh2", 0.1)});
+    ChoiceResult r = choose_representations(rows.inputs, rows.aggregate, {}, false, {}, choice_budgets({}));
+    // 108: sh3; zh3_q16 (16 B, +4.8 %) beats sh3_q28 (28 B, +2 %) on bytes; zh3_dering_q16 is 6 % above.
+    EXPECT_EQ(name_of(r, at(r, 108).choice), "sh3");
+    EXPECT_EQ(name_of(r, at(r, 108).cheaper), "zh3_q16");
+    EXPECT_NEAR(at(r, 108).cheaper_increase, 0.0524 / 0.050 - 1, 1e-12);
+    // 28: sh3_q28; the 16-byte ones within 5 %: zh3_q16 (+2.7 %) before zh3_dering_q16 (+3.9 %).
+    EXPECT_EQ(name_of(r, at(r, 28).choice), "sh3_q28");
+    EXPECT_EQ(name_of(r, at(r, 28).cheaper), "zh3_q16");
+    // 16: nothing smaller.
+    EXPECT_EQ(name_of(r, at(r, 16).cheaper), "none");
+    EXPECT_EQ(choice_table(r)[5][10], "zh3_q16 16 B +4.8%");
+    // Non-negative only: zh3_q16 is out, and so is it as the cheaper one; 108's cheaper is then
+    // sh3_q28 (zh3_dering_q16 is 6 % above sh3).
+    ChoiceConstraints c;
+    c.nonnegative = true;
+    r = choose_representations(rows.inputs, rows.aggregate, {}, false, c, choice_budgets({}));
+    EXPECT_EQ(name_of(r, at(r, 108).cheaper), "sh3_q28");
+    EXPECT_EQ(name_of(r, at(r, 28).cheaper), "zh3_dering_q16");
+    EXPECT_EQ(choice_table(r)[5][10], "sh3_q28 28 B +2.0%");
+    // The choice's negativity: the worst input's fraction and minimum.
+    r = choose_representations(rows.inputs, rows.aggregate, {}, false, {}, choice_budgets({}));
+    EXPECT_EQ(name_of(r, at(r, 16).choice), "zh3_q16");
+    EXPECT_EQ(r.candidates[at(r, 16).choice].max_negative_fraction, 0.01);
+    EXPECT_EQ(r.candidates[at(r, 16).choice].min_irradiance, -0.1);
+}
+
+// The sunrise map (the case): the choice's negativity in text and JSON is what the audit
+// measured for that representation; the 16-byte pick goes negative on ~1.7 % of the directions,
+// the 108-byte pick (sh3) down to about -0.032; sh3_q28 is named as sh3's cheaper alternative.
+TEST(AuditChoice, SunriseShowsNegativityAndTheCheaperAlternative) {
+    std::string sunrise;
+    for (const std::string& p : test::envmap_paths())
+        if (fs::path(p).stem() == "sunrise") sunrise = p;
+    ASSERT_FALSE(sunrise.empty());
+    const auto json = test::run_zhc({"audit", sunrise, "--no-timing", "--json"});
+    ASSERT_EQ(json.exit_code, 0) << json.err;
+    const auto text = test::run_zhc({"audit", sunrise, "--no-timing"});
+    ASSERT_EQ(text.exit_code, 0) << text.err;
+    const nlohmann::json doc = nlohmann::json::parse(json.out);
+    const nlohmann::json& reps = doc["files"][0]["representations"];
+    EXPECT_EQ(doc["choice"]["cheaper_within"], 0.05);
+    for (const auto& b : doc["choice"]["budgets"]) {
+        const auto& c = b["choice"];
+        const std::string name = c["representation"];
+        SCOPED_TRACE(name);
+        EXPECT_EQ(c["max_negative_fraction"], reps[name]["negative_fraction"]);
+        EXPECT_EQ(c["min_irradiance"], reps[name]["min_irradiance"]);
+        // The text row of this budget shows the same two numbers.
+        char row[160];
+        std::snprintf(row, sizeof row, "%-7d", b["budget_bytes"].get<int>());
+        const std::size_t at_row = text.out.find("\n" + std::string(row), text.out.find("\nchoice: "));
+        ASSERT_NE(at_row, std::string::npos) << row;
+        std::istringstream cells(text.out.substr(at_row + 1, text.out.find('\n', at_row + 1) - at_row - 1));
+        std::vector<std::string> v;
+        for (std::string w; cells >> w;) v.push_back(w);
+        ASSERT_GE(v.size(), 6u);
+        EXPECT_EQ(v[1], name);
+        char neg[32], min[32];
+        std::snprintf(neg, sizeof neg, "%.4f", c["max_negative_fraction"].get<double>());
+        std::snprintf(min, sizeof min, "%.4g", c["min_irradiance"].get<double>());
+        EXPECT_EQ(v[4], neg);
+        EXPECT_EQ(v[5], min);
+    }
+    const auto& b16 = doc["choice"]["budgets"][0];
+    const auto& b108 = doc["choice"]["budgets"][4];
+    ASSERT_EQ(b16["budget_bytes"], 16);
+    ASSERT_EQ(b108["budget_bytes"], 108);
+    EXPECT_NEAR(b16["choice"]["max_negative_fraction"].get<double>(), 0.017, 0.003);
+    EXPECT_EQ(b108["choice"]["representation"], "sh3");
+    EXPECT_NEAR(b108["choice"]["min_irradiance"].get<double>(), -0.032, 0.002);
+    ASSERT_FALSE(b108["cheaper"].is_null());
+    EXPECT_EQ(b108["cheaper"]["representation"], "sh3_q28");
+    EXPECT_GT(b108["cheaper_increase"].get<double>(), 0.0);
+    EXPECT_LE(b108["cheaper_increase"].get<double>(), 0.05);
+    EXPECT_NE(text.out.find("sh3_q28 28 B +"), std::string::npos);
 }
 
 // The slow twin: from the per-input rows alone (not the aggregate), each budget's qualifying
@@ -355,9 +450,9 @@ TEST(AuditChoice, CliTextMarkdownHtmlAndJsonCarryTheSameChoice) {
             const std::size_t a = cell.find_first_not_of(' '), e = cell.find_last_not_of(' ');
             if (a != std::string::npos) cells.push_back(cell.substr(a, e - a + 1));
         }
-        ASSERT_EQ(cells.size(), 9u) << md.substr(row, 120);
+        ASSERT_EQ(cells.size(), 12u) << md.substr(row, 120);
         EXPECT_EQ(cells[1], name_of(r, b.choice));
-        EXPECT_EQ(cells[4], b.runner_up < 0 ? "-" : name_of(r, b.runner_up));
+        EXPECT_EQ(cells[6], b.runner_up < 0 ? "-" : name_of(r, b.runner_up));
         // JSON: the same choice and runner-up.
         EXPECT_EQ(budgets[i]["budget_bytes"], b.budget);
         EXPECT_EQ(budgets[i]["choice"].is_null() ? "none" : budgets[i]["choice"]["representation"].get<std::string>(),

@@ -51,8 +51,12 @@ ChoiceResult choose_representations(const std::vector<InputAudit>& inputs,
         ChoiceCandidate k;
         k.codec = aggregate[c].codec;
         k.error = aggregate[c].metrics.relative_rmse;
+        k.min_irradiance = aggregate[c].metrics.min_irradiance;
         for (const InputAudit& in : inputs)
-            if (c < in.results.size()) k.max_negative_fraction = std::max(k.max_negative_fraction, in.results[c].metrics.negative_fraction);
+            if (c < in.results.size()) {
+                k.max_negative_fraction = std::max(k.max_negative_fraction, in.results[c].metrics.negative_fraction);
+                k.min_irradiance = std::min(k.min_irradiance, in.results[c].metrics.min_irradiance);
+            }
         k.encode_ns = timed ? aggregate[c].encode_ns : -1;
         k.spirv_instructions = c < instructions.size() ? instructions[c] : -1;
         k.error_not_finite = !std::isfinite(k.error);
@@ -101,6 +105,16 @@ ChoiceResult choose_representations(const std::vector<InputAudit>& inputs,
                 b.runner_up = ranked[1];
                 b.margin = out.candidates[b.runner_up].error - k.error;
             }
+            // The cheaper one: fewest bytes below the choice's within kCheaperWithin of its error;
+            // `ranked` is in error order, so the first of the fewest bytes has the lowest error.
+            const double limit = k.error * (1.0 + kCheaperWithin);
+            for (int c : ranked) {
+                const ChoiceCandidate& x = out.candidates[c];
+                if (x.codec->size_bytes >= k.codec->size_bytes || !(x.error <= limit)) continue;
+                if (b.cheaper < 0 || x.codec->size_bytes < out.candidates[b.cheaper].codec->size_bytes) b.cheaper = c;
+            }
+            if (b.cheaper >= 0)
+                b.cheaper_increase = k.error > 0 ? out.candidates[b.cheaper].error / k.error - 1.0 : 0.0;
         } else if (b.fitting == 0) {
             b.reason = "none: no audited representation stores at most " + std::to_string(budget) + " bytes per probe" +
                        (out.candidates.empty() ? std::string() : " (the smallest: " + std::to_string(smallest) + " bytes)");
@@ -127,14 +141,18 @@ ChoiceResult choose_representations(const std::vector<InputAudit>& inputs,
 }
 
 std::vector<std::vector<std::string>> choice_table(const ChoiceResult& r) {
-    std::vector<std::vector<std::string>> rows{
-        {"budget", "choice", "bytes", "rel_rmse", "runner_up", "bytes", "rel_rmse", "margin", "qualifying"}};
+    std::vector<std::vector<std::string>> rows{{"budget", "choice", "bytes", "rel_rmse", "neg_frac", "min_irr", "runner_up",
+                                                "bytes", "rel_rmse", "margin", "cheaper_" + fmt(100.0 * kCheaperWithin, "%.0f%%"),
+                                                "qualifying"}};
     for (const BudgetChoice& b : r.budgets) {
         std::vector<std::string> row{std::to_string(b.budget)};
         const ChoiceCandidate* c = r.chosen(b);
         const ChoiceCandidate* s = r.second(b);
-        if (c) row.insert(row.end(), {std::string(c->codec->name), std::to_string(c->codec->size_bytes), fmt(c->error, "%.4f")});
-        else row.insert(row.end(), {"none", "-", "-"});
+        if (c)
+            row.insert(row.end(), {std::string(c->codec->name), std::to_string(c->codec->size_bytes), fmt(c->error, "%.4f"),
+                                   fmt(c->max_negative_fraction, "%.4f"), fmt(c->min_irradiance)});
+        else
+            row.insert(row.end(), {"none", "-", "-", "-", "-"});
         if (s) {
             std::string margin = fmt(b.margin, "+%.4f");
             if (c->error > 0) margin += fmt(100.0 * b.margin / c->error, " (+%.1f%%)");
@@ -142,6 +160,10 @@ std::vector<std::vector<std::string>> choice_table(const ChoiceResult& r) {
         } else {
             row.insert(row.end(), {"-", "-", "-", "-"});
         }
+        const ChoiceCandidate* k = r.cheaper(b);
+        row.push_back(k ? std::string(k->codec->name) + " " + std::to_string(k->codec->size_bytes) + " B " +
+                              fmt(100.0 * b.cheaper_increase, "%+.1f%%")
+                        : "-");
         row.push_back(std::to_string(b.qualifying) + " of " + std::to_string(b.fitting));
         rows.push_back(std::move(row));
     }
@@ -154,8 +176,11 @@ std::string choice_intro(const ChoiceResult& r) {
            std::string(r.inputs > 1 ? ", the mean over the " + std::to_string(r.inputs) + " inputs" : "") +
            ") among those storing at most that many bytes per probe and meeting the constraints (" + r.constraints.text() +
            "); ties go to fewer bytes, then table order. The runner-up is the next best; margin: its relative rmse minus "
-           "the choice's (and that as a percentage of the choice's). qualifying: representations meeting the "
-           "constraints of those that fit.";
+           "the choice's (and that as a percentage of the choice's). neg_frac and min_irr: the choice's largest fraction of "
+           "directions reconstructing below 0 on an input and its smallest irradiance. cheaper_" +
+           fmt(100.0 * kCheaperWithin, "%.0f%%") + ": the smallest representation with fewer bytes whose relative rmse is at most " +
+           fmt(100.0 * kCheaperWithin, "%.0f%%") + " above the choice's, its bytes and how much above. qualifying: "
+           "representations meeting the constraints of those that fit.";
 }
 
 std::vector<std::string> choice_notes(const ChoiceResult& r) {

@@ -16,6 +16,12 @@
 // deterministic. The runner-up is the next one in that
 // order; the margin is the runner-up's error minus the choice's.
 //
+// Beside each choice: its negativity (the largest fraction of audited directions where some
+// channel reconstructs below 0, over the inputs, and the smallest irradiance reconstructed on any
+// input), and the cheaper representation: among the qualifying ones that fit, the one with the
+// fewest bytes per probe below the choice's whose error is at most kCheaperWithin (5 %) above the
+// choice's (ties: lower error, then the audit's order); none when no smaller one is that close.
+//
 // Experimental: this API may change between minor versions (docs/api.md "Public headers").
 // Thread safety (docs/api.md): every function here is reentrant and keeps no state between
 // calls; calls may run concurrently on different arguments and on the same const ones.
@@ -28,6 +34,10 @@
 #include "codec/audit/audit_run.h"
 
 namespace zhc {
+
+// How much more relative rmse (as a fraction of the choice's) a smaller representation may have to
+// be named as the cheaper one: 0.05, 5 %.
+inline constexpr double kCheaperWithin = 0.05;
 
 struct ChoiceConstraints {
     bool nonnegative = false;
@@ -53,6 +63,7 @@ struct ChoiceCandidate {
     const Codec* codec = nullptr;
     double error = 0;                   // aggregate relative rmse
     double max_negative_fraction = 0;   // the largest negative_fraction over the inputs
+    double min_irradiance = 0;          // the smallest min_irradiance over the inputs
     double encode_ns = -1;              // aggregate mean encode time per probe; < 0: not measured
     long long spirv_instructions = -1;  // < 0: not known
     // The constraints it breaks (none: it qualifies).
@@ -70,6 +81,8 @@ struct BudgetChoice {
     int choice = -1;             // index into ChoiceResult::candidates; -1: none qualifies
     int runner_up = -1;          // -1: none
     double margin = 0;           // runner-up error minus the choice's (0 without a runner-up)
+    int cheaper = -1;            // fewer bytes, error within kCheaperWithin of the choice's; -1: none
+    double cheaper_increase = 0; // the cheaper one's error over the choice's, minus 1 (0.015: +1.5 %)
     // One line: why the choice (or "none: ..." and why nothing qualifies).
     std::string reason;
 };
@@ -83,6 +96,7 @@ struct ChoiceResult {
     const ChoiceCandidate* second(const BudgetChoice& b) const {
         return b.runner_up < 0 ? nullptr : &candidates[b.runner_up];
     }
+    const ChoiceCandidate* cheaper(const BudgetChoice& b) const { return b.cheaper < 0 ? nullptr : &candidates[b.cheaper]; }
 };
 
 // The choice for each budget from an audit's per-input results and aggregate (AuditRun).
@@ -95,9 +109,11 @@ ChoiceResult choose_representations(const std::vector<InputAudit>& inputs,
                                     const ChoiceConstraints& constraints, const std::vector<std::size_t>& budgets);
 
 // The choice as a table for text and Markdown (row 0 is the header): budget, choice, bytes,
-// rel_rmse, runner_up, bytes, rel_rmse, margin ("+0.0184 (+16.5%)": the difference and the
-// percentage of the choice's error), qualifying ("12 of 14": qualifying of fitting). A budget with
-// no choice shows "none" and "-".
+// rel_rmse, neg_frac and min_irr (the choice's negativity), runner_up, bytes, rel_rmse, margin
+// ("+0.0184 (+16.5%)": the difference and the percentage of the choice's error), cheaper_5%
+// ("sh3_q28 28 B +1.5%": the cheaper representation, its bytes and its error over the choice's; "-"
+// when none), qualifying ("12 of 14": qualifying of fitting). A budget with no choice shows "none"
+// and "-".
 std::vector<std::vector<std::string>> choice_table(const ChoiceResult& result);
 // One paragraph: the metric, the pooling, the constraints, how ties break.
 std::string choice_intro(const ChoiceResult& result);

@@ -5,8 +5,12 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
 #include "formats/envmap/envmap.h"
+#include "formats/envmap/envmap_cube.h"
 #include "formats/io/file_io.h"
+#include "formats/io/json_depth.h"
 #include "formats/probes/probe_file.h"
 #include "codec/probe/probe_set.h"
 #include "formats/report/raster.h"
@@ -19,7 +23,24 @@ namespace {
 bool audit_extension(const std::string& ext) { return ext == ".exr" || ext == ".hdr" || ext == ".zhp" || ext == ".json"; }
 }  // namespace
 
-Result<std::vector<std::string>> expand_audit_inputs(const std::vector<std::string>& paths) {
+namespace {
+// Why a JSON file found in a folder is not a probe list ("" when it may be one): a document with a
+// "format" other than zhc-probes (a zhc-scene file), a glTF file ("asset"), or no "probes" array.
+// A file that does not parse is kept: the loader names what is wrong with it.
+std::string not_a_probe_list(const std::string& path) {
+    auto bytes = read_file_bytes(path, std::uint64_t(2) << 30);
+    if (!bytes || !check_json_depth(*bytes, path)) return "";
+    const auto doc = nlohmann::json::parse(bytes->begin(), bytes->end(), nullptr, false);
+    if (!doc.is_object()) return "";
+    if (doc.contains("format") && doc["format"].is_string() && doc["format"] != "zhc-probes")
+        return "a " + doc["format"].get<std::string>() + " file, not a probe list";
+    if (doc.contains("asset") && doc["asset"].is_object()) return "a glTF file, not a probe list";
+    if (!doc.contains("probes") || !doc["probes"].is_array()) return "no \"probes\" array: not a probe list";
+    return "";
+}
+}  // namespace
+
+Result<std::vector<std::string>> expand_audit_inputs(const std::vector<std::string>& paths, std::vector<std::string>* skipped) {
     std::vector<std::string> out;
     for (const std::string& p : paths) {
         std::error_code ec;
@@ -30,7 +51,15 @@ Result<std::vector<std::string>> expand_audit_inputs(const std::vector<std::stri
                     found.push_back(e.path().string());
             if (ec) return make_error(ErrorCode::kIoError, p + ": cannot list folder (" + ec.message() + ")");
             std::sort(found.begin(), found.end());
-            out.insert(out.end(), found.begin(), found.end());
+            for (const std::string& f : found) {
+                if (file_extension(f) == ".json") {
+                    if (const std::string why = not_a_probe_list(f); !why.empty()) {
+                        if (skipped) skipped->push_back(f + ": " + why);
+                        continue;
+                    }
+                }
+                out.push_back(f);
+            }
         } else if (fs::exists(p, ec)) {
             out.push_back(p);
         } else {
@@ -67,7 +96,7 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
                               : std::string()) +
                          ", reference: the map integrated at " + std::to_string(in.map.width) + "x" +
                          std::to_string(in.map.height);
-        in.reference = "the map's irradiance, integrated directly at " + std::to_string(in.map.width) + "x" +
+        in.reference = "the map's irradiance, integrated over each pixel's exact footprint at " + std::to_string(in.map.width) + "x" +
                        std::to_string(in.map.height);
         return in;
     }
@@ -101,6 +130,12 @@ Result<AuditInput> load_audit_input(const std::string& path, const std::vector<V
 }
 
 Error unknown_probe_input(const std::string& path, std::span<const std::uint8_t> bytes) {
+    // A KTX2, KTX 1 or DDS texture that is not a cube map: the cube reader's own reason (exit 5, as
+    // `zhc project` says it: "KTX 1 numberOfFaces 1 (byte 52): a 2-D texture, not a cube map").
+    if (is_ktx2(bytes) || is_ktx1(bytes) || is_dds(bytes)) {
+        auto img = read_envmap_memory(bytes, path, {});
+        if (!img) return img.error();
+    }
     return Error{ErrorCode::kBadFormat, path + ": not an environment map (EXR/.hdr, KTX2/KTX 1/DDS cube map), .zhp probe file or JSON probe list" +
                                             git_lfs_hint(bytes)};
 }

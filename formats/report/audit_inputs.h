@@ -22,10 +22,14 @@ struct AuditLoadOptions {
 };
 
 // Files and folders -> the list of files to audit (folders: their .exr/.hdr/.zhp/.json files,
-// sorted by name, not recursive). Missing paths are an error.
-Result<std::vector<std::string>> expand_audit_inputs(const std::vector<std::string>& paths);
+// sorted by name, not recursive). Missing paths are an error. A folder's JSON file that is not a
+// probe list (a zhc-scene file, a glTF file, a document with no "probes" array) is left out and,
+// when `skipped` is given, listed there as "PATH: why"; a file named on its own is always kept.
+Result<std::vector<std::string>> expand_audit_inputs(const std::vector<std::string>& paths,
+                                                     std::vector<std::string>* skipped = nullptr);
 // The error for a file of no format audit, convert and info read (exit 4, kBadFormat), with the
-// Git LFS hint when the bytes are an LFS pointer.
+// Git LFS hint when the bytes are an LFS pointer; for a KTX2, KTX 1 or DDS texture that is not a
+// cube map, the environment-map reader's own error (exit 5, kUnsupported, as `zhc project` gives).
 Error unknown_probe_input(const std::string& path, std::span<const std::uint8_t> bytes);
 
 // Reads one file as an AuditInput (codec/audit/audit_run.h): an environment map (.exr, .hdr; its
