@@ -40,11 +40,11 @@ int report_write(const Error& error);
 // --- Shared option groups: every verb spells these the same way (README "Options"). -------------
 // The representation: `-r, --representations` in every verb that picks codec-table entries.
 // kList: a comma-separated subset (audit, bench; empty = all). kOne: exactly one name (convert,
-// bake, gltf embed). `old_spelling` ("--to", "--encoding") is that verb's alias, accepted for existing
-// scripts. `what` completes the help text.
+// bake, gltf embed). `other_name` ("--to", "--encoding") is a second name of the same option in that
+// verb; the help says so. `what` completes the help text.
 enum class RepresentationCount { kOne, kList };
 CLI::Option* add_representations_option(CLI::App* app, std::string& names, RepresentationCount count,
-                                        const std::string& what, const std::string& old_spelling = "");
+                                        const std::string& what, const std::string& other_name = "");
 // The codec-table entry a kOne `-r` value names. An unknown name prints select_codecs' one line
 // (the name and every known name: the same words in every verb that parses `-r`) and returns null;
 // the verb then exits kExitUsage.
@@ -67,6 +67,15 @@ StorageOptionUse storage_options_used(const Codec& codec);
 // INPUT (choose another output path)" and returns kExitUsage; kExitOk when they differ. Inputs
 // that are folders or do not exist never match.
 int refuse_output_over_input(const std::string& option, const std::string& output, const std::vector<std::string>& inputs);
+
+// Refuses an output whose folder takes no new files (formats/io/file_io.h check_folder_takes_files:
+// missing, not a folder, read-only): prints "zhc: error: OPTION PATH: why (checked before the work;
+// nothing was written)" and returns kExitOutputFailed; kExitOk when a file can be created there.
+// main() runs it, before the verb, on every file output given (-o/--output, --html, --markdown,
+// --depfile; not demo's -o, a folder, nor lightmap encode's -o, a prefix: encode checks its first
+// plane), and refuses --depfile (exit 7) when the verb was given no file output to name as the
+// depfile's target (audit without --markdown/--html/--images, lightmap audit without --html).
+int refuse_unwritable_output(const std::string& option, const std::string& path);
 
 // `--threads N`, N in 0..256, 0 = all cores (hardware_concurrency), the default of every verb
 // (README "Options"). Every verb that takes it gives identical output for any count.

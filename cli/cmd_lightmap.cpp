@@ -5,6 +5,7 @@
 // (BC4_UNORM): 2.5 bytes per texel; with --container dds the same blocks in PREFIX.{iz,d,wa}.dds.
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -12,6 +13,7 @@
 #include "cli.h"
 #include "json_output.h"
 #include "codec/lightmap/lightmap.h"
+#include "formats/lightmap/astc.h"
 #include "formats/lightmap/dds.h"
 #include "formats/envmap/envmap.h"
 #include "formats/io/file_io.h"
@@ -34,6 +36,7 @@ struct Options {
     std::string html;       // audit: also write the HTML report here (whole-image path)
     std::string paths_base; // audit: --paths-relative-to
     std::string target = "bc", footprint = "4x4";  // encode
+    bool footprint_given = false;                   // encode: --footprint on the command line
     std::vector<std::string> targets;               // audit: side-by-side comparison
     int threads = 0, size = 256, height = 0, stride = 17, band_rows = 0;
     bool json = false, half = false;
@@ -90,16 +93,56 @@ std::string shown_inputs(const std::vector<std::string>& files, const std::strin
     return inputs_text(shown);
 }
 
+// Whether `path` is a KTX2 file whose vkFormat is an ASTC format zhc writes (an I_z plane of an
+// ASTC target). Reads the 16 header bytes directly: the file is not an input of the command.
+bool is_astc_ktx2(const std::string& path) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return false;
+    std::uint8_t h[16] = {};
+    const bool whole = std::fread(h, 1, sizeof h, f) == sizeof h;
+    std::fclose(f);
+    static constexpr std::uint8_t kKtx2Id[12] = {0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n'};
+    if (!whole || std::memcmp(h, kKtx2Id, sizeof kKtx2Id) != 0) return false;
+    const std::uint32_t vk = std::uint32_t(h[12]) | std::uint32_t(h[13]) << 8 | std::uint32_t(h[14]) << 16 | std::uint32_t(h[15]) << 24;
+    return astc::format_of_vk(vk).has_value();
+}
+
+// The planes of the other target under `prefix`, which a new encode leaves stale (decode would pair
+// them with the new ones, or --container dds read an older lightmap): after a bc encode, the ASTC
+// planes PREFIX.dwa.ktx2 and (when this encode wrote DDS) an ASTC PREFIX.iz.ktx2; after an astc or
+// astc-ldr encode, the BC planes PREFIX.d.ktx2, PREFIX.wa.ktx2 and PREFIX.{iz,d,wa}.dds. The same
+// target's other container (a bc set in both KTX2 and DDS) is kept: both hold the same target.
+std::vector<std::string> other_target_planes(const std::string& prefix, bool astc, bool dds) {
+    std::vector<std::string> candidates;
+    if (astc) {
+        for (const char* p : {".d.ktx2", ".wa.ktx2", ".iz.dds", ".d.dds", ".wa.dds"}) candidates.push_back(prefix + p);
+    } else {
+        candidates.push_back(prefix + ".dwa.ktx2");
+        if (dds && is_astc_ktx2(prefix + ".iz.ktx2")) candidates.push_back(prefix + ".iz.ktx2");
+    }
+    std::vector<std::string> present;
+    std::error_code ec;
+    for (const std::string& c : candidates)
+        if (std::filesystem::is_regular_file(c, ec)) present.push_back(c);
+    return present;
+}
+
 int run_encode(const Options& o) {
     const auto files = input_files(o.inputs);
     const bool astc = o.target != "bc";
     if (astc && o.container == "dds")
         return report(make_error(ErrorCode::kUnsupported, "--container dds: DDS has no ASTC formats; --target " + o.target +
                                                               " writes KTX2 only (PREFIX.iz.ktx2, PREFIX.dwa.ktx2)"));
+    if (!astc && o.footprint_given) {
+        std::fprintf(stderr, "zhc: error: --footprint %s: --target bc does not use it (the ASTC block footprint: give --target astc or astc-ldr)\n",
+                     o.footprint.c_str());
+        return kExitUsage;
+    }
     const std::string out_ext = o.container == "dds" ? ".dds" : ".ktx2";
     const std::vector<const char*> planes = astc ? std::vector<const char*>{".iz", ".dwa"} : std::vector<const char*>{".iz", ".d", ".wa"};
     for (const char* plane : planes)
         if (int rc = refuse_output_over_input("-o", o.output + plane + out_ext, files); rc != kExitOk) return rc;
+    if (int rc = refuse_unwritable_output("-o", o.output + planes[0] + out_ext); rc != kExitOk) return rc;
     lightmap_stream::EncodeOptions eo;
     eo.target = o.target == "astc" ? lightmap_stream::Target::kAstc
                                    : (o.target == "astc-ldr" ? lightmap_stream::Target::kAstcLdr : lightmap_stream::Target::kBc);
@@ -117,6 +160,15 @@ int run_encode(const Options& o) {
     progress.finish();
     if (!r) return output_failed ? report_output(r.error()) : report(r.error());
     const std::string ext = eo.dds ? ".dds" : ".ktx2";
+    // Only now, with the new planes in place: a failed encode leaves the earlier set whole.
+    for (const std::string& stale : other_target_planes(o.output, astc, eo.dds)) {
+        std::error_code ec;
+        if (!std::filesystem::remove(stale, ec) || ec)
+            return report_output(make_error(ErrorCode::kIoError, stale + ": a plane of the other target under this prefix, stale next to the "
+                                                                 "new planes, cannot be removed (" + ec.message() + ")"));
+        std::fprintf(stderr, "zhc: note: removed %s: a %s plane of an earlier encode under this prefix (this --target %s wrote %s.%s%s)\n",
+                     stale.c_str(), astc ? "bc" : "astc", o.target.c_str(), o.output.c_str(), astc ? "{iz,dwa}" : "{iz,d,wa}", ext.c_str());
+    }
     const double texels = double(r->width) * r->height;
     std::printf("%s: %dx%d texels -> %s.%s%s (%s; %llu bytes of blocks, %.3f bytes/texel)\n", inputs_text(files).c_str(), r->width,
                 r->height, o.output.c_str(), astc ? "{iz,dwa}" : "{iz,d,wa}", ext.c_str(),
@@ -159,7 +211,7 @@ int run_decode(const Options& o) {
 }
 
 // audit --html: the report needs the whole image's planes, so this path reads the whole lightmap
-// (one EXR, at most 4096 x 4096) as before streaming.
+// (one EXR, at most 4096 x 4096) in one piece.
 // extra: rows appended to the summary table (audit --targets: one per target).
 int run_audit_html(const Options& o, const std::string& input, const std::vector<LightmapHtmlRow>& extra = {}) {
     LightmapReadOptions ro;
@@ -407,7 +459,10 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
     band(syn);
     return [o, enc, dec, aud, syn] {
         o->threads = resolve_threads(o->threads);  // 0 = all cores
-        if (enc->parsed()) return run_encode(*o);
+        if (enc->parsed()) {
+            o->footprint_given = enc->get_option("--footprint")->count() > 0;
+            return run_encode(*o);
+        }
         if (dec->parsed()) return run_decode(*o);
         if (aud->parsed()) return run_audit(*o);
         if (syn->parsed()) return run_synth(*o);

@@ -58,13 +58,13 @@ int report_write(const Error& error) {
 }
 
 CLI::Option* add_representations_option(CLI::App* app, std::string& names, RepresentationCount count,
-                                        const std::string& what, const std::string& old_spelling) {
+                                        const std::string& what, const std::string& other_name) {
     const bool one = count == RepresentationCount::kOne;
     std::string spelling = "-r,--representations";
-    if (!old_spelling.empty()) spelling += "," + old_spelling;
+    if (!other_name.empty()) spelling += "," + other_name;
     std::string help = (one ? "one codec table representation (e.g. zh3_q16, sh3_q28, sh2_q, sh3)"
                             : "comma-separated subset of the codec table") + (what.empty() ? "" : "; " + what);
-    if (!old_spelling.empty()) help += " (" + old_spelling + ": older spelling)";
+    if (!other_name.empty()) help += "; " + other_name + " is another name for -r, the same option";
     CLI::Option* opt = app->add_option(spelling, names, help)->type_name(one ? "NAME" : "NAME,...");
     if (one)
         opt->check(CLI::Validator(
@@ -245,6 +245,92 @@ std::string shown_path(const std::string& path, const std::string& base) {
     return rel.empty() ? p.generic_string() : rel.generic_string();
 }
 
+namespace {
+// The value of an INT/UINT option as plain decimal: an optional sign (only '+' for UINT), then
+// digits. CLI11 converts integers with base auto-detection (strtoll base 0): "020" would be octal
+// 16 and "0x10" hexadecimal 16, and a word reached the range check ("abc not in range"). Leading
+// zeros are dropped here, so the conversion after sees decimal.
+std::string decimal_integer(std::string& value, bool is_unsigned) {
+    std::string digits = value;
+    std::string sign;
+    if (!digits.empty() && (digits[0] == '+' || digits[0] == '-')) {
+        if (digits[0] == '-') sign = "-";
+        digits.erase(0, 1);
+    }
+    const bool all_digits = !digits.empty() && std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+    if (!all_digits) return "'" + value + "' is not a decimal integer";
+    if (is_unsigned && sign == "-") return "'" + value + "' is negative: a count or size is 0 or more";
+    const std::size_t first = digits.find_first_not_of('0');
+    digits = first == std::string::npos ? "0" : digits.substr(first);
+    value = sign + digits;
+    return "";
+}
+
+void parse_integers_as_decimal(CLI::App* app) {
+    for (CLI::Option* opt : app->get_options()) {
+        const std::string type = opt->get_type_name();
+        const bool is_unsigned = type.rfind("UINT", 0) == 0;
+        if (!is_unsigned && type.rfind("INT", 0) != 0) continue;
+        if (type.size() > (is_unsigned ? 4u : 3u) && type[is_unsigned ? 4 : 3] != ':') continue;  // e.g. "INTERVAL"
+        // transform() runs before the checks added earlier (CLI11 puts transforms first).
+        opt->transform(CLI::Validator([is_unsigned](std::string& v) { return decimal_integer(v, is_unsigned); }, "", "decimal"));
+    }
+    for (CLI::App* sub : app->get_subcommands({})) parse_integers_as_decimal(sub);
+}
+
+// The verb that was parsed, innermost ("lightmap encode": encode), and its words.
+const CLI::App* parsed_leaf(const CLI::App& app, std::string* words) {
+    const CLI::App* at = &app;
+    for (;;) {
+        const auto parsed = at->get_subcommands();
+        if (parsed.empty()) return at;
+        at = parsed.front();
+        *words += (words->empty() ? "" : " ") + at->get_name();
+    }
+}
+
+// The options that name a file the verb writes (the verb's folder and prefix outputs are checked
+// by the verb: demo's -o is a folder it creates, lightmap encode's -o a prefix).
+bool is_file_output(const std::string& verb, const CLI::Option& opt) {
+    for (const char* name : {"--html", "--markdown", "--depfile"})
+        if (opt.check_name(name)) return true;
+    return opt.check_name("--output") && verb != "demo" && verb != "lightmap encode";
+}
+
+// Before the work: every file output given must go to a folder that takes new files, and
+// --depfile needs a file output to name as its target. kExitOk, or the refusal's exit code.
+int check_outputs_before_work(const CLI::App& app) {
+    std::string verb;
+    const CLI::App* leaf = parsed_leaf(app, &verb);
+    bool depfile = false, writes_file = false;
+    for (const CLI::Option* opt : leaf->get_options()) {
+        if (opt->count() == 0) continue;
+        if (opt->check_name("--depfile")) depfile = true;
+        else if (opt->check_name("--output") || opt->check_name("--html") || opt->check_name("--markdown") || opt->check_name("--images"))
+            writes_file = true;
+        if (!is_file_output(verb, *opt)) continue;
+        const std::string option = opt->check_name("--output") ? "-o" : opt->get_name();
+        if (int rc = refuse_unwritable_output(option, opt->as<std::string>()); rc != kExitOk) return rc;
+    }
+    if (depfile && !writes_file) {
+        std::fprintf(stderr, "zhc: error: --depfile %s: zhc %s writes no file here, and a depfile needs one to name as its target "
+                             "(give %s; docs/build-integration.md)\n",
+                     depfile_path().c_str(), verb.c_str(), verb == "audit" ? "--markdown, --html or --images" : "--html");
+        return kExitOutputFailed;
+    }
+    return kExitOk;
+}
+}  // namespace
+
+int refuse_unwritable_output(const std::string& option, const std::string& path) {
+    if (Status s = check_folder_takes_files(path); !s) {
+        std::fprintf(stderr, "zhc: error: %s %s: %s (checked before the work; nothing was written)\n", option.c_str(), path.c_str(),
+                     s.error().message.c_str());
+        return kExitOutputFailed;
+    }
+    return kExitOk;
+}
+
 // CLI11 reports a verb it does not know as "A subcommand is required": name the word instead
 // ("unknown verb 'bogus'", "unknown verb 'gltf bogus'"). Empty when the verbs on the command line
 // are all known.
@@ -275,6 +361,9 @@ int main(int argc, char** argv) {
     std::stable_sort(registered.begin(), registered.end(), [](const Verb& a, const Verb& b) { return a.order < b.order; });
     std::vector<std::function<int()>> runners;
     for (const Verb& v : registered) runners.push_back(v.setup(app));
+    parse_integers_as_decimal(&app);
+    // Ctrl-C, kill, a closed terminal: the temporary files of unfinished outputs go too.
+    zhc::remove_temporaries_on_signals();
 
     try {
         app.parse(argc, argv);
@@ -300,6 +389,7 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < all.size() && i < runners.size(); ++i) {
         if (all[i]->parsed()) {
             try {
+                if (const int rc = check_outputs_before_work(app); rc != kExitOk) return rc;
                 return run_with_depfile(runners[i]);
             } catch (const std::exception& e) {
                 std::fprintf(stderr, "zhc: internal error: %s\n", e.what());

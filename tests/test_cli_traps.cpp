@@ -4,12 +4,21 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <regex>
+#include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "codec/probe/codec.h"
@@ -444,6 +453,386 @@ TEST(CliTraps, InfoDescribesTwoDimensionalTexturesImageMagickWrote) {
         EXPECT_EQ(j["faces"], 1);
         EXPECT_EQ(j["read_by_zhc"].get<std::string>().rfind("no: ", 0), 0u) << j["read_by_zhc"];
     }
+}
+
+// ---- Ctrl-C and kill: no temporary files left ----------------------------------------------------
+
+// The names in `dir` that contain ".tmp-" (the temp-then-rename writers' temporaries).
+std::vector<std::string> temporaries_in(const std::string& dir) {
+    std::vector<std::string> found;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().filename().string().find(".tmp-") != std::string::npos) found.push_back(e.path().filename().string());
+    return found;
+}
+
+struct SignalRun {
+    bool saw_temporary = false;  // a temporary appeared before the signal was sent
+    int status = 0;              // waitpid's
+};
+// Starts zhc with `args` (stdout/stderr to /dev/null), waits until a temporary file appears in
+// `dir` (at most 120 s), sends `sig`, and waits for the process. The child starts with the
+// default action for the three signals whatever the test runner had (a runner started in the
+// background ignores SIGINT, and an ignored signal stays ignored across exec).
+SignalRun run_and_signal(const std::vector<std::string>& args, const std::string& dir, int sig) {
+    std::vector<std::string> argv_s{ZHC_CLI_PATH};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : argv_s) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    SignalRun r;
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        for (const int s : {SIGINT, SIGTERM, SIGHUP}) ::signal(s, SIG_DFL);
+        const int null = ::open("/dev/null", O_RDWR);
+        ::dup2(null, 0);
+        ::dup2(null, 1);
+        ::dup2(null, 2);
+        ::execv(argv[0], argv.data());
+        ::_exit(127);
+    }
+    EXPECT_GT(pid, 0);
+    if (pid <= 0) return r;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (std::chrono::steady_clock::now() < deadline) {
+        if (!temporaries_in(dir).empty()) {
+            r.saw_temporary = true;
+            break;
+        }
+        if (::waitpid(pid, &r.status, WNOHANG) == pid) return r;  // ended before a temporary showed
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    ::kill(pid, sig);
+    ::waitpid(pid, &r.status, 0);
+    return r;
+}
+
+// lightmap synth, encode and decode stopped by SIGINT (Ctrl-C) and SIGTERM (kill) while they write:
+// the process ends by that signal (exit status "killed by SIGINT", as without the handler), no
+// *.tmp-PID-* file is left, and the outputs of an earlier run under the same names are untouched.
+TEST(CliTraps, SignalRemovesTemporariesAndKeepsFinalNames) {
+    const std::string dir = test::fresh_dir("traps_signals");
+    const std::string map = test::envmap_paths()[0];
+    // The earlier run's outputs (small), kept to compare bytes afterwards.
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", map, "-o", dir + "/lm.exr", "--size", "16"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", dir + "/lm.exr", "-o", dir + "/lm"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "decode", dir + "/lm", "-o", dir + "/lm_d.exr"}).exit_code, 0);
+    // The big jobs' input: 1024 x 1024 texels, one thread, small bands, so each job writes for a while.
+    const std::string big = dir + "/big.exr";
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", map, "-o", big, "--size", "1024", "--half"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", big, "-o", dir + "/big"}).exit_code, 0);
+    const std::vector<std::string> finals = {"lm.exr", "lm.iz.ktx2", "lm.d.ktx2", "lm.wa.ktx2", "lm_d.exr"};
+    std::vector<std::vector<std::uint8_t>> before;
+    for (const auto& f : finals) before.push_back(test::read_bytes(dir + "/" + f));
+    const std::vector<std::vector<std::string>> jobs = {
+        {"lightmap", "synth", map, "-o", dir + "/lm.exr", "--size", "1024", "--threads", "1", "--band-rows", "16"},
+        {"lightmap", "encode", big, "-o", dir + "/lm", "--threads", "1", "--band-rows", "16", "--quality", "slow"},
+        {"lightmap", "decode", dir + "/big", "-o", dir + "/lm_d.exr", "--band-rows", "16"},
+    };
+    for (const int sig : {SIGINT, SIGTERM}) {
+        for (const auto& job : jobs) {
+            SCOPED_TRACE(job[1] + " " + ::strsignal(sig));
+            const SignalRun r = run_and_signal(job, dir, sig);
+            EXPECT_TRUE(r.saw_temporary) << "the job ended before it wrote a temporary file";
+            EXPECT_TRUE(WIFSIGNALED(r.status)) << "status " << r.status;
+            if (WIFSIGNALED(r.status)) {
+                EXPECT_EQ(WTERMSIG(r.status), sig);
+            }
+            const auto left = temporaries_in(dir);
+            EXPECT_TRUE(left.empty()) << left.size() << " left, e.g. " << (left.empty() ? "" : left[0]);
+            for (const auto& t : left) fs::remove(dir + "/" + t);
+            for (size_t i = 0; i < finals.size(); ++i) EXPECT_EQ(test::read_bytes(dir + "/" + finals[i]), before[i]) << finals[i];
+        }
+    }
+}
+
+// A signal the process was started ignoring stays ignored (nohup, a background job): the command
+// runs to the end and writes its output.
+TEST(CliTraps, IgnoredSignalStaysIgnored) {
+    const std::string dir = test::fresh_dir("traps_signal_ignored");
+    const std::string out = dir + "/lm.exr";
+    // sh starts a background job with SIGINT ignored (and `trap '' INT` says so for any shell).
+    const std::string script = dir + "/run.sh";
+    const std::string text = "trap '' INT\n\"" + std::string(ZHC_CLI_PATH) + "\" lightmap synth '" + test::envmap_paths()[0] + "' -o '" + out +
+                             "' --size 512 --threads 1 --band-rows 8 >/dev/null 2>&1 &\npid=$!\n"
+                             "i=0; while ! ls '" + dir + "' | grep -q 'tmp-' && [ $i -lt 6000 ]; do sleep 0.01; i=$((i+1)); done\n"
+                             "ls '" + dir + "' | grep -q 'tmp-' || exit 99\nkill -INT $pid\nwait $pid\n";
+    test::write_bytes(script, std::vector<std::uint8_t>(text.begin(), text.end()));
+    const int status = std::system(("sh '" + script + "'").c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "99: no temporary seen before the job ended";
+    EXPECT_TRUE(fs::exists(out));
+    EXPECT_TRUE(temporaries_in(dir).empty());
+}
+
+// ---- lightmap encode: one prefix, one target ----------------------------------------------------
+
+std::set<std::string> files_in(const std::string& dir, const std::string& prefix) {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().filename().string().rfind(prefix, 0) == 0) names.insert(e.path().filename().string());
+    return names;
+}
+
+// The README's sequence (bc, then --target astc under the same prefix) and the other orders: after
+// each encode the prefix holds exactly that encode's planes plus the same target's other container,
+// each removed file is named in one note line, and decode reads the newest lightmap (the bytes a
+// fresh prefix decodes to).
+TEST(CliTraps, EncodeRemovesTheOtherTargetsPlanes) {
+    const std::string dir = test::fresh_dir("traps_stale_planes");
+    const std::string lm = dir + "/lm.exr";
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", test::envmap_paths()[0], "-o", lm, "--size", "24"}).exit_code, 0);
+    // Fresh-prefix references.
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", lm, "-o", dir + "/ref_bc"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", lm, "-o", dir + "/ref_astc", "--target", "astc"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "decode", dir + "/ref_bc", "-o", dir + "/ref_bc.exr"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "decode", dir + "/ref_astc", "-o", dir + "/ref_astc.exr"}).exit_code, 0);
+    const std::string p = dir + "/out";
+    struct Step {
+        std::vector<std::string> extra;
+        std::set<std::string> after;    // files "out.*" afterwards
+        std::set<std::string> removed;  // named in notes
+        std::string decodes_like;       // "" = no decode check
+    };
+    const std::vector<Step> steps = {
+        {{}, {"out.iz.ktx2", "out.d.ktx2", "out.wa.ktx2"}, {}, "ref_bc.exr"},
+        // The README's trap: astc after bc leaves no BC d / w_a planes.
+        {{"--target", "astc"}, {"out.iz.ktx2", "out.dwa.ktx2"}, {"out.d.ktx2", "out.wa.ktx2"}, "ref_astc.exr"},
+        {{}, {"out.iz.ktx2", "out.d.ktx2", "out.wa.ktx2"}, {"out.dwa.ktx2"}, "ref_bc.exr"},
+        // The same target in the other container is kept.
+        {{"--container", "dds"}, {"out.iz.ktx2", "out.d.ktx2", "out.wa.ktx2", "out.iz.dds", "out.d.dds", "out.wa.dds"}, {}, ""},
+        {{"--target", "astc-ldr"}, {"out.iz.ktx2", "out.dwa.ktx2"}, {"out.d.ktx2", "out.wa.ktx2", "out.iz.dds", "out.d.dds", "out.wa.dds"}, ""},
+        // bc in DDS after astc: the ASTC I_z plane (.iz.ktx2) goes with its d/w_a plane.
+        {{"--container", "dds"}, {"out.iz.dds", "out.d.dds", "out.wa.dds"}, {"out.iz.ktx2", "out.dwa.ktx2"}, "ref_bc.exr"},
+    };
+    for (size_t i = 0; i < steps.size(); ++i) {
+        const Step& st = steps[i];
+        SCOPED_TRACE("step " + std::to_string(i));
+        std::vector<std::string> args{"lightmap", "encode", lm, "-o", p};
+        args.insert(args.end(), st.extra.begin(), st.extra.end());
+        const auto r = test::run_zhc(args);
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_EQ(files_in(dir, "out."), st.after);
+        std::set<std::string> noted;
+        const std::regex note("zhc: note: removed " + dir + "/(out\\.[a-z.0-9]+): a (bc|astc) plane of an earlier encode under this prefix");
+        for (std::sregex_iterator it(r.err.begin(), r.err.end(), note), end; it != end; ++it) noted.insert((*it)[1]);
+        EXPECT_EQ(noted, st.removed) << r.err;
+        EXPECT_EQ(count_lines(r.err), st.removed.size()) << r.err;
+        if (!st.decodes_like.empty()) {
+            const std::string out = dir + "/dec" + std::to_string(i) + ".exr";
+            const auto d = test::run_zhc({"lightmap", "decode", p, "-o", out});
+            ASSERT_EQ(d.exit_code, 0) << d.err;
+            EXPECT_EQ(test::read_bytes(out), test::read_bytes(dir + "/" + st.decodes_like));
+        }
+    }
+    // A failed encode (an input that is not a lightmap) removes nothing.
+    const std::set<std::string> kept = files_in(dir, "out.");
+    const auto bad = test::run_zhc({"lightmap", "encode", dir + "/ref_bc.iz.ktx2", "-o", p, "--target", "astc"});
+    EXPECT_NE(bad.exit_code, 0);
+    EXPECT_EQ(files_in(dir, "out."), kept);
+}
+
+// ---- options the command would ignore or misread -------------------------------------------------
+
+TEST(CliTraps, FootprintWithoutAstcTargetRefused) {
+    const std::string dir = test::fresh_dir("traps_footprint");
+    const std::string lm = dir + "/lm.exr";
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", test::envmap_paths()[0], "-o", lm, "--size", "16"}).exit_code, 0);
+    for (const std::vector<std::string>& extra : {std::vector<std::string>{"--footprint", "6x6"}, {"--footprint", "4x4", "--target", "bc"},
+                                                  {"--footprint", "8x8", "--container", "dds"}}) {
+        std::vector<std::string> args{"lightmap", "encode", lm, "-o", dir + "/o"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const auto r = test::run_zhc(args);
+        EXPECT_EQ(r.exit_code, 2) << extra[1];
+        EXPECT_EQ(r.err.rfind("zhc: error: --footprint " + extra[1] + ": --target bc does not use it", 0), 0u) << r.err;
+        EXPECT_EQ(count_lines(r.err), 1u);
+        EXPECT_EQ(r.out, "");
+        EXPECT_TRUE(files_in(dir, "o.").empty());
+    }
+    // With an ASTC target it is used: 6x6 blocks are smaller than 4x4 ones.
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", lm, "-o", dir + "/a6", "--target", "astc", "--footprint", "6x6"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", lm, "-o", dir + "/a4", "--target", "astc"}).exit_code, 0);
+    EXPECT_LT(fs::file_size(dir + "/a6.dwa.ktx2"), fs::file_size(dir + "/a4.dwa.ktx2"));
+}
+
+// The verbs and their integer options, read from the help (every option whose type is INT or UINT).
+std::vector<std::pair<std::vector<std::string>, std::string>> integer_options() {
+    std::vector<std::pair<std::vector<std::string>, std::string>> found;
+    const std::vector<std::vector<std::string>> verbs = {{"project"}, {"convert"}, {"bake"}, {"audit"}, {"bench"}, {"demo"}, {"dering"},
+                                                         {"info"}, {"gltf", "embed"}, {"gltf", "extract"}, {"gltf", "eval"},
+                                                         {"lightmap", "encode"}, {"lightmap", "decode"}, {"lightmap", "audit"},
+                                                         {"lightmap", "synth"}};
+    const std::regex option(R"((--[a-z0-9-]+) U?INT\b)");
+    for (const auto& verb : verbs) {
+        std::vector<std::string> args = verb;
+        args.push_back("--help");
+        const auto r = test::run_zhc(args);
+        EXPECT_EQ(r.exit_code, 0) << verb[0];
+        for (std::sregex_iterator it(r.out.begin(), r.out.end(), option), end; it != end; ++it) found.push_back({verb, (*it)[1]});
+    }
+    return found;
+}
+
+// Integers are decimal in every option: "0x10" and "1e3" are refused naming the option (CLI11's
+// base auto-detection read them as 16 and refused "1e3" as out of range), a word says it is not a
+// number, and a leading zero is decimal ("020" is 20, not octal 16).
+TEST(CliTraps, IntegerOptionsAreDecimal) {
+    const auto options = integer_options();
+    std::set<std::string> names;
+    for (const auto& [verb, opt] : options) names.insert(opt);
+    // The ones the trap was found with, and the common ones: the help scan sees them.
+    for (const char* must : {"--threads", "--budget", "--size", "--band-rows", "--bits", "--zstd", "--directions", "--stride"})
+        EXPECT_TRUE(names.count(must)) << must;
+    EXPECT_GT(options.size(), 25u);
+    for (const auto& [verb, opt] : options) {
+        for (const char* bad : {"0x10", "abc", "1e3", "12abc"}) {
+            std::vector<std::string> args = verb;
+            args.push_back(opt);
+            args.push_back(bad);
+            const auto r = test::run_zhc(args);
+            EXPECT_EQ(r.exit_code, 2) << verb.back() << " " << opt << " " << bad;
+            EXPECT_NE(r.err.find(opt), std::string::npos) << r.err;
+            EXPECT_NE(r.err.find(std::string("'") + bad + "' is not a decimal integer"), std::string::npos) << r.err;
+            EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+        }
+    }
+    // UINT options refuse a sign (strtoull wrapped -1 to 2^64 - 1).
+    const auto neg = test::run_zhc({"audit", "x.json", "--budget", "-1"});
+    EXPECT_EQ(neg.exit_code, 2);
+    EXPECT_NE(neg.err.find("'-1' is negative"), std::string::npos) << neg.err;
+    // --budget 020 is budget 20: the same report as --budget 20, and another than --budget 16.
+    const std::string dir = test::fresh_dir("traps_decimal");
+    const std::string in = golden_json(dir);
+    auto audit = [&](const std::string& budget) {
+        const auto r = test::run_zhc({"audit", in, "--directions", "64", "--no-timing", "--json", "--budget", budget});
+        EXPECT_EQ(r.exit_code, 0) << budget << ": " << r.err;
+        return r.out;
+    };
+    const std::string b20 = audit("20");
+    EXPECT_EQ(audit("020"), b20);
+    EXPECT_EQ(audit("+0020"), b20);
+    EXPECT_NE(audit("16"), b20);
+    EXPECT_NE(b20.find("\"budget_bytes\": 20"), std::string::npos);
+    EXPECT_EQ(b20.find("\"budget_bytes\": 16,"), b20.find("\"budget_bytes\"")) << "16 is the first budget";
+    // --size 016 synthesises 16 x 16, byte for byte as --size 16.
+    const std::string map = test::envmap_paths()[0];
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", map, "-o", dir + "/a.exr", "--size", "016"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", map, "-o", dir + "/b.exr", "--size", "16"}).exit_code, 0);
+    EXPECT_EQ(test::read_bytes(dir + "/a.exr"), test::read_bytes(dir + "/b.exr"));
+    // Range checks still apply after the decimal reading: 0257 is 257, above --threads' 256.
+    const auto range = test::run_zhc({"project", map, "--threads", "0257"});
+    EXPECT_EQ(range.exit_code, 2);
+    EXPECT_NE(range.err.find("--threads"), std::string::npos) << range.err;
+}
+
+// ---- outputs checked before the work --------------------------------------------------------------
+
+// A file output whose folder takes no files: refused with exit 7 before the work (stdout empty:
+// the verbs print their report only after the work), naming the option, the path and the folder.
+void expect_refused_before_work(const std::vector<std::string>& args, const std::string& option, const std::string& path,
+                                const std::string& why) {
+    std::string cmd;
+    for (const auto& a : args) cmd += a + " ";
+    const auto r = test::run_zhc(args);
+    EXPECT_EQ(r.exit_code, 7) << cmd << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("zhc: error: " + option + " " + path + ": ", 0), 0u) << cmd << "\n" << r.err;
+    EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("checked before the work"), std::string::npos) << r.err;
+    EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+    EXPECT_EQ(r.out, "") << cmd;
+}
+
+TEST(CliTraps, UnwritableOutputFolderRefusedBeforeWork) {
+    const std::string dir = test::fresh_dir("traps_unwritable");
+    const std::string in = golden_json(dir);
+    const std::string scene = std::string(ZHC_TEST_DATA_DIR) + "/../conformance/inputs/scene.json";
+    const std::string lm = dir + "/lm.exr";
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", test::envmap_paths()[0], "-o", lm, "--size", "256"}).exit_code, 0);
+    test::write_bytes(dir + "/file", {'x'});
+    // Folders that take no file, for any user: missing, and a file where the folder should be.
+    struct Place {
+        std::string folder, why;
+    };
+    std::vector<Place> places = {{dir + "/missing", "the folder " + dir + "/missing does not exist"},
+                                 {dir + "/file", dir + "/file is not a folder"}};
+    // A read-only folder (root writes there anyway: checked where the tests run as another user).
+    const std::string ro = dir + "/read_only";
+    fs::create_directory(ro);
+    fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+    if (::geteuid() != 0) places.push_back({ro, "cannot create a file in the folder " + ro + " (Permission denied)"});
+    // Into a folder that takes files the bake runs and prints its report on stdout: an empty stdout
+    // below means the refusal came before the bake.
+    const auto bake_ok = test::run_zhc({"bake", scene, "-o", dir + "/ok.zhp"});
+    ASSERT_EQ(bake_ok.exit_code, 0) << bake_ok.err;
+    EXPECT_NE(bake_ok.out.find("bake total"), std::string::npos);
+    for (const Place& pl : places) {
+        SCOPED_TRACE(pl.folder);
+        expect_refused_before_work({"bake", scene, "-o", pl.folder + "/p.zhp"}, "-o", pl.folder + "/p.zhp", pl.why);
+        expect_refused_before_work({"audit", in, "-r", "sh3", "--directions", "64", "--html", pl.folder + "/r.html"}, "--html",
+                                   pl.folder + "/r.html", pl.why);
+        expect_refused_before_work({"audit", in, "-r", "sh3", "--directions", "64", "--markdown", pl.folder + "/r.md"}, "--markdown",
+                                   pl.folder + "/r.md", pl.why);
+        expect_refused_before_work({"lightmap", "audit", lm, "--html", pl.folder + "/l.html"}, "--html", pl.folder + "/l.html", pl.why);
+        expect_refused_before_work({"lightmap", "encode", lm, "-o", pl.folder + "/x"}, "-o", pl.folder + "/x.iz.ktx2", pl.why);
+        expect_refused_before_work({"lightmap", "encode", lm, "-o", pl.folder + "/x", "--container", "dds"}, "-o", pl.folder + "/x.iz.dds",
+                                   pl.why);
+        expect_refused_before_work({"convert", in, "-o", pl.folder + "/c.zhp", "-r", "zh3_q16"}, "-o", pl.folder + "/c.zhp", pl.why);
+        expect_refused_before_work({"convert", in, "-o", dir + "/c.zhp", "--depfile", pl.folder + "/c.d"}, "--depfile", pl.folder + "/c.d",
+                                   pl.why);
+        EXPECT_FALSE(fs::exists(dir + "/c.zhp"));
+    }
+    fs::permissions(ro, fs::perms::owner_all);
+    // A folder that takes files leaves no probe file behind.
+    EXPECT_TRUE(temporaries_in(dir).empty());
+}
+
+// --depfile with nothing to name as its target: refused before the work (audit prints its tables
+// only after it), exit 7 as documented (docs/build-integration.md).
+TEST(CliTraps, DepfileWithoutFileOutputRefusedBeforeWork) {
+    const std::string dir = test::fresh_dir("traps_depfile_target");
+    const std::string in = golden_json(dir);
+    const std::string lm = dir + "/lm.exr";
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", test::envmap_paths()[0], "-o", lm, "--size", "16"}).exit_code, 0);
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"audit", in, "--directions", "64", "--depfile", dir + "/a.d"}, {"lightmap", "audit", lm, "--depfile", dir + "/a.d"}}) {
+        const auto r = test::run_zhc(args);
+        EXPECT_EQ(r.exit_code, 7) << args[0];
+        EXPECT_EQ(r.err.rfind("zhc: error: --depfile " + dir + "/a.d: zhc " + (args[0] == "audit" ? "audit" : "lightmap audit") +
+                                  " writes no file here, and a depfile needs one",
+                              0),
+                  0u)
+            << r.err;
+        EXPECT_EQ(count_lines(r.err), 1u);
+        EXPECT_EQ(r.out, "");
+        EXPECT_FALSE(fs::exists(dir + "/a.d"));
+    }
+    // With a file output the depfile is written and names it.
+    const auto ok = test::run_zhc({"audit", in, "--directions", "64", "--markdown", dir + "/r.md", "--depfile", dir + "/a.d"});
+    ASSERT_EQ(ok.exit_code, 0) << ok.err;
+    const auto d = test::read_bytes(dir + "/a.d");
+    EXPECT_EQ(std::string(d.begin(), d.end()).rfind(dir + "/r.md:", 0), 0u);
+}
+
+// ---- help texts say what an option is ----------------------------------------------------------
+
+TEST(CliTraps, HelpTextsSayWhatOptionsAre) {
+    for (const std::vector<std::string>& verb :
+         {std::vector<std::string>{}, {"project"}, {"convert"}, {"bake"}, {"audit"}, {"bench"}, {"demo"}, {"dering"}, {"info"}, {"gltf"},
+          {"gltf", "embed"}, {"gltf", "extract"}, {"gltf", "eval"}, {"lightmap"}, {"lightmap", "encode"}, {"lightmap", "decode"},
+          {"lightmap", "audit"}, {"lightmap", "synth"}}) {
+        std::vector<std::string> args = verb;
+        args.push_back("--help");
+        const auto r = test::run_zhc(args);
+        ASSERT_EQ(r.exit_code, 0);
+        // (Value names are not history: lightmap encode's --solve takes "old", the talk's name for its baseline.)
+        const std::regex history(R"(\b(older|formerly|deprecated|legacy|used to|no longer|renamed|previously|was replaced|the old)\b)",
+                                 std::regex::icase);
+        std::smatch m;
+        EXPECT_FALSE(std::regex_search(r.out, m, history)) << (verb.empty() ? "zhc" : verb.back()) << ": '" << m.str() << "' in\n" << r.out;
+    }
+    // The second names say what they are.
+    EXPECT_NE(test::run_zhc({"bake", "--help"}).out.find("--to is another name for -r, the same option"), std::string::npos);
+    EXPECT_NE(test::run_zhc({"convert", "--help"}).out.find("--to is another name for -r, the same option"), std::string::npos);
+    EXPECT_NE(test::run_zhc({"gltf", "embed", "--help"}).out.find("--encoding is another name for -r, the same option"), std::string::npos);
 }
 
 }  // namespace

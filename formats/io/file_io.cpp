@@ -1,5 +1,7 @@
 #include "formats/io/file_io.h"
 
+#include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -139,13 +141,79 @@ Status FileRangeReader::read(std::uint64_t offset, std::uint8_t* out, std::size_
 }
 
 namespace {
+// The temporary files alive now, for the signal handler: fixed slots of static storage (the handler
+// may touch nothing else: no allocation, no locks). A slot's state is kFree, kBusy (being filled or
+// emptied by a normal thread: the handler skips it) or kLive (path holds a NUL-terminated name).
+// A name that does not fit, or a registration when every slot is live, is not tracked: that
+// temporary is still removed on every normal path, only not on a signal.
+constexpr int kFree = 0, kBusy = 1, kLive = 2;
+constexpr std::size_t kTemporarySlots = 128, kTemporaryPathBytes = 4096;
+struct TemporarySlot {
+    std::atomic<int> state{kFree};
+    char path[kTemporaryPathBytes];
+};
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads the slot states");
+TemporarySlot g_temporaries[kTemporarySlots];
+
+void register_temporary(const std::string& path) {
+    if (path.size() >= kTemporaryPathBytes) return;
+    for (TemporarySlot& slot : g_temporaries) {
+        int expected = kFree;
+        if (!slot.state.compare_exchange_strong(expected, kBusy)) continue;
+        std::memcpy(slot.path, path.c_str(), path.size() + 1);
+        slot.state.store(kLive);
+        return;
+    }
+}
+
+extern "C" void remove_temporaries_and_reraise(int sig) {
+    // Async-signal-safe only: atomic loads, unlink, sigaction, raise. A temporary already renamed
+    // over its final name is gone under its temporary name: unlink fails and the output stays.
+    const int saved_errno = errno;
+    for (TemporarySlot& slot : g_temporaries)
+        if (slot.state.load() == kLive) ::unlink(slot.path);
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    ::sigemptyset(&dfl.sa_mask);
+    ::sigaction(sig, &dfl, nullptr);
+    errno = saved_errno;
+    ::raise(sig);  // the default action: the process ends by this signal, as without the handler
+}
+
 std::string temporary_name_for(const std::string& path) {
     std::random_device rd;
     char suffix[32];
     std::snprintf(suffix, sizeof suffix, ".tmp-%d-%08x", static_cast<int>(::getpid()), rd());
-    return path + suffix;
+    const std::string name = path + suffix;
+    register_temporary(name);
+    return name;
 }
 }  // namespace
+
+void release_temporary_path(const std::string& path) {
+    for (TemporarySlot& slot : g_temporaries) {
+        if (slot.state.load() != kLive || path.size() >= kTemporaryPathBytes || std::strcmp(slot.path, path.c_str()) != 0) continue;
+        int expected = kLive;
+        if (!slot.state.compare_exchange_strong(expected, kBusy)) continue;
+        slot.state.store(kFree);
+        return;
+    }
+}
+
+void remove_temporaries_on_signals() {
+    for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+        struct sigaction old {};
+        if (::sigaction(sig, nullptr, &old) != 0) continue;
+        // A signal the process was started ignoring (nohup, a background job's SIGINT) stays ignored,
+        // and a handler someone else installed stays theirs.
+        if ((old.sa_flags & SA_SIGINFO) || old.sa_handler != SIG_DFL) continue;
+        struct sigaction sa {};
+        sa.sa_handler = remove_temporaries_and_reraise;
+        ::sigemptyset(&sa.sa_mask);
+        for (const int other : {SIGINT, SIGTERM, SIGHUP}) ::sigaddset(&sa.sa_mask, other);  // one cleanup at a time
+        ::sigaction(sig, &sa, nullptr);
+    }
+}
 
 Status write_via_temporary(const std::string& path, const std::function<Status(const std::string&)>& writer) {
     const std::string tmp = temporary_name_for(path);
@@ -153,13 +221,16 @@ Status write_via_temporary(const std::string& path, const std::function<Status(c
     std::error_code ec;
     if (!st) {
         fs::remove(tmp, ec);
+        release_temporary_path(tmp);
         return st;
     }
     fs::rename(tmp, path, ec);
     if (ec) {
         fs::remove(tmp, ec);
+        release_temporary_path(tmp);
         return make_error(ErrorCode::kIoError, path + ": cannot write (" + ec.message() + ")");
     }
+    release_temporary_path(tmp);
     record_output(path);
     return Ok{};
 }
@@ -189,7 +260,10 @@ void AtomicFileSet::discard() {
         if (f) std::fclose(f);
     files_.clear();
     std::error_code ec;
-    for (const auto& t : temps_) fs::remove(t, ec);
+    for (const auto& t : temps_) {
+        fs::remove(t, ec);
+        release_temporary_path(t);
+    }
     temps_.clear();
     paths_.clear();
     written_.clear();
@@ -204,6 +278,7 @@ Status AtomicFileSet::open(const std::vector<std::string>& paths) {
         std::FILE* f = std::fopen(temps_.back().c_str(), "wb");
         if (!f) {
             const Error e = make_error(ErrorCode::kIoError, path + ": cannot create (" + std::strerror(errno) + ")");
+            release_temporary_path(temps_.back());
             temps_.pop_back();  // never created
             discard();
             return e;
@@ -257,6 +332,7 @@ Status AtomicFileSet::commit() {
         renamed.push_back(paths_[i]);
     }
     for (const auto& path : paths_) record_output(path);
+    for (const auto& t : temps_) release_temporary_path(t);
     files_.clear();
     temps_.clear();
     paths_.clear();
@@ -275,6 +351,24 @@ Status write_files_atomic(const std::vector<std::pair<std::string, std::vector<s
 }
 
 std::string temporary_path_for(const std::string& path) { return temporary_name_for(path); }
+
+Status check_folder_takes_files(const std::string& path) {
+    const fs::path parent = fs::path(path).parent_path();
+    const std::string folder = (parent.empty() ? fs::path(".") : parent).string();
+    const std::string tmp = temporary_name_for(path);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    const int err = errno;
+    if (fd >= 0) {
+        ::close(fd);
+        ::unlink(tmp.c_str());
+    }
+    release_temporary_path(tmp);
+    if (fd >= 0) return Ok{};
+    std::error_code ec;
+    if (!fs::exists(folder, ec)) return make_error(ErrorCode::kIoError, "the folder " + folder + " does not exist");
+    if (!fs::is_directory(folder, ec)) return make_error(ErrorCode::kIoError, folder + " is not a folder");
+    return make_error(ErrorCode::kIoError, "cannot create a file in the folder " + folder + " (" + std::strerror(err) + ")");
+}
 
 std::string file_extension(const std::string& path) {
     std::string ext = fs::path(path).extension().string();

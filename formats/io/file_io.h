@@ -1,10 +1,11 @@
 // zhc/formats/io/file_io.h — bounded file reads and atomic file writes.
 //
 // Thread safety (docs/api.md): every function here is reentrant; calls may run concurrently
-// on different files and arguments. The one process-wide state is the FileRecorder that a
+// on different files and arguments. The process-wide state is the FileRecorder that a
 // ScopedFileRecording installs (below): it observes which files are opened and written, under its
-// own lock, and never changes what a call does. There is one recorder per process, so run one
-// recording at a time: two concurrent recordings would each see the other's files.
+// own lock, and never changes what a call does (there is one recorder per process, so run one
+// recording at a time: two concurrent recordings would each see the other's files); and the table
+// of live temporary names that remove_temporaries_on_signals' handler removes (lock-free slots).
 #pragma once
 
 #include <cstdint>
@@ -92,8 +93,28 @@ private:
 // is given; on success that file is renamed over `path`, on failure it is removed.
 Status write_via_temporary(const std::string& path, const std::function<Status(const std::string&)>& writer);
 
-// A fresh temporary name next to `path` (the one write_via_temporary and AtomicFileSet use).
+// A fresh temporary name next to `path` (the one write_via_temporary and AtomicFileSet use):
+// `path` + ".tmp-PID-XXXXXXXX". The name is registered for removal on a signal (below) until
+// release_temporary_path(name), which the caller calls once the file is renamed or removed.
 std::string temporary_path_for(const std::string& path);
+void release_temporary_path(const std::string& temporary);
+
+// Whether a file can be created next to `path`, found by creating and removing a temporary file
+// there (so permissions, a read-only mount, a missing folder and a file in place of the folder
+// all show, for any user). Errors (kIoError) say what is wrong with the folder, without `path`.
+// For commands that check their outputs before a long computation; the write itself still
+// reports its own failures.
+Status check_folder_takes_files(const std::string& path);
+
+// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove every registered temporary file
+// (the writers above, and any temporary_path_for name not yet released) and then end the process
+// by the same signal with its default action, so the exit status still says "killed by SIGINT".
+// Final names are never touched: a file renamed into place is no longer a temporary. A signal
+// that is ignored or already has a handler when this is called is left alone. The zhc CLI calls
+// it first thing; a program using the library may call it too. The handler is async-signal-safe
+// (it reads fixed static slots: at most 128 live temporaries of under 4096 bytes are tracked;
+// beyond that a temporary is removed on every normal path, only not on a signal).
+void remove_temporaries_on_signals();
 
 // Which files a command read and wrote, for build systems (`--depfile`, `zhc info --inputs`;
 // docs/build-integration.md). While a FileRecorder is installed (ScopedFileRecording), every

@@ -366,6 +366,7 @@ public:
         if (!tmp_.empty()) {
             std::error_code ec;
             std::filesystem::remove(tmp_, ec);
+            release_temporary_path(tmp_);
         }
     }
     Status open(const std::string& path, int w, int h, const std::vector<std::string>& names, bool half, int threads) {
@@ -425,6 +426,7 @@ public:
         std::error_code ec;
         std::filesystem::rename(tmp_, path_, ec);
         if (ec) return make_error(ErrorCode::kIoError, path_ + ": cannot write (" + ec.message() + ")");
+        release_temporary_path(tmp_);
         tmp_.clear();
         record_output(path_);
         return Ok{};
