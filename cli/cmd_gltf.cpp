@@ -1,5 +1,5 @@
 // zhc gltf embed SCENE.gltf|.glb PROBES -o OUT.glb|.gltf [--encoding NAME] [--sh-axes zhc|gltf]
-//                [--draco] [--draco-bits N] [--replace]
+//                [--draco] [--draco-bits N] [--name NAME] [--replace]
 // zhc gltf extract IN.glb|.gltf -o PROBES.zhp|.json [--volume I]
 // zhc gltf eval IN.glb|.gltf --probe I --dir X,Y,Z [--volume V]
 //
@@ -22,7 +22,7 @@ namespace cmd_gltf {  // one namespace per verb file: the CLI is a unity build
 namespace {
 
 struct Options {
-    std::string scene, probes, input, output, encoding, sh_axes = "zhc";
+    std::string scene, probes, input, output, encoding, sh_axes = "zhc", name = GltfEmbedOptions{}.name;
     bool draco = false, replace = false;
     int draco_bits = 0;
     std::size_t volume = 0;
@@ -67,6 +67,7 @@ int run_embed(const Options& o) {
     eo.sh_axes = o.sh_axes == "gltf" ? GltfShAxes::kGltf : GltfShAxes::kZhc;
     eo.draco = o.draco;
     eo.draco_bits = o.draco_bits;
+    eo.name = o.name;
     eo.replace = o.replace;
     eo.output_path = o.output;
     auto out = embed_probes_gltf(*scene, o.scene, *set, eo);
@@ -174,8 +175,10 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
         ->check(CLI::IsMember({"zhc", "gltf"}));
     embed->add_flag("--draco", o->draco, "store positions + coefficients as a Draco point cloud (points layout, sh3/sh2)");
     embed->add_option("--draco-bits", o->draco_bits, "Draco quantisation bits (0 = lossless, default)")->check(CLI::Range(0, 30));
+    embed->add_option("--name", o->name, "volume (and node) name (default zhc_probes)")
+        ->check([](const std::string& v) { return v.empty() ? std::string("the volume name is empty") : std::string(); });
     embed->add_flag("--replace", o->replace,
-                    "replace the scene's volume of the same name (zhc_probes) in place; without it such a scene is refused");
+                    "replace the scene's volume of the same name in place; without it such a scene is refused");
     add_depfile_option(embed);
     CLI::App* extract = sub->add_subcommand("extract", "Read a ZHC_light_probes volume back into a probe file");
     extract->add_option("IN", o->input, "glTF asset (.gltf or .glb)")->required();

@@ -501,8 +501,8 @@ TEST(GltfInputs, BakeIntoCompressedAssetsRoundTrips) {
 
 // gltf embed onto an asset that already has a volume of the name it writes (zhc_probes): refused
 // (exit 2, naming the volume, nothing written) unless --replace, which replaces that volume in
-// place: still one volume, the same node referencing it, and extract returns the new probes.
-// A bake of an already baked asset replaces its volume the same way.
+// place: still one volume, the same node referencing it, and extract returns the new probes;
+// --name adds a volume of another name. A bake of an already baked asset replaces its volume.
 TEST(GltfInputs, EmbedOntoAnExistingVolumeRefusedOrReplaced) {
     const std::string dir = test::fresh_dir("gltf_inputs_replace");
     ASSERT_EQ(test::run_zhc({"bake", data("gt_list.glb"), "-o", dir + "/lit.glb", "--quiet"}).exit_code, 0);
@@ -521,6 +521,16 @@ TEST(GltfInputs, EmbedOntoAnExistingVolumeRefusedOrReplaced) {
     }
     auto other = read_probe_file(dir + "/other.zhp");
     ASSERT_TRUE(other.ok());
+    // Another name adds a second volume, the first kept.
+    const auto named = test::run_zhc({"gltf", "embed", dir + "/lit.glb", dir + "/other.zhp", "-o", dir + "/two.glb", "--name", "other"});
+    ASSERT_EQ(named.exit_code, 0) << named.err;
+    auto two = read_gltf_probes_file(dir + "/two.glb");
+    ASSERT_TRUE(two.ok()) << two.error().message;
+    ASSERT_EQ(two->volumes.size(), 2u);
+    EXPECT_EQ(two->volumes[0].name, "zhc_probes");
+    EXPECT_EQ(two->volumes[0].set.representation, "sh3");
+    EXPECT_EQ(two->volumes[1].name, "other");
+    EXPECT_EQ(two->volumes[1].set.payload, other->payload);
     for (const char* out : {"/replaced.glb", "/replaced.gltf"}) {
         SCOPED_TRACE(out);
         const auto r = test::run_zhc({"gltf", "embed", dir + "/lit.glb", dir + "/other.zhp", "-o", dir + out, "--replace"});

@@ -187,7 +187,7 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
             return make_error(ErrorCode::kInvalidArgument, scene_path + ": already has a " + kGltfProbeExtension + " volume named '" +
                                                                options.name + "' (extensions." + kGltfProbeExtension + ".volumes[" +
                                                                std::to_string(*replaced) + "]): refusing to add a second one of that name "
-                                                               "(zhc gltf embed --replace replaces it)");
+                                                               "(zhc gltf embed --replace replaces it, --name NAME adds a volume of another name)");
     }
     // The output is the input's own JSON (order and values kept by ordered_json) with our
     // additions; tinygltf's model only supplies the bytes of each buffer.

@@ -151,8 +151,10 @@ fs.writeFileSync(W('grid.json'), JSON.stringify({ format: 'zhc-probes', version:
   probes: probes.slice(0, 24).map((sh3) => ({ sh3 })) }));
 const { json: triJson, bin: triBin } = triangleSceneParts();
 fs.writeFileSync(W('tri.glb'), glb(triJson, triBin));
-run(['gltf', 'embed', W('baked_zh3_q16.glb'), W('points.json'), '-o', W('two_volumes_draco14.glb'), '--draco', '--draco-bits', '14']);
-run(['gltf', 'embed', W('two_volumes_draco14.glb'), W('points.json'), '-o', W('three_volumes_draco_lossless.glb'), '--draco']);
+run(['gltf', 'embed', W('baked_zh3_q16.glb'), W('points.json'), '-o', W('two_volumes_draco14.glb'), '--draco', '--draco-bits', '14',
+  '--name', 'points_draco14']);
+run(['gltf', 'embed', W('two_volumes_draco14.glb'), W('points.json'), '-o', W('three_volumes_draco_lossless.glb'), '--draco',
+  '--name', 'points_draco_lossless']);
 run(['gltf', 'embed', W('tri.glb'), W('points.json'), '-o', W('points_sh3_gltf_axes.glb'), '--sh-axes', 'gltf']);
 run(['gltf', 'embed', W('tri.glb'), W('grid.json'), '-o', W('grid_sh2_q.gltf'), '--encoding', 'sh2_q']);
 inputs.push({ name: 'two_volumes_draco14.glb', file: W('two_volumes_draco14.glb') });
