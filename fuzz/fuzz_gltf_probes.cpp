@@ -1,7 +1,8 @@
 // ZHC_light_probes reading (formats/probes/gltf_probes.h) from untrusted GLB / glTF JSON bytes. Inputs
 // live in a directory that does not exist, so any external URI fails (the URI checks and the
 // file-system guard are exercised without touching real files). A successful read gives valid sets;
-// embedding one back into the same asset and reading again gives the same bytes.
+// embedding one back into the same asset (as a volume of a new name) and reading again gives the
+// same bytes.
 #include <cstdint>
 #include <cstdlib>
 
@@ -27,6 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const zhc::ProbeSet& set = s->volumes[0].set;
     zhc::GltfEmbedOptions o;
     o.binary = (size & 1) != 0;
+    o.name = "zhc_fuzz_embedded";  // a volume of a name the asset already has is refused (GltfEmbedOptions::replace)
     auto out = zhc::embed_probes_gltf({data, size}, path, set, o, limits);
     if (!out) return 0;  // e.g. the grown asset exceeds a limit
     auto back = zhc::read_gltf_probes(*out, path, limits);
