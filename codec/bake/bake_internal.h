@@ -1,0 +1,23 @@
+// zhc/codec/bake/bake_internal.h — helpers the bake's files share (not installed, not API).
+#pragma once
+
+#include <string>
+
+#include "codec/bake/scene.h"
+
+namespace zhc::bake_detail {
+
+// Shadow-ray start offset: rays start a hair off the probe so a probe lying exactly on an
+// occluder's surface is not blocked by that surface's own boundary test. Scale-free enough for
+// scenes in metres (1e-9 m).
+constexpr double kRayEpsilon = 1e-9;
+
+// acc (27 doubles, coefficient-major RGB) += w[k] * Y(d).
+void add_weighted_basis(Vec3 d, const double w[3], double acc[27]);
+bool finite3(Vec3 v);
+// Finite and >= 0 in every channel.
+bool colour_ok(Rgb c);
+// The report's name of a light: "sun 'key'", "point 'lamp'", "directional", ...
+std::string effect_name(const SceneLight& l);
+
+}  // namespace zhc::bake_detail
