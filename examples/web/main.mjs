@@ -1,8 +1,10 @@
 // A glTF baked by zhc, lit by its own probes in three.js (WebGL2):
 //
-//   zhc bake ../hall.gltf -o hall.glb -r zh3_q16
+//   zhc bake ../hall.gltf -o hall.glb -r zh3_q16        index.html
+//   zhc bake ../hall.gltf -o hall.zhp -r zh3_q16        index.html?gltf=../hall.gltf&zhp=hall.zhp
 //
-// 1. GLTFLoader with ZhcLightProbesPlugin loads the asset and decodes its ZHC_light_probes volume;
+// 1. GLTFLoader with ZhcLightProbesPlugin loads the asset and decodes its ZHC_light_probes volume
+//    (or, with ?zhp=, the probes come from a .zhp file next to an asset that has none);
 // 2. the asset's KHR_lights_punctual lights are hidden: their light is already in the probes;
 // 3. the compact volume (the probes' stored bytes in a 3D texture, decoded in the shader) lights the
 //    asset's materials and a white sphere that moves through the volume: each fragment gets the
@@ -11,11 +13,13 @@
 // The page's state is on window.zhcExample (the test tests/js/web_example.mjs samples it).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { volumeFromZhp, volumeIrradiance } from '@zhc/runtime';
 import { ZhcLightProbesPlugin } from '@zhc/runtime/three';
-import { patchMaterialWithVolume } from '@zhc/runtime/volume';
+import { compactVolumeFromZhp, patchMaterialWithVolume } from '@zhc/runtime/volume';
 
 const query = new URLSearchParams(location.search);
 const url = query.get('gltf') ?? './hall.glb';
+const zhpUrl = query.get('zhp');
 const info = document.getElementById('info');
 
 const canvas = document.getElementById('view');
@@ -27,8 +31,23 @@ renderer.toneMapping = THREE.ACESFilmicToneMapping;
 const loader = new GLTFLoader();
 loader.register((parser) => new ZhcLightProbesPlugin(parser));
 const gltf = await loader.loadAsync(url);
-const volume = gltf.userData.zhcLightProbes?.[0];
-if (!volume || volume.layout !== 'grid') throw new Error(`${url}: no ZHC_light_probes grid volume (bake with zhc bake ... -o ${url})`);
+// The probes: the asset's first volume, or a .zhp file's grid.
+let volume, compact, sample;
+if (zhpUrl) {
+  const response = await fetch(zhpUrl);
+  if (!response.ok) throw new Error(`${zhpUrl}: HTTP ${response.status}`);
+  const bytes = new Uint8Array(await response.arrayBuffer());
+  // A .zhp grid is in zhc's axes (Z up): (x, y, z)_glTF = (y, z, x)_zhc places it in the scene.
+  const zhcToGltf = new THREE.Matrix4().set(0, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 0, 0, 1);
+  compact = compactVolumeFromZhp(bytes, { THREE, matrixWorld: zhcToGltf });
+  const decoded = volumeFromZhp(bytes);
+  volume = { name: zhpUrl, encoding: compact.encoding, grid: decoded };
+  sample = (p, n) => volumeIrradiance(decoded, p, n);
+} else {
+  volume = gltf.userData.zhcLightProbes?.[0];
+  if (!volume || volume.layout !== 'grid') throw new Error(`${url}: no ZHC_light_probes grid volume (bake with zhc bake ... -o ${url})`);
+  sample = (p, n) => volume.irradianceAt(p, n);
+}
 
 // 2. The baked punctual lights: GLTFLoader creates them from KHR_lights_punctual, and the bake put
 // their light into the probes. Hidden lights light nothing (and keep their nodes and targets).
@@ -50,7 +69,7 @@ gltf.scene.traverse((object) => {
 
 // 3. The compact volume (zh3_q16, sh3_q28, sh2_q and the other packed grids; `zhc bake -r zh3_q16`),
 // placed by the volume's node; every material of the asset is patched once.
-const compact = volume.compactVolume();
+compact ??= volume.compactVolume();
 const patched = new Set();
 gltf.scene.traverse((object) => {
   if (!object.isMesh) return;
@@ -82,14 +101,14 @@ scene.add(mover);
 function pathAt(t) {
   return new THREE.Vector3(centre.x + 0.35 * size.x * Math.cos(t), centre.y, centre.z + 0.35 * size.z * Math.sin(t));
 }
-// Irradiance at a world point for a world normal, from the decoded probes (the node's local frame).
+// Irradiance at a world point for a world normal, from the decoded probes (in the grid's frame).
 // Points map by the inverse of the node's matrixWorld M, normals by the transpose of M's 3x3.
 const worldToNode = new THREE.Matrix4().fromArray(compact.worldToGrid);
 const normalToNode = new THREE.Matrix3().setFromMatrix4(new THREE.Matrix4().fromArray(compact.matrixWorld)).transpose();
 function irradianceAtWorld(point, normal) {
   const p = point.clone().applyMatrix4(worldToNode);
   const n = normal.clone().applyMatrix3(normalToNode);
-  return volume.irradianceAt(p.toArray(), n.toArray());
+  return sample(p.toArray(), n.toArray());
 }
 
 const camera = new THREE.PerspectiveCamera(50, 1, 0.05, 200);

@@ -16,7 +16,8 @@ const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 async function main() {
   const report = { errors: window.zhcErrors, three: THREE.REVISION };
-  for (let i = 0; i < 1200 && !(window.zhcExample && window.zhcExample.frames >= 5); i++) await sleep(100);
+  // Up to 120 s for 5 frames; an error in the page (the example failed to start) ends the wait.
+  for (let i = 0; i < 1200 && !(window.zhcExample && window.zhcExample.frames >= 5) && window.zhcErrors.length === 0; i++) await sleep(100);
   const ex = window.zhcExample;
   report.ready = !!ex && ex.frames >= 5;
   if (!report.ready) return report;
