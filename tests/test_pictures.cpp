@@ -162,3 +162,47 @@ TEST(Pictures, AuditImagesAreReadableAndCompact) {
             EXPECT_GT(differ, static_cast<size_t>(sh * sw / 4)) << "error strips " << a << " and " << b << " look alike";
         }
 }
+
+// Long representation names and file names fit: the label column widens to the longest label
+// (zh3_solved_channel_q16 is wider than the 170-pixel default) and the canvas to the title, so no
+// label runs under its strip and no title runs off the picture.
+TEST(Pictures, AuditImagesFitLongLabelsAndTitles) {
+    const std::string dir = zhc::test::fresh_dir("pictures_audit_labels");
+    const std::string map = dir + "/a_map_with_a_rather_long_file_name_for_the_title_line.hdr";
+    fs::copy_file(std::string(ZHC_TEST_DATA_DIR) + "/hdr/simple-rle.hdr", map);
+    const auto r = zhc::test::run_zhc({"audit", map, "--representations", "sh3,zh3_solved_channel_q16,zh3_solved_channel", "--no-timing",
+                                       "--directions", "64", "--images", dir + "/img"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto img = decode_image_rgb8(zhc::test::read_bytes(dir + "/img/a_map_with_a_rather_long_file_name_for_the_title_line.png"));
+    ASSERT_TRUE(img.ok());
+    const int text_px = 17, pad = 8, title_h = 34, sh = 128, sw = 256;
+    const int widest = Canvas::text_width("zh3_solved_channel_q16", text_px);
+    ASSERT_GT(pad + widest + pad, 170);  // the default column would clip it
+    const int label_w = pad + widest + pad;
+    auto px = [&](int x, int y) { return &img->rgb[(static_cast<size_t>(y) * img->width + x) * 3]; };
+    auto background = [&](int x, int y) {
+        const std::uint8_t* p = px(x, y);
+        return p[0] == 32 && p[1] == 32 && p[2] == 36;
+    };
+    for (int row = 0; row < 4; ++row) {
+        SCOPED_TRACE(row);
+        const int y0 = title_h + row * (sh + pad);
+        // The label's ink ends before the column does; the gap before the strip is empty.
+        int right = -1;
+        for (int y = y0; y < y0 + sh; ++y)
+            for (int x = 0; x < label_w + pad; ++x)
+                if (!background(x, y)) right = std::max(right, x);
+        EXPECT_GT(right, pad);           // a label is drawn
+        EXPECT_LT(right, label_w - 1);   // and ends inside its column
+        // The strip starts right after the gap.
+        EXPECT_FALSE(background(label_w + pad, y0 + sh / 2));
+        EXPECT_FALSE(background(label_w + pad + sw - 1, y0 + sh / 2));
+    }
+    // The title's ink stays inside the picture with room to spare.
+    int title_right = -1;
+    for (int y = 0; y < title_h; ++y)
+        for (int x = 0; x < img->width; ++x)
+            if (!background(x, y)) title_right = std::max(title_right, x);
+    EXPECT_GT(title_right, label_w + sw);  // the long title is wider than the strips' start
+    EXPECT_LT(title_right, img->width - pad / 2);
+}

@@ -201,11 +201,18 @@ Status write_audit_images(const std::string& dir, const AuditInput& input, const
     }
     const ErrorScale scale = ErrorScale::from_percentile(errors);
 
-    const int text_px = 17, title_px = 20, label_w = 170, pad = 8, title_h = 34, legend_h = 62;
+    // The label column is as wide as the longest label (at least 170 pixels, so that the strips
+    // of pictures with short names line up); the canvas at least as wide as the title.
+    const int text_px = 17, title_px = 20, pad = 8, title_h = 34, legend_h = 62;
+    int widest = Canvas::text_width("reference", text_px);
+    for (const Codec* codec : codecs) widest = std::max(widest, Canvas::text_width(std::string(codec->name), text_px));
+    const int label_w = std::max(170, pad + widest + pad);
+    const std::string title = fs::path(input.path).filename().string() + ": irradiance (tone-mapped) | error / mean";
     const int rows = 1 + static_cast<int>(codecs.size());
-    Canvas canvas(label_w + 2 * sw + 3 * pad + 28, title_h + rows * (sh + pad) + legend_h, {32, 32, 36});
+    Canvas canvas(std::max(label_w + 2 * sw + 3 * pad + 28, 2 * pad + Canvas::text_width(title, title_px)),
+                  title_h + rows * (sh + pad) + legend_h, {32, 32, 36});
     const Rgb8 white{235, 235, 235}, magenta{255, 0, 255};
-    canvas.text(pad, 7, fs::path(input.path).filename().string() + ": irradiance (tone-mapped) | error / mean", title_px, white);
+    canvas.text(pad, 7, title, title_px, white);
     auto draw_row = [&](int row, const std::string& label, const std::vector<Rgb>& rec, bool with_error) {
         const int y0 = title_h + row * (sh + pad);
         canvas.text(pad, y0 + sh / 2 - text_px / 2, label, text_px, white);
