@@ -479,6 +479,12 @@ TEST(GltfInputs, MeshoptPlaceholderWithoutFallbackFlag) {
     const std::string bad_text = bad.dump();
     test::write_bytes(bad_dir + "/bad.gltf", std::vector<std::uint8_t>(bad_text.begin(), bad_text.end()));
     expect_refused(bad_dir + "/bad.gltf", 4, "buffers[1]: no uri");
+    // So does one that is a compressed view's source.
+    bad = json::parse(test::read_bytes(data("gltf-pipeline/EXT_meshopt_compression/meshopt-no-fallback/meshopt-no-fallback.gltf")));
+    bad["bufferViews"][2]["extensions"]["EXT_meshopt_compression"]["buffer"] = 1;
+    const std::string source_text = bad.dump();
+    test::write_bytes(bad_dir + "/source.gltf", std::vector<std::uint8_t>(source_text.begin(), source_text.end()));
+    expect_refused(bad_dir + "/source.gltf", 4, "buffers[1]: no uri");
 }
 
 // Probes baked into a copy of a compressed asset: the fallback buffer stays uri-less, the copy

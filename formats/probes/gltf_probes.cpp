@@ -297,10 +297,12 @@ Result<Loaded> load(std::span<const std::uint8_t> bytes, const std::string& path
     std::vector<std::uint8_t> patched_glb;
     std::string patched_text;
     std::vector<size_t> placeholder_buffers;
-    if (out.doc.contains("buffers"))
+    if (out.doc.contains("buffers")) {
+        const std::vector<bool> placeholder = meshopt_placeholders(out.doc);
         for (size_t i = 0; i < out.doc["buffers"].size(); ++i)
-            if (!out.doc["buffers"][i].contains("uri") && is_meshopt_placeholder(out.doc, i) && !(i == 0 && out.binary && glb.has_bin))
+            if (!out.doc["buffers"][i].contains("uri") && placeholder[i] && !(i == 0 && out.binary && glb.has_bin))
                 placeholder_buffers.push_back(i);
+    }
     // A base64 data: URI holding more bytes than its buffer's byteLength is valid glTF (as a
     // longer .bin file is): tinygltf is shown the decoded length and the buffer is cut back to
     // byteLength after loading. One holding fewer is refused here, naming the buffer.

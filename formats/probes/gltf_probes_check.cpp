@@ -59,25 +59,35 @@ const json* meshopt_of_view(const json& view) {
     return nullptr;
 }
 
-bool refers_to(const json& obj, size_t buffer) {
-    return obj.is_object() && obj.contains("buffer") && obj["buffer"].is_number_unsigned() && obj["buffer"].get<std::uint64_t>() == buffer;
+// The buffer index an object's "buffer" names, or n (none, or not an index below n).
+size_t buffer_of(const json& obj, size_t n) {
+    if (!obj.is_object() || !obj.contains("buffer") || !obj["buffer"].is_number_unsigned()) return n;
+    const std::uint64_t b = obj["buffer"].get<std::uint64_t>();
+    return b < n ? static_cast<size_t>(b) : n;
 }
 
 }  // namespace
 
-bool is_meshopt_placeholder(const json& doc, size_t buffer) {
-    if (!doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array() || buffer >= doc["buffers"].size()) return false;
-    if (is_meshopt_fallback(doc["buffers"][buffer])) return true;
-    if (!doc.contains("bufferViews") || !doc["bufferViews"].is_array()) return false;
-    bool used = false;
-    for (const json& view : doc["bufferViews"]) {
-        const json* mo = meshopt_of_view(view);
-        if (mo && refers_to(*mo, buffer)) return false;  // holds compressed bytes
-        if (!refers_to(view, buffer)) continue;
-        if (!mo) return false;  // a plain view reads it
-        used = true;
-    }
-    return used;
+std::vector<bool> meshopt_placeholders(const json& doc) {
+    if (!doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return {};
+    const json& buffers = doc["buffers"];
+    const size_t n = buffers.size();
+    // Per buffer, one pass over the views: 1 = a compressed view decodes into it, 2 = its bytes
+    // are read (a plain view, or the source of a compressed view).
+    std::vector<std::uint8_t> use(n, 0);
+    if (doc.contains("bufferViews") && doc["bufferViews"].is_array())
+        for (const json& view : doc["bufferViews"]) {
+            const json* mo = meshopt_of_view(view);
+            if (mo) {
+                if (const size_t src = buffer_of(*mo, n); src < n) use[src] |= 2;
+                if (const size_t dst = buffer_of(view, n); dst < n) use[dst] |= 1;
+            } else if (const size_t b = buffer_of(view, n); b < n) {
+                use[b] |= 2;
+            }
+        }
+    std::vector<bool> out(n);
+    for (size_t i = 0; i < n; ++i) out[i] = is_meshopt_fallback(buffers[i]) || use[i] == 1;
+    return out;
 }
 
 namespace {
@@ -188,6 +198,7 @@ Status precheck(const json& doc, const std::string& path, const GltfLimits& limi
     if (doc.contains("buffers")) {
         const json& bufs = doc["buffers"];
         if (!bufs.is_array()) return fail(ErrorCode::kBadFormat, path, "\"buffers\" is not an array");
+        const std::vector<bool> placeholder = meshopt_placeholders(doc);
         for (size_t i = 0; i < bufs.size(); ++i) {
             const std::string where = "buffers[" + std::to_string(i) + "]";
             if (!bufs[i].is_object()) return fail(ErrorCode::kBadFormat, path, where + " is not an object");
@@ -222,7 +233,7 @@ Status precheck(const json& doc, const std::string& path, const GltfLimits& limi
                         return fail(ErrorCode::kBadFormat, path, where + ".uri: the data: URI's base64 is " + std::to_string(n) +
                                                                  " characters, not a multiple of 4");
                 }
-            } else if (is_meshopt_placeholder(doc, i) && !(i == 0 && glb && glb->has_bin)) {
+            } else if (placeholder[i] && !(i == 0 && glb && glb->has_bin)) {
                 // EXT/KHR_meshopt_compression: a placeholder buffer needs no bytes (every view of
                 // it is decoded from a compressed buffer); nothing is loaded for it.
             } else if (i == 0 && glb) {

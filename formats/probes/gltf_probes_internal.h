@@ -54,11 +54,11 @@ Result<GlbParts> split_glb(std::span<const std::uint8_t> b, const std::string& p
 // "" when the URI is an acceptable relative reference inside the input's directory (or a data
 // URI), else why not (percent escapes decoded first).
 std::string uri_problem(const std::string& uri);
-// Whether buffers[buffer] needs no bytes under EXT_/KHR_meshopt_compression: marked
+// Per buffer, whether it needs no bytes under EXT_/KHR_meshopt_compression: marked
 // `"fallback": true`, or referenced by at least one bufferView and only by views that carry the
 // extension (each decoded from its compressed source, never from this buffer) and never the
-// source of a compressed view.
-bool is_meshopt_placeholder(const json& doc, size_t buffer);
+// source of a compressed view. One pass over the views; empty when `buffers` is not an array.
+std::vector<bool> meshopt_placeholders(const json& doc);
 // Every declared size and buffer URI, glTF 2.x only (asset.version / minVersion), before
 // tinygltf allocates anything; `glb` is null for a .gltf file.
 Status precheck(const json& doc, const std::string& path, const GltfLimits& limits, const GlbParts* glb);
