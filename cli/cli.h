@@ -69,12 +69,14 @@ StorageOptionUse storage_options_used(const Codec& codec);
 int refuse_output_over_input(const std::string& option, const std::string& output, const std::vector<std::string>& inputs);
 
 // Refuses an output whose folder takes no new files (formats/io/file_io.h check_folder_takes_files:
-// missing, not a folder, read-only): prints "zhc: error: OPTION PATH: why (checked before the work;
-// nothing was written)" and returns kExitOutputFailed; kExitOk when a file can be created there.
+// missing, not a folder, read-only): prints "zhc: error: OPTION PATH: why (checked before the
+// work)" and returns kExitOutputFailed; kExitOk when a file can be created there.
 // main() runs it, before the verb, on every file output given (-o/--output, --html, --markdown,
-// --depfile; not demo's -o, a folder, nor lightmap encode's -o, a prefix: encode checks its first
-// plane), and refuses --depfile (exit 7) when the verb was given no file output to name as the
-// depfile's target (audit without --markdown/--html/--images, lightmap audit without --html).
+// --depfile), except where the verb does it itself: demo (its -o is a folder it creates, and it
+// checks --html once the folder exists) and lightmap encode's -o (a prefix: encode checks its first
+// plane). main() also refuses --depfile (exit 7) before the work when the verb was given no file
+// output to name as the depfile's target (audit without --markdown/--html/--images, lightmap audit
+// without --html).
 int refuse_unwritable_output(const std::string& option, const std::string& path);
 
 // `--threads N`, N in 0..256, 0 = all cores (hardware_concurrency), the default of every verb

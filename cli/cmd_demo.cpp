@@ -110,6 +110,9 @@ int run(const Options& o) {
     std::error_code ec;
     fs::create_directories(o.dir, ec);
     if (ec) return report_output(make_error(ErrorCode::kIoError, o.dir + ": cannot create folder (" + ec.message() + ")"));
+    // --html may name a file in the folder just created: checked here, before the work, not in main().
+    if (!o.html.empty())
+        if (const int rc = refuse_unwritable_output("--html", o.html); rc != kExitOk) return rc;
     const auto path = [&](const std::string& name) { return (fs::path(o.dir) / name).string(); };
     std::vector<std::pair<std::string, std::string>> outputs;  // path, what
 

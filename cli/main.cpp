@@ -289,12 +289,14 @@ const CLI::App* parsed_leaf(const CLI::App& app, std::string* words) {
     }
 }
 
-// The options that name a file the verb writes (the verb's folder and prefix outputs are checked
-// by the verb: demo's -o is a folder it creates, lightmap encode's -o a prefix).
+// The options that name a file the verb writes. The verbs check the others themselves: demo's -o is
+// a folder it creates and its --html may go into that folder (demo checks it after creating the
+// folder), lightmap encode's -o is a prefix (encode checks its first plane).
 bool is_file_output(const std::string& verb, const CLI::Option& opt) {
+    if (verb == "demo") return false;
     for (const char* name : {"--html", "--markdown", "--depfile"})
         if (opt.check_name(name)) return true;
-    return opt.check_name("--output") && verb != "demo" && verb != "lightmap encode";
+    return opt.check_name("--output") && verb != "lightmap encode";
 }
 
 // Before the work: every file output given must go to a folder that takes new files, and
@@ -324,7 +326,7 @@ int check_outputs_before_work(const CLI::App& app) {
 
 int refuse_unwritable_output(const std::string& option, const std::string& path) {
     if (Status s = check_folder_takes_files(path); !s) {
-        std::fprintf(stderr, "zhc: error: %s %s: %s (checked before the work; nothing was written)\n", option.c_str(), path.c_str(),
+        std::fprintf(stderr, "zhc: error: %s %s: %s (checked before the work)\n", option.c_str(), path.c_str(),
                      s.error().message.c_str());
         return kExitOutputFailed;
     }

@@ -779,8 +779,15 @@ TEST(CliTraps, UnwritableOutputFolderRefusedBeforeWork) {
         expect_refused_before_work({"convert", in, "-o", dir + "/c.zhp", "--depfile", pl.folder + "/c.d"}, "--depfile", pl.folder + "/c.d",
                                    pl.why);
         EXPECT_FALSE(fs::exists(dir + "/c.zhp"));
+        // demo checks --html once it has created its -o folder (the report may go into it).
+        expect_refused_before_work({"demo", "-o", dir + "/demo", "--html", pl.folder + "/d.html"}, "--html", pl.folder + "/d.html", pl.why);
+        EXPECT_FALSE(fs::exists(dir + "/demo/scene.json"));
     }
     fs::permissions(ro, fs::perms::owner_all);
+    // demo's --html into the -o folder it creates (the folder does not exist before the run).
+    const auto demo = test::run_zhc({"demo", "-o", dir + "/demo2", "--html", dir + "/demo2/r.html", "--directions", "16"});
+    EXPECT_EQ(demo.exit_code, 0) << demo.err;
+    EXPECT_TRUE(fs::exists(dir + "/demo2/r.html"));
     // A folder that takes files leaves no probe file behind.
     EXPECT_TRUE(temporaries_in(dir).empty());
 }
