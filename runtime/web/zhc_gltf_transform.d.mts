@@ -1,7 +1,7 @@
 // Type declarations of zhc_gltf_transform.mjs (`@zhc/runtime/gltf-transform`): ZHC_light_probes as a
 // glTF-Transform 4.x Extension, built on the @gltf-transform/core module the caller passes.
 import { Extension, ExtensionProperty } from '@gltf-transform/core';
-import type { Buffer, IProperty, ReaderContext, WriterContext } from '@gltf-transform/core';
+import type { Buffer, IProperty, PropertyType, ReaderContext, WriterContext } from '@gltf-transform/core';
 import type * as GltfTransformCore from '@gltf-transform/core';
 
 export declare const ZHC_LIGHT_PROBES: 'ZHC_light_probes';
@@ -64,6 +64,8 @@ declare class ZhcLightProbesExtension extends Extension {
   /** The volumes in file order. */
   listVolumes(): ZhcLightProbeVolumeProperty[];
   read(context: ReaderContext): this;
+  /** Before writing buffers: the probe bytes become bufferViews of the volume's buffer. */
+  prewrite(context: WriterContext, propertyType: PropertyType): this;
   write(context: WriterContext): this;
 }
 

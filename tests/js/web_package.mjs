@@ -11,8 +11,10 @@
 //     the package has no dependencies; three, @types/three and @gltf-transform/* are linked from
 //     tests/js/node_modules, installed by js.npm_install, so nothing is downloaded);
 //  4. every export of every entry point, as Node imports it through the `exports` map, is declared
-//     (TypeScript's own resolution of the same specifiers through the `types` conditions) and the
-//     declarations export no value the module lacks; web_package/consumer.ts imports every one;
+//     (TypeScript's own resolution of the same specifiers through the `types` conditions) as what
+//     it is (function, class, value; parameter counts against the functions' and methods' lengths;
+//     a class's methods), the declarations export no value the module lacks, the declared name
+//     unions equal the codec table's values; web_package/consumer.ts imports every export;
 //  5. `tsc --strict --noEmit` on the consumer (tests/js/web_package: consumer.ts and its tsconfig,
 //     moduleResolution nodenext, then bundler) passes, @ts-expect-error misuses included; with one
 //     parameter of the installed declarations widened to `any`, tsc fails on that misuse (so the
@@ -110,7 +112,20 @@ for (const f of ['consumer.ts', 'tsconfig.json', 'draco3dgltf.d.ts', 'run_consum
 // --- 4. every export declared --------------------------------------------------------------------------
 const specifiers = entries.map(([key]) => (key === '.' ? pkg.name : `${pkg.name}/${key.slice(2)}`));
 const listed = spawnSync(process.execPath, ['--input-type=module', '-e',
-  `const out = {}; for (const s of ${JSON.stringify(specifiers)}) out[s] = Object.keys(await import(s)).sort();
+  `const out = { shapes: {} };
+   const shape = (v) => {
+     if (typeof v !== 'function') return { kind: typeof v };
+     if (!/^class\\b/.test(Function.prototype.toString.call(v))) return { kind: 'function', length: v.length };
+     const methods = {};
+     for (const n of Object.getOwnPropertyNames(v.prototype))
+       if (n !== 'constructor' && !n.startsWith('_') && typeof Object.getOwnPropertyDescriptor(v.prototype, n).value === 'function') methods[n] = v.prototype[n].length;
+     return { kind: 'class', length: v.length, derived: Object.getPrototypeOf(v) !== Function.prototype, methods };
+   };
+   for (const s of ${JSON.stringify(specifiers)}) {
+     const m = await import(s);
+     out[s] = Object.keys(m).sort();
+     out.shapes[s] = Object.fromEntries(Object.keys(m).map((n) => [n, shape(m[n])]));
+   }
    const r = await import('${pkg.name}');
    out.table = { ZhcEncodingName: r.ENCODING_TABLE.map((e) => e.name), ZhcEncodingAlias: Object.keys(r.ENCODING_ALIASES),
      ZhcLayout: [...new Set(r.ENCODING_TABLE.map((e) => e.layout))], ZhcHallucination: [...new Set(r.ENCODING_TABLE.map((e) => e.hallucination))],
@@ -122,6 +137,34 @@ const runtimeExports = listed.status === 0 ? JSON.parse(listed.stdout.toString()
 const tsconfig = ts.getParsedCommandLineOfConfigFile(path.join(consumer, 'tsconfig.json'), {}, { ...ts.sys, onUnRecoverableConfigFileDiagnostic: () => {} });
 const program = ts.createProgram(tsconfig.fileNames, tsconfig.options);
 const checker2 = program.getTypeChecker();
+// What a declared value is: a function (the number of parameters before the first optional one,
+// and of all), a class (its constructor's numbers and those of the methods declared here), or
+// something else.
+const arity = (sig) => {
+  const params = sig.getParameters().map((p) => p.valueDeclaration);
+  const optional = (d) => !!(d && ts.isParameter(d) && (d.questionToken || d.initializer || d.dotDotDotToken));
+  const firstOptional = params.findIndex(optional);
+  return { required: firstOptional < 0 ? params.length : firstOptional, total: params.length };
+};
+function declaredShape(symbol) {
+  const type = checker2.getTypeOfSymbol(symbol);
+  const ctors = type.getConstructSignatures();
+  if (ctors.length) {
+    // A class (or a const typed as one): the methods this package declares on its instances.
+    const methods = {};
+    for (const prop of checker2.getPropertiesOfType(ctors[0].getReturnType())) {
+      const d = prop.valueDeclaration;
+      if (d && (ts.isMethodDeclaration(d) || ts.isMethodSignature(d)) && d.getSourceFile().fileName.startsWith(installed + path.sep))
+        methods[prop.name] = checker2.getTypeOfSymbol(prop).getCallSignatures().map(arity);
+    }
+    return { kind: 'class', ctor: ctors.map(arity), methods };
+  }
+  const sigs = type.getCallSignatures();
+  return sigs.length ? { kind: 'function', sigs: sigs.map(arity) } : { kind: 'other' };
+}
+// A JavaScript function's length counts its parameters before the first one with a default; a
+// parameter without a default may still be optional (the code handles undefined).
+const fits = (sigs, length) => (sigs ?? []).some((a) => a.required <= length && length <= a.total);
 const consumerSource = program.getSourceFile(path.join(consumer, 'consumer.ts'));
 const imported = {}, declared = {};
 for (const st of consumerSource.statements) {
@@ -138,13 +181,15 @@ for (const st of consumerSource.statements) {
   const moduleSymbol = checker2.getSymbolAtLocation(st.moduleSpecifier);
   if (!moduleSymbol) continue;
   const file = moduleSymbol.valueDeclaration?.getSourceFile().fileName ?? '';
-  declared[spec] = { file, values: new Set() };
+  declared[spec] = { file, values: new Set(), shapes: {} };
   for (const sym of checker2.getExportsOfModule(moduleSymbol)) {
     const target = sym.flags & ts.SymbolFlags.Alias ? checker2.getAliasedSymbol(sym) : sym;
-    if (target.flags & ts.SymbolFlags.Value) declared[spec].values.add(sym.name);
+    if (!(target.flags & ts.SymbolFlags.Value)) continue;
+    declared[spec].values.add(sym.name);
+    declared[spec].shapes[sym.name] = declaredShape(target);
   }
 }
-let exportCount = 0;
+let exportCount = 0, shapeCount = 0;
 for (const spec of specifiers) {
   const names = runtimeExports[spec] ?? [];
   exportCount += names.length;
@@ -155,10 +200,31 @@ for (const spec of specifiers) {
   const missing = names.filter((n) => !d.values.has(n)), extra = [...d.values].filter((n) => !names.includes(n));
   check(missing.length === 0, `${spec}: all ${names.length} exports declared${missing.length ? ` (missing: ${missing.join(', ')})` : ''}`);
   check(extra.length === 0, `${spec}: no declared value the module lacks${extra.length ? ` (${extra.join(', ')})` : ''}`);
+  // Each export is declared as what it is: functions with their parameters (required <= the
+  // JavaScript function's length <= all), classes with their constructor and every method (but
+  // the _-prefixed helpers, internal by convention).
+  const wrongShape = [];
+  for (const n of names) {
+    const rt = runtimeExports.shapes[spec][n], dt = d.shapes[n];
+    if (!dt) continue;
+    if (rt.kind === 'function') {
+      if (dt.kind !== 'function' || !fits(dt.sigs, rt.length)) wrongShape.push(`${n}: function of length ${rt.length}, declared ${JSON.stringify(dt)}`);
+    } else if (rt.kind === 'class') {
+      // (a derived class without a constructor of its own has length 0: its parent's takes the arguments)
+      if (dt.kind !== 'class' || !((rt.derived && rt.length === 0) || fits(dt.ctor, rt.length))) wrongShape.push(`${n}: class, constructor length ${rt.length}, declared ${JSON.stringify(dt)}`);
+      else {
+        const rm = Object.keys(rt.methods).sort(), dm = Object.keys(dt.methods).sort();
+        if (JSON.stringify(rm) !== JSON.stringify(dm)) wrongShape.push(`${n}: methods ${rm.join(',')}, declared ${dm.join(',')}`);
+        for (const m of rm) if (dt.methods[m] && !fits(dt.methods[m], rt.methods[m])) wrongShape.push(`${n}.${m}: length ${rt.methods[m]}, declared ${JSON.stringify(dt.methods[m])}`);
+      }
+    } else if (dt.kind !== 'other') wrongShape.push(`${n}: a ${rt.kind}, declared as a ${dt.kind}`);
+    shapeCount++;
+  }
+  check(wrongShape.length === 0, `${spec}: every export declared as what it is (functions' and methods' parameters, classes)${wrongShape.length ? `: ${wrongShape.join('; ')}` : ''}`);
   const notImported = names.filter((n) => !imported[spec]?.has(n));
   check(notImported.length === 0, `${spec}: consumer.ts imports every export${notImported.length ? ` (not: ${notImported.join(', ')})` : ''}`);
 }
-console.log(`${exportCount} exports in ${specifiers.length} entry points, all declared and imported by the consumer`);
+console.log(`${exportCount} exports in ${specifiers.length} entry points, all declared and imported by the consumer; ${shapeCount} compared as function / class / value with their parameter counts`);
 // The declared unions of names that the codec table generates (zhc_runtime.mjs's GENERATED block):
 // each union = the table's values, so a new table entry cannot leave the declarations behind.
 {
