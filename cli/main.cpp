@@ -305,12 +305,28 @@ int check_outputs_before_work(const CLI::App& app) {
     std::string verb;
     const CLI::App* leaf = parsed_leaf(app, &verb);
     bool depfile = false, writes_file = false;
+    // A folder the verb creates for its pictures (audit --images) may also receive a report: a file
+    // output in a folder that does not exist yet but lies inside it is the verb's to check.
+    std::vector<std::filesystem::path> created;
+    for (const CLI::Option* opt : leaf->get_options())
+        if (opt->count() > 0 && opt->check_name("--images"))
+            created.push_back(std::filesystem::absolute(opt->as<std::string>()).lexically_normal());
+    auto inside_created = [&](const std::string& path) {
+        std::error_code ec;
+        const std::filesystem::path folder = std::filesystem::absolute(path).lexically_normal().parent_path();
+        if (std::filesystem::exists(folder, ec)) return false;
+        for (const auto& c : created) {
+            const auto rel = folder.lexically_relative(c);
+            if (!rel.empty() && *rel.begin() != "..") return true;
+        }
+        return false;
+    };
     for (const CLI::Option* opt : leaf->get_options()) {
         if (opt->count() == 0) continue;
         if (opt->check_name("--depfile")) depfile = true;
         else if (opt->check_name("--output") || opt->check_name("--html") || opt->check_name("--markdown") || opt->check_name("--images"))
             writes_file = true;
-        if (!is_file_output(verb, *opt)) continue;
+        if (!is_file_output(verb, *opt) || inside_created(opt->as<std::string>())) continue;
         const std::string option = opt->check_name("--output") ? "-o" : opt->get_name();
         if (int rc = refuse_unwritable_output(option, opt->as<std::string>()); rc != kExitOk) return rc;
     }

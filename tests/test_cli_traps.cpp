@@ -788,6 +788,14 @@ TEST(CliTraps, UnwritableOutputFolderRefusedBeforeWork) {
     const auto demo = test::run_zhc({"demo", "-o", dir + "/demo2", "--html", dir + "/demo2/r.html", "--directions", "16"});
     EXPECT_EQ(demo.exit_code, 0) << demo.err;
     EXPECT_TRUE(fs::exists(dir + "/demo2/r.html"));
+    // audit --html into the --images folder that audit creates.
+    const auto images = test::run_zhc({"audit", in, "-r", "sh3", "--directions", "64", "--images", dir + "/pics", "--html", dir + "/pics/r.html",
+                                       "--markdown", dir + "/pics/r.md"});
+    EXPECT_EQ(images.exit_code, 0) << images.err;
+    EXPECT_TRUE(fs::exists(dir + "/pics/r.html"));
+    // ... but not into a folder beside it.
+    expect_refused_before_work({"audit", in, "-r", "sh3", "--directions", "64", "--images", dir + "/pics2", "--html", dir + "/other/r.html"},
+                               "--html", dir + "/other/r.html", "the folder " + dir + "/other does not exist");
     // A folder that takes files leaves no probe file behind.
     EXPECT_TRUE(temporaries_in(dir).empty());
 }
