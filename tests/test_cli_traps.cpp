@@ -728,11 +728,30 @@ TEST(CliTraps, IntegerOptionsAreDecimal) {
 
 // A file output whose folder takes no files: refused with exit 7 before the work (stdout empty:
 // the verbs print their report only after the work), naming the option, the path and the folder.
+// zhc run as user nobody (setpriv, util-linux): how a root test process meets a read-only folder.
+test::CommandResult run_zhc_as_nobody(const std::vector<std::string>& args, const std::string& dir) {
+    auto quote = [](const std::string& a) {
+        std::string q = "'";
+        for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        return q + "'";
+    };
+    std::string cmd = "setpriv --reuid=65534 --regid=65534 --clear-groups " + quote(ZHC_CLI_PATH);
+    for (const auto& a : args) cmd += " " + quote(a);
+    cmd += " > " + quote(dir + "/nobody.out") + " 2> " + quote(dir + "/nobody.err") + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    test::CommandResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    const auto out = test::read_bytes(dir + "/nobody.out"), err = test::read_bytes(dir + "/nobody.err");
+    r.out.assign(out.begin(), out.end());
+    r.err.assign(err.begin(), err.end());
+    return r;
+}
+
 void expect_refused_before_work(const std::vector<std::string>& args, const std::string& option, const std::string& path,
-                                const std::string& why) {
+                                const std::string& why, const std::string& nobody_dir = "") {
     std::string cmd;
     for (const auto& a : args) cmd += a + " ";
-    const auto r = test::run_zhc(args);
+    const auto r = nobody_dir.empty() ? test::run_zhc(args) : run_zhc_as_nobody(args, nobody_dir);
     EXPECT_EQ(r.exit_code, 7) << cmd << "\n" << r.err;
     EXPECT_EQ(r.err.rfind("zhc: error: " + option + " " + path + ": ", 0), 0u) << cmd << "\n" << r.err;
     EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
@@ -751,6 +770,7 @@ TEST(CliTraps, UnwritableOutputFolderRefusedBeforeWork) {
     // Folders that take no file, for any user: missing, and a file where the folder should be.
     struct Place {
         std::string folder, why;
+        bool as_nobody = false;
     };
     std::vector<Place> places = {{dir + "/missing", "the folder " + dir + "/missing does not exist"},
                                  {dir + "/file", dir + "/file is not a folder"}};
@@ -758,7 +778,11 @@ TEST(CliTraps, UnwritableOutputFolderRefusedBeforeWork) {
     const std::string ro = dir + "/read_only";
     fs::create_directory(ro);
     fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
-    if (::geteuid() != 0) places.push_back({ro, "cannot create a file in the folder " + ro + " (Permission denied)"});
+    // Root writes there anyway: a root test process runs zhc as user nobody for this folder (the
+    // test folder open to it, the read-only folder not).
+    const bool root = ::geteuid() == 0;
+    if (root) fs::permissions(dir, fs::perms::all);
+    places.push_back({ro, "cannot create a file in the folder " + ro + " (Permission denied)", root});
     // Into a folder that takes files the bake runs and prints its report on stdout: an empty stdout
     // below means the refusal came before the bake.
     const auto bake_ok = test::run_zhc({"bake", scene, "-o", dir + "/ok.zhp"});
@@ -766,21 +790,22 @@ TEST(CliTraps, UnwritableOutputFolderRefusedBeforeWork) {
     EXPECT_NE(bake_ok.out.find("bake total"), std::string::npos);
     for (const Place& pl : places) {
         SCOPED_TRACE(pl.folder);
-        expect_refused_before_work({"bake", scene, "-o", pl.folder + "/p.zhp"}, "-o", pl.folder + "/p.zhp", pl.why);
+        const std::string as = pl.as_nobody ? dir : "";  // run as nobody, its output files in dir
+        expect_refused_before_work({"bake", scene, "-o", pl.folder + "/p.zhp"}, "-o", pl.folder + "/p.zhp", pl.why, as);
         expect_refused_before_work({"audit", in, "-r", "sh3", "--directions", "64", "--html", pl.folder + "/r.html"}, "--html",
-                                   pl.folder + "/r.html", pl.why);
+                                   pl.folder + "/r.html", pl.why, as);
         expect_refused_before_work({"audit", in, "-r", "sh3", "--directions", "64", "--markdown", pl.folder + "/r.md"}, "--markdown",
-                                   pl.folder + "/r.md", pl.why);
-        expect_refused_before_work({"lightmap", "audit", lm, "--html", pl.folder + "/l.html"}, "--html", pl.folder + "/l.html", pl.why);
-        expect_refused_before_work({"lightmap", "encode", lm, "-o", pl.folder + "/x"}, "-o", pl.folder + "/x.iz.ktx2", pl.why);
+                                   pl.folder + "/r.md", pl.why, as);
+        expect_refused_before_work({"lightmap", "audit", lm, "--html", pl.folder + "/l.html"}, "--html", pl.folder + "/l.html", pl.why, as);
+        expect_refused_before_work({"lightmap", "encode", lm, "-o", pl.folder + "/x"}, "-o", pl.folder + "/x.iz.ktx2", pl.why, as);
         expect_refused_before_work({"lightmap", "encode", lm, "-o", pl.folder + "/x", "--container", "dds"}, "-o", pl.folder + "/x.iz.dds",
-                                   pl.why);
-        expect_refused_before_work({"convert", in, "-o", pl.folder + "/c.zhp", "-r", "zh3_q16"}, "-o", pl.folder + "/c.zhp", pl.why);
+                                   pl.why, as);
+        expect_refused_before_work({"convert", in, "-o", pl.folder + "/c.zhp", "-r", "zh3_q16"}, "-o", pl.folder + "/c.zhp", pl.why, as);
         expect_refused_before_work({"convert", in, "-o", dir + "/c.zhp", "--depfile", pl.folder + "/c.d"}, "--depfile", pl.folder + "/c.d",
-                                   pl.why);
+                                   pl.why, as);
         EXPECT_FALSE(fs::exists(dir + "/c.zhp"));
         // demo checks --html once it has created its -o folder (the report may go into it).
-        expect_refused_before_work({"demo", "-o", dir + "/demo", "--html", pl.folder + "/d.html"}, "--html", pl.folder + "/d.html", pl.why);
+        expect_refused_before_work({"demo", "-o", dir + "/demo", "--html", pl.folder + "/d.html"}, "--html", pl.folder + "/d.html", pl.why, as);
         EXPECT_FALSE(fs::exists(dir + "/demo/scene.json"));
     }
     fs::permissions(ro, fs::perms::owner_all);
