@@ -308,12 +308,12 @@ int check_outputs_before_work(const CLI::App& app) {
     // A folder the verb creates for its pictures (audit --images) may also receive a report: a file
     // output in a folder that does not exist yet but lies inside it is the verb's to check.
     std::vector<std::filesystem::path> created;
+    std::error_code ec;
     for (const CLI::Option* opt : leaf->get_options())
         if (opt->count() > 0 && opt->check_name("--images"))
-            created.push_back(std::filesystem::absolute(opt->as<std::string>()).lexically_normal());
+            created.push_back(std::filesystem::absolute(opt->as<std::string>(), ec).lexically_normal());
     auto inside_created = [&](const std::string& path) {
-        std::error_code ec;
-        const std::filesystem::path folder = std::filesystem::absolute(path).lexically_normal().parent_path();
+        const std::filesystem::path folder = std::filesystem::absolute(path, ec).lexically_normal().parent_path();
         if (std::filesystem::exists(folder, ec)) return false;
         for (const auto& c : created) {
             const auto rel = folder.lexically_relative(c);
