@@ -388,7 +388,11 @@ int run(const Options& o) {
 const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()> {
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("audit", "Irradiance error, size and speed of every representation on your lighting");
-    sub->add_option("INPUTS", o->inputs, "environment maps (.exr, .hdr), probe files, or folders of them")->required();
+    sub->add_option("INPUTS", o->inputs,
+                    "environment maps (.exr, .hdr, KTX2 / KTX 1 / DDS cube maps), probe files, or folders of them (their "
+                    ".exr, .hdr, .zhp and .json files; a JSON file that is not a probe list, such as a scene, is skipped "
+                    "with a note)")
+        ->required();
     add_representations_option(sub, o->representations, RepresentationCount::kList, "default: all");
     add_json_flag(sub, o->json, "files, aggregate, gates, choice");
     sub->add_option("--markdown", o->markdown, "also write the tables as Markdown to this file");

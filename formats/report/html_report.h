@@ -55,8 +55,8 @@ struct SpherePictures {
 // The normal shown at pixel (x, y) of a 2*size x size sphere picture; false outside the discs.
 bool sphere_pixel_normal(int x, int y, int size, Vec3* normal);
 
-// Evaluates the reference (an environment map: direct integration of the map box-downsampled to
-// 64x32; probes: probe 0's SH3 irradiance) and every codec's runtime irradiance of probe 0 at the
+// Evaluates the reference (an environment map: integrate_irradiance, each pixel over its exact
+// footprint, of the map box-downsampled to 64x32; probes: probe 0's SH3 irradiance) and every codec's runtime irradiance of probe 0 at the
 // sphere pictures' normals, and on a lat-long map of normals of 2*size x size pixels, at most 128 x 64
 // (irradiance is smooth, and the report stays small). size is clamped to [8, 512].
 SpherePictures render_sphere_pictures(const AuditInput& input, const std::vector<const Codec*>& codecs,
