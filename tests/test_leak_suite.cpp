@@ -13,7 +13,7 @@
 //    probes are exactly the invalid ones); the masks take 2 bytes per probe; a probe at the shading
 //    point itself (the SH3 limit) is within 10 % of the truth on the lit side and every volume is
 //    further off;
-//  * determinism: the same files and numbers with 1 and 2 bake threads.
+//  * determinism: the same files and numbers with 1 and 2 bake threads; the metrics on known values.
 // The table of every configuration is printed (docs/leaks.md has it; bench/bench_leak prints it
 // with per-sample cost). The target of a scheme that stops leaks (dark side under 1 % of the lit
 // side everywhere) is not asserted: today's samplings do not meet it.
@@ -76,6 +76,17 @@ const Case& named_case(const std::string& name) {
         if (c.scene.name == name) return c;
     ADD_FAILURE() << "no case " << name;
     return suite().front();
+}
+
+TEST(LeakSuite, MetricsOfKnownValues) {
+    // Lit points 2 and 4 (truth 3 and 3), dark points 1 and 0 (truth 0).
+    std::vector<ShadingPoint> pts(4);
+    pts[2].side = pts[3].side = Side::kDark;
+    const Metrics m = metrics(pts, {2, 4, 1, 0}, {3, 3, 0, 0});
+    EXPECT_EQ(m.lit_mean, 3.0);
+    EXPECT_EQ(m.dark_mean, 0.5);
+    EXPECT_EQ(m.leak, 0.5 / 3.0);
+    EXPECT_EQ(m.lit_error, 2.0 / 6.0);  // (|2 - 3| + |4 - 3|) / (3 + 3)
 }
 
 TEST(LeakSuite, TruthIsThePointLightsClosedFormAndZeroBehindTheWall) {
