@@ -142,8 +142,9 @@ Status FileRangeReader::read(std::uint64_t offset, std::uint8_t* out, std::size_
 
 namespace {
 // The temporary files alive now, for the signal handler: fixed slots of static storage (the handler
-// may touch nothing else: no allocation, no locks). A slot's state is kFree, kBusy (being filled or
-// emptied by a normal thread: the handler skips it) or kLive (path holds a NUL-terminated name).
+// may touch nothing else: no allocation, no locks). A slot's state is kFree, kBusy (held for a moment
+// by a normal thread that fills, compares or empties it: the handler skips it) or kLive (path holds
+// a NUL-terminated name).
 // A name that does not fit, or a registration when every slot is live, is not tracked: that
 // temporary is still removed on every normal path, only not on a signal.
 constexpr int kFree = 0, kBusy = 1, kLive = 2;
@@ -191,12 +192,14 @@ std::string temporary_name_for(const std::string& path) {
 }  // namespace
 
 void release_temporary_path(const std::string& path) {
+    if (path.size() >= kTemporaryPathBytes) return;  // never registered
     for (TemporarySlot& slot : g_temporaries) {
-        if (slot.state.load() != kLive || path.size() >= kTemporaryPathBytes || std::strcmp(slot.path, path.c_str()) != 0) continue;
+        // Hold the slot (kBusy) while comparing: another thread may release and refill it.
         int expected = kLive;
         if (!slot.state.compare_exchange_strong(expected, kBusy)) continue;
-        slot.state.store(kFree);
-        return;
+        const bool mine = std::strcmp(slot.path, path.c_str()) == 0;
+        slot.state.store(mine ? kFree : kLive);
+        if (mine) return;
     }
 }
 
