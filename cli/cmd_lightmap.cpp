@@ -410,7 +410,10 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
                     "SH lightmap EXR (sh0.R .. sh8.B, or linear SH sh0.R .. sh3.B), or 4 / 9 EXRs one per coefficient "
                     "(R, G, B), or one name with {i} for the coefficient index")
         ->required();
-    enc->add_option("-o,--output", o->output, "output prefix")->required();
+    enc->add_option("-o,--output", o->output,
+                    "output prefix; the other target's planes under it are removed (bc: PREFIX.dwa.ktx2; astc: PREFIX.{d,wa}.ktx2 and "
+                    "PREFIX.{iz,d,wa}.dds; docs/lightmap-formats.md)")
+        ->required();
     enc->add_option("--container", o->container, "ktx2 (default) | dds (DX10 header): PREFIX.{iz,d,wa}.ktx2 or .dds")
         ->check(CLI::IsMember({"ktx2", "dds"}));
     enc->add_option("--target", o->target,
@@ -418,7 +421,7 @@ const VerbRegistration registration(60, [](CLI::App& app) -> std::function<int()
                     "astc-ldr (I_z in ASTC LDR by a per-texture log2 range, for GPUs without ASTC HDR); ASTC effort from --quality: "
                     "fast, default = medium, slow = thorough")
         ->check(CLI::IsMember({"bc", "astc", "astc-ldr"}));
-    enc->add_option("--footprint", o->footprint, "ASTC block footprint: 4x4 (default, 2 B/texel), 5x5, 6x6 (0.89 B/texel), 8x8")
+    enc->add_option("--footprint", o->footprint, "ASTC block footprint, with --target astc or astc-ldr only: 4x4 (default, 2 B/texel), 5x5, 6x6 (0.89 B/texel), 8x8")
         ->check(CLI::IsMember({"4x4", "5x5", "6x6", "8x8"}));
     std::string solve_help = "IrradZ fit: " + choices_help(lightmap::fits());
     std::vector<std::string> solve_names = choice_names(lightmap::fits());
