@@ -22,7 +22,7 @@
 // Benchmarks never decide pass/fail (tests/test_leak_suite.cpp asserts the measured facts).
 //
 // Usage: bench_leak [--points N] [--threads N] [--json FILE]
-//   --points: shading points per surface of a region (free points: twice that; default 24)
+//   --points: shading points per surface of a region (free points: twice that; default 96)
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -91,7 +91,7 @@ void json_metrics(std::ostream& o, const char* key, const Metrics& x) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    int per_face = 24, threads = 1;
+    int per_face = 96, threads = 1;
     std::string json;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];

@@ -15,7 +15,7 @@
 //    walls, 1.4 x 1.4 x 1.4 m inside) in its middle, a probe inside the box.
 // Probe grids of about 1.5 m spacing lie inside each scene's rooms.
 //
-// Shading points (fixed seeds): on every surface of the side's region (floor, ceiling, walls; a
+// Shading points (Kronecker sequences, fixed seeds): on every surface of the side's region (floor, ceiling, walls; a
 // point is kept only where geometry lies right behind it, so window openings and open sides drop
 // out), 1e-4 off the surface, normal into the air; and free points with uniformly random normals.
 // Regions: "lit" and "dark" air within one cell of the separating geometry (the wall; the corner's
@@ -104,9 +104,31 @@ inline Scene empty_scene() {
     return s;
 }
 
+// A Kronecker (R_d) low-discrepancy sequence, frac(shift + k alpha) with alpha_i = phi_d^-i
+// (phi_d the root of x^(d+1) = x + 1) and a random shift per call: deterministic, and its means
+// converge much faster than independent random points'.
+template <int D>
+struct Kronecker {
+    double alpha[D], shift[D];
+    std::uint64_t k = 0;
+    explicit Kronecker(std::mt19937_64& rng) {
+        double phi = 2;
+        for (int i = 0; i < 64; ++i) phi = std::pow(1 + phi, 1.0 / (D + 1));
+        for (int i = 0; i < D; ++i) {
+            alpha[i] = std::pow(phi, -(i + 1));
+            shift[i] = u01(rng);
+        }
+    }
+    void next(double out[D]) {
+        ++k;
+        for (int i = 0; i < D; ++i) out[i] = std::fmod(shift[i] + double(k) * alpha[i], 1.0);
+    }
+};
+
 // Samples `per_face` points on each face of [lo, hi] (normal into the box, or out of it when
 // `outward`) kept where geometry lies right behind them, and `free_points` points inside with
-// random normals; points inside a solid or inside `exclude_lo..exclude_hi` are rejected.
+// uniformly distributed normals; points inside a solid or inside `exclude_lo..exclude_hi` are
+// rejected. Positions (and the free points' normals) follow Kronecker sequences.
 inline void sample_region(const OccluderBvh& bvh, Vec3 lo, Vec3 hi, Side side, bool outward, int per_face,
                           int free_points, std::mt19937_64& rng, std::vector<ShadingPoint>& out,
                           Vec3 exclude_lo = {1, 1, 1}, Vec3 exclude_hi = {0, 0, 0}) {
@@ -115,10 +137,15 @@ inline void sample_region(const OccluderBvh& bvh, Vec3 lo, Vec3 hi, Side side, b
         for (int s = 0; s < 2; ++s) {
             Vec3 n{};
             set_axis(n, a, (s == 0) != outward ? 1.0 : -1.0);
+            Kronecker<2> seq(rng);
             for (int k = 0; k < per_face; ++k) {
+                double uv[2];
+                seq.next(uv);
                 Vec3 p{};
-                for (int b = 0; b < 3; ++b)
-                    set_axis(p, b, axis_of(lo, b) + margin + u01(rng) * (axis_of(hi, b) - axis_of(lo, b) - 2 * margin));
+                for (int b = 0, j = 0; b < 3; ++b) {
+                    if (b == a) continue;
+                    set_axis(p, b, axis_of(lo, b) + margin + uv[j++] * (axis_of(hi, b) - axis_of(lo, b) - 2 * margin));
+                }
                 set_axis(p, a, (s == 0 ? axis_of(lo, a) : axis_of(hi, a)) + kSurfaceOffset * axis_of(n, a));
                 if (!bvh.occluded(p, -1.0 * n, 0.0, 10 * kSurfaceOffset) || bvh.inside_any_solid(p)) continue;
                 if (inside_box(p, exclude_lo, exclude_hi)) continue;
@@ -126,13 +153,15 @@ inline void sample_region(const OccluderBvh& bvh, Vec3 lo, Vec3 hi, Side side, b
                 out.push_back({p, n, side, kind});
             }
         }
+    Kronecker<5> seq(rng);
     for (int k = 0; k < free_points;) {
+        double x[5];
+        seq.next(x);
         Vec3 p{};
-        for (int b = 0; b < 3; ++b)
-            set_axis(p, b, axis_of(lo, b) + 0.02 + u01(rng) * (axis_of(hi, b) - axis_of(lo, b) - 0.04));
-        const double z = 2 * u01(rng) - 1, phi = 2 * M_PI * u01(rng), r = std::sqrt(std::max(0.0, 1 - z * z));
+        for (int b = 0; b < 3; ++b) set_axis(p, b, axis_of(lo, b) + 0.02 + x[b] * (axis_of(hi, b) - axis_of(lo, b) - 0.04));
+        const double z = 2 * x[3] - 1, phi = 2 * M_PI * x[4], r = std::sqrt(std::max(0.0, 1 - z * z));
         const Vec3 n{r * std::cos(phi), r * std::sin(phi), z};
-        if (bvh.inside_any_solid(p) || inside_box(p, exclude_lo, exclude_hi)) continue;  // rejected: draw again
+        if (bvh.inside_any_solid(p) || inside_box(p, exclude_lo, exclude_hi)) continue;  // rejected: the next one
         out.push_back({p, n, side, "free"});
         ++k;
     }
