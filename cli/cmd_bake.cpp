@@ -90,6 +90,11 @@ int run(const Options& o) {
                      o.output.c_str());
         return kExitUsage;
     }
+    if (ext != ".zhp" && o.zstd != 0) {
+        std::fprintf(stderr, "zhc: error: --zstd %d: the output %s is not a .zhp container, the only output --zstd compresses\n", o.zstd,
+                     o.output.c_str());
+        return kExitUsage;
+    }
     const Codec* codec = representation_named(o.to);
     if (!codec) return kExitUsage;
     if (int rc = refuse_output_over_input("-o", o.output, {o.scene}); rc != kExitOk) return rc;

@@ -123,6 +123,11 @@ int run(const Options& o) {
         std::fprintf(stderr, "zhc: error: %s: output extension must be .zhp or .json\n", o.output.c_str());
         return kExitUsage;
     }
+    if (ext == ".json" && o.zstd != 0) {
+        std::fprintf(stderr, "zhc: error: --zstd %d: the output %s is a JSON probe list, which is not compressed (--zstd is for a .zhp output)\n",
+                     o.zstd, o.output.c_str());
+        return kExitUsage;
+    }
     if (!o.to.empty() && !representation_named(o.to)) return kExitUsage;
     if (int rc = refuse_output_over_input("-o", o.output, {o.input}); rc != kExitOk) return rc;
     auto params = params_from(o);

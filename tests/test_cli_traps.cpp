@@ -654,6 +654,30 @@ TEST(CliTraps, FootprintWithoutAstcTargetRefused) {
     EXPECT_LT(fs::file_size(dir + "/a6.dwa.ktx2"), fs::file_size(dir + "/a4.dwa.ktx2"));
 }
 
+// --zstd compresses a .zhp body only: with a JSON or glTF output it would change nothing.
+TEST(CliTraps, ZstdWithoutZhpOutputRefused) {
+    const std::string dir = test::fresh_dir("traps_zstd");
+    const std::string in = golden_json(dir);
+    const std::string scene = std::string(ZHC_TEST_DATA_DIR) + "/../conformance/inputs/scene.json";
+    for (const std::vector<std::string>& args : {std::vector<std::string>{"convert", in, "-o", dir + "/o.json", "--zstd", "3"},
+                                                 {"bake", scene, "-o", dir + "/o.json", "--zstd", "3"},
+                                                 {"bake", scene, "-o", dir + "/o.glb", "--zstd", "19"}}) {
+        const auto r = test::run_zhc(args);
+        EXPECT_EQ(r.exit_code, 2) << args[0] << " " << args[3];
+        EXPECT_EQ(r.err.rfind("zhc: error: --zstd " + args[5] + ": the output " + args[3], 0), 0u) << r.err;
+        EXPECT_EQ(count_lines(r.err), 1u);
+        EXPECT_EQ(r.out, "");
+        EXPECT_FALSE(fs::exists(args[3]));
+    }
+    // Into a .zhp it is used (the body is compressed: other bytes than without), and --zstd 0 (none)
+    // goes with any output.
+    ASSERT_EQ(test::run_zhc({"bake", scene, "-o", dir + "/z.zhp", "--zstd", "19", "--quiet"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"bake", scene, "-o", dir + "/p.zhp", "--quiet"}).exit_code, 0);
+    EXPECT_NE(test::read_bytes(dir + "/z.zhp"), test::read_bytes(dir + "/p.zhp"));
+    EXPECT_EQ(test::run_zhc({"convert", in, "-o", dir + "/o.json", "--zstd", "0"}).exit_code, 0);
+    EXPECT_EQ(test::run_zhc({"bake", scene, "-o", dir + "/o.glb", "--zstd", "0", "--quiet"}).exit_code, 0);
+}
+
 // The verbs and their integer options, read from the help (every option whose type is INT or UINT).
 std::vector<std::pair<std::vector<std::string>, std::string>> integer_options() {
     std::vector<std::pair<std::vector<std::string>, std::string>> found;
