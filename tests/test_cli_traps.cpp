@@ -545,6 +545,74 @@ TEST(CliTraps, SignalRemovesTemporariesAndKeepsFinalNames) {
     }
 }
 
+// Starts zhc with `args`, sends `sig` after `delay`, and returns waitpid's status (the process may
+// have ended by itself before).
+int run_and_signal_after(const std::vector<std::string>& args, std::chrono::microseconds delay, int sig) {
+    std::vector<std::string> argv_s{ZHC_CLI_PATH};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : argv_s) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        for (const int s : {SIGINT, SIGTERM, SIGHUP}) ::signal(s, SIG_DFL);
+        const int null = ::open("/dev/null", O_RDWR);
+        ::dup2(null, 0);
+        ::dup2(null, 1);
+        ::dup2(null, 2);
+        ::execv(argv[0], argv.data());
+        ::_exit(127);
+    }
+    int status = 0;
+    if (pid <= 0) return -1;
+    std::this_thread::sleep_for(delay);
+    ::kill(pid, sig);
+    ::waitpid(pid, &status, 0);
+    return status;
+}
+
+// A signal at any moment of an encode over an earlier lightmap's planes leaves either the earlier
+// set or the whole new one, never a mix (the renames of a set run with the signals held off), and
+// no temporary. Signals are sent at 40 moments spread over the encode's run time.
+TEST(CliTraps, SignalDuringEncodeLeavesOneWholeSet) {
+    const std::string dir = test::fresh_dir("traps_signal_publish");
+    const auto maps = test::envmap_paths();
+    ASSERT_GE(maps.size(), 2u);
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", maps[0], "-o", dir + "/a.exr", "--size", "64"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "synth", maps[1], "-o", dir + "/b.exr", "--size", "64"}).exit_code, 0);
+    const std::vector<std::string> planes = {".iz.ktx2", ".d.ktx2", ".wa.ktx2"};
+    auto set_of = [&](const std::string& prefix) {
+        std::vector<std::vector<std::uint8_t>> v;
+        for (const auto& p : planes) v.push_back(fs::exists(prefix + p) ? test::read_bytes(prefix + p) : std::vector<std::uint8_t>{});
+        return v;
+    };
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", dir + "/a.exr", "-o", dir + "/a"}).exit_code, 0);
+    ASSERT_EQ(test::run_zhc({"lightmap", "encode", dir + "/b.exr", "-o", dir + "/b"}).exit_code, 0);
+    const auto old_set = set_of(dir + "/a"), new_set = set_of(dir + "/b");
+    ASSERT_NE(old_set, new_set);
+    const std::vector<std::string> job = {"lightmap", "encode", dir + "/b.exr", "-o", dir + "/out", "--threads", "1"};
+    const auto t0 = std::chrono::steady_clock::now();
+    ASSERT_EQ(test::run_zhc(job).exit_code, 0);
+    const auto run_us = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
+    int killed = 0, finished = 0;
+    for (int i = 0; i < 40; ++i) {
+        for (size_t p = 0; p < planes.size(); ++p) fs::copy_file(dir + "/a" + planes[p], dir + "/out" + planes[p], fs::copy_options::overwrite_existing);
+        const int status = run_and_signal_after(job, std::chrono::microseconds(run_us * i / 32), i % 2 ? SIGINT : SIGTERM);
+        const auto now = set_of(dir + "/out");
+        EXPECT_TRUE(now == old_set || now == new_set) << "moment " << i << ": a mixed set";
+        EXPECT_TRUE(temporaries_in(dir).empty()) << "moment " << i;
+        if (WIFSIGNALED(status)) {
+            ++killed;
+        } else {
+            EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+            EXPECT_EQ(now, new_set);
+            ++finished;
+        }
+    }
+    EXPECT_GT(killed, 10);  // the moments cover the run: most stop it, the last ones come after its end
+    std::printf("encode of 64x64: %.1f ms; %d runs stopped by the signal, %d finished\n", run_us / 1000.0, killed, finished);
+}
+
 // A signal the process was started ignoring stays ignored (nohup, a background job): the command
 // runs to the end and writes its output.
 TEST(CliTraps, IgnoredSignalStaysIgnored) {

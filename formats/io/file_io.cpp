@@ -1,7 +1,9 @@
 #include "formats/io/file_io.h"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -167,10 +169,41 @@ void register_temporary(const std::string& path) {
     }
 }
 
+// Threads renaming temporaries over their final names now. A set of files is published whole or
+// not at all: the publishing thread blocks the three signals for its renames, and a handler running
+// on another thread waits for them to end before it removes anything.
+std::atomic<int> g_publishing{0};
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads the count");
+
+class Publishing {
+public:
+    Publishing() {
+        sigset_t block;
+        ::sigemptyset(&block);
+        for (const int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaddset(&block, sig);
+        ::pthread_sigmask(SIG_BLOCK, &block, &previous_);
+        g_publishing.fetch_add(1);
+    }
+    ~Publishing() {
+        g_publishing.fetch_sub(1);
+        ::pthread_sigmask(SIG_SETMASK, &previous_, nullptr);  // a signal that came meanwhile is handled now
+    }
+    Publishing(const Publishing&) = delete;
+    Publishing& operator=(const Publishing&) = delete;
+
+private:
+    sigset_t previous_;
+};
+
 extern "C" void remove_temporaries_and_reraise(int sig) {
-    // Async-signal-safe only: atomic loads, unlink, sigaction, raise. A temporary already renamed
-    // over its final name is gone under its temporary name: unlink fails and the output stays.
+    // Async-signal-safe only: atomic loads, nanosleep, unlink, sigaction, raise. A temporary
+    // already renamed over its final name is gone under its temporary name: unlink fails and the
+    // output stays.
     const int saved_errno = errno;
+    while (g_publishing.load() > 0) {  // renames on another thread (never this one: it blocks us)
+        struct timespec ms = {0, 1000000};
+        ::nanosleep(&ms, nullptr);
+    }
     for (TemporarySlot& slot : g_temporaries)
         if (slot.state.load() == kLive) ::unlink(slot.path);
     struct sigaction dfl {};
@@ -227,13 +260,17 @@ Status write_via_temporary(const std::string& path, const std::function<Status(c
         release_temporary_path(tmp);
         return st;
     }
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
+    {
+        const Publishing publishing;
+        fs::rename(tmp, path, ec);
+        if (ec) {
+            const std::string why = ec.message();
+            fs::remove(tmp, ec);
+            release_temporary_path(tmp);
+            return make_error(ErrorCode::kIoError, path + ": cannot write (" + why + ")");
+        }
         release_temporary_path(tmp);
-        return make_error(ErrorCode::kIoError, path + ": cannot write (" + ec.message() + ")");
     }
-    release_temporary_path(tmp);
     record_output(path);
     return Ok{};
 }
@@ -322,6 +359,7 @@ Status AtomicFileSet::commit() {
             discard();
             return e;
         }
+    const Publishing publishing;  // until the set is renamed (or rolled back) and released
     std::vector<std::string> renamed;
     for (size_t i = 0; i < paths_.size(); ++i) {
         std::error_code rec;
