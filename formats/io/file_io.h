@@ -109,7 +109,9 @@ Status check_folder_takes_files(const std::string& path);
 // Installs handlers for SIGINT, SIGTERM and SIGHUP that remove every registered temporary file
 // (the writers above, and any temporary_path_for name not yet released) and then end the process
 // by the same signal with its default action, so the exit status still says "killed by SIGINT".
-// Final names are never touched: a file renamed into place is no longer a temporary. A signal
+// Final names are never touched: a file renamed into place is no longer a temporary, and the
+// renames of one write (all files of an AtomicFileSet) run with the signals held off, so a signal
+// leaves the earlier files or the whole new set, never a mix. A signal
 // that is ignored or already has a handler when this is called is left alone. The zhc CLI calls
 // it first thing; a program using the library may call it too. The handler is async-signal-safe
 // (it reads fixed static slots: at most 128 live temporaries of under 4096 bytes are tracked;
