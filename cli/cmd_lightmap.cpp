@@ -163,11 +163,13 @@ int run_encode(const Options& o) {
     // Only now, with the new planes in place: a failed encode leaves the earlier set whole.
     for (const std::string& stale : other_target_planes(o.output, astc, eo.dds)) {
         std::error_code ec;
-        if (!std::filesystem::remove(stale, ec) || ec)
+        const bool removed = std::filesystem::remove(stale, ec);
+        if (ec)
             return report_output(make_error(ErrorCode::kIoError, stale + ": a plane of the other target under this prefix, stale next to the "
                                                                  "new planes, cannot be removed (" + ec.message() + ")"));
-        std::fprintf(stderr, "zhc: note: removed %s: a %s plane of an earlier encode under this prefix (this --target %s wrote %s.%s%s)\n",
-                     stale.c_str(), astc ? "bc" : "astc", o.target.c_str(), o.output.c_str(), astc ? "{iz,dwa}" : "{iz,d,wa}", ext.c_str());
+        if (removed)
+            std::fprintf(stderr, "zhc: note: removed %s: a %s plane of an earlier encode under this prefix (this --target %s wrote %s.%s%s)\n",
+                         stale.c_str(), astc ? "bc" : "astc", o.target.c_str(), o.output.c_str(), astc ? "{iz,dwa}" : "{iz,d,wa}", ext.c_str());
     }
     const double texels = double(r->width) * r->height;
     std::printf("%s: %dx%d texels -> %s.%s%s (%s; %llu bytes of blocks, %.3f bytes/texel)\n", inputs_text(files).c_str(), r->width,
