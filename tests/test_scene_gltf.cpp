@@ -3,6 +3,7 @@
 // cones, directional lights, mesh occluders with node transforms, strict errors, and the embedded
 // probes equal to the .zhp output.
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
@@ -418,6 +419,77 @@ TEST(SceneGltfCli, JsonSceneToMinimalGlb) {
     EXPECT_EQ(hub->size(), 24u);
     // Errors (a glTF without asset.version, a missing input, an .obj output): tests/conformance
     // scenegltf_*, cli_usage_bake_obj.
+}
+
+}  // namespace
+}  // namespace zhc
+
+namespace zhc {
+namespace {
+
+// castle-engine/demo-models gltf/lines and gltf/points (GPL-2+, unmodified, tests/data/gltf/
+// castle-demo-models): LINES / POINTS meshes and a point light. Their vertices span the default
+// probe grid (8 x 8 x 8 over every vertex and the light), they occlude nothing, and the bake is
+// not zero.
+TEST(SceneGltf, LinesAndPointsSpanTheDefaultGrid) {
+    for (const char* name : {"lines/lines.gltf", "points/points.gltf"}) {
+        const std::string path = std::string(ZHC_TEST_DATA_DIR) + "/gltf/castle-demo-models/" + name;
+        auto s = parse_scene_gltf(test::read_bytes(path), path);
+        ASSERT_TRUE(s.ok()) << s.error().message;
+        EXPECT_TRUE(s->occluders.empty()) << name;
+        ASSERT_EQ(s->probes.kind, ProbePlacementKind::kGrid) << name;
+        EXPECT_EQ(s->probes.counts, (std::array<std::uint32_t, 3>{8, 8, 8})) << name;
+        for (int a = 0; a < 3; ++a) EXPECT_GT(s->probes.max[a] - s->probes.min[a], 0.5) << name << " axis " << a;
+        const auto probes = bake(*s);
+        double sum = 0;
+        for (const Sh3Radiance& p : probes) sum += std::fabs(p[0][0]);
+        EXPECT_GT(sum, 0) << name;
+    }
+}
+
+// glTF materials: albedo = base colour x (1 - metallic), emission = emissive x strength; no
+// material (the spec's default, fully metallic) and black materials reflect nothing; a lit
+// reflecting floor adds light to a probe above it, and a bake with the default material is the
+// same bytes as one without any material.
+TEST(SceneGltf, MaterialsReflectAndEmit) {
+    const std::vector<float> floor = {-5, 0, -5, 5, 0, -5, 5, 0, 5, -5, 0, 5};  // glTF y up
+    const std::vector<std::uint16_t> quad = {0, 2, 1, 0, 3, 2};
+    auto make = [&](json material) {
+        Asset a;
+        const size_t m = a.mesh(floor, quad);
+        if (!material.is_null()) {
+            a.doc["materials"].push_back(material);
+            a.doc["meshes"][m]["primitives"][0]["material"] = 0;
+        }
+        a.node({{"mesh", m}});
+        a.node(Asset::light_node(a.light({{"type", "point"}, {"intensity", 10.0}}), {{"translation", {0, 2, 0}}}));
+        a.doc["extras"]["zhc"]["probes"] = {{"positions", {{0, 0, 1}}}};
+        return a;
+    };
+    auto none = parse(make(nullptr));
+    ASSERT_TRUE(none.ok()) << none.error().message;
+    EXPECT_TRUE(none->materials.empty());
+    EXPECT_FALSE(scene_has_transport(*none));
+    auto metal = parse(make({{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1}}}}}));  // metallic 1
+    ASSERT_TRUE(metal.ok());
+    EXPECT_TRUE(metal->materials.empty());
+    auto grey = parse(make({{"name", "grey"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.4, 0.2, 1}}, {"metallicFactor", 0.25}}},
+                            {"emissiveFactor", {0.5, 0, 0}},
+                            {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4.0}}}}}}));
+    ASSERT_TRUE(grey.ok()) << grey.error().message;
+    ASSERT_EQ(grey->materials.size(), 1u);
+    EXPECT_FLOAT_EQ(grey->materials[0].albedo.r, 0.6f);
+    EXPECT_FLOAT_EQ(grey->materials[0].albedo.g, 0.3f);
+    EXPECT_FLOAT_EQ(grey->materials[0].albedo.b, 0.15f);
+    EXPECT_FLOAT_EQ(grey->materials[0].emission.r, 2.0f);
+    for (const Occluder& o : grey->occluders) EXPECT_EQ(o.material, 0u);
+    EXPECT_TRUE(scene_has_transport(*grey));
+    const auto p_none = bake(*none), p_metal = bake(*metal), p_grey = bake(*grey);
+    ASSERT_EQ(p_none.size(), 1u);
+    EXPECT_EQ(std::memcmp(p_none.data(), p_metal.data(), sizeof(Sh3Radiance)), 0);
+    // The floor (below the probe, zhc -z) now reflects and emits: the downward irradiance grows.
+    auto down = [](const Sh3Radiance& p) { return p[0][0] / (2 * std::sqrt(kPi)) - p[2][0] * std::sqrt(3 / (4 * kPi)) * 2 / 3; };
+    EXPECT_GT(down(p_grey[0]), down(p_none[0]) + 0.5);
 }
 
 }  // namespace
