@@ -81,23 +81,35 @@ Scene mesh_scene(std::uint32_t n, int res) {
 // measurement freed is reused and uncounted): the resident set before the mesh scene is made, then
 // the high-water mark of making it and baking it given up (bake_scene(Scene&&), as `zhc bake`
 // runs it), per triangle. -1 where /proc or the child fails.
-double bake_peak_bytes_per_triangle(std::uint32_t n, int res) {
+// The mesh scene with reflected light: the sphere mesh and a floor under it reflect (albedo 0.5).
+Scene reflecting_mesh_scene(std::uint32_t n, int res) {
+    Scene s = mesh_scene(n, res);
+    s.materials.push_back(SceneMaterial{"grey", {0.5f, 0.5f, 0.5f}, {0, 0, 0}});
+    for (Occluder& o : s.occluders) o.material = 0;
+    s.occluders.push_back(triangle_occluder({-50, -50, -0.5}, {50, -50, -0.5}, {50, 50, -0.5}));
+    s.occluders.push_back(triangle_occluder({-50, -50, -0.5}, {50, 50, -0.5}, {-50, 50, -0.5}));
+    s.occluders[s.occluders.size() - 1].material = s.occluders[s.occluders.size() - 2].material = 0;
+    s.transport.min_rays = s.transport.max_rays = 256;
+    return s;
+}
+
+double bake_peak_bytes_per_triangle(std::uint32_t n, int res, bool reflecting = false) {
     char exe[4096];
     const ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);  // in the shell it names sh
     if (len <= 0) return -1;
     exe[len] = 0;
     char cmd[4200];
-    std::snprintf(cmd, sizeof cmd, "'%s' --peak-child %u %d", exe, n, res);
+    std::snprintf(cmd, sizeof cmd, "'%s' --peak-child %u %d%s", exe, n, res, reflecting ? " reflecting" : "");
     FILE* f = popen(cmd, "r");
     if (!f) return -1;
     double v = -1;
     if (std::fscanf(f, "%lf", &v) != 1) v = -1;
     return pclose(f) == 0 ? v : -1;
 }
-int peak_child(std::uint32_t n, int res) {
+int peak_child(std::uint32_t n, int res, bool reflecting) {
     const double rss0 = bench::proc_status_bytes("VmRSS:");
     if (rss0 <= 0 || !bench::reset_peak()) return std::printf("-1\n"), 0;
-    Scene s = mesh_scene(n, res);
+    Scene s = reflecting ? reflecting_mesh_scene(n, res) : mesh_scene(n, res);
     const double tris = double(s.occluders.size());
     bench::keep(bake_scene(std::move(s)));
     const double hwm = bench::proc_status_bytes("VmHWM:");
@@ -126,8 +138,8 @@ std::string join(const std::vector<std::string>& rows) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc == 4 && std::string(argv[1]) == "--peak-child")
-        return peak_child(static_cast<std::uint32_t>(std::atoi(argv[2])), std::atoi(argv[3]));
+    if ((argc == 4 || argc == 5) && std::string(argv[1]) == "--peak-child")
+        return peak_child(static_cast<std::uint32_t>(std::atoi(argv[2])), std::atoi(argv[3]), argc == 5);
     std::uint32_t n = 64;
     std::string json;
     for (int i = 1; i < argc; ++i) {
@@ -360,12 +372,38 @@ int main(int argc, char** argv) {
                                 s.occluders.size(), probes, shadow_rate, r.occlusion_rays / probes, r.occlusion_rays / o_s,
                                 probes / d_s, r.mask_rays / probes, r.mask_rays / m_s);
     }
+    // Reflected light (codec/bake/transport.h) over the 596k-triangle sphere mesh and a floor,
+    // both grey 0.5, 4 x 4 x 4 probes, 256 paths each: time per probe and per million rays, the
+    // noise, and the bake's peak memory per triangle beside the same scene without materials.
+    std::string transport_json = "null";
+    {
+        Scene s = reflecting_mesh_scene(4, 546);
+        const double tris = double(s.occluders.size());
+        BakeReport r;
+        bench::keep(bake_scene(s, BakeOptions{}, &r));
+        const TransportReport& t = r.transport;
+        const double peak_plain = bake_peak_bytes_per_triangle(4, 546), peak_reflect = bake_peak_bytes_per_triangle(4, 546, true);
+        std::printf("\nreflected light, %.0f triangles (sphere mesh and floor, albedo 0.5), %llu probes x %llu paths, 1 thread\n", tris,
+                    static_cast<unsigned long long>(t.probes), static_cast<unsigned long long>(t.probes ? t.paths / t.probes : 0));
+        std::printf("%-40s %10.2f ms per probe, %.1f ms per million rays (%llu rays, %.2f bounces per path)\n", "  path tracing",
+                    t.milliseconds / double(std::max<std::uint64_t>(t.probes, 1)), t.milliseconds / (double(t.rays) * 1e-6),
+                    static_cast<unsigned long long>(t.rays), t.paths ? double(t.vertices) / double(t.paths) : 0.0);
+        std::printf("%-40s median %.2f %%, max %.2f %% relative standard error\n", "  noise", 100 * t.noise_median, 100 * t.noise_max);
+        std::printf("%-40s %.1f bytes per triangle (without materials: %.1f)\n", "  bake peak memory", peak_reflect, peak_plain);
+        transport_json = format("{\"triangles\": %.0f, \"probes\": %llu, \"paths\": %llu, \"rays\": %llu, \"ms_per_probe\": %.4g, "
+                                "\"ms_per_million_rays\": %.4g, \"noise_median\": %.4g, \"bake_peak_bytes_per_triangle\": %.4g, "
+                                "\"bake_peak_bytes_per_triangle_without_materials\": %.4g}",
+                                tris, static_cast<unsigned long long>(t.probes), static_cast<unsigned long long>(t.paths),
+                                static_cast<unsigned long long>(t.rays), t.milliseconds / double(std::max<std::uint64_t>(t.probes, 1)),
+                                t.milliseconds / (double(t.rays) * 1e-6), t.noise_median, peak_reflect, peak_plain);
+    }
     if (!json.empty()) {
         std::ofstream out(json);
         out << "{\n  \"benchmark\": \"bake\",\n"
             << format("  \"probes_per_axis\": %u, \"lights\": %d, \"repeats\": %d, \"threads\": 1, \"clock\": \"thread_cpu\",\n", n, lights, repeats)
             << format("  \"floor_probe_lights_per_s\": %.6g,\n", floor_rate) << "  \"closed_form\": [" << join(closed_rows)
             << "],\n  \"occluded\": [" << join(occluded_rows) << "],\n  \"occlusion_passes\": " << occlusion_json
+            << ",\n  \"reflected_light\": " << transport_json
             << ",\n  \"meshes\": [" << join(mesh_rows).substr(0, join(mesh_rows).size() - 2);
         if (!bench::finish_json(out, json)) return 1;
     }
