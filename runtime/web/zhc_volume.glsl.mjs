@@ -333,7 +333,14 @@ export function compactVolume(source, { THREE, matrixWorld, masks = true } = {})
 // irradiance convention; BRDF_Lambert = albedo / pi makes a white Lambertian surface show E) at the
 // fragment's world position and normal, where three.js adds its light probes. The volume replaces
 // nothing else (add no LightProbeGrid for the same probes). compact = compactVolume(..., { THREE }).
+// WebGPURenderer's node materials (three/webgpu) have no GLSL chunks to patch: refused here, in one
+// message naming what is unsupported and what to use, before any shader is built.
 export function patchMaterialWithVolume(material, compact, THREE) {
+  if (material?.isNodeMaterial || !THREE?.ShaderChunk?.lights_fragment_begin)
+    throw new Error('zhc compact volume: patchMaterialWithVolume patches the GLSL of WebGLRenderer materials; ' +
+      (material?.isNodeMaterial ? `${material.type} is a node material` : 'this three.js namespace has no ShaderChunk (three/webgpu)') +
+      ', and WebGPURenderer is not supported by the compact path: render with WebGLRenderer, or light the scene with ' +
+      'volume.lightProbeGrid(LightProbeGrid), which applies no validity or visibility masks');
   if (!compact.uniforms) throw new Error('zhc compact volume: build it with compactVolume(source, { THREE })');
   const begin = 'vec3 irradiance = getAmbientLightIrradiance( ambientLightColor );';
   if (!THREE.ShaderChunk.lights_fragment_begin.includes(begin))
