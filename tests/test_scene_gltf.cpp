@@ -2,9 +2,11 @@
 // the test (JSON + a base64 buffer) against the same scene written as zhc JSON (the twin), spot
 // cones, directional lights, mesh occluders with node transforms, strict errors, and the embedded
 // probes equal to the .zhp output.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 
 #include <nlohmann/json.hpp>
 
@@ -13,7 +15,9 @@
 #include "formats/probes/probe_file.h"
 #include "formats/scene/scene_gltf.h"
 #include "formats/scene/scene_json.h"
+#include "formats/io/file_io.h"
 #include "formats/report/html_report.h"
+#include "formats/report/raster.h"
 #include "support.h"
 
 namespace zhc {
@@ -490,6 +494,308 @@ TEST(SceneGltf, MaterialsReflectAndEmit) {
     // The floor (below the probe, zhc -z) now reflects and emits: the downward irradiance grows.
     auto down = [](const Sh3Radiance& p) { return p[0][0] / (2 * std::sqrt(kPi)) - p[2][0] * std::sqrt(3 / (4 * kPi)) * 2 / 3; };
     EXPECT_GT(down(p_grey[0]), down(p_none[0]) + 0.5);
+}
+
+// ---- textures in the reflected light ------------------------------------------------------
+
+std::string png_uri(const std::vector<std::uint8_t>& rgb, int w, int h) {
+    return "data:image/png;base64," + base64(png_bytes_rgb8(rgb.data(), rgb.size(), w, h));
+}
+
+// A glTF floor (y = 0, x and z in [x0, x1] x [-5, 5]) with TEXCOORD_0 u = (x + 5) / 10,
+// v = (z + 5) / 10; returns the mesh index.
+size_t uv_floor(Asset& a, float x0, float x1, bool uvs) {
+    const std::vector<float> xyz = {x0, 0, -5, x1, 0, -5, x1, 0, 5, x0, 0, 5};
+    const size_t m = a.mesh(xyz, {0, 2, 1, 0, 3, 2});
+    if (uvs) {
+        std::vector<float> uv;
+        for (size_t i = 0; i < 4; ++i) {
+            uv.push_back((xyz[i * 3] + 5) / 10);
+            uv.push_back((xyz[i * 3 + 2] + 5) / 10);
+        }
+        const size_t v = a.view(uv.data(), uv.size() * 4);
+        a.doc["accessors"].push_back({{"bufferView", v}, {"componentType", 5126}, {"count", 4}, {"type", "VEC2"}});
+        a.doc["meshes"][m]["primitives"][0]["attributes"]["TEXCOORD_0"] = a.doc["accessors"].size() - 1;
+    }
+    return m;
+}
+// The floor with a base colour texture from `image` (an images[] entry), a NEAREST sampler, a
+// point light 2 above it (when `lit`) and three probes.
+Asset textured_floor(json image, bool lit = true) {
+    Asset a;
+    const size_t m = uv_floor(a, -5, 5, true);
+    a.doc["images"] = json::array({image});
+    a.doc["samplers"] = json::array({{{"magFilter", 9728}}});
+    a.doc["textures"] = json::array({{{"source", 0}, {"sampler", 0}}});
+    a.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1}}, {"metallicFactor", 0}, {"baseColorTexture", {{"index", 0}}}}}}});
+    a.doc["meshes"][m]["primitives"][0]["material"] = 0;
+    a.node({{"mesh", m}});
+    if (lit) a.node(Asset::light_node(a.light({{"type", "point"}, {"intensity", 10.0}}), {{"translation", {0, 2, 0}}}));
+    a.doc["extras"]["zhc"]["probes"] = {{"positions", {{0, -2, 1}, {0, 2, 1}, {1, 0.5, 0.5}}}};
+    return a;
+}
+const std::vector<std::uint8_t> kBlackWhite = {0, 0, 0, 255, 255, 255};  // 2 x 1: u < 0.5 black
+
+// A floor whose base colour texture is black over u < 0.5 and white over u > 0.5 (a PNG in a data
+// URI, sRGB-decoded: 0 and 1 exactly) bakes as the same floor split into a black and a white
+// material (within rounding: the triangles differ, the surfaces do not).
+TEST(SceneGltf, TexturedFloorEqualsTwoMaterials) {
+    auto tex = parse(textured_floor({{"uri", png_uri(kBlackWhite, 2, 1)}}));
+    ASSERT_TRUE(tex.ok()) << tex.error().message;
+    ASSERT_EQ(tex->textures.size(), 1u);
+    EXPECT_EQ(tex->textures[0].width, 2u);
+    EXPECT_TRUE(tex->textures[0].nearest);
+    EXPECT_EQ(tex->textures[0].texels, (std::vector<float>{0, 0, 0, 1, 1, 1}));
+    ASSERT_EQ(tex->surfaces.size(), 2u);
+    for (const Occluder& o : tex->occluders) EXPECT_TRUE(is_surface(o.material));
+    ASSERT_EQ(tex->materials.size(), 1u);
+    EXPECT_EQ(tex->materials[0].base_texture, 0);
+    Asset twin;
+    const size_t black = uv_floor(twin, -5, 0, false), white = uv_floor(twin, 0, 5, false);
+    twin.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}, {"metallicFactor", 0}}}},
+                                         {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1}}, {"metallicFactor", 0}}}}});
+    twin.doc["meshes"][black]["primitives"][0]["material"] = 0;
+    twin.doc["meshes"][white]["primitives"][0]["material"] = 1;
+    twin.node({{"mesh", black}});
+    twin.node({{"mesh", white}});
+    twin.node(Asset::light_node(twin.light({{"type", "point"}, {"intensity", 10.0}}), {{"translation", {0, 2, 0}}}));
+    twin.doc["extras"]["zhc"]["probes"] = {{"positions", {{0, -2, 1}, {0, 2, 1}, {1, 0.5, 0.5}}}};
+    auto two = parse(twin);
+    ASSERT_TRUE(two.ok()) << two.error().message;
+    EXPECT_TRUE(two->textures.empty());
+    const auto pt = bake(*tex), p2 = bake(*two);
+    ASSERT_EQ(pt.size(), 3u);
+    ASSERT_EQ(p2.size(), 3u);
+    for (size_t i = 0; i < 3; ++i)
+        for (int c = 0; c < 9; ++c)
+            for (int k = 0; k < 3; ++k) EXPECT_NEAR(pt[i][c][k], p2[i][c][k], 1e-5 * (1 + std::fabs(p2[i][0][k]))) << i << " " << c;
+    // The probe over the black half (glTF x < 0: zhc y < 0) sees less light below it than the other.
+    EXPECT_LT(pt[0][0][0], pt[1][0][0] * 0.9);
+}
+
+// sRGB decoding for base colour and emissive (glTF 2.0 spec 3.9.2), linear for metallic-roughness:
+// one image used both ways is two textures; the blue channel of metallic-roughness scales metallic.
+TEST(SceneGltf, TextureColourSpaces) {
+    Asset a = textured_floor({{"uri", png_uri({128, 64, 255}, 1, 1)}});
+    json& mat = a.doc["materials"][0];
+    mat["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", 0}};
+    mat["pbrMetallicRoughness"]["metallicFactor"] = 1.0;
+    mat["emissiveTexture"] = {{"index", 0}};
+    mat["emissiveFactor"] = {1, 1, 1};
+    auto s = parse(a);
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    ASSERT_EQ(s->textures.size(), 2u);
+    const SceneMaterial& m = s->materials[0];
+    ASSERT_GE(m.base_texture, 0);
+    ASSERT_GE(m.metal_rough_texture, 0);
+    EXPECT_EQ(m.emissive_texture, m.base_texture);
+    EXPECT_NE(m.metal_rough_texture, m.base_texture);
+    auto srgb = [](double c8) { const double c = c8 / 255; return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); };
+    const auto& lin = s->textures[static_cast<size_t>(m.metal_rough_texture)].texels;
+    const auto& col = s->textures[static_cast<size_t>(m.base_texture)].texels;
+    EXPECT_NEAR(col[0], 0.21586, 1e-5);  // sRGB 128
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(col[static_cast<size_t>(k)], srgb(k == 0 ? 128 : k == 1 ? 64 : 255), 1e-7);
+        EXPECT_NEAR(lin[static_cast<size_t>(k)], (k == 0 ? 128 : k == 1 ? 64 : 255) / 255.0, 1e-7);
+    }
+    // Metallic 1 x blue 1: no diffuse part anywhere; the floor only emits.
+    double albedo_seen = 0;
+    SceneTexture mr = s->textures[static_cast<size_t>(m.metal_rough_texture)];
+    double rgb[3];
+    sample_texture(mr, 0.3, 0.7, rgb);
+    albedo_seen = m.base_factor[0] * (1 - m.metallic * rgb[2]);
+    EXPECT_EQ(albedo_seen, 0.0);
+    EXPECT_TRUE(scene_has_transport(*s));
+}
+
+// Images are read only for a bake that traces reflected light: an image URI escaping the asset's
+// folder, or a missing image, is no error for a scene with nothing to reflect, and a one-line
+// error naming the image where the textures are decoded; an image beside the asset is read and
+// recorded as an input (--depfile).
+TEST(SceneGltf, ImagesReadOnlyForReflectedLight) {
+    const std::string root = test::fresh_dir("scene_gltf_texture_uris");
+    fs::create_directories(root + "/asset");
+    test::write_bytes(root + "/tex.png", png_bytes_rgb8(kBlackWhite.data(), kBlackWhite.size(), 2, 1));
+    test::write_bytes(root + "/asset/beside.png", png_bytes_rgb8(kBlackWhite.data(), kBlackWhite.size(), 2, 1));
+    struct Case {
+        const char* uri;
+        ErrorCode code;
+    };
+    for (const Case& c : {Case{"../tex.png", ErrorCode::kBadFormat}, Case{"missing.png", ErrorCode::kIoError}}) {
+        const std::string in = root + "/asset/scene.gltf";
+        for (bool lit : {false, true}) {
+            const std::string text = textured_floor({{"uri", c.uri}}, lit).text();
+            test::write_bytes(in, std::vector<std::uint8_t>(text.begin(), text.end()));
+            auto bytes = read_file_bytes(in, std::uint64_t(1) << 30);
+            ASSERT_TRUE(bytes.ok());
+            auto s = parse_scene_gltf(*bytes, in);
+            if (!lit) {
+                ASSERT_TRUE(s.ok()) << c.uri << ": " << s.error().message;
+                EXPECT_TRUE(s->surfaces.empty());
+                EXPECT_TRUE(s->textures.empty());
+                for (const Occluder& o : s->occluders) EXPECT_EQ(o.material, 0u);
+                continue;
+            }
+            ASSERT_FALSE(s.ok()) << c.uri;
+            EXPECT_EQ(s.error().code, c.code) << s.error().message;
+            EXPECT_NE(s.error().message.find("images[0].uri"), std::string::npos) << s.error().message;
+            EXPECT_EQ(s.error().message.find('\n'), std::string::npos) << s.error().message;
+        }
+    }
+    const std::string in = root + "/asset/scene.gltf";
+    const std::string text = textured_floor({{"uri", "beside.png"}}).text();
+    test::write_bytes(in, std::vector<std::uint8_t>(text.begin(), text.end()));
+    FileRecorder rec;
+    {
+        ScopedFileRecording on(&rec);
+        auto bytes = read_file_bytes(in, std::uint64_t(1) << 30);
+        ASSERT_TRUE(bytes.ok());
+        auto s = parse_scene_gltf(*bytes, in);
+        ASSERT_TRUE(s.ok()) << s.error().message;
+        ASSERT_EQ(s->textures.size(), 1u);
+        EXPECT_EQ(s->textures[0].texels[3], 1.0f);
+    }
+    const auto inputs = rec.inputs();
+    EXPECT_NE(std::find(inputs.begin(), inputs.end(), root + "/asset/beside.png"), inputs.end()) << inputs.size();
+    // The command line: exit 4 for the escaping image, one line.
+    const std::string esc = textured_floor({{"uri", "../tex.png"}}).text();
+    test::write_bytes(in, std::vector<std::uint8_t>(esc.begin(), esc.end()));
+    const auto r = test::run_zhc({"bake", in, "-o", root + "/out.zhp", "--quiet"});
+    EXPECT_EQ(r.exit_code, 4) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(root + "/out.zhp"));
+}
+
+// The texel limit (SceneJsonLimits::max_texels) is checked from the image's header before decoding.
+TEST(SceneGltf, TexelLimit) {
+    const Asset a = textured_floor({{"uri", png_uri(kBlackWhite, 2, 1)}});
+    SceneLoadOptions o;
+    o.limits.max_texels = 1;
+    auto s = parse_scene_gltf(a.bytes(), "big.gltf", o);
+    ASSERT_FALSE(s.ok());
+    EXPECT_EQ(s.error().code, ErrorCode::kTooLarge);
+    EXPECT_NE(s.error().message.find("images[0]"), std::string::npos) << s.error().message;
+    EXPECT_NE(s.error().message.find("limit of 1 texels"), std::string::npos) << s.error().message;
+    o.limits.max_texels = 2;
+    EXPECT_TRUE(parse_scene_gltf(a.bytes(), "big.gltf", o).ok());
+}
+
+// GLB edits: the JSON chunk replaced, the BIN chunk kept.
+std::vector<std::uint8_t> edit_glb(const std::string& file, const std::function<void(json&)>& edit) {
+    std::vector<std::uint8_t> b = test::read_bytes(file);
+    const std::uint32_t jlen = test::get32(b, 12);
+    json j = json::parse(b.begin() + 20, b.begin() + 20 + jlen);
+    const std::vector<std::uint8_t> rest(b.begin() + 20 + jlen, b.end());
+    edit(j);
+    std::string t = j.dump();
+    while (t.size() % 4) t.push_back(' ');
+    std::vector<std::uint8_t> out(20);
+    out.insert(out.end(), t.begin(), t.end());
+    out.insert(out.end(), rest.begin(), rest.end());
+    std::memcpy(out.data(), "glTF", 4);
+    test::put32(out, 4, 2);
+    test::put32(out, 8, static_cast<std::uint32_t>(out.size()));
+    test::put32(out, 12, static_cast<std::uint32_t>(t.size()));
+    std::memcpy(out.data() + 16, "JSON", 4);
+    return out;
+}
+json textured_material(json& j) {
+    j["images"] = json::array({{{"uri", png_uri(kBlackWhite, 2, 1)}}});
+    j["textures"] = json::array({{{"source", 0}}});
+    j["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"metallicFactor", 0}, {"baseColorTexture", {{"index", 0}}}}}}});
+    return j;
+}
+
+// A meshopt-compressed TEXCOORD_0 (gp_meshopt.glb, gltf-pipeline's meshopt encoding: a VEC2
+// accessor over the compressed POSITION view, so each UV is its vertex's glTF (x, y)) is decoded;
+// a Draco-compressed textured primitive (gt_draco.glb) keeps its factors, with a note.
+TEST(SceneGltf, CompressedTexturedPrimitives) {
+    const std::string dir = std::string(ZHC_TEST_DATA_DIR) + "/gltf/";
+    const auto mo = edit_glb(dir + "gp_meshopt.glb", [](json& j) {
+        textured_material(j);
+        j["accessors"].push_back({{"bufferView", 0}, {"byteOffset", 0}, {"componentType", 5126}, {"count", 16}, {"type", "VEC2"}});
+        j["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = j["accessors"].size() - 1;
+        j["meshes"][0]["primitives"][0]["material"] = 0;
+    });
+    auto s = parse_scene_gltf(mo, "meshopt_textured.glb");
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    ASSERT_FALSE(s->surfaces.empty());
+    ASSERT_EQ(s->textures.size(), 1u);
+    size_t textured = 0;
+    for (const Occluder& o : s->occluders) {
+        if (!is_surface(o.material)) continue;
+        ++textured;
+        const SurfaceUv& uv = s->surfaces[o.material & ~kSurfaceBit];
+        const Vec3 v[3] = {o.v0, o.v1, o.v2};
+        for (int k = 0; k < 3; ++k) {  // zhc (x, y, z) = glTF (z, x, y)
+            EXPECT_FLOAT_EQ(uv.uv[k][0], float(v[k].y));
+            EXPECT_FLOAT_EQ(uv.uv[k][1], float(v[k].z));
+        }
+    }
+    EXPECT_EQ(textured, 16u);  // 48 indices
+    EXPECT_FALSE(bake(*s).empty());
+    std::vector<std::string> notes;
+    const auto dr = edit_glb(dir + "gt_draco.glb", [](json& j) {
+        textured_material(j);
+        j["meshes"][0]["primitives"][0]["material"] = 0;
+    });
+    auto d = parse_scene_gltf(dr, "draco_textured.glb", {}, {}, &notes);
+    ASSERT_TRUE(d.ok()) << d.error().message;
+    EXPECT_TRUE(d->surfaces.empty());
+    ASSERT_EQ(d->materials.size(), 1u);
+    EXPECT_FLOAT_EQ(d->materials[0].albedo.r, 0.5f);
+    bool noted = false;
+    for (const std::string& n : notes) noted = noted || n.find("Draco-compressed texture coordinates are not read") != std::string::npos;
+    EXPECT_TRUE(noted);
+}
+
+// gltf-pipeline's box-textured-embedded (COLLADA2GLTF: a unit box, PNG in a bufferView, UVs up to
+// 6 with REPEAT) and box-textured-separate (the same PNG as "cesium logo.png" beside the asset, a
+// percent-encoded URI) under a point light: the texture is decoded (128 x 128), every triangle is
+// textured, both files bake the same probes, and the box's lit face reflects less light than a
+// white box's would.
+TEST(SceneGltf, GltfPipelineTexturedBox) {
+    const std::string dir = std::string(ZHC_TEST_DATA_DIR) + "/gltf/gltf-pipeline/";
+    auto with_light = [](json& j) {
+        j["extensionsUsed"].push_back("KHR_lights_punctual");
+        j["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", 20.0}}});
+        j["nodes"].push_back({{"translation", {0, 0, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+        j["scenes"][0]["nodes"].push_back(j["nodes"].size() - 1);
+        // zhc axes: the box spans [-0.5, 0.5]^3; the light and probes sit outside it.
+        j["nodes"].back()["translation"] = {0, 0, 2.0};  // glTF z = zhc x
+        j["extras"]["zhc"]["probes"] = {{"positions", {{1.0, 0.2, 0.1}, {0.8, -0.3, 0.6}}}};
+    };
+    std::vector<Sh3Radiance> probes[2];
+    int i = 0;
+    for (const char* name : {"box-textured-embedded/box-textured-embedded.gltf", "box-textured-separate/box-textured-separate.gltf"}) {
+        json j = json::parse(test::read_bytes(dir + name));
+        with_light(j);
+        const std::string path = test::fresh_dir(std::string("pipeline_box_") + std::to_string(i)) + "/box.gltf";
+        if (i == 1)
+            for (const char* f : {"box-textured-separate.bin", "cesium logo.png"})
+                fs::copy_file(dir + "box-textured-separate/" + f, fs::path(path).parent_path() / f);
+        const std::string t = j.dump();
+        test::write_bytes(path, std::vector<std::uint8_t>(t.begin(), t.end()));
+        auto s = parse_scene_gltf(std::vector<std::uint8_t>(t.begin(), t.end()), path);
+        ASSERT_TRUE(s.ok()) << name << ": " << s.error().message;
+        ASSERT_EQ(s->textures.size(), 1u) << name;
+        EXPECT_EQ(s->textures[0].width, 128u);
+        EXPECT_EQ(s->textures[0].height, 128u);
+        EXPECT_EQ(s->surfaces.size(), 12u);
+        for (const Occluder& o : s->occluders) EXPECT_TRUE(is_surface(o.material));
+        probes[i] = bake(*s);
+        // The same box untextured (white factor): it reflects more.
+        if (i == 0) {
+            Scene w = *s;
+            for (Occluder& o : w.occluders) o.material = w.surfaces[o.material & ~kSurfaceBit].material;
+            w.materials[0].base_texture = -1;
+            const auto pw = bake(w);
+            EXPECT_LT(probes[0][0][0][1], pw[0][0][1] - 0.01) << "textured " << probes[0][0][0][1] << " white " << pw[0][0][1];
+        }
+        ++i;
+    }
+    ASSERT_EQ(probes[0].size(), 2u);
+    for (size_t p = 0; p < 2; ++p) EXPECT_EQ(probes[0][p], probes[1][p]) << p;
 }
 
 }  // namespace

@@ -348,5 +348,213 @@ TEST(Transport, JsonMaterialsAndLimits) {
     }
 }
 
+// Texture sampling (codec/bake/transport.h sample_texture): nearest and bilinear, each glTF wrap
+// mode on UVs outside [0, 1], v along the rows.
+TEST(Transport, TextureSamplingAndWrapModes) {
+    SceneTexture t;
+    t.width = 4;
+    t.height = 2;
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 4; ++x)
+            for (int k = 0; k < 3; ++k) t.texels.push_back(float(x + 10 * y + 100 * k));
+    double c[3];
+    t.nearest = true;
+    struct Case {
+        TextureWrap w;
+        double u;
+        double want;
+    };
+    // Texel column = floor(4 u) wrapped: repeat mod 4; clamp to [0, 3]; mirror over a period of 8.
+    for (const Case& k : {Case{TextureWrap::kRepeat, 1.1, 0}, Case{TextureWrap::kClamp, 1.1, 3}, Case{TextureWrap::kMirror, 1.1, 3},
+                          Case{TextureWrap::kRepeat, -0.1, 3}, Case{TextureWrap::kClamp, -0.1, 0}, Case{TextureWrap::kMirror, -0.1, 0},
+                          Case{TextureWrap::kRepeat, 2.6, 2}, Case{TextureWrap::kMirror, 1.6, 1}, Case{TextureWrap::kMirror, -1.1, 3},
+                          Case{TextureWrap::kClamp, 1e12, 3}, Case{TextureWrap::kRepeat, 0.3, 1}}) {
+        t.wrap_s = k.w;
+        sample_texture(t, k.u, 0.25, c);
+        EXPECT_EQ(c[0], k.want) << "wrap " << int(k.w) << " u " << k.u;
+        EXPECT_EQ(c[2], k.want + 200) << "wrap " << int(k.w) << " u " << k.u;
+    }
+    t.wrap_s = TextureWrap::kRepeat;
+    sample_texture(t, 0.3, 0.75, c);  // second row
+    EXPECT_EQ(c[0], 11);
+    t.wrap_t = TextureWrap::kClamp;
+    sample_texture(t, 0.3, 7.0, c);
+    EXPECT_EQ(c[0], 11);
+    // Bilinear between texel centres (u = (i + 0.5) / 4): halfway between columns 1 and 2 is 1.5.
+    t.nearest = false;
+    t.wrap_t = TextureWrap::kClamp;
+    sample_texture(t, 0.5, 0.25, c);
+    EXPECT_DOUBLE_EQ(c[0], 1.5);
+    sample_texture(t, 0.5, 0.5, c);  // halfway between the rows too
+    EXPECT_DOUBLE_EQ(c[0], 6.5);
+    // Repeat blends the last column with the first across the edge; clamp holds the edge texel.
+    t.wrap_s = TextureWrap::kRepeat;
+    sample_texture(t, 1.0, 0.25, c);
+    EXPECT_DOUBLE_EQ(c[0], 1.5);  // (3 + 0) / 2
+    t.wrap_s = TextureWrap::kClamp;
+    sample_texture(t, 1.0, 0.25, c);
+    EXPECT_DOUBLE_EQ(c[0], 3.0);
+    t.wrap_s = TextureWrap::kMirror;
+    sample_texture(t, 1.0, 0.25, c);
+    EXPECT_DOUBLE_EQ(c[0], 3.0);  // the mirrored neighbour of column 3 is column 3
+}
+
+// A floor of four triangles (x < 0 and x > 0 halves) under a sun, probes above it. `textured`:
+// one white-factor material whose base colour texture is black over u < 0.5 and white (albedo
+// `rho` via the factor) over u > 0.5, u = (x + R) / 2R; else the left half has a black material
+// and the right half one of albedo rho.
+Scene split_floor(bool textured, bool nearest, int texels, TextureWrap wrap = TextureWrap::kClamp, float u_shift = 0) {
+    Scene s = at_positions({{-2, 0.5, 1}, {0, 0, 0.7}, {2.5, -1, 1.5}, {0.3, 0.2, 0.2}});
+    const double R = 50, rho = 0.7;
+    const Vec3 a{-R, -R, 0}, b{0, -R, 0}, c{0, R, 0}, d{-R, R, 0}, e{R, -R, 0}, f{R, R, 0};
+    s.occluders = {triangle_occluder(a, b, c), triangle_occluder(a, c, d), triangle_occluder(b, e, f), triangle_occluder(b, f, c)};
+    SceneLight sun;
+    sun.kind = LightKind::kDirectional;
+    sun.direction = normalize_or({0.3, 0.2, 1.0}, {0, 0, 1});
+    sun.color = {1.0f, 0.8f, 0.6f};
+    s.lights.push_back(sun);
+    s.transport.min_rays = s.transport.max_rays = 1024;
+    if (!textured) {
+        SceneMaterial black, white;
+        white.albedo = {float(rho), float(rho), float(rho)};
+        s.materials = {black, white};
+        for (size_t i = 0; i < 4; ++i) s.occluders[i].material = i < 2 ? 0 : 1;
+        return s;
+    }
+    SceneMaterial m;
+    m.base_factor = {float(rho), float(rho), float(rho)};
+    m.metallic = 0;
+    m.albedo = m.base_factor;
+    m.base_texture = 0;
+    s.materials = {m};
+    SceneTexture t;
+    t.width = static_cast<std::uint32_t>(texels);
+    t.height = 1;
+    t.nearest = nearest;
+    t.wrap_s = t.wrap_t = wrap;
+    for (int x = 0; x < texels; ++x)
+        for (int k = 0; k < 3; ++k) t.texels.push_back(x < texels / 2 ? 0.0f : 1.0f);
+    s.textures = {t};
+    for (size_t i = 0; i < 4; ++i) {
+        SurfaceUv uv;
+        uv.material = 0;
+        const Occluder& o = s.occluders[i];
+        const Vec3 v[3] = {o.v0, o.v1, o.v2};
+        for (int j = 0; j < 3; ++j) {
+            uv.uv[j][0] = float((v[j].x + R) / (2 * R)) + u_shift;
+            uv.uv[j][1] = float((v[j].y + R) / (2 * R));
+        }
+        s.surfaces.push_back(uv);
+        s.occluders[i].material = kSurfaceBit | static_cast<std::uint32_t>(i);
+    }
+    return s;
+}
+
+// A half black, half white texture equals the floor split into two materials: the same bytes
+// with nearest sampling (every hit sees the same albedo, so the paths are the same), within the
+// bilinear blend band's share with a 256-texel bilinear texture; the same bytes for any thread count.
+TEST(Transport, HalfBlackHalfWhiteTextureEqualsTwoMaterials) {
+    const Scene two = split_floor(false, false, 0);
+    const Scene tex = split_floor(true, true, 2);
+    ASSERT_TRUE(validate_scene(tex).ok());
+    EXPECT_TRUE(scene_has_transport(tex));
+    BakeReport r_two, r_tex;
+    const auto p_two = bake(two, 1, &r_two), p_tex = bake(tex, 1, &r_tex);
+    ASSERT_EQ(p_two.size(), 4u);
+    ASSERT_EQ(p_tex.size(), 4u);
+    EXPECT_TRUE(r_tex.transport.traced);
+    EXPECT_EQ(r_two.transport.vertices, r_tex.transport.vertices);
+    EXPECT_EQ(std::memcmp(p_two.data(), p_tex.data(), p_two.size() * sizeof(Sh3Radiance)), 0);
+    const auto p_tex3 = bake(tex, 3);
+    EXPECT_EQ(std::memcmp(p_tex.data(), p_tex3.data(), p_tex.size() * sizeof(Sh3Radiance)), 0);
+    // Bilinear over 256 texels: a blend band of 1/256 of the floor's width around x = 0.
+    const auto p_bil = bake(split_floor(true, false, 256), 2);
+    // Repeat with UVs shifted by 2 (outside [0, 1]) samples the same texels.
+    const auto p_rep = bake(split_floor(true, false, 256, TextureWrap::kRepeat, 2.0f), 2);
+    ASSERT_EQ(p_bil.size(), 4u);
+    ASSERT_EQ(p_rep.size(), 4u);
+    for (size_t i = 0; i < 4; ++i)
+        for (const Vec3& n : kAxes)
+            for (int k = 0; k < 3; ++k) {
+                const double ref = irradiance(p_two[i], n, k), scale = irradiance(p_two[i], {0, 0, 1}, k);
+                EXPECT_NEAR(irradiance(p_bil[i], n, k), ref, 0.02 * scale) << "probe " << i;
+                EXPECT_NEAR(irradiance(p_rep[i], n, k), ref, 0.02 * scale) << "probe " << i;
+            }
+    // Clamp with UVs shifted by 2 reads the white edge everywhere: more light below each probe.
+    const auto p_clamp = bake(split_floor(true, false, 256, TextureWrap::kClamp, 2.0f), 2);
+    for (size_t i = 0; i < 4; ++i) EXPECT_GT(irradiance(p_clamp[i], {0, 0, -1}, 0), irradiance(p_two[i], {0, 0, -1}, 0) * 1.05) << i;
+}
+
+// A constant texture of 1 (base colour, metallic-roughness blue channel, emissive) equals the
+// factors alone within 1e-6, and a texel c scales the albedo as a factor of c does.
+TEST(Transport, ConstantTextureEqualsFactors) {
+    auto floor = [](SceneMaterial m, bool textured, float base_texel, float metal_texel) {
+        Scene s = split_floor(false, false, 0);
+        s.materials = {m};
+        if (textured) {
+            for (int ti = 0; ti < 3; ++ti) {
+                SceneTexture t;
+                t.width = t.height = 3;
+                const float v = ti == 0 ? base_texel : ti == 1 ? metal_texel : 1.0f;
+                t.texels.assign(27, v);
+                s.textures.push_back(t);
+            }
+            s.materials[0].base_texture = 0;
+            s.materials[0].metal_rough_texture = 1;
+            s.materials[0].emissive_texture = 2;
+            for (size_t i = 0; i < 4; ++i) {
+                SurfaceUv uv;
+                uv.uv[1][0] = 3.5f;   // far outside [0, 1]: constant anyway
+                uv.uv[2][1] = -2.0f;
+                s.surfaces.push_back(uv);
+                s.occluders[i].material = kSurfaceBit | static_cast<std::uint32_t>(i);
+            }
+        } else {
+            for (Occluder& o : s.occluders) o.material = 0;
+        }
+        return s;
+    };
+    SceneMaterial plain;
+    plain.albedo = {0.45f, 0.3f, 0.15f};  // base (0.6, 0.4, 0.2) x (1 - 0.25)
+    plain.emission = {0.2f, 0.1f, 0.05f};
+    SceneMaterial tex = plain;
+    tex.base_factor = {0.6f, 0.4f, 0.2f};
+    tex.metallic = 0.25f;
+    const auto a = bake(floor(plain, false, 1, 1)), b = bake(floor(tex, true, 1, 1));
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i)
+        for (int c = 0; c < 9; ++c)
+            for (int k = 0; k < 3; ++k) EXPECT_NEAR(b[i][c][k], a[i][c][k], 1e-6 * (1 + std::fabs(a[i][c][k]))) << i << " " << c;
+    // Base texel 0.5 and metallic blue 0.4: albedo = base x 0.5 x (1 - 0.25 x 0.4) = base x 0.45.
+    SceneMaterial scaled = plain;
+    scaled.albedo = {0.6f * 0.45f, 0.4f * 0.45f, 0.2f * 0.45f};
+    const auto c = bake(floor(scaled, false, 1, 1)), d = bake(floor(tex, true, 0.5f, 0.4f));
+    for (size_t i = 0; i < c.size(); ++i)
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(d[i][0][k], c[i][0][k], 1e-5 * (1 + std::fabs(c[i][0][k]))) << i;
+}
+
+// validate_scene checks the texture and surface tables.
+TEST(Transport, TextureTablesValidated) {
+    Scene s = split_floor(true, true, 2);
+    ASSERT_TRUE(validate_scene(s).ok());
+    Scene bad = s;
+    bad.materials[0].base_texture = 1;
+    EXPECT_FALSE(validate_scene(bad).ok());
+    bad = s;
+    bad.textures[0].texels.pop_back();
+    EXPECT_FALSE(validate_scene(bad).ok());
+    bad = s;
+    bad.surfaces[0].material = 3;
+    EXPECT_FALSE(validate_scene(bad).ok());
+    bad = s;
+    bad.occluders[3].material = kSurfaceBit | 4u;
+    auto r = validate_scene(bad);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().message.find("occluders[3]"), std::string::npos) << r.error().message;
+    bad = s;
+    bad.surfaces[1].uv[0][0] = std::nanf("");
+    EXPECT_FALSE(validate_scene(bad).ok());
+}
+
 }  // namespace
 }  // namespace zhc

@@ -133,6 +133,10 @@ struct Scene {
     // reflected-light pass (codec/bake/transport.h).
     std::vector<SceneMaterial> materials;
     SceneTransport transport;
+    // Textures of textured materials, and the UVs of textured triangles (Occluder::material
+    // kSurfaceBit | index; codec/bake/transport.h SurfaceUv).
+    std::vector<SceneTexture> textures;
+    std::vector<SurfaceUv> surfaces;
 };
 
 // The built-in default scene of `zhc demo`: the default gradient sky and sun (codec/bake/sky.h), three

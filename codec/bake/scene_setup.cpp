@@ -147,7 +147,26 @@ Status validate_scene(const Scene& s) {
         for (int k = 0; k < 3; ++k) {
             if (!(m.albedo[k] >= 0 && m.albedo[k] <= 1)) return bad(at + ": albedo must be in [0, 1]");
             if (!(m.emission[k] >= 0) || !std::isfinite(m.emission[k])) return bad(at + ": emission must be finite and >= 0");
+            if (m.textured() && !(m.base_factor[k] >= 0 && m.base_factor[k] <= 1)) return bad(at + ": base colour factor must be in [0, 1]");
         }
+        if (m.textured() && !(m.metallic >= 0 && m.metallic <= 1)) return bad(at + ": metallic must be in [0, 1]");
+        for (int t : {m.base_texture, m.metal_rough_texture, m.emissive_texture})
+            if (t < -1 || (t >= 0 && static_cast<size_t>(t) >= s.textures.size()))
+                return bad(at + ": texture " + std::to_string(t) + " is not in textures");
+    }
+    for (size_t i = 0; i < s.textures.size(); ++i) {
+        const SceneTexture& t = s.textures[i];
+        if (t.width == 0 || t.height == 0 || t.texels.size() != std::size_t(t.width) * t.height * 3)
+            return bad("textures[" + std::to_string(i) + "]: needs width x height x 3 texels, width and height > 0");
+        for (float f : t.texels)
+            if (!std::isfinite(f) || f < 0) return bad("textures[" + std::to_string(i) + "]: texels must be finite and >= 0");
+    }
+    for (size_t i = 0; i < s.surfaces.size(); ++i) {
+        const SurfaceUv& u = s.surfaces[i];
+        if (u.material >= s.materials.size())
+            return bad("surfaces[" + std::to_string(i) + "]: material " + std::to_string(u.material) + " is not in materials");
+        for (const auto& c : u.uv)
+            if (!std::isfinite(c[0]) || !std::isfinite(c[1])) return bad("surfaces[" + std::to_string(i) + "]: UV is not finite");
     }
     if (s.transport.max_bounces < 0 || s.transport.max_bounces > 1024) return bad("transport.bounces must be in [0, 1024]");
     if (!(s.transport.max_noise > 0 && s.transport.max_noise <= 1)) return bad("transport.max_noise must be in (0, 1]");
@@ -156,8 +175,12 @@ Status validate_scene(const Scene& s) {
     for (size_t i = 0; i < s.occluders.size(); ++i) {
         const Occluder& o = s.occluders[i];
         const std::string at = "occluders[" + std::to_string(i) + "]";
-        if (o.material != kNoMaterial && o.material >= s.materials.size())
+        if (is_surface(o.material)) {
+            if (o.kind != OccluderKind::kTriangle || (o.material & ~kSurfaceBit) >= s.surfaces.size())
+                return bad(at + ": surface " + std::to_string(o.material & ~kSurfaceBit) + " is not in surfaces (or not a triangle)");
+        } else if (o.material != kNoMaterial && o.material >= s.materials.size()) {
             return bad(at + ": material " + std::to_string(o.material) + " is not in materials");
+        }
         if (o.kind == OccluderKind::kSphere) {
             if (!finite3(o.center()) || !(o.radius() > 0) || !std::isfinite(o.radius()))
                 return bad(at + ": sphere needs a finite centre and radius > 0");

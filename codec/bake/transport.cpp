@@ -43,28 +43,129 @@ double sh_irradiance_luminance(const double sh[27], Vec3 n) {
 
 const Vec3 kAxes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 
+// The largest albedo a material can have anywhere (texels are at most 1).
+double albedo_bound(const SceneMaterial& m, int k) {
+    if (!m.textured()) return m.albedo[k];
+    return m.metal_rough_texture >= 0 ? m.base_factor[k] : m.albedo[k];
+}
+bool may_reflect(const SceneMaterial& m) {
+    return albedo_bound(m, 0) > 0 || albedo_bound(m, 1) > 0 || albedo_bound(m, 2) > 0;
+}
+
+// Texel index i on an axis of n texels, wrapped.
+std::int64_t wrap_index(double i, std::int64_t n, TextureWrap w) {
+    const double dn = double(n);
+    switch (w) {
+        case TextureWrap::kClamp: return static_cast<std::int64_t>(std::clamp(i, 0.0, dn - 1));
+        case TextureWrap::kMirror: {
+            const double m = i - 2 * dn * std::floor(i / (2 * dn));  // in [0, 2n)
+            const auto k = std::min(static_cast<std::int64_t>(m), 2 * n - 1);
+            return k < n ? k : 2 * n - 1 - k;
+        }
+        default: {
+            const double m = i - dn * std::floor(i / dn);
+            return std::min(static_cast<std::int64_t>(m), n - 1);
+        }
+    }
+}
+
 }  // namespace
+
+void sample_texture(const SceneTexture& t, double u, double v, double rgb[3]) {
+    rgb[0] = rgb[1] = rgb[2] = 1;
+    if (t.width == 0 || t.height == 0 || t.texels.size() < std::size_t(t.width) * t.height * 3) return;
+    if (!std::isfinite(u)) u = 0;
+    if (!std::isfinite(v)) v = 0;
+    // Far outside [0, 1] a float UV has no fractional bits left: keep the arithmetic in range.
+    u = std::clamp(u, -1e9, 1e9);
+    v = std::clamp(v, -1e9, 1e9);
+    const std::int64_t w = t.width, h = t.height;
+    auto texel = [&](std::int64_t x, std::int64_t y, int k) { return double(t.texels[static_cast<std::size_t>((y * w + x) * 3 + k)]); };
+    if (t.nearest) {
+        const std::int64_t x = wrap_index(std::floor(u * double(w)), w, t.wrap_s), y = wrap_index(std::floor(v * double(h)), h, t.wrap_t);
+        for (int k = 0; k < 3; ++k) rgb[k] = texel(x, y, k);
+        return;
+    }
+    const double fx = u * double(w) - 0.5, fy = v * double(h) - 0.5;
+    const double x0 = std::floor(fx), y0 = std::floor(fy);
+    const double ax = fx - x0, ay = fy - y0;
+    const std::int64_t xa = wrap_index(x0, w, t.wrap_s), xb = wrap_index(x0 + 1, w, t.wrap_s);
+    const std::int64_t ya = wrap_index(y0, h, t.wrap_t), yb = wrap_index(y0 + 1, h, t.wrap_t);
+    for (int k = 0; k < 3; ++k) {
+        const double top = (1 - ax) * texel(xa, ya, k) + ax * texel(xb, ya, k);
+        const double bottom = (1 - ax) * texel(xa, yb, k) + ax * texel(xb, yb, k);
+        rgb[k] = (1 - ay) * top + ay * bottom;
+    }
+}
 
 bool scene_has_transport(const Scene& s) {
     if (s.transport.max_bounces <= 0 || s.materials.empty()) return false;
     bool reflects = false, emits = false;
     for (const SceneMaterial& m : s.materials) {
-        reflects = reflects || any_positive(m.albedo);
+        reflects = reflects || may_reflect(m);
         emits = emits || any_positive(m.emission);
     }
     if (!reflects && !emits) return false;
     // Is some occluder made of a reflecting or emitting material?
     bool used = false;
-    for (const Occluder& o : s.occluders)
-        if (o.material < s.materials.size()) {
-            const SceneMaterial& m = s.materials[o.material];
-            if (any_positive(m.albedo) || any_positive(m.emission)) {
+    for (const Occluder& o : s.occluders) {
+        std::uint32_t mi = o.material;
+        if (is_surface(mi)) mi = (mi & ~kSurfaceBit) < s.surfaces.size() ? s.surfaces[mi & ~kSurfaceBit].material : kNoMaterial;
+        if (mi < s.materials.size()) {
+            const SceneMaterial& m = s.materials[mi];
+            if (may_reflect(m) || any_positive(m.emission)) {
                 used = true;
                 break;
             }
         }
+    }
     if (!used) return false;
     return emits || !s.lights.empty() || s.sky || s.environment;
+}
+
+bool PathTracer::shade(const Occluder& occ, Vec3 x, double albedo[3], double emission[3]) const {
+    std::uint32_t mi = occ.material;
+    const SurfaceUv* uv = nullptr;
+    if (is_surface(mi)) {
+        uv = &scene_.surfaces[mi & ~kSurfaceBit];
+        mi = uv->material;
+    }
+    if (mi >= materials_.size()) return false;
+    const SceneMaterial& m = materials_[mi];
+    for (int k = 0; k < 3; ++k) {
+        albedo[k] = m.albedo[k];
+        emission[k] = m.emission[k];
+    }
+    if (!uv || !m.textured()) return true;
+    // Barycentric coordinates of x in (v0, v1, v2), then the UV there.
+    const Vec3 e1 = occ.v1 - occ.v0, e2 = occ.v2 - occ.v0, q = x - occ.v0;
+    const double d00 = dot(e1, e1), d01 = dot(e1, e2), d11 = dot(e2, e2), d20 = dot(q, e1), d21 = dot(q, e2);
+    const double den = d00 * d11 - d01 * d01;
+    double b1 = 1.0 / 3, b2 = 1.0 / 3;
+    if (den > 0) {
+        b1 = (d11 * d20 - d01 * d21) / den;
+        b2 = (d00 * d21 - d01 * d20) / den;
+    }
+    const double b0 = 1 - b1 - b2;
+    const double u = b0 * uv->uv[0][0] + b1 * uv->uv[1][0] + b2 * uv->uv[2][0];
+    const double v = b0 * uv->uv[0][1] + b1 * uv->uv[1][1] + b2 * uv->uv[2][1];
+    const auto& tex = scene_.textures;
+    if (m.base_texture >= 0 || m.metal_rough_texture >= 0) {
+        double base[3] = {1, 1, 1}, metal = m.metallic;
+        if (m.base_texture >= 0) sample_texture(tex[static_cast<std::size_t>(m.base_texture)], u, v, base);
+        if (m.metal_rough_texture >= 0) {
+            double mr[3];
+            sample_texture(tex[static_cast<std::size_t>(m.metal_rough_texture)], u, v, mr);
+            metal *= mr[2];
+        }
+        for (int k = 0; k < 3; ++k) albedo[k] = double(m.base_factor[k]) * base[k] * (1.0 - metal);
+    }
+    if (m.emissive_texture >= 0) {
+        double e[3];
+        sample_texture(tex[static_cast<std::size_t>(m.emissive_texture)], u, v, e);
+        for (int k = 0; k < 3; ++k) emission[k] *= e[k];
+    }
+    return true;
 }
 
 PathTracer::PathTracer(const Scene& scene, const OccluderBvh& bvh) : scene_(scene), bvh_(bvh), materials_(scene.materials), limits_(scene.transport) {
@@ -108,7 +209,7 @@ PathTracer::PathTracer(const Scene& scene, const OccluderBvh& bvh) : scene_(scen
     }
     double a_max = 0;
     for (const SceneMaterial& m : materials_)
-        for (int k = 0; k < 3; ++k) a_max = std::max(a_max, double(m.albedo[k]));
+        for (int k = 0; k < 3; ++k) a_max = std::max(a_max, albedo_bound(m, k));
     energy_left_ = std::pow(a_max, limits_.max_bounces);
     // Surface offset: relative to the scene's extent (rounding of hit points is ~1e-16 of it).
     double extent = 1.0;
@@ -211,18 +312,18 @@ void PathTracer::path_radiance(Vec3 x, Vec3 d, std::uint32_t prim, Rng& rng, dou
     L[0] = L[1] = L[2] = 0;
     for (int depth = 1;; ++depth) {
         const Occluder& occ = bvh_.primitive(prim);
-        if (occ.material >= materials_.size()) return;  // absorbs everything, emits nothing
-        const SceneMaterial& m = materials_[occ.material];
+        double albedo[3], emission[3];
+        if (!shade(occ, x, albedo, emission)) return;  // absorbs everything, emits nothing
         const Vec3 n = surface_normal(occ, x, d);
         ++st.vertices;
         st.max_depth = std::max(st.max_depth, depth);
-        for (int k = 0; k < 3; ++k) L[k] += T[k] * m.emission[k];
-        if (!any_positive(m.albedo)) return;
+        for (int k = 0; k < 3; ++k) L[k] += T[k] * emission[k];
+        if (!(albedo[0] > 0 || albedo[1] > 0 || albedo[2] > 0)) return;
         double E[3] = {0, 0, 0};
         light_irradiance(x, n, rng, E, &st.rays);
         for (int k = 0; k < 3; ++k) {
-            L[k] += T[k] * m.albedo[k] / kPi * E[k];
-            T[k] *= m.albedo[k];
+            L[k] += T[k] * albedo[k] / kPi * E[k];
+            T[k] *= albedo[k];
         }
         if (depth >= limits_.max_bounces) {
             ++st.cut;

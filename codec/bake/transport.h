@@ -45,12 +45,49 @@ namespace zhc {
 
 struct Scene;
 
-// A Lambertian surface (Occluder::material indexes Scene::materials).
+// A Lambertian surface (Occluder::material indexes Scene::materials, or names a textured surface:
+// kSurfaceBit below). Untextured, `albedo` and `emission` are the surface's everywhere. Textured
+// (glTF metal-rough materials, docs/scene.md "Reflected light"), at a point of UV (u, v):
+//     albedo   = base_factor x base(u, v) x (1 - metallic x metal_rough(u, v).b)
+//     emission = emission x emissive(u, v)
+// where an absent texture reads 1 (so without a metallic-roughness texture the albedo is
+// base_factor x base(u, v) x (1 - metallic)); `albedo` still holds base_factor x (1 - metallic),
+// the value of a texel of 1.
 struct SceneMaterial {
     std::string name;
     Rgb albedo{0, 0, 0};    // diffuse reflectance, each channel in [0, 1]
     Rgb emission{0, 0, 0};  // emitted radiance, >= 0 (the scene's radiance units)
+    // Textures (indices into Scene::textures, -1: none); only read on triangles with a SurfaceUv.
+    int base_texture = -1, metal_rough_texture = -1, emissive_texture = -1;
+    Rgb base_factor{0, 0, 0};  // with textures: the base colour factor, each channel in [0, 1]
+    float metallic = 0;        // with textures: the metallic factor, in [0, 1]
+    bool textured() const { return base_texture >= 0 || metal_rough_texture >= 0 || emissive_texture >= 0; }
 };
+
+// A texture as the tracer samples it: linear RGB texels, row 0 at v = 0 (glTF's UV origin is the
+// image's first row), bilinear or nearest, each axis wrapped as glTF samplers do.
+enum class TextureWrap : std::uint8_t { kRepeat, kClamp, kMirror };
+struct SceneTexture {
+    std::string name;
+    std::uint32_t width = 0, height = 0;
+    std::vector<float> texels;  // width x height x 3 (R, G, B), row-major from row 0
+    TextureWrap wrap_s = TextureWrap::kRepeat, wrap_t = TextureWrap::kRepeat;
+    bool nearest = false;  // magnification filter NEAREST; else bilinear
+};
+// The texel of `tex` at (u, v), linear RGB (bilinear between the four nearest texel centres, or
+// the nearest texel), wrapped per axis.
+void sample_texture(const SceneTexture& tex, double u, double v, double rgb[3]);
+
+// A textured triangle's UVs (texture coordinates of v0, v1, v2 in the Occluder's order) and its
+// material. An Occluder whose `material` is kSurfaceBit | i (and not kNoMaterial) is textured: its
+// material is surfaces[i].material, and the UV at a point of it is interpolated barycentrically.
+// The Occluder carries the index, so the side table survives the BVH's reordering.
+constexpr std::uint32_t kSurfaceBit = 0x80000000u;
+struct SurfaceUv {
+    std::uint32_t material = 0;
+    float uv[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+};
+inline bool is_surface(std::uint32_t material) { return material != kNoMaterial && (material & kSurfaceBit) != 0; }
 
 // Limits of the reflected-light pass (JSON "transport", `zhc bake --bounces/--max-noise/--rays`).
 struct SceneTransport {
@@ -107,6 +144,9 @@ private:
     const Scene& scene_;
     const OccluderBvh& bvh_;
     std::vector<SceneMaterial> materials_;
+    // The material of the surface `occ` at x: albedo and emission (textures sampled); false when
+    // it has none (absorbs everything, emits nothing).
+    bool shade(const Occluder& occ, Vec3 x, double albedo[3], double emission[3]) const;
     std::vector<Light> lights_;
     // Distant radiance: environment SH (rotated, scaled), the sky, hemisphere lights.
     bool has_env_ = false;

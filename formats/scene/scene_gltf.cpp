@@ -223,16 +223,37 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
             l.shadows = shadows;
             s.lights.push_back(std::move(l));
         }
-        // The glTF materials follow extras.zhc's: their occluders' indices shift by that many.
-        if (!s.materials.empty())
+        // The glTF materials follow extras.zhc's: their occluders' and surfaces' indices shift by
+        // that many (a textured triangle's material is its surface's: kSurfaceBit).
+        if (!s.materials.empty()) {
             for (Occluder& o : r.occluders_)
-                if (o.material != kNoMaterial) o.material += static_cast<std::uint32_t>(s.materials.size());
+                if (o.material != kNoMaterial && !is_surface(o.material)) o.material += static_cast<std::uint32_t>(s.materials.size());
+            for (SurfaceUv& u : r.surfaces_) u.material += static_cast<std::uint32_t>(s.materials.size());
+        }
+        const size_t first_gltf_material = s.materials.size();
         s.materials.insert(s.materials.end(), r.materials_.begin(), r.materials_.end());
         // Moved, not copied, when extras.zhc adds none: the mesh triangles are the bulk of the memory.
         if (s.occluders.empty()) s.occluders = std::move(r.occluders_);
         else s.occluders.insert(s.occluders.end(), r.occluders_.begin(), r.occluders_.end());
         std::vector<Occluder>().swap(r.occluders_);
         if (ibl) s.environment = std::move(ibl);
+        // Textures are decoded only for a bake that traces reflected light; otherwise (and for
+        // materials with no UVs) the factors alone stand and no image is read.
+        s.surfaces = std::move(r.surfaces_);
+        if (!s.surfaces.empty() && scene_has_transport(s)) {
+            r.decode_textures();
+            for (size_t i = 0; i < r.materials_.size(); ++i) {
+                SceneMaterial& m = s.materials[first_gltf_material + i];
+                m.base_texture = r.materials_[i].base_texture;
+                m.metal_rough_texture = r.materials_[i].metal_rough_texture;
+                m.emissive_texture = r.materials_[i].emissive_texture;
+            }
+            s.textures = std::move(r.textures_);
+        } else {
+            for (Occluder& o : s.occluders)
+                if (is_surface(o.material)) o.material = s.surfaces[o.material & ~kSurfaceBit].material;
+            std::vector<SurfaceUv>().swap(s.surfaces);
+        }
         if (notes) *notes = r.notes_;
         if (Status v = validate_scene(s); !v) return make_error(v.error().code, path + ": " + v.error().message);
         if (Status b = check_ray_budget(s, options.limits, path); !b) return b.error();

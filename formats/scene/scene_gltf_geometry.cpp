@@ -8,10 +8,15 @@
 
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 
+#include <stb_image.h>
+
+#include "formats/io/file_io.h"
 #include "formats/probes/gltf_draco.h"
 #include "formats/probes/gltf_meshopt.h"
+#include "formats/probes/gltf_probes_internal.h"
 
 namespace zhc::scene_gltf_detail {
 
@@ -194,6 +199,11 @@ void Reader::add_triangles(const std::vector<Vec3>& verts, const std::vector<std
         if (mode != 4 && (a == b || b == c || a == c)) return;
         occluders_.push_back(triangle_occluder(verts[a], verts[b], verts[c]));
         occluders_.back().material = current_material_;
+        if (current_uvs_) {
+            const auto& uv = *current_uvs_;
+            occluders_.back().material = kSurfaceBit | static_cast<std::uint32_t>(surfaces_.size());
+            surfaces_.push_back(SurfaceUv{current_material_, {{uv[a][0], uv[a][1]}, {uv[b][0], uv[b][1]}, {uv[c][0], uv[c][1]}}});
+        }
     };
     const size_t n = idx.size();
     if (mode == 4) {
@@ -383,8 +393,9 @@ void Reader::add_point_bounds(const json& prim, const std::string& pp, const Ins
 // The zhc material of a primitive's glTF material (glTF 2.0 spec 3.9): Lambertian albedo = base
 // colour factor x (1 - metallic factor), the diffuse part of the metal-rough model; emission =
 // emissive factor x KHR_materials_emissive_strength. No material (the spec's default: white,
-// fully metallic) and a material that neither reflects diffusely nor emits: kNoMaterial. Textures
-// are not sampled: a textured material uses its factors (noted once per material).
+// fully metallic) and a material that neither reflects diffusely nor emits: kNoMaterial. Its
+// textures (base colour, metallic-roughness, emissive) are recorded for decode_textures; the
+// factors multiply their texels (codec/bake/transport.h SceneMaterial).
 std::uint32_t Reader::material_of(const json& prim, const std::string& pp) {
     if (!prim.contains("material")) return kNoMaterial;
     const json& mats = array_of(doc_, "materials");
@@ -394,7 +405,20 @@ std::uint32_t Reader::material_of(const json& prim, const std::string& pp) {
     const json& m = mats[mi];
     if (!m.is_object()) fail(ErrorCode::kInvalidValue, mp, "must be an object");
     double base[4] = {1, 1, 1, 1}, metallic = 1, emissive[3] = {0, 0, 0}, strength = 1;
-    bool textured = false;
+    MaterialTextures mt;
+    bool transformed = false, mixed_sets = false;
+    bool first_set = true;
+    // A textureInfo: its texture index and texCoord set (one set per material is read).
+    auto texture_info = [&](const json& j, const std::string& where) -> int {
+        if (!j.is_object()) fail(ErrorCode::kInvalidValue, where, "must be an object");
+        const int ti = static_cast<int>(index(j.contains("index") ? j["index"] : json(), where + ".index", array_of(doc_, "textures").size(), "textures"));
+        const std::uint64_t set = count(j, "texCoord", where, false, 0);
+        if (first_set) mt.tex_coord = set;
+        else if (set != mt.tex_coord) mixed_sets = true;
+        first_set = false;
+        transformed = transformed || (j.contains("extensions") && j["extensions"].is_object() && j["extensions"].contains("KHR_texture_transform"));
+        return ti;
+    };
     if (m.contains("pbrMetallicRoughness")) {
         const json& pbr = m["pbrMetallicRoughness"];
         if (!pbr.is_object()) fail(ErrorCode::kInvalidValue, mp + ".pbrMetallicRoughness", "must be an object");
@@ -403,13 +427,15 @@ std::uint32_t Reader::material_of(const json& prim, const std::string& pp) {
             for (int k = 0; k < 4; ++k) base[k] = f[static_cast<size_t>(k)];
         }
         if (pbr.contains("metallicFactor")) metallic = number(pbr["metallicFactor"], mp + ".pbrMetallicRoughness.metallicFactor");
-        textured = pbr.contains("baseColorTexture") || pbr.contains("metallicRoughnessTexture");
+        if (pbr.contains("baseColorTexture")) mt.base = texture_info(pbr["baseColorTexture"], mp + ".pbrMetallicRoughness.baseColorTexture");
+        if (pbr.contains("metallicRoughnessTexture"))
+            mt.metal_rough = texture_info(pbr["metallicRoughnessTexture"], mp + ".pbrMetallicRoughness.metallicRoughnessTexture");
     }
     if (m.contains("emissiveFactor")) {
         const std::vector<double> f = numbers(m["emissiveFactor"], mp + ".emissiveFactor", 3);
         for (int k = 0; k < 3; ++k) emissive[k] = f[static_cast<size_t>(k)];
     }
-    textured = textured || m.contains("emissiveTexture");
+    if (m.contains("emissiveTexture")) mt.emissive = texture_info(m["emissiveTexture"], mp + ".emissiveTexture");
     if (m.contains("extensions") && m["extensions"].is_object() && m["extensions"].contains("KHR_materials_emissive_strength")) {
         const json& e = m["extensions"]["KHR_materials_emissive_strength"];
         if (e.is_object() && e.contains("emissiveStrength"))
@@ -420,12 +446,19 @@ std::uint32_t Reader::material_of(const json& prim, const std::string& pp) {
     for (int k = 0; k < 3; ++k) {
         sm.albedo[k] = static_cast<float>(std::clamp(base[k], 0.0, 1.0) * (1.0 - std::clamp(metallic, 0.0, 1.0)));
         sm.emission[k] = static_cast<float>(std::clamp(emissive[k], 0.0, 1.0) * std::max(0.0, strength));
+        sm.base_factor[k] = static_cast<float>(std::clamp(base[k], 0.0, 1.0));
     }
+    sm.metallic = static_cast<float>(std::clamp(metallic, 0.0, 1.0));
+    if (mixed_sets) notes_.push_back(mp + ": its textures use different texCoord sets: TEXCOORD_" + std::to_string(mt.tex_coord) + " is used for all of them");
+    if (transformed) notes_.push_back(mp + ": KHR_texture_transform is not applied to the UVs its textures are sampled at");
+    // A metallic-roughness texture can lower the metallic factor, so base colour alone may reflect.
+    const bool reflects = sm.albedo.r > 0 || sm.albedo.g > 0 || sm.albedo.b > 0 ||
+                          (mt.metal_rough >= 0 && (sm.base_factor.r > 0 || sm.base_factor.g > 0 || sm.base_factor.b > 0));
     std::uint32_t id = kNoMaterial;
-    if (sm.albedo.r > 0 || sm.albedo.g > 0 || sm.albedo.b > 0 || sm.emission.r > 0 || sm.emission.g > 0 || sm.emission.b > 0) {
+    if (reflects || sm.emission.r > 0 || sm.emission.g > 0 || sm.emission.b > 0) {
         id = static_cast<std::uint32_t>(materials_.size());
         materials_.push_back(sm);
-        if (textured) notes_.push_back(mp + ": textures are not sampled for reflected light (its factors are used)");
+        material_textures_.push_back(mt);
     }
     material_ids_[mi] = id;
     return id;
@@ -451,9 +484,13 @@ void Reader::add_mesh(size_t mi, const Instancing& inst) {
             continue;
         }
         current_material_ = material_of(prim, pp);
+        current_uvs_ = nullptr;
         if (!prim.contains("attributes") || !prim["attributes"].is_object() || !prim["attributes"].contains("POSITION"))
             fail(ErrorCode::kInvalidValue, pp + ".attributes.POSITION", "missing");
+        const bool textured = current_material_ != kNoMaterial && material_textures_[current_material_].any();
         if (prim.contains("extensions") && prim["extensions"].is_object() && prim["extensions"].contains("KHR_draco_mesh_compression")) {
+            if (textured)
+                notes_.push_back(pp + ": Draco-compressed texture coordinates are not read: its material's factors are used without textures");
             add_draco(prim, prim["extensions"]["KHR_draco_mesh_compression"], pp, mode, inst);
             continue;
         }
@@ -476,6 +513,9 @@ void Reader::add_mesh(size_t mi, const Instancing& inst) {
         if (triangle_count(mode, ni) == 0 || inst.count == 0) continue;
         if (nv > options_.limits.max_triangles * 3) fail(ErrorCode::kTooLarge, pap, std::to_string(nv) + " vertices exceed 3 x the triangle limit");
         const std::vector<Vec3> verts = read_positions(pa, nv);
+        std::vector<std::array<float, 2>> uvs;
+        if (textured) uvs = read_uvs(prim, pp, nv);
+        if (!uvs.empty()) current_uvs_ = &uvs;
         std::vector<std::uint32_t> idx(ni);
         if (indexed) {
             const std::string iap = at("accessors", ia);
@@ -495,6 +535,191 @@ void Reader::add_mesh(size_t mi, const Instancing& inst) {
             for (std::uint64_t i = 0; i < ni; ++i) idx[i] = static_cast<std::uint32_t>(i);
         }
         add_instances(verts, idx, mode, inst, pap);
+        current_uvs_ = nullptr;
+    }
+}
+
+// ---- textures -------------------------------------------------------------------------------
+
+std::vector<std::array<float, 2>> Reader::read_uvs(const json& prim, const std::string& pp, std::uint64_t nv) {
+    const MaterialTextures& mt = material_textures_[current_material_];
+    const std::string key = "TEXCOORD_" + std::to_string(mt.tex_coord);
+    const json& attrs = prim["attributes"];
+    if (!attrs.contains(key)) {
+        notes_.push_back(pp + ": its material is textured but it has no " + key + ": the material's factors are used without textures");
+        return {};
+    }
+    const std::string kp = pp + ".attributes." + key;
+    const size_t ta = index(attrs[key], kp, array_of(doc_, "accessors").size(), "accessors");
+    const std::string tap = at("accessors", ta);
+    const json& acc = accessor(ta, tap);
+    if (!acc.contains("type") || acc["type"] != "VEC2") fail(ErrorCode::kInvalidValue, tap, key + " must be a VEC2 accessor");
+    if (count(acc, "count", tap, true, 0) != nv)
+        fail(ErrorCode::kInvalidValue, tap, key + " must have as many elements as POSITION (" + std::to_string(nv) + ")");
+    const std::uint64_t ct = count(acc, "componentType", tap, true, 0);
+    if (acc.contains("normalized") && !acc["normalized"].is_boolean()) fail(ErrorCode::kInvalidValue, tap + ".normalized", "must be true or false");
+    const bool normalized = acc.contains("normalized") && acc["normalized"].get<bool>();
+    const bool ok = ct == kFloat ? !normalized : normalized && (ct == kUbyte || ct == kUshort);
+    if (!ok)
+        fail(ErrorCode::kUnsupported, tap, key + " must be FLOAT, or UNSIGNED_BYTE or UNSIGNED_SHORT normalized (got componentType " +
+                                               std::to_string(ct) + (normalized ? " normalized" : "") + ")");
+    const std::uint64_t csize = ct == kFloat ? 4 : ct == kUshort ? 2 : 1;
+    const View v = accessor_view(ta, nv, 2 * csize, tap);
+    std::vector<std::array<float, 2>> uvs(nv);
+    for (std::uint64_t i = 0; i < nv; ++i)
+        for (int k = 0; k < 2; ++k) {
+            const std::uint8_t* c = v.data + i * v.stride + csize * static_cast<std::uint64_t>(k);
+            float x;
+            if (ct == kFloat) {
+                const std::uint32_t bits = le32(c);
+                std::memcpy(&x, &bits, 4);
+                if (!std::isfinite(x)) fail(ErrorCode::kInvalidValue, tap, key + " element " + std::to_string(i) + " is not finite");
+            } else {
+                x = ct == kUshort ? static_cast<float>((c[0] | c[1] << 8) / 65535.0) : static_cast<float>(c[0] / 255.0);
+            }
+            uvs[i][static_cast<size_t>(k)] = x;
+        }
+    return uvs;
+}
+
+namespace {
+
+int base64_value(char c) {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    if (c == '+' || c == '-') return 62;
+    if (c == '/' || c == '_') return 63;
+    return -1;
+}
+
+// sRGB transfer function decoded (IEC 61966-2-1), for 8-bit values: a table.
+const float* srgb_table() {
+    static const auto table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i) {
+            const double c = i / 255.0;
+            t[static_cast<size_t>(i)] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+        }
+        return t;
+    }();
+    return table.data();
+}
+
+}  // namespace
+
+// An image's encoded bytes: its bufferView, its data: URI, or the file its URI names beside the
+// asset (confined to the asset's folder as buffers are; recorded for --depfile by read_file_bytes).
+std::vector<std::uint8_t> Reader::image_bytes(size_t ii, const std::string& ip) {
+    namespace fs = std::filesystem;
+    const json& img = array_of(doc_, "images")[ii];
+    if (!img.is_object()) fail(ErrorCode::kInvalidValue, ip, "must be an object");
+    if (img.contains("bufferView")) {
+        const size_t vi = index(img["bufferView"], ip + ".bufferView", array_of(doc_, "bufferViews").size(), "bufferViews");
+        const std::span<const std::uint8_t> b = view_bytes(vi, at("bufferViews", vi));
+        return {b.begin(), b.end()};
+    }
+    if (!img.contains("uri") || !img["uri"].is_string()) fail(ErrorCode::kInvalidValue, ip, "has neither a uri nor a bufferView");
+    const std::string uri = img["uri"].get<std::string>();
+    if (uri.rfind("data:", 0) == 0) {
+        const size_t comma = uri.find(',');
+        if (comma == std::string::npos || comma < 12 || uri.compare(comma - 7, 7, ";base64") != 0)
+            fail(ErrorCode::kBadFormat, ip + ".uri", "a data: URI that is not base64");
+        if (uri.size() - comma > gltf_limits_.max_buffer_bytes / 3 * 4 + 4)
+            fail(ErrorCode::kTooLarge, ip + ".uri", "data: URI above the buffer limit of " + std::to_string(gltf_limits_.max_buffer_bytes) + " bytes");
+        std::vector<std::uint8_t> out;
+        out.reserve((uri.size() - comma) / 4 * 3);
+        std::uint32_t acc = 0;
+        int bits = 0;
+        for (size_t i = comma + 1; i < uri.size() && uri[i] != '='; ++i) {
+            const int v = base64_value(uri[i]);
+            if (v < 0) fail(ErrorCode::kBadFormat, ip + ".uri", "the data: URI's base64 has a character that is not base64 at offset " + std::to_string(i));
+            acc = (acc << 6) | static_cast<std::uint32_t>(v);
+            bits += 6;
+            if (bits >= 8) {
+                bits -= 8;
+                out.push_back(static_cast<std::uint8_t>((acc >> bits) & 0xFF));
+            }
+        }
+        return out;
+    }
+    const fs::path user_dir = fs::path(path_).parent_path();
+    std::error_code ec;
+    const fs::path base = fs::weakly_canonical(user_dir.empty() ? fs::path(".") : user_dir, ec);
+    if (ec) fail(ErrorCode::kIoError, ip + ".uri", "cannot resolve the asset's folder");
+    if (const std::string why = gltf_detail::uri_problem(uri); !why.empty())
+        fail(ErrorCode::kBadFormat, ip + ".uri", "image '" + uri + "' is not read: " + why);
+    const fs::path file = fs::weakly_canonical(base / gltf_detail::uri_path(uri), ec);
+    if (ec || !gltf_detail::inside(base, file)) fail(ErrorCode::kBadFormat, ip + ".uri", "image '" + uri + "' resolves outside the input's directory");
+    if (!fs::is_regular_file(file, ec))
+        fail(ErrorCode::kIoError, ip + ".uri", "referenced file '" + gltf_detail::uri_path(uri) + "' not found in " + base.string());
+    auto bytes = read_file_bytes(gltf_detail::user_spelling(user_dir, base, file).string(), gltf_limits_.max_buffer_bytes);
+    if (!bytes) throw Fail{make_error(bytes.error().code, path_ + ": " + ip + ".uri: " + bytes.error().message)};
+    return std::move(bytes).value();
+}
+
+// The zhc texture of glTF texture `ti` (decoded once per colour space): its source image decoded
+// with stb_image (PNG, JPEG, ...) after its size was checked against the texel limit, sRGB
+// decoded to linear for colour (base colour, emissive) or kept linear (metallic-roughness); its
+// sampler's wrap modes and magnification filter.
+int Reader::texture_of(int ti, bool srgb) {
+    if (auto it = texture_ids_.find({ti, srgb}); it != texture_ids_.end()) return it->second;
+    const std::string tp = at("textures", static_cast<size_t>(ti));
+    const json& t = array_of(doc_, "textures")[static_cast<size_t>(ti)];
+    if (!t.is_object()) fail(ErrorCode::kInvalidValue, tp, "must be an object");
+    if (!t.contains("source"))
+        fail(ErrorCode::kUnsupported, tp + ".source", "missing (an image only an extension gives, such as KTX2 or WebP, is not decoded)");
+    const size_t ii = index(t["source"], tp + ".source", array_of(doc_, "images").size(), "images");
+    const std::string ip = at("images", ii);
+    SceneTexture tex;
+    tex.name = ip;
+    if (t.contains("sampler")) {
+        const size_t si = index(t["sampler"], tp + ".sampler", array_of(doc_, "samplers").size(), "samplers");
+        const std::string sp = at("samplers", si);
+        const json& smp = array_of(doc_, "samplers")[si];
+        if (!smp.is_object()) fail(ErrorCode::kInvalidValue, sp, "must be an object");
+        auto wrap = [&](const char* key) {
+            const std::uint64_t w = count(smp, key, sp, false, 10497);
+            if (w == 10497) return TextureWrap::kRepeat;
+            if (w == 33071) return TextureWrap::kClamp;
+            if (w == 33648) return TextureWrap::kMirror;
+            fail(ErrorCode::kInvalidValue, sp + "." + key, "must be 33071, 33648 or 10497 (got " + std::to_string(w) + ")");
+        };
+        tex.wrap_s = wrap("wrapS");
+        tex.wrap_t = wrap("wrapT");
+        tex.nearest = count(smp, "magFilter", sp, false, 9729) == 9728;
+    }
+    const std::vector<std::uint8_t> bytes = image_bytes(ii, ip);
+    if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max())) fail(ErrorCode::kTooLarge, ip, "image above 2 GiB");
+    int w = 0, h = 0, n = 0;
+    if (!stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &w, &h, &n) || w <= 0 || h <= 0)
+        fail(ErrorCode::kBadFormat, ip, std::string("image does not decode: ") + (stbi_failure_reason() ? stbi_failure_reason() : "unknown format"));
+    const std::uint64_t texels = std::uint64_t(w) * std::uint64_t(h);
+    if (texels > options_.limits.max_texels || texels_ + texels > options_.limits.max_texels)
+        fail(ErrorCode::kTooLarge, ip, std::to_string(w) + " x " + std::to_string(h) + " texels take the textures over the limit of " +
+                                           std::to_string(options_.limits.max_texels) + " texels");
+    texels_ += texels;
+    stbi_uc* px = stbi_load_from_memory(bytes.data(), static_cast<int>(bytes.size()), &w, &h, &n, 3);
+    if (!px) fail(ErrorCode::kBadFormat, ip, std::string("image does not decode: ") + (stbi_failure_reason() ? stbi_failure_reason() : "unknown"));
+    tex.width = static_cast<std::uint32_t>(w);
+    tex.height = static_cast<std::uint32_t>(h);
+    tex.texels.resize(static_cast<size_t>(texels) * 3);
+    const float* lut = srgb_table();
+    for (size_t i = 0; i < tex.texels.size(); ++i) tex.texels[i] = srgb ? lut[px[i]] : static_cast<float>(px[i] / 255.0);
+    stbi_image_free(px);
+    const int id = static_cast<int>(textures_.size());
+    textures_.push_back(std::move(tex));
+    texture_ids_[{ti, srgb}] = id;
+    return id;
+}
+
+void Reader::decode_textures() {
+    for (size_t i = 0; i < materials_.size(); ++i) {
+        const MaterialTextures& mt = material_textures_[i];
+        SceneMaterial& m = materials_[i];
+        if (mt.base >= 0) m.base_texture = texture_of(mt.base, true);
+        if (mt.metal_rough >= 0) m.metal_rough_texture = texture_of(mt.metal_rough, false);
+        if (mt.emissive >= 0) m.emissive_texture = texture_of(mt.emissive, true);
     }
 }
 

@@ -166,6 +166,22 @@ public:
     void add_point_bounds(const json& prim, const std::string& pp, const Instancing& inst);
     // The primitive's material as a zhc SceneMaterial index (materials_), or kNoMaterial.
     std::uint32_t material_of(const json& prim, const std::string& pp);
+    // A textured primitive's UVs (TEXCOORD_n of the material's texture set: FLOAT, or normalized
+    // UNSIGNED_BYTE / UNSIGNED_SHORT), one per vertex; empty (with a note) when it has none.
+    std::vector<std::array<float, 2>> read_uvs(const json& prim, const std::string& pp, std::uint64_t nv);
+
+    // Textures (scene_gltf_geometry.cpp): the glTF textures each zhc material references, decoded
+    // by decode_textures (only when the bake traces reflected light) into textures_, whose
+    // indices it then writes into materials_ (texture indices are materials_'s own: the caller
+    // shifts nothing). `user_dir` is the asset's folder as named (external images resolve there).
+    struct MaterialTextures {
+        int base = -1, metal_rough = -1, emissive = -1;  // glTF texture indices
+        std::uint64_t tex_coord = 0;
+        bool any() const { return base >= 0 || metal_rough >= 0 || emissive >= 0; }
+    };
+    void decode_textures();
+    int texture_of(int gltf_texture, bool srgb);
+    std::vector<std::uint8_t> image_bytes(size_t ii, const std::string& ip);
 
     // EXT_mesh_gpu_instancing (scene_gltf_geometry.cpp)
     Instancing read_instancing(const json& e, const Mat4& world, const std::string& ep);
@@ -174,6 +190,9 @@ public:
     std::vector<SceneLight> lights_;
     std::vector<Occluder> occluders_;
     std::vector<SceneMaterial> materials_;  // Occluder::material of occluders_ indexes these
+    std::vector<MaterialTextures> material_textures_;  // per materials_ entry
+    std::vector<SurfaceUv> surfaces_;       // textured triangles (Occluder::material kSurfaceBit | i)
+    std::vector<SceneTexture> textures_;    // decoded (decode_textures)
     std::vector<std::string> notes_;  // what was read but is not baked, for the report
     std::optional<size_t> scene_;     // the scene walked (none: an asset without scenes)
     double lo_[3] = {INFINITY, INFINITY, INFINITY}, hi_[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -188,6 +207,9 @@ private:
     std::uint64_t triangles_ = 0;
     std::map<size_t, std::uint32_t> material_ids_;  // glTF material -> materials_ index or kNoMaterial
     std::uint32_t current_material_ = kNoMaterial;  // of the primitive being added
+    const std::vector<std::array<float, 2>>* current_uvs_ = nullptr;  // its UVs when textured
+    std::map<std::pair<int, bool>, int> texture_ids_;  // (glTF texture, sRGB) -> textures_ index
+    std::uint64_t texels_ = 0;                          // decoded so far (limit: max_texels)
     std::map<size_t, std::vector<std::uint8_t>> decoded_;  // meshopt-compressed views, decoded once
     std::uint64_t decoded_total_ = 0;
 };

@@ -626,7 +626,13 @@ std::string scene_json(const Scene& s) {
     }
     if (!lights.empty()) doc["lights"] = lights;
     json occ = json::array();
+    // A textured triangle is written with its material's factors (JSON scenes hold no textures).
+    auto material_of = [&](std::uint32_t material) {
+        if (is_surface(material) && (material & ~kSurfaceBit) < s.surfaces.size()) return s.surfaces[material & ~kSurfaceBit].material;
+        return material;
+    };
     auto with_material = [&](json j, std::uint32_t material) {
+        material = material_of(material);
         if (material < s.materials.size()) {
             j["albedo"] = rgb_json(s.materials[material].albedo);
             j["emission"] = rgb_json(s.materials[material].emission);
@@ -642,7 +648,7 @@ std::string scene_json(const Scene& s) {
         } else {
             // Consecutive triangles of one material are one mesh entry.
             json pos = json::array();
-            for (; i < s.occluders.size() && s.occluders[i].kind == OccluderKind::kTriangle && s.occluders[i].material == o.material; ++i)
+            for (; i < s.occluders.size() && s.occluders[i].kind == OccluderKind::kTriangle && material_of(s.occluders[i].material) == material_of(o.material); ++i)
                 for (const Vec3& v : {s.occluders[i].v0, s.occluders[i].v1, s.occluders[i].v2})
                     for (int a = 0; a < 3; ++a) pos.push_back(v[a]);
             --i;

@@ -35,6 +35,9 @@ struct SceneJsonLimits {
     // Upper bound on shadow rays a bake may cast (probes x samples over shadowed lights), so a
     // hostile scene cannot ask for hours of tracing.
     std::uint64_t max_rays = std::uint64_t(1) << 32;
+    // Texels of the textures a glTF scene's reflected light samples, over all of them (each is
+    // held as 3 floats: 12 bytes per texel).
+    std::uint64_t max_texels = std::uint64_t(1) << 25;
 };
 
 struct SceneLoadOptions {
