@@ -666,6 +666,37 @@ TEST(SceneGltf, ImagesReadOnlyForReflectedLight) {
     EXPECT_FALSE(fs::exists(root + "/out.zhp"));
 }
 
+// KHR_mesh_quantization texture coordinates: normalized UNSIGNED_SHORT (c / 65535), BYTE
+// (max(c / 127, -1)) and unnormalized UNSIGNED_BYTE (c) read as the spec says.
+TEST(SceneGltf, QuantizedTexcoords) {
+    struct Case {
+        int component;
+        bool normalized;
+        std::vector<std::uint8_t> raw;  // 4 UVs
+        std::vector<float> want;
+    };
+    const std::vector<Case> cases = {
+        {5123, true, {0, 0, 0, 0, 0xFF, 0xFF, 0, 0, 0xFF, 0xFF, 0xFF, 0xFF, 0, 0, 0xFF, 0x7F}, {0, 0, 1, 0, 1, 1, 0, 32767 / 65535.f}},
+        {5120, true, {0, 0, 127, 0x81, 0x80, 0, 64, 0}, {0, 0, 1, -1, -1, 0, 64 / 127.f, 0}},
+        {5121, false, {0, 0, 2, 0, 2, 3, 0, 3}, {0, 0, 2, 0, 2, 3, 0, 3}},
+    };
+    for (const Case& c : cases) {
+        Asset a = textured_floor({{"uri", png_uri(kBlackWhite, 2, 1)}});
+        const size_t v = a.view(c.raw.data(), c.raw.size());
+        a.doc["accessors"].push_back({{"bufferView", v}, {"componentType", c.component}, {"normalized", c.normalized}, {"count", 4}, {"type", "VEC2"}});
+        a.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = a.doc["accessors"].size() - 1;
+        auto s = parse(a);
+        ASSERT_TRUE(s.ok()) << s.error().message;
+        ASSERT_EQ(s->surfaces.size(), 2u);
+        // Triangle 0 is vertices (0, 2, 1) of the quad.
+        const int order[3] = {0, 2, 1};
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_FLOAT_EQ(s->surfaces[0].uv[k][0], c.want[static_cast<size_t>(order[k] * 2)]) << c.component;
+            EXPECT_FLOAT_EQ(s->surfaces[0].uv[k][1], c.want[static_cast<size_t>(order[k] * 2 + 1)]) << c.component;
+        }
+    }
+}
+
 // The texel limit (SceneJsonLimits::max_texels) is checked from the image's header before decoding.
 TEST(SceneGltf, TexelLimit) {
     const Asset a = textured_floor({{"uri", png_uri(kBlackWhite, 2, 1)}});

@@ -559,11 +559,10 @@ std::vector<std::array<float, 2>> Reader::read_uvs(const json& prim, const std::
     const std::uint64_t ct = count(acc, "componentType", tap, true, 0);
     if (acc.contains("normalized") && !acc["normalized"].is_boolean()) fail(ErrorCode::kInvalidValue, tap + ".normalized", "must be true or false");
     const bool normalized = acc.contains("normalized") && acc["normalized"].get<bool>();
-    const bool ok = ct == kFloat ? !normalized : normalized && (ct == kUbyte || ct == kUshort);
-    if (!ok)
-        fail(ErrorCode::kUnsupported, tap, key + " must be FLOAT, or UNSIGNED_BYTE or UNSIGNED_SHORT normalized (got componentType " +
+    const std::uint64_t csize = ct == kFloat ? 4 : ct == kByte || ct == kUbyte ? 1 : ct == kShort || ct == kUshort ? 2 : 0;
+    if (csize == 0 || (ct == kFloat && normalized))
+        fail(ErrorCode::kUnsupported, tap, key + " must be FLOAT, or BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT (got componentType " +
                                                std::to_string(ct) + (normalized ? " normalized" : "") + ")");
-    const std::uint64_t csize = ct == kFloat ? 4 : ct == kUshort ? 2 : 1;
     const View v = accessor_view(ta, nv, 2 * csize, tap);
     std::vector<std::array<float, 2>> uvs(nv);
     for (std::uint64_t i = 0; i < nv; ++i)
@@ -575,7 +574,23 @@ std::vector<std::array<float, 2>> Reader::read_uvs(const json& prim, const std::
                 std::memcpy(&x, &bits, 4);
                 if (!std::isfinite(x)) fail(ErrorCode::kInvalidValue, tap, key + " element " + std::to_string(i) + " is not finite");
             } else {
-                x = ct == kUshort ? static_cast<float>((c[0] | c[1] << 8) / 65535.0) : static_cast<float>(c[0] / 255.0);
+                // KHR_mesh_quantization: integers as they are, or normalized (glTF 2.0 spec 3.11).
+                double q = 0;
+                switch (ct) {
+                    case kByte: q = normalized ? std::max(static_cast<std::int8_t>(c[0]) / 127.0, -1.0) : static_cast<std::int8_t>(c[0]); break;
+                    case kUbyte: q = normalized ? c[0] / 255.0 : c[0]; break;
+                    case kShort: {
+                        const auto w = static_cast<std::int16_t>(static_cast<std::uint16_t>(c[0] | c[1] << 8));
+                        q = normalized ? std::max(w / 32767.0, -1.0) : w;
+                        break;
+                    }
+                    default: {
+                        const std::uint16_t w = static_cast<std::uint16_t>(c[0] | c[1] << 8);
+                        q = normalized ? w / 65535.0 : w;
+                        break;
+                    }
+                }
+                x = static_cast<float>(q);
             }
             uvs[i][static_cast<size_t>(k)] = x;
         }

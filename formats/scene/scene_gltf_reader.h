@@ -166,8 +166,9 @@ public:
     void add_point_bounds(const json& prim, const std::string& pp, const Instancing& inst);
     // The primitive's material as a zhc SceneMaterial index (materials_), or kNoMaterial.
     std::uint32_t material_of(const json& prim, const std::string& pp);
-    // A textured primitive's UVs (TEXCOORD_n of the material's texture set: FLOAT, or normalized
-    // UNSIGNED_BYTE / UNSIGNED_SHORT), one per vertex; empty (with a note) when it has none.
+    // A textured primitive's UVs (TEXCOORD_n of the material's texture set: FLOAT, or
+    // (KHR_mesh_quantization) [UNSIGNED_]BYTE / SHORT, normalized or not), one per vertex; empty
+    // (with a note) when it has none.
     std::vector<std::array<float, 2>> read_uvs(const json& prim, const std::string& pp, std::uint64_t nv);
 
     // Textures (scene_gltf_geometry.cpp): the glTF textures each zhc material references, decoded

@@ -151,6 +151,22 @@ def scene_cases(work):
     cases.append({"name": "house (two rooms, 8 cd lamp)", "gltf": path, "render_gltf": path, "probes": probes,
                   "light": HOUSE_LIGHT[0], "intensity": HOUSE_LIGHT[1], "visible": [p[0] < -0.1 for p in probes],
                   "extra_light": None})
+    # 3. Textures: CesiumGS/gltf-pipeline specs/data/2.0/box-textured-embedded (COLLADA2GLTF's unit
+    # box, a 128 x 128 PNG base colour texture tiled up to 6 times, metallic 0; Apache-2.0),
+    # unmodified; a point light and probes near the +x face (zhc axes) through extras.zhc in a copy.
+    # The normals facing the box see only the light the textured face reflects.
+    src = os.path.join(DATA, "gltf", "gltf-pipeline", "box-textured-embedded", "box-textured-embedded.gltf")
+    doc = json.load(open(src))
+    light, intensity = [1.6, 0.2, 0.3], 10.0
+    probes = [[0.8, 0.0, 0.0], [0.9, 0.3, -0.2], [0.75, -0.3, 0.35], [1.1, 0.1, 0.4]]
+    doc.setdefault("extras", {})["zhc"] = {
+        "probes": {"positions": probes}, "occlusion": {"sky_samples": 0},
+        "lights": [{"type": "point", "position": light, "intensity": intensity, "shadows": True}]}
+    path = os.path.join(work, "box-textured-embedded.gltf")
+    json.dump(doc, open(path, "w"))
+    cases.append({"name": "box-textured-embedded (gltf-pipeline, base colour texture)", "gltf": path, "render_gltf": src,
+                  "probes": probes, "light": light, "intensity": intensity, "visible": [True] * len(probes),
+                  "extra_light": "%g,%g,%g,%g" % (light[0], light[1], light[2], intensity)})
     return cases
 
 

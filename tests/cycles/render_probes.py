@@ -9,7 +9,9 @@
 #
 # Set-up, written down (tests/cycles/README.md):
 #  * materials: each imported material becomes a Lambertian Diffuse BSDF of the glTF base colour
-#    times (1 - metallic) (zhc's model of glTF materials; Principled BSDF's specular layer dropped),
+#    times (1 - metallic) (zhc's model of glTF materials; Principled BSDF's specular layer dropped);
+#    a base colour texture the importer linked to Base Color (an sRGB Image Texture, times the
+#    factor) stays linked, times (1 - metallic), into the Diffuse BSDF's colour,
 #    plus an Emission of emissive x strength / 683 (zhc reads emissive x strength as cd/m^2; Cycles
 #    radiance is W/(m^2 sr), 683 lm/W as the importer's lights);
 #  * lights: the importer's "standard" lighting mode turns I cd into I x 4 pi / 683 W; a Cycles point
@@ -69,12 +71,24 @@ for mat in bpy.data.materials:
     metallic = bsdf.inputs["Metallic"].default_value
     emission = list(bsdf.inputs["Emission"].default_value)[:3]
     strength = bsdf.inputs["Emission Strength"].default_value if "Emission Strength" in bsdf.inputs else 1.0
+    # A base colour texture: the importer links an Image Texture (sRGB, the sampler's interpolation
+    # and UV map), times the factor where it is not 1, into Base Color; that socket is kept.
+    base_link = next((l for l in mat.node_tree.links if l.to_socket == bsdf.inputs["Base Color"]), None)
+    base_source = base_link.from_socket if base_link is not None else None
     for n in list(nodes):
-        nodes.remove(n)
+        if base_source is None or n.type in ("BSDF_PRINCIPLED", "OUTPUT_MATERIAL"):
+            nodes.remove(n)
     out = nodes.new("ShaderNodeOutputMaterial")
     diffuse = nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = [c * (1.0 - metallic) for c in base] + [1.0]
     diffuse.inputs["Roughness"].default_value = 0.0
+    if base_source is not None:
+        scale = nodes.new("ShaderNodeMixRGB")  # texture x (1 - metallic)
+        scale.blend_type = "MULTIPLY"
+        scale.inputs["Fac"].default_value = 1.0
+        scale.inputs["Color2"].default_value = [1.0 - metallic] * 3 + [1.0]
+        mat.node_tree.links.new(base_source, scale.inputs["Color1"])
+        mat.node_tree.links.new(scale.outputs["Color"], diffuse.inputs["Color"])
     emit = nodes.new("ShaderNodeEmission")
     emit.inputs["Color"].default_value = emission + [1.0]
     emit.inputs["Strength"].default_value = strength / WATTS_TO_LUMENS
