@@ -571,6 +571,11 @@ TEST(SceneGltf, TexturedFloorEqualsTwoMaterials) {
             for (int k = 0; k < 3; ++k) EXPECT_NEAR(pt[i][c][k], p2[i][c][k], 1e-5 * (1 + std::fabs(p2[i][0][k]))) << i << " " << c;
     // The probe over the black half (glTF x < 0: zhc y < 0) sees less light below it than the other.
     EXPECT_LT(pt[0][0][0], pt[1][0][0] * 0.9);
+    // Written as a zhc JSON scene: one mesh with the material's factors (JSON holds no textures).
+    const json back = json::parse(scene_json(*tex));
+    ASSERT_EQ(back["occluders"].size(), 1u);
+    EXPECT_EQ(back["occluders"][0]["positions"].size(), 18u);
+    EXPECT_NEAR(back["occluders"][0]["albedo"][0].get<double>(), 0.8, 1e-6);
 }
 
 // sRGB decoding for base colour and emissive (glTF 2.0 spec 3.9.2), linear for metallic-roughness:
@@ -606,6 +611,49 @@ TEST(SceneGltf, TextureColourSpaces) {
     albedo_seen = m.base_factor[0] * (1 - m.metallic * rgb[2]);
     EXPECT_EQ(albedo_seen, 0.0);
     EXPECT_TRUE(scene_has_transport(*s));
+}
+
+// KHR_texture_transform: u' = T R S u (offset, rotation, scale), per texture.
+TEST(SceneGltf, TextureTransform) {
+    Asset a = textured_floor({{"uri", png_uri(kBlackWhite, 2, 1)}});
+    a.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"] = {
+        {"offset", {0.1, 0.2}}, {"rotation", kPi / 2}, {"scale", {2, 3}}};
+    auto s = parse(a);
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    const auto& t = s->materials[0].base_uv;
+    const float want[6] = {0, 3, 0.1f, -2, 0, 0.2f};
+    for (int i = 0; i < 6; ++i) EXPECT_NEAR(t[static_cast<size_t>(i)], want[i], 1e-6) << i;
+    EXPECT_EQ(s->materials[0].emissive_uv, SceneMaterial::kIdentityUv);
+    a.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["scale"] = {1e300, 1};
+    auto bad = parse(a);
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.error().message.find("KHR_texture_transform"), std::string::npos) << bad.error().message;
+}
+
+// A fully metallic factor with a metallic-roughness texture whose blue channel is 0 reflects its
+// base colour: the texture is decoded (the decision to trace counts it) and the floor bakes as a
+// diffuse one of that colour.
+TEST(SceneGltf, MetallicRoughnessTextureMakesMetalDiffuse) {
+    Asset a = textured_floor({{"uri", png_uri({0, 0, 0}, 1, 1)}});
+    json& pbr = a.doc["materials"][0]["pbrMetallicRoughness"];
+    pbr.erase("baseColorTexture");
+    pbr["metallicRoughnessTexture"] = {{"index", 0}};
+    pbr["metallicFactor"] = 1.0;
+    auto s = parse(a);
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    ASSERT_EQ(s->textures.size(), 1u);
+    EXPECT_FALSE(s->surfaces.empty());
+    EXPECT_TRUE(scene_has_transport(*s));
+    Asset d = textured_floor({{"uri", png_uri({0, 0, 0}, 1, 1)}});
+    d.doc["materials"][0]["pbrMetallicRoughness"].erase("baseColorTexture");
+    auto plain = parse(d);
+    ASSERT_TRUE(plain.ok()) << plain.error().message;
+    EXPECT_TRUE(plain->textures.empty());
+    const auto p1 = bake(*s), p2 = bake(*plain);
+    ASSERT_EQ(p1.size(), p2.size());
+    for (size_t i = 0; i < p1.size(); ++i)
+        for (int c = 0; c < 9; ++c)
+            for (int k = 0; k < 3; ++k) EXPECT_NEAR(p1[i][c][k], p2[i][c][k], 1e-6 * (1 + std::fabs(p2[i][0][k])));
 }
 
 // Images are read only for a bake that traces reflected light: an image URI escaping the asset's

@@ -533,6 +533,22 @@ TEST(Transport, ConstantTextureEqualsFactors) {
         for (int k = 0; k < 3; ++k) EXPECT_NEAR(d[i][0][k], c[i][0][k], 1e-5 * (1 + std::fabs(c[i][0][k]))) << i;
 }
 
+// A texture's UV transform (KHR_texture_transform): an offset of half the texture with REPEAT swaps
+// the black and the white half, so the floor bakes as the split floor with its materials swapped.
+TEST(Transport, UvTransformOffsetSwapsHalves) {
+    Scene tex = split_floor(true, true, 2, TextureWrap::kRepeat);
+    tex.materials[0].base_uv = {1, 0, 0.5f, 0, 1, 0};
+    Scene two = split_floor(false, false, 0);
+    std::swap(two.materials[0], two.materials[1]);
+    const auto a = bake(tex), b = bake(two);
+    ASSERT_EQ(a.size(), 4u);
+    ASSERT_EQ(b.size(), 4u);
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Sh3Radiance)), 0);
+    Scene bad = tex;
+    bad.materials[0].base_uv[2] = INFINITY;
+    EXPECT_FALSE(validate_scene(bad).ok());
+}
+
 // validate_scene checks the texture and surface tables.
 TEST(Transport, TextureTablesValidated) {
     Scene s = split_floor(true, true, 2);

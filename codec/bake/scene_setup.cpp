@@ -150,6 +150,9 @@ Status validate_scene(const Scene& s) {
             if (m.textured() && !(m.base_factor[k] >= 0 && m.base_factor[k] <= 1)) return bad(at + ": base colour factor must be in [0, 1]");
         }
         if (m.textured() && !(m.metallic >= 0 && m.metallic <= 1)) return bad(at + ": metallic must be in [0, 1]");
+        for (const SceneMaterial::UvTransform* t : {&m.base_uv, &m.metal_rough_uv, &m.emissive_uv})
+            for (float f : *t)
+                if (!std::isfinite(f)) return bad(at + ": texture UV transform must be finite");
         for (int t : {m.base_texture, m.metal_rough_texture, m.emissive_texture})
             if (t < -1 || (t >= 0 && static_cast<size_t>(t) >= s.textures.size()))
                 return bad(at + ": texture " + std::to_string(t) + " is not in textures");

@@ -149,20 +149,24 @@ bool PathTracer::shade(const Occluder& occ, Vec3 x, double albedo[3], double emi
     const double b0 = 1 - b1 - b2;
     const double u = b0 * uv->uv[0][0] + b1 * uv->uv[1][0] + b2 * uv->uv[2][0];
     const double v = b0 * uv->uv[0][1] + b1 * uv->uv[1][1] + b2 * uv->uv[2][1];
-    const auto& tex = scene_.textures;
+    // Texture t at the UV mapped by its transform.
+    auto sample = [&](int t, const SceneMaterial::UvTransform& x, double rgb[3]) {
+        const double su = double(x[0]) * u + double(x[1]) * v + double(x[2]), sv = double(x[3]) * u + double(x[4]) * v + double(x[5]);
+        sample_texture(scene_.textures[static_cast<std::size_t>(t)], su, sv, rgb);
+    };
     if (m.base_texture >= 0 || m.metal_rough_texture >= 0) {
         double base[3] = {1, 1, 1}, metal = m.metallic;
-        if (m.base_texture >= 0) sample_texture(tex[static_cast<std::size_t>(m.base_texture)], u, v, base);
+        if (m.base_texture >= 0) sample(m.base_texture, m.base_uv, base);
         if (m.metal_rough_texture >= 0) {
             double mr[3];
-            sample_texture(tex[static_cast<std::size_t>(m.metal_rough_texture)], u, v, mr);
+            sample(m.metal_rough_texture, m.metal_rough_uv, mr);
             metal *= mr[2];
         }
         for (int k = 0; k < 3; ++k) albedo[k] = double(m.base_factor[k]) * base[k] * (1.0 - metal);
     }
     if (m.emissive_texture >= 0) {
         double e[3];
-        sample_texture(tex[static_cast<std::size_t>(m.emissive_texture)], u, v, e);
+        sample(m.emissive_texture, m.emissive_uv, e);
         for (int k = 0; k < 3; ++k) emission[k] *= e[k];
     }
     return true;

@@ -8,7 +8,8 @@
 //     L_o(x) = L_e(x) + rho(x) / pi * integral over the hemisphere at x of L_i(x, w') cos(n, w') dw'
 //
 // for Lambertian surfaces of albedo rho (glTF: base colour times (1 - metallic), the diffuse part)
-// and emitted radiance L_e (glTF: emissive factor times KHR_materials_emissive_strength). The
+// and emitted radiance L_e (glTF: emissive factor times KHR_materials_emissive_strength), each
+// times its textures at x's UV on textured triangles (SceneMaterial, SurfaceUv below). The
 // probe's SH3 gains  sum_k (4 pi / N) L_o(x_k) Y(w_k)  over N directions w_k; a direction that meets
 // no surface adds nothing here (its sky/environment light is the closed form's).
 //
@@ -34,6 +35,7 @@
 // a probe's result is the same whatever the thread count or the order of probes.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -59,6 +61,11 @@ struct SceneMaterial {
     Rgb emission{0, 0, 0};  // emitted radiance, >= 0 (the scene's radiance units)
     // Textures (indices into Scene::textures, -1: none); only read on triangles with a SurfaceUv.
     int base_texture = -1, metal_rough_texture = -1, emissive_texture = -1;
+    // Per texture, the affine map of the triangle's UV to the UV it is sampled at
+    // (glTF KHR_texture_transform): u' = t[0] u + t[1] v + t[2], v' = t[3] u + t[4] v + t[5].
+    using UvTransform = std::array<float, 6>;
+    static constexpr UvTransform kIdentityUv{1, 0, 0, 0, 1, 0};
+    UvTransform base_uv = kIdentityUv, metal_rough_uv = kIdentityUv, emissive_uv = kIdentityUv;
     Rgb base_factor{0, 0, 0};  // with textures: the base colour factor, each channel in [0, 1]
     float metallic = 0;        // with textures: the metallic factor, in [0, 1]
     bool textured() const { return base_texture >= 0 || metal_rough_texture >= 0 || emissive_texture >= 0; }

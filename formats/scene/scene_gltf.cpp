@@ -239,17 +239,25 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
         if (ibl) s.environment = std::move(ibl);
         // Textures are decoded only for a bake that traces reflected light; otherwise (and for
         // materials with no UVs) the factors alone stand and no image is read.
+        // The decision sees the textures as present (a metallic-roughness texture can make a fully
+        // metallic factor reflect), with no image read yet.
         s.surfaces = std::move(r.surfaces_);
-        if (!s.surfaces.empty() && scene_has_transport(s)) {
-            r.decode_textures();
+        auto set_textures = [&](bool provisional) {
             for (size_t i = 0; i < r.materials_.size(); ++i) {
                 SceneMaterial& m = s.materials[first_gltf_material + i];
-                m.base_texture = r.materials_[i].base_texture;
-                m.metal_rough_texture = r.materials_[i].metal_rough_texture;
-                m.emissive_texture = r.materials_[i].emissive_texture;
+                const Reader::MaterialTextures& mt = r.material_textures_[i];
+                m.base_texture = provisional ? (mt.base >= 0 ? 0 : -1) : r.materials_[i].base_texture;
+                m.metal_rough_texture = provisional ? (mt.metal_rough >= 0 ? 0 : -1) : r.materials_[i].metal_rough_texture;
+                m.emissive_texture = provisional ? (mt.emissive >= 0 ? 0 : -1) : r.materials_[i].emissive_texture;
             }
+        };
+        set_textures(true);
+        if (!s.surfaces.empty() && scene_has_transport(s)) {
+            r.decode_textures();
+            set_textures(false);
             s.textures = std::move(r.textures_);
         } else {
+            set_textures(false);  // none decoded: -1
             for (Occluder& o : s.occluders)
                 if (is_surface(o.material)) o.material = s.surfaces[o.material & ~kSurfaceBit].material;
             std::vector<SurfaceUv>().swap(s.surfaces);

@@ -28,8 +28,10 @@
 // directional E_zhc = E_lux * colour / pi (zhc's irradiance is normalised, integral L dw = pi E).
 //
 // Loading goes through the ZHC_light_probes reader's checks (formats/probes/gltf_probes.h load_gltf_raw:
-// glTF 2.x only, bounded sizes, URIs resolved in the asset's own directory and confined to it,
-// no image read or decoded); every index, count, stride and byte range used here is
+// glTF 2.x only, bounded sizes, URIs resolved in the asset's own directory and confined to it);
+// images are read and decoded (stb_image, under SceneJsonLimits::max_texels) only for the
+// textures of a scene that traces reflected light (docs/scene.md "Reflected light"), their URIs
+// confined like buffers'; every index, count, stride and byte range used here is
 // bound-checked. Errors are one line naming the file and the JSON path: kIoError (a referenced
 // file missing), kBadFormat (not glTF), kInvalidValue (a bad field or index, compressed data
 // that does not decode to what it declares), kUnsupported (glTF 1.x/3.x, an unknown light type,

@@ -406,17 +406,34 @@ std::uint32_t Reader::material_of(const json& prim, const std::string& pp) {
     if (!m.is_object()) fail(ErrorCode::kInvalidValue, mp, "must be an object");
     double base[4] = {1, 1, 1, 1}, metallic = 1, emissive[3] = {0, 0, 0}, strength = 1;
     MaterialTextures mt;
-    bool transformed = false, mixed_sets = false;
+    SceneMaterial sm;
+    bool mixed_sets = false;
     bool first_set = true;
-    // A textureInfo: its texture index and texCoord set (one set per material is read).
-    auto texture_info = [&](const json& j, const std::string& where) -> int {
+    // A textureInfo: its texture index, texCoord set (one set per material is read) and
+    // KHR_texture_transform (offset, rotation, scale: u' = T R S u, the extension's order).
+    auto texture_info = [&](const json& j, const std::string& where, SceneMaterial::UvTransform* uv) -> int {
         if (!j.is_object()) fail(ErrorCode::kInvalidValue, where, "must be an object");
         const int ti = static_cast<int>(index(j.contains("index") ? j["index"] : json(), where + ".index", array_of(doc_, "textures").size(), "textures"));
-        const std::uint64_t set = count(j, "texCoord", where, false, 0);
+        std::uint64_t set = count(j, "texCoord", where, false, 0);
+        if (j.contains("extensions") && j["extensions"].is_object() && j["extensions"].contains("KHR_texture_transform")) {
+            const std::string tp = where + ".extensions.KHR_texture_transform";
+            const json& t = j["extensions"]["KHR_texture_transform"];
+            if (!t.is_object()) fail(ErrorCode::kInvalidValue, tp, "must be an object");
+            std::vector<double> off{0, 0}, scale{1, 1};
+            double rot = 0;
+            if (t.contains("offset")) off = numbers(t["offset"], tp + ".offset", 2);
+            if (t.contains("scale")) scale = numbers(t["scale"], tp + ".scale", 2);
+            if (t.contains("rotation")) rot = number(t["rotation"], tp + ".rotation");
+            if (t.contains("texCoord")) set = count(t, "texCoord", tp, false, 0);
+            const double c = std::cos(rot), s = std::sin(rot);
+            *uv = {static_cast<float>(c * scale[0]), static_cast<float>(s * scale[1]), static_cast<float>(off[0]),
+                   static_cast<float>(-s * scale[0]), static_cast<float>(c * scale[1]), static_cast<float>(off[1])};
+            for (float f : *uv)
+                if (!std::isfinite(f)) fail(ErrorCode::kInvalidValue, tp, "offset, rotation and scale must give a finite transform");
+        }
         if (first_set) mt.tex_coord = set;
         else if (set != mt.tex_coord) mixed_sets = true;
         first_set = false;
-        transformed = transformed || (j.contains("extensions") && j["extensions"].is_object() && j["extensions"].contains("KHR_texture_transform"));
         return ti;
     };
     if (m.contains("pbrMetallicRoughness")) {
@@ -427,21 +444,20 @@ std::uint32_t Reader::material_of(const json& prim, const std::string& pp) {
             for (int k = 0; k < 4; ++k) base[k] = f[static_cast<size_t>(k)];
         }
         if (pbr.contains("metallicFactor")) metallic = number(pbr["metallicFactor"], mp + ".pbrMetallicRoughness.metallicFactor");
-        if (pbr.contains("baseColorTexture")) mt.base = texture_info(pbr["baseColorTexture"], mp + ".pbrMetallicRoughness.baseColorTexture");
+        if (pbr.contains("baseColorTexture")) mt.base = texture_info(pbr["baseColorTexture"], mp + ".pbrMetallicRoughness.baseColorTexture", &sm.base_uv);
         if (pbr.contains("metallicRoughnessTexture"))
-            mt.metal_rough = texture_info(pbr["metallicRoughnessTexture"], mp + ".pbrMetallicRoughness.metallicRoughnessTexture");
+            mt.metal_rough = texture_info(pbr["metallicRoughnessTexture"], mp + ".pbrMetallicRoughness.metallicRoughnessTexture", &sm.metal_rough_uv);
     }
     if (m.contains("emissiveFactor")) {
         const std::vector<double> f = numbers(m["emissiveFactor"], mp + ".emissiveFactor", 3);
         for (int k = 0; k < 3; ++k) emissive[k] = f[static_cast<size_t>(k)];
     }
-    if (m.contains("emissiveTexture")) mt.emissive = texture_info(m["emissiveTexture"], mp + ".emissiveTexture");
+    if (m.contains("emissiveTexture")) mt.emissive = texture_info(m["emissiveTexture"], mp + ".emissiveTexture", &sm.emissive_uv);
     if (m.contains("extensions") && m["extensions"].is_object() && m["extensions"].contains("KHR_materials_emissive_strength")) {
         const json& e = m["extensions"]["KHR_materials_emissive_strength"];
         if (e.is_object() && e.contains("emissiveStrength"))
             strength = number(e["emissiveStrength"], mp + ".extensions.KHR_materials_emissive_strength.emissiveStrength");
     }
-    SceneMaterial sm;
     sm.name = m.contains("name") && m["name"].is_string() ? m["name"].get<std::string>() : mp;
     for (int k = 0; k < 3; ++k) {
         sm.albedo[k] = static_cast<float>(std::clamp(base[k], 0.0, 1.0) * (1.0 - std::clamp(metallic, 0.0, 1.0)));
@@ -449,8 +465,7 @@ std::uint32_t Reader::material_of(const json& prim, const std::string& pp) {
         sm.base_factor[k] = static_cast<float>(std::clamp(base[k], 0.0, 1.0));
     }
     sm.metallic = static_cast<float>(std::clamp(metallic, 0.0, 1.0));
-    if (mixed_sets) notes_.push_back(mp + ": its textures use different texCoord sets: TEXCOORD_" + std::to_string(mt.tex_coord) + " is used for all of them");
-    if (transformed) notes_.push_back(mp + ": KHR_texture_transform is not applied to the UVs its textures are sampled at");
+    if (mixed_sets) notes_.push_back(mp + ": its textures use different texCoord sets (KHR_texture_transform's included): TEXCOORD_" + std::to_string(mt.tex_coord) + " is used for all of them");
     // A metallic-roughness texture can lower the metallic factor, so base colour alone may reflect.
     const bool reflects = sm.albedo.r > 0 || sm.albedo.g > 0 || sm.albedo.b > 0 ||
                           (mt.metal_rough >= 0 && (sm.base_factor.r > 0 || sm.base_factor.g > 0 || sm.base_factor.b > 0));
