@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
             sum.resize(names.size());
             std::printf("%-28s %5s", "scene", "truth");
             for (const std::string& nm : names) std::printf(" | %-15s", nm.c_str());
-            std::printf(" | moved | dark pts in plane cells\n");
+            std::printf(" | moved | dark pts in plane cells | plane fit: cells crossed, with a plane, pairs wrong / blocked\n");
             header = true;
         }
         const std::vector<double> truth = truth_of(ls);
@@ -139,7 +139,9 @@ int main(int argc, char** argv) {
                 ++dark;
                 dark_plane += cell_has_plane(cs->volumes[2], sp.p);
             }
-        std::printf(" | %5zu | %5.1f%%\n", cs->moved, dark ? 100.0 * double(dark_plane) / double(dark) : 0.0);
+        const PlaneFitStats& pf = cs->plane_reloc_stats;
+        std::printf(" | %5zu | %5.1f%% | %3zu %3zu %5zu / %-5zu\n", cs->moved, dark ? 100.0 * double(dark_plane) / double(dark) : 0.0,
+                    pf.blocked_cells, pf.planes, pf.wrong_pairs, pf.blocked_pairs);
         if (rounds > 0) {
             const std::vector<double> ns = time_all(*cs, ls.points, rounds);
             for (size_t k = 0; k < ns.size(); ++k)
