@@ -374,6 +374,14 @@ TEST(Transport, TextureSamplingAndWrapModes) {
         EXPECT_EQ(c[0], k.want) << "wrap " << int(k.w) << " u " << k.u;
         EXPECT_EQ(c[2], k.want + 200) << "wrap " << int(k.w) << " u " << k.u;
     }
+    // Far outside [0, 1] (no fractional bits left) every mode still names a texel of the texture.
+    for (TextureWrap w : {TextureWrap::kRepeat, TextureWrap::kClamp, TextureWrap::kMirror})
+        for (double u : {-1e30, -123456789.123, 987654321.5, 1e30, double(NAN), double(INFINITY)}) {
+            t.wrap_s = t.wrap_t = w;
+            sample_texture(t, u, u, c);
+            EXPECT_TRUE(c[0] >= 0 && c[0] <= 13 && c[0] == std::floor(c[0])) << int(w) << " " << u << " " << c[0];
+        }
+    t.wrap_t = TextureWrap::kRepeat;
     t.wrap_s = TextureWrap::kRepeat;
     sample_texture(t, 0.3, 0.75, c);  // second row
     EXPECT_EQ(c[0], 11);

@@ -58,12 +58,12 @@ std::int64_t wrap_index(double i, std::int64_t n, TextureWrap w) {
     switch (w) {
         case TextureWrap::kClamp: return static_cast<std::int64_t>(std::clamp(i, 0.0, dn - 1));
         case TextureWrap::kMirror: {
-            const double m = i - 2 * dn * std::floor(i / (2 * dn));  // in [0, 2n)
+            const double m = std::max(0.0, i - 2 * dn * std::floor(i / (2 * dn)));  // in [0, 2n) up to rounding
             const auto k = std::min(static_cast<std::int64_t>(m), 2 * n - 1);
             return k < n ? k : 2 * n - 1 - k;
         }
         default: {
-            const double m = i - dn * std::floor(i / dn);
+            const double m = std::max(0.0, i - dn * std::floor(i / dn));
             return std::min(static_cast<std::int64_t>(m), n - 1);
         }
     }
