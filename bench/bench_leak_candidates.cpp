@@ -92,6 +92,7 @@ int main(int argc, char** argv) {
                 "within 10 %% of plain's mean nor closer to the truth.\n\n",
                 per_face, opt.bias, opt.clearance);
     std::vector<Summary> sum;
+    std::vector<std::string> lit_lines;  // mean irradiance on the lit side: truth and every candidate
     std::vector<std::string> names;
     std::vector<double> bytes;
     bool header = false;
@@ -119,6 +120,18 @@ int main(int argc, char** argv) {
         const Metrics tm = metrics(ls.points, truth, truth);
         std::vector<Metrics> ms;
         for (const CandidateVolume& cv : cs->volumes) ms.push_back(metrics(ls.points, sample_candidate(cv, ls.points), truth));
+        {
+            char buf[64];
+            std::string line = ls.name;
+            line.resize(28, ' ');
+            std::snprintf(buf, sizeof buf, " %7.4f", tm.lit_mean);
+            line += buf;
+            for (const Metrics& m : ms) {
+                std::snprintf(buf, sizeof buf, " %7.4f", m.lit_mean);
+                line += buf;
+            }
+            lit_lines.push_back(line);
+        }
         std::printf("%-28s %4.1f%%", ls.name.c_str(), 100 * tm.leak);
         for (size_t k = 0; k < ms.size(); ++k) {
             const Metrics& m = ms[k];
@@ -164,5 +177,9 @@ int main(int argc, char** argv) {
                     100 * s.worst_leak, s.under_1, s.rows, s.above_plain, s.lit_off, 100 * s.worst_lit_err,
                     s.ratio_rows ? s.ratio_sum / s.ratio_rows : 0.0);
     }
+    std::printf("\nMean irradiance on the lit side:\n%-28s %7s", "scene", "truth");
+    for (const std::string& nm : names) std::printf(" %7.7s", nm.c_str());
+    std::printf("\n");
+    for (const std::string& l : lit_lines) std::printf("%s\n", l.c_str());
     return 0;
 }
