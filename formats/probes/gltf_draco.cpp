@@ -155,7 +155,7 @@ Result<DecodedProbeCloud> decode_probe_point_cloud(std::span<const std::uint8_t>
 }
 
 Result<DecodedDracoMesh> decode_draco_mesh(std::span<const std::uint8_t> bytes, int position_id, std::uint64_t expected_points,
-                                           std::uint64_t expected_faces, const std::string& where) {
+                                           std::uint64_t expected_faces, const std::string& where, int texcoord_id) {
     auto bad = [&](const std::string& what) { return make_error(ErrorCode::kBadFormat, where + ": Draco: " + what); };
     // Header (Draco 2.x): "DRACO", major, minor, encoder type (1 = triangular mesh), method.
     if (bytes.size() < 11 || std::memcmp(bytes.data(), "DRACO", 5) != 0) return bad("not a Draco bitstream");
@@ -179,6 +179,13 @@ Result<DecodedDracoMesh> decode_draco_mesh(std::span<const std::uint8_t> bytes, 
     out.positions.resize(mesh->num_points());
     for (draco::PointIndex p(0); p < mesh->num_points(); ++p)
         if (!pos->ConvertValue<float>(pos->mapped_index(p), 3, out.positions[p.value()].data())) return bad("cannot read POSITION");
+    if (texcoord_id >= 0) {
+        const draco::PointAttribute* uv = mesh->GetAttributeByUniqueId(static_cast<uint32_t>(texcoord_id));
+        if (!uv || uv->num_components() != 2) return bad("TEXCOORD attribute " + std::to_string(texcoord_id) + " missing or not 2 components");
+        out.texcoords.resize(mesh->num_points());
+        for (draco::PointIndex p(0); p < mesh->num_points(); ++p)
+            if (!uv->ConvertValue<float>(uv->mapped_index(p), 2, out.texcoords[p.value()].data())) return bad("cannot read TEXCOORD");
+    }
     out.faces.resize(mesh->num_faces());
     for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f) {
         const draco::Mesh::Face& face = mesh->face(f);

@@ -41,12 +41,14 @@ Result<DecodedProbeCloud> decode_probe_point_cloud(std::span<const std::uint8_t>
 // dequantised to float) of the Draco attribute with unique id `position_id`, and the faces as
 // point indices. Only triangular-mesh bitstreams are read (kUnsupported otherwise); the point
 // and face counts must equal `expected_points` / `expected_faces` (the primitive's accessors,
-// checked against zhc's limits before this is called) or the result is kInvalidValue.
+// checked against zhc's limits before this is called) or the result is kInvalidValue. With
+// `texcoord_id` >= 0, also that 2-component attribute per point (texture coordinates, dequantised).
 struct DecodedDracoMesh {
     std::vector<std::array<float, 3>> positions;
     std::vector<std::array<std::uint32_t, 3>> faces;
+    std::vector<std::array<float, 2>> texcoords;  // empty unless texcoord_id >= 0
 };
 Result<DecodedDracoMesh> decode_draco_mesh(std::span<const std::uint8_t> bytes, int position_id, std::uint64_t expected_points,
-                                           std::uint64_t expected_faces, const std::string& where);
+                                           std::uint64_t expected_faces, const std::string& where, int texcoord_id = -1);
 
 }  // namespace zhc

@@ -358,8 +358,22 @@ void Reader::add_draco(const json& prim, const json& ext, const std::string& pp,
     const json& views = array_of(doc_, "bufferViews");
     const size_t vi = index(ext.contains("bufferView") ? ext["bufferView"] : json(), ep + ".bufferView", views.size(), "bufferViews");
     const std::span<const std::uint8_t> bytes = view_bytes(vi, at("bufferViews", vi));
-    auto mesh = decode_draco_mesh(bytes, static_cast<int>(pid), nv, ni / 3, ep);
+    // A textured primitive's UVs: the Draco attribute of its material's TEXCOORD_n.
+    int uv_id = -1;
+    if (current_material_ != kNoMaterial && material_textures_[current_material_].any()) {
+        const std::string key = "TEXCOORD_" + std::to_string(material_textures_[current_material_].tex_coord);
+        if (ext["attributes"].contains(key) && ext["attributes"][key].is_number_integer() && ext["attributes"][key].get<std::int64_t>() >= 0 &&
+            ext["attributes"][key].get<std::int64_t>() <= std::numeric_limits<int>::max())
+            uv_id = static_cast<int>(ext["attributes"][key].get<std::int64_t>());
+        else
+            notes_.push_back(pp + ": its material is textured but its Draco stream has no " + key + ": the material's factors are used without textures");
+    }
+    auto mesh = decode_draco_mesh(bytes, static_cast<int>(pid), nv, ni / 3, ep, uv_id);
     if (!mesh) throw Fail{make_error(mesh.error().code, path_ + ": " + mesh.error().message)};
+    std::vector<std::array<float, 2>> uvs = std::move(mesh->texcoords);
+    for (size_t i = 0; i < uvs.size(); ++i)
+        if (!std::isfinite(uvs[i][0]) || !std::isfinite(uvs[i][1])) fail(ErrorCode::kInvalidValue, ep, "Draco texture coordinate " + std::to_string(i) + " is not finite");
+    current_uvs_ = uvs.empty() ? nullptr : &uvs;
     std::vector<Vec3> verts(mesh->positions.size());
     for (size_t i = 0; i < verts.size(); ++i) {
         const auto& q = mesh->positions[i];
@@ -371,6 +385,7 @@ void Reader::add_draco(const json& prim, const json& ext, const std::string& pp,
     idx.reserve(mesh->faces.size() * 3);
     for (const auto& f : mesh->faces) idx.insert(idx.end(), f.begin(), f.end());
     add_instances(verts, idx, 4, inst, ep);
+    current_uvs_ = nullptr;
 }
 
 void Reader::add_point_bounds(const json& prim, const std::string& pp, const Instancing& inst) {
@@ -504,9 +519,8 @@ void Reader::add_mesh(size_t mi, const Instancing& inst) {
             fail(ErrorCode::kInvalidValue, pp + ".attributes.POSITION", "missing");
         const bool textured = current_material_ != kNoMaterial && material_textures_[current_material_].any();
         if (prim.contains("extensions") && prim["extensions"].is_object() && prim["extensions"].contains("KHR_draco_mesh_compression")) {
-            if (textured)
-                notes_.push_back(pp + ": Draco-compressed texture coordinates are not read: its material's factors are used without textures");
             add_draco(prim, prim["extensions"]["KHR_draco_mesh_compression"], pp, mode, inst);
+            current_uvs_ = nullptr;
             continue;
         }
         const size_t pa = index(prim["attributes"]["POSITION"], pp + ".attributes.POSITION", n_acc, "accessors");
