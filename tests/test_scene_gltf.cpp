@@ -705,6 +705,16 @@ TEST(SceneGltf, ImagesReadOnlyForReflectedLight) {
     }
     const auto inputs = rec.inputs();
     EXPECT_NE(std::find(inputs.begin(), inputs.end(), root + "/asset/beside.png"), inputs.end()) << inputs.size();
+    // `zhc bake --depfile` lists the image when the bake decodes it, and not otherwise.
+    for (bool lit : {true, false}) {
+        const std::string t = textured_floor({{"uri", "beside.png"}}, lit).text();
+        test::write_bytes(in, std::vector<std::uint8_t>(t.begin(), t.end()));
+        const auto b = test::run_zhc({"bake", in, "-o", root + "/dep.zhp", "--depfile", root + "/dep.d", "--quiet"});
+        ASSERT_EQ(b.exit_code, 0) << b.err;
+        const auto dep = test::read_bytes(root + "/dep.d");
+        const std::string d(dep.begin(), dep.end());
+        EXPECT_EQ(d.find("beside.png") != std::string::npos, lit) << d;
+    }
     // The command line: exit 4 for the escaping image, one line.
     const std::string esc = textured_floor({{"uri", "../tex.png"}}).text();
     test::write_bytes(in, std::vector<std::uint8_t>(esc.begin(), esc.end()));
