@@ -76,8 +76,10 @@ int main(int argc, char** argv) {
         else if (a == "--bias" && i + 1 < argc) opt.bias = std::atof(argv[++i]);
         else if (a == "--clearance" && i + 1 < argc) opt.clearance = std::atof(argv[++i]);
         else if (a == "--rounds" && i + 1 < argc) rounds = std::max(0, std::atoi(argv[++i]));
+        else if (a == "--reach" && i + 1 < argc) opt.reach = std::atof(argv[++i]);
+        else if (a == "--max-wrong" && i + 1 < argc) opt.max_wrong = std::atof(argv[++i]);
         else {
-            std::fprintf(stderr, "usage: %s [--points N] [--bias B] [--clearance C] [--rounds N]\n", argv[0]);
+            std::fprintf(stderr, "usage: %s [--points N] [--bias B] [--clearance C] [--reach R] [--max-wrong W] [--rounds N]\n", argv[0]);
             return 2;
         }
     }
@@ -113,7 +115,7 @@ int main(int argc, char** argv) {
             sum.resize(names.size());
             std::printf("%-28s %5s", "scene", "truth");
             for (const std::string& nm : names) std::printf(" | %-15s", nm.c_str());
-            std::printf(" | moved | dark pts in plane cells | plane fit: cells crossed, with a plane, pairs wrong / blocked\n");
+            std::printf(" | moved, towards walls | dark pts in plane cells | plane fit: cells crossed, with a plane, pairs wrong / blocked\n");
             header = true;
         }
         const std::vector<double> truth = truth_of(ls);
@@ -153,7 +155,7 @@ int main(int argc, char** argv) {
                 dark_plane += cell_has_plane(cs->volumes[2], sp.p);
             }
         const PlaneFitStats& pf = cs->plane_reloc_stats;
-        std::printf(" | %5zu | %5.1f%% | %3zu %3zu %5zu / %-5zu\n", cs->moved, dark ? 100.0 * double(dark_plane) / double(dark) : 0.0,
+        std::printf(" | %3zu %3zu | %5.1f%% | %3zu %3zu %5zu / %-5zu\n", cs->moved, cs->moved_towards, dark ? 100.0 * double(dark_plane) / double(dark) : 0.0,
                     pf.blocked_cells, pf.planes, pf.wrong_pairs, pf.blocked_pairs);
         if (rounds > 0) {
             const std::vector<double> ns = time_all(*cs, ls.points, rounds);

@@ -186,8 +186,10 @@ inline Vec3 smallest_eigenvector(double a[3][3]) {
 // last probe of an axis).
 inline std::vector<CellPlane> cell_planes(const OccluderBvh& bvh, const GridInfo& g, const std::vector<Vec3>& baked,
                                           const std::vector<std::uint8_t>& valid, const PlaneFitOptions& opt = {},
-                                          PlaneFitStats* stats = nullptr, std::vector<CellPlane>* second = nullptr) {
+                                          PlaneFitStats* stats = nullptr, std::vector<CellPlane>* second = nullptr,
+                                          std::vector<double>* wrong_fraction = nullptr) {
     std::vector<CellPlane> out(g.count());
+    if (wrong_fraction) wrong_fraction->assign(g.count(), 0.0);
     if (second) second->assign(g.count(), CellPlane{});
     PlaneFitStats st;
     const double unit = plane_unit(g);
@@ -328,6 +330,7 @@ inline std::vector<CellPlane> cell_planes(const OccluderBvh& bvh, const GridInfo
                 st.blocked_pairs += blocked;
                 st.wrong_pairs += best_wrong;
                 out[g.index(x, y, z)] = qc[size_t(best)];
+                if (wrong_fraction) (*wrong_fraction)[g.index(x, y, z)] = blocked ? double(best_wrong) / double(blocked) : 0.0;
             }
     if (stats) *stats = st;
     return out;
@@ -472,6 +475,58 @@ inline std::vector<std::uint8_t> masks_at(const OccluderBvh& bvh, const GridInfo
         }
         out[i] = mask;
     }
+    return out;
+}
+
+// Relocation towards walls: a valid probe farther than `reach` x min(spacing) from the plane of one
+// of its cells (planes fitted with the probes at `baked`; only planes that predict at most
+// `max_wrong` of their cell's blocked pairs wrongly: a wall the plane describes) moves along the plane's normal to
+// `reach` x min(spacing) from it (the largest such move over its cells), where that point is clear
+// (clear_point at `clearance`) and on the same side of the plane. Returns the new positions
+// (`moved` counts the moved probes).
+inline std::vector<Vec3> relocate_towards_planes(const OccluderBvh& bvh, const GridInfo& g, const std::vector<Vec3>& baked,
+                                                 const std::vector<std::uint8_t>& valid, const std::vector<CellPlane>& planes,
+                                                 const std::vector<double>& wrong_fraction, double max_wrong, double reach,
+                                                 double clearance, std::size_t* moved) {
+    std::vector<Vec3> out = baked;
+    const double h = g.min_spacing(), unit = plane_unit(g);
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < g.count(); ++i) {
+        if (!valid[i]) continue;
+        const std::uint32_t idx[3] = {std::uint32_t(i % g.n[0]), std::uint32_t((i / g.n[0]) % g.n[1]),
+                                      std::uint32_t(i / (std::size_t(g.n[0]) * g.n[1]))};
+        Vec3 best{};
+        double best_len = 0;
+        for (int k = 0; k < 8; ++k) {  // the cell in which probe i is corner k
+            long c[3];
+            bool ok = true;
+            for (int a = 0; a < 3; ++a) {
+                c[a] = long(idx[a]) - ((k >> a) & 1);
+                if (c[a] < 0 || c[a] + 1 >= long(g.n[a])) ok = false;
+            }
+            if (!ok) continue;
+            const CellPlane& cp = planes[g.index(std::uint32_t(c[0]), std::uint32_t(c[1]), std::uint32_t(c[2]))];
+            if (cp.offset == CellPlane::kNoPlane) continue;
+            if (wrong_fraction[g.index(std::uint32_t(c[0]), std::uint32_t(c[1]), std::uint32_t(c[2]))] > max_wrong) continue;
+            const Vec3 nq = oct_decode(cp.ou, cp.ov);
+            const Vec3 centre = cell_centre(g, std::uint32_t(c[0]), std::uint32_t(c[1]), std::uint32_t(c[2]));
+            const double sd = plane_side_value(cp, nq, centre, unit, baked[i]);
+            if (std::fabs(sd) <= reach * h) continue;
+            const double len = std::fabs(sd) - reach * h;
+            if (len > best_len) {
+                best_len = len;
+                best = (sd > 0 ? -len : len) * nq;
+            }
+        }
+        if (best_len <= 0) continue;
+        const Vec3 q = baked[i] + best;
+        if (!clear_point(bvh, q, clearance * h)) continue;
+        const Vec3 v = q - baked[i];
+        if (bvh.occluded(baked[i], normalized(v), 1e-9, length(v))) continue;
+        out[i] = q;
+        ++count;
+    }
+    if (moved) *moved = count;
     return out;
 }
 
@@ -729,13 +784,16 @@ struct CandidateSet {
     std::vector<CandidateVolume> volumes;
     std::size_t moved = 0, stuck = 0;
     PlaneFitStats plane_stats, plane_reloc_stats, plane2_stats;
-    std::vector<std::uint8_t> plain_zhp, reloc_zhp;
+    std::vector<std::uint8_t> plain_zhp, reloc_zhp, towards_zhp;
+    std::size_t moved_towards = 0;
     std::string error;
 };
 
 struct CandidateOptions {
     double bias = 0.0;        // normal bias of the new schemes, fraction of min(spacing)
     double clearance = 0.1;   // relocation radius, fraction of min(spacing)
+    double reach = 0.4;       // relocation towards walls: the farthest a probe stays from its cells' planes
+    double max_wrong = 0.02;  // ... counting only planes predicting at most this fraction of blocked pairs wrongly
 };
 
 inline std::unique_ptr<CandidateSet> build_candidates(const LeakScene& ls, const Baked& b, const CandidateOptions& opt = {}) {
@@ -814,9 +872,56 @@ inline std::unique_ptr<CandidateSet> build_candidates(const LeakScene& ls, const
         c.planes = cell_planes(bvh, g, rp.reloc.positions, rp.validity, {}, &cs->plane_reloc_stats);
     }
     {
+        // Relocation towards walls: probes moved to `reach` spacing from their cells' planes, baked
+        // there (positions bake), the planes refitted with the corners at the new positions.
+        std::vector<double> wrong;
+        const std::vector<CellPlane> first = cell_planes(bvh, g, rp.reloc.positions, rp.validity, {}, nullptr, nullptr, &wrong);
+        std::size_t moved2 = 0;
+        const std::vector<Vec3> pos2 = relocate_towards_planes(bvh, g, rp.reloc.positions, rp.validity, first, wrong,
+                                                               opt.max_wrong, opt.reach, opt.clearance, &moved2);
+        cs->moved_towards = moved2;
+        std::vector<Sh3Radiance> probes2 = rp.probes;
+        Scene s = ls.scene;
+        s.probes = {};
+        s.probes.kind = ProbePlacementKind::kPositions;
+        std::vector<std::size_t> which;
+        for (std::size_t i = 0; i < g.count(); ++i)
+            if (pos2[i].x != rp.reloc.positions[i].x || pos2[i].y != rp.reloc.positions[i].y || pos2[i].z != rp.reloc.positions[i].z) {
+                s.probes.positions.push_back(pos2[i]);
+                which.push_back(i);
+            }
+        if (!which.empty()) {
+            auto baked2 = bake_scene(s, BakeOptions{});
+            if (!baked2) {
+                cs->error = ls.name + ": " + baked2.error().message;
+                return cs;
+            }
+            for (std::size_t k = 0; k < which.size(); ++k) probes2[which[k]] = (*baked2)[k];
+        }
+        auto set = encode_probe_set(probes2, "sh3", {}, probe_layout(ls.scene.probes));
+        if (!set) {
+            cs->error = ls.name + ": " + set.error().message;
+            return cs;
+        }
+        auto bytes = serialize_probe_set(*set);
+        if (!bytes) {
+            cs->error = ls.name + ": cannot write the relocated .zhp";
+            return cs;
+        }
+        cs->towards_zhp = std::move(*bytes);
+        zhc_volume tv;
+        if (zhc_volume_from_zhp(&tv, cs->towards_zhp.data(), cs->towards_zhp.size()) != ZHC_OK) {
+            cs->error = ls.name + ": cannot open the relocated volume";
+            return cs;
+        }
+        CandidateVolume& c = add("reloc2+plane", kPlaneBytesPerCell + 1, tv, Scheme::kPlane, opt.bias);
+        c.validity = rp.validity;
+        c.planes = cell_planes(bvh, g, pos2, rp.validity);
+    }
+    {
         CandidateVolume& c = add("reloc+pl+extrap", kPlaneBytesPerCell + 1, rv, Scheme::kPlane, opt.bias);
         c.validity = rp.validity;
-        c.planes = cs->volumes[cs->volumes.size() - 2].planes;
+        c.planes = cs->volumes[cs->volumes.size() - 3].planes;  // reloc+plane's
         c.extrapolate = true;
     }
     return cs;

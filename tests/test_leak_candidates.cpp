@@ -5,12 +5,13 @@
 //    a constant field stays constant under every candidate;
 //  * the plane quantisation: the axes are exact through the octahedral code; the fitted plane of a
 //    wall through the middle of a cell is axis-aligned and lies inside the wall;
-//  * the chosen scheme (probe relocation + one separating plane per cell, 6 bytes per probe): no
-//    leak in any of the 18 two-room configurations, the window room below plain and below 3 %,
-//    never above plain's leak anywhere; the lit side at the probe column inside the wall closer to
-//    the truth than plain; 15 probes moved there; the failures that set the choice apart
-//    (masks above plain, per-octant distances above 1 % in the two rooms, the plane without
-//    relocation 2.5x plain's lit error with the probe column inside the wall);
+//  * the chosen scheme (probes relocated out of geometry and towards the walls that a cell's plane
+//    describes, + one separating plane per cell, 6 bytes per probe): no leak in any of the 18
+//    two-room configurations, the lit side within 1.5 points of plain's error or closer, the
+//    window room below plain and below 3 %, never above plain's leak anywhere; 15 probes moved out
+//    of the wall; the failures that set the choice apart (masks above plain, per-octant distances
+//    above 1 % in the two rooms, the plane without relocation 2.5x plain's lit error with the
+//    probe column inside the wall and 10 points above it with the wall at 0.8);
 //  * a normal bias of 5 % of the cell lets light through a 2 % wall (why the scheme uses none).
 #include <gtest/gtest.h>
 
@@ -164,7 +165,7 @@ TEST(LeakCandidates, PlaneQuantisation) {
 
 TEST(LeakCandidates, ChosenSchemeStopsTheLeaksItCan) {
     for (const Case& c : suite()) {
-        const int plain = candidate(c, "plain"), chosen = candidate(c, "reloc+plane");
+        const int plain = candidate(c, "plain"), chosen = candidate(c, "reloc2+plane");
         const Metrics& p = c.m[size_t(plain)];
         const Metrics& m = c.m[size_t(chosen)];
         EXPECT_EQ(c.cs->bytes[size_t(chosen)], 6.0);
@@ -173,8 +174,11 @@ TEST(LeakCandidates, ChosenSchemeStopsTheLeaksItCan) {
         if (c.scene.offset >= 0) {
             // No light on the dark side of any two-room configuration (measured 0.00 %).
             EXPECT_LT(m.leak, 1e-4) << c.scene.name;
-            // The lit side: never more than 50 % off the truth (measured 13-44 %).
-            EXPECT_LT(m.lit_error, 0.50) << c.scene.name;
+            // The lit side as close to the truth as plain's or closer, within 1.5 points (measured
+            // -7.2 to +0.8 points).
+            EXPECT_LT(m.lit_error, p.lit_error + 0.015) << c.scene.name;
+            // One or two columns of 15 probes moved towards the wall (measured 15 or 30).
+            EXPECT_TRUE(c.cs->moved_towards == 15 || c.cs->moved_towards == 30) << c.scene.name << " " << c.cs->moved_towards;
             if (c.scene.offset == 0.0) {
                 EXPECT_EQ(c.cs->moved, 15u) << c.scene.name;  // the probe column inside the wall
                 EXPECT_EQ(c.cs->stuck, 0u);
@@ -186,8 +190,12 @@ TEST(LeakCandidates, ChosenSchemeStopsTheLeaksItCan) {
             if (c.scene.offset == 0.2) {
                 // Per-octant min distances let the dark side through (measured 1.6-1.8 %).
                 EXPECT_GT(c.m[size_t(candidate(c, "octant min"))].leak, 0.01) << c.scene.name;
-                // The lit side within 2 percentage points of plain (measured +0.8 / +0.3 / -0.2).
-                EXPECT_LT(m.lit_error, p.lit_error + 0.02) << c.scene.name;
+            }
+            if (c.scene.offset == 0.8 && c.scene.thickness < 0.2) {
+                // Without relocation towards the wall the lit side keeps the probe plane 1.2 m from
+                // it (measured 42-44 % against plain's 28 %; relocated 25 %).
+                EXPECT_GT(c.m[size_t(candidate(c, "reloc+plane"))].lit_error, p.lit_error + 0.10) << c.scene.name;
+                EXPECT_LT(m.lit_error, p.lit_error - 0.02) << c.scene.name;
             }
             if (c.scene.offset >= 0.6 && c.scene.thickness < 0.2) {  // today's masks: 4x plain's leak or more
                 EXPECT_GT(c.m[size_t(candidate(c, "masks"))].leak, 3 * p.leak) << c.scene.name;
@@ -196,16 +204,18 @@ TEST(LeakCandidates, ChosenSchemeStopsTheLeaksItCan) {
     }
     const Case& window = suite()[suite().size() - 2];
     ASSERT_EQ(window.scene.name, "window room (sky)");
-    const Metrics& wm = window.m[size_t(candidate(window, "reloc+plane"))];
+    const Metrics& wm = window.m[size_t(candidate(window, "reloc2+plane"))];
     const Metrics& wp = window.m[size_t(candidate(window, "plain"))];
-    EXPECT_LT(wm.leak, 0.03);                      // measured 2.0 % (truth 2.6 %; plain 5.6 %)
-    EXPECT_LT(wm.lit_error, 0.5 * wp.lit_error);   // measured 11 % against 30 %
+    EXPECT_LT(wm.leak, 0.03);                      // measured 2.2 % (truth 2.6 %; plain 5.6 %)
+    EXPECT_LT(wm.lit_error, 0.5 * wp.lit_error);   // measured 7.9 % against 30 %
     // What it does not stop (docs/leaks.md "Candidates"): the corridor's shadow boundary in open
     // air and the box needing 3 planes per cell; both stay above 1 % and at or below plain.
     const Case& corridor = suite()[suite().size() - 3];
     const Case& box = suite().back();
-    EXPECT_GT(corridor.m[size_t(candidate(corridor, "reloc+plane"))].leak, 0.10);
-    EXPECT_GT(box.m[size_t(candidate(box, "reloc+plane"))].leak, 0.10);
+    EXPECT_GT(corridor.m[size_t(candidate(corridor, "reloc2+plane"))].leak, 0.10);
+    EXPECT_GT(box.m[size_t(candidate(box, "reloc2+plane"))].leak, 0.10);
+    EXPECT_EQ(corridor.cs->moved_towards, 24u);  // only walls a plane describes (measured 24 and 0)
+    EXPECT_EQ(box.cs->moved_towards, 0u);
 }
 
 // A normal bias above half the wall's thickness moves free points near a 2 % wall (3 cm) through
