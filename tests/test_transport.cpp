@@ -93,19 +93,24 @@ TEST(Transport, FurnaceSphereMesh) {
     furnace(std::move(shell), 0.5, {2.0f, 2.0f, 2.0f}, 0.02);
 }
 
+// The plane z = 0 as a square of half-size R (two triangles) of grey albedo rho, material 0.
+void add_plane(Scene& s, double R, double rho) {
+    SceneMaterial m;
+    m.albedo = {float(rho), float(rho), float(rho)};
+    s.materials.push_back(m);
+    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, -R, 0}, {R, R, 0}));
+    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, R, 0}, {-R, R, 0}));
+    for (Occluder& o : s.occluders) o.material = static_cast<std::uint32_t>(s.materials.size() - 1);
+}
+
 // One bounce with a closed form: a sun of normalised irradiance E0 at elevation theta over a plane
 // of albedo rho lights it with E = pi E0 cos theta, so the plane's radiance is rho E0 cos theta
 // everywhere; a probe above it sees that radiance over the lower hemisphere (a hemisphere light)
 // plus the sun itself.
 TEST(Transport, SunOverInfinitePlane) {
     Scene s = at_positions({{0, 0, 1}, {3, -2, 0.5}});
-    const double R = 1e5, rho = 0.6;
-    SceneMaterial m;
-    m.albedo = {float(rho), float(rho), float(rho)};
-    s.materials.push_back(m);
-    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, -R, 0}, {R, R, 0}));
-    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, R, 0}, {-R, R, 0}));
-    for (Occluder& o : s.occluders) o.material = 0;
+    const double rho = 0.6;
+    add_plane(s, 1e5, rho);
     SceneLight sun;
     sun.kind = LightKind::kDirectional;
     sun.direction = normalize_or({0.3, 0.2, 1.0}, {0, 0, 1});
@@ -139,14 +144,9 @@ TEST(Transport, SunOverInfinitePlane) {
 // probe sees over the lower hemisphere with a fine midpoint rule in (theta, phi).
 TEST(Transport, PointLightOverPlaneAgainstQuadrature) {
     const Vec3 probe{0.4, -0.3, 1.0}, light{0, 0, 2.0};
-    const double rho = 0.7, I = 5.0, R = 1e4;
+    const double rho = 0.7, I = 5.0;
     Scene s = at_positions({probe});
-    SceneMaterial m;
-    m.albedo = {float(rho), float(rho), float(rho)};
-    s.materials.push_back(m);
-    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, -R, 0}, {R, R, 0}));
-    s.occluders.push_back(triangle_occluder({-R, -R, 0}, {R, R, 0}, {-R, R, 0}));
-    for (Occluder& o : s.occluders) o.material = 0;
+    add_plane(s, 1e4, rho);
     SceneLight l;
     l.kind = LightKind::kPoint;
     l.position = light;
