@@ -21,8 +21,11 @@
 //    when |x_b - p_k| <= the distance of its octant that holds the cell (code 0: invalid probe).
 // Bake side: cell_planes() fits the planes by tracing segments between sample points of the cell
 // and its corners; octant_distances() traces a fan of rays per octant; relocate_probes() moves
-// probes that lie inside or near geometry to the nearest clear point (the probe is baked there,
-// nothing is stored; the sampler still weights it at its grid position).
+// probes that lie inside or near geometry to the nearest clear point, relocate_towards_planes()
+// moves probes far from a wall that crosses one of their cells towards it (a moved probe is baked
+// there, nothing is stored; the sampler still weights it at its grid position); masks_at() traces
+// today's masks to the baked positions. build_candidates() assembles every candidate of one scene
+// (docs/leaks.md "Candidates"; the chosen one is "reloc2+plane").
 #pragma once
 
 #include <algorithm>
