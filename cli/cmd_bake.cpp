@@ -105,6 +105,7 @@ int run(const Options& o) {
     // is glTF (and always for a glTF scene) unless the scene's environment.latlong says otherwise;
     // the effects report names the orientation used.
     if (gltf_out) lo.default_latlong = LatLongConvention::kGltf;
+    lo.bounces = o.bounces;  // before the scene is read: --bounces 0 decodes no texture
     // A glTF input is read once: it is both the scene and, for -o .glb/.gltf, the host asset.
     const bool gltf_in = is_gltf_path(o.scene);
     std::vector<std::uint8_t> input_asset;

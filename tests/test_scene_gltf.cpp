@@ -714,6 +714,12 @@ TEST(SceneGltf, ImagesReadOnlyForReflectedLight) {
         const auto dep = test::read_bytes(root + "/dep.d");
         const std::string d(dep.begin(), dep.end());
         EXPECT_EQ(d.find("beside.png") != std::string::npos, lit) << d;
+        if (!lit) continue;
+        // --bounces 0 traces no reflected light: the image is not decoded either.
+        const auto z = test::run_zhc({"bake", in, "-o", root + "/dep0.zhp", "--depfile", root + "/dep0.d", "--quiet", "--bounces", "0"});
+        ASSERT_EQ(z.exit_code, 0) << z.err;
+        const auto dep0 = test::read_bytes(root + "/dep0.d");
+        EXPECT_EQ(std::string(dep0.begin(), dep0.end()).find("beside.png"), std::string::npos);
     }
     // The command line: exit 4 for the escaping image, one line.
     const std::string esc = textured_floor({{"uri", "../tex.png"}}).text();

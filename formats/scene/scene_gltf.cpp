@@ -252,6 +252,7 @@ Result<Scene> parse_unchecked(std::span<const std::uint8_t> bytes, const std::st
             }
         };
         set_textures(true);
+        if (options.bounces >= 0) s.transport.max_bounces = options.bounces;
         if (!s.surfaces.empty() && scene_has_transport(s)) {
             r.decode_textures();
             set_textures(false);

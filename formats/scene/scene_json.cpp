@@ -461,6 +461,7 @@ Scene parse(const Reader& r, const json& doc, const std::string& name, const std
             read_occluder(r, a[i], Reader::index("occluders", i), limits, s.occluders, triangles, s.materials);
     }
     if (doc.contains("transport")) s.transport = read_transport(r, doc["transport"]);
+    if (options.bounces >= 0) s.transport.max_bounces = options.bounces;
     if (Status budget = check_ray_budget(s, limits, ""); !budget) throw Fail{make_error(budget.error().code, name + ": " + budget.error().message)};
     return s;
 }

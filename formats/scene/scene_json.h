@@ -46,6 +46,9 @@ struct SceneLoadOptions {
     bool load_environment = true;  // false: keep the map path in environment->source, SH zero
     // environment.latlong when the scene does not say (glTF scenes and glTF outputs: kGltf).
     LatLongConvention default_latlong = LatLongConvention::kOpenExr;
+    // >= 0: replaces the scene's transport.bounces (`zhc bake --bounces`) while the scene is read,
+    // so that a glTF scene decodes its textures only when the bake will trace reflected light.
+    int bounces = -1;
 };
 
 // `name` is used in messages; `base_dir` resolves the environment map path.
