@@ -103,12 +103,7 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    std::vector<LeakScene> scenes;
-    for (double th : wall_thicknesses())
-        for (double off : wall_offsets()) scenes.push_back(two_rooms(off, th, per_face));
-    scenes.push_back(l_corridor(per_face));
-    scenes.push_back(window_room(per_face));
-    scenes.push_back(closed_box(per_face));
+    std::vector<LeakScene> scenes = suite_scenes(per_face);
 
     std::printf("Leak suite (tests/leak_scenes.h): direct light only (transport.max_bounces = 0), sh3 probes,\n"
                 "zhc_volume_irradiance on volumes from zhc_volume_from_zhp; %d points per surface, %d free per region.\n\n",

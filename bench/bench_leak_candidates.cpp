@@ -83,12 +83,7 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    std::vector<LeakScene> scenes;
-    for (double th : wall_thicknesses())
-        for (double off : wall_offsets()) scenes.push_back(two_rooms(off, th, per_face));
-    scenes.push_back(l_corridor(per_face));
-    scenes.push_back(window_room(per_face));
-    scenes.push_back(closed_box(per_face));
+    std::vector<LeakScene> scenes = suite_scenes(per_face);
     std::printf("Leak suite, candidates (tests/leak_candidates.h): %d points per surface, normal bias %.3f, relocation "
                 "radius %.3f of the spacing.\nPer cell: leak %% / lit err %%; '*' leak above plain's, '!' lit side neither "
                 "within 10 %% of plain's mean nor closer to the truth.\n\n",

@@ -36,6 +36,7 @@
 #include <memory>
 #include <vector>
 
+#include "codec/bake/bake_internal.h"
 #include "leak_scenes.h"
 
 namespace zhc::leak {
@@ -430,54 +431,18 @@ inline Relocation relocate_probes(const OccluderBvh& bvh, const GridInfo& g, dou
     return r;
 }
 
-// Today's 8-bit masks (codec/bake/scene.cpp grid_visibility_mask: 9 points per neighbouring cell,
-// visible when at least half of the points outside solids reach the probe) traced to each probe's
-// baked position instead of its grid position.
+// Today's 8-bit masks (the bake's grid_visibility_mask, codec/bake/bake_internal.h) traced to
+// each probe's baked position instead of its grid position.
 inline std::vector<std::uint8_t> masks_at(const OccluderBvh& bvh, const GridInfo& g, const std::vector<Vec3>& baked) {
+    ProbeGrid pg;
+    pg.origin = g.origin;
+    pg.spacing = g.spacing;
+    pg.counts = {g.n[0], g.n[1], g.n[2]};
     std::vector<std::uint8_t> out(g.count());
-    for (std::size_t i = 0; i < g.count(); ++i) {
-        const std::uint32_t idx[3] = {std::uint32_t(i % g.n[0]), std::uint32_t((i / g.n[0]) % g.n[1]),
-                                      std::uint32_t(i / (std::size_t(g.n[0]) * g.n[1]))};
-        const Vec3 gp = g.position(i), p = baked[i];
-        std::uint8_t mask = 0;
-        for (int c = 0; c < 8; ++c) {
-            const int side[3] = {c & 1, (c >> 1) & 1, (c >> 2) & 1};
-            double centre[3], half[3];
-            bool inside_grid = true;
-            for (int a = 0; a < 3; ++a) {
-                const double s = g.spacing[a];
-                if (g.n[a] <= 1) {
-                    if (side[a] == 0) inside_grid = false;
-                    centre[a] = gp[a];
-                    half[a] = 0;
-                    continue;
-                }
-                if ((side[a] == 0 && idx[a] == 0) || (side[a] == 1 && idx[a] + 1 >= g.n[a])) inside_grid = false;
-                centre[a] = gp[a] + (side[a] ? 0.5 : -0.5) * s;
-                half[a] = 0.25 * s;
-            }
-            if (!inside_grid) {
-                mask = std::uint8_t(mask | (1u << c));
-                continue;
-            }
-            int votes = 0, reach = 0;
-            for (int k = 0; k < 9; ++k) {
-                Vec3 q{centre[0], centre[1], centre[2]};
-                if (k > 0) {
-                    const int b = k - 1;
-                    q = {centre[0] + ((b & 1) ? half[0] : -half[0]), centre[1] + ((b & 2) ? half[1] : -half[1]),
-                         centre[2] + ((b & 4) ? half[2] : -half[2])};
-                }
-                if (bvh.inside_any_solid(q)) continue;
-                ++votes;
-                const Vec3 v = p - q;
-                const double len = length(v);
-                if (!(len > 2e-9) || !bvh.occluded(q, (1.0 / len) * v, 1e-9, len - 1e-9)) ++reach;
-            }
-            if (votes == 0 || 2 * reach >= votes) mask = std::uint8_t(mask | (1u << c));
-        }
-        out[i] = mask;
-    }
+    std::uint64_t rays = 0;
+    for (std::size_t i = 0; i < g.count(); ++i)
+        out[i] = bake_detail::grid_visibility_mask(bvh, pg, std::uint32_t(i % g.n[0]), std::uint32_t((i / g.n[0]) % g.n[1]),
+                                                   std::uint32_t(i / (std::size_t(g.n[0]) * g.n[1])), baked[i], &rays);
     return out;
 }
 

@@ -323,6 +323,15 @@ inline const std::vector<double>& wall_thicknesses() {
     static const std::vector<double> v{0.02, 0.10, 0.20};
     return v;
 }
+inline std::vector<LeakScene> suite_scenes(int per_face = 24) {
+    std::vector<LeakScene> scenes;
+    for (double th : wall_thicknesses())
+        for (double off : wall_offsets()) scenes.push_back(two_rooms(off, th, per_face));
+    scenes.push_back(l_corridor(per_face));
+    scenes.push_back(window_room(per_face));
+    scenes.push_back(closed_box(per_face));
+    return scenes;
+}
 
 // ---- ground truth -----------------------------------------------------------------------------
 

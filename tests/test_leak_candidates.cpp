@@ -44,12 +44,7 @@ int candidate(const Case& c, const std::string& name) {
 
 const std::vector<Case>& suite() {
     static const std::vector<Case> cases = [] {
-        std::vector<LeakScene> scenes;
-        for (double th : wall_thicknesses())
-            for (double off : wall_offsets()) scenes.push_back(two_rooms(off, th));
-        scenes.push_back(l_corridor());
-        scenes.push_back(window_room());
-        scenes.push_back(closed_box());
+        std::vector<LeakScene> scenes = suite_scenes();
         std::vector<Case> out;
         for (LeakScene& s : scenes) {
             Case c;

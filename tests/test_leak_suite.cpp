@@ -40,12 +40,7 @@ struct Case {
 // Every configuration, baked and measured once per process (printed as a table).
 const std::vector<Case>& suite() {
     static const std::vector<Case> cases = [] {
-        std::vector<LeakScene> scenes;
-        for (double th : wall_thicknesses())
-            for (double off : wall_offsets()) scenes.push_back(two_rooms(off, th));
-        scenes.push_back(l_corridor());
-        scenes.push_back(window_room());
-        scenes.push_back(closed_box());
+        std::vector<LeakScene> scenes = suite_scenes();
         std::vector<Case> out;
         std::printf("%-30s %4s %3s %9s %7s | %7s %7s | %7s %7s %7s\n", "scene", "prb", "inv", "lit/dark", "truth", "plain",
                     "masks", "floor", "plain", "masks");

@@ -1,6 +1,7 @@
 // zhc/codec/bake/bake_internal.h — helpers the bake's files share (not installed, not API).
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "codec/bake/scene.h"
@@ -19,5 +20,9 @@ bool finite3(Vec3 v);
 bool colour_ok(Rgb c);
 // The report's name of a light: "sun 'key'", "point 'lamp'", "directional", ...
 std::string effect_name(const SceneLight& l);
+// The 8-bit visibility mask of grid probe (x, y, z) (codec/bake/scene.cpp), its rays aimed at
+// `target`; *rays counts them.
+std::uint8_t grid_visibility_mask(const OccluderBvh& bvh, const ProbeGrid& g, std::uint32_t x, std::uint32_t y,
+                                  std::uint32_t z, Vec3 target, std::uint64_t* rays);
 
 }  // namespace zhc::bake_detail

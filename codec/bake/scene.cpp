@@ -147,13 +147,19 @@ void parallel_blocks(size_t count, size_t block, int threads, Fn&& fn) {
     for (auto& th : pool) th.join();
 }
 
+
+}  // namespace
+
+namespace bake_detail {
+
 // The visibility mask of grid probe (x, y, z): bit (cx + 2 cy + 4 cz) set when the probe is
 // visible from the cell on its side (cx, cy, cz). A cell beyond the grid keeps its bit set (it is
 // never sampled). Per cell kMaskPoints points (the centre, centre +- spacing/4 per axis); a point
 // inside a box/sphere occluder does not vote; the bit is set when at least half of the voting
-// points reach the probe unblocked (all points inside solids: set).
+// points reach the probe unblocked (all points inside solids: set). The rays go to `target`: the
+// probe's grid position in the bake, a moved position in the leak study (tests/leak_candidates.h).
 std::uint8_t grid_visibility_mask(const OccluderBvh& bvh, const ProbeGrid& g, std::uint32_t x, std::uint32_t y,
-                                  std::uint32_t z, std::uint64_t* rays) {
+                                  std::uint32_t z, Vec3 target, std::uint64_t* rays) {
     const std::uint32_t idx[3] = {x, y, z};
     const Vec3 p{g.origin.x + x * g.spacing.x, g.origin.y + y * g.spacing.y, g.origin.z + z * g.spacing.z};
     std::uint8_t mask = 0;
@@ -189,7 +195,7 @@ std::uint8_t grid_visibility_mask(const OccluderBvh& bvh, const ProbeGrid& g, st
             }
             if (bvh.inside_any_solid(q)) continue;
             ++votes;
-            const Vec3 v = p - q;
+            const Vec3 v = target - q;
             const double len = length(v);
             if (!(len > 2 * kRayEpsilon)) {
                 ++reach;
@@ -203,7 +209,7 @@ std::uint8_t grid_visibility_mask(const OccluderBvh& bvh, const ProbeGrid& g, st
     return mask;
 }
 
-}  // namespace
+}  // namespace bake_detail
 
 namespace {
 Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh& bvh, bool transport, double bvh_ms,
@@ -507,7 +513,7 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
                 const std::uint32_t x = static_cast<std::uint32_t>(i % g.counts[0]),
                                     y = static_cast<std::uint32_t>((i / g.counts[0]) % g.counts[1]),
                                     z = static_cast<std::uint32_t>(i / (size_t(g.counts[0]) * g.counts[1]));
-                leak->visibility[i] = grid_visibility_mask(bvh, g, x, y, z, &mr[static_cast<size_t>(t)]);
+                leak->visibility[i] = grid_visibility_mask(bvh, g, x, y, z, positions[i], &mr[static_cast<size_t>(t)]);
             }
         });
         for (std::uint64_t r : mr) mask_rays += r;
