@@ -28,7 +28,7 @@ import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { read, write } from 'ktx-parse';
-import { makeRand, checker, ulpDiff } from './fixtures.mjs';
+import { makeRand, checker, ulpDiff, freshWork, repoRoot } from './fixtures.mjs';
 import { chromiumPages } from './chromium_page.mjs';
 import { irradzIrradianceAstc, parseIzLog2Range, izFromLdr, decodeHemioct } from '../../runtime/web/zhc_runtime.mjs';
 
@@ -38,11 +38,9 @@ if (!zhc || !texelsTool || !workArg || !envmapDir) {
   process.exit(2);
 }
 const chromium = chromiumArg || '/usr/bin/chromium';
-const work = path.resolve(workArg);
-fs.rmSync(work, { recursive: true, force: true });
-fs.mkdirSync(work, { recursive: true });
+const work = freshWork(workArg);
 const here = path.dirname(fileURLToPath(import.meta.url));
-const repo = path.resolve(here, '..', '..');
+const repo = repoRoot;
 const W = (f) => path.join(work, f);
 const { check, finish } = checker();
 const run = (...args) => execFileSync(zhc, args, { maxBuffer: 1 << 28 }).toString();

@@ -1,4 +1,18 @@
-// Shared inputs of the runtime/web tests: a minimal GLB scene and deterministic probe lists.
+// Shared inputs of the runtime/web tests: a minimal GLB scene and deterministic probe lists; the
+// repository root and a test's emptied work folder.
+import fs from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+export const repoRoot = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
+
+// The absolute work folder `dir`, emptied (removed and made again).
+export function freshWork(dir) {
+  const work = path.resolve(dir);
+  fs.rmSync(work, { recursive: true, force: true });
+  fs.mkdirSync(work, { recursive: true });
+  return work;
+}
 export function glb(jsonObj, bin) {
   let jsonBytes = Buffer.from(JSON.stringify(jsonObj));
   jsonBytes = Buffer.concat([jsonBytes, Buffer.alloc((4 - (jsonBytes.length % 4)) % 4, 0x20)]);

@@ -33,7 +33,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { makeRand, checker } from './fixtures.mjs';
+import { makeRand, checker, freshWork, repoRoot } from './fixtures.mjs';
 import { chromiumPages } from './chromium_page.mjs';
 
 const [zhc, sampler, workArg, chromiumArg] = process.argv.slice(2);
@@ -42,11 +42,9 @@ if (!zhc || !sampler || !workArg) {
   process.exit(2);
 }
 const chromium = chromiumArg || '/usr/bin/chromium';
-const work = path.resolve(workArg);
-fs.rmSync(work, { recursive: true, force: true });
-fs.mkdirSync(work, { recursive: true });
+const work = freshWork(workArg);
 const here = path.dirname(fileURLToPath(import.meta.url));
-const repo = path.resolve(here, '..', '..');
+const repo = repoRoot;
 const W = (f) => path.join(work, f);
 const { check, finish } = checker();
 const run = (...args) => execFileSync(zhc, args, { maxBuffer: 1 << 28 }).toString();

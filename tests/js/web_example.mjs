@@ -21,7 +21,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { checker } from './fixtures.mjs';
+import { checker, freshWork, repoRoot } from './fixtures.mjs';
 import { chromiumPages } from './chromium_page.mjs';
 
 const [zhc, npm, workArg, chromiumArg] = process.argv.slice(2);
@@ -30,11 +30,9 @@ if (!zhc || !npm || !workArg) {
   process.exit(2);
 }
 const chromium = chromiumArg || '/usr/bin/chromium';
-const work = path.resolve(workArg);
-fs.rmSync(work, { recursive: true, force: true });
-fs.mkdirSync(work, { recursive: true });
+const work = freshWork(workArg);
 const here = path.dirname(fileURLToPath(import.meta.url));
-const repo = path.resolve(here, '..', '..');
+const repo = repoRoot;
 const exampleDir = path.join(repo, 'examples', 'web');
 const { check, finish } = checker();
 

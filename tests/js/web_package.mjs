@@ -29,18 +29,16 @@ import path from 'node:path';
 import { execFileSync, spawnSync } from 'node:child_process';
 import { createRequire } from 'node:module';
 import { fileURLToPath } from 'node:url';
-import { checker } from './fixtures.mjs';
+import { checker, freshWork, repoRoot } from './fixtures.mjs';
 
 const [zhc, npm, workArg] = process.argv.slice(2);
 if (!zhc || !npm || !workArg) {
   console.error('usage: node web_package.mjs ZHC_BINARY NPM WORK_DIR');
   process.exit(2);
 }
-const work = path.resolve(workArg);
-fs.rmSync(work, { recursive: true, force: true });
-fs.mkdirSync(work, { recursive: true });
+const work = freshWork(workArg);
 const here = path.dirname(fileURLToPath(import.meta.url));
-const repo = path.resolve(here, '..', '..');
+const repo = repoRoot;
 const webDir = path.join(repo, 'runtime', 'web');
 const modules = path.join(here, 'node_modules');
 const { check, finish } = checker();
