@@ -33,25 +33,11 @@ export interface ZhcProbeVolumeFields {
   nodes?: Object3D[];
 }
 
-/** One decoded ZHC_light_probes volume: gltf.userData.zhcLightProbes[i]. */
-export declare class ZhcProbeVolume implements ZhcProbeVolumeFields {
+/** One decoded ZHC_light_probes volume: gltf.userData.zhcLightProbes[i]. Its fields are
+ * ZhcProbeVolumeFields' (declaration merging: the interface below gives the class those members). */
+export interface ZhcProbeVolume extends ZhcProbeVolumeFields {}
+export declare class ZhcProbeVolume {
   constructor(desc: ZhcProbeVolumeFields);
-  name?: string;
-  encoding: ZhcEncodingName | string;
-  kind: ZhcKind;
-  count: number;
-  shAxes: 'zhc' | 'gltf';
-  layout: 'grid' | 'points' | 'none';
-  grid?: ZhcGrid;
-  draco?: boolean;
-  params?: ZhcParams;
-  bytesPerProbe?: number;
-  bytes?: Uint8Array;
-  positions?: Float32Array;
-  sh?: Float32Array;
-  validity?: Uint8Array | null;
-  visibility?: Uint8Array | null;
-  nodes?: Object3D[];
   /** SH3 radiance of probe p in the stored axes, bit exact with zhc (a view). Throws RangeError for a bad index. */
   probeSH(p: number): Float32Array;
   /** SH3 radiance of probe p in glTF axes. */
