@@ -465,21 +465,15 @@ std::vector<std::string> temporaries_in(const std::string& dir) {
     return found;
 }
 
-struct SignalRun {
-    bool saw_temporary = false;  // a temporary appeared before the signal was sent
-    int status = 0;              // waitpid's
-};
-// Starts zhc with `args` (stdout/stderr to /dev/null), waits until a temporary file appears in
-// `dir` (at most 120 s), sends `sig`, and waits for the process. The child starts with the
-// default action for the three signals whatever the test runner had (a runner started in the
-// background ignores SIGINT, and an ignored signal stays ignored across exec).
-SignalRun run_and_signal(const std::vector<std::string>& args, const std::string& dir, int sig) {
+// Starts zhc with `args`, standard streams on /dev/null, the default action for SIGINT, SIGTERM and
+// SIGHUP whatever the test runner had (a runner started in the background ignores SIGINT, and an
+// ignored signal stays ignored across exec); returns the child's pid (<= 0 when fork failed).
+pid_t spawn_zhc(const std::vector<std::string>& args) {
     std::vector<std::string> argv_s{ZHC_CLI_PATH};
     argv_s.insert(argv_s.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (std::string& a : argv_s) argv.push_back(a.data());
     argv.push_back(nullptr);
-    SignalRun r;
     const pid_t pid = ::fork();
     if (pid == 0) {
         for (const int s : {SIGINT, SIGTERM, SIGHUP}) ::signal(s, SIG_DFL);
@@ -490,6 +484,18 @@ SignalRun run_and_signal(const std::vector<std::string>& args, const std::string
         ::execv(argv[0], argv.data());
         ::_exit(127);
     }
+    return pid;
+}
+
+struct SignalRun {
+    bool saw_temporary = false;  // a temporary appeared before the signal was sent
+    int status = 0;              // waitpid's
+};
+// Starts zhc with `args` (spawn_zhc), waits until a temporary file appears in `dir` (at most
+// 120 s), sends `sig`, and waits for the process.
+SignalRun run_and_signal(const std::vector<std::string>& args, const std::string& dir, int sig) {
+    SignalRun r;
+    const pid_t pid = spawn_zhc(args);
     EXPECT_GT(pid, 0);
     if (pid <= 0) return r;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
@@ -548,21 +554,7 @@ TEST(CliTraps, SignalRemovesTemporariesAndKeepsFinalNames) {
 // Starts zhc with `args`, sends `sig` after `delay`, and returns waitpid's status (the process may
 // have ended by itself before).
 int run_and_signal_after(const std::vector<std::string>& args, std::chrono::microseconds delay, int sig) {
-    std::vector<std::string> argv_s{ZHC_CLI_PATH};
-    argv_s.insert(argv_s.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& a : argv_s) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    const pid_t pid = ::fork();
-    if (pid == 0) {
-        for (const int s : {SIGINT, SIGTERM, SIGHUP}) ::signal(s, SIG_DFL);
-        const int null = ::open("/dev/null", O_RDWR);
-        ::dup2(null, 0);
-        ::dup2(null, 1);
-        ::dup2(null, 2);
-        ::execv(argv[0], argv.data());
-        ::_exit(127);
-    }
+    const pid_t pid = spawn_zhc(args);
     int status = 0;
     if (pid <= 0) return -1;
     std::this_thread::sleep_for(delay);
