@@ -70,6 +70,17 @@ struct Summary {
 int main(int argc, char** argv) {
     int per_face = 96, rounds = 5;
     CandidateOptions opt;
+    std::vector<double> offsets, thicknesses;  // --walls: two rooms at these only, instead of the suite
+    auto list = [](const char* text) {
+        std::vector<double> v;
+        for (const char* p = text; *p;) {
+            char* end = nullptr;
+            v.push_back(std::strtod(p, &end));
+            if (end == p) return std::vector<double>{};
+            p = *end == ',' ? end + 1 : end;
+        }
+        return v;
+    };
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--points" && i + 1 < argc) per_face = std::max(1, std::atoi(argv[++i]));
@@ -78,12 +89,21 @@ int main(int argc, char** argv) {
         else if (a == "--rounds" && i + 1 < argc) rounds = std::max(0, std::atoi(argv[++i]));
         else if (a == "--reach" && i + 1 < argc) opt.reach = std::atof(argv[++i]);
         else if (a == "--max-wrong" && i + 1 < argc) opt.max_wrong = std::atof(argv[++i]);
+        else if (a == "--walls" && i + 2 < argc && !(offsets = list(argv[i + 1])).empty() && !(thicknesses = list(argv[i + 2])).empty())
+            i += 2;
         else {
-            std::fprintf(stderr, "usage: %s [--points N] [--bias B] [--clearance C] [--reach R] [--max-wrong W] [--rounds N]\n", argv[0]);
+            std::fprintf(stderr, "usage: %s [--points N] [--bias B] [--clearance C] [--reach R] [--max-wrong W] [--rounds N]\n"
+                                 "          [--walls OFFSETS THICKNESSES]   (comma lists, fractions of the cell: two rooms only)\n", argv[0]);
             return 2;
         }
     }
-    std::vector<LeakScene> scenes = suite_scenes(per_face);
+    std::vector<LeakScene> scenes;
+    if (offsets.empty()) {
+        scenes = suite_scenes(per_face);
+    } else {
+        for (double th : thicknesses)
+            for (double off : offsets) scenes.push_back(two_rooms(off, th, per_face));
+    }
     std::printf("Leak suite, candidates (tests/leak_candidates.h): %d points per surface, normal bias %.3f, relocation "
                 "radius %.3f of the spacing.\nPer cell: leak %% / lit err %%; '*' leak above plain's, '!' lit side neither "
                 "within 10 %% of plain's mean nor closer to the truth.\n\n",
