@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 
 #include "codec/bake/occluders.h"
 #include "codec/bake/scene.h"
@@ -578,6 +579,44 @@ TEST(Transport, TextureTablesValidated) {
     bad = s;
     bad.surfaces[1].uv[0][0] = std::nanf("");
     EXPECT_FALSE(validate_scene(bad).ok());
+}
+
+}  // namespace
+}  // namespace zhc
+
+namespace zhc {
+namespace {
+
+// The command line: --bounces/--max-noise/--rays reach the bake (the report's lines name them),
+// a bad --rays exits 2 in one line before any work, and a scene whose every probe is zero gets a
+// warning.
+TEST(TransportCli, OptionsReportAndRefusals) {
+    const std::string dir = test::fresh_dir("transport_cli");
+    const std::string scene = dir + "/room.json";
+    const std::string text = R"({"format":"zhc-scene","version":1,"probes":{"positions":[[0,0,1],[0.5,0.5,1.5]]},
+        "lights":[{"type":"point","position":[0,0,2],"intensity":5,"shadows":true}],
+        "occluders":[{"type":"mesh","positions":[-5,-5,0, 5,-5,0, 5,5,0, -5,-5,0, 5,5,0, -5,5,0],"albedo":0.5}]})";
+    test::write_bytes(scene, std::vector<std::uint8_t>(text.begin(), text.end()));
+    const auto ok = test::run_zhc({"bake", scene, "-o", dir + "/out.json", "--bounces", "7", "--max-noise", "0.5", "--rays", "256:256"});
+    ASSERT_EQ(ok.exit_code, 0) << ok.err;
+    EXPECT_NE(ok.out.find("(path traced: "), std::string::npos) << ok.out;
+    EXPECT_NE(ok.out.find("(256 per probe)"), std::string::npos) << ok.out;
+    EXPECT_NE(ok.out.find("of at most 7)"), std::string::npos) << ok.out;
+    const auto off = test::run_zhc({"bake", scene, "-o", dir + "/off.json", "--bounces", "0"});
+    ASSERT_EQ(off.exit_code, 0) << off.err;
+    EXPECT_EQ(off.out.find("path traced"), std::string::npos) << off.out;
+    for (const char* bad : {"0", "10:5", "abc", "5:", "2000000"}) {
+        const auto r = test::run_zhc({"bake", scene, "-o", dir + "/bad.json", "--rays", bad});
+        EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
+        EXPECT_NE(r.err.find("--rays"), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_FALSE(std::filesystem::exists(dir + "/bad.json")) << bad;
+    }
+    const std::string dark = R"({"format":"zhc-scene","version":1,"probes":{"positions":[[0,0,1]]}})";
+    test::write_bytes(dir + "/dark.json", std::vector<std::uint8_t>(dark.begin(), dark.end()));
+    const auto z = test::run_zhc({"bake", dir + "/dark.json", "-o", dir + "/dark_out.json"});
+    ASSERT_EQ(z.exit_code, 0) << z.err;
+    EXPECT_NE(z.err.find("warning: " + dir + "/dark.json: every probe is zero"), std::string::npos) << z.err;
 }
 
 }  // namespace
