@@ -38,9 +38,13 @@
 // masks (ProbeSet::visibility): per grid probe and each of its 8 cells, kMaskPoints rays from the
 // cell's centre region to the probe.
 //
+// Reflected and emitted light (docs/scene.md "Reflected light"): where an occluder's material
+// reflects or emits, each valid probe also gathers the radiance leaving the surfaces it sees,
+// path-traced by codec/bake/transport.h to a noise target; nothing is traced otherwise.
+//
 // Determinism: every probe is computed by itself with the effects in scene order, summed in
-// double; dilation reads only baked valid probes; so the result is the same bytes whatever the
-// thread count.
+// double, its random numbers seeded by its index; dilation reads only baked valid probes; so the
+// result is the same bytes whatever the thread count.
 //
 // Experimental: this API may change between minor versions (docs/api.md "Public headers").
 // Thread safety (docs/api.md): every function here is reentrant and keeps no state between
