@@ -805,6 +805,7 @@ typedef struct zhc_zhp_info {
     uint32_t body_crc32;
     uint64_t validity_offset;     /* version 2: count bytes (0/1) after the payload; 0 = absent */
     uint64_t visibility_offset;   /* version 2, grid only: count 8-bit cell masks; 0 = absent */
+    uint64_t planes_offset;       /* version 2, grid only: count 5-byte cell planes; 0 = absent */
 } zhc_zhp_info;
 
 /* CRC-32, IEEE 802.3 (reflected 0xEDB88320, init and final XOR 0xFFFFFFFF); continue a running
@@ -825,15 +826,15 @@ static inline uint32_t zhc_crc32(uint32_t crc, const void* data, size_t size) {
  * 184). Checks, in zhc's reader order (formats/probes/probe_file.cpp): magic (a short prefix of it:
  * TRUNCATED, else BAD_FORMAT), version 1 or 2 (UNSUPPORTED), 184 bytes present (TRUNCATED), header
  * CRC-32 (CHECKSUM), header size 184, reserved bytes zero (BAD_FORMAT; version 2: byte 21 holds the
- * per-probe sections, bit 0 validity, bit 1 visibility: other bits UNSUPPORTED, none or visibility
- * without a grid BAD_FORMAT), enum ranges of kind, DC format, L2
+ * per-probe sections, bit 0 validity, bit 1 visibility, bit 2 cell planes: other bits UNSUPPORTED,
+ * none, or visibility or planes without a grid BAD_FORMAT), enum ranges of kind, DC format, L2
  * bound, zonal mapping, axis mode, compression, layout (UNSUPPORTED), sqrt 0/1 and bits 2..8
  * (BAD_FORMAT), representation name printable ASCII, zero padded (BAD_FORMAT) and known
  * (UNSUPPORTED), bytes per probe = the encoding's (BAD_FORMAT), luminance weights finite
  * (INVALID_VALUE), half DC only on sh2_q / hall_curve_q (BAD_FORMAT), probe count <= 2^26
  * (TOO_LARGE), grid values finite (INVALID_VALUE), grid counts multiply to the count or grid fields
  * all +0 without a grid (BAD_FORMAT), body bytes = count (12 [positions] + probe size + 1 per
- * per-probe section) (BAD_FORMAT)
+ * validity / visibility section + 5 for planes) (BAD_FORMAT)
  * and <= 2 GiB (TOO_LARGE), stored body = body when uncompressed, <= ZSTD_compressBound when
  * compressed (BAD_FORMAT). Does not look at the body (see zhc_zhp_open).
  * On ZHC_OK fills f (format, a/b the codec's 0.6/0.08) and info (either may be NULL).
@@ -862,8 +863,8 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
     if ((version == 1 && h[21]) || (h[22] | h[23]) || zhc__u32(h + 68) || zhc__u32(h + 156)) return ZHC_ERR_BAD_FORMAT;
     if (version == 2) {
         leak = h[21];
-        if (leak > 3) return ZHC_ERR_UNSUPPORTED;
-        if (leak == 0 || ((leak & 2) && h[20] != 1)) return ZHC_ERR_BAD_FORMAT;
+        if (leak > 7) return ZHC_ERR_UNSUPPORTED;
+        if (leak == 0 || ((leak & 6) && h[20] != 1)) return ZHC_ERR_BAD_FORMAT;
     }
     if (h[12] > 1 || h[14] > 2 || h[15] > 1 || h[17] > 2 || h[18] > 1 || h[19] > 1 || h[20] > 2)
         return ZHC_ERR_UNSUPPORTED;
@@ -922,7 +923,8 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
         if (counts[0] | counts[1] | counts[2]) return ZHC_ERR_BAD_FORMAT;
     }
     pos_bytes = inf.layout == 2 ? count * 12 : 0;
-    raw_expected = pos_bytes + count * inf.probe_size + count * (uint64_t)((leak & 1) + ((leak >> 1) & 1));
+    raw_expected = pos_bytes + count * inf.probe_size +
+                   count * (uint64_t)((leak & 1) + ((leak >> 1) & 1) + 5 * ((leak >> 2) & 1));
     raw = zhc__u64(h + 160);
     if (raw != raw_expected) return ZHC_ERR_BAD_FORMAT;
     if (raw > ((uint64_t)1 << 31)) return ZHC_ERR_TOO_LARGE;
@@ -938,6 +940,8 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
     inf.payload_offset = ZHC_ZHP_HEADER_BYTES + pos_bytes;
     if (leak & 1) inf.validity_offset = inf.payload_offset + count * inf.probe_size;
     if (leak & 2) inf.visibility_offset = inf.payload_offset + count * inf.probe_size + ((leak & 1) ? count : 0);
+    if (leak & 4)
+        inf.planes_offset = inf.payload_offset + count * inf.probe_size + ((leak & 1) ? count : 0) + ((leak & 2) ? count : 0);
     if (f) *f = fmt;
     if (info) *info = inf;
     return ZHC_OK;
@@ -946,7 +950,8 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
 /* A whole .zhp file in memory (`file`, `size` bytes): the header as zhc_zhp_parse_header, then
  * file size = 184 + stored body (TRUNCATED / TRAILING_BYTES), body CRC-32 (CHECKSUM), a compressed
  * body (ZHC_ERR_COMPRESSED: f and info are still filled, the payload offset is meaningless), finite
- * positions and validity bytes 0/1 (INVALID_VALUE). On ZHC_OK probe i's bytes are at file + info->payload_offset +
+ * positions, validity bytes 0/1 and "no plane" (offset -32768) in the plane entry of every grid
+ * probe that is the last along some axis (no cell has it as corner 0) (INVALID_VALUE). On ZHC_OK probe i's bytes are at file + info->payload_offset +
  * i * info->probe_size. Safe for untrusted input; accepts exactly the uncompressed files zhc's
  * reader accepts, with the same error class. */
 static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const void* file, size_t size) {
@@ -969,6 +974,15 @@ static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const vo
     if (inf.validity_offset)
         for (i = 0; i < inf.probe_count; ++i)
             if (p[inf.validity_offset + i] > 1) return ZHC_ERR_INVALID_VALUE;
+    if (inf.planes_offset) {
+        const uint64_t nx = inf.grid_counts[0], ny = inf.grid_counts[1], nz = inf.grid_counts[2];
+        for (i = 0; i < inf.probe_count; ++i) {
+            const uint64_t x = i % nx, y = (i / nx) % ny, z = i / (nx * ny);
+            const uint8_t* e = p + inf.planes_offset + 5 * i;
+            if ((x + 1 == nx || y + 1 == ny || z + 1 == nz) && !(e[2] == 0x00 && e[3] == 0x80))
+                return ZHC_ERR_INVALID_VALUE;
+        }
+    }
     return ZHC_OK;
 }
 
@@ -984,8 +998,9 @@ static inline int zhc_probe_format_from_zhp(zhc_probe_format* f, const void* hea
  * at origin + (x spacing[0], y spacing[1], z spacing[2]), its stored bytes at
  * probes + number * probe_size. The volume REFERS to the caller's bytes (nothing is copied): they
  * must outlive it. Fill it with zhc_volume_from_zhp or zhc_volume_init (which validate), not by hand;
- * after zhc_volume_init a caller may point `validity` / `visibility` at its own per-probe bytes
- * (count bytes each, same probe order; docs/runtime.md "Validity and visibility"). */
+ * after zhc_volume_init a caller may point `validity` / `visibility` / `planes` at its own bytes
+ * (count bytes each, 5 count for planes, same probe order; docs/runtime.md "Validity and
+ * visibility", "Cell planes"). */
 typedef struct zhc_volume {
     zhc_probe_format format;
     const uint8_t* probes;  /* counts[0] counts[1] counts[2] probes of probe_size bytes */
@@ -998,6 +1013,11 @@ typedef struct zhc_volume {
      * probe i is visible from its neighbouring cell on side (cx, cy, cz) (1 = towards +axis). */
     const uint8_t* validity;
     const uint8_t* visibility;
+    /* planes + 5 i: the separating plane of the cell whose corner 0 is probe i (docs/runtime.md
+     * "Cell planes"): ou, ov (octahedral normal, code / 127 - 1, 255 reads as 254), offset (int16
+     * little-endian, units of |spacing| / 65534 from the cell's centre along the normal; -32768 = no
+     * plane), sides (bit k: corner k lies on the positive side). */
+    const uint8_t* planes;
 } zhc_volume;
 
 /* A volume from its parts: format (validated: ZHC_ERR_ARGUMENT), the stored probes (`size` bytes,
@@ -1040,8 +1060,8 @@ static inline int zhc_volume_init(zhc_volume* v, const zhc_probe_format* format,
  * ZHC_ERR_NOT_GRID for a valid file without a grid layout (none, or scattered `points`: see
  * docs/runtime.md for what to do with those), then the grid checks of zhc_volume_init (an empty
  * grid, spacing <= 0 or a far corner that overflows: ZHC_ERR_INVALID_VALUE). On error v is zeroed.
- * A version 2 file's validity and visibility sections fill v->validity / v->visibility (pointing
- * into `file`); without them both are NULL. Safe for untrusted input (any bytes, any size). */
+ * A version 2 file's validity, visibility and plane sections fill v->validity / v->visibility /
+ * v->planes (pointing into `file`); without them they are NULL. Safe for untrusted input (any bytes, any size). */
 static inline int zhc_volume_from_zhp(zhc_volume* v, const void* file, size_t size) {
     zhc_probe_format f;
     zhc_zhp_info info;
@@ -1056,6 +1076,7 @@ static inline int zhc_volume_from_zhp(zhc_volume* v, const void* file, size_t si
     if (r != ZHC_OK) return r;
     if (info.validity_offset) v->validity = (const uint8_t*)file + info.validity_offset;
     if (info.visibility_offset) v->visibility = (const uint8_t*)file + info.visibility_offset;
+    if (info.planes_offset) v->planes = (const uint8_t*)file + info.planes_offset;
     return ZHC_OK;
 }
 
@@ -1074,17 +1095,56 @@ static inline void zhc__volume_axis(double p, double origin, double spacing, uin
     *f = n >= 2 ? t - (double)i : 0.0;
 }
 
+/* The unit normal of a cell plane's octahedral code (ou, ov): a = min(ou, 254) / 127 - 1, b likewise;
+ * z = 1 - |a| - |b|; z < 0 folds (a, b) to ((1 - |b|) s(a), (1 - |a|) s(b)), s(t) = t < 0 ? -1 : 1;
+ * n = normalize(a, b, z). The six axes are exact (codes 0, 127, 254). */
+static inline void zhc_plane_normal(uint8_t ou, uint8_t ov, double n[3]) {
+    double a = (double)(ou < 254 ? ou : 254) / 127.0 - 1.0, b = (double)(ov < 254 ? ov : 254) / 127.0 - 1.0;
+    const double z = 1.0 - fabs(a) - fabs(b);
+    double l;
+    if (z < 0.0) {
+        const double a0 = a;
+        a = (1.0 - fabs(b)) * (a0 < 0.0 ? -1.0 : 1.0);
+        b = (1.0 - fabs(a0)) * (b < 0.0 ? -1.0 : 1.0);
+    }
+    l = sqrt(a * a + b * b + z * z);
+    n[0] = a / l;
+    n[1] = b / l;
+    n[2] = z / l;
+}
+
+/* Which side of the plane of the cell whose corner 0 is probe `cell` (first probe i0) the point
+ * `position` lies on: returns 0 when the cell has no plane, else 1 with *side = (n . (x - c) -
+ * offset |spacing| / 65534 >= 0), c = origin + (i0 + 0.5) spacing (the cell's centre), and *sides the
+ * entry's side bits. */
+static inline int zhc__volume_plane_side(const zhc_volume* v, size_t cell, const uint32_t i0[3], const double position[3],
+                                         int* side, unsigned* sides) {
+    const uint8_t* e = v->planes + 5 * cell;
+    const int offset = (int)(int16_t)(uint16_t)(e[2] | (e[3] << 8));
+    double n[3], s, diag;
+    int c;
+    if (offset == -32768) return 0;
+    zhc_plane_normal(e[0], e[1], n);
+    diag = sqrt(v->spacing[0] * v->spacing[0] + v->spacing[1] * v->spacing[1] + v->spacing[2] * v->spacing[2]);
+    s = -(double)offset * (diag / 65534.0);
+    for (c = 0; c < 3; ++c) s += n[c] * (position[c] - (v->origin[c] + ((double)i0[c] + 0.5) * v->spacing[c]));
+    *side = s >= 0.0;
+    *sides = e[4];
+    return 1;
+}
+
 /* SH3 radiance at `position` (the probe set's frame): the trilinear blend of the decoded SH3 of the
  * 8 probes of the grid cell containing the position (clamped to the grid's box first, so outside
  * the box the value is that of the nearest point of the box), weights
  * w = prod_axes (f or 1 - f), accumulated in double in a fixed order. Probes of weight 0 are not
  * read (a probe that decodes to NaN affects only the cells around it). sh3[i*3+k] as
  * zhc_decode_probe. An invalid volume (zeroed, or not from zhc_volume_init/from_zhp) gives zeros.
- * With v->validity or v->visibility set, corner (dx, dy, dz)'s weight is w times (validity != 0)
- * times bit 7 - (dx + 2 dy + 4 dz) of its visibility mask, and the weights are divided by their
- * sum (summed over corners 0..7 in order); when every weight vanishes the plain trilinear weights
- * are used (the documented fallback). Without either pointer the result is the plain blend, bit
- * for bit. */
+ * With v->validity, v->visibility or v->planes set, corner k = dx + 2 dy + 4 dz is kept when its
+ * weight w is non-zero, its validity byte is non-zero, bit 7 - k of its visibility mask is set, and
+ * (the cell has no plane, or bit k of the plane's `sides` equals the position's side of it,
+ * zhc__volume_plane_side); the kept weights are divided by their sum (summed over corners 0..7 in
+ * order); when none is kept the plain trilinear weights are used (the documented fallback). Without
+ * any of the three pointers the result is the plain blend, bit for bit. */
 static inline void zhc_volume_sh3(const zhc_volume* v, const double position[3], double sh3[27]) {
     uint32_t i0[3];
     double f[3], w[8], sum = 0.0;
@@ -1100,13 +1160,17 @@ static inline void zhc_volume_sh3(const zhc_volume* v, const double position[3],
                         (size_t)v->counts[0] *
                             ((size_t)(i0[1] + (uint32_t)by) + (size_t)v->counts[1] * (size_t)(i0[2] + (uint32_t)bz));
     }
-    if (v->validity || v->visibility) {
+    if (v->validity || v->visibility || v->planes) {
         double m[8];
+        int side = 0, has_plane = 0;
+        unsigned sides = 0;
+        if (v->planes) has_plane = zhc__volume_plane_side(v, index[0], i0, position, &side, &sides);
         for (corner = 0; corner < 8; ++corner) {
             m[corner] = 0.0;
             if (w[corner] == 0.0) continue; /* a corner beyond a count-1 axis is not read */
             if (v->validity && !v->validity[index[corner]]) continue;
             if (v->visibility && !((v->visibility[index[corner]] >> (7 - corner)) & 1u)) continue;
+            if (has_plane && (int)((sides >> corner) & 1u) != side) continue;
             m[corner] = w[corner];
             sum += m[corner];
         }

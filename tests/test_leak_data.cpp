@@ -186,8 +186,10 @@ TEST(LeakData, HostileVersion2FilesGetDistinctErrors) {
     longer.push_back(0);
     EXPECT_EQ(code_of(longer), ErrorCode::kTrailingBytes);
     // Section flags: unknown bits (a newer writer) unsupported; none in version 2, or any in version
-    // 1, malformed; visibility only with a grid layout.
-    EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 21, {4})), ErrorCode::kUnsupported);
+    // 1, malformed; visibility and planes only with a grid layout.
+    EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 21, {8})), ErrorCode::kUnsupported);
+    // Bit 2 (cell planes) is known: declared without its 5 bytes per probe, the body size is wrong.
+    EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 21, {7})), ErrorCode::kBadFormat);
     EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 21, {0x83})), ErrorCode::kUnsupported);
     EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 21, {0})), ErrorCode::kBadFormat);
     EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 8, {1, 0})), ErrorCode::kBadFormat);

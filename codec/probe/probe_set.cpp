@@ -78,6 +78,20 @@ Status validate_leak_data(const ProbeSet& set) {
             return make_error(ErrorCode::kInvalidArgument, "visibility holds " + std::to_string(set.visibility.size()) +
                                                                " bytes, expected 0 or " + std::to_string(set.count));
     }
+    if (!set.planes.empty()) {
+        if (set.layout.kind != ProbeLayoutKind::kGrid)
+            return make_error(ErrorCode::kInvalidArgument, "cell planes need a grid layout");
+        if (set.planes.size() != 5 * set.count)
+            return make_error(ErrorCode::kInvalidArgument, "planes hold " + std::to_string(set.planes.size()) +
+                                                               " bytes, expected 0 or " + std::to_string(5 * set.count));
+        const auto& n = set.layout.grid.counts;
+        for (std::uint64_t i = 0; i < set.count; ++i) {
+            const std::uint64_t x = i % n[0], y = (i / n[0]) % n[1], z = i / (std::uint64_t(n[0]) * n[1]);
+            if ((x + 1 == n[0] || y + 1 == n[1] || z + 1 == n[2]) && !(set.planes[5 * i + 2] == 0x00 && set.planes[5 * i + 3] == 0x80))
+                return make_error(ErrorCode::kInvalidArgument, "plane of probe " + std::to_string(i) +
+                                                                   " is set, but no cell has that probe as its first corner");
+        }
+    }
     return Ok{};
 }
 
@@ -151,6 +165,7 @@ Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view represe
     if (!out) return out;
     out->validity = set.validity;  // per-probe leak data does not depend on the representation
     out->visibility = set.visibility;
+    out->planes = set.planes;
     return out;
 }
 

@@ -68,6 +68,13 @@ struct ProbeSet {
     // reads bit 7 - (dx + 2 dy + 4 dz) of that corner probe.
     std::vector<std::uint8_t> validity;
     std::vector<std::uint8_t> visibility;
+    // planes (grid layouts only): empty or 5 count bytes; entry i (bytes 5i..5i+4) is the separating
+    // plane of the grid cell whose corner 0 is probe i (docs/runtime.md "Cell planes"): ou, ov (the
+    // normal's octahedral code, zhc axes), offset (int16 little-endian from the cell's centre along
+    // the normal in units of |spacing| / 65534; -32768 = no plane), sides (bit k: corner k of the
+    // cell lies on the positive side). Probes that are the last along some axis have no cell: their
+    // entries are "no plane".
+    std::vector<std::uint8_t> planes;
 
     // nullptr when `representation` is not in the table.
     const Codec* codec() const { return find_codec(representation); }
@@ -76,7 +83,8 @@ struct ProbeSet {
 // Checks every invariant above; kInvalidArgument naming the first broken one.
 Status validate_probe_set(const ProbeSet& set);
 // The leak-data part of it: validity and visibility each empty or `count` bytes, validity values
-// 0/1, visibility only with a grid layout.
+// 0/1, visibility only with a grid layout; planes empty or 5 count bytes with a grid layout, "no
+// plane" on the entries of the last probe along each axis.
 Status validate_leak_data(const ProbeSet& set);
 
 // Probe i's stored bytes -> hub, and hub -> stored bytes. With params.kind == kIrradiance the

@@ -57,7 +57,7 @@ enum : std::size_t {
     kOffAxisMode = 18,      // u8
     kOffCompression = 19,   // u8 0 none 1 zstd
     kOffLayoutKind = 20,    // u8
-    kOffLeakFlags = 21,     // u8 version 2: bit 0 validity, bit 1 visibility (version 1: zero)
+    kOffLeakFlags = 21,     // u8 version 2: bit 0 validity, bit 1 visibility, bit 2 planes (version 1: zero)
     kOffReserved0 = 22,     // 2 bytes zero
     kOffName = 24,          // 32 bytes ASCII, zero padded
     kNameBytes = 32,
@@ -84,11 +84,12 @@ std::uint64_t positions_bytes(const ProbeSet& set) {
     return set.layout.kind == ProbeLayoutKind::kPositions ? set.count * 12 : 0;
 }
 
-constexpr std::uint8_t kLeakValidity = 1, kLeakVisibility = 2;
+constexpr std::uint8_t kLeakValidity = 1, kLeakVisibility = 2, kLeakPlanes = 4;
 
 std::uint8_t leak_flags(const ProbeSet& set) {
     return static_cast<std::uint8_t>((set.validity.empty() ? 0 : kLeakValidity) |
-                                     (set.visibility.empty() ? 0 : kLeakVisibility));
+                                     (set.visibility.empty() ? 0 : kLeakVisibility) |
+                                     (set.planes.empty() ? 0 : kLeakPlanes));
 }
 
 }  // namespace
@@ -109,14 +110,15 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
                           "zstd level must be 0 (none) .. " + std::to_string(ZSTD_maxCLevel()));
     const std::uint8_t leak = leak_flags(set);
     std::vector<std::uint8_t> body(positions_bytes(set) + set.payload.size() + set.validity.size() +
-                                   set.visibility.size());
+                                   set.visibility.size() + set.planes.size());
     if (set.layout.kind == ProbeLayoutKind::kPositions)
         for (size_t i = 0; i < set.count; ++i)
             for (size_t c = 0; c < 3; ++c) le::store_f32(body.data() + 12 * i + 4 * c, set.layout.positions[i][c]);
     if (!set.payload.empty()) std::memcpy(body.data() + positions_bytes(set), set.payload.data(), set.payload.size());
-    // Version 2 sections after the payload: validity then visibility, one byte per probe each.
+    // Version 2 sections after the payload: validity, visibility (one byte per probe each), planes
+    // (5 bytes per probe).
     std::size_t at = positions_bytes(set) + set.payload.size();
-    for (const std::vector<std::uint8_t>* v : {&set.validity, &set.visibility}) {
+    for (const std::vector<std::uint8_t>* v : {&set.validity, &set.visibility, &set.planes}) {
         if (!v->empty()) std::memcpy(body.data() + at, v->data(), v->size());
         at += v->size();
     }
@@ -202,12 +204,14 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
         return err(ErrorCode::kBadFormat, name, "reserved header bytes are not zero (bytes 21-23, 68-71, 156-159)");
     const std::uint8_t leak = h[kOffLeakFlags];
     if (version == kProbeFileVersionLeak) {
-        if (leak > (kLeakValidity | kLeakVisibility))
+        if (leak > (kLeakValidity | kLeakVisibility | kLeakPlanes))
             return err(ErrorCode::kUnsupported, name, "unknown per-probe sections " + std::to_string(leak) + " (byte 21)");
         if (leak == 0)
             return err(ErrorCode::kBadFormat, name, "version 2 without per-probe sections (byte 21 is 0; such a file is version 1)");
         if ((leak & kLeakVisibility) && h[kOffLayoutKind] != static_cast<std::uint8_t>(ProbeLayoutKind::kGrid))
             return err(ErrorCode::kBadFormat, name, "visibility masks without a grid layout (bytes 20-21)");
+        if ((leak & kLeakPlanes) && h[kOffLayoutKind] != static_cast<std::uint8_t>(ProbeLayoutKind::kGrid))
+            return err(ErrorCode::kBadFormat, name, "cell planes without a grid layout (bytes 20-21)");
     }
     auto enum_field = [&](std::size_t off, int max, const char* what) -> Status {
         if (h[off] > max)
@@ -291,7 +295,8 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
     }
     // Body sizes: count <= 2^26 and size_bytes < 2^8 keep these products far from overflow.
     const std::uint64_t pos_bytes = layout_kind == ProbeLayoutKind::kPositions ? count * 12 : 0;
-    const std::uint64_t leak_sections = ((leak & kLeakValidity) ? 1u : 0u) + ((leak & kLeakVisibility) ? 1u : 0u);
+    const std::uint64_t leak_sections =
+        ((leak & kLeakValidity) ? 1u : 0u) + ((leak & kLeakVisibility) ? 1u : 0u) + ((leak & kLeakPlanes) ? 5u : 0u);
     const std::uint64_t raw_expected = pos_bytes + count * probe_bytes + count * leak_sections;
     const std::uint64_t raw_bytes = le::load(h + kOffRawBody, 8);
     if (raw_bytes != raw_expected)
@@ -359,9 +364,22 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
                                                                std::to_string(set.validity[i]) + ", expected 0 or 1");
         at += count;
     }
-    if (leak & kLeakVisibility)
+    if (leak & kLeakVisibility) {
         set.visibility.assign(body.begin() + static_cast<std::ptrdiff_t>(at),
                               body.begin() + static_cast<std::ptrdiff_t>(at + count));
+        at += count;
+    }
+    if (leak & kLeakPlanes) {
+        set.planes.assign(body.begin() + static_cast<std::ptrdiff_t>(at),
+                          body.begin() + static_cast<std::ptrdiff_t>(at + 5 * count));
+        const auto& n = set.layout.grid.counts;
+        for (std::uint64_t i = 0; i < count; ++i) {
+            const std::uint64_t x = i % n[0], y = (i / n[0]) % n[1], z = i / (std::uint64_t(n[0]) * n[1]);
+            if ((x + 1 == n[0] || y + 1 == n[1] || z + 1 == n[2]) && !(set.planes[5 * i + 2] == 0x00 && set.planes[5 * i + 3] == 0x80))
+                return err(ErrorCode::kInvalidValue, name, "plane of probe " + std::to_string(i) +
+                                                               " is set, but no cell has that probe as its first corner");
+        }
+    }
     if (info) {
         info->version = version;
         info->compressed = compressed;
