@@ -429,4 +429,31 @@ bool OccluderBvh::inside_any_solid(Vec3 p) const {
     return false;
 }
 
+bool OccluderBvh::overlaps_box(Vec3 lo, Vec3 hi) const {
+    if (nodes_.empty()) return false;
+    const double blo[3] = {lo.x, lo.y, lo.z}, bhi[3] = {hi.x, hi.y, hi.z};
+    auto overlap = [&](const double* a_lo, const double* a_hi) {
+        for (int a = 0; a < 3; ++a)
+            if (a_hi[a] < blo[a] || a_lo[a] > bhi[a]) return false;
+        return true;
+    };
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {
+        const Node& n = nodes_[stack.back()];
+        stack.pop_back();
+        if (!overlap(n.lo, n.hi)) continue;
+        if (n.count > 0) {
+            for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
+                double plo[3], phi[3];
+                bounds_of(prims_[i], plo, phi);
+                if (overlap(plo, phi)) return true;
+            }
+        } else {
+            stack.push_back(n.left);
+            stack.push_back(n.right);
+        }
+    }
+    return false;
+}
+
 }  // namespace zhc

@@ -89,6 +89,10 @@ public:
     RayHit nearest(Vec3 o, Vec3 d, double t_min, double t_max) const;
     // Is p inside (or on) any sphere or box occluder?
     bool inside_any_solid(Vec3 p) const;
+    // Does the bounding box of any occluder overlap the closed box [lo, hi]? Conservative (a true
+    // answer does not mean a surface lies inside the box); the plane fit skips cells it says false
+    // for (codec/bake/leak_planes.h).
+    bool overlaps_box(Vec3 lo, Vec3 hi) const;
     // The primitive a nearest() hit names (leaf order; RayHit::prim).
     const Occluder& primitive(std::uint32_t i) const { return prims_[i]; }
     std::size_t node_count() const { return nodes_.size(); }
