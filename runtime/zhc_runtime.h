@@ -951,7 +951,8 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
  * file size = 184 + stored body (TRUNCATED / TRAILING_BYTES), body CRC-32 (CHECKSUM), a compressed
  * body (ZHC_ERR_COMPRESSED: f and info are still filled, the payload offset is meaningless), finite
  * positions, validity bytes 0/1 and "no plane" (offset -32768) in the plane entry of every grid
- * probe that is the last along some axis (no cell has it as corner 0) (INVALID_VALUE). On ZHC_OK probe i's bytes are at file + info->payload_offset +
+ * probe that is the last along some axis of count >= 2 (no cell has it as corner 0; along an axis of
+ * count 1 the one probe starts the flat cell) (INVALID_VALUE). On ZHC_OK probe i's bytes are at file + info->payload_offset +
  * i * info->probe_size. Safe for untrusted input; accepts exactly the uncompressed files zhc's
  * reader accepts, with the same error class. */
 static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const void* file, size_t size) {
@@ -979,7 +980,7 @@ static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const vo
         for (i = 0; i < inf.probe_count; ++i) {
             const uint64_t x = i % nx, y = (i / nx) % ny, z = i / (nx * ny);
             const uint8_t* e = p + inf.planes_offset + 5 * i;
-            if ((x + 1 == nx || y + 1 == ny || z + 1 == nz) && !(e[2] == 0x00 && e[3] == 0x80))
+            if (((nx > 1 && x + 1 == nx) || (ny > 1 && y + 1 == ny) || (nz > 1 && z + 1 == nz)) && !(e[2] == 0x00 && e[3] == 0x80))
                 return ZHC_ERR_INVALID_VALUE;
         }
     }

@@ -87,7 +87,7 @@ Status validate_leak_data(const ProbeSet& set) {
         const auto& n = set.layout.grid.counts;
         for (std::uint64_t i = 0; i < set.count; ++i) {
             const std::uint64_t x = i % n[0], y = (i / n[0]) % n[1], z = i / (std::uint64_t(n[0]) * n[1]);
-            if ((x + 1 == n[0] || y + 1 == n[1] || z + 1 == n[2]) && !(set.planes[5 * i + 2] == 0x00 && set.planes[5 * i + 3] == 0x80))
+            if (((n[0] > 1 && x + 1 == n[0]) || (n[1] > 1 && y + 1 == n[1]) || (n[2] > 1 && z + 1 == n[2])) && !(set.planes[5 * i + 2] == 0x00 && set.planes[5 * i + 3] == 0x80))
                 return make_error(ErrorCode::kInvalidArgument, "plane of probe " + std::to_string(i) +
                                                                    " is set, but no cell has that probe as its first corner");
         }

@@ -72,8 +72,8 @@ struct ProbeSet {
     // plane of the grid cell whose corner 0 is probe i (docs/runtime.md "Cell planes"): ou, ov (the
     // normal's octahedral code, zhc axes), offset (int16 little-endian from the cell's centre along
     // the normal in units of |spacing| / 65534; -32768 = no plane), sides (bit k: corner k of the
-    // cell lies on the positive side). Probes that are the last along some axis have no cell: their
-    // entries are "no plane".
+    // cell lies on the positive side). Probes that are the last along some axis of count >= 2 start
+    // no cell: their entries are "no plane".
     std::vector<std::uint8_t> planes;
 
     // nullptr when `representation` is not in the table.
