@@ -88,6 +88,8 @@ export interface ZhpFile {
   payload: Uint8Array;
   validity: Uint8Array | null;
   visibility: Uint8Array | null;
+  /** Cell planes (byte 21 bit 2): 5 bytes per probe, the plane of the cell whose corner 0 is the probe. */
+  planes: Uint8Array | null;
 }
 
 /** makeVolume's input: the stored bytes (encoding, params, bytes) or the decoded SH3 (sh), and the grid. */
@@ -102,6 +104,10 @@ export interface ZhcVolumeInput {
   counts: Vec3Like;
   validity?: ArrayLike<number> | null;
   visibility?: ArrayLike<number> | null;
+  /** Cell planes, 5 bytes per probe (ou, ov, offset lo, offset hi, sides), probe order. */
+  planes?: ArrayLike<number> | null;
+  /** 'zhc' (default): the grid is in the axes of the normals' code; 'gltf': the grid in glTF axes, the codes in zhc axes. */
+  planesAxes?: 'zhc' | 'gltf';
 }
 /** A decoded probe grid (frozen): makeVolume / volumeFromZhp. */
 export interface ZhcVolume {
@@ -112,6 +118,8 @@ export interface ZhcVolume {
   readonly sh: ArrayLike<number>;
   readonly validity: ArrayLike<number> | null;
   readonly visibility: ArrayLike<number> | null;
+  readonly planes: ArrayLike<number> | null;
+  readonly planesAxes: 'zhc' | 'gltf';
 }
 
 export declare const PI: number;

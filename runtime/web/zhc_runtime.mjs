@@ -526,8 +526,9 @@ export function crc32(bytes, start = 0, end = bytes.length) {
 }
 
 // Parses a .zhp file (Uint8Array). Returns {encoding, params, count, bytesPerProbe, layout,
-// payload (Uint8Array view), positions (Float32Array or null), grid}. Throws on anything the C++
-// reader rejects that matters here; zstd-compressed bodies are not supported (throws).
+// payload (Uint8Array view), positions (Float32Array or null), grid, validity, visibility, planes
+// (Uint8Array views of the per-probe sections, or null)}. Throws on anything the C++ reader rejects
+// that matters here; zstd-compressed bodies are not supported (throws).
 export function parseZhp(bytes) {
   const magic = [0x89, 0x5a, 0x48, 0x50, 0x0d, 0x0a, 0x1a, 0x0a];
   if (bytes.length < 184 || magic.some((m, i) => bytes[i] !== m)) throw new Error('zhp: not a .zhp file');
@@ -536,10 +537,11 @@ export function parseZhp(bytes) {
   const version = dv.getUint16(8, true);
   if (version !== 1 && version !== 2) throw new Error('zhp: unsupported version');
   if (dv.getUint16(10, true) !== 184) throw new Error('zhp: bad header size');
-  // Version 2: byte 21 lists the per-probe sections after the payload (bit 0 validity, bit 1
-  // visibility); version 1: zero.
+  // Version 2: byte 21 lists the per-probe sections after the payload, in this order (bit 0
+  // validity, bit 1 visibility: 1 byte per probe each; bit 2 cell planes: 5 bytes per probe);
+  // version 1: zero.
   const sections = bytes[21];
-  if (version === 1 ? sections !== 0 : sections === 0 || sections > 3) throw new Error('zhp: bad per-probe sections (byte 21)');
+  if (version === 1 ? sections !== 0 : sections === 0 || sections > 7) throw new Error('zhp: bad per-probe sections (byte 21)');
   const enumOf = (off, names) => {
     const v = bytes[off];
     if (v >= names.length) throw new Error(`zhp: unknown enum value ${v} at byte ${off}`);
@@ -565,7 +567,8 @@ export function parseZhp(bytes) {
   const body = Number(dv.getBigUint64(160, true));
   const posBytes = layout === 'positions' ? count * 12 : 0;
   if ((sections & 2) && layout !== 'grid') throw new Error('zhp: visibility masks without a grid layout');
-  const sectionBytes = count * ((sections & 1) + ((sections >> 1) & 1));
+  if ((sections & 4) && layout !== 'grid') throw new Error('zhp: cell planes without a grid layout');
+  const sectionBytes = count * ((sections & 1) + ((sections >> 1) & 1) + 5 * ((sections >> 2) & 1));
   if (body !== posBytes + count * bpp + sectionBytes || 184 + body > bytes.length) throw new Error('zhp: body size mismatch');
   if (crc32(bytes, 184, 184 + body) !== dv.getUint32(176, true)) throw new Error('zhp: body CRC mismatch');
   const grid = layout === 'grid' ? {
@@ -573,6 +576,7 @@ export function parseZhp(bytes) {
     spacing: [0, 1, 2].map((j) => dv.getFloat64(120 + 8 * j, true)),
     counts: [0, 1, 2].map((j) => dv.getUint32(144 + 4 * j, true)),
   } : null;
+  if (grid && grid.counts[0] * grid.counts[1] * grid.counts[2] !== count) throw new Error('zhp: the grid counts do not multiply to the probe count');
   let positions = null;
   if (layout === 'positions') {
     positions = new Float32Array(count * 3);
@@ -580,10 +584,24 @@ export function parseZhp(bytes) {
   }
   const payloadEnd = 184 + posBytes + count * bpp;
   const payload = bytes.subarray(184 + posBytes, payloadEnd);
-  const validity = (sections & 1) ? bytes.subarray(payloadEnd, payloadEnd + count) : null;
-  const visibility = (sections & 2) ? bytes.subarray(184 + body - count, 184 + body) : null;
+  const validityAt = payloadEnd, visibilityAt = validityAt + (sections & 1) * count;
+  const planesAt = visibilityAt + ((sections >> 1) & 1) * count;
+  const validity = (sections & 1) ? bytes.subarray(validityAt, validityAt + count) : null;
+  const visibility = (sections & 2) ? bytes.subarray(visibilityAt, visibilityAt + count) : null;
+  const planes = (sections & 4) ? bytes.subarray(planesAt, planesAt + 5 * count) : null;
   if (validity && validity.some((v) => v > 1)) throw new Error('zhp: validity byte other than 0 or 1');
-  return { encoding: name, params, count, bytesPerProbe: bpp, layout, grid, positions, payload, validity, visibility };
+  if (planes) {
+    // The last probe along an axis of count >= 2 starts no cell: its entry must be "no plane"
+    // (zhc_zhp_open; along an axis of count 1 the one probe starts the flat cell).
+    const [nx, ny, nz] = grid.counts;
+    for (let i = 0; i < count; i++) {
+      const x = i % nx, y = Math.floor(i / nx) % ny, z = Math.floor(i / (nx * ny));
+      if (((nx > 1 && x + 1 === nx) || (ny > 1 && y + 1 === ny) || (nz > 1 && z + 1 === nz)) &&
+          !(planes[5 * i + 2] === 0x00 && planes[5 * i + 3] === 0x80))
+        throw new Error(`zhp: probe ${i} is the last along an axis (it starts no cell) but its cell plane entry is not "no plane"`);
+    }
+  }
+  return { encoding: name, params, count, bytesPerProbe: bpp, layout, grid, positions, payload, validity, visibility, planes };
 }
 
 // Decodes every probe of a payload: Float32Array(count * 27), probe p at p * 27.
@@ -606,10 +624,16 @@ export function decodeAll(encoding, payload, count, params = DEFAULT_PARAMS) {
 // probe, at least), origin, spacing, counts } (the grid as in .zhp / glTF: probe (x, y, z) is number
 // x + nx (y + ny z) at origin + (x sx, y sy, z sz)), or { sh (Float32Array(count x 27), decoded
 // radiance), origin, spacing, counts }; optional validity / visibility (Uint8Array, one byte per
-// probe, docs/runtime.md "Validity and visibility"; null = absent). Throws Error naming the
+// probe, docs/runtime.md "Validity and visibility"; null = absent) and planes (Uint8Array, 5 bytes
+// per probe: the separating plane of the cell whose corner 0 is the probe, docs/runtime.md "Cell
+// planes"; null = absent). planesAxes: 'zhc' (default) when the grid's frame is the one the plane
+// normals' code is in (a .zhp), 'gltf' when the grid is in glTF axes and the codes in zhc axes
+// (ZHC_light_probes volumes: the decoded n is used as (n.y, n.z, n.x)). Throws Error naming the
 // problem: counts integers >= 1, origin and spacing finite, spacing > 0, far corner finite
-// (zhc_volume_init's rules), validity / visibility shorter than the probe count.
-export function makeVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, origin, spacing, counts, validity = null, visibility = null }) {
+// (zhc_volume_init's rules), validity / visibility shorter than the probe count, planes shorter
+// than 5 x the probe count, planesAxes not 'zhc' or 'gltf'.
+export function makeVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, origin, spacing, counts, validity = null, visibility = null,
+                             planes = null, planesAxes = 'zhc' }) {
   const arr3 = (a, what) => {
     if (!a || a.length !== 3) throw new Error(`zhc volume: ${what} must have 3 entries`);
     return [Number(a[0]), Number(a[1]), Number(a[2])];
@@ -634,7 +658,9 @@ export function makeVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, origi
   }
   for (const [what, a] of [['validity', validity], ['visibility', visibility]])
     if (a && a.length < count) throw new Error(`zhc volume: ${what} has ${a.length} bytes for ${count} probes`);
-  return Object.freeze({ origin: o, spacing: s, counts: n, count, sh: decoded, validity, visibility });
+  if (planes && planes.length < 5 * count) throw new Error(`zhc volume: planes has ${planes.length} bytes for ${count} probes (5 per probe)`);
+  if (planesAxes !== 'zhc' && planesAxes !== 'gltf') throw new Error(`zhc volume: planesAxes must be 'zhc' or 'gltf', got ${planesAxes}`);
+  return Object.freeze({ origin: o, spacing: s, counts: n, count, sh: decoded, validity, visibility, planes, planesAxes });
 }
 
 // A volume from a whole .zhp file (Uint8Array): parseZhp's checks, then a grid layout (throws
@@ -643,7 +669,7 @@ export function volumeFromZhp(bytes) {
   const z = parseZhp(bytes);
   if (z.layout !== 'grid') throw new Error(`zhc volume: the .zhp layout is ${z.layout}, not a grid`);
   return makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid,
-                      validity: z.validity, visibility: z.visibility });
+                      validity: z.validity, visibility: z.visibility, planes: z.planes });
 }
 
 // Grid coordinate along one axis: [first probe of the cell, weight of the next] (zhc__volume_axis).
@@ -657,10 +683,52 @@ function volumeAxis(p, origin, spacing, n) {
   return [i, n >= 2 ? t - i : 0.0];
 }
 
+// The unit normal of a cell plane's octahedral code (ou, ov), in zhc axes (zhc_plane_normal):
+// a = min(ou, 254) / 127 - 1, b likewise, z = 1 - |a| - |b|; z < 0 folds (a, b) to
+// ((1 - |b|) s(a), (1 - |a|) s(b)), s(t) = t < 0 ? -1 : 1; n = normalize(a, b, z). The same doubles.
+function planeNormal(ou, ov) {
+  let a = (ou < 254 ? ou : 254) / 127.0 - 1.0, b = (ov < 254 ? ov : 254) / 127.0 - 1.0;
+  const z = 1.0 - Math.abs(a) - Math.abs(b);
+  if (z < 0.0) {
+    const a0 = a;
+    a = (1.0 - Math.abs(b)) * (a0 < 0.0 ? -1.0 : 1.0);
+    b = (1.0 - Math.abs(a0)) * (b < 0.0 ? -1.0 : 1.0);
+  }
+  const l = Math.sqrt(a * a + b * b + z * z);
+  return [a / l, b / l, z / l];
+}
+
+// zhc axis c of a glTF-axes grid: glTF (x, y, z) = zhc (y, z, x), so zhc x, y, z are glTF z, x, y.
+const GLTF_AXIS_OF_ZHC = [2, 0, 1];
+
+// The side of the plane of the cell whose corner 0 is probe `cell` (first probe i0) that `position`
+// lies on: null when the cell has no plane, else n . (x - c) - offset |spacing| / 65534 >= 0,
+// c = origin + (i0 + 0.5) spacing (zhc__volume_plane_side: the same doubles in the same order).
+// planesAxes 'gltf': n is in zhc axes and the grid in glTF axes; the sums run over zhc's axes
+// (glTF components z, x, y), so the side is the one the C header computes on the .zhp.
+function planeSide(vol, cell, i0, position) {
+  const e = vol.planes, at = 5 * cell;
+  const raw = e[at + 2] | (e[at + 3] << 8);
+  const offset = raw >= 0x8000 ? raw - 0x10000 : raw;
+  if (offset === -32768) return null;
+  const n = planeNormal(e[at], e[at + 1]);
+  const ax = vol.planesAxes === 'gltf' ? GLTF_AXIS_OF_ZHC : [0, 1, 2];
+  const sp = vol.spacing, o = vol.origin;
+  const diag = Math.sqrt(sp[ax[0]] * sp[ax[0]] + sp[ax[1]] * sp[ax[1]] + sp[ax[2]] * sp[ax[2]]);
+  let s = -offset * (diag / 65534.0);
+  for (let c = 0; c < 3; c++) {
+    const g = ax[c];
+    s += n[c] * (position[g] - (o[g] + (i0[g] + 0.5) * sp[g]));
+  }
+  return s >= 0.0 ? 1 : 0;
+}
+
 // Blended SH3 radiance at `position` (the volume's frame): Float64Array(27), index i*3+k
-// (zhc_volume_sh3). Probes of weight 0 are skipped. With validity / visibility: corner (dx, dy, dz)
-// weighs w x valid x bit 7 - (dx + 2 dy + 4 dz) of its mask, weights divided by their sum (corner
-// order), all eight vanishing: the plain trilinear weights (zhc_volume_sh3, the same doubles).
+// (zhc_volume_sh3). Probes of weight 0 are skipped. With validity / visibility / planes: corner
+// k = dx + 2 dy + 4 dz keeps its weight w when w > 0, the probe is valid, bit 7 - k of its mask is
+// set, and (the cell has no plane, or bit k of the plane's sides equals the position's side of
+// it); kept weights divided by their sum (corner order), none kept: the plain trilinear weights
+// (zhc_volume_sh3, the same doubles).
 export function volumeSH3(vol, position) {
   const out = new Float64Array(27);
   const [ix, fx] = volumeAxis(position[0], vol.origin[0], vol.spacing[0], vol.counts[0]);
@@ -673,13 +741,16 @@ export function volumeSH3(vol, position) {
     w[corner] = (bx ? fx : 1.0 - fx) * (by ? fy : 1.0 - fy) * (bz ? fz : 1.0 - fz);
     index[corner] = (ix + bx) + nx * ((iy + by) + ny * (iz + bz));
   }
-  if (vol.validity || vol.visibility) {
+  if (vol.validity || vol.visibility || vol.planes) {
     const m = new Float64Array(8);
     let sum = 0.0;
+    const side = vol.planes ? planeSide(vol, index[0], [ix, iy, iz], position) : null;
+    const sides = side === null ? 0 : vol.planes[5 * index[0] + 4];
     for (let corner = 0; corner < 8; corner++) {
       if (w[corner] === 0.0) continue;
       if (vol.validity && !vol.validity[index[corner]]) continue;
       if (vol.visibility && !((vol.visibility[index[corner]] >> (7 - corner)) & 1)) continue;
+      if (side !== null && ((sides >> corner) & 1) !== side) continue;
       m[corner] = w[corner];
       sum += m[corner];
     }

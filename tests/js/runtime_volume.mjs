@@ -12,12 +12,22 @@
 //     against the C sampler on probes_zh3_q16.zhp at the same points in zhc axes: within 1e-6 of the
 //     mean irradiance (the plugin blends in glTF probe order: a different order of the same sums);
 //  3b. the same with validity and visibility sections (version 2 files), fallback included;
-//  4. volumeFromZhp refuses a points file and a spacing <= 0 grid; irradianceAt refuses non-grids.
+//  3c. cell planes (byte 21 bit 2): random planes (random codes, offsets, geometric or random sides,
+//      "no plane" cells) alone and with validity and visibility, bit for bit against the C header;
+//      all "no plane": the masks-only result bit for bit; a hand-made 3x2x2 grid of constant probes
+//      with two axis planes: each side shows its own probe's value, a plane whose corners all lie
+//      on the other side falls back to the plain blend; constant probes stay constant under any
+//      planes; the same volumes in glTF axes (planesAxes 'gltf': the grid, probe order and sides
+//      bits permuted, the normal code kept) against the C header on the .zhp;
+//  4. volumeFromZhp refuses a points file and a spacing <= 0 grid; irradianceAt refuses non-grids;
+//     parseZhp refuses a plane on a probe that starts no cell and planes without a grid, makeVolume
+//     short planes and a bad planesAxes.
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { register } from 'node:module';
-import { makeRand, checker, zhpWithSections, triangleScene } from './fixtures.mjs';
+import { makeRand, checker, triangleScene } from './fixtures.mjs';
+import { zhpWithPlanes, encodeNormal, planeEntry, planesSection, randomPlanes, gltfProbeOrder, gltfBits, gltfPlanes, NO_PLANE } from './planes_fixtures.mjs';
 
 register('./three_resolver.mjs', import.meta.url);
 const runtime = await import('../../runtime/web/zhc_runtime.mjs');
@@ -133,7 +143,8 @@ async function loadThree(file) {
 // The demo's files rewritten as version 2 with random validity (1 in 4 invalid) and visibility masks
 // (each bit set with p = 1/2), plus an all-invalid one (the fallback): JS and the C sampler
 // (zhc_volume_from_zhp fills zhc_volume::validity / ::visibility) give the same float32 values.
-const withSections = (bytes, validity, visibility) => zhpWithSections(bytes, validity, visibility, runtime.crc32);
+// (zhpWithPlanes: the demo's files may carry a planes section, which these replace too.)
+const withSections = (bytes, validity, visibility) => zhpWithPlanes(bytes, { validity, visibility }, runtime.crc32);
 {
   const rand = makeRand(27);
   let masked = 0, differ = 0;
@@ -146,8 +157,8 @@ const withSections = (bytes, validity, visibility) => zhpWithSections(bytes, val
     const file = W(`leak_${mode}_${name}`);
     fs.writeFileSync(file, withSections(v1, validity, visibility));
     const vol = runtime.volumeFromZhp(new Uint8Array(fs.readFileSync(file)));
-    // The demo's files carry the bake's own masks: the plain blend is the volume without them.
-    const plain = Object.freeze({ ...runtime.volumeFromZhp(v1), validity: null, visibility: null });
+    // The demo's files carry the bake's own sections: the plain blend is the volume without them.
+    const plain = Object.freeze({ ...runtime.volumeFromZhp(v1), validity: null, visibility: null, planes: null });
     check((vol.validity !== null) === Boolean(validity) && (vol.visibility !== null) === Boolean(visibility), `${file}: sections read`);
     const pts = randomPoints(vol, 5000, 300 + mode);
     const want = sampleC(file, pts);
@@ -194,6 +205,149 @@ const withSections = (bytes, validity, visibility) => zhpWithSections(bytes, val
   check(mean > 0 && worst <= 1e-6, 'masked plugin irradianceAt agrees with the C header within 1e-6 of the mean');
 }
 
+// --- 3c: cell planes ---------------------------------------------------------------------------------
+{
+  const rand = makeRand(38);
+  const same = (a, b) => a.every((x, k) => Object.is(x, b[k]));
+  let planeSamples = 0;
+  for (const [name, withValidity, withVisibility] of [['probes_sh3.zhp', false, false], ['probes_zh3_q16.zhp', false, false],
+    ['probes_zh3_q16.zhp', true, false], ['probes_sh3.zhp', true, true]]) {
+    const v1 = new Uint8Array(fs.readFileSync(W('demo/' + name)));
+    const z1 = runtime.parseZhp(v1);
+    const count = z1.count;
+    const validity = withValidity ? Uint8Array.from({ length: count }, () => (rand() < 0.2 ? 0 : 1)) : null;
+    const visibility = withVisibility ? Uint8Array.from({ length: count }, () => Math.floor(rand() * 256)) : null;
+    const planes = randomPlanes(z1.grid, rand);
+    const file = W(`planes_${validity ? 'v' : ''}${visibility ? 'm' : ''}_${name}`);
+    fs.writeFileSync(file, zhpWithPlanes(v1, { validity, visibility, planes }, runtime.crc32));
+    const z = runtime.parseZhp(new Uint8Array(fs.readFileSync(file)));
+    check(z.planes && z.planes.length === 5 * count && z.planes.every((x, i) => x === planes[i]), `${file}: parseZhp returns the planes section`);
+    const vol = runtime.volumeFromZhp(new Uint8Array(fs.readFileSync(file)));
+    // The same volume without planes (masks only, or plain), and with every entry "no plane".
+    const masksOnly = runtime.makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, validity, visibility });
+    const noPlanes = runtime.makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, validity, visibility,
+      planes: planesSection(z.grid, () => null) });
+    const pts = randomPoints(vol, 5000, 400 + planeSamples);
+    const want = sampleC(file, pts);
+    let identical = 0, differ = 0, noneSame = 0;
+    pts.forEach(({ p, n }, i) => {
+      const got = runtime.volumeIrradiance(vol, p, n);
+      if (want[i] && same(got, want[i])) identical++;
+      const base = runtime.volumeIrradiance(masksOnly, p, n);
+      if (!same(got, base)) differ++;
+      if (same(runtime.volumeIrradiance(noPlanes, p, n), base)) noneSame++;
+    });
+    console.log(`volume with planes${validity ? ' + validity' : ''}${visibility ? ' + visibility' : ''} (${name}): ` +
+      `${identical}/${pts.length} bit-identical to the C header, ${differ} differ from the volume without planes`);
+    check(identical === pts.length, `${name} planes${validity ? ' validity' : ''}${visibility ? ' visibility' : ''}: volumeIrradiance equals the C header bit for bit`);
+    check(differ > pts.length / 4, `${name} planes: the planes change the result (${differ} of ${pts.length})`);
+    check(noneSame === pts.length, `${name}: every entry "no plane" gives the result without planes bit for bit`);
+    planeSamples += identical;
+
+    // glTF axes: grid and probe order permuted, sides and mask bits permuted, the normal codes kept;
+    // SH in zhc axes (what zhc writes, shAxes "zhc"), so the normal passed is in zhc axes.
+    const order = gltfProbeOrder(z.grid.counts);
+    const sh = runtime.decodeAll(z.encoding, z.payload, count, z.params);
+    const shG = new Float32Array(count * 27);
+    order.forEach((q, g) => shG.set(sh.subarray(q * 27, q * 27 + 27), g * 27));
+    const perm = (a) => [a[1], a[2], a[0]];
+    const gridG = { origin: perm(z.grid.origin), spacing: perm(z.grid.spacing), counts: perm(z.grid.counts) };
+    const gltfVol = (planesAxes) => runtime.makeVolume({ sh: shG, ...gridG,
+      validity: validity && Uint8Array.from(order, (q) => validity[q]),
+      visibility: visibility && Uint8Array.from(order, (q) => gltfBits(visibility[q])),
+      planes: gltfPlanes(z.grid.counts, planes), planesAxes });
+    const gvol = gltfVol('gltf'), wrong = gltfVol('zhc');
+    let mean = 0, worst = 0, wrongFar = 0;
+    for (const e of want) mean += (Math.abs(e[0]) + Math.abs(e[1]) + Math.abs(e[2])) / 3;
+    mean /= want.length;
+    pts.forEach(({ p, n }, i) => {
+      const got = runtime.volumeIrradiance(gvol, runtime.zhcToGltfDir(p), n);
+      const bad = runtime.volumeIrradiance(wrong, runtime.zhcToGltfDir(p), n);
+      let far = false;
+      for (let k = 0; k < 3; k++) {
+        worst = Math.max(worst, Math.abs(got[k] - want[i][k]) / mean);
+        if (Math.abs(bad[k] - want[i][k]) > 1e-6 * mean) far = true;
+      }
+      if (far) wrongFar++;
+    });
+    console.log(`  the same in glTF axes (planesAxes 'gltf'): max error / mean ${worst.toExponential(2)} against the C header; ` +
+      `the normal code read in the grid's axes ('zhc') is off at ${wrongFar} of ${pts.length}`);
+    check(mean > 0 && worst <= 1e-6, `${name} planes in glTF axes: volumeIrradiance agrees with the C header within 1e-6 of the mean`);
+    check(wrongFar > pts.length / 20, `${name} planes in glTF axes: planesAxes 'zhc' (no swizzle) would be wrong (${wrongFar})`);
+  }
+  console.log(`volumes with planes: ${planeSamples} samples bit-identical between JS and C`);
+
+  // Hand-made: a 3x2x2 grid (spacing 2, 1, 1.5), probe columns x = 0, 1, 2 of constant radiance
+  // A, B, C. Cell (0, 0, 0): the plane x = 0.6 (normal +x: corners dx = 1 positive); cell (1, 0, 0):
+  // the plane x = 3 with normal -x (corners dx = 0 positive). Left of 0.6: A alone; 0.6..3: B alone;
+  // right of 3: C alone. Cell (0, 0, 0) with sides 0xFF in a second file: a point on the negative
+  // side keeps no corner and takes the plain blend.
+  const grid = { origin: [0, 0, 0], spacing: [2, 1, 1.5], counts: [3, 2, 2] };
+  const colour = [[1.0, 0.5, 0.25], [0.125, 0.25, 2.0], [3.0, 0.75, 0.5]];
+  const probes = [];
+  for (let i = 0; i < 12; i++) {
+    const dc = colour[i % 3];
+    probes.push({ sh3: Array.from({ length: 9 }, (_, j) => (j === 0 ? dc.map((c) => c * 2 * Math.sqrt(Math.PI)) : [0, 0, 0])) });
+  }
+  fs.writeFileSync(W('hand.json'), JSON.stringify({ format: 'zhc-probes', version: 1, layout: { type: 'grid', ...grid }, probes }));
+  run('convert', W('hand.json'), '-o', W('hand_v1.zhp'), '--to', 'sh3');
+  const handV1 = new Uint8Array(fs.readFileSync(W('hand_v1.zhp')));
+  const plusX = encodeNormal([1, 0, 0]), minusX = encodeNormal([-1, 0, 0]);
+  check(plusX[0] === 254 && plusX[1] === 127 && minusX[0] === 0 && minusX[1] === 127, 'the +x and -x codes are (254, 127) and (0, 127)');
+  const handPlanes = (sides0) => planesSection(grid, (i0) => {
+    if (i0[1] !== 0 || i0[2] !== 0) return null;
+    return i0[0] === 0 ? planeEntry(grid, i0, plusX, [0.6, 0, 0], sides0) : planeEntry(grid, i0, minusX, [3, 0, 0]);
+  });
+  const planesA = handPlanes(null);
+  check(planesA[4] === 0xAA && planesA[5 + 4] === 0x55, `hand-made sides: 0xAA (dx = 1 positive) and 0x55 (${planesA[4]}, ${planesA[9]})`);
+  fs.writeFileSync(W('hand.zhp'), zhpWithPlanes(handV1, { planes: planesA }, runtime.crc32));
+  fs.writeFileSync(W('hand_ff.zhp'), zhpWithPlanes(handV1, { planes: handPlanes(0xFF) }, runtime.crc32));
+  const hand = runtime.volumeFromZhp(new Uint8Array(fs.readFileSync(W('hand.zhp'))));
+  const handFF = runtime.volumeFromZhp(new Uint8Array(fs.readFileSync(W('hand_ff.zhp'))));
+  const handPlain = runtime.volumeFromZhp(handV1);
+  const hr = makeRand(5);
+  const handPts = [];
+  for (let i = 0; i < 400; i++) {
+    // x avoids the planes by 1e-3; y, z inside the box (cells i0_y = i0_z = 0: the planes' cells).
+    let x;
+    do x = f32(4 * hr()); while (Math.abs(x - 0.6) < 1e-3 || Math.abs(x - 3) < 1e-3);
+    const zz = 2 * hr() - 1, phi = 2 * Math.PI * hr(), r = Math.sqrt(1 - zz * zz);
+    handPts.push({ p: [x, f32(hr()), f32(1.5 * hr())], n: [f32(r * Math.cos(phi)), f32(r * Math.sin(phi)), f32(zz)] });
+  }
+  const wantHand = sampleC(W('hand.zhp'), handPts), wantFF = sampleC(W('hand_ff.zhp'), handPts);
+  let handSame = 0, sideOk = 0, ffSame = 0, ffPlain = 0, ffNeg = 0;
+  handPts.forEach(({ p, n }, i) => {
+    const got = runtime.volumeIrradiance(hand, p, n);
+    if (same(got, wantHand[i])) handSame++;
+    const column = p[0] < 0.6 ? 0 : p[0] < 3 ? 1 : 2;
+    const own = runtime.irradiance(handPlain.sh.subarray(column * 27, column * 27 + 27), runtime.normalizeOr(n));
+    if (got.every((g, k) => Math.abs(g - own[k]) <= 1e-6 * Math.abs(own[k]))) sideOk++;
+    const gotFF = runtime.volumeIrradiance(handFF, p, n);
+    if (same(gotFF, wantFF[i])) ffSame++;
+    if (p[0] < 0.6) {
+      ffNeg++;
+      if (same(gotFF, runtime.volumeIrradiance(handPlain, p, n))) ffPlain++;
+    }
+  });
+  console.log(`hand-made planes: ${handSame}/${handPts.length} bit-identical to the C header, ${sideOk} show their side's probe alone; ` +
+    `sides 0xFF: ${ffSame} bit-identical, ${ffPlain}/${ffNeg} on the negative side equal the plain blend`);
+  check(handSame === handPts.length && ffSame === handPts.length, 'hand-made planes: bit-identical to the C header');
+  check(sideOk === handPts.length, 'hand-made planes: every point shows the probe column on its side of the plane (within 1e-6)');
+  check(ffNeg >= 50 && ffPlain === ffNeg, 'a plane with every corner on the positive side: points on the negative side take the plain blend');
+  // Constant probes stay constant under any planes (the kept weights are renormalised).
+  const one = new Float32Array(27 * 12);
+  for (let p = 0; p < 12; p++) one.set([0.7, 0.4, 0.2, 0.1, -0.05, 0.02, 0.3, 0.1, 0, 0.01, 0.02, 0.03].concat(Array(15).fill(0.01)), 27 * p);
+  const constVol = runtime.makeVolume({ sh: one, ...grid, planes: randomPlanes(grid, makeRand(9), { pNone: 0, pRandomSides: 0.5 }) });
+  let constWorst = 0;
+  const ref = (n) => runtime.irradiance(one.subarray(0, 27), runtime.normalizeOr(n));
+  handPts.forEach(({ p, n }) => {
+    const got = runtime.volumeIrradiance(constVol, p, n), e = ref(n);
+    for (let k = 0; k < 3; k++) constWorst = Math.max(constWorst, Math.abs(got[k] - e[k]) / (Math.abs(e[k]) + 1e-3));
+  });
+  console.log(`constant probes under random planes: max relative difference ${constWorst.toExponential(2)}`);
+  check(constWorst <= 1e-6, 'constant probes stay constant under random planes (1e-6)');
+}
+
 // --- 4: refusals ----------------------------------------------------------------------------------------
 fs.writeFileSync(W('points.json'), JSON.stringify({ format: 'zhc-probes', version: 1, layout: { type: 'positions' },
   probes: [{ position: [0, 0, 0], sh3: Array.from({ length: 9 }, () => [1, 1, 1]) }] }));
@@ -214,5 +368,25 @@ check(throwsWith(() => runtime.makeVolume({ sh: new Float32Array(27), origin: [0
   'makeVolume refuses a zero count');
 check(throwsWith(() => runtime.makeVolume({ sh: new Float32Array(27), origin: [0, 0, 0], spacing: [1, 1, 1], counts: [2, 1, 1] }), /SH3 floats/),
   'makeVolume refuses too few probes');
+{
+  const sh = new Float32Array(54), grid = { origin: [0, 0, 0], spacing: [1, 1, 1], counts: [2, 1, 1] };
+  check(throwsWith(() => runtime.makeVolume({ sh, ...grid, planes: new Uint8Array(9) }), /planes has 9 bytes for 2 probes/),
+    'makeVolume refuses planes shorter than 5 bytes per probe');
+  check(throwsWith(() => runtime.makeVolume({ sh, ...grid, planes: new Uint8Array(10), planesAxes: 'yzx' }), /planesAxes must be 'zhc' or 'gltf'/),
+    'makeVolume refuses a planesAxes other than zhc / gltf');
+  // A plane on the last probe along x (it starts no cell), and planes on a points file.
+  const v1 = new Uint8Array(fs.readFileSync(W('demo/probes_zh3_q16.zhp')));
+  const z = runtime.parseZhp(v1);
+  const planes = planesSection(z.grid, () => null);
+  const last = z.grid.counts[0] - 1;  // probe (nx - 1, 0, 0)
+  planes.set([127, 127, 0, 0, 0x0F], 5 * last);
+  check(throwsWith(() => runtime.parseZhp(zhpWithPlanes(v1, { planes }, runtime.crc32)), new RegExp(`probe ${last} is the last along an axis`)),
+    'parseZhp refuses a plane on a probe that starts no cell');
+  planes.set(NO_PLANE, 5 * last);
+  check(runtime.parseZhp(zhpWithPlanes(v1, { planes }, runtime.crc32)).planes !== null, 'the same file with "no plane" there is read');
+  const pts = new Uint8Array(fs.readFileSync(W('points.zhp')));
+  check(throwsWith(() => runtime.parseZhp(zhpWithPlanes(pts, { planes: new Uint8Array(5).fill(0) }, runtime.crc32)), /cell planes without a grid layout/),
+    'parseZhp refuses planes without a grid layout');
+}
 console.log(`volumes: ${cases.length} files, ${identical}/${total} samples bit-identical between JS and C`);
 finish('runtime/web volume');

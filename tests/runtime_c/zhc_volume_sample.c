@@ -2,8 +2,8 @@
  * runtime/zhc_runtime.h alone (zhc_volume_from_zhp) and prints, for every line
  * "px py pz nx ny nz" of POINTS.txt (floats), the irradiance zhc_volume_irradiance gives at that
  * position and normal: "%.9g %.9g %.9g" (enough digits to read back the same float). --plain drops
- * the file's validity and visibility masks (plain trilinear blending: what a sampler that cannot
- * read them, such as three.js's LightProbeGrid texture, computes).
+ * the file's validity and visibility masks and cell planes (plain trilinear blending: what a sampler
+ * that cannot read them, such as three.js's LightProbeGrid texture, computes).
  * Exit codes: 0 ok, 1 usage/IO, 2 + zhc_error when the file is not a volume. Built as strict C99
  * (tests/runtime_c); tests/test_runtime_c_volume.cpp runs it. */
 #include <stdio.h>
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
         free(data);
         return 2 + r;
     }
-    if (argc == 4) volume.validity = volume.visibility = NULL;
+    if (argc == 4) volume.validity = volume.visibility = volume.planes = NULL;
     points = fopen(argv[2], "r");
     if (!points) {
         fprintf(stderr, "%s: cannot open\n", argv[2]);
