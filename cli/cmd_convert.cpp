@@ -162,9 +162,10 @@ int run(const Options& o) {
             auto set = encode_probe_set(in->list.probes, rep, *params, in->list.layout, &stats);
             if (!set) return report(set.error());
             out = std::move(set).value();
-            if (in->set) {  // validity and visibility masks do not depend on the representation
+            if (in->set) {  // validity, visibility masks and cell planes do not depend on the representation
                 out.validity = in->set->validity;
                 out.visibility = in->set->visibility;
+                out.planes = in->set->planes;
             }
         }
         ProbeFileWriteOptions wo;

@@ -398,7 +398,8 @@ bool is_float_vec3_encoding(const std::string& name) {
     return c && c->traits.float_bands > 0;
 }
 
-// Re-encodes every probe after rotating it by r (decode -> rotate -> encode).
+// Re-encodes every probe after rotating it by r (decode -> rotate -> encode); validity, visibility
+// and cell planes are kept.
 Result<ProbeSet> rotate_set(const ProbeSet& set, const Mat3& r) {
     auto hub = decode_probe_set(set);
     if (!hub) return hub.error();
@@ -407,6 +408,7 @@ Result<ProbeSet> rotate_set(const ProbeSet& set, const Mat3& r) {
     if (!out) return out;
     out->validity = set.validity;  // per-probe data, independent of the SH axes
     out->visibility = set.visibility;
+    out->planes = set.planes;
     return out;
 }
 

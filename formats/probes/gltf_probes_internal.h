@@ -101,12 +101,12 @@ Vec3 from_gltf(Vec3 v);
 // Whether the encoding's coefficients are stored as a VEC3 float accessor (else UNSIGNED_BYTE SCALAR).
 bool is_float_vec3_encoding(const std::string& name);
 
-// Re-encodes every probe after rotating it by r (decode -> rotate -> encode); validity and
-// visibility are kept.
+// Re-encodes every probe after rotating it by r (decode -> rotate -> encode); validity,
+// visibility and cell planes are kept.
 Result<ProbeSet> rotate_set(const ProbeSet& set, const Mat3& r);
 
-// A visibility mask (bit cx + 2 cy + 4 cz, c per grid axis) from zhc's grid axes to the glTF
-// grid's (glTF axis 0, 1, 2 = zhc axis 1, 2, 0) and back.
+// A visibility mask or a cell plane's sides byte (bit cx + 2 cy + 4 cz, c per grid axis) from
+// zhc's grid axes to the glTF grid's (glTF axis 0, 1, 2 = zhc axis 1, 2, 0) and back.
 std::uint8_t visibility_to_gltf(std::uint8_t mask);
 std::uint8_t visibility_from_gltf(std::uint8_t mask);
 

@@ -80,6 +80,45 @@ struct VolumeReader {
         return std::span<const std::uint8_t>(data.data() + view_off + acc_off, static_cast<size_t>(need));
     }
 
+    // Optional cell planes (docs/gltf-extension.md "Cell planes"): `planes` (VEC4 UNSIGNED_BYTE: ou,
+    // ov, offset lo, offset hi) and `planeSides` (SCALAR UNSIGNED_BYTE, corner bits in the glTF
+    // grid's axes), both or neither, `count` elements in glTF probe order, grid layouts only. Into
+    // set.planes (zhc order, zhc corner bits); `set` has its layout.
+    Status read_planes(const json& v, ProbeSet& set, std::uint64_t& stored_bytes) const {
+        const bool has_planes = v.contains("planes"), has_sides = v.contains("planeSides");
+        if (!has_planes && !has_sides) return Ok{};
+        if (has_planes != has_sides)
+            return bad(ErrorCode::kBadFormat, has_planes ? "planes without planeSides (the cell planes need both accessors)"
+                                                         : "planeSides without planes (the cell planes need both accessors)");
+        if (set.layout.kind != ProbeLayoutKind::kGrid) return bad(ErrorCode::kBadFormat, "planes need layout grid");
+        const tinygltf::Model& m = in.model;
+        auto pa = index(v, "planes", m.accessors.size());
+        if (!pa) return pa.error();
+        auto pb = accessor_bytes(*pa, kUbyte, TINYGLTF_TYPE_VEC4, set.count, "planes");
+        if (!pb) return pb.error();
+        auto sa = index(v, "planeSides", m.accessors.size());
+        if (!sa) return sa.error();
+        auto sb = accessor_bytes(*sa, kUbyte, TINYGLTF_TYPE_SCALAR, set.count, "planeSides");
+        if (!sb) return sb.error();
+        const auto& zc = set.layout.grid.counts;
+        const std::uint64_t gx_n = zc[1], gy_n = zc[2], gz_n = zc[0];  // glTF (nx, ny, nz) = zhc (ny, nz, nx)
+        std::vector<std::uint8_t> entries(5 * set.count);
+        for (std::uint64_t g = 0; g < set.count; ++g) {
+            const std::uint8_t* e = pb->data() + 4 * g;
+            const std::uint64_t gx = g % gx_n, gy = (g / gx_n) % gy_n, gz = g / (gx_n * gy_n);
+            if ((gx + 1 == gx_n || gy + 1 == gy_n || gz + 1 == gz_n) && !(e[2] == 0x00 && e[3] == 0x80))
+                return bad(ErrorCode::kInvalidValue, "planes accessor " + std::to_string(*pa) + ": probe " + std::to_string(g) +
+                                                         " (glTF order) is the last along an axis and starts no cell, but its plane is set "
+                                                         "(offset " + std::to_string(static_cast<std::int16_t>(e[2] | e[3] << 8)) +
+                                                         ", expected -32768 = no plane)");
+            std::memcpy(entries.data() + 5 * g, e, 4);
+            entries[5 * g + 4] = visibility_from_gltf((*sb)[g]);
+        }
+        set.planes = reorder_grid(entries, 5, zc, /*to_gltf_order=*/false);
+        stored_bytes += pb->size() + sb->size();
+        return Ok{};
+    }
+
     Result<GltfProbeVolume> read(const json& v) const {
         if (!v.is_object()) return bad(ErrorCode::kBadFormat, "not an object");
         GltfProbeVolume out;
@@ -254,6 +293,7 @@ struct VolumeReader {
             out.stored_bytes += b->size();
             (is_validity ? set.validity : set.visibility) = std::move(data);
         }
+        if (auto planes = read_planes(v, set, out.stored_bytes); !planes) return planes.error();
         auto valid = validate_probe_set(set);
         if (!valid) return bad(ErrorCode::kBadFormat, valid.error().message);
         if (out.sh_axes == GltfShAxes::kGltf) {

@@ -308,8 +308,8 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
                                   ? add_accessor(view, kFloat, "VEC3", set.count * (size / 12), options.name + " coefficients")
                                   : add_accessor(view, kUbyte, "SCALAR", set.count * size, options.name + " coefficients");
     }
-    // Leak-avoidance data: one UNSIGNED_BYTE per probe in the volume's probe order; visibility
-    // masks in the glTF grid's axes.
+    // Leak-avoidance data in the volume's probe order: one UNSIGNED_BYTE per probe (validity,
+    // visibility masks in the glTF grid's axes) and the cell planes (docs/gltf-extension.md "Cell planes").
     if (!set.validity.empty()) {
         std::vector<std::uint8_t> bytes = set.validity;
         if (set.layout.kind == ProbeLayoutKind::kGrid) bytes = reorder_grid(bytes, 1, set.layout.grid.counts, /*to_gltf_order=*/true);
@@ -321,6 +321,17 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
         for (std::uint8_t& b : bytes) b = visibility_to_gltf(b);
         vol["visibility"] = add_accessor(append_view(bytes, options.name + " visibility"), kUbyte, "SCALAR", set.count,
                                          options.name + " visibility");
+    }
+    if (!set.planes.empty()) {  // grid only (validate_probe_set): the 5-byte entries split in two accessors
+        const std::vector<std::uint8_t> entries = reorder_grid(set.planes, 5, set.layout.grid.counts, /*to_gltf_order=*/true);
+        std::vector<std::uint8_t> planes(4 * set.count), sides(set.count);
+        for (std::size_t i = 0; i < set.count; ++i) {
+            std::memcpy(planes.data() + 4 * i, entries.data() + 5 * i, 4);  // ou, ov, offset lo, offset hi: as stored
+            sides[i] = visibility_to_gltf(entries[5 * i + 4]);              // corner bits permuted like the masks
+        }
+        vol["planes"] = add_accessor(append_view(planes, options.name + " planes"), kUbyte, "VEC4", set.count, options.name + " planes");
+        vol["planeSides"] = add_accessor(append_view(sides, options.name + " planeSides"), kUbyte, "SCALAR", set.count,
+                                         options.name + " planeSides");
     }
     if (!options.output_path.empty()) {
         auto st = relocate_images(doc, scene_path, options, limits, append_view);
