@@ -31,12 +31,12 @@ using gltf_test::json;
 
 constexpr std::uint32_t kNx = 3, kNy = 2, kNz = 4;  // every axis its own count: a wrong order shows
 
-ProbeLayout grid_layout() {
+ProbeLayout grid_layout(std::array<std::uint32_t, 3> counts) {
     ProbeLayout l;
     l.kind = ProbeLayoutKind::kGrid;
     l.grid.origin = {-1, 0.5, 2};
     l.grid.spacing = {0.5, 1, 0.25};
-    l.grid.counts = {kNx, kNy, kNz};
+    l.grid.counts = counts;
     return l;
 }
 
@@ -63,15 +63,17 @@ double plane_distance(const std::uint8_t* e, const Vec3& n, const Vec3& origin, 
     return dot(n, p - c) - offset_of(e) * length(spacing) / 65534.0;
 }
 
-// A zh3_q16 (or `rep`) 3x2x4 grid with a plane in most cells: random normal codes and offsets, the
-// sides computed from where the corners are; "no plane" entries (offset -32768) on the last probe
-// along each axis and on a few cells, their other bytes random (they must survive too).
-ProbeSet planes_set(const std::string& rep = "zh3_q16", unsigned seed = 3) {
-    std::vector<Sh3Radiance> hub(kNx * kNy * kNz);
+// A zh3_q16 (or `rep`) grid (3x2x4 unless `counts`) with a plane in most cells: random normal
+// codes and offsets, the sides computed from where the corners are; "no plane" entries (offset
+// -32768) on the last probe along each axis of two or more probes and on a few cells, their other
+// bytes random (they must survive too). Along an axis of one probe, that probe starts a flat cell.
+ProbeSet planes_set(const std::string& rep = "zh3_q16", unsigned seed = 3, std::array<std::uint32_t, 3> counts = {kNx, kNy, kNz}) {
+    const std::uint64_t nx = counts[0], ny = counts[1], nz = counts[2];
+    std::vector<Sh3Radiance> hub(nx * ny * nz);
     for (size_t i = 0; i < hub.size(); ++i)
         for (int c = 0; c < 9; ++c)
             for (int k = 0; k < 3; ++k) hub[i][c][k] = c == 0 ? float(1 + i % 5 + k) : float(0.1 * std::sin(double(i * 27 + size_t(c) * 3 + size_t(k))));
-    auto set = encode_probe_set(hub, rep, {}, grid_layout());
+    auto set = encode_probe_set(hub, rep, {}, grid_layout(counts));
     EXPECT_TRUE(set.ok());
     std::mt19937 rng(seed);
     std::uniform_int_distribution<int> byte(0, 255), offset(-32767, 32767);
@@ -79,9 +81,9 @@ ProbeSet planes_set(const std::string& rep = "zh3_q16", unsigned seed = 3) {
     set->planes.resize(5 * set->count);
     for (std::uint64_t i = 0; i < set->count; ++i) {
         std::uint8_t* e = set->planes.data() + 5 * i;
-        const std::array<std::uint64_t, 3> i0{i % kNx, (i / kNx) % kNy, i / (kNx * kNy)};
+        const std::array<std::uint64_t, 3> i0{i % nx, (i / nx) % ny, i / (nx * ny)};
         for (int b = 0; b < 5; ++b) e[b] = static_cast<std::uint8_t>(byte(rng));
-        if (i0[0] + 1 == kNx || i0[1] + 1 == kNy || i0[2] + 1 == kNz || i % 7 == 3) {
+        if ((nx > 1 && i0[0] + 1 == nx) || (ny > 1 && i0[1] + 1 == ny) || (nz > 1 && i0[2] + 1 == nz) || i % 7 == 3) {
             e[2] = 0x00;
             e[3] = 0x80;
             continue;
@@ -148,6 +150,16 @@ TEST(GltfPlanes, RoundTripExactEitherAxesContainerAndEncoding) {
                     EXPECT_TRUE(*a == *b) << rep << ": .zhp -> glTF -> .zhp is not byte for byte";
                 }
             }
+    // A flat grid (one probe along zhc y = glTF x): those probes start cells and hold planes.
+    const ProbeSet flat = planes_set("zh3_q16", 5, {3, 1, 2});
+    int flat_planes = 0;
+    for (std::uint64_t i = 0; i < flat.count; ++i) flat_planes += offset_of(flat.planes.data() + 5 * i) != -32768;
+    EXPECT_GE(flat_planes, 1);
+    auto flat_bytes = embed_probes_gltf(empty_gltf(), "in.gltf", flat, {});
+    ASSERT_TRUE(flat_bytes.ok()) << flat_bytes.error().message;
+    auto flat_back = read_gltf_probes(*flat_bytes, "flat.glb");
+    ASSERT_TRUE(flat_back.ok()) << flat_back.error().message;
+    EXPECT_EQ(flat_back->volumes[0].set.planes, flat.planes);
     // Without planes: neither key.
     ProbeSet plain = planes_set();
     plain.planes.clear();

@@ -106,7 +106,10 @@ struct VolumeReader {
         for (std::uint64_t g = 0; g < set.count; ++g) {
             const std::uint8_t* e = pb->data() + 4 * g;
             const std::uint64_t gx = g % gx_n, gy = (g / gx_n) % gy_n, gz = g / (gx_n * gy_n);
-            if ((gx + 1 == gx_n || gy + 1 == gy_n || gz + 1 == gz_n) && !(e[2] == 0x00 && e[3] == 0x80))
+            // The last probe along an axis of two or more starts no cell (along an axis of one, the
+            // probe starts a flat cell: validate_leak_data).
+            const bool last = (gx_n > 1 && gx + 1 == gx_n) || (gy_n > 1 && gy + 1 == gy_n) || (gz_n > 1 && gz + 1 == gz_n);
+            if (last && !(e[2] == 0x00 && e[3] == 0x80))
                 return bad(ErrorCode::kInvalidValue, "planes accessor " + std::to_string(*pa) + ": probe " + std::to_string(g) +
                                                          " (glTF order) is the last along an axis and starts no cell, but its plane is set "
                                                          "(offset " + std::to_string(static_cast<std::int16_t>(e[2] | e[3] << 8)) +
