@@ -169,7 +169,7 @@ int main(int argc, char** argv) {
                 ++dark;
                 dark_plane += cell_has_plane(cs->volumes[2], sp.p);
             }
-        const PlaneFitStats& pf = cs->plane_reloc_stats;
+        const leak::PlaneFitStats& pf = cs->plane_reloc_stats;
         std::printf(" | %3zu %3zu | %5.1f%% | %3zu %3zu %5zu / %-5zu\n", cs->moved, cs->moved_towards, dark ? 100.0 * double(dark_plane) / double(dark) : 0.0,
                     pf.blocked_cells, pf.planes, pf.wrong_pairs, pf.blocked_pairs);
         if (rounds > 0) {

@@ -128,7 +128,7 @@ int run(const Options& o) {
     BakeOptions bo;
     bo.threads = threads;
     BakeReport rep;
-    ProbeLeakData leak;  // validity and visibility masks: the demo's containers equal `zhc bake`'s
+    ProbeLeakData leak;  // validity and cell planes: the demo's containers equal `zhc bake`'s
     auto baked = bake_scene(scene, bo, &rep, &leak);
     if (!baked) return report(baked.error());
     const std::vector<Sh3Radiance>& probes = *baked;
@@ -145,6 +145,7 @@ int run(const Options& o) {
         if (!set) return report(set.error());
         set->validity = leak.validity;
         set->visibility = leak.visibility;
+        set->planes = leak.planes;
         if (std::string(rep_name) == "zh3_q16") q16_set = *set;
         if (Status s = write_probe_file(path(std::string("probes_") + rep_name + ".zhp"), *set); !s)
             return report_output(s.error());

@@ -264,6 +264,23 @@ int run(const Options& o) {
             j["axis"] = axis_name(*codec, p);
         }
         j["luminance_weights"] = {p.luminance.r, p.luminance.g, p.luminance.b};
+        if (!set->validity.empty() || !set->visibility.empty() || !set->planes.empty()) {
+            // Per-probe leak data (docs/zhp-container.md; docs/runtime.md "Cell planes").
+            nlohmann::ordered_json leak;
+            if (!set->validity.empty()) {
+                std::uint64_t invalid = 0;
+                for (std::uint8_t v : set->validity) invalid += v == 0;
+                leak["invalid_probes"] = invalid;
+            }
+            if (!set->visibility.empty()) leak["visibility_masks"] = true;
+            if (!set->planes.empty()) {
+                std::uint64_t planes = 0;
+                for (size_t i = 0; i < set->count; ++i) planes += !(set->planes[5 * i + 2] == 0x00 && set->planes[5 * i + 3] == 0x80);
+                leak["cells_with_a_plane"] = planes;
+            }
+            leak["bytes_per_probe"] = (set->validity.empty() ? 0 : 1) + (set->visibility.empty() ? 0 : 1) + (set->planes.empty() ? 0 : 5);
+            j["leak_data"] = leak;
+        }
         auto hub = decode_probe_set(*set);
         if (!hub) return report(hub.error());
         probe_stats(*hub, j);

@@ -131,17 +131,17 @@ TEST(LeakCandidates, PlaneQuantisation) {
     const GridInfo g = grid_of(ls.scene);
     std::vector<Vec3> pos;
     for (std::size_t i = 0; i < g.count(); ++i) pos.push_back(g.position(i));
-    PlaneFitStats st;
-    const std::vector<CellPlane> planes = cell_planes(bvh, g, pos, b.leak.validity, {}, &st);
+    leak::PlaneFitStats st;
+    const std::vector<leak::CellPlane> planes = cell_planes(bvh, g, pos, b.leak.validity, {}, &st);
     const double t = 0.10 * kCell, centre = 5 + 0.5 * t;
     std::size_t crossed = 0;
     for (std::uint32_t z = 0; z + 1 < g.n[2]; ++z)
         for (std::uint32_t y = 0; y + 1 < g.n[1]; ++y)
             for (std::uint32_t x = 0; x + 1 < g.n[0]; ++x) {
-                const CellPlane& cp = planes[g.index(x, y, z)];
+                const leak::CellPlane& cp = planes[g.index(x, y, z)];
                 const Vec3 lo = g.position(g.index(x, y, z));
                 const bool crosses = lo.x < centre && lo.x + g.spacing.x > centre;
-                EXPECT_EQ(cp.offset != CellPlane::kNoPlane, crosses) << x << " " << y << " " << z;
+                EXPECT_EQ(cp.offset != leak::CellPlane::kNoPlane, crosses) << x << " " << y << " " << z;
                 if (!crosses) continue;
                 ++crossed;
                 const Vec3 nq = oct_decode(cp.ou, cp.ov), c = cell_centre(g, x, y, z);

@@ -24,9 +24,11 @@ Scene at_positions(std::vector<Vec3> ps) {
     return s;
 }
 
+// The visibility masks are traced (these tests check them beside validity).
 std::vector<Sh3Radiance> bake(const Scene& s, int threads = 1, BakeReport* rep = nullptr, ProbeLeakData* leak = nullptr) {
     BakeOptions o;
     o.threads = threads;
+    o.visibility_masks = true;
     auto r = bake_scene(s, o, rep, leak);
     EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
     return r.ok() ? *r : std::vector<Sh3Radiance>{};
@@ -285,6 +287,7 @@ TEST(ProbeValidity, ProbesInsideABoxOrAClosedMeshAreInvalidAndDilated) {
         s.lights = {p};
         s.occluders = std::move(occ);
         s.occluders.push_back(box({-1, -1, -3}, {5, 1, -2}));  // a floor: every probe sees some geometry
+        s.occlusion.move_probes = false;  // validity and dilation of probes baked where they are
         return s;
     };
     struct Case {
@@ -397,6 +400,7 @@ TEST(VisibilityMasks, AWallThroughACellSeparatesItsProbes) {
     s.probes.max = {1, 1, 1};
     s.probes.counts = {2, 2, 2};
     s.occluders = {box({0.3, -10, -10}, {0.35, 10, 10})};
+    s.occlusion.move_probes = false;  // the masks of probes at their grid points
     ProbeLeakData leak;
     bake(s, 1, nullptr, &leak);
     ASSERT_EQ(leak.visibility.size(), 8u);
@@ -419,6 +423,7 @@ TEST(VisibilityMasks, MatchTheSlowTwinOnTwoWalls) {
     s.probes.counts = {4, 3, 4};
     const std::vector<Slab> slabs = {{0, 1.3, 1.4}, {2, 2.1, 2.15}};
     s.occluders = {box({1.3, -10, -10}, {1.4, 10, 10}), box({-10, -10, 2.1}, {10, 10, 2.15})};
+    s.occlusion.move_probes = false;  // the twin aims at the grid points
     ProbeLeakData leak;
     BakeReport rep;
     bake(s, 2, &rep, &leak);
@@ -507,7 +512,9 @@ LeakStats leak_stats(const std::vector<Sh3Radiance>& got, const std::vector<Sh3R
 struct LeakResult {
     LeakStats plain, valid_only, masked;
 };
-LeakResult measure_leak(const Scene& scene, const char* label) {
+LeakResult measure_leak(const Scene& moved_scene, const char* label) {
+    Scene scene = moved_scene;
+    scene.occlusion.move_probes = false;  // validity and masks of probes baked at their grid points
     ProbeLeakData leak;
     BakeReport rep;
     const auto probes = bake(scene, 2, &rep, &leak);
@@ -587,9 +594,36 @@ TEST(SkyOcclusionCli, KeysFlagsReportAndErrors) {
     auto run = test::run_zhc({"bake", data, "-o", dir + "/a.zhp", "--sky-samples", "128", "--threads", "2"});
     ASSERT_EQ(run.exit_code, 0) << run.err;
     EXPECT_NE(run.out.find("sky (constant)           (occluded: 128 rays/probe)"), std::string::npos) << run.out;
-    EXPECT_NE(run.out.find("probe validity (the same 128 rays/probe): 16 of 196 probes inside geometry, 16 dilated"),
+    // The 16 probes of the row inside the south wall are baked beside it (leak_planes.h): none is
+    // left invalid; the planes are fitted and the leak estimate printed.
+    EXPECT_NE(run.out.find("probe validity (the same 128 rays/probe): 0 of 196 probes inside geometry, 0 dilated"),
               std::string::npos) << run.out;
-    EXPECT_NE(run.out.find("visibility masks:"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("probes kept out of walls: 16 in or near geometry at their grid points: 16 baked at a clear point nearby, "
+                           "0 left inside geometry (invalid, dilated), 0 left near it;"),
+              std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("cell planes: 21 of 24 cells crossed by geometry have a plane (108 cells;"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("leak estimate: "), std::string::npos) << run.out;
+    EXPECT_EQ(run.out.find("visibility masks:"), std::string::npos) << run.out;
+    {
+        // occlusion.move_probes false: the row stays inside the wall, invalid and dilated.
+        const auto raw = test::read_bytes(data);
+        std::string text(raw.begin(), raw.end());
+        const std::string key = "\"occlusion\": {";
+        ASSERT_NE(text.find(key), std::string::npos);
+        text.insert(text.find(key) + key.size(), "\"move_probes\": false, ");
+        const std::string kept = dir + "/kept.json";
+        test::write_bytes(kept, std::vector<std::uint8_t>(text.begin(), text.end()));
+        auto k = test::run_zhc({"bake", kept, "-o", dir + "/k.zhp", "--sky-samples", "128"});
+        ASSERT_EQ(k.exit_code, 0) << k.err;
+        EXPECT_NE(k.out.find("probe validity (the same 128 rays/probe): 16 of 196 probes inside geometry, 16 dilated"),
+                  std::string::npos) << k.out;
+        EXPECT_EQ(k.out.find("probes kept out of walls"), std::string::npos) << k.out;
+        auto ks = read_scene_file(kept);
+        ASSERT_TRUE(ks.ok());
+        EXPECT_FALSE(ks->occlusion.move_probes);
+        const std::string kt = scene_json(*ks);
+        EXPECT_NE(kt.find("\"move_probes\": false"), std::string::npos) << kt;
+    }
     // Flag range (usage error 2), JSON key range (4).
     EXPECT_EQ(test::run_zhc({"bake", data, "-o", dir + "/b.zhp", "--sky-samples", "-1"}).exit_code, 2);
     EXPECT_EQ(test::run_zhc({"bake", data, "-o", dir + "/b.zhp", "--invalid-fraction", "1.5"}).exit_code, 2);

@@ -128,24 +128,7 @@ void add_light_shadowed(const Effect& e, const OccluderBvh& bvh, Vec3 p, double 
 
 namespace {
 
-// Runs fn(lo, hi, thread) over [0, count) in blocks of `block`, on `threads` threads. Each block is
-// independent, so the results do not depend on the thread count.
-template <class Fn>
-void parallel_blocks(size_t count, size_t block, int threads, Fn&& fn) {
-    const size_t blocks = (count + block - 1) / block;
-    const int n = std::max(1, std::min<int>(threads, static_cast<int>(std::max<size_t>(blocks, 1))));
-    std::atomic<size_t> next{0};
-    auto worker = [&](int t) {
-        for (size_t b = next++; b < blocks; b = next++) fn(b * block, std::min(count, (b + 1) * block), t);
-    };
-    if (n == 1) {
-        worker(0);
-        return;
-    }
-    std::vector<std::thread> pool;
-    for (int t = 0; t < n; ++t) pool.emplace_back(worker, t);
-    for (auto& th : pool) th.join();
-}
+using bake_detail::parallel_blocks;
 
 
 }  // namespace
@@ -259,7 +242,7 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
                                            Clock::time_point t_start, const BakeOptions& options, BakeReport* report,
                                            ProbeLeakData* leak) {
     if (leak) *leak = {};
-    const std::vector<Vec3> positions = probe_positions(scene.probes);
+    std::vector<Vec3> positions = probe_positions(scene.probes);
     const size_t count = positions.size();
     const bool grid = scene.probes.kind == ProbePlacementKind::kGrid;
     const int n_occ = bvh.empty() ? 0 : scene.occlusion.sky_samples;
@@ -361,6 +344,22 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
         info.push_back({effect_name(l), "closed form", 0, 0});
     }
 
+    const std::uint64_t invalid_limit =
+        static_cast<std::uint64_t>(std::floor(scene.occlusion.invalid_fraction * n_occ));  // invalid: back > limit
+    // Grids with occluders: where each probe is baked (leak_planes.h), with the validity test of
+    // the occlusion pass below (the same directions and limit, so both agree on every probe).
+    const ProbeLayout layout = probe_layout(scene.probes);
+    const InsideTest inside_test{&dirs, invalid_limit};
+    const LeakPlacementOptions placement;
+    ProbeRelocation reloc;
+    double reloc_ms = 0;
+    if (validity && scene.occlusion.move_probes) {
+        const auto t_reloc = Clock::now();
+        reloc = relocate_grid_probes(bvh, layout.grid, inside_test, placement, true, std::max(1, options.threads));
+        positions = reloc.positions;
+        reloc_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_reloc).count();
+    }
+
     // Probes in blocks; each block runs the occlusion pass, then the effects in order into a
     // double accumulator. Blocks are independent, so any thread count gives the same bytes.
     // Reflected light: a path tracer over the same tree; its probes are costly, so blocks are small.
@@ -381,8 +380,6 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
                                                  std::vector<std::uint64_t>(effects.size() + 1, 0));
     std::mutex progress_mutex;
     std::uint64_t probes_done = 0;
-    const std::uint64_t invalid_limit =
-        static_cast<std::uint64_t>(std::floor(scene.occlusion.invalid_fraction * n_occ));  // invalid: back > limit
     parallel_blocks(count, kBlock, threads, [&](size_t lo, size_t hi, int t) {
         std::vector<double> acc((hi - lo) * 27, 0.0);
         std::vector<int> blocked(hi - lo, 0);
@@ -460,7 +457,6 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
     // invalid probes does not matter.
     const auto t_dil = Clock::now();
     std::uint64_t invalid = 0, dilated = 0;
-    const ProbeLayout layout = probe_layout(scene.probes);
     if (validity) {
         const auto& g = layout.grid;
         const long nx = g.counts[0], ny = g.counts[1], nz = g.counts[2];
@@ -499,12 +495,23 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
     }
     const double dil_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_dil).count();
 
+    // The planes per cell, fitted to the probes where they were baked (asked for, grid, occluders).
+    double plane_ms = 0;
+    PlaneFitStats plane_stats;
+    if (leak && validity) {
+        const auto t_plane = Clock::now();
+        leak->validity = valid;
+        leak->baked_positions = positions;
+        leak->planes = cell_planes_bytes(fit_cell_planes(bvh, layout.grid, positions, valid, placement.lattice,
+                                                         std::max(1, options.threads), &plane_stats));
+        plane_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_plane).count();
+    }
+
     // Visibility masks (asked for, grid, occluders).
     double mask_ms = 0;
     std::uint64_t mask_rays = 0;
-    if (leak && validity) {
+    if (leak && validity && options.visibility_masks) {
         const auto t_mask = Clock::now();
-        leak->validity = valid;
         leak->visibility.assign(count, 0xFF);
         const auto& g = layout.grid;
         std::vector<std::uint64_t> mr(static_cast<size_t>(std::max(1, options.threads)), 0);
@@ -549,10 +556,20 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
         report->dilated_probes = dilated;
         report->dilation_ms = dil_ms;
         report->mask_rays = mask_rays;
-        report->mask_probes = leak && validity ? count : 0;
+        report->mask_probes = leak && validity && options.visibility_masks ? count : 0;
         report->validity_checked = validity;
         report->mask_ms = mask_ms;
         report->rays += mask_rays;
+        report->moved_out = reloc.moved_out;
+        report->moved_towards = reloc.moved_towards;
+        report->left_inside = reloc.left_inside;
+        report->left_near = reloc.left_near;
+        report->relocation_rays = reloc.rays;
+        report->relocation_ms = reloc_ms;
+        report->rays += reloc.rays;
+        report->planes = plane_stats;
+        report->plane_ms = plane_ms;
+        report->rays += plane_stats.rays;
         if (tracer) {
             TransportReport& tr = report->transport;
             tr.traced = true;

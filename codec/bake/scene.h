@@ -34,9 +34,13 @@
 // blocked ray -> the closed forms exactly, all blocked -> exactly zero. The same rays classify the
 // probe (grid layouts): more than `invalid_fraction` of them starting inside a box/sphere or meeting
 // a triangle's back face first -> invalid; its SH becomes the inverse-distance blend of the valid
-// probes of the nearest grid shell (at most kDilationShells steps away) holding any. Visibility
-// masks (ProbeSet::visibility): per grid probe and each of its 8 cells, kMaskPoints rays from the
-// cell's centre region to the probe.
+// probes of the nearest grid shell (at most kDilationShells steps away) holding any. Before that,
+// grid probes in or near geometry are baked at a clear point nearby and probes far from a wall that
+// crosses one of their cells nearer to it (`occlusion.move_probes`), and one separating plane per
+// cell is fitted to the probes where they were baked (ProbeSet::planes; codec/bake/leak_planes.h):
+// only probes that stay inside geometry are invalid. Visibility masks (ProbeSet::visibility, on
+// request): per grid probe and each of its 8 cells, kMaskPoints rays from the cell's centre region
+// to the probe.
 //
 // Reflected and emitted light (docs/scene.md "Reflected light"): where an occluder's material
 // reflects or emits, each valid probe also gathers the radiance leaving the surfaces it sees,
@@ -59,6 +63,7 @@
 #include <string>
 #include <vector>
 
+#include "codec/bake/leak_planes.h"
 #include "codec/bake/occluders.h"
 #include "codec/probe/probe_set.h"
 #include "codec/sh/sh.h"
@@ -120,6 +125,10 @@ struct ProbePlacement {
 struct SceneOcclusion {
     int sky_samples = 256;          // rays per probe; 0: sky/environment not occluded, no validity/masks
     double invalid_fraction = 0.25;  // invalid when more than this fraction of rays see "inside"
+    // Grids: bake probes that lie in or near geometry at a clear point nearby, and probes far from
+    // a wall that crosses one of their cells nearer to it (codec/bake/leak_planes.h); false: every
+    // probe is baked at its grid point.
+    bool move_probes = true;
 };
 // Visibility-mask rays per (probe, cell): the cell's centre and the 8 points centre +- spacing/4.
 constexpr int kMaskPoints = 9;
@@ -176,6 +185,14 @@ struct BakeReport {
     double dilation_ms = 0;
     std::uint64_t mask_rays = 0, mask_probes = 0;
     double mask_ms = 0;
+    // Probes kept out of walls and the planes per cell (codec/bake/leak_planes.h); zero when not
+    // run (validity_checked false). moved_out + left_inside + left_near: the probes in or near
+    // geometry at their grid points; left_inside are the invalid, dilated ones.
+    std::uint64_t moved_out = 0, moved_towards = 0, left_inside = 0, left_near = 0;
+    std::uint64_t relocation_rays = 0;
+    double relocation_ms = 0;
+    PlaneFitStats planes;  // the fit stored with the probes (ProbeLeakData::planes asked for)
+    double plane_ms = 0;
     // Reflected and emitted light (codec/bake/transport.h); traced == false when not run.
     TransportReport transport;
     // "sky (closed form): 0.3 ms; sun 'key' (closed form, shadowed: 4096 rays): 1.2 ms"
@@ -184,15 +201,20 @@ struct BakeReport {
 
 struct BakeOptions {
     int threads = 1;
+    // With ProbeLeakData asked for: also trace the 8-bit visibility masks (the leak study's
+    // comparison, docs/leaks.md); the planes are always fitted.
+    bool visibility_masks = false;
     // Called after each block of probes with (probes done, total), one call at a time (serialised
     // across threads), done increasing; the baked bytes never depend on it.
     std::function<void(std::uint64_t done, std::uint64_t total)> progress;
 };
 
-// Leak-avoidance data of a grid bake (codec/probe/probe_set.h ProbeSet::validity/visibility).
+// Leak-avoidance data of a grid bake (codec/probe/probe_set.h ProbeSet::validity/visibility/planes).
 struct ProbeLeakData {
     std::vector<std::uint8_t> validity;    // 1 valid, 0 inside geometry (dilated)
-    std::vector<std::uint8_t> visibility;  // bit (cx + 2 cy + 4 cz): visible from that cell
+    std::vector<std::uint8_t> visibility;  // BakeOptions::visibility_masks: bit (cx + 2 cy + 4 cz): visible from that cell
+    std::vector<std::uint8_t> planes;      // 5 bytes per probe: the plane of the cell it starts (leak_planes.h)
+    std::vector<Vec3> baked_positions;     // where each probe was baked (its grid point unless moved)
 };
 
 // Bakes every probe (validate_scene first; kInvalidValue on a bad scene). `leak`, when given, is

@@ -193,7 +193,7 @@ SceneSky read_sky(const Reader& r, const json& j) {
 
 SceneOcclusion read_occlusion(const Reader& r, const json& j) {
     const std::string p = "occlusion";
-    r.object(j, p, {"sky_samples", "invalid_fraction"});
+    r.object(j, p, {"sky_samples", "invalid_fraction", "move_probes"});
     SceneOcclusion o;
     if (j.contains("sky_samples")) {
         const json& s = j["sky_samples"];
@@ -209,6 +209,7 @@ SceneOcclusion read_occlusion(const Reader& r, const json& j) {
         if (f > 1) r.fail(ErrorCode::kInvalidValue, p + ".invalid_fraction", "must be in [0, 1] (got " + j["invalid_fraction"].dump() + ")");
         o.invalid_fraction = f;
     }
+    if (j.contains("move_probes")) o.move_probes = r.boolean(j["move_probes"], p + ".move_probes");
     return o;
 }
 
@@ -585,8 +586,11 @@ std::string scene_json(const Scene& s) {
         }
     }
     const SceneOcclusion defaults;
-    if (s.occlusion.sky_samples != defaults.sky_samples || s.occlusion.invalid_fraction != defaults.invalid_fraction)
+    if (s.occlusion.sky_samples != defaults.sky_samples || s.occlusion.invalid_fraction != defaults.invalid_fraction ||
+        s.occlusion.move_probes != defaults.move_probes) {
         doc["occlusion"] = {{"sky_samples", s.occlusion.sky_samples}, {"invalid_fraction", s.occlusion.invalid_fraction}};
+        if (s.occlusion.move_probes != defaults.move_probes) doc["occlusion"]["move_probes"] = s.occlusion.move_probes;
+    }
     json lights = json::array();
     for (const SceneLight& l : s.lights) {
         json j;
