@@ -374,11 +374,19 @@ inline std::vector<double> truth_of(const LeakScene& ls) {
 
 // ---- bake and volumes -------------------------------------------------------------------------
 
+// Two bakes of one scene: every probe at its grid point (occlusion.move_probes false, visibility
+// masks traced), written without leak data (plain) and with validity + masks; and the default bake
+// (probes kept out of walls, codec/bake/leak_planes.h) with validity + planes, as `zhc bake`
+// writes it.
 struct Baked {
-    std::vector<Sh3Radiance> probes;
+    std::vector<Sh3Radiance> probes;  // at the grid points
     ProbeLeakData leak;
     BakeReport report;
-    std::vector<std::uint8_t> plain_zhp, masked_zhp;  // sh3 .zhp without / with the leak sections
+    std::vector<std::uint8_t> plain_zhp, masked_zhp;  // sh3 .zhp without / with validity + masks
+    std::vector<Sh3Radiance> planes_probes;           // the default bake
+    ProbeLeakData planes_leak;
+    BakeReport planes_report;
+    std::vector<std::uint8_t> planes_zhp;             // sh3 .zhp with validity + planes
     std::string error;                                 // non-empty: the bake or a write failed
 };
 
@@ -386,7 +394,10 @@ inline Baked bake_volumes(const LeakScene& ls, int threads = 1) {
     Baked b;
     BakeOptions opt;
     opt.threads = threads;
-    auto probes = bake_scene(ls.scene, opt, &b.report, &b.leak);
+    opt.visibility_masks = true;
+    Scene in_place = ls.scene;
+    in_place.occlusion.move_probes = false;
+    auto probes = bake_scene(in_place, opt, &b.report, &b.leak);
     if (!probes) {
         b.error = ls.name + ": " + probes.error().message;
         return b;
@@ -407,6 +418,27 @@ inline Baked bake_volumes(const LeakScene& ls, int threads = 1) {
     }
     b.plain_zhp = std::move(*plain);
     b.masked_zhp = std::move(*masked);
+    BakeOptions def;
+    def.threads = threads;
+    auto moved = bake_scene(ls.scene, def, &b.planes_report, &b.planes_leak);
+    if (!moved) {
+        b.error = ls.name + ": " + moved.error().message;
+        return b;
+    }
+    b.planes_probes = std::move(*moved);
+    auto pset = encode_probe_set(b.planes_probes, "sh3", {}, probe_layout(ls.scene.probes));
+    if (!pset) {
+        b.error = ls.name + ": " + pset.error().message;
+        return b;
+    }
+    pset->validity = b.planes_leak.validity;
+    pset->planes = b.planes_leak.planes;
+    auto pz = serialize_probe_set(*pset);
+    if (!pz) {
+        b.error = ls.name + ": cannot write the .zhp with planes";
+        return b;
+    }
+    b.planes_zhp = std::move(*pz);
     return b;
 }
 
@@ -481,12 +513,13 @@ inline Metrics metrics(const std::vector<ShadingPoint>& pts, const std::vector<d
     return m;
 }
 
-// One scene measured: the truth's own dark/lit ratio, the SH3 floor, plain and masks.
+// One scene measured: the truth's own dark/lit ratio, the SH3 floor, plain, masks and planes.
 struct Measured {
     std::size_t probes = 0, invalid = 0, lit_points = 0, dark_points = 0;
-    Metrics truth, floor, plain, masks;
-    double mask_bytes_per_probe = 0;  // extra .zhp bytes per probe of validity + visibility
-    std::vector<double> truth_e, plain_e, masks_e;
+    Metrics truth, floor, plain, masks, planes;
+    double mask_bytes_per_probe = 0;    // extra .zhp bytes per probe of validity + visibility
+    double planes_bytes_per_probe = 0;  // extra .zhp bytes per probe of validity + planes
+    std::vector<double> truth_e, plain_e, masks_e, planes_e;
 };
 
 inline bool open_volume(const std::vector<std::uint8_t>& zhp, zhc_volume* v) {
@@ -504,13 +537,16 @@ inline Measured measure(const LeakScene& ls, const Baked& b, bool with_floor = t
         const std::vector<double> f = at_point_sh3(ls);
         if (f.size() == ls.points.size()) m.floor = metrics(ls.points, f, m.truth_e);
     }
-    zhc_volume plain, masked;
-    if (!open_volume(b.plain_zhp, &plain) || !open_volume(b.masked_zhp, &masked)) return m;
+    zhc_volume plain, masked, planes;
+    if (!open_volume(b.plain_zhp, &plain) || !open_volume(b.masked_zhp, &masked) || !open_volume(b.planes_zhp, &planes)) return m;
     m.plain_e = sample_points(plain, ls.points);
     m.masks_e = sample_points(masked, ls.points);
+    m.planes_e = sample_points(planes, ls.points);
     m.plain = metrics(ls.points, m.plain_e, m.truth_e);
     m.masks = metrics(ls.points, m.masks_e, m.truth_e);
+    m.planes = metrics(ls.points, m.planes_e, m.truth_e);
     m.mask_bytes_per_probe = m.probes ? double(b.masked_zhp.size() - b.plain_zhp.size()) / double(m.probes) : 0;
+    m.planes_bytes_per_probe = m.probes ? double(b.planes_zhp.size() - b.plain_zhp.size()) / double(m.probes) : 0;
     return m;
 }
 

@@ -19,6 +19,8 @@
 // side everywhere) is not asserted: today's samplings do not meet it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <string>
@@ -42,16 +44,17 @@ const std::vector<Case>& suite() {
     static const std::vector<Case> cases = [] {
         std::vector<LeakScene> scenes = suite_scenes();
         std::vector<Case> out;
-        std::printf("%-30s %4s %3s %9s %7s | %7s %7s | %7s %7s %7s\n", "scene", "prb", "inv", "lit/dark", "truth", "plain",
-                    "masks", "floor", "plain", "masks");
+        std::printf("%-30s %4s %3s %9s %7s | %7s %7s %7s | %7s %7s %7s %7s\n", "scene", "prb", "inv", "lit/dark", "truth", "plain",
+                    "masks", "planes", "floor", "plain", "masks", "planes");
         for (LeakScene& s : scenes) {
             Case c;
             c.baked = bake_volumes(s, 2);
             EXPECT_TRUE(c.baked.error.empty()) << c.baked.error;
             c.m = measure(s, c.baked);
-            std::printf("%-30s %4zu %3zu %4zu/%-4zu %6.2f%% | %6.2f%% %6.2f%% | %6.1f%% %6.1f%% %6.1f%%\n", s.name.c_str(),
-                        c.m.probes, c.m.invalid, c.m.lit_points, c.m.dark_points, 100 * c.m.truth.leak, 100 * c.m.plain.leak,
-                        100 * c.m.masks.leak, 100 * c.m.floor.lit_error, 100 * c.m.plain.lit_error, 100 * c.m.masks.lit_error);
+            std::printf("%-30s %4zu %3zu %4zu/%-4zu %6.2f%% | %6.2f%% %6.2f%% %6.2f%% | %6.1f%% %6.1f%% %6.1f%% %6.1f%%\n",
+                        s.name.c_str(), c.m.probes, c.m.invalid, c.m.lit_points, c.m.dark_points, 100 * c.m.truth.leak,
+                        100 * c.m.plain.leak, 100 * c.m.masks.leak, 100 * c.m.planes.leak, 100 * c.m.floor.lit_error,
+                        100 * c.m.plain.lit_error, 100 * c.m.masks.lit_error, 100 * c.m.planes.lit_error);
             c.scene = std::move(s);
             out.push_back(std::move(c));
         }
@@ -230,6 +233,46 @@ TEST(LeakSuite, BytesPerProbeAndTheSh3Floor) {
     }
 }
 
+// The default bake (probes kept out of walls, one plane per cell; what `zhc bake` writes and every
+// runtime applies): issue 38's acceptance on the suite.
+TEST(LeakSuite, TheDefaultBakesPlanesStopTheLeakInEveryTwoRoomConfiguration) {
+    for (const Case& c : suite()) {
+        SCOPED_TRACE(c.scene.name);
+        // 6 bytes per probe: validity (1) + the plane of the cell it starts (5).
+        EXPECT_EQ(c.m.planes_bytes_per_probe, 6.0);
+        EXPECT_EQ(c.baked.planes_leak.planes.size(), 5 * c.m.probes);
+        EXPECT_TRUE(c.baked.planes_leak.visibility.empty());
+        // Never above plain's leak (the truth's own ratio allowed where light really passes).
+        EXPECT_LE(c.m.planes.leak, std::max(c.m.plain.leak, c.m.truth.leak) + 1e-12);
+        // The lit side: closer to the truth than plain, or its mean within 10 % of plain's.
+        const bool closer = c.m.planes.lit_error <= c.m.plain.lit_error;
+        const bool near_plain = std::fabs(c.m.planes.lit_mean - c.m.plain.lit_mean) <= 0.1 * c.m.plain.lit_mean;
+        if (c.scene.name != "closed box in a lit room") {
+            EXPECT_TRUE(closer || near_plain) << c.m.planes.lit_error << " vs " << c.m.plain.lit_error;
+        }
+        for (double e : c.m.planes_e) EXPECT_TRUE(std::isfinite(e)) << e;
+        if (c.scene.offset >= 0) {
+            // Two rooms: below 1 % of the lit side (exactly zero here), at every offset and thickness.
+            EXPECT_LT(c.m.planes.leak, 0.01);
+            EXPECT_LT(c.m.planes.leak, 1e-4);
+            // No probe stays invalid: the in-wall column is baked beside the wall.
+            EXPECT_EQ(c.baked.planes_report.left_inside, 0u);
+            EXPECT_GT(c.baked.planes_report.planes.planes, 0u);
+        }
+    }
+    // The in-wall column (offset 0): its 15 probes are moved out; the lit side then is closer to
+    // the truth than plain's.
+    for (double th : wall_thicknesses()) {
+        const Case& c = two_rooms_case(0.0, th);
+        EXPECT_GE(c.baked.planes_report.moved_out, 15u) << th;
+        EXPECT_LT(c.m.planes.lit_error, c.m.plain.lit_error) << th;
+    }
+    // The window room: the outside's light inside within the truth's own ratio + 1 point.
+    const Case& w = named_case("window room (sky)");
+    EXPECT_LT(w.m.planes.leak, w.m.truth.leak + 0.01);
+    EXPECT_LT(w.m.planes.lit_error, 0.5 * w.m.plain.lit_error);
+}
+
 TEST(LeakSuite, SameFilesAndNumbersWithOneAndTwoThreads) {
     const LeakScene a = two_rooms(0.6, 0.02), b = two_rooms(0.6, 0.02);
     ASSERT_EQ(a.points.size(), b.points.size());
@@ -241,9 +284,11 @@ TEST(LeakSuite, SameFilesAndNumbersWithOneAndTwoThreads) {
     ASSERT_TRUE(b1.error.empty() && b2.error.empty());
     EXPECT_EQ(b1.plain_zhp, b2.plain_zhp);
     EXPECT_EQ(b1.masked_zhp, b2.masked_zhp);
+    EXPECT_EQ(b1.planes_zhp, b2.planes_zhp);
     const Measured m1 = measure(a, b1, false), m2 = measure(b, b2, false);
     EXPECT_EQ(m1.plain_e, m2.plain_e);
     EXPECT_EQ(m1.masks_e, m2.masks_e);
+    EXPECT_EQ(m1.planes_e, m2.planes_e);
     EXPECT_EQ(m1.truth_e, m2.truth_e);
     // And the suite's own bake of the same configuration (2 threads, in suite()).
     EXPECT_EQ(two_rooms_case(0.6, 0.02).baked.masked_zhp, b1.masked_zhp);
