@@ -10,7 +10,8 @@
 //  * refusals, one line naming the accessor: wrong type / componentType / count, one accessor of the
 //    two, planes on a volume without a grid layout, a plane on a probe that starts no cell;
 //  * the CLI: `zhc gltf embed` then `zhc gltf extract` give the input .zhp byte for byte, a tampered
-//    asset exits 4 in one line, `zhc convert` to another representation keeps the planes.
+//    asset exits 4 in one line, `zhc convert` to another representation keeps the planes;
+//  * a default `zhc bake` of examples/hall.gltf to .glb carries the planes the .zhp bake writes.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -329,6 +330,33 @@ TEST(GltfPlanes, CliEmbedExtractConvert) {
     ASSERT_TRUE(converted.ok()) << converted.error().message;
     EXPECT_EQ(converted->representation, "sh2_q");
     EXPECT_EQ(converted->planes, set.planes);
+}
+
+// A default bake of a glTF scene with walls (examples/hall.gltf) writes validity and planes; its
+// glTF output carries the same planes, and extracting it gives the .zhp bake byte for byte.
+TEST(GltfPlanes, BakedGlbCarriesTheBakesPlanes) {
+    const std::string dir = test::fresh_dir("gltf_planes_baked");
+    const std::string hall = std::string(ZHC_TEST_DATA_DIR) + "/../../examples/hall.gltf";
+    auto r = test::run_zhc({"bake", hall, "-o", dir + "/hall.zhp", "-r", "zh3_q16", "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = test::run_zhc({"bake", hall, "-o", dir + "/hall.glb", "-r", "zh3_q16", "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Bytes zhp = test::read_bytes(dir + "/hall.zhp");
+    auto baked = parse_probe_set(zhp, "hall.zhp");
+    ASSERT_TRUE(baked.ok()) << baked.error().message;
+    int planes = 0;
+    for (std::uint64_t i = 0; i < baked->count && !baked->planes.empty(); ++i) planes += offset_of(baked->planes.data() + 5 * i) != -32768;
+    EXPECT_GE(planes, 1) << "the bake of hall.gltf writes cell planes";
+    const Bytes glb = test::read_bytes(dir + "/hall.glb");
+    const json vol = gltf_test::gltf_json(glb)["extensions"]["ZHC_light_probes"]["volumes"][0];
+    EXPECT_TRUE(vol.contains("planes") && vol.contains("planeSides")) << vol.dump();
+    auto s = read_gltf_probes(glb, "hall.glb");
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    EXPECT_EQ(s->volumes[0].set.planes, baked->planes);
+    EXPECT_EQ(s->volumes[0].set.validity, baked->validity);
+    r = test::run_zhc({"gltf", "extract", dir + "/hall.glb", "-o", dir + "/back.zhp"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(test::read_bytes(dir + "/back.zhp") == zhp) << "zhc gltf extract of the baked .glb differs from the baked .zhp";
 }
 
 }  // namespace

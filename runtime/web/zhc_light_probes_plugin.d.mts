@@ -29,6 +29,9 @@ export interface ZhcProbeVolumeFields {
   sh?: Float32Array;
   validity?: Uint8Array | null;
   visibility?: Uint8Array | null;
+  /** Cell planes (accessors planes + planeSides), 5 bytes per probe in glTF probe order: ou, ov (normal
+   * code, zhc axes), offset lo, offset hi, sides (glTF corner bits); null when absent. */
+  planes?: Uint8Array | null;
   /** The Object3Ds that place the volume (one per referencing node), set by the plugin. */
   nodes?: Object3D[];
 }
@@ -44,7 +47,7 @@ export declare class ZhcProbeVolume {
   probeSHGltf(p: number): Float32Array;
   /** Irradiance of probe p at a direction in glTF / three.js axes (node-local). */
   irradiance(p: number, dir: Vec3Like): Vec3;
-  /** Irradiance at any point of a grid volume (node-local glTF axes), 8 probes blended (masks applied). */
+  /** Irradiance at any point of a grid volume (node-local glTF axes), 8 probes blended (masks and cell planes applied). */
   irradianceAt(position: Vec3Like, normal: Vec3Like): Vec3;
   /** The compact path: stored bytes in an RGBA32UI Data3DTexture, uniforms and GLSL (three.js passed in). */
   compactVolume(options?: Omit<ZhcCompactOptions, 'THREE'>): ZhcCompactVolume;
@@ -98,6 +101,8 @@ export declare function buildVolume(
   positionsArray: ArrayLike<number> | null,
   validityArray?: ArrayLike<number> | null,
   visibilityArray?: ArrayLike<number> | null,
+  planesArray?: ArrayLike<number> | null,
+  planeSidesArray?: ArrayLike<number> | null,
 ): ZhcProbeVolume;
 
 /** What the plugin puts in gltf.userData. */

@@ -58,13 +58,16 @@ export class ZhcProbeVolume {
   // decoded SH3 (the point clamped to the grid's box), evaluated at `normal`; position and normal in
   // glTF / three.js axes, node-local (docs/runtime.md "Probe volumes"). The normal is normalised
   // (zero: +Y). With validity / visibility accessors the weights are masked and renormalised
-  // (docs/runtime.md "Validity and visibility"). Throws for points / none layouts (scattered probes: see the docs) and for a grid
+  // (docs/runtime.md "Validity and visibility"); with cell planes (`planes`) a corner on the other
+  // side of its cell's plane from the position is dropped too (docs/gltf-extension.md "Cell
+  // planes"). Throws for points / none layouts (scattered probes: see the docs) and for a grid
   // whose spacing is not > 0.
   irradianceAt(position, normal) {
     if (this.layout !== 'grid') throw new Error(`zhc: volume '${this.name}' has layout ${this.layout}: irradianceAt needs a grid`);
     if (!this.sh) this.#check(0);
     if (!this.#volume)
-      this.#volume = makeVolume({ sh: this.sh, ...this.grid, validity: this.validity ?? null, visibility: this.visibility ?? null });
+      this.#volume = makeVolume({ sh: this.sh, ...this.grid, validity: this.validity ?? null, visibility: this.visibility ?? null,
+        planes: this.planes ?? null, planesAxes: 'gltf' });
     const d = normalizeOr([normal[0], normal[1], normal[2]], [0, 1, 0]);
     return volumeIrradiance(this.#volume, position, this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
   }
@@ -96,7 +99,7 @@ export class ZhcProbeVolume {
   // texel centre, so the hardware trilinear filter blends the same 8 probes with the same weights as
   // zhc's volume. three.js samples at `position + normal * spacing / 2` (its offset against
   // self-shadowing) and shades BRDF_Lambert * pi E, i.e. albedo * zhc's E there. The volume's
-  // validity / visibility masks are not applied (a filtered texture cannot drop corners): the grid
+  // validity / visibility masks and cell planes are not applied (a filtered texture cannot drop corners): the grid
   // shows the plain trilinear blend (docs/runtime.md, three.js section).
   lightProbeGrid(GridClass, { matrixWorld, type } = {}) {
     if (typeof GridClass !== 'function') throw new TypeError('zhc: lightProbeGrid needs three.js\'s LightProbeGridWebGL or LightProbeGrid class');
@@ -209,8 +212,11 @@ export function lightProbeGridAtlas(volume, half = false) {
 // Parses one volume's JSON (and the accessor arrays already loaded) into a ZhcProbeVolume.
 // Throws Error naming the problem on malformed input.
 // validityArray / visibilityArray: the optional `validity` / `visibility` accessors (count bytes,
-// glTF probe order, masks in glTF grid axes: docs/gltf-extension.md), or null.
-export function buildVolume(v, coefficientsArray, positionsArray, validityArray = null, visibilityArray = null) {
+// glTF probe order, masks in glTF grid axes: docs/gltf-extension.md), or null. planesArray /
+// planeSidesArray: the optional `planes` (4 count bytes) / `planeSides` (count bytes) accessors,
+// both or neither (docs/gltf-extension.md "Cell planes"), or null.
+export function buildVolume(v, coefficientsArray, positionsArray, validityArray = null, visibilityArray = null,
+  planesArray = null, planeSidesArray = null) {
   if (typeof v.encoding !== 'string') throw new Error('ZHC_light_probes: missing encoding');
   const enc = encodingInfo(v.encoding);
   const count = v.count;
@@ -259,11 +265,36 @@ export function buildVolume(v, coefficientsArray, positionsArray, validityArray 
   };
   const validity = perProbe(validityArray, 'validity'), visibility = perProbe(visibilityArray, 'visibility');
   if (visibility && v.layout !== 'grid') throw new Error('ZHC_light_probes: visibility needs layout grid');
+  const planes = cellPlanes(v, count, planesArray, planeSidesArray);
   return new ZhcProbeVolume({
     name: v.name, encoding: encodingName(v.encoding), kind: params.kind, count, shAxes, layout: v.layout, grid: v.grid,
     params, bytesPerProbe: enc.bytes, bytes, positions, sh: decodeAll(v.encoding, bytes, count, params),
-    validity, visibility,
+    validity, visibility, planes,
   });
+}
+
+// The `planes` / `planeSides` accessors as one Uint8Array of 5 bytes per probe in glTF probe
+// order (ou, ov, offset lo, offset hi as stored, then the sides byte in glTF corner bits), or null
+// when both are absent. Throws for one without the other, a layout other than grid, a wrong size,
+// or a plane on a probe that starts no cell (the last along a glTF grid axis of two or more probes).
+function cellPlanes(v, count, planesArray, sidesArray) {
+  if (!planesArray && !sidesArray) return null;
+  if (!planesArray || !sidesArray)
+    throw new Error(`ZHC_light_probes: ${planesArray ? 'planes without planeSides' : 'planeSides without planes'} (the cell planes need both accessors)`);
+  if (v.layout !== 'grid') throw new Error('ZHC_light_probes: planes need layout grid');
+  if (planesArray.length !== 4 * count) throw new Error('ZHC_light_probes: planes accessor size (VEC4, count elements)');
+  if (sidesArray.length !== count) throw new Error('ZHC_light_probes: planeSides accessor size');
+  const [nx, ny, nz] = v.grid.counts;
+  const out = new Uint8Array(5 * count);
+  for (let p = 0; p < count; p++) {
+    for (let b = 0; b < 4; b++) out[5 * p + b] = planesArray[4 * p + b];
+    out[5 * p + 4] = sidesArray[p];
+    const x = p % nx, y = Math.floor(p / nx) % ny, z = Math.floor(p / (nx * ny));
+    const last = (nx > 1 && x + 1 === nx) || (ny > 1 && y + 1 === ny) || (nz > 1 && z + 1 === nz);
+    if (last && !(out[5 * p + 2] === 0x00 && out[5 * p + 3] === 0x80))
+      throw new Error(`ZHC_light_probes: planes accessor: probe ${p} is the last along an axis and starts no cell, but its plane is set`);
+  }
+  return out;
 }
 
 export class ZhcLightProbesPlugin {
@@ -298,7 +329,7 @@ export class ZhcLightProbesPlugin {
       const coeffs = (await this.parser.getDependency('accessor', v.coefficients)).array;
       const pos = v.positions !== undefined ? (await this.parser.getDependency('accessor', v.positions)).array : null;
       const acc = async (key) => (v[key] !== undefined ? (await this.parser.getDependency('accessor', v[key])).array : null);
-      volumes.push(buildVolume(v, coeffs, pos, await acc('validity'), await acc('visibility')));
+      volumes.push(buildVolume(v, coeffs, pos, await acc('validity'), await acc('visibility'), await acc('planes'), await acc('planeSides')));
     }
     for (const v of volumes) v.nodes = [];
     for (const anchor of this.anchors) {
