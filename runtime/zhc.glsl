@@ -725,7 +725,21 @@ vec3 zhcHlshIrradiance(vec3 iz, vec3 ca, vec3 cx, vec3 cy, vec3 m) {
 //
 // Corner (dx, dy, dz) of the cell then weighs w times bit 7 - (dx + 2 dy + 4 dz) of its mask, the
 // weights are divided by their sum, and when all eight vanish the plain trilinear weights are
-// used. Without ZHC_VOLUME_MASK the blend is the plain trilinear one, as before.
+// used.
+//
+// Cell planes (docs/runtime.md "Cell planes"): define also (or instead) ZHC_VOLUME_PLANE(cell) as an
+// expression giving the 5-byte plane entry of the cell whose corner 0 is probe `cell` as a uvec2,
+// .x = bytes 0..3 little-endian (ou | ov << 8 | offset << 16), .y = byte 4 (sides), e.g. from an
+// RG32UI 3D texture with one texel per probe or 2 uints per probe of a buffer:
+//
+//   #define ZHC_VOLUME_PLANE(i) uvec2(zhcPlaneWords[2u * (i)], zhcPlaneWords[2u * (i) + 1u])
+//
+// When the entry's offset is not -32768 the point's side of the plane, dot(n, p - c) - offset
+// |spacing| / 65534 >= 0 (n the octahedral code's normal, c the cell's centre; float), drops the
+// corners whose sides bit k = dx + 2 dy + 4 dz differs, before the renormalisation above. With
+// ZHC_VOLUME_PLANE_AXES_GLTF defined the grid is in glTF axes while the code's normal is in zhc
+// axes: the normal used is (n.y, n.z, n.x). Without ZHC_VOLUME_MASK and ZHC_VOLUME_PLANE the blend
+// is the plain trilinear one.
 
 struct ZhcVolume {
     vec3 origin;   // position of probe (0, 0, 0)
@@ -742,6 +756,31 @@ ZhcSh3 zhcVolumeProbe(uint probe, ZhcFormat f) {
     return zhcDecode(w, f);
 }
 
+#ifdef ZHC_VOLUME_PLANE
+// The unit normal of a cell plane's octahedral code (ou, ov) (zhc_plane_normal of zhc_runtime.h, in
+// float): a = min(code, 254) / 127 - 1, z = 1 - |a| - |b|, folded when z < 0.
+vec3 zhcPlaneNormal(uint ou, uint ov) {
+    vec2 ab = vec2(float(min(ou, 254u)), float(min(ov, 254u))) / 127.0 - 1.0;
+    float z = 1.0 - abs(ab.x) - abs(ab.y);
+    if (z < 0.0) ab = (1.0 - abs(ab.yx)) * mix(vec2(-1.0), vec2(1.0), greaterThanEqual(ab, vec2(0.0)));
+    return normalize(vec3(ab, z));
+}
+
+// The corners kept by the plane entry e (ZHC_VOLUME_PLANE's uvec2) of the cell with first probe i0
+// at p: bit k set when corner k's sides bit equals p's side; 0xFF when the entry has no plane.
+uint zhcVolumePlaneKeep(uvec2 e, ZhcVolume v, uvec3 i0, vec3 p) {
+    int offset = int(e.x) >> 16;  // bytes 2-3, sign-extended
+    if (offset == -32768) return 0xFFu;
+    vec3 nrm = zhcPlaneNormal(e.x & 0xFFu, (e.x >> 8) & 0xFFu);
+#ifdef ZHC_VOLUME_PLANE_AXES_GLTF
+    nrm = nrm.yzx;  // glTF (x, y, z) = zhc (y, z, x)
+#endif
+    vec3 c = v.origin + (vec3(i0) + 0.5) * v.spacing;
+    float s = dot(nrm, p - c) - float(offset) * (length(v.spacing) / 65534.0);
+    return (s >= 0.0 ? e.y : ~e.y) & 0xFFu;
+}
+#endif
+
 // Blended SH3 radiance at p: t = clamp((p - origin) / spacing, 0, counts - 1) (NaN: 0), cell
 // i0 = min(floor(t), counts - 2), weights prod (f or 1 - f), f = t - i0. ~8 x (fetch + decode +
 // 27 fma) + 20 flops.
@@ -752,16 +791,24 @@ ZhcSh3 zhcVolumeSh3(ZhcVolume v, ZhcFormat f, vec3 p) {
     t = min(t, vec3(n - 1u));
     uvec3 i0 = min(uvec3(t), max(n, uvec3(2u)) - 2u);
     vec3 fr = t - vec3(i0);
-#ifdef ZHC_VOLUME_MASK
-    // Masked weights (8 mask loads, ~8 selects + 8 adds + 8 divisions), then the blend below.
+#if defined(ZHC_VOLUME_MASK) || defined(ZHC_VOLUME_PLANE)
+    // Kept weights (validity and visibility: 8 mask loads; a plane: 1 entry load + a side test),
+    // ~8 selects + 8 adds + 8 divisions, then the blend below.
+    uint planeKeep = 0xFFu;  // bit k: corner k is on the point's side of the cell's plane (or no plane)
+#ifdef ZHC_VOLUME_PLANE
+    planeKeep = zhcVolumePlaneKeep(uvec2(ZHC_VOLUME_PLANE(i0.x + n.x * (i0.y + n.y * i0.z))), v, i0, p);
+#endif
     float wm[8];
     float sum = 0.0;
     for (uint c = 0u; c < 8u; ++c) {
         uvec3 b = uvec3(c & 1u, (c >> 1) & 1u, c >> 2);
         vec3 wv = mix(1.0 - fr, fr, notEqual(b, uvec3(0u)));
         float w = wv.x * wv.y * wv.z;
+        uint bit = w == 0.0 ? 0u : (planeKeep >> c) & 1u;
+#ifdef ZHC_VOLUME_MASK
         uvec3 q = i0 + b;
-        uint bit = w == 0.0 ? 0u : (uint(ZHC_VOLUME_MASK(q.x + n.x * (q.y + n.y * q.z))) >> (7u - c)) & 1u;
+        bit = bit == 0u ? 0u : (uint(ZHC_VOLUME_MASK(q.x + n.x * (q.y + n.y * q.z))) >> (7u - c)) & 1u;
+#endif
         wm[c] = bit != 0u ? w : 0.0;
         sum += wm[c];
     }
@@ -771,8 +818,8 @@ ZhcSh3 zhcVolumeSh3(ZhcVolume v, ZhcFormat f, vec3 p) {
         uvec3 b = uvec3(c & 1u, (c >> 1) & 1u, c >> 2);
         vec3 wv = mix(1.0 - fr, fr, notEqual(b, uvec3(0u)));
         float w = wv.x * wv.y * wv.z;
-#ifdef ZHC_VOLUME_MASK
-        if (sum > 0.0) w = wm[c] / sum;  // else: every corner masked, plain trilinear
+#if defined(ZHC_VOLUME_MASK) || defined(ZHC_VOLUME_PLANE)
+        if (sum > 0.0) w = wm[c] / sum;  // else: every corner dropped, plain trilinear
 #endif
         if (w == 0.0) continue;
         uvec3 q = i0 + b;

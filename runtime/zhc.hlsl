@@ -838,7 +838,22 @@ float3 zhc_irradz_irradiance_astc(float3 iz, float3 dwa, uint model, float3 n)
 //
 // Corner (dx, dy, dz) of the cell then weighs w times bit 7 - (dx + 2 dy + 4 dz) of its mask, the
 // weights are divided by their sum, and when all eight vanish the plain trilinear weights are
-// used. Without ZHC_VOLUME_MASK the blend is the plain trilinear one.
+// used.
+//
+// Cell planes (docs/runtime.md "Cell planes"): define also (or instead) ZHC_VOLUME_PLANE(cell) as an
+// expression giving the 5-byte plane entry of the cell whose corner 0 is probe `cell` as a uint2,
+// .x = bytes 0..3 little-endian (ou | ov << 8 | offset << 16), .y = byte 4 (sides), e.g. from an
+// RG32UI 3D texture with one texel per probe or 2 uints per probe of a buffer:
+//
+//   ByteAddressBuffer probePlanes;  // 2 words per probe
+//   #define ZHC_VOLUME_PLANE(i) probePlanes.Load2(8u * (i))
+//
+// When the entry's offset is not -32768 the point's side of the plane, dot(n, p - c) - offset
+// |spacing| / 65534 >= 0 (n the octahedral code's normal, c the cell's centre; float), drops the
+// corners whose sides bit k = dx + 2 dy + 4 dz differs, before the renormalisation above. With
+// ZHC_VOLUME_PLANE_AXES_GLTF defined the grid is in glTF axes while the code's normal is in zhc
+// axes: the normal used is (n.y, n.z, n.x). Without ZHC_VOLUME_MASK and ZHC_VOLUME_PLANE the blend
+// is the plain trilinear one.
 struct ZhcVolume
 {
     float3 origin;   // position of probe (0, 0, 0)
@@ -856,6 +871,38 @@ ZhcSH3 zhc_volume_probe(uint probe, ZhcFormat f)
     return zhc_decode_sh3(w, f);
 }
 
+#ifdef ZHC_VOLUME_PLANE
+// The unit normal of a cell plane's octahedral code (ou, ov) (zhc_plane_normal of zhc_runtime.h, in
+// float): a = min(code, 254) / 127 - 1, z = 1 - |a| - |b|, folded when z < 0.
+float3 zhc_plane_normal(uint ou, uint ov)
+{
+    float a = float(min(ou, 254u)) / 127.0f - 1.0f, b = float(min(ov, 254u)) / 127.0f - 1.0f;
+    float z = 1.0f - abs(a) - abs(b);
+    if (z < 0.0f)
+    {
+        float a0 = a;
+        a = (1.0f - abs(b)) * (a0 >= 0.0f ? 1.0f : -1.0f);
+        b = (1.0f - abs(a0)) * (b >= 0.0f ? 1.0f : -1.0f);
+    }
+    return normalize(float3(a, b, z));
+}
+
+// The corners kept by the plane entry e (ZHC_VOLUME_PLANE's uint2) of the cell with first probe i0
+// at p: bit k set when corner k's sides bit equals p's side; 0xFF when the entry has no plane.
+uint zhc_volume_plane_keep(uint2 e, ZhcVolume v, uint3 i0, float3 p)
+{
+    int offset = asint(e.x) >> 16;  // bytes 2-3, sign-extended
+    if (offset == -32768) return 0xFFu;
+    float3 nrm = zhc_plane_normal(e.x & 0xFFu, (e.x >> 8) & 0xFFu);
+#ifdef ZHC_VOLUME_PLANE_AXES_GLTF
+    nrm = nrm.yzx;  // glTF (x, y, z) = zhc (y, z, x)
+#endif
+    float3 c = v.origin + (float3(i0) + 0.5f) * v.spacing;
+    float s = dot(nrm, p - c) - float(offset) * (length(v.spacing) / 65534.0f);
+    return (s >= 0.0f ? e.y : ~e.y) & 0xFFu;
+}
+#endif
+
 // Blended SH3 radiance at p: t = clamp((p - origin) / spacing, 0, counts - 1) (NaN: 0), cell
 // i0 = min(floor(t), counts - 2), weights prod (f or 1 - f), f = t - i0.
 ZhcSH3 zhc_volume_sh3(ZhcVolume v, ZhcFormat f, float3 p)
@@ -866,8 +913,13 @@ ZhcSH3 zhc_volume_sh3(ZhcVolume v, ZhcFormat f, float3 p)
     t = min(t, float3(n - 1u));
     uint3 i0 = min(uint3(t), max(n, uint3(2u, 2u, 2u)) - 2u);
     float3 fr = t - float3(i0);
-#ifdef ZHC_VOLUME_MASK
-    // Masked weights (8 mask loads, ~8 selects + 8 adds + 8 divisions), then the blend below.
+#if defined(ZHC_VOLUME_MASK) || defined(ZHC_VOLUME_PLANE)
+    // Kept weights (validity and visibility: 8 mask loads; a plane: 1 entry load + a side test),
+    // ~8 selects + 8 adds + 8 divisions, then the blend below.
+    uint planeKeep = 0xFFu;  // bit k: corner k is on the point's side of the cell's plane (or no plane)
+#ifdef ZHC_VOLUME_PLANE
+    planeKeep = zhc_volume_plane_keep(uint2(ZHC_VOLUME_PLANE(i0.x + n.x * (i0.y + n.y * i0.z))), v, i0, p);
+#endif
     float wm[8];
     float sum = 0.0f;
     [unroll] for (uint m = 0u; m < 8u; ++m)
@@ -877,8 +929,11 @@ ZhcSH3 zhc_volume_sh3(ZhcVolume v, ZhcFormat f, float3 p)
         float wy = b.y != 0u ? fr.y : 1.0f - fr.y;
         float wz = b.z != 0u ? fr.z : 1.0f - fr.z;
         float w = wx * wy * wz;
+        uint bit = w == 0.0f ? 0u : (planeKeep >> m) & 1u;
+#ifdef ZHC_VOLUME_MASK
         uint3 q = i0 + b;
-        uint bit = w == 0.0f ? 0u : (uint(ZHC_VOLUME_MASK(q.x + n.x * (q.y + n.y * q.z))) >> (7u - m)) & 1u;
+        if (bit != 0u) bit = (uint(ZHC_VOLUME_MASK(q.x + n.x * (q.y + n.y * q.z))) >> (7u - m)) & 1u;
+#endif
         wm[m] = bit != 0u ? w : 0.0f;
         sum += wm[m];
     }
@@ -892,8 +947,8 @@ ZhcSH3 zhc_volume_sh3(ZhcVolume v, ZhcFormat f, float3 p)
         float wy = b.y != 0u ? fr.y : 1.0f - fr.y;
         float wz = b.z != 0u ? fr.z : 1.0f - fr.z;
         float w = wx * wy * wz;
-#ifdef ZHC_VOLUME_MASK
-        if (sum > 0.0f) w = wm[c] / sum;  // else: every corner masked, plain trilinear
+#if defined(ZHC_VOLUME_MASK) || defined(ZHC_VOLUME_PLANE)
+        if (sum > 0.0f) w = wm[c] / sum;  // else: every corner dropped, plain trilinear
 #endif
         if (w == 0.0f) continue;
         uint3 q = i0 + b;

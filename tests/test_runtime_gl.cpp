@@ -36,6 +36,7 @@
 #include "codec/probe/runtime_table.h"
 #include "codec/probe/zh3.h"
 #include "support.h"
+#include "volume_planes_cases.h"
 #include "zhc_runtime.h"
 #include "zhc_runtime_params.hpp"
 
@@ -62,6 +63,11 @@ layout(std430, binding = 0) readonly buffer Words { uint words[]; };
 const char* kTestMaskPrelude = R"(
 layout(std430, binding = 3) readonly buffer Masks { uint masks[]; };
 #define ZHC_VOLUME_MASK(i) ((masks[(i) >> 2] >> (8u * ((i) & 3u))) & 0xFFu)
+)";
+// The plane variants' extra prelude: per-probe cell-plane entries, 2 words each (ZHC_VOLUME_PLANE).
+const char* kTestPlanePrelude = R"(
+layout(std430, binding = 4) readonly buffer Planes { uint planeWords[]; };
+#define ZHC_VOLUME_PLANE(i) uvec2(planeWords[2u * (i)], planeWords[2u * (i) + 1u])
 )";
 const char* kTestMain = R"(
 layout(local_size_x = 64) in;
@@ -119,6 +125,16 @@ void main() {
         vec3 nn = vec3(normals[6u * i + 3u], normals[6u * i + 4u], normals[6u * i + 5u]);
         vec3 e = zhcVolumeIrradiance(ZhcVolume(uVolOrigin, uVolSpacing, uVolCounts), f, p, nn);
         outv[o] = e.x; outv[o + 1u] = e.y; outv[o + 2u] = e.z;
+#ifdef ZHC_VOLUME_PLANE
+        {  // the corners the cell's plane keeps at p (zhcVolumeSh3's cell)
+            ZhcVolume vv = ZhcVolume(uVolOrigin, uVolSpacing, uVolCounts);
+            uvec3 cn = max(vv.counts, uvec3(1u));
+            vec3 t = (p - vv.origin) / vv.spacing;
+            t = min(mix(vec3(0.0), t, greaterThanEqual(t, vec3(0.0))), vec3(cn - 1u));
+            uvec3 i0 = min(uvec3(t), max(cn, uvec3(2u)) - 2u);
+            outv[o + 3u] = float(zhcVolumePlaneKeep(ZHC_VOLUME_PLANE(i0.x + cn.x * (i0.y + cn.y * i0.z)), vv, i0, p));
+        }
+#endif
     } else if (uMode == 6u) {  // the generated table: item i is encoding id i (ids past the end included)
         outv[o] = float(zhcEncodingBytes(i));
         outv[o + 1u] = float(zhcEncodingFamily(i));
@@ -175,10 +191,13 @@ protected:
             why_ = std::string("cannot read ") + ZHC_RUNTIME_GLSL_PATH;
             return;
         }
-        // Two programs: the plain one, and one with ZHC_VOLUME_MASK (validity and visibility).
-        for (int masked = 0; masked < 2; ++masked) {
+        // Four programs: the plain one, one with ZHC_VOLUME_MASK (validity and visibility), one with
+        // ZHC_VOLUME_MASK and ZHC_VOLUME_PLANE, one with ZHC_VOLUME_PLANE alone on a glTF-axes grid.
+        for (int variant = 0; variant < kPrograms; ++variant) {
+            const bool masked = variant == kMasked || variant == kPlanes, planes = variant == kPlanes || variant == kPlanesGltf;
             const std::string source = std::string(kEs ? "#version 310 es\n" : "#version 450\n") + kTestPrelude +
-                                       (masked ? kTestMaskPrelude : "") + library + kTestMain;
+                                       (masked ? kTestMaskPrelude : "") + (planes ? kTestPlanePrelude : "") +
+                                       (variant == kPlanesGltf ? "#define ZHC_VOLUME_PLANE_AXES_GLTF 1\n" : "") + library + kTestMain;
             const char* src = source.c_str();
             GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
             glShaderSource(sh, 1, &src, nullptr);
@@ -197,7 +216,7 @@ protected:
             glLinkProgram(prog);
             glDeleteShader(sh);
             glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-            (masked ? masked_program_ : program_) = prog;
+            programs_[variant] = prog;
             if (!ok) {
                 char log[8192] = {};
                 glGetProgramInfoLog(prog, sizeof log, nullptr, log);
@@ -205,12 +224,12 @@ protected:
                 return;
             }
         }
-        glGenBuffers(4, buffers_);
+        glGenBuffers(5, buffers_);
     }
     static void TearDownTestSuite() {
-        if (program_) glDeleteProgram(program_);
-        if (masked_program_) glDeleteProgram(masked_program_);
-        if (buffers_[0]) glDeleteBuffers(4, buffers_);
+        for (GLuint& prog : programs_)
+            if (prog) glDeleteProgram(prog);
+        if (buffers_[0]) glDeleteBuffers(5, buffers_);
         test::destroy_context(&egl_);
     }
     void SetUp() override {
@@ -219,6 +238,7 @@ protected:
     }
 
 public:
+    enum Program { kPlain, kMasked, kPlanes, kPlanesGltf, kPrograms };
     struct Uniforms {
         std::uint32_t mode = 0, stride = 0;
         std::uint32_t a[4] = {0, 0, 0, 0}, b[4] = {0, 0, 0, 0};
@@ -228,7 +248,7 @@ public:
 
     // The grid of mode 4 (probe volume).
     static void set_volume(const float origin[3], const float spacing[3], const std::uint32_t counts[3]) {
-        for (GLuint prog : {program_, masked_program_}) {
+        for (GLuint prog : programs_) {
             glProgramUniform3f(prog, glGetUniformLocation(prog, "uVolOrigin"), origin[0], origin[1], origin[2]);
             glProgramUniform3f(prog, glGetUniformLocation(prog, "uVolSpacing"), spacing[0], spacing[1], spacing[2]);
             glProgramUniform3ui(prog, glGetUniformLocation(prog, "uVolCounts"), counts[0], counts[1], counts[2]);
@@ -236,11 +256,13 @@ public:
     }
 
     // Runs the shader on `count` items; returns count * kOutFloats floats.
-    // With `masks` (4 combined mask bytes per word): the ZHC_VOLUME_MASK program.
+    // With `masks` (4 combined mask bytes per word): the ZHC_VOLUME_MASK program; with `planes` (2
+    // words per probe) the `variant` program (kPlanes: masks and planes, kPlanesGltf: planes alone).
     static std::vector<float> run(const Uniforms& un, const std::vector<std::uint32_t>& words,
                                   const std::vector<float>& normals, std::size_t count,
-                                  const std::vector<std::uint32_t>* masks = nullptr) {
-        const GLuint program = masks ? masked_program_ : program_;
+                                  const std::vector<std::uint32_t>* masks = nullptr,
+                                  const std::vector<std::uint32_t>* planes = nullptr, Program variant = kPlanes) {
+        const GLuint program = programs_[planes ? variant : (masks ? kMasked : kPlain)];
         auto upload = [](GLuint buf, GLuint binding, const void* data, std::size_t bytes) {
             glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
             glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(std::max<std::size_t>(bytes, 16)), nullptr,
@@ -252,6 +274,7 @@ public:
         upload(buffers_[1], 1, normals.data(), normals.size() * 4);
         upload(buffers_[2], 2, nullptr, count * kOutFloats * 4);
         if (masks) upload(buffers_[3], 3, masks->data(), masks->size() * 4);
+        if (planes) upload(buffers_[4], 4, planes->data(), planes->size() * 4);
         glUseProgram(program);
         glUniform1ui(glGetUniformLocation(program, "uCount"), static_cast<GLuint>(count));
         glUniform1ui(glGetUniformLocation(program, "uStride"), un.stride);
@@ -277,8 +300,8 @@ public:
 
 protected:
     static inline test::EglContext egl_;
-    static inline GLuint program_ = 0, masked_program_ = 0;
-    static inline GLuint buffers_[4] = {0, 0, 0, 0};
+    static inline GLuint programs_[kPrograms] = {0, 0, 0, 0};
+    static inline GLuint buffers_[5] = {0, 0, 0, 0, 0};
     static inline std::string why_, renderer_;
 };
 
@@ -862,10 +885,166 @@ void compare_masked_volumes(int samples) {
         }
 }
 
+// Cell planes (ZHC_VOLUME_PLANE, docs/runtime.md "Cell planes") against the C header with
+// zhc_volume::planes set: a 6x5x4 grid per entry, a plane in 3 of 4 cells (random normal code, through
+// a random point of the cell, the corners' sides as the bake writes them), uploaded as 2 words per
+// probe. `gltf` false: the kPlanes program (masks and planes) with random validity (1 in 4 invalid)
+// and visibility (each bit set with p = 3/4); true: the kPlanesGltf program (planes alone,
+// ZHC_VOLUME_PLANE_AXES_GLTF) on the same volume in glTF axes (grid, probe order and sides bits
+// permuted, normal codes kept), sampled at the permuted points, against the header on the zhc-axes
+// volume. Per sample: the corners the plane keeps (the shader's zhcVolumePlaneKeep) equal the
+// header's, and the irradiance lies within compare_masked_volumes' bound, the weight part divided by
+// the kept weight sum M (samples with 0 < M < 1e-3 counted, not compared). Points within 1e-4
+// |spacing| of their cell's plane (or 1e-5 cell widths of a face between cells), where float and
+// double may pick different sides, are counted, not compared.
+template <class Fixture>
+void compare_plane_volumes(int samples, bool gltf) {
+    const std::vector<Sh3Radiance> maps = envmap_probes();
+    ASSERT_EQ(maps.size(), 8u);
+    std::printf("%-22s %8s %10s %8s %6s %8s %s\n", gltf ? "planes (glTF axes)" : "masks + planes", "samples", "max u S", "skipped", "near",
+                "by plane", "corner sets");
+    for (const char* name : {"sh3", "zh3_q16", "sh3_q28", "hall_adaptive_q16"}) {
+        const Codec* codec = find_codec(name);
+        ASSERT_NE(codec, nullptr);
+        const GlslEntry& e = glsl_entries().at(name);
+        std::mt19937_64 rng(0x9a7u + codec->size_bytes + (gltf ? 1u : 0u));
+        std::uniform_real_distribution<double> u(0, 1);
+        const std::uint32_t counts[3] = {6, 5, 4};
+        const float origin_f[3] = {-1.5f, 2.0f, 0.25f}, spacing_f[3] = {0.75f, 0.5f, 1.25f};
+        const double origin[3] = {origin_f[0], origin_f[1], origin_f[2]};
+        const double spacing[3] = {spacing_f[0], spacing_f[1], spacing_f[2]};
+        const std::uint32_t count = counts[0] * counts[1] * counts[2];
+        const CodecOptions p{};
+        std::vector<std::uint8_t> bytes(count * codec->size_bytes), validity(count), visibility(count);
+        std::vector<Sh3Radiance> decoded;
+        std::vector<std::uint32_t> masks((count + 3) / 4, 0);
+        for (std::uint32_t i = 0; i < count; ++i) {
+            encode_probe(*codec, p, random_probe(rng, maps, int(i % 3)), bytes.data() + i * codec->size_bytes, nullptr);
+            decoded.push_back(decode_probe(*codec, p, bytes.data() + i * codec->size_bytes));
+            validity[i] = rng() % 4 == 0 ? 0 : 1;
+            visibility[i] = std::uint8_t(rng() | rng());
+            masks[i / 4] |= std::uint32_t(validity[i] ? visibility[i] : 0u) << (8 * (i % 4));
+        }
+        const std::vector<std::uint8_t> planes = planes_test::random_cell_planes(rng, origin, spacing, counts, 0.75);
+        zhc_probe_format fmt;
+        ASSERT_TRUE(runtime_format(name, p, &fmt));
+        zhc_volume vol;
+        ASSERT_EQ(zhc_volume_init(&vol, &fmt, bytes.data(), bytes.size(), origin, spacing, counts), ZHC_OK);
+        if (!gltf) {
+            vol.validity = validity.data();
+            vol.visibility = visibility.data();
+        }
+        vol.planes = planes.data();
+        // The GPU's copy: zhc axes, or glTF axes (probe words and plane entries in glTF order).
+        const planes_test::GltfGrid g = planes_test::gltf_grid(origin, spacing, counts);
+        std::vector<std::uint8_t> gpu_bytes = bytes;
+        if (gltf)
+            for (std::uint32_t j = 0; j < count; ++j)
+                std::memcpy(gpu_bytes.data() + j * codec->size_bytes, bytes.data() + g.gltf_to_zhc[j] * codec->size_bytes, codec->size_bytes);
+        const std::vector<std::uint32_t> plane_words = planes_test::plane_words(gltf ? planes_test::gltf_planes(g, planes) : planes);
+        std::vector<float> items;
+        std::vector<double> positions;  // zhc axes
+        for (int i = 0; i < samples; ++i) {
+            float pos[3];
+            for (int c = 0; c < 3; ++c) {
+                const double size = (counts[c] - 1) * spacing[c];
+                pos[c] = float(origin[c] - 0.25 * size + 1.5 * size * u(rng));
+                positions.push_back(pos[c]);
+            }
+            for (int c = 0; c < 3; ++c) items.push_back(gltf ? pos[(c + 1) % 3] : pos[c]);
+            const Vec3 n = test::uniform_direction(u(rng), u(rng));
+            items.push_back(float(n.x));
+            items.push_back(float(n.y));
+            items.push_back(float(n.z));
+        }
+        std::vector<std::uint32_t> w(gpu_bytes.size() / 4);
+        std::memcpy(w.data(), gpu_bytes.data(), gpu_bytes.size());
+        typename Fixture::Uniforms un;
+        un.mode = 4;
+        un.a[0] = e.family;
+        un.a[1] = e.hallucination;
+        un.a[2] = static_cast<std::uint32_t>(p.bits);
+        un.a[3] = p.sqrt_encoding ? 1u : 0u;
+        un.b[0] = static_cast<std::uint32_t>(p.l2_bound);
+        un.b[1] = static_cast<std::uint32_t>(p.dc_format);
+        un.b[2] = static_cast<std::uint32_t>(p.zonal_mapping);
+        un.b[3] = axis_mode(e, p);
+        un.kind = static_cast<std::uint32_t>(p.kind);
+        un.lum[0] = static_cast<float>(p.luminance.r);
+        un.lum[1] = static_cast<float>(p.luminance.g);
+        un.lum[2] = static_cast<float>(p.luminance.b);
+        un.curve[0] = static_cast<float>(p.hallucinate_a);
+        un.curve[1] = static_cast<float>(p.hallucinate_b);
+        if (gltf) {
+            const float go[3] = {float(g.origin[0]), float(g.origin[1]), float(g.origin[2])};
+            const float gs[3] = {float(g.spacing[0]), float(g.spacing[1]), float(g.spacing[2])};
+            Fixture::set_volume(go, gs, g.counts);
+        } else {
+            Fixture::set_volume(origin_f, spacing_f, counts);
+        }
+        const std::vector<float> gpu = Fixture::run(un, w, items, std::size_t(samples), gltf ? nullptr : &masks, &plane_words,
+                                                    gltf ? Fixture::kPlanesGltf : Fixture::kPlanes);
+        Tally t;
+        long compared = 0, skipped = 0, near = 0, by_plane = 0, keep_compared = 0, keep_wrong = 0;
+        std::string first_keep;
+        for (int i = 0; i < samples; ++i) {
+            const double* pos = positions.data() + 3 * size_t(i);
+            const double nrm[3] = {items[6 * size_t(i) + 3], items[6 * size_t(i) + 4], items[6 * size_t(i) + 5]};
+            const planes_test::Sample sm = planes_test::sample(vol, pos);
+            if (sm.near) {
+                ++near;
+                continue;
+            }
+            const unsigned want_keep = gltf ? planes_test::gltf_sides(std::uint8_t(sm.plane_keep)) : sm.plane_keep;
+            const unsigned got_keep = unsigned(gpu[size_t(i) * kOutFloats + 3]);
+            ++keep_compared;
+            if (got_keep != want_keep && keep_wrong++ == 0)
+                first_keep = std::string(name) + " sample " + std::to_string(i) + ": shader keeps " + std::to_string(got_keep) +
+                             ", C " + std::to_string(want_keep);
+            by_plane += sm.plane_keep != 0xFF;
+            double ref[3];
+            zhc_volume_irradiance_d(&vol, pos, nrm, ref);
+            double scale[3] = {0, 0, 0}, extra = 0;
+            for (int c = 0; c < 3; ++c)
+                extra += (std::fabs(pos[c]) + std::fabs(origin[c])) / spacing[c] +
+                         std::min(std::max((pos[c] - origin[c]) / spacing[c], 0.0), double(counts[c] - 1)) + 2;
+            for (int b = 0; b < 8; ++b) {
+                const std::uint32_t q[3] = {sm.i0[0] + (b & 1), sm.i0[1] + ((b >> 1) & 1), sm.i0[2] + (b >> 2)};
+                const Scale sc = probe_scale(e, p, decoded[q[0] + counts[0] * (q[1] + counts[1] * q[2])]);
+                for (int k = 0; k < 3; ++k) scale[k] += sc.irradiance[k];
+            }
+            double bound = 48 + 3 * extra;
+            if (sm.kept_sum > 0) {
+                if (sm.kept_sum < 1e-3) {
+                    ++skipped;
+                    continue;
+                }
+                bound = 2 * bound / sm.kept_sum;
+            }
+            ++compared;
+            for (int k = 0; k < 3; ++k)
+                check_value(t, &t.max_irr, ref[k], gpu[size_t(i) * kOutFloats + std::size_t(k)], scale[k], bound,
+                            std::string(name) + " sample " + std::to_string(i) + " channel " + std::to_string(k));
+        }
+        std::printf("%-22s %8ld %10.3f %8ld %6ld %8ld %ld of %ld equal\n", name, compared, t.max_irr, skipped, near, by_plane,
+                    keep_compared - keep_wrong, keep_compared);
+        EXPECT_EQ(t.failures, 0) << name << ": " << t.first_failure;
+        EXPECT_EQ(t.compared, 3 * compared) << name;
+        EXPECT_EQ(keep_wrong, 0) << first_keep;
+        EXPECT_LE(skipped, samples / 100) << name;
+        EXPECT_LE(near, samples / 100) << name;
+        EXPECT_GT(by_plane, samples / 4) << name << ": the planes act";
+    }
+}
+
 TEST_F(RuntimeGl, ProbeVolumesMatchTheCHeader) { compare_volumes<RuntimeGl>(int(test::sample_count(10000))); }
 TEST_F(RuntimeGl, MaskedProbeVolumesMatchTheCHeader) { compare_masked_volumes<RuntimeGl>(int(test::sample_count(10000))); }
 TEST_F(RuntimeGles, MaskedProbeVolumesMatchTheCHeader) { compare_masked_volumes<RuntimeGles>(int(test::sample_count(2000))); }
 TEST_F(RuntimeGles, ProbeVolumesMatchTheCHeader) { compare_volumes<RuntimeGles>(int(test::sample_count(2000))); }
+TEST_F(RuntimeGl, PlaneProbeVolumesMatchTheCHeader) { compare_plane_volumes<RuntimeGl>(int(test::sample_count(10000)), false); }
+TEST_F(RuntimeGl, PlaneProbeVolumesInGltfAxesMatchTheCHeader) { compare_plane_volumes<RuntimeGl>(int(test::sample_count(10000)), true); }
+TEST_F(RuntimeGles, PlaneProbeVolumesMatchTheCHeader) { compare_plane_volumes<RuntimeGles>(int(test::sample_count(2000)), false); }
+TEST_F(RuntimeGles, PlaneProbeVolumesInGltfAxesMatchTheCHeader) { compare_plane_volumes<RuntimeGles>(int(test::sample_count(2000)), true); }
 
 }  // namespace
 }  // namespace zhc

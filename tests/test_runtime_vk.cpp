@@ -45,6 +45,7 @@
 #include "codec/probe/zh3.h"
 #include "support.h"
 #include "vk_compute.h"
+#include "volume_planes_cases.h"
 #include "zhc_runtime.h"
 #include "zhc_runtime_params.hpp"
 
@@ -83,14 +84,18 @@ public:
     // failure). One pipeline and one set of buffers serve every call (pipeline creation is the slow part).
     static constexpr std::size_t kCapacity = 1u << 17;
     // params: 16 uints, or 32 for the probe-volume mode (grid in params 16..24).
-    // masked: the ZHC_VOLUME_MASK build (runtime_test_masked.spv; masks at word params[25]).
+    // variant: the build of runtime_test.hlsl: kMasked ZHC_VOLUME_MASK (runtime_test_masked.spv; masks
+    // at word params[25]), kPlanes ZHC_VOLUME_MASK and ZHC_VOLUME_PLANE (runtime_test_planes.spv;
+    // plane entries at word params[26]), kPlanesGltf ZHC_VOLUME_PLANE alone with
+    // ZHC_VOLUME_PLANE_AXES_GLTF (runtime_test_planes_gltf.spv).
+    enum Variant { kPlain, kMasked, kPlanes, kPlanesGltf, kVariants };
     std::vector<float> run(const std::uint32_t* params, const std::vector<std::uint32_t>& words,
-                           const std::vector<float>& normals4, std::size_t count, bool masked = false) {
+                           const std::vector<float>& normals4, std::size_t count, Variant variant = kPlain) {
         std::string err;
-        std::unique_ptr<vk::Kernel>& kernel_ = masked ? masked_kernel_ : plain_kernel_;
+        std::unique_ptr<vk::Kernel>& kernel_ = kernels_[variant];
         if (!kernel_) {
             const std::size_t sizes[4] = {32 * 4, kCapacity * 27 * 4, kCapacity * 16, kCapacity * kOutFloats * 4};
-            kernel_ = context_->make_kernel(masked ? masked_spirv_ : spirv_, sizes, &err);
+            kernel_ = context_->make_kernel(spirv_[variant], sizes, &err);
             if (!kernel_) {
                 ADD_FAILURE() << err;
                 return {};
@@ -116,17 +121,20 @@ public:
 private:
     Gpu() {
         vk::force_icd(ZHC_LVP_ICD);
-        spirv_ = vk::read_spirv(ZHC_RUNTIME_TEST_SPV);
-        masked_spirv_ = vk::read_spirv(ZHC_RUNTIME_TEST_MASKED_SPV);
-        if (spirv_.empty() || masked_spirv_.empty()) {
-            error_ = std::string("cannot read ") + ZHC_RUNTIME_TEST_SPV + " or " + ZHC_RUNTIME_TEST_MASKED_SPV;
-            return;
+        const char* paths[kVariants] = {ZHC_RUNTIME_TEST_SPV, ZHC_RUNTIME_TEST_MASKED_SPV, ZHC_RUNTIME_TEST_PLANES_SPV,
+                                        ZHC_RUNTIME_TEST_PLANES_GLTF_SPV};
+        for (int v = 0; v < kVariants; ++v) {
+            spirv_[v] = vk::read_spirv(paths[v]);
+            if (spirv_[v].empty()) {
+                error_ = std::string("cannot read ") + paths[v];
+                return;
+            }
         }
         context_ = vk::Context::create(true, &error_);
     }
-    std::vector<std::uint32_t> spirv_, masked_spirv_;
+    std::vector<std::uint32_t> spirv_[kVariants];
     std::unique_ptr<vk::Context> context_;
-    std::unique_ptr<vk::Kernel> plain_kernel_, masked_kernel_;  // destroyed before context_ (declared after it)
+    std::unique_ptr<vk::Kernel> kernels_[kVariants];  // destroyed before context_ (declared after it)
     std::string error_;
 };
 
@@ -836,7 +844,7 @@ TEST_F(RuntimeVk, MaskedProbeVolumesMatchTheCHeader) {
             words.resize(words.size() + (count + 3) / 4, 0);
             for (std::uint32_t i = 0; i < count; ++i)
                 words[params[25] + i / 4] |= std::uint32_t(validity[i] ? visibility[i] : 0) << (8 * (i % 4));
-            const std::vector<float> out = Gpu::get().run(params, words, items, std::size_t(samples), /*masked=*/true);
+            const std::vector<float> out = Gpu::get().run(params, words, items, std::size_t(samples), Gpu::kMasked);
             ASSERT_EQ(out.size(), std::size_t(samples) * kOutFloats);
             double max_rel = 0;
             long compared = 0, failures = 0, skipped = 0, renormalised = 0;
@@ -891,6 +899,168 @@ TEST_F(RuntimeVk, MaskedProbeVolumesMatchTheCHeader) {
             EXPECT_LE(skipped, samples / 100) << name;
             EXPECT_TRUE(all_invalid ? renormalised == 0 : renormalised > samples / 2) << name << ": " << renormalised;
         }
+}
+
+// Cell planes (ZHC_VOLUME_PLANE, docs/runtime.md "Cell planes") against the C header with
+// zhc_volume::planes: a 6x5x4 grid per entry, a plane in 3 of 4 cells (random normal code through a
+// random point of the cell, the corners' sides as the bake writes them), 2 words per probe after the
+// masks. runtime_test_planes.spv: with random validity (1 in 4 invalid) and visibility (each bit set
+// with p = 3/4); runtime_test_planes_gltf.spv: planes alone with ZHC_VOLUME_PLANE_AXES_GLTF on the
+// same volume in glTF axes (grid, probe order and sides bits permuted, normal codes kept) at the
+// permuted points, against the header on the zhc-axes volume. Per sample the corners the plane keeps
+// (zhc_volume_plane_keep) equal the header's, and the irradiance lies within
+// MaskedProbeVolumesMatchTheCHeader's bound with M the kept weight sum (0 < M < 1e-3: counted, not
+// compared). Points within 1e-4 |spacing| of their cell's plane (or 1e-5 cell widths of a face
+// between cells) are counted, not compared.
+TEST_F(RuntimeVk, PlaneProbeVolumesMatchTheCHeader) {
+    const int samples = int(test::sample_count(10000));
+    for (const bool gltf : {false, true}) {
+        std::printf("%-22s %8s %12s %8s %6s %8s %s\n", gltf ? "planes (glTF axes)" : "masks + planes", "samples", "max err/eps T", "skipped",
+                    "near", "by plane", "corner sets");
+        for (const char* name : {"sh3", "zh3_q16", "sh3_q28", "hall_adaptive_q16"}) {
+            const Codec* codec = find_codec(name);
+            ASSERT_NE(codec, nullptr);
+            const int id = hlsl_encoding(name);
+            ASSERT_GE(id, 0) << name;
+            std::mt19937_64 rng(0x706cu + codec->size_bytes + (gltf ? 1u : 0u));
+            std::uniform_real_distribution<double> u(0, 1);
+            const std::uint32_t counts[3] = {6, 5, 4};
+            const float origin_f[3] = {-1.5f, 2.0f, 0.25f}, spacing_f[3] = {0.75f, 0.5f, 1.25f};
+            const double origin[3] = {origin_f[0], origin_f[1], origin_f[2]};
+            const double spacing[3] = {spacing_f[0], spacing_f[1], spacing_f[2]};
+            const std::uint32_t count = counts[0] * counts[1] * counts[2];
+            const CodecOptions p;
+            std::vector<std::uint8_t> bytes(count * codec->size_bytes), validity(count), visibility(count);
+            std::vector<Sh3Radiance> decoded;
+            for (std::uint32_t i = 0; i < count; ++i) {
+                const Sh3Radiance hub = i % 3 == 0 ? random_lights(rng) : (i % 3 == 1 ? random_sh(rng) : random_envmap(rng));
+                encode_probe(*codec, p, hub, bytes.data() + i * codec->size_bytes, nullptr);
+                decoded.push_back(decode_probe(*codec, p, bytes.data() + i * codec->size_bytes));
+                validity[i] = rng() % 4 == 0 ? 0 : 1;
+                visibility[i] = std::uint8_t(rng() | rng());
+            }
+            const std::vector<std::uint8_t> planes = planes_test::random_cell_planes(rng, origin, spacing, counts, 0.75);
+            zhc_probe_format fmt;
+            ASSERT_TRUE(runtime_format(name, p, &fmt));
+            zhc_volume vol;
+            ASSERT_EQ(zhc_volume_init(&vol, &fmt, bytes.data(), bytes.size(), origin, spacing, counts), ZHC_OK);
+            if (!gltf) {
+                vol.validity = validity.data();
+                vol.visibility = visibility.data();
+            }
+            vol.planes = planes.data();
+            const planes_test::GltfGrid g = planes_test::gltf_grid(origin, spacing, counts);
+            std::vector<std::uint8_t> gpu_bytes = bytes;
+            if (gltf)
+                for (std::uint32_t j = 0; j < count; ++j)
+                    std::memcpy(gpu_bytes.data() + j * codec->size_bytes, bytes.data() + g.gltf_to_zhc[j] * codec->size_bytes,
+                                codec->size_bytes);
+            std::vector<float> items;  // position, 0, normal, 0
+            std::vector<double> positions;  // zhc axes
+            for (int i = 0; i < samples; ++i) {
+                float pos[3];
+                for (int c = 0; c < 3; ++c) {
+                    const double size = (counts[c] - 1) * spacing[c];
+                    pos[c] = float(origin[c] - 0.25 * size + 1.5 * size * u(rng));
+                    positions.push_back(pos[c]);
+                }
+                for (int c = 0; c < 3; ++c) items.push_back(gltf ? pos[(c + 1) % 3] : pos[c]);
+                items.push_back(0.0f);
+                add_normal(rng, &items);
+            }
+            std::uint32_t params[32] = {static_cast<std::uint32_t>(id),
+                                        static_cast<std::uint32_t>(p.bits),
+                                        p.sqrt_encoding ? 1u : 0u,
+                                        static_cast<std::uint32_t>(p.l2_bound),
+                                        static_cast<std::uint32_t>(p.dc_format),
+                                        static_cast<std::uint32_t>(p.zonal_mapping),
+                                        static_cast<std::uint32_t>(p.axis_mode),
+                                        static_cast<std::uint32_t>(p.kind),
+                                        float_bits(static_cast<float>(p.luminance.r)),
+                                        float_bits(static_cast<float>(p.luminance.g)),
+                                        float_bits(static_cast<float>(p.luminance.b)),
+                                        float_bits(static_cast<float>(p.hallucinate_a)),
+                                        float_bits(static_cast<float>(p.hallucinate_b)),
+                                        static_cast<std::uint32_t>(samples),
+                                        static_cast<std::uint32_t>(codec->size_bytes / 4),
+                                        3u};
+            for (int c = 0; c < 3; ++c) {
+                params[16 + c] = float_bits(gltf ? float(g.origin[c]) : origin_f[c]);
+                params[19 + c] = float_bits(gltf ? float(g.spacing[c]) : spacing_f[c]);
+                params[22 + c] = gltf ? g.counts[c] : counts[c];
+            }
+            std::vector<std::uint32_t> words(gpu_bytes.size() / 4);
+            std::memcpy(words.data(), gpu_bytes.data(), gpu_bytes.size());
+            params[25] = static_cast<std::uint32_t>(words.size());
+            words.resize(words.size() + (count + 3) / 4, 0);
+            for (std::uint32_t i = 0; i < count; ++i)
+                words[params[25] + i / 4] |= std::uint32_t(validity[i] ? visibility[i] : 0) << (8 * (i % 4));
+            params[26] = static_cast<std::uint32_t>(words.size());
+            const std::vector<std::uint32_t> pw = planes_test::plane_words(gltf ? planes_test::gltf_planes(g, planes) : planes);
+            words.insert(words.end(), pw.begin(), pw.end());
+            const std::vector<float> out =
+                Gpu::get().run(params, words, items, std::size_t(samples), gltf ? Gpu::kPlanesGltf : Gpu::kPlanes);
+            ASSERT_EQ(out.size(), std::size_t(samples) * kOutFloats);
+            double max_rel = 0;
+            long compared = 0, failures = 0, skipped = 0, near = 0, by_plane = 0, keep_compared = 0, keep_wrong = 0;
+            std::string first, first_keep;
+            for (int i = 0; i < samples; ++i) {
+                const double* pos = positions.data() + 3 * std::size_t(i);
+                const std::size_t at = 8 * std::size_t(i);
+                const double nrm[3] = {items[at + 4], items[at + 5], items[at + 6]};
+                const planes_test::Sample sm = planes_test::sample(vol, pos);
+                if (sm.near) {
+                    ++near;
+                    continue;
+                }
+                const unsigned want_keep = gltf ? planes_test::gltf_sides(std::uint8_t(sm.plane_keep)) : sm.plane_keep;
+                const unsigned got_keep = unsigned(out[std::size_t(i) * kOutFloats]);
+                ++keep_compared;
+                if (got_keep != want_keep && keep_wrong++ == 0)
+                    first_keep = std::string(name) + " item " + std::to_string(i) + ": shader keeps " + std::to_string(got_keep) + ", C " +
+                                 std::to_string(want_keep);
+                by_plane += sm.plane_keep != 0xFF;
+                double ref[3];
+                zhc_volume_irradiance_d(&vol, pos, nrm, ref);
+                double t[3] = {0, 0, 0}, extra = 0;
+                for (int c = 0; c < 3; ++c)
+                    extra += (std::fabs(pos[c]) + std::fabs(origin[c])) / spacing[c] +
+                             std::min(std::max((pos[c] - origin[c]) / spacing[c], 0.0), double(counts[c] - 1)) + 2;
+                for (int b = 0; b < 8; ++b) {
+                    const std::uint32_t q[3] = {sm.i0[0] + (b & 1), sm.i0[1] + ((b >> 1) & 1), sm.i0[2] + (b >> 2)};
+                    double tb[3], kappa;
+                    probe_scales(*codec, p, decoded[q[0] + counts[0] * (q[1] + counts[1] * q[2])], tb, &kappa);
+                    for (int k = 0; k < 3; ++k) t[k] += tb[k];
+                }
+                double weight_part = 1.5 * extra;
+                if (sm.kept_sum > 0) {
+                    if (sm.kept_sum < 1e-3) {
+                        ++skipped;
+                        continue;
+                    }
+                    weight_part = 2 * weight_part / sm.kept_sum;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_TRUE(std::isfinite(t[k]) && std::isfinite(ref[k])) << name << " item " << i;
+                    const double got = out[std::size_t(i) * kOutFloats + 27 + std::size_t(k)];
+                    const double err = std::fabs(got - ref[k]);
+                    const double bound = (40 + weight_part) * FLT_EPSILON * t[k] + kFlushFloor;
+                    if (!(err <= bound) && failures++ == 0)
+                        first = std::string(name) + " item " + std::to_string(i) + " channel " + std::to_string(k) + ": shader " +
+                                std::to_string(got) + " C " + std::to_string(ref[k]);
+                    max_rel = std::max(max_rel, err / (FLT_EPSILON * t[k] + kFlushFloor));
+                }
+                ++compared;
+            }
+            std::printf("%-22s %8ld %12.3f %8ld %6ld %8ld %ld of %ld equal\n", name, compared, max_rel, skipped, near, by_plane,
+                        keep_compared - keep_wrong, keep_compared);
+            EXPECT_EQ(failures, 0) << first;
+            EXPECT_EQ(keep_wrong, 0) << first_keep;
+            EXPECT_LE(skipped, samples / 100) << name;
+            EXPECT_LE(near, samples / 100) << name;
+            EXPECT_GT(by_plane, samples / 4) << name << ": the planes act";
+        }
+    }
 }
 
 }  // namespace

@@ -8,8 +8,11 @@
 // (params 16..24: grid origin, spacing (float bits), counts; binding 2 holds position, normal as two
 // float4 per item; irradiance in floats 27..29); 4: the ASTC LDR fallback's I_z decode
 // (zhc_irradz_iz_from_ldr; per item 5 floats t rgb, lo, hi; result in floats 27..29).
-// Compiled twice: plain, and with -DZHC_TEST_MASKED (ZHC_VOLUME_MASK: validity and visibility masks
-// at word params[25] of binding 1).
+// Compiled four times: plain; with -DZHC_TEST_MASKED (ZHC_VOLUME_MASK: validity and visibility masks
+// at word params[25] of binding 1); with -DZHC_TEST_MASKED -DZHC_TEST_PLANES (and ZHC_VOLUME_PLANE:
+// cell-plane entries, 2 words per probe, at word params[26]; mode 3 also writes the corners the
+// cell's plane keeps in float 0); with -DZHC_TEST_PLANES -DZHC_VOLUME_PLANE_AXES_GLTF (planes alone,
+// the grid in glTF axes).
 [[vk::binding(0, 0)]] StructuredBuffer<uint> params;
 [[vk::binding(1, 0)]] ByteAddressBuffer words;
 [[vk::binding(2, 0)]] StructuredBuffer<float4> normals;
@@ -20,6 +23,10 @@
 // The masked build (runtime_test_masked.spv): combined masks, 4 per word, after the probe words at
 // word params[25].
 #define ZHC_VOLUME_MASK(i) ((words.Load(4u * (params[25] + ((i) >> 2))) >> (8u * ((i) & 3u))) & 0xFFu)
+#endif
+#ifdef ZHC_TEST_PLANES
+// The plane builds: entry of cell i (ou | ov << 8 | offset << 16, sides) at word params[26] + 2 i.
+#define ZHC_VOLUME_PLANE(i) words.Load2(4u * (params[26] + 2u * (i)))
 #endif
 #include "zhc.hlsl"
 
@@ -55,6 +62,16 @@ void main(uint3 id : SV_DispatchThreadID)
         results[o + 27u] = e.x;
         results[o + 28u] = e.y;
         results[o + 29u] = e.z;
+#ifdef ZHC_VOLUME_PLANE
+        {  // the corners the cell's plane keeps (zhc_volume_sh3's cell)
+            float3 p = normals[2u * i].xyz;
+            uint3 cn = max(v.counts, uint3(1u, 1u, 1u));
+            float3 t = (p - v.origin) / v.spacing;
+            t = min(float3(t.x >= 0.0f ? t.x : 0.0f, t.y >= 0.0f ? t.y : 0.0f, t.z >= 0.0f ? t.z : 0.0f), float3(cn - 1u));
+            uint3 i0 = min(uint3(t), max(cn, uint3(2u, 2u, 2u)) - 2u);
+            results[o] = float(zhc_volume_plane_keep(ZHC_VOLUME_PLANE(i0.x + cn.x * (i0.y + cn.y * i0.z)), v, i0, p));
+        }
+#endif
         return;
     }
     if (mode == 4u)
