@@ -1,9 +1,11 @@
 // glTF-Transform pipelines keep ZHC_light_probes (CTest: js.gltf_transform_keep).
 // Usage: node gltf_transform_keep.mjs ZHC_BINARY WORK_DIR CORPUS_DIR
 //  1. inputs zhc wrote: the demo's probes.glb (zh3_q16 grid), baked glTF scenes (`zhc bake` of the
-//     corpus' gt_list.glb / gt_draco.glb: meshes, lights, a grid in sh3, zh3_q16, sh3_q28), and
-//     `zhc gltf embed` outputs with a second volume (Draco point cloud, float points with
-//     positions, --sh-axes gltf), one with the probe nodes under a transformed parent, one .gltf;
+//     corpus' gt_list.glb / gt_draco.glb: meshes, lights, a grid in sh3, zh3_q16, sh3_q28, with the
+//     bake's validity and cell planes accessors), and `zhc gltf embed` outputs with a second volume
+//     (Draco point cloud, float points with positions, --sh-axes gltf), one with the probe nodes
+//     under a transformed parent, one .gltf, a grid with validity, visibility and random cell
+//     planes (grid_leak.glb);
 //  2. the real CLI (node_modules/.bin/gltf-transform, @gltf-transform/cli 4.x) runs
 //     copy, optimize, meshopt, draco, dedup, prune, quantize, flatten, sparse, weld on each
 //     with --config runtime/web/gltf-transform.config.mjs;
@@ -21,7 +23,8 @@ import validator from 'gltf-validator';
 import * as core from '@gltf-transform/core';
 import { ALL_EXTENSIONS } from '@gltf-transform/extensions';
 import { cloneDocument } from '@gltf-transform/functions';
-import { glb, triangleSceneParts, randomProbes, checker, zhpWithSections } from './fixtures.mjs';
+import { glb, triangleSceneParts, randomProbes, checker, makeRand } from './fixtures.mjs';
+import { zhpWithPlanes, randomPlanes } from './planes_fixtures.mjs';
 import { crc32 } from '../../runtime/web/zhc_runtime.mjs';
 import { defineZhcLightProbes } from '../../runtime/web/zhc_gltf_transform.mjs';
 
@@ -101,6 +104,8 @@ function definition(vol) {
   delete d.positions;
   delete d.validity;
   delete d.visibility;
+  delete d.planes;
+  delete d.planeSides;
   if (d.draco) delete d.draco.bufferView;
   return JSON.stringify(d);
 }
@@ -161,16 +166,23 @@ inputs.push({ name: 'two_volumes_draco14.glb', file: W('two_volumes_draco14.glb'
 inputs.push({ name: 'three_volumes_draco_lossless.glb', file: W('three_volumes_draco_lossless.glb') });
 inputs.push({ name: 'points_sh3_gltf_axes.glb', file: W('points_sh3_gltf_axes.glb') });
 inputs.push({ name: 'grid_sh2_q.gltf', file: W('grid_sh2_q.gltf') });
-// A grid with validity and visibility accessors: a version 2 .zhp embedded.
+// A grid with validity, visibility and cell planes accessors: a version 2 .zhp embedded.
 {
   run(['convert', W('grid.json'), '-o', W('grid_q16.zhp'), '--to', 'zh3_q16']);
   const validity = Uint8Array.from({ length: 24 }, (_, i) => (i % 5 === 2 ? 0 : 1));
   const visibility = Uint8Array.from({ length: 24 }, (_, i) => (i * 37 + 11) & 0xff);
-  fs.writeFileSync(W('grid_leak.zhp'), zhpWithSections(new Uint8Array(fs.readFileSync(W('grid_q16.zhp'))), validity, visibility, crc32));
+  const planes = randomPlanes({ origin: [-1, 0.5, 2], spacing: [0.5, 1, 2], counts: [3, 2, 4] }, makeRand(38));
+  fs.writeFileSync(W('grid_leak.zhp'), zhpWithPlanes(new Uint8Array(fs.readFileSync(W('grid_q16.zhp'))), { validity, visibility, planes }, crc32));
   run(['gltf', 'embed', W('tri.glb'), W('grid_leak.zhp'), '-o', W('grid_leak.glb')]);
   const vol = readJson(W('grid_leak.glb')).json.extensions.ZHC_light_probes.volumes[0];
-  check(Number.isInteger(vol.validity) && Number.isInteger(vol.visibility), 'grid_leak.glb: validity and visibility accessors');
+  check(['validity', 'visibility', 'planes', 'planeSides'].every((k) => Number.isInteger(vol[k])),
+    'grid_leak.glb: validity, visibility, planes and planeSides accessors');
   inputs.push({ name: 'grid_leak.glb', file: W('grid_leak.glb'), leak: true });
+}
+// The default bake of a scene with walls writes cell planes into the glTF output too.
+for (const name of ['baked_zh3_q16.glb', 'baked_sh3.glb']) {
+  const vol = readJson(W(name)).json.extensions.ZHC_light_probes.volumes[0];
+  check(Number.isInteger(vol.planes) && Number.isInteger(vol.planeSides), `${name}: the bake's planes and planeSides accessors`);
 }
 
 // Node placement that a transform could get wrong: the probe nodes of the two-volume file under a
@@ -198,10 +210,10 @@ for (const inp of inputs) {
   inp.placements = placements(inp.json);
   inp.extracted = extractAll(inp.file, inp.volumes.length, `in_${inp.name}`);
   console.log(`input ${inp.name}: ${inp.volumes.map((v) => `${v.encoding}/${v.layout}${v.draco ? '/draco' : ''}`).join(', ')}`);
-  if (inp.leak) {  // the extraction is a version 2 .zhp with the embedded sections (last 48 bytes)
+  if (inp.leak) {  // the extraction is the embedded version 2 .zhp (sections: 24 + 24 + 5 x 24 bytes)
     const z = inp.extracted[0].zhp, src = fs.readFileSync(W('grid_leak.zhp'));
-    check(z[8] === 2 && z[21] === 3 && z.subarray(z.length - 48).equals(src.subarray(src.length - 48)),
-      'grid_leak.glb: zhc gltf extract gives the validity and visibility it was embedded with');
+    check(z[8] === 2 && z[21] === 7 && z.equals(src),
+      'grid_leak.glb: zhc gltf extract gives the .zhp it was embedded from (validity, visibility, planes)');
   }
 }
 
@@ -209,7 +221,7 @@ for (const inp of inputs) {
 // Every command on the inputs that cover the encodings' storage kinds (quantised grid, float
 // grid with a Draco-compressed mesh... see `full`), copy and optimize on all of them.
 const commands = ['copy', 'optimize', 'meshopt', 'draco', 'dedup', 'prune', 'quantize', 'flatten', 'sparse', 'weld'];
-const full = new Set(['demo_probes.glb', 'baked_zh3_q16.glb', 'placed.glb', 'points_sh3_gltf_axes.glb']);
+const full = new Set(['demo_probes.glb', 'baked_zh3_q16.glb', 'placed.glb', 'points_sh3_gltf_axes.glb', 'grid_leak.glb']);
 function gltfTransform(args) {
   return spawnSync(cli, args, { encoding: 'utf8', cwd: work });
 }
