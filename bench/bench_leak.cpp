@@ -5,11 +5,13 @@
 // L-shaped corridor; a room lit only through a window by the sky; a closed box in a lit room. Each
 // is baked with bake_scene (direct light only: transport.max_bounces = 0; the scenes' occluders
 // have no material, so no reflected light would be traced anyway), its probes written as sh3 .zhp
-// files by formats/probes without and with the leak sections (validity + visibility masks), opened
-// with zhc_volume_from_zhp and sampled with zhc_volume_irradiance at the shading points.
+// files by formats/probes without and with the leak sections, opened with zhc_volume_from_zhp and
+// sampled with zhc_volume_irradiance at the shading points.
 //
-// Columns, per scene and sampling ("plain": the file without the sections, plain trilinear over
-// the baked, dilated probes; "masks": validity + 8-bit visibility masks as shipped):
+// Columns, per scene and sampling ("plain": probes baked at their grid points, the file without
+// leak sections, plain trilinear over the baked, dilated probes; "masks": the same probes with
+// validity + 8-bit visibility masks; "planes": the default bake, probes kept out of walls, validity
+// + one plane per cell, codec/bake/leak_planes.h, what `zhc bake` writes):
 //  * leak: mean irradiance at the dark side's points / mean irradiance at the lit side's points
 //    (points within one cell of the separating geometry); the truth's own ratio beside it (0 where
 //    the dark side gets no light);
@@ -18,7 +20,7 @@
 //    (the SH3 limit no interpolation can beat);
 //  * B/probe: extra bytes per probe of the leak data in the .zhp (0 for plain);
 //  * ns: CPU time per zhc_volume_irradiance call (thread CPU time, median of 9 interleaved rounds
-//    over every shading point) and masks / plain in the same run.
+//    over every shading point) and masks / plain, planes / plain in the same run.
 // Benchmarks never decide pass/fail (tests/test_leak_suite.cpp asserts the measured facts).
 //
 // Usage: bench_leak [--points N] [--threads N] [--json FILE]
@@ -41,23 +43,24 @@ struct Row {
     std::string name;
     double offset = -1, thickness = -1;
     Measured m;
-    double ns_plain = 0, ns_masks = 0;
-    std::uint64_t mask_rays = 0;
+    double ns_plain = 0, ns_masks = 0, ns_planes = 0;
+    std::uint64_t mask_rays = 0, plane_rays = 0, relocation_rays = 0;
 };
 
-// ns per zhc_volume_irradiance call over every shading point; plain and masks in interleaved rounds.
-void time_calls(const Baked& b, const std::vector<ShadingPoint>& pts, double* ns_plain, double* ns_masks) {
-    zhc_volume v[2];
-    if (!open_volume(b.plain_zhp, &v[0]) || !open_volume(b.masked_zhp, &v[1])) return;
+// ns per zhc_volume_irradiance call over every shading point; plain, masks and planes in
+// interleaved rounds.
+void time_calls(const Baked& b, const std::vector<ShadingPoint>& pts, double* ns_plain, double* ns_masks, double* ns_planes) {
+    zhc_volume v[3];
+    if (!open_volume(b.plain_zhp, &v[0]) || !open_volume(b.masked_zhp, &v[1]) || !open_volume(b.planes_zhp, &v[2])) return;
     std::vector<float> p, n;
     for (const ShadingPoint& sp : pts) {
         p.insert(p.end(), {float(sp.p.x), float(sp.p.y), float(sp.p.z)});
         n.insert(n.end(), {float(sp.n.x), float(sp.n.y), float(sp.n.z)});
     }
     const int inner = std::max(1, 200000 / int(pts.size()));
-    std::vector<double> t[2];
+    std::vector<double> t[3];
     for (int round = 0; round < 9; ++round)
-        for (int which = 0; which < 2; ++which) {
+        for (int which = 0; which < 3; ++which) {
             const bench::Timing tm = bench::time_repeats_cpu(1, [&] {
                 float acc = 0;
                 for (int r = 0; r < inner; ++r)
@@ -73,14 +76,17 @@ void time_calls(const Baked& b, const std::vector<ShadingPoint>& pts, double* ns
     for (auto& x : t) std::sort(x.begin(), x.end());
     *ns_plain = t[0][t[0].size() / 2];
     *ns_masks = t[1][t[1].size() / 2];
+    *ns_planes = t[2][t[2].size() / 2];
 }
 
 void print_row(const Row& r) {
     const Measured& m = r.m;
-    std::printf("%-30s %4zu %3zu %4zu/%-4zu %6.2f%% | %6.2f%% %6.2f%% | %6.1f%% %6.1f%% %6.1f%% | %4.1f | %5.1f %5.1f %5.2fx\n",
+    std::printf("%-30s %4zu %3zu %4zu/%-4zu %6.2f%% | %6.2f%% %6.2f%% %6.2f%% | %6.1f%% %6.1f%% %6.1f%% %6.1f%% | %3.0f %3.0f | "
+                "%5.1f %5.1f %5.1f %5.2fx %5.2fx\n",
                 r.name.c_str(), m.probes, m.invalid, m.lit_points, m.dark_points, 100 * m.truth.leak, 100 * m.plain.leak,
-                100 * m.masks.leak, 100 * m.floor.lit_error, 100 * m.plain.lit_error, 100 * m.masks.lit_error,
-                m.mask_bytes_per_probe, r.ns_plain, r.ns_masks, r.ns_plain > 0 ? r.ns_masks / r.ns_plain : 0.0);
+                100 * m.masks.leak, 100 * m.planes.leak, 100 * m.floor.lit_error, 100 * m.plain.lit_error, 100 * m.masks.lit_error,
+                100 * m.planes.lit_error, m.mask_bytes_per_probe, m.planes_bytes_per_probe, r.ns_plain, r.ns_masks, r.ns_planes,
+                r.ns_plain > 0 ? r.ns_masks / r.ns_plain : 0.0, r.ns_plain > 0 ? r.ns_planes / r.ns_plain : 0.0);
 }
 
 void json_metrics(std::ostream& o, const char* key, const Metrics& x) {
@@ -108,10 +114,12 @@ int main(int argc, char** argv) {
     std::printf("Leak suite (tests/leak_scenes.h): direct light only (transport.max_bounces = 0), sh3 probes,\n"
                 "zhc_volume_irradiance on volumes from zhc_volume_from_zhp; %d points per surface, %d free per region.\n\n",
                 per_face, 2 * per_face);
-    std::printf("%-30s %4s %3s %9s %7s | %7s %7s | %7s %7s %7s | %4s | %5s %5s %6s\n", "scene", "prb", "inv", "lit/dark",
-                "truth", "plain", "masks", "floor", "plain", "masks", "B/pr", "ns", "ns", "masks/");
-    std::printf("%-30s %4s %3s %9s %7s | %7s %7s | %7s %7s %7s | %4s | %5s %5s %6s\n", "", "", "", "points", "leak",
-                "leak", "leak", "lit err", "lit err", "lit err", "mask", "plain", "masks", "plain");
+    std::printf("%-30s %4s %3s %9s %7s | %7s %7s %7s | %7s %7s %7s %7s | %3s %3s | %5s %5s %5s %6s %6s\n", "scene", "prb", "inv",
+                "lit/dark", "truth", "plain", "masks", "planes", "floor", "plain", "masks", "planes", "B/p", "B/p", "ns", "ns", "ns",
+                "masks/", "planes/");
+    std::printf("%-30s %4s %3s %9s %7s | %7s %7s %7s | %7s %7s %7s %7s | %3s %3s | %5s %5s %5s %6s %6s\n", "", "", "", "points",
+                "leak", "leak", "leak", "leak", "lit err", "lit err", "lit err", "lit err", "msk", "pln", "plain", "masks", "plane",
+                "plain", "plain");
     std::vector<Row> rows;
     for (const LeakScene& ls : scenes) {
         const Baked b = bake_volumes(ls, threads);
@@ -125,7 +133,9 @@ int main(int argc, char** argv) {
         r.thickness = ls.thickness;
         r.m = measure(ls, b);
         r.mask_rays = b.report.mask_rays;
-        time_calls(b, ls.points, &r.ns_plain, &r.ns_masks);
+        r.plane_rays = b.planes_report.planes.rays;
+        r.relocation_rays = b.planes_report.relocation_rays;
+        time_calls(b, ls.points, &r.ns_plain, &r.ns_masks, &r.ns_planes);
         print_row(r);
         rows.push_back(std::move(r));
     }
@@ -136,7 +146,8 @@ int main(int argc, char** argv) {
             const Row& r = rows[i];
             o << "    {\"scene\": \"" << r.name << "\", \"offset\": " << r.offset << ", \"thickness\": " << r.thickness
               << ", \"probes\": " << r.m.probes << ", \"invalid\": " << r.m.invalid << ", \"lit_points\": " << r.m.lit_points
-              << ", \"dark_points\": " << r.m.dark_points << ", \"mask_rays\": " << r.mask_rays << ", ";
+              << ", \"dark_points\": " << r.m.dark_points << ", \"mask_rays\": " << r.mask_rays << ", \"plane_rays\": " << r.plane_rays
+              << ", \"relocation_rays\": " << r.relocation_rays << ", ";
             json_metrics(o, "truth", r.m.truth);
             o << ", ";
             json_metrics(o, "floor", r.m.floor);
@@ -144,8 +155,11 @@ int main(int argc, char** argv) {
             json_metrics(o, "plain", r.m.plain);
             o << ", ";
             json_metrics(o, "masks", r.m.masks);
-            o << ", \"bytes_per_probe\": {\"plain\": 0, \"masks\": " << r.m.mask_bytes_per_probe << "}, \"ns_per_sample\": {\"plain\": "
-              << r.ns_plain << ", \"masks\": " << r.ns_masks << "}}" << (i + 1 < rows.size() ? "," : "") << "\n";
+            o << ", ";
+            json_metrics(o, "planes", r.m.planes);
+            o << ", \"bytes_per_probe\": {\"plain\": 0, \"masks\": " << r.m.mask_bytes_per_probe << ", \"planes\": "
+              << r.m.planes_bytes_per_probe << "}, \"ns_per_sample\": {\"plain\": " << r.ns_plain << ", \"masks\": " << r.ns_masks
+              << ", \"planes\": " << r.ns_planes << "}}" << (i + 1 < rows.size() ? "," : "") << "\n";
         }
         if (!bench::finish_json(o, json)) return 1;
     }

@@ -55,30 +55,7 @@ void print_report(const BakeReport& r) {
                 static_cast<unsigned long long>(r.probes));
     for (const BakeEffect& e : r.effects) std::printf("  %-24s %-42s %10.3f ms\n", e.name.c_str(), ("(" + e.method + ")").c_str(), e.milliseconds);
     if (r.effects.empty()) std::printf("  (none: the scene lists no lighting; every probe is zero)\n");
-    if (r.validity_checked)
-        std::printf("  probe validity (the same %llu rays/probe): %llu of %llu probes inside geometry, %llu dilated (%.3f ms)\n",
-                    static_cast<unsigned long long>(r.occlusion_rays / r.probes), static_cast<unsigned long long>(r.invalid_probes), static_cast<unsigned long long>(r.probes),
-                    static_cast<unsigned long long>(r.dilated_probes), r.dilation_ms);
-    if (r.validity_checked && r.moved_out + r.left_inside + r.left_near + r.moved_towards > 0)
-        std::printf("  probes kept out of walls: %llu in or near geometry at their grid points: %llu baked at a clear point nearby, "
-                    "%llu left inside geometry (invalid, dilated), %llu left near it; %llu moved towards a wall (%llu rays, %.3f ms)\n",
-                    static_cast<unsigned long long>(r.moved_out + r.left_inside + r.left_near), static_cast<unsigned long long>(r.moved_out),
-                    static_cast<unsigned long long>(r.left_inside), static_cast<unsigned long long>(r.left_near),
-                    static_cast<unsigned long long>(r.moved_towards), static_cast<unsigned long long>(r.relocation_rays), r.relocation_ms);
-    if (r.planes.cells > 0) {
-        const PlaneFitStats& p = r.planes;
-        const std::uint64_t blocked = p.blocked_pairs + p.unresolved_pairs, leaking = p.leaking_pairs + p.unresolved_pairs;
-        std::printf("  cell planes: %llu of %llu cells crossed by geometry have a plane (%llu cells; %llu rays, %.3f ms)\n",
-                    static_cast<unsigned long long>(p.planes), static_cast<unsigned long long>(p.crossed_cells),
-                    static_cast<unsigned long long>(p.cells), static_cast<unsigned long long>(p.rays), r.plane_ms);
-        if (blocked > 0)
-            std::printf("  leak estimate: %llu of %llu blocked (sample point, probe) pairs in those cells still blend (%.2f %%); "
-                        "%llu visible pairs dropped (%.2f %% of the pairs)\n",
-                        static_cast<unsigned long long>(leaking), static_cast<unsigned long long>(blocked), 100.0 * double(leaking) / double(blocked),
-                        static_cast<unsigned long long>(p.dropped_pairs), p.pairs ? 100.0 * double(p.dropped_pairs) / double(p.pairs) : 0.0);
-        else
-            std::printf("  leak estimate: no geometry crosses a cell: nothing to separate\n");
-    }
+    for (const std::string& line : r.leak_lines()) std::printf("  %s\n", line.c_str());
     if (r.mask_probes > 0)
         std::printf("  visibility masks: %llu rays (%.1f rays/probe) %.3f ms\n", static_cast<unsigned long long>(r.mask_rays),
                     double(r.mask_rays) / double(r.mask_probes), r.mask_ms);

@@ -136,6 +136,7 @@ int run(const Options& o) {
                 static_cast<unsigned long long>(rep.probes), rep.total_ms, threads);
     for (const BakeEffect& e : rep.effects)
         std::printf("  %-16s %-38s %9.3f ms\n", e.name.c_str(), ("(" + e.method + ")").c_str(), e.milliseconds);
+    for (const std::string& l : rep.leak_lines()) std::printf("  %s\n", l.c_str());
 
     // 3. Containers: the SH3 hub and the 16-byte zh3_q16.
     const ProbeLayout layout = probe_layout(scene.probes);
@@ -213,6 +214,8 @@ int run(const Options& o) {
     md << "# zhc demo audit\n\n" << rep.probes << " probes of the built-in scene, baked (" << rep.summary()
        << ").\nIrradiance error of every representation against the baked SH3 at " << o.directions
        << " directions per probe.\n\n";
+    for (const std::string& l : rep.leak_lines()) md << "- " << l << "\n";
+    md << "\n";
     print_table(md, rows, true);
     md << "\n## Choice\n\n" << choice_intro(choice) << "\n\n";
     print_table(md, choice_table(choice), true);
@@ -281,6 +284,11 @@ int run(const Options& o) {
         h.settings = {{"scene", "built-in default scene (written to " + path("scene.json") + ")"},
                       {"probe grid", std::to_string(c[0]) + "x" + std::to_string(c[1]) + "x" + std::to_string(c[2])},
                       {"bake", rep.summary()},
+                      {"walls and leaks", [&] {
+                           std::string t;
+                           for (const std::string& l : rep.leak_lines()) t += (t.empty() ? "" : "; ") + l;
+                           return t.empty() ? std::string("no occluders: nothing to separate") : t;
+                       }()},
                       {"directions", std::to_string(o.directions)},
                       {"timing", "not measured by the demo (zhc audit and zhc bench time encode and decode)"},
                       {"command", "zhc demo -o " + o.dir + " --directions " + std::to_string(o.directions) +

@@ -213,6 +213,40 @@ TEST(LeakCandidates, ChosenSchemeStopsTheLeaksItCan) {
     EXPECT_EQ(box.cs->moved_towards, 0u);
 }
 
+// The bake's own implementation (codec/bake/leak_planes.h, the default `zhc bake`) against this
+// prototype, written separately: the same moved probes, the same planes byte for byte, and the C
+// runtime's samples of its .zhp equal to the prototype sampler's at every shading point.
+TEST(LeakCandidates, TheBakeIsThePrototypeOfTheChosenScheme) {
+    for (const Case& c : suite()) {
+        SCOPED_TRACE(c.scene.name);
+        const int chosen = candidate(c, "reloc2+plane");
+        const CandidateVolume& cv = c.cs->volumes[size_t(chosen)];
+        ASSERT_EQ(c.baked.planes_leak.planes.size(), 5 * cv.planes.size());
+        for (size_t i = 0; i < cv.planes.size(); ++i) {
+            const std::uint8_t* e = &c.baked.planes_leak.planes[5 * i];
+            const std::int16_t off = std::int16_t(std::uint16_t(e[2] | (e[3] << 8)));
+            EXPECT_EQ(off, cv.planes[i].offset) << i;
+            if (off == cv.planes[i].offset && off != leak::CellPlane::kNoPlane) {
+                EXPECT_EQ(e[0], cv.planes[i].ou) << i;
+                EXPECT_EQ(e[1], cv.planes[i].ov) << i;
+                EXPECT_EQ(e[4], cv.planes[i].sides) << i;
+            }
+        }
+        EXPECT_EQ(c.baked.planes_leak.validity, cv.validity);
+        EXPECT_EQ(c.baked.planes_report.moved_out, c.cs->moved);
+        EXPECT_EQ(c.baked.planes_report.moved_towards, c.cs->moved_towards);
+        // The probes: the prototype bakes the moved ones as positions; the bake bakes them in place.
+        auto proto = parse_probe_set(c.cs->towards_zhp, "prototype");
+        auto bake = parse_probe_set(c.baked.planes_zhp, "bake");
+        ASSERT_TRUE(proto.ok() && bake.ok());
+        EXPECT_EQ(proto->payload, bake->payload);
+        zhc_volume v;
+        ASSERT_TRUE(open_volume(c.baked.planes_zhp, &v));
+        ASSERT_NE(v.planes, nullptr);
+        EXPECT_EQ(sample_points(v, c.scene.points), sample_candidate(cv, c.scene.points));
+    }
+}
+
 // A normal bias above half the wall's thickness moves free points near a 2 % wall (3 cm) through
 // it: the plane then leaks (measured 0.33 % at 96 points per surface); without bias it does not.
 TEST(LeakCandidates, NormalBiasThroughAThinWallLeaks) {

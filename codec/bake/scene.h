@@ -197,6 +197,11 @@ struct BakeReport {
     TransportReport transport;
     // "sky (closed form): 0.3 ms; sun 'key' (closed form, shadowed: 4096 rays): 1.2 ms"
     std::string summary() const;
+    // What the bake did against leaks, one line each (empty when validity was not checked): the
+    // probes in or near geometry and where they went, the planes per cell and the leak estimate
+    // (blocked sample-to-probe pairs the planes still blend). `zhc bake` prints them, the demo's
+    // report shows them.
+    std::vector<std::string> leak_lines() const;
 };
 
 struct BakeOptions {

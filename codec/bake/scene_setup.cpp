@@ -209,4 +209,42 @@ std::string BakeReport::summary() const {
     return out;
 }
 
+std::vector<std::string> BakeReport::leak_lines() const {
+    std::vector<std::string> out;
+    if (!validity_checked) return out;
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "probe validity (the same %llu rays/probe): %llu of %llu probes inside geometry, %llu dilated (%.3f ms)",
+                  static_cast<unsigned long long>(probes ? occlusion_rays / probes : 0), static_cast<unsigned long long>(invalid_probes),
+                  static_cast<unsigned long long>(probes), static_cast<unsigned long long>(dilated_probes), dilation_ms);
+    out.push_back(buf);
+    if (moved_out + left_inside + left_near + moved_towards > 0) {
+        std::snprintf(buf, sizeof buf,
+                      "probes kept out of walls: %llu in or near geometry at their grid points: %llu baked at a clear point nearby, "
+                      "%llu left inside geometry (invalid, dilated), %llu left near it; %llu moved towards a wall (%llu rays, %.3f ms)",
+                      static_cast<unsigned long long>(moved_out + left_inside + left_near), static_cast<unsigned long long>(moved_out),
+                      static_cast<unsigned long long>(left_inside), static_cast<unsigned long long>(left_near),
+                      static_cast<unsigned long long>(moved_towards), static_cast<unsigned long long>(relocation_rays), relocation_ms);
+        out.push_back(buf);
+    }
+    if (planes.cells > 0) {
+        const PlaneFitStats& p = planes;
+        const std::uint64_t blocked = p.blocked_pairs + p.unresolved_pairs, leaking = p.leaking_pairs + p.unresolved_pairs;
+        std::snprintf(buf, sizeof buf, "cell planes: %llu of %llu cells crossed by geometry have a plane (%llu cells; %llu rays, %.3f ms)",
+                      static_cast<unsigned long long>(p.planes), static_cast<unsigned long long>(p.crossed_cells),
+                      static_cast<unsigned long long>(p.cells), static_cast<unsigned long long>(p.rays), plane_ms);
+        out.push_back(buf);
+        if (blocked > 0)
+            std::snprintf(buf, sizeof buf,
+                          "leak estimate: %llu of %llu blocked (sample point, probe) pairs in those cells still blend (%.2f %%); "
+                          "%llu visible pairs dropped (%.2f %% of the pairs)",
+                          static_cast<unsigned long long>(leaking), static_cast<unsigned long long>(blocked),
+                          100.0 * double(leaking) / double(blocked), static_cast<unsigned long long>(p.dropped_pairs),
+                          p.pairs ? 100.0 * double(p.dropped_pairs) / double(p.pairs) : 0.0);
+        else
+            std::snprintf(buf, sizeof buf, "leak estimate: no geometry crosses a cell: nothing to separate");
+        out.push_back(buf);
+    }
+    return out;
+}
+
 }  // namespace zhc
