@@ -15,6 +15,10 @@ export interface ZhcVolumeGlslOptions {
   normalAxes?: 'gltf' | 'same';
   /** Apply validity / visibility masks (a second sampler after the probe texture). */
   masked?: boolean;
+  /** Apply cell planes (an RG32UI sampler after the probe and mask textures). */
+  planes?: boolean;
+  /** 'zhc' (default): the grid is in the axes of the plane normals' code; 'gltf': the grid in glTF axes (n used as n.yzx). */
+  planesAxes?: 'zhc' | 'gltf';
 }
 /** The GLSL ES 3.00 volume chunk for one encoding and parameter set (throws for an encoding without a compact decoder). */
 export declare function zhcVolumeGlsl(options?: ZhcVolumeGlslOptions): string;
@@ -34,6 +38,10 @@ export interface ZhcCompactSource {
   shAxes?: 'zhc' | 'gltf';
   validity?: ArrayLike<number> | null;
   visibility?: ArrayLike<number> | null;
+  /** Cell planes, 5 bytes per probe in probe order. */
+  planes?: ArrayLike<number> | null;
+  /** The axes of the grid relative to the planes' normal code (default 'gltf'; a ZhpFile: 'zhc'). */
+  planesAxes?: 'zhc' | 'gltf';
 }
 export interface ZhcCompactOptions {
   /** The three.js module: adds `texture`, `maskTexture` and `uniforms`. */
@@ -42,6 +50,8 @@ export interface ZhcCompactOptions {
   matrixWorld?: Matrix4 | ArrayLike<number>;
   /** false: the plain trilinear blend, masks dropped (default true). */
   masks?: boolean;
+  /** false: cell planes dropped (default true). */
+  planes?: boolean;
 }
 /** The uniforms patchMaterialWithVolume and a ShaderMaterial use. */
 export interface ZhcCompactUniforms {
@@ -51,6 +61,8 @@ export interface ZhcCompactUniforms {
   zhcWorldNormalToVolume: { value: Matrix3 };
   /** With masks (masked: true). */
   zhcVolumeMaskTex?: { value: Data3DTexture };
+  /** With cell planes (planed: true). */
+  zhcVolumePlaneTex?: { value: Data3DTexture };
 }
 export interface ZhcCompactVolume {
   encoding: string;
@@ -63,6 +75,12 @@ export interface ZhcCompactVolume {
   masked: boolean;
   mask: Uint8Array | null;
   maskBytes: number;
+  /** Whether the chunk applies cell planes (an RG32UI plane texture). */
+  planed: boolean;
+  /** The plane texels, 2 words per probe (bytes 0..3 little-endian, byte 4), or null. */
+  planeData: Uint32Array | null;
+  planeBytes: number;
+  planesAxes: 'zhc' | 'gltf';
   grid: ZhcGrid;
   normalAxes: 'gltf' | 'same';
   glsl: string;
@@ -73,6 +91,7 @@ export interface ZhcCompactVolume {
   /** With the THREE option: */
   texture?: Data3DTexture;
   maskTexture?: Data3DTexture;
+  planeTexture?: Data3DTexture;
   uniforms?: ZhcCompactUniforms;
 }
 /** The compact volume of a grid (throws Error naming the problem: not a grid, an encoding without a compact decoder, ...). */

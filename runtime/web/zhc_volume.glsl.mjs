@@ -13,8 +13,11 @@
 // A grid with validity / visibility masks (a baked one) also gets its combined mask bytes
 // (valid ? visibility : 0) in an R8UI 3D texture, one texel per probe, and the masked, renormalised
 // weights of zhc_volume_sh3 (docs/runtime.md "Validity and visibility"); `masks: false` drops them.
+// A grid with cell planes gets them in an RG32UI 3D texture, one texel per probe (the plane of the
+// cell whose corner 0 is that probe: .x = bytes 0..3 little-endian, .y = byte 4), and the side test
+// of zhc_volume_sh3 (docs/runtime.md "Cell planes"); `planes: false` drops them.
 //
-//   zhcVolumeGlsl({ encoding, params, normalAxes, masked })   GLSL ES 3.00 chunk (zhc_irradiance's included):
+//   zhcVolumeGlsl({ encoding, params, normalAxes, masked, planes, planesAxes })   GLSL ES 3.00 chunk (zhc_irradiance's included):
 //     struct ZhcVolume { vec3 origin; vec3 spacing; vec3 counts; };
 //     vec3 zhcVolumeIrradiance(highp usampler3D tex, ZhcVolume v, vec3 position, vec3 normal)
 //       position in the grid's frame (a glTF volume: its node's local glTF axes; a .zhp: zhc axes),
@@ -22,7 +25,9 @@
 //       shAxes "zhc" volumes in glTF axes the chunk maps the normal to zhc axes (normalAxes 'gltf').
 //     void zhcVolumeSh3(highp usampler3D tex, ZhcVolume v, vec3 position, out vec3 c[9])  blended SH3
 //     masked: both take `highp usampler3D maskTex` after tex, and ZHC_VOLUME_MASKED is defined
-//   compactVolume(source, { THREE, matrixWorld, masks })   texture payloads + uniforms (+ Data3DTextures
+//     planes: both take `highp usampler3D planeTex` after tex (and maskTex), ZHC_VOLUME_PLANES is
+//       defined, and ZHC_VOLUME_PLANE_AXES_GLTF for planesAxes 'gltf'
+//   compactVolume(source, { THREE, matrixWorld, masks, planes })   texture payloads + uniforms (+ Data3DTextures
 //     when THREE is given) from a ZhcProbeVolume (the GLTFLoader plugin) or parseZhp(bytes)
 //   patchMaterialWithVolume(material, compact, THREE)  onBeforeCompile: a stock three.js material
 //     (MeshLambertMaterial, MeshStandardMaterial, MeshPhysicalMaterial, ...) gets the volume's
@@ -52,7 +57,14 @@ function compactLayout(encoding) {
 // visibility"): it defines ZHC_VOLUME_MASKED, and zhcVolumeSh3 / zhcVolumeIrradiance take a second
 // sampler, the combined mask bytes as an R8UI 3D texture (n_x x n_y x n_z, one texel per probe),
 // right after the probe texture. Unmasked (the default) the chunk has neither.
-export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same', masked = false } = {}) {
+// planes: the chunk applies a grid's cell planes (docs/runtime.md "Cell planes"): it defines
+// ZHC_VOLUME_PLANES, and the two functions take the planes as an RG32UI 3D texture (n_x x n_y x
+// n_z, texel (x, y, z) = the plane entry of the cell whose corner 0 is probe (x, y, z)) after the
+// probe texture and the mask texture. planesAxes: 'zhc' when the grid's frame is the one the
+// normals' code is in (a .zhp), 'gltf' when the grid is in glTF axes (a ZHC_light_probes volume:
+// the decoded normal n is used as n.yzx; defines ZHC_VOLUME_PLANE_AXES_GLTF). Without planes (the
+// default) the chunk has none of it.
+export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same', masked = false, planes = false, planesAxes = 'zhc' } = {}) {
   const layout = compactLayout(encoding);
   // The *_channel_q16 encodings imply per-channel axes whatever the params say (a .zhp header's
   // axisMode field is the one of the luminance variants).
@@ -65,17 +77,41 @@ export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same', mask
     sh2_q: 'zhcSh3Sh2Q(w0, c);',
   }[layout];
   if (typeof masked !== 'boolean') throw new Error('zhcVolumeGlsl: masked must be true or false');
-  // The masked chunk's additions; each is empty without masks, so the unmasked text stays as it is.
-  const maskDefine = masked ? '#define ZHC_VOLUME_MASKED 1\n' : '';
-  const maskParam = masked ? 'highp usampler3D maskTex, ' : '';
-  const maskArg = masked ? 'maskTex, ' : '';
-  const maskDoc = masked ? `
+  if (typeof planes !== 'boolean') throw new Error('zhcVolumeGlsl: planes must be true or false');
+  if (planesAxes !== 'zhc' && planesAxes !== 'gltf') throw new Error("zhcVolumeGlsl: planesAxes must be 'zhc' or 'gltf'");
+  // The masked / planes chunk's additions; each is empty without them, so the plain text stays as it is.
+  const kept = masked || planes;
+  const maskDefine = (masked ? '#define ZHC_VOLUME_MASKED 1\n' : '') + (planes ? '#define ZHC_VOLUME_PLANES 1\n' : '') +
+    (planes && planesAxes === 'gltf' ? '#define ZHC_VOLUME_PLANE_AXES_GLTF 1\n' : '');
+  const maskParam = (masked ? 'highp usampler3D maskTex, ' : '') + (planes ? 'highp usampler3D planeTex, ' : '');
+  const maskArg = (masked ? 'maskTex, ' : '') + (planes ? 'planeTex, ' : '');
+  const maskDoc = (masked ? `
 // Masked (ZHC_VOLUME_MASKED): maskTex holds each probe's combined mask byte m = valid ? visibility
 // : 0 at texel (x, y, z); corner b = (bx, by, bz) keeps its weight w_b when bit 7 - (bx + 2 by +
 // 4 bz) of its m is set, else 0; the kept weights are divided by their sum (summed over corners
-// 0..7 in order); when every corner is dropped the plain weights stay (zhc_volume_sh3's fallback).` : '';
-  const maskWeights = masked ? `
-  // Masked weights first (8 mask fetches), then the blend below with w_b = m_b / sum.
+// 0..7 in order); when every corner is dropped the plain weights stay (zhc_volume_sh3's fallback).` : '') + (planes ? `
+// Cell planes (ZHC_VOLUME_PLANES): planeTex holds at texel i0 the plane of the cell whose corner 0
+// is probe i0: .x = ou | ov << 8 | offset << 16 (int16), .y = sides. Offset -32768: no plane.
+// Else side = (dot(n, p - c) - offset |spacing| / 65534 >= 0), n the decoded normal (zhcPlaneNormal;
+// n.yzx for ZHC_VOLUME_PLANE_AXES_GLTF), c = origin + (i0 + 0.5) spacing, and corner b keeps its
+// weight only when bit (bx + 2 by + 4 bz) of sides equals side${masked ? ' (and its mask bit is set)' : ''}; the kept weights
+// are divided by their sum as above, none kept: the plain weights.` : '');
+  const planeSide = planes ? `
+  // The cell's plane (1 fetch): which side of it p lies on.
+  uvec2 pe = texelFetch(planeTex, i0, 0).xy;
+  int planeOffset = int(pe.x >> 16u) - (pe.x >= 0x80000000u ? 65536 : 0);
+  bool hasPlane = planeOffset != -32768;
+  uint side = 0u;
+  if (hasPlane) {
+    vec3 pn = zhcPlaneNormal(pe.x & 255u, (pe.x >> 8u) & 255u);
+#ifdef ZHC_VOLUME_PLANE_AXES_GLTF
+    pn = pn.yzx;  // the code is in zhc axes, the grid in glTF axes: glTF (x, y, z) = zhc (y, z, x)
+#endif
+    vec3 c = v.origin + (vec3(i0) + 0.5) * v.spacing;
+    side = dot(pn, p - c) - float(planeOffset) * (length(v.spacing) / 65534.0) >= 0.0 ? 1u : 0u;
+  }` : '';
+  const maskWeights = kept ? `${planeSide}
+  // ${masked ? 'Masked' : 'Kept'} weights first${masked ? ' (8 mask fetches)' : ''}, then the blend below with w_b = m_b / sum.
   float wm[8];
   float sum = 0.0;
   for (int corner = 0; corner < 8; ++corner) {
@@ -83,13 +119,25 @@ export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same', mask
     vec3 wv = mix(1.0 - fr, fr, notEqual(b, ivec3(0)));
     float w = wv.x * wv.y * wv.z;
     wm[corner] = 0.0;
-    if (w == 0.0) continue;  // also every corner beyond a count-1 axis: not fetched
-    uint m = texelFetch(maskTex, i0 + b, 0).r;
-    if (((m >> uint(7 - corner)) & 1u) != 0u) wm[corner] = w;
+    if (w == 0.0) continue;  // also every corner beyond a count-1 axis: not fetched${planes ? `
+    if (hasPlane && ((pe.y >> uint(corner)) & 1u) != side) continue;  // the other side of the plane` : ''}${masked ? `
+    uint m = texelFetch(maskTex, i0 + b, 0).r;` : ''}
+    ${masked ? 'if (((m >> uint(7 - corner)) & 1u) != 0u) ' : ''}wm[corner] = w;
     sum += wm[corner];
   }` : '';
-  const maskUse = masked ? `
+  const maskUse = kept ? `
     if (sum > 0.0) w = wm[corner] / sum;  // else: every corner dropped, the plain weights` : '';
+  const planeNormal = planes ? `// The unit normal of a cell plane's octahedral code (zhc_plane_normal, in float): a = min(ou, 254)
+// / 127 - 1, b likewise, z = 1 - |a| - |b|; z < 0 folds (a, b) to ((1 - |b|) s(a), (1 - |a|) s(b)),
+// s(t) = t < 0 ? -1 : 1; normalised.
+vec3 zhcPlaneNormal(uint ou, uint ov) {
+  vec2 ab = vec2(min(uvec2(ou, ov), uvec2(254u))) / 127.0 - 1.0;
+  float z = 1.0 - abs(ab.x) - abs(ab.y);
+  if (z < 0.0) ab = (1.0 - abs(ab.yx)) * mix(vec2(1.0), vec2(-1.0), lessThan(ab, vec2(0.0)));
+  return normalize(vec3(ab, z));
+}
+
+` : '';
   return `${zhcIrradianceGlsl(params)}
 // ---- zhc compact volume (runtime/web/zhc_volume.glsl.mjs): ${encoding}, ${texels} RGBA32UI texel(s) per probe ----
 #define ZHC_VOLUME_TEXELS ${texels}
@@ -157,7 +205,7 @@ void zhcSh3Sh2Q(uvec4 words, out vec3 c[9]) {
   zhcStoredToRadiance(c);
 }
 
-// SH3 radiance of grid probe q (integer coordinates inside the grid).
+${planeNormal}// SH3 radiance of grid probe q (integer coordinates inside the grid).
 void zhcVolumeProbe(highp usampler3D tex, ivec3 q, out vec3 c[9]) {
   ivec3 t = ivec3(q.x * ZHC_VOLUME_TEXELS, q.y, q.z);
   uvec4 w0 = texelFetch(tex, t, 0);
@@ -227,6 +275,23 @@ export function compactVolumeMask(validity, visibility, count) {
   return out;
 }
 
+// The plane texels of a grid (docs/runtime.md "Cell planes": what reaches the GPU):
+// Uint32Array(2 count), probe p's texel (.x, .y) = (bytes 0..3 of its entry little-endian, byte 4);
+// null when planes are absent or every entry is "no plane" (offset -32768: nothing to apply).
+function compactVolumePlanes(planes, count) {
+  if (!planes) return null;
+  if (planes.length < 5 * count) throw new Error(`zhc compact volume: planes has ${planes.length} bytes for ${count} probes (5 per probe)`);
+  const out = new Uint32Array(2 * count);
+  let any = false;
+  for (let p = 0; p < count; p++) {
+    const e = 5 * p;
+    out[2 * p] = (planes[e] | (planes[e + 1] << 8) | (planes[e + 2] << 16) | (planes[e + 3] << 24)) >>> 0;
+    out[2 * p + 1] = planes[e + 4];
+    if (!(planes[e + 2] === 0x00 && planes[e + 3] === 0x80)) any = true;
+  }
+  return any ? out : null;
+}
+
 // Column-major 4x4 helpers (three.js Matrix4.elements order), no three.js needed.
 function invertAffine(m) {
   const a = [m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]];  // columns
@@ -254,12 +319,18 @@ function invertAffine(m) {
 // 8 texel fetches per sample fewer and 1 byte per probe less, for grids whose masks do not matter
 // where they are sampled or to match three.js's own grid, which cannot apply them). A source whose
 // combined bytes are all 0xFF (nothing masked) gets the plain chunk: its masked weights are the
-// plain ones divided by their sum, 1 up to rounding.
-// Returns { encoding, layout, texelsPerProbe, gpuBytesPerProbe (probe texels, plus 1 with masks),
-// gpuBytes (both textures), size: [w, h, d], data, masked, mask (the combined bytes or null),
-// maskBytes, grid: { origin, spacing, counts }, glsl (zhcVolumeGlsl for it), texture?, maskTexture?,
-// uniforms? }.
-export function compactVolume(source, { THREE, matrixWorld, masks = true } = {}) {
+// plain ones divided by their sum, 1 up to rounding. planes (default true: a source with cell
+// planes, a ZhcProbeVolume's or parseZhp's `planes`, 5 bytes per probe, gets the chunk with
+// ZHC_VOLUME_PLANES and an RG32UI plane texture; false: no side test, 1 fetch per sample and 8
+// bytes per probe fewer). A source whose entries are all "no plane" gets no plane texture. The
+// plane normals' code is in zhc axes: a ZhcProbeVolume's grid is in glTF axes (planesAxes 'gltf'),
+// a parseZhp result's in zhc axes ('zhc'); a source may name its own `planesAxes`.
+// Returns { encoding, layout, texelsPerProbe, gpuBytesPerProbe (probe texels, plus 1 with masks,
+// plus 8 with planes), gpuBytes (all textures), size: [w, h, d], data, masked, mask (the combined
+// bytes or null), maskBytes, planed, planeData (the plane texels or null), planeBytes, planesAxes,
+// grid: { origin, spacing, counts }, glsl (zhcVolumeGlsl for it), texture?, maskTexture?,
+// planeTexture?, uniforms? }.
+export function compactVolume(source, { THREE, matrixWorld, masks = true, planes = true } = {}) {
   const isZhp = source.payload !== undefined;
   if ((source.layout ?? 'grid') !== 'grid' || !source.grid) throw new Error(`zhc compact volume: needs a grid (layout ${source.layout})`);
   const layout = compactLayout(source.encoding);
@@ -276,16 +347,22 @@ export function compactVolume(source, { THREE, matrixWorld, masks = true } = {})
   const data = compactVolumeWords(bytes, bytesPerProbe, counts, texels);
   const normalAxes = !isZhp && source.shAxes === 'zhc' ? 'gltf' : 'same';
   if (typeof masks !== 'boolean') throw new Error('zhc compact volume: masks must be true or false');
+  if (typeof planes !== 'boolean') throw new Error('zhc compact volume: planes must be true or false');
   const count = counts[0] * counts[1] * counts[2];
   let mask = masks ? compactVolumeMask(source.validity ?? null, source.visibility ?? null, count) : null;
   if (mask && mask.every((m) => m === 0xFF)) mask = null;
   const masked = mask !== null;
+  const planesAxes = source.planesAxes ?? (isZhp ? 'zhc' : 'gltf');
+  if (planesAxes !== 'zhc' && planesAxes !== 'gltf') throw new Error("zhc compact volume: planesAxes must be 'zhc' or 'gltf'");
+  const planeData = planes ? compactVolumePlanes(source.planes ?? null, count) : null;
+  const planed = planeData !== null;
   const out = {
-    encoding: source.encoding, layout, texelsPerProbe: texels, gpuBytesPerProbe: 16 * texels + (masked ? 1 : 0),
-    gpuBytes: data.byteLength + (masked ? mask.byteLength : 0),
+    encoding: source.encoding, layout, texelsPerProbe: texels, gpuBytesPerProbe: 16 * texels + (masked ? 1 : 0) + (planed ? 8 : 0),
+    gpuBytes: data.byteLength + (masked ? mask.byteLength : 0) + (planed ? planeData.byteLength : 0),
     size: [counts[0] * texels, counts[1], counts[2]], data, masked, mask, maskBytes: masked ? mask.byteLength : 0,
+    planed, planeData, planeBytes: planed ? planeData.byteLength : 0, planesAxes,
     grid: { origin: [...origin], spacing: [...spacing], counts: [...counts] },
-    normalAxes, glsl: zhcVolumeGlsl({ encoding: source.encoding, params: source.params, normalAxes, masked }),
+    normalAxes, glsl: zhcVolumeGlsl({ encoding: source.encoding, params: source.params, normalAxes, masked, planes: planed, planesAxes }),
   };
   let m = matrixWorld?.elements ?? matrixWorld;
   if (!m && !isZhp && source.nodes?.length === 1) {
@@ -325,6 +402,19 @@ export function compactVolume(source, { THREE, matrixWorld, masks = true } = {})
       out.maskTexture = mtex;
       out.uniforms.zhcVolumeMaskTex = { value: mtex };
     }
+    if (planed) {
+      // The cell planes: one RG32UI texel per probe, (x, y, z) at texel (x, y, z).
+      const ptex = new THREE.Data3DTexture(planeData, counts[0], counts[1], counts[2]);
+      ptex.format = THREE.RGIntegerFormat;
+      ptex.type = THREE.UnsignedIntType;
+      ptex.internalFormat = 'RG32UI';
+      ptex.minFilter = ptex.magFilter = THREE.NearestFilter;
+      ptex.generateMipmaps = false;
+      ptex.unpackAlignment = 1;
+      ptex.needsUpdate = true;
+      out.planeTexture = ptex;
+      out.uniforms.zhcVolumePlaneTex = { value: ptex };
+    }
   }
   return out;
 }
@@ -340,7 +430,7 @@ export function patchMaterialWithVolume(material, compact, THREE) {
     throw new Error('zhc compact volume: patchMaterialWithVolume patches the GLSL of WebGLRenderer materials; ' +
       (material?.isNodeMaterial ? `${material.type} is a node material` : 'this three.js namespace has no ShaderChunk (three/webgpu)') +
       ', and WebGPURenderer is not supported by the compact path: render with WebGLRenderer, or light the scene with ' +
-      'volume.lightProbeGrid(LightProbeGrid), which applies no validity or visibility masks');
+      'volume.lightProbeGrid(LightProbeGrid), which applies no validity, visibility masks or cell planes (it leaks through walls)');
   if (!compact.uniforms) throw new Error('zhc compact volume: build it with compactVolume(source, { THREE })');
   const begin = 'vec3 irradiance = getAmbientLightIrradiance( ambientLightColor );';
   if (!THREE.ShaderChunk.lights_fragment_begin.includes(begin))
@@ -348,7 +438,7 @@ export function patchMaterialWithVolume(material, compact, THREE) {
   const decl = `precision highp usampler3D;
 ${compact.glsl}
 uniform highp usampler3D zhcVolumeTex;
-${compact.masked ? 'uniform highp usampler3D zhcVolumeMaskTex;\n' : ''}uniform ZhcVolume zhcVolume;
+${compact.masked ? 'uniform highp usampler3D zhcVolumeMaskTex;\n' : ''}${compact.planed ? 'uniform highp usampler3D zhcVolumePlaneTex;\n' : ''}uniform ZhcVolume zhcVolume;
 uniform mat4 zhcWorldToVolume;
 uniform mat3 zhcWorldNormalToVolume;
 `;
@@ -356,7 +446,7 @@ uniform mat3 zhcWorldNormalToVolume;
 	{
 		vec3 zhcWorldPos = ( ( vec4( geometryPosition, 1.0 ) - viewMatrix[ 3 ] ) * viewMatrix ).xyz;
 		vec3 zhcWorldNormal = transformNormalByInverseViewMatrix( geometryNormal, viewMatrix );
-		irradiance += PI * zhcVolumeIrradiance( zhcVolumeTex, ${compact.masked ? 'zhcVolumeMaskTex, ' : ''}zhcVolume, ( zhcWorldToVolume * vec4( zhcWorldPos, 1.0 ) ).xyz,
+		irradiance += PI * zhcVolumeIrradiance( zhcVolumeTex, ${compact.masked ? 'zhcVolumeMaskTex, ' : ''}${compact.planed ? 'zhcVolumePlaneTex, ' : ''}zhcVolume, ( zhcWorldToVolume * vec4( zhcWorldPos, 1.0 ) ).xyz,
 			zhcWorldNormalToVolume * zhcWorldNormal );
 	}`;
   const previous = material.onBeforeCompile;

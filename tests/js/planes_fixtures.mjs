@@ -162,3 +162,17 @@ export function gltfPlanes(counts, planes) {
   });
   return out;
 }
+
+// The side of its cell's plane that point p (zhc axes) lies on, in doubles (zhc__volume_plane_side's
+// rule): null when the cell has no plane, else { side, sides, cell }.
+export function planeSideAt(grid, planes, p) {
+  const i0 = [0, 1, 2].map((c) => axis(p[c], grid.origin[c], grid.spacing[c], grid.counts[c])[0]);
+  const cell = i0[0] + grid.counts[0] * (i0[1] + grid.counts[1] * i0[2]);
+  const e = planes.subarray(5 * cell, 5 * cell + 5);
+  const offset = (e[2] | (e[3] << 8)) << 16 >> 16;
+  if (offset === -32768) return null;
+  const n = decodeNormal(e[0], e[1]), c = cellCentre(grid, i0), unit = diagonal(grid) / 65534;
+  let s = -offset * unit;
+  for (let a = 0; a < 3; a++) s += n[a] * (p[a] - c[a]);
+  return { side: s >= 0 ? 1 : 0, sides: e[4], cell };
+}

@@ -89,8 +89,8 @@ for (const f of files) {
 fs.writeFileSync(W('three_grid_spec.json'), JSON.stringify({ files: files.map(({ glb, rootTranslation, rootScale, samples }) => ({ glb, rootTranslation, rootScale, samples })) }));
 
 // The C header at the samples: glTF (x, y, z) = zhc (y, z, x), so zhc = (z, x, y) of glTF.
-// `plain`: the masks dropped (three.js's grid is a texture blended by trilinear filtering, which
-// cannot apply the validity and visibility masks; the plugin's irradianceAt does apply them).
+// `plain`: the leak data dropped (three.js's grid is a texture blended by trilinear filtering, which
+// cannot apply validity, visibility masks or cell planes; the plugin's irradianceAt does apply them).
 function sampleC(zhp, samples, plain = false) {
   const toZhc = (v) => [v[2], v[0], v[1]];
   const file = W('points.txt');
@@ -204,8 +204,8 @@ for (const [tag, report] of Object.entries(reports)) for (const r of report.file
   console.log(`  MeshStandardMaterial grid vs LightProbe(blended SH): ${fmt(sg)}`);
   console.log(`  (three.js's half-cell offset: E at the shaded point vs at three.js's sample point differs by mean ` +
     `${(off.sum / off.n).toExponential(2)}, max ${off.max.toExponential(2)} relative)`);
-  console.log(`  JS irradianceAt (glTF, masked) vs C (.zhp, zhc axes, masked): max |diff| / mean E ${(jsAbs / meanE).toExponential(2)}`);
-  console.log(`  (the validity and visibility masks, which the grid texture cannot apply, move E by up to ${maskMoves.toExponential(2)} S here)`);
+  console.log(`  JS irradianceAt (glTF, leak data applied) vs C (.zhp, zhc axes, leak data applied): max |diff| / mean E ${(jsAbs / meanE).toExponential(2)}`);
+  console.log(`  (the leak data (validity, masks, cell planes), which the grid texture cannot apply, move E by up to ${maskMoves.toExponential(2)} S here)`);
   check(jsAbs <= 1e-6 * meanE, `${tag} ${r.glb}: the plugin's irradianceAt agrees with the C header (1e-6 of the mean, js.runtime_volume's bound)`);
 }
 finish('three.js LightProbeGrid');

@@ -288,8 +288,11 @@ report.irradianceAt.forEach((e, i) => { for (let k = 0; k < 3; k++) worst = Math
 console.log(`irradianceAt (glTF) vs volumeIrradiance (.zhp, zhc axes): max |diff| ${worst.toExponential(2)}, mean E ${mean.toPrecision(4)}`);
 check(mean > 0 && worst <= 1e-6 * mean, 'the plugin\'s irradianceAt on the .glb = volumeIrradiance on the .zhp at the same points (1e-6 of the mean)');
 check(report.zhpCount === report.glbCount && report.glbCount === vdef.count, `the .zhp and the .glb hold the same ${vdef.count} probes`);
-check(report.compactSize.join() === vdef.grid.counts.join() && report.compactGpuBytesPerProbe === 17 && report.compactMasked === true,
-  'the compact volume: one RGBA32UI texel per zh3_q16 probe plus the mask byte');
+// The bake writes validity and cell planes: the compact volume holds the plane texel (8 bytes) and,
+// when a probe is invalid, the mask byte.
+check(report.compactSize.join() === vdef.grid.counts.join() && vdef.planes !== undefined &&
+  report.compactGpuBytesPerProbe === 16 + (report.compactMasked ? 1 : 0) + 8,
+  `the compact volume: one RGBA32UI texel per zh3_q16 probe plus the RG32UI plane texel${report.compactMasked ? ' and the mask byte' : ''} (${report.compactGpuBytesPerProbe} bytes)`);
 check(report.patchedSame === true, 'patchMaterialWithVolume returns the material, with onBeforeCompile set');
 const g = vdef.grid;
 check(report.gridSize.every((s, c) => Math.abs(s - g.counts[c] * g.spacing[c]) <= 1e-12 * Math.abs(s)) && report.atlasDepth === 7 * (g.counts[2] + 2),

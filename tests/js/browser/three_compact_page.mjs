@@ -10,19 +10,22 @@
 //      volumes, the zhc -> glTF axis rotation); the centre pixel of a 33 x 33 target shades the pole.
 //  (C) a patched MeshStandardMaterial (roughness 1, metalness 0) and, as its twin, the same material
 //      lit by a THREE.LightProbe holding zhc's blended SH3 at q (JS volumeSH3, three.js's basis).
-// A volume with validity / visibility masks gets the masked chunk and the R8UI mask texture (spec
-// `masks: false`: compactVolume's opt-out; spec `validity` / `visibility`: synthetic masks handed to
-// compactVolume with the parsed .zhp); the ShaderMaterial passes the mask sampler when the
-// chunk defines ZHC_VOLUME_MASKED, and the LightProbe twin blends with the same masks (volumeSH3).
+// A volume with validity / visibility masks gets the masked chunk and the R8UI mask texture, one
+// with cell planes the planes chunk and the RG32UI plane texture (spec `masks: false` / `planes:
+// false`: compactVolume's opt-outs; spec `validity` / `visibility`: synthetic masks handed to
+// compactVolume with the parsed .zhp, planes dropped; spec `source`: a compact source in glTF axes
+// built from a .zhp, planesAxes 'gltf'); the ShaderMaterial passes the mask and plane samplers when
+// the chunk defines ZHC_VOLUME_MASKED / ZHC_VOLUME_PLANES, and the LightProbe twin blends with the
+// same leak data (volumeSH3).
 // Reported: the pixels, GPU bytes per probe of the compact texture and of three.js's own grid
-// (LightProbeGridWebGL atlas via the plugin's lightProbeGrid, float and binary16), the mask
-// texture's bytes, refusals.
+// (LightProbeGridWebGL atlas via the plugin's lightProbeGrid, float and binary16), the mask and
+// plane textures' bytes, refusals.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { LightProbeGridWebGL } from 'three/addons/lighting/LightProbeGridWebGL.js';
 import { ZhcLightProbesPlugin } from '/runtime/web/zhc_light_probes_plugin.mjs';
 import { compactVolume, compactVolumeFromZhp, patchMaterialWithVolume } from '/runtime/web/zhc_volume.glsl.mjs';
-import { parseZhp, makeVolume, volumeFromZhp, volumeSH3, rotateZhcToGltf, toThreeConvention, gltfToZhcDir } from '/runtime/web/zhc_runtime.mjs';
+import { parseZhp, makeVolume, volumeSH3, rotateZhcToGltf, toThreeConvention, gltfToZhcDir } from '/runtime/web/zhc_runtime.mjs';
 
 // zhc axes -> glTF axes: (x, y, z)_glTF = (y, z, x)_zhc (a rotation).
 const ZHC_TO_GLTF = new THREE.Matrix4().set(0, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 0, 0, 1);
@@ -52,7 +55,7 @@ async function main() {
       root.add(gltf.scene);
       root.updateMatrixWorld(true);
       matrixWorld = v.nodes[0].matrixWorld.clone();
-      r.shVolume = makeVolume({ sh: v.sh, ...v.grid, validity: v.validity, visibility: v.visibility });
+      r.shVolume = makeVolume({ sh: v.sh, ...v.grid, validity: v.validity, visibility: v.visibility, planes: v.planes ?? null, planesAxes: 'gltf' });
       compact = v.compactVolume();  // the plugin's method; default placement: the node's matrixWorld
       r.defaultMatrix = compact.matrixWorld.every((x, i) => x === matrixWorld.elements[i]);
       const gridF = v.lightProbeGrid(LightProbeGridWebGL);
@@ -73,19 +76,32 @@ async function main() {
         throwsWith(() => compactVolume({ ...base, bytes: v.bytes.subarray(0, 16), grid: v.grid }), /need/),
         throwsWith(() => compactVolume(v, { matrixWorld: new THREE.Matrix4().makeScale(1, 0, 1) }), /singular/),
       ];
+    } else if (f.source) {
+      // A compact source in glTF axes (grid, probe order, bits permuted; SH and normal codes in zhc
+      // axes): the grid frame is glTF's, placed by the root alone.
+      root.updateMatrixWorld(true);
+      matrixWorld = root.matrixWorld.clone();
+      const u8 = (a) => (a ? Uint8Array.from(a) : null);
+      const src = { ...f.source, bytes: u8(f.source.bytes), validity: u8(f.source.validity), visibility: u8(f.source.visibility), planes: u8(f.source.planes) };
+      compact = compactVolume(src, { THREE, matrixWorld });
+      r.shVolume = makeVolume({ encoding: src.encoding, params: src.params, bytes: src.bytes, ...src.grid, validity: src.validity,
+        visibility: src.visibility, planes: src.planes, planesAxes: 'gltf' });
+      r.count = src.bytes.length / src.bytesPerProbe;
     } else {
       const bytes = new Uint8Array(await (await fetch(`/work/${f.zhp}`)).arrayBuffer());
       root.updateMatrixWorld(true);
       matrixWorld = root.matrixWorld.clone().multiply(ZHC_TO_GLTF);
       const z = parseZhp(bytes);
       if (f.validity) {
-        // Synthetic masks (the spec's arrays) on a .zhp without any: the source object carries them.
+        // Synthetic masks (the spec's arrays) in place of the file's leak data: the source object
+        // carries them, its planes dropped (`planes: false`).
         const masks = { validity: Uint8Array.from(f.validity), visibility: Uint8Array.from(f.visibility) };
-        compact = compactVolume({ ...z, ...masks }, { THREE, matrixWorld });
+        compact = compactVolume({ ...z, ...masks }, { THREE, matrixWorld, planes: false });
         r.shVolume = makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, ...masks });
       } else {
-        compact = compactVolumeFromZhp(bytes, { THREE, matrixWorld, masks: f.masks });
-        r.shVolume = f.masks ? volumeFromZhp(bytes) : makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid });
+        compact = compactVolumeFromZhp(bytes, { THREE, matrixWorld, masks: f.masks, planes: f.planes });
+        r.shVolume = makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, validity: f.masks ? z.validity : null,
+          visibility: f.masks ? z.visibility : null, planes: f.planes ? z.planes : null });
       }
       r.count = parseZhp(bytes).count;
     }
@@ -101,6 +117,13 @@ async function main() {
     r.maskTextureBytes = compact.maskTexture ? compact.maskTexture.image.data.byteLength : 0;
     r.maskSize = compact.maskTexture ? [compact.maskTexture.image.width, compact.maskTexture.image.height, compact.maskTexture.image.depth] : null;
     r.mask = compact.mask ? Array.from(compact.mask) : null;
+    r.planed = compact.planed;
+    r.glslPlaned = compact.glsl.includes('#define ZHC_VOLUME_PLANES 1');
+    r.glslPlaneAxesGltf = compact.glsl.includes('#define ZHC_VOLUME_PLANE_AXES_GLTF 1');
+    r.planeBytes = compact.planeBytes;
+    r.planeTextureBytes = compact.planeTexture ? compact.planeTexture.image.data.byteLength : 0;
+    r.planeSize = compact.planeTexture ? [compact.planeTexture.image.width, compact.planeTexture.image.height, compact.planeTexture.image.depth] : null;
+    r.planeData = compact.planeData ? Array.from(compact.planeData) : null;
 
     // (A) ShaderMaterial, one pixel per sample.
     const N = f.samples.length;
@@ -122,13 +145,19 @@ uniform highp usampler3D zhcVolumeMaskTex;
 #else
 #define ZHC_MASK_ARG
 #endif
+#ifdef ZHC_VOLUME_PLANES
+uniform highp usampler3D zhcVolumePlaneTex;
+#define ZHC_PLANE_ARG zhcVolumePlaneTex,
+#else
+#define ZHC_PLANE_ARG
+#endif
 uniform ZhcVolume zhcVolume;
 out highp vec4 zhcOut;
 void main() {
   int i = int(gl_FragCoord.x);
   vec3 q = texelFetch(uSamples, ivec2(0, i), 0).xyz;
   vec3 d = texelFetch(uSamples, ivec2(1, i), 0).xyz;
-  zhcOut = vec4(zhcVolumeIrradiance(zhcVolumeTex, ZHC_MASK_ARG zhcVolume, q, d), 1.0);
+  zhcOut = vec4(zhcVolumeIrradiance(zhcVolumeTex, ZHC_MASK_ARG ZHC_PLANE_ARG zhcVolume, q, d), 1.0);
 }`,
     });
     const quad = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
@@ -195,7 +224,7 @@ void main() {
       for (let i = 0; i < 9; i++) sh.coefficients[i].set(g[i * 3], g[i * 3 + 1], g[i * 3 + 2]);
       r.standardProbe.push(shot(standardPlain, new THREE.LightProbe(sh)));
       // Term scale of the blended SH3 at the normal: sum_i s_l |c_i Y_i(n)| per channel (>= |E|).
-      const [x, y, z] = f.glb ? gltfToZhcDir(s.d) : s.d;
+      const [x, y, z] = f.gltf ? gltfToZhcDir(s.d) : s.d;
       const Y = [0.28209479177387814, 0.4886025119029199 * y, 0.4886025119029199 * z, 0.4886025119029199 * x,
         1.0925484305920792 * x * y, 1.0925484305920792 * y * z, 0.31539156525252005 * (3 * z * z - 1),
         1.0925484305920792 * x * z, 0.5462742152960396 * (x * x - y * y)];

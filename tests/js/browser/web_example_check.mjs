@@ -29,6 +29,7 @@ async function main() {
   report.encoding = volume.encoding;
   report.counts = [...volume.grid.counts];
   report.masked = compact.masked;
+  report.planed = compact.planed;
   report.gpuBytes = compact.gpuBytes;
   const gl = renderer.getContext();
   report.webgl2 = gl instanceof WebGL2RenderingContext;
