@@ -74,8 +74,9 @@ export class ZhcProbeVolume {
 
   // The compact path (zhc_volume.glsl.mjs): the stored probe bytes as an RGBA32UI Data3DTexture,
   // its uniforms and GLSL chunk; patchMaterialWithVolume(material, volume.compactVolume(), THREE)
-  // lights a stock material with it. Validity / visibility masks are applied (an R8UI mask texture).
-  // Options: matrixWorld (default: the single node's), masks (false: the plain blend).
+  // lights a stock material with it. Validity / visibility masks (an R8UI mask texture) and cell
+  // planes (an RG32UI texture; glTF-axes grid, normal codes in zhc axes) are applied.
+  // Options: matrixWorld (default: the single node's), masks and planes (false: without them).
   compactVolume(options = {}) {
     if (this.draco) throw new Error(`zhc: volume '${this.name}' is Draco-compressed (not decoded)`);
     return compactVolume(this, { THREE, ...options });
