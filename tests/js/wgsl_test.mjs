@@ -26,6 +26,11 @@
 //     points in and around the box plus every probe's position, against the JS runtime's
 //     volumeIrradianceD (a port of the C header's zhc_volume_irradiance_d, bit-identical per
 //     js.runtime_volume) and the test's own double twin, with the bound of test_runtime_gl's volume test;
+//     Masked volumes (runtime/zhc_volume_mask.wgsl) with random validity and visibility, and volumes
+//     with cell planes (runtime/zhc_volume_plane.wgsl, zhcVolumeIrradiancePlanes): random planes
+//     (tests/js/planes_fixtures.mjs) with validity and masks in zhc axes, and planes alone on the
+//     same grid in glTF axes (the override ZHC_VOLUME_PLANE_AXES_GLTF), against the runtime's
+//     volumeIrradianceD on the zhc-axes volume; the corners each plane keeps must equal the JS side's;
 //  5. asserts: no console error or WebGPU validation error, no compilation message, every probe and
 //     sample of every encoding compared, every value within its bound; prints the per-encoding maxima.
 // Time bounded: the browser part times out after 420 s (Chromium killed).
@@ -35,6 +40,7 @@ import { execFile } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { promisify } from 'node:util';
 import { randomProbes, makeRand, checker } from './fixtures.mjs';
+import { randomPlanes, planeMargin, planeSideAt, gltfProbeOrder, gltfPlanes, gltfBits } from './planes_fixtures.mjs';
 import { chromiumPages, readBody } from './chromium_page.mjs';
 import * as runtime from '../../runtime/web/zhc_runtime.mjs';
 
@@ -90,8 +96,8 @@ runtime.ENCODING_TABLE.forEach((row, id) => {
 // the documented functions exist, and a broken copy is rejected (the check can fail).
 {
   const { WgslReflect } = await import('wgsl_reflect/wgsl_reflect.module.js');  // (its package "main" does not load as ESM)
-  const volumeText = fs.readFileSync(path.join(repo, 'runtime', 'zhc_volume.wgsl'), 'utf8') + '\n' +
-    fs.readFileSync(path.join(repo, 'runtime', 'zhc_volume_mask.wgsl'), 'utf8');
+  const volumeText = ['zhc_volume.wgsl', 'zhc_volume_mask.wgsl', 'zhc_volume_plane.wgsl']
+    .map((f) => fs.readFileSync(path.join(repo, 'runtime', f), 'utf8')).join('\n');
   const kernelText = fs.readFileSync(path.join(here, 'browser', 'wgsl_kernel.wgsl'), 'utf8');
   const parse = (code) => {
     try {
@@ -115,7 +121,8 @@ runtime.ENCODING_TABLE.forEach((row, id) => {
     const fns = new Set(full.functions.map((f) => f.name));
     for (const f of ['zhcDecode', 'zhcIrradiance', 'zhcIrradianceSh3', 'zhcEvalSh3', 'zhcDecodeSh3F32', 'zhcDecodeSh2F32', 'zhcDecodeZh3F32',
       'zhcDecodeZh3Q16', 'zhcDecodeSh3Q28', 'zhcDecodeSh2Q', 'zhcIrradianceSh3F32', 'zhcIrradianceSh2F32', 'zhcIrradianceZh3F32',
-      'zhcIrradianceZh3Q16', 'zhcIrradianceSh3Q28', 'zhcIrradianceSh2Q', 'zhcVolumeSh3', 'zhcVolumeIrradiance'])
+      'zhcIrradianceZh3Q16', 'zhcIrradianceSh3Q28', 'zhcIrradianceSh2Q', 'zhcVolumeSh3', 'zhcVolumeIrradiance', 'zhcVolumeSh3Masked',
+      'zhcVolumeIrradianceMasked', 'zhcPlaneNormal', 'zhcVolumePlaneKeep', 'zhcVolumeSh3Planes', 'zhcVolumeIrradiancePlanes'])
       check(fns.has(f), `WGSL function ${f} exists`);
     check(!alone.error && alone.entry.compute.length === 0 && alone.storage.length === 0 && alone.uniforms.length === 0,
       'runtime/zhc.wgsl declares no bindings and no entry points');
@@ -286,11 +293,11 @@ function formatBytes(e, p) {
 }
 // A job for the page (wgsl_page.mjs): header, the kernel's Job uniform (stride, count, grid), the
 // format uniform, the probe words, the item inputs.
-function jobBytes(kernel, count, outFloats, itemFloats, stride, grid, fmt, words, itemData, maskOffset = 0) {
+function jobBytes(kernel, count, outFloats, itemFloats, stride, grid, fmt, words, itemData, maskOffset = 0, planeOffset = 0) {
   const head = new Uint32Array(16);
   head.set([kernel, count, outFloats, itemFloats, words.length]);
   const job = new ArrayBuffer(64);
-  new Uint32Array(job, 0, 4).set([stride, count, maskOffset, 0]);
+  new Uint32Array(job, 0, 4).set([stride, count, maskOffset, planeOffset]);
   if (grid) {
     new Float32Array(job, 16, 8).set([...grid.origin, 0, ...grid.spacing, 0]);
     new Uint32Array(job, 48, 4).set([...grid.counts, 0]);
@@ -442,6 +449,7 @@ function volumeJob(c) {
     c.validity = Uint8Array.from({ length: count }, () => (c.masked === 'all invalid' || caseRand() < 0.25 ? 0 : 1));
     c.visibility = Uint8Array.from({ length: count }, () => Math.floor(caseRand() * 256));
   }
+  if (c.planes) return planeVolumeJob(c, counts, count);
   c.vol = runtime.makeVolume({ encoding: c.e.name, params: c.p, bytes: c.bytes, origin: volumeOrigin, spacing: volumeSpacing, counts,
     validity: c.validity ?? null, visibility: c.visibility ?? null });
   const n = kVolumeSamples + count;
@@ -551,7 +559,113 @@ function compareMaskedVolume(c, gpu) {
   }
 }
 for (const e of encodings) maskedTallies.set(e.name + ' all invalid', { ...tally(), samples: 0, skipped: 0, renormalised: 0 });
+
+// Volumes with cell planes (zhc_volume_plane.wgsl). c.planes 'zhc': random validity (1 in 4
+// invalid), visibility (each bit set with p = 3/4) and planes (1 in 4 cells without; 1 in 5 with
+// random sides bits, the rest with the corners' own sides), uploaded in zhc axes; 'gltf': the same
+// planes alone, the probe words, grid and plane entries in glTF axes (masks all 0xFF), the points
+// permuted, the kernel with ZHC_VOLUME_PLANE_AXES_GLTF = true. Reference: the runtime's
+// volumeIrradianceD on the zhc-axes volume (bit for bit the C header's, js.runtime_volume).
+function planeVolumeJob(c, counts, count) {
+  const grid = { origin: volumeOrigin, spacing: volumeSpacing, counts };
+  const gltf = c.planes === 'gltf';
+  c.validity = gltf ? null : Uint8Array.from({ length: count }, () => (caseRand() < 0.25 ? 0 : 1));
+  c.visibility = gltf ? null : Uint8Array.from({ length: count }, () => Math.floor(caseRand() * 256) | Math.floor(caseRand() * 256));
+  c.planeBytes = randomPlanes(grid, caseRand, { pNone: 0.25, pRandomSides: 0.2 });
+  c.vol = runtime.makeVolume({ encoding: c.e.name, params: c.p, bytes: c.bytes, ...grid, validity: c.validity, visibility: c.visibility,
+    planes: c.planeBytes });
+  c.items = new Float32Array(6 * kVolumeSamples);  // zhc axes
+  for (let i = 0; i < kVolumeSamples; i++) {
+    for (let a = 0; a < 3; a++) {
+      const size = (counts[a] - 1) * volumeSpacing[a];
+      c.items[6 * i + a] = volumeOrigin[a] - 0.25 * size + 1.5 * size * caseRand();
+    }
+    const zz = 2 * caseRand() - 1, phi = 2 * Math.PI * caseRand(), r = Math.sqrt(Math.max(0, 1 - zz * zz));
+    c.items.set([r * Math.cos(phi), r * Math.sin(phi), zz], 6 * i + 3);
+  }
+  c.samples = kVolumeSamples;
+  c.outFloats = 4 * kVolumeSamples;
+  const order = gltf ? gltfProbeOrder(counts) : null;  // glTF probe j = zhc probe order[j]
+  const bpp = c.e.bytes;
+  let probeBytes = c.bytes, gpuItems = c.items, gpuGrid = grid, gpuPlanes = c.planeBytes;
+  if (gltf) {
+    probeBytes = new Uint8Array(count * bpp);
+    order.forEach((q, j) => probeBytes.set(c.bytes.subarray(q * bpp, (q + 1) * bpp), j * bpp));
+    const perm = (v) => [v[1], v[2], v[0]];  // glTF (x, y, z) = zhc (y, z, x)
+    gpuGrid = { origin: perm(volumeOrigin), spacing: perm(volumeSpacing), counts: perm(counts) };
+    gpuPlanes = gltfPlanes(counts, c.planeBytes);
+    gpuItems = new Float32Array(c.items);
+    for (let i = 0; i < kVolumeSamples; i++) gpuItems.set(perm(c.items.subarray(6 * i, 6 * i + 3)), 6 * i);
+  }
+  const probeWords = wordsOf(probeBytes), maskWords = Math.ceil(count / 4);
+  const words = new Uint32Array(probeWords.length + maskWords + 2 * count);
+  words.set(probeWords);
+  for (let q = 0; q < count; q++) {
+    const m = gltf ? 0xff : (c.validity[q] ? c.visibility[q] : 0);
+    words[probeWords.length + (q >> 2)] |= m << (8 * (q & 3));
+    const e = gpuPlanes.subarray(5 * q, 5 * q + 5);
+    words[probeWords.length + maskWords + 2 * q] = (e[0] | (e[1] << 8) | (e[2] << 16) | (e[3] << 24)) >>> 0;
+    words[probeWords.length + maskWords + 2 * q + 1] = e[4];
+  }
+  return jobBytes(gltf ? 4 : 3, kVolumeSamples, 4, 6, bpp / 4, gpuGrid, formatBytes(c.e, c.p), words, gpuItems,
+    probeWords.length, probeWords.length + maskWords);
+}
+// Per sample (zhc axes): points within 1e-4 |spacing| of their cell's plane or 1e-5 cell widths of a
+// face between cells (float and double may pick different sides or cells) are counted, not
+// compared; else the corners the plane keeps (the kernel's zhcVolumePlaneKeep, glTF corner bits
+// for 'gltf') equal planeSideAt's, and the irradiance lies within compareMaskedVolume's bound with
+// M the weight kept by validity, masks and plane (0 < M < 1e-3: counted, not compared).
+const planeTallies = new Map();
+for (const e of encodings)
+  for (const axes of ['zhc', 'gltf'])
+    planeTallies.set(`${e.name} ${axes}`, { ...tally(), samples: 0, skipped: 0, near: 0, byPlane: 0, keepWrong: 0, firstKeep: '' });
+function comparePlaneVolume(c, gpu) {
+  const t = planeTallies.get(`${c.e.name} ${c.planes}`);
+  const counts = c.grid.counts, grid = { origin: volumeOrigin, spacing: volumeSpacing, counts };
+  for (let i = 0; i < kVolumeSamples; i++) {
+    const pos = [c.items[6 * i], c.items[6 * i + 1], c.items[6 * i + 2]];
+    const nrm = [c.items[6 * i + 3], c.items[6 * i + 4], c.items[6 * i + 5]];
+    const { corners, ax } = volumeIrradianceD(c, pos, nrm);
+    let nearFace = false;
+    for (let a = 0; a < 3; a++) {
+      const tt = (pos[a] - volumeOrigin[a]) / volumeSpacing[a];
+      for (let face = 1; face + 1 < counts[a]; face++) nearFace = nearFace || Math.abs(tt - face) < 1e-5;
+    }
+    if (nearFace || planeMargin(grid, c.planeBytes, pos) < 1e-4) { t.near++; continue; }
+    const ps = planeSideAt(grid, c.planeBytes, pos);
+    const keep = ps ? (ps.side ? ps.sides : ~ps.sides & 0xff) : 0xff;
+    const wantKeep = c.planes === 'gltf' ? gltfBits(keep) : keep;
+    if (gpu[4 * i + 3] !== wantKeep && t.keepWrong++ === 0)
+      t.firstKeep = `${c.e.name} ${c.planes} sample ${i} (position ${pos.join(',')}): wgsl keeps ${gpu[4 * i + 3]}, JS ${wantKeep}`;
+    if (keep !== 0xff) t.byPlane++;
+    let extra = 0, kept = 0;
+    for (let a = 0; a < 3; a++) extra += (Math.abs(pos[a]) + Math.abs(volumeOrigin[a])) / volumeSpacing[a] + ax[a].t + 2;
+    for (let corner = 0; corner < 8; corner++) {
+      const b = [corner & 1, (corner >> 1) & 1, corner >> 2];
+      const w = (b[0] ? ax[0].f : 1 - ax[0].f) * (b[1] ? ax[1].f : 1 - ax[1].f) * (b[2] ? ax[2].f : 1 - ax[2].f);
+      const q = (ax[0].i0 + b[0]) + counts[0] * ((ax[1].i0 + b[1]) + counts[1] * (ax[2].i0 + b[2]));
+      const seen = !c.validity || (c.validity[q] && (c.visibility[q] >> (7 - corner)) & 1);
+      if (w !== 0 && seen && (keep >> corner) & 1) kept += w;
+    }
+    let weightPart = 3 * extra;
+    if (kept > 0) {
+      if (kept < 1e-3) { t.skipped++; continue; }
+      weightPart = 2 * weightPart / kept;
+    }
+    const rgb = runtime.volumeIrradianceD(c.vol, pos, nrm);
+    const scale = [0, 0, 0];
+    for (const q of corners) {
+      const sc = probeScale(c.e, c.p, c.decoded[q]);
+      for (let k = 0; k < 3; k++) scale[k] += sc.irradiance[k];
+    }
+    t.samples++;
+    for (let k = 0; k < 3; k++)
+      checkValue(t, 'maxIrr', rgb[k], gpu[4 * i + k], scale[k], 48 + weightPart,
+        () => `${c.e.name} ${c.planes} planes sample ${i} (position ${pos.join(',')}) channel ${k}`);
+  }
+}
 function compareVolume(c, gpu) {
+  if (c.planes) return comparePlaneVolume(c, gpu);
   if (c.masked) return compareMaskedVolume(c, gpu);
   const t = volumeTallies.get(c.e.name);
   for (let i = 0; i < c.samples; i++) {
@@ -587,6 +701,9 @@ for (const e of encodings)
 for (const e of encodings)
   for (const masked of ['random', 'all invalid'])
     cases.push({ e, volume: true, masked, grid: volumeGrids[0], zhp: W(`${e.name}_${volumeGrids[0].batch}.zhp`) });
+for (const e of encodings)
+  for (const planes of ['zhc', 'gltf'])
+    cases.push({ e, volume: true, planes, grid: volumeGrids[0], zhp: W(`${e.name}_${volumeGrids[0].batch}.zhp`) });
 
 // --- 3. server + Chromium ---------------------------------------------------------------------
 const roots = { '/runtime/': path.join(repo, 'runtime'), '/test/': path.join(here, 'browser') };
@@ -614,6 +731,7 @@ const routes = {
       (current.volume ? compareVolume : compareCase)(current, gpu);
       compareMs += Date.now() - tc;
       current.bytes = current.normals = current.items = current.decoded = current.vol = current.validity = current.visibility = null;
+      current.planeBytes = null;
       jobsDone++;
     }
     res.end('ok');
@@ -667,6 +785,16 @@ for (const [name, t] of maskedTallies) {
   check(t.samples + t.skipped === kVolumeSamples && t.skipped <= kVolumeSamples / 100 && t.compared === 3 * t.samples,
     `${name} masked volume: every sample compared or counted (${t.samples} + ${t.skipped} skipped)`);
   check(name.endsWith('all invalid') ? t.renormalised === 0 : t.renormalised > kVolumeSamples / 2, `${name}: the masks act (${t.renormalised} renormalised)`);
+}
+console.log('probe volumes with cell planes (zhc_volume_plane.wgsl): max error in u S of zhcVolumeIrradiancePlanes vs volumeIrradianceD:');
+for (const [name, t] of planeTallies) {
+  console.log(`${name.padEnd(34)} ${String(t.samples).padStart(7)} samples ${t.maxIrr.toFixed(3).padStart(8)} u S, skipped ${t.skipped}, ` +
+    `near a plane or face ${t.near}, cut by a plane ${t.byPlane}, kept corners differ ${t.keepWrong}`);
+  check(t.failures === 0, `${name} planes volume: ${t.failures} values out of bound; first: ${t.failures ? t.firstFailure : ''}`);
+  check(t.keepWrong === 0, `${name} planes volume: the kept corners equal the JS side's; first: ${t.firstKeep}`);
+  check(t.samples + t.skipped + t.near === kVolumeSamples && t.skipped <= kVolumeSamples / 100 && t.near <= kVolumeSamples / 100 &&
+    t.compared === 3 * t.samples, `${name} planes volume: every sample compared or counted (${t.samples} + ${t.skipped} + ${t.near})`);
+  check(t.byPlane > kVolumeSamples / 4, `${name}: the planes act (${t.byPlane} samples cut)`);
 }
 console.log(`wall time: encoding ${((tEncoded - t0) / 1000).toFixed(1)} s, browser + comparison ${((tBrowser - tEncoded) / 1000).toFixed(1)} s ` +
   `(of which JS reference + comparison ${(compareMs / 1000).toFixed(1)} s), total ${((Date.now() - t0) / 1000).toFixed(1)} s`);

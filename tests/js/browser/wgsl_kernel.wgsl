@@ -1,5 +1,5 @@
 // Compute kernels of tests/js/wgsl_test.mjs, appended to runtime/zhc.wgsl + runtime/zhc_volume.wgsl
-// + runtime/zhc_volume_mask.wgsl by the page.
+// + runtime/zhc_volume_mask.wgsl + runtime/zhc_volume_plane.wgsl by the page.
 // decode_kernel: item i = the probe words words[i * stride .. + stride) (stride <= 27) and the unit
 // normal items[3 i .. 3 i + 2]; writes zhcDecode (27 floats, SH3 radiance) and zhcIrradiance
 // (3 floats) at out[30 i ..].
@@ -7,6 +7,9 @@
 // in words[]; writes zhcVolumeIrradiance (3 floats) at out[3 i ..].
 // masked_volume_kernel: the same with zhcVolumeIrradianceMasked; the combined masks (4 per word) in
 // words[] from word job.pad0 on.
+// plane_volume_kernel: the same with zhcVolumeIrradiancePlanes; the masks as above, the plane
+// entries (2 words per probe) from word job.pad1 on; writes 4 floats per item at out[4 i ..]: the
+// irradiance and the corners the cell's plane keeps (zhcVolumePlaneKeep, as a float).
 
 struct Job {
     stride: u32,
@@ -35,6 +38,7 @@ fn zhcMyFormat() -> ZhcFormat {
 // The probe words of zhc_volume.wgsl's functions, and the masks of zhc_volume_mask.wgsl's.
 fn zhcVolumeWord(i: u32) -> u32 { return words[i]; }
 fn zhcVolumeMask(i: u32) -> u32 { return (words[job.pad0 + (i >> 2u)] >> (8u * (i & 3u))) & 0xFFu; }
+fn zhcVolumePlane(i: u32) -> vec2<u32> { return vec2<u32>(words[job.pad1 + 2u * i], words[job.pad1 + 2u * i + 1u]); }
 
 @compute @workgroup_size(64)
 fn decode_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -78,4 +82,24 @@ fn masked_volume_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
     outv[3u * i] = e.x;
     outv[3u * i + 1u] = e.y;
     outv[3u * i + 2u] = e.z;
+}
+
+@compute @workgroup_size(64)
+fn plane_volume_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= job.count) { return; }
+    let p = vec3<f32>(items[6u * i], items[6u * i + 1u], items[6u * i + 2u]);
+    let n = vec3<f32>(items[6u * i + 3u], items[6u * i + 4u], items[6u * i + 5u]);
+    let v = ZhcVolume(job.origin.xyz, job.spacing.xyz, job.counts.xyz);
+    let e = zhcVolumeIrradiancePlanes(v, fmt, p, n);
+    // zhcVolumeSh3Planes' cell, and the corners its plane keeps.
+    let cn = max(v.counts, vec3<u32>(1u));
+    var t = (p - v.origin) / v.spacing;
+    t = min(select(vec3<f32>(0.0), t, t >= vec3<f32>(0.0)), vec3<f32>(cn - 1u));
+    let i0 = min(vec3<u32>(t), max(cn, vec3<u32>(2u)) - 2u);
+    let keep = zhcVolumePlaneKeep(zhcVolumePlane(i0.x + cn.x * (i0.y + cn.y * i0.z)), v, i0, p);
+    outv[4u * i] = e.x;
+    outv[4u * i + 1u] = e.y;
+    outv[4u * i + 2u] = e.z;
+    outv[4u * i + 3u] = f32(keep);
 }

@@ -4,8 +4,10 @@
 // Protocol: GET /job/next -> 204 when done, else a binary job: a 16-u32 header [kernel, count,
 // outFloats, itemFloats, wordCount, 0...], the kernel's `Job` uniform (64 bytes), the ZhcFormat
 // uniform (80 bytes), `wordCount` u32 probe words and `count * itemFloats` f32 item inputs (kernel 0:
-// decode_kernel, kernel 1: volume_kernel, kernel 2: masked_volume_kernel of wgsl_kernel.wgsl). POST /job/result: the `count *
-// outFloats` output floats. POST /result: a JSON summary.
+// decode_kernel, kernel 1: volume_kernel, kernel 2: masked_volume_kernel, kernel 3:
+// plane_volume_kernel of wgsl_kernel.wgsl, kernel 4: plane_volume_kernel with the override
+// ZHC_VOLUME_PLANE_AXES_GLTF = true). POST /job/result: the `count * outFloats` output floats.
+// POST /result: a JSON summary.
 
 const errors = window.zhcErrors;
 const summary = { webgpu: false, adapter: '', jobs: 0, compilation: [], errors };
@@ -26,14 +28,18 @@ async function main() {
   device.addEventListener('uncapturederror', (e) => errors.push('uncaptured WebGPU error: ' + e.error.message));
   summary.webgpu = true;
   const code = [await text('/runtime/zhc.wgsl'), await text('/runtime/zhc_volume.wgsl'), await text('/runtime/zhc_volume_mask.wgsl'),
-    await text('/test/wgsl_kernel.wgsl')].join('\n');
+    await text('/runtime/zhc_volume_plane.wgsl'), await text('/test/wgsl_kernel.wgsl')].join('\n');
   device.pushErrorScope('validation');
   const module = device.createShaderModule({ code });
   const ci = await module.getCompilationInfo();
   for (const m of ci.messages) summary.compilation.push(`${m.type} ${m.lineNum}:${m.linePos} ${m.message}`);
   const pipelines = {};
-  for (const entry of ['decode_kernel', 'volume_kernel', 'masked_volume_kernel'])
+  for (const entry of ['decode_kernel', 'volume_kernel', 'masked_volume_kernel', 'plane_volume_kernel'])
     if (code.includes(`fn ${entry}(`)) pipelines[entry] = device.createComputePipeline({ layout: 'auto', compute: { module, entryPoint: entry } });
+  if (code.includes('fn plane_volume_kernel(')) {
+    pipelines.plane_volume_kernel_gltf = device.createComputePipeline({ layout: 'auto',
+      compute: { module, entryPoint: 'plane_volume_kernel', constants: { ZHC_VOLUME_PLANE_AXES_GLTF: 1 } } });
+  }
   const err = await device.popErrorScope();
   if (err) throw new Error('shader module / pipeline: ' + err.message);
 
@@ -60,7 +66,7 @@ async function main() {
     const outSize = 4 * count * outFloats;
     const out = device.createBuffer({ size: outSize, usage: GPUBufferUsage.STORAGE | GPUBufferUsage.COPY_SRC });
     const read = device.createBuffer({ size: outSize, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST });
-    const pipeline = pipelines[['decode_kernel', 'volume_kernel', 'masked_volume_kernel'][kernel]];
+    const pipeline = pipelines[['decode_kernel', 'volume_kernel', 'masked_volume_kernel', 'plane_volume_kernel', 'plane_volume_kernel_gltf'][kernel]];
     if (!pipeline) throw new Error(`kernel ${kernel} is not in the shader`);
     device.pushErrorScope('validation');
     const bind = device.createBindGroup({ layout: pipeline.getBindGroupLayout(0), entries: [
