@@ -25,6 +25,18 @@
 // invocations per dispatch, median of 9 after a warm-up, kernels in interleaved rounds; the packed
 // sh3 row is the baseline. The GPU's results are compared with the CPU model at the same inputs.
 //
+// Leak data's cost (a second table, "leak_rows" in the JSON): zh3_q16 stored bytes on the demo grid
+// in two kernel families, each plain, with masks (the demo bake's validity and visibility, combined:
+// ZHC_VOLUME_MASK), with planes (the demo bake's cell planes: ZHC_VOLUME_PLANE), with a plane through
+// the centre of every cell (every sample cut), and with validity + planes (what a default bake
+// writes); masks and plane entries follow the probe words in the buffer. "8 fetches": the packed
+// rows' kernel (8 corner decodes unrolled, none skipped) with the weights kept by zhc.hlsl's
+// zhc_volume_plane_keep and the masks, renormalised; "zhc.hlsl": zhc_volume_irradiance itself (a
+// corner loop that skips weight-0 corners, and so dropped ones). SPIR-V and lavapipe ns as above, in
+// the same interleaved rounds; "vs plain": the ratio to the family's plain row; "cut": the share of
+// the timed samples where the data drops a corner of non-zero weight. The GPU's results are
+// compared with zhc_volume_irradiance_d of the same volume.
+//
 // Usage: bench_volume [--samples N] [--gltf FILE] [--json FILE] [--keep DIR]
 #include <algorithm>
 #include <cmath>
@@ -65,6 +77,7 @@ struct Grid {
     std::string name;
     std::vector<Sh3Radiance> probes;
     ProbeLayout layout;
+    ProbeLeakData leak;  // the bake's validity, visibility masks and cell planes
 };
 
 struct Stats {
@@ -83,6 +96,10 @@ struct Row {
     double ns = NAN;         // lavapipe ns per sample; NAN not measured
     double vs_model = NAN;   // max |GPU - CPU model| / mean |model| over the timed samples
     Stats err[2];
+    // Leak-data rows (zhc_volume_irradiance of zh3_q16 with masks / planes): which data the kernel and
+    // the timed volume use; leak_row false for the layout rows above.
+    bool leak_row = false, unrolled = false, masks = false, planes = false, every_cell = false;
+    double cut = NAN;  // share of the timed samples where the leak data drops a corner
 };
 
 bool encode(const Grid& g, const char* rep, std::vector<std::uint8_t>* payload, zhc_volume* vol, zhc_probe_format* fmt) {
@@ -149,6 +166,104 @@ int spirv_instructions(const std::string& dir, const std::string& name, const st
 }
 #endif
 
+// The leak-data kernels: zh3_q16 words at word 0 of binding 0, the combined masks (4 per word) at
+// word `mask_base`, the plane entries (2 words per probe) at `plane_base`. unrolled false:
+// zhc_volume_irradiance of zhc.hlsl with ZHC_VOLUME_MASK and / or ZHC_VOLUME_PLANE (a loop over the
+// corners that skips weight-0 ones); true: the packed rows' kernel (8 corner decodes unrolled, none
+// skipped) with the weights kept by zhc.hlsl's zhc_volume_plane_keep and the masks, renormalised.
+std::string leak_kernel(bool masks, bool planes, bool unrolled, std::uint32_t mask_base, std::uint32_t plane_base) {
+    std::ostringstream s;
+    s << zhc_volume_kernels::kKernelHead
+      << "[[vk::binding(0, 0)]] ByteAddressBuffer probeWords;\n#define ZHC_VOLUME_WORD(i) probeWords.Load(4u * (i))\n";
+    if (masks) s << "#define ZHC_VOLUME_MASK(i) ((probeWords.Load(4u * (" << mask_base << "u + ((i) >> 2))) >> (8u * ((i) & 3u))) & 0xFFu)\n";
+    if (planes) s << "#define ZHC_VOLUME_PLANE(i) probeWords.Load2(4u * (" << plane_base << "u + 2u * (i)))\n";
+    s << "#include \"zhc.hlsl\"\n"
+      << zhc_volume_kernels::kKernelMainHead
+      << "    ZhcVolume v;\n    v.origin = gOrigin.xyz;\n    v.spacing = gSpacing.xyz;\n    v.counts = gCounts.xyz;\n"
+         "    const ZhcFormat f = zhc_default_format("
+      << ZHC_ENC_ZH3_Q16 << "u);\n";
+    if (!unrolled) {
+        s << "    float3 e = zhc_volume_irradiance(v, f, p, nrm);\n";
+    } else {
+        s << "    uint3 n = max(v.counts, uint3(1u, 1u, 1u));\n"
+             "    float3 t = (p - v.origin) / v.spacing;\n"
+             "    t = float3(t.x >= 0.0f ? t.x : 0.0f, t.y >= 0.0f ? t.y : 0.0f, t.z >= 0.0f ? t.z : 0.0f);\n"
+             "    t = min(t, float3(n - 1u));\n"
+             "    uint3 i0 = min(uint3(t), max(n, uint3(2u, 2u, 2u)) - 2u);\n"
+             "    float3 fr = t - float3(i0);\n"
+             "    uint keep = 0xFFu;\n";
+        if (planes) s << "    keep = zhc_volume_plane_keep(ZHC_VOLUME_PLANE(i0.x + n.x * (i0.y + n.y * i0.z)), v, i0, p);\n";
+        s << "    float w[8], wm[8];\n    float sum = 0.0f;\n"
+             "    [unroll] for (uint m = 0u; m < 8u; ++m)\n    {\n"
+             "        uint3 b = uint3(m & 1u, (m >> 1) & 1u, m >> 2);\n"
+             "        w[m] = (b.x != 0u ? fr.x : 1.0f - fr.x) * (b.y != 0u ? fr.y : 1.0f - fr.y) * (b.z != 0u ? fr.z : 1.0f - fr.z);\n"
+             "        uint bit = (keep >> m) & 1u;\n";
+        if (masks) s << "        uint3 q = i0 + b;\n        bit &= (ZHC_VOLUME_MASK(q.x + n.x * (q.y + n.y * q.z)) >> (7u - m)) & 1u;\n";
+        s << "        wm[m] = bit != 0u ? w[m] : 0.0f;\n        sum += wm[m];\n    }\n"
+             "    ZhcSH3 acc;\n"
+             "    [unroll] for (int i = 0; i < 9; ++i) acc.c[i] = float3(0.0f, 0.0f, 0.0f);\n"
+             "    [unroll] for (uint c = 0u; c < 8u; ++c)\n    {\n"
+             "        uint3 b = uint3(c & 1u, (c >> 1) & 1u, c >> 2);\n"
+             "        float wc = sum > 0.0f ? wm[c] / sum : w[c];\n"
+             "        uint3 q = i0 + b;\n"
+             "        ZhcSH3 s = zhc_volume_probe(q.x + n.x * (q.y + n.y * q.z), f);\n"
+             "        [unroll] for (int j = 0; j < 9; ++j) acc.c[j] += wc * s.c[j];\n"
+             "    }\n"
+             "    float3 e = zhc_sh3_irradiance(acc, zhc_normalize_or_z(nrm));\n";
+    }
+    s << zhc_volume_kernels::kKernelMainTail;
+    return s.str();
+}
+
+// A plane through the centre of every cell (random normal code, the corners' sides), "no plane" on
+// the probes that start no cell: every sample of the grid is cut by its cell's plane.
+std::vector<std::uint8_t> planes_every_cell(const zhc_volume& v, std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::vector<std::uint8_t> out;
+    for (std::uint32_t z = 0; z < v.counts[2]; ++z)
+        for (std::uint32_t y = 0; y < v.counts[1]; ++y)
+            for (std::uint32_t x = 0; x < v.counts[0]; ++x) {
+                std::uint8_t e[5] = {127, 127, 0x00, 0x80, 0};
+                const std::uint32_t i0[3] = {x, y, z};
+                bool last = false;
+                for (int c = 0; c < 3; ++c) last = last || (v.counts[c] > 1 && i0[c] + 1 == v.counts[c]);
+                if (!last) {
+                    e[0] = std::uint8_t(rng() % 255);
+                    e[1] = std::uint8_t(rng() % 255);
+                    e[2] = e[3] = 0;  // offset 0: through the centre
+                    double n[3];
+                    zhc_plane_normal(e[0], e[1], n);
+                    for (int k = 0; k < 8; ++k) {
+                        double s = 0;
+                        for (int c = 0; c < 3; ++c) s += n[c] * ((((k >> c) & 1) - 0.5) * v.spacing[c]);
+                        if (s >= 0) e[4] = std::uint8_t(e[4] | (1u << k));
+                    }
+                }
+                out.insert(out.end(), e, e + 5);
+            }
+    return out;
+}
+
+// Whether the leak data of v drops a corner of non-zero weight at p (zhc_volume_sh3's rules).
+bool leak_cuts(const zhc_volume& v, const double p[3]) {
+    std::uint32_t i0[3];
+    double f[3];
+    for (int c = 0; c < 3; ++c) zhc__volume_axis(p[c], v.origin[c], v.spacing[c], v.counts[c], &i0[c], &f[c]);
+    const std::size_t cell = i0[0] + std::size_t(v.counts[0]) * (i0[1] + std::size_t(v.counts[1]) * i0[2]);
+    int side = 0, has = 0;
+    unsigned sides = 0;
+    if (v.planes) has = zhc__volume_plane_side(&v, cell, i0, p, &side, &sides);
+    for (int k = 0; k < 8; ++k) {
+        const double w = ((k & 1) ? f[0] : 1 - f[0]) * ((k >> 1 & 1) ? f[1] : 1 - f[1]) * ((k >> 2) ? f[2] : 1 - f[2]);
+        if (w == 0) continue;
+        const std::size_t q = cell + std::size_t(k & 1) + std::size_t(v.counts[0]) * (std::size_t((k >> 1) & 1) + std::size_t(v.counts[1]) * std::size_t(k >> 2));
+        if (v.validity && !v.validity[q]) return true;
+        if (v.visibility && !((v.visibility[q] >> (7 - k)) & 1)) return true;
+        if (has && int((sides >> k) & 1) != side) return true;
+    }
+    return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -168,12 +283,15 @@ int main(int argc, char** argv) {
     std::vector<Grid> grids;
     {
         const Scene scene = default_scene();
-        auto baked = bake_scene(scene);
+        BakeOptions options;
+        options.visibility_masks = true;  // the leak rows' masks
+        ProbeLeakData leak;
+        auto baked = bake_scene(scene, options, nullptr, &leak);
         if (!baked) {
             std::fprintf(stderr, "demo bake: %s\n", baked.error().message.c_str());
             return 1;
         }
-        grids.push_back({"demo", *baked, probe_layout(scene.probes)});
+        grids.push_back({"demo", *baked, probe_layout(scene.probes), leak});
     }
     {
         auto bytes = read_file_bytes(gltf, std::uint64_t(1) << 30);
@@ -191,7 +309,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "%s: %s\n", gltf.c_str(), baked.error().message.c_str());
             return 1;
         }
-        grids.push_back({"gltf", *baked, probe_layout(scene->probes)});
+        grids.push_back({"gltf", *baked, probe_layout(scene->probes), {}});
     }
 
     const char* packed[] = {"sh3", "zh3_q16", "sh2_q", "sh3_q28"};
@@ -225,6 +343,37 @@ int main(int argc, char** argv) {
         r.filtered = true;
         r.layout = l;
         rows.push_back(r);
+    }
+    {
+        // Leak rows on the demo grid: masks after the zh3_q16 words, plane entries after the masks.
+        const std::uint64_t count = std::uint64_t(grids[0].layout.grid.counts[0]) * grids[0].layout.grid.counts[1] *
+                                    grids[0].layout.grid.counts[2];
+        const std::uint32_t mask_base = static_cast<std::uint32_t>(count * 4), plane_base = mask_base + static_cast<std::uint32_t>((count + 3) / 4);
+        const struct {
+            const char* name;
+            bool masks, planes, every_cell;
+        } leak_rows[] = {{"plain", false, false, false},
+                         {"+ masks", true, false, false},
+                         {"+ planes", false, true, false},
+                         {"+ planes, every cell", false, true, true},
+                         {"+ validity + planes", true, true, false}};
+        for (int unrolled = 1; unrolled >= 0; --unrolled)
+        for (const auto& lr : leak_rows) {
+            Row r;
+            r.name = std::string(unrolled ? "8 fetches " : "zhc.hlsl ") + lr.name;
+            r.kind = unrolled ? "zh3_q16 stored bytes, 8 corner decodes unrolled (the packed rows' kernel), kept weights"
+                              : "zh3_q16 stored bytes, zhc.hlsl zhc_volume_irradiance (corner loop, weight-0 corners skipped)";
+            r.textures = "stored bytes";
+            r.bytes = 16 + (lr.masks ? 1 : 0) + (lr.planes ? 5 : 0);
+            r.fetches = 8;
+            r.source = leak_kernel(lr.masks, lr.planes, unrolled != 0, mask_base, plane_base);
+            r.leak_row = true;
+            r.unrolled = unrolled != 0;
+            r.masks = lr.masks;
+            r.planes = lr.planes;
+            r.every_cell = lr.every_cell;
+            rows.push_back(r);
+        }
     }
 
     for (std::size_t gi = 0; gi < grids.size(); ++gi) {
@@ -335,6 +484,7 @@ int main(int argc, char** argv) {
                 zhc_volume vol{};
                 std::vector<std::uint8_t> bytes;
                 std::vector<std::vector<std::uint8_t>> tex;
+                std::vector<std::uint8_t> payload, validity, visibility, planes;  // leak rows: what vol points at
             };
             std::vector<Timed> timed;
             timed.reserve(rows.size());
@@ -353,6 +503,34 @@ int main(int argc, char** argv) {
                         if (spec[i].storage == L::Storage::kSnorm8) f = spec[i].components == 4 ? VK_FORMAT_R8G8B8A8_SNORM : VK_FORMAT_R8_SNORM;
                         images.push_back({static_cast<std::uint32_t>(f), ref.counts[0], ref.counts[1], ref.counts[2], t.tex[i]});
                     }
+                } else if (r.leak_row) {
+                    zhc_probe_format fmt;
+                    if (!encode(g, "zh3_q16", &t.bytes, &t.vol, &fmt)) return 1;
+                    const std::size_t count = g.probes.size();
+                    const bool has_leak = g.leak.validity.size() == count && g.leak.planes.size() == 5 * count;
+                    if (!has_leak && (r.masks || r.planes)) {
+                        std::fprintf(stderr, "%s: the demo bake has no validity or planes\n", r.name.c_str());
+                        continue;
+                    }
+                    // Words: the probes, then the combined masks (valid ? visibility : 0, 4 per word;
+                    // absent visibility: 0xFF), then 2 words per plane entry; the model's volume sees
+                    // the same data.
+                    t.payload = t.bytes;
+                    t.validity = g.leak.validity;
+                    t.visibility = g.leak.visibility;
+                    t.planes = r.every_cell ? planes_every_cell(t.vol, 38) : g.leak.planes;
+                    t.bytes.resize(t.payload.size() + 4 * ((count + 3) / 4) + 8 * count, 0);
+                    // The masks row: validity and visibility; the validity + planes row: validity alone.
+                    const bool use_visibility = r.masks && !r.planes && t.visibility.size() == count;
+                    for (std::size_t i = 0; i < count && has_leak; ++i) {
+                        const std::uint8_t m = t.validity[i] ? (use_visibility ? t.visibility[i] : 0xFF) : 0;
+                        t.bytes[t.payload.size() + i] = m;  // little-endian: byte i of the mask words
+                        for (int b = 0; b < 5; ++b) t.bytes[t.payload.size() + 4 * ((count + 3) / 4) + 8 * i + std::size_t(b)] = t.planes[5 * i + std::size_t(b)];
+                    }
+                    t.vol.probes = t.payload.data();
+                    if (r.masks) t.vol.validity = t.validity.data();
+                    if (use_visibility) t.vol.visibility = t.visibility.data();
+                    if (r.planes) t.vol.planes = t.planes.data();
                 } else {
                     zhc_probe_format fmt;
                     if (!encode(g, r.name.c_str(), &t.bytes, &t.vol, &fmt)) return 1;
@@ -400,6 +578,15 @@ int main(int argc, char** argv) {
                     mag += norm3(e) / kSamples;
                 }
                 t.row->vs_model = worst / mag;
+                if (t.row->leak_row) {
+                    std::uint32_t cut = 0;
+                    for (std::uint32_t i = 0; i < kSamples; ++i) {
+                        double pd[3];
+                        for (int c = 0; c < 3; ++c) pd[c] = inputs[8 * i + static_cast<std::uint32_t>(c)];
+                        cut += leak_cuts(t.vol, pd);
+                    }
+                    t.row->cut = double(cut) / kSamples;
+                }
             }
             timed.clear();  // kernels before the context
         }
@@ -416,15 +603,33 @@ int main(int argc, char** argv) {
     std::printf("%-22s %6s  %-26s %7s %6s %10s %10s %10s | %10s %10s %10s %8s %6s %9s\n", "layout", "B/probe", "textures", "fetches",
                 "SPIR-V", "mean", "p95", "max", "mean", "p95", "max", "ns", "vs sh3", "GPU-model");
     for (const Row& r : rows)
+        if (!r.leak_row)
         std::printf("%-22s %6.0f  %-26s %7d %6d %10.3g %10.3g %10.3g | %10.3g %10.3g %10.3g %8.1f %6.2f %9.2g\n", r.name.c_str(), r.bytes,
                     r.textures.c_str(), r.fetches, r.spirv, r.err[0].mean, r.err[0].p95, r.err[0].max, r.err[1].mean, r.err[1].p95,
                     r.err[1].max, r.ns, r.ns / base_ns, r.vs_model);
+    // The plain row of each leak-row family (8 fetches unrolled, zhc.hlsl's loop).
+    auto plain_ns = [&](const Row& row) {
+        for (const Row& r : rows)
+            if (r.leak_row && r.unrolled == row.unrolled && !r.masks && !r.planes) return r.ns;
+        return double(NAN);
+    };
+    std::printf("\nleak data's cost (demo grid, zh3_q16 stored bytes; \"8 fetches\": the packed rows' unrolled kernel with the kept\n"
+                "weights, \"zhc.hlsl\": zhc_volume_irradiance's corner loop that skips weight-0 corners): B/probe with the leak\n"
+                "data, SPIR-V as above, lavapipe ns (same rounds), vs plain: ratio to its family's plain row, cut: share of the\n"
+                "timed samples where the data drops a corner\n\n");
+    std::printf("%-32s %7s %6s %8s %8s %6s %9s\n", "kernel", "B/probe", "SPIR-V", "ns", "vs plain", "cut", "GPU-model");
+    for (const Row& r : rows)
+        if (r.leak_row)
+            std::printf("%-32s %7.0f %6d %8.1f %8.3f %6.3f %9.2g\n", r.name.c_str(), r.bytes, r.spirv, r.ns, r.ns / plain_ns(r), r.cut,
+                        r.vs_model);
     if (!json.empty()) {
         std::ofstream out(json);
         out << "{\n  \"benchmark\": \"volume\",\n  \"device\": \"" << device << "\",\n  \"samples\": " << samples << ",\n  \"grids\": [\"demo\", \"" << gltf
             << "\"],\n  \"rows\": [\n";
-        for (std::size_t i = 0; i < rows.size(); ++i) {
-            const Row& r = rows[i];
+        std::vector<const Row*> layout_rows, leak_rows;
+        for (const Row& r : rows) (r.leak_row ? leak_rows : layout_rows).push_back(&r);
+        for (std::size_t i = 0; i < layout_rows.size(); ++i) {
+            const Row& r = *layout_rows[i];
             char buf[1024];
             std::snprintf(buf, sizeof buf,
                           "    {\"layout\": \"%s\", \"kind\": \"%s\", \"textures\": \"%s\", \"bytes_per_probe\": %g, \"fetches\": %d, "
@@ -434,7 +639,21 @@ int main(int argc, char** argv) {
                           "\"gltf\": {\"mean\": %.6g, \"p95\": %.6g, \"max\": %.6g}}%s\n",
                           r.name.c_str(), r.kind.c_str(), r.textures.c_str(), r.bytes, r.fetches, r.spirv, std::isfinite(r.ns) ? r.ns : -1.0,
                           std::isfinite(r.ns / base_ns) ? r.ns / base_ns : -1.0, std::isfinite(r.vs_model) ? r.vs_model : -1.0, r.err[0].mean, r.err[0].p95, r.err[0].max,
-                          r.err[1].mean, r.err[1].p95, r.err[1].max, i + 1 < rows.size() ? "," : "");
+                          r.err[1].mean, r.err[1].p95, r.err[1].max, i + 1 < layout_rows.size() ? "," : "");
+            out << buf;
+        }
+        out << "  ],\n  \"leak_rows\": [\n";
+        for (std::size_t i = 0; i < leak_rows.size(); ++i) {
+            const Row& r = *leak_rows[i];
+            char buf[1024];
+            std::snprintf(buf, sizeof buf,
+                          "    {\"kernel\": \"%s\", \"unrolled\": %s, \"masks\": %s, \"planes\": %s, \"planes_every_cell\": %s, \"bytes_per_probe\": %g, "
+                          "\"spirv_instructions_minus_skeleton\": %d, \"lavapipe_ns_per_sample\": %.4g, \"ratio_to_plain\": %.4g, "
+                          "\"cut\": %.4g, \"gpu_vs_model\": %.4g}%s\n",
+                          r.name.c_str(), r.unrolled ? "true" : "false", r.masks ? "true" : "false", r.planes ? "true" : "false",
+                          r.every_cell ? "true" : "false", r.bytes, r.spirv, std::isfinite(r.ns) ? r.ns : -1.0,
+                          std::isfinite(r.ns / plain_ns(r)) ? r.ns / plain_ns(r) : -1.0,
+                          std::isfinite(r.cut) ? r.cut : -1.0, std::isfinite(r.vs_model) ? r.vs_model : -1.0, i + 1 < leak_rows.size() ? "," : "");
             out << buf;
         }
         if (!bench::finish_json(out, json)) return 1;
