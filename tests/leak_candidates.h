@@ -87,40 +87,11 @@ struct CellPlane {
 };
 constexpr double kPlaneBytesPerCell = 5;
 
-inline Vec3 oct_decode(std::uint8_t ou, std::uint8_t ov) {
-    double a = std::min(ou, std::uint8_t(254)) / 127.0 - 1, b = std::min(ov, std::uint8_t(254)) / 127.0 - 1;
-    const double z = 1 - std::fabs(a) - std::fabs(b);
-    if (z < 0) {
-        const double a0 = a;
-        a = (1 - std::fabs(b)) * (a0 < 0 ? -1 : 1);
-        b = (1 - std::fabs(a0)) * (b < 0 ? -1 : 1);
-    }
-    return normalized({a, b, z});
-}
+// The stored code's normal and the nearest code: the bake's own (codec/bake/leak_planes.h), so the
+// prototype's planes mean what the runtime reads.
+inline Vec3 oct_decode(std::uint8_t ou, std::uint8_t ov) { return cell_plane_normal(ou, ov); }
 
-inline void oct_encode(Vec3 n, std::uint8_t* ou, std::uint8_t* ov) {
-    n = normalized(n);
-    const double s = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
-    double a = n.x / s, b = n.y / s;
-    if (n.z < 0) {
-        const double a0 = a;
-        a = (1 - std::fabs(b)) * (a0 < 0 ? -1 : 1);
-        b = (1 - std::fabs(a0)) * (b < 0 ? -1 : 1);
-    }
-    // The nearest code of the 3 x 3 around the rounded one (by the decoded normal's angle).
-    const int u0 = int(std::lround((a + 1) * 127)), v0 = int(std::lround((b + 1) * 127));
-    double best = -2;
-    for (int du = -1; du <= 1; ++du)
-        for (int dv = -1; dv <= 1; ++dv) {
-            const int u = std::clamp(u0 + du, 0, 254), v = std::clamp(v0 + dv, 0, 254);
-            const double c = dot(oct_decode(std::uint8_t(u), std::uint8_t(v)), n);
-            if (c > best) {
-                best = c;
-                *ou = std::uint8_t(u);
-                *ov = std::uint8_t(v);
-            }
-        }
-}
+inline void oct_encode(Vec3 n, std::uint8_t* ou, std::uint8_t* ov) { encode_cell_plane_normal(n, ou, ov); }
 
 // Centre of the cell whose corner 0 is probe (x, y, z).
 inline Vec3 cell_centre(const GridInfo& g, std::uint32_t x, std::uint32_t y, std::uint32_t z) {
@@ -143,41 +114,6 @@ struct PlaneFitStats {
     std::size_t pairs = 0, blocked_pairs = 0, wrong_pairs = 0;  // (sample point, corner) pairs of cells with a plane
     std::uint64_t rays = 0;
 };
-
-// Symmetric 3x3 eigenvector of the smallest eigenvalue (Jacobi rotations).
-inline Vec3 smallest_eigenvector(double a[3][3]) {
-    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    for (int sweep = 0; sweep < 32; ++sweep) {
-        double off = std::fabs(a[0][1]) + std::fabs(a[0][2]) + std::fabs(a[1][2]);
-        if (off < 1e-15) break;
-        for (int p = 0; p < 2; ++p)
-            for (int q = p + 1; q < 3; ++q) {
-                if (std::fabs(a[p][q]) < 1e-300) continue;
-                const double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-                const double t = (theta >= 0 ? 1 : -1) / (std::fabs(theta) + std::sqrt(theta * theta + 1));
-                const double c = 1 / std::sqrt(t * t + 1), s = t * c;
-                for (int k = 0; k < 3; ++k) {  // A = J^T A J
-                    const double akp = a[k][p], akq = a[k][q];
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for (int k = 0; k < 3; ++k) {
-                    const double apk = a[p][k], aqk = a[q][k];
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                for (int k = 0; k < 3; ++k) {
-                    const double vkp = v[k][p], vkq = v[k][q];
-                    v[k][p] = c * vkp - s * vkq;
-                    v[k][q] = s * vkp + c * vkq;
-                }
-            }
-    }
-    int m = 0;
-    for (int i = 1; i < 3; ++i)
-        if (a[i][i] < a[m][m]) m = i;
-    return {v[0][m], v[1][m], v[2][m]};
-}
 
 // Fits one plane per cell. `baked` holds each probe's baked position (the grid's, or a relocated
 // one), `valid` its validity (invalid corners are neither scored nor kept). Per cell: the sample
@@ -254,7 +190,7 @@ inline std::vector<CellPlane> cell_planes(const OccluderBvh& bvh, const GridInfo
                     for (int r = 0; r < 3; ++r)
                         for (int s = 0; s < 3; ++s) cov[r][s] += d[r] * d[s];
                 }
-                cand.push_back({smallest_eigenvector(cov), mean});
+                cand.push_back({zhc::smallest_eigenvector(cov), mean});
                 for (int a = 0; a < 3; ++a) {
                     std::vector<double> coord;
                     for (const Vec3& h : hits) coord.push_back(h[a]);

@@ -54,41 +54,6 @@ bool clear_point(const OccluderBvh& bvh, const InsideTest& test, Vec3 p, double 
     return !inside_geometry(bvh, test, p, rays);
 }
 
-// Symmetric 3x3: the eigenvector of the smallest eigenvalue (cyclic Jacobi rotations).
-Vec3 smallest_eigenvector(double a[3][3]) {
-    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    for (int sweep = 0; sweep < 32; ++sweep) {
-        const double off = std::fabs(a[0][1]) + std::fabs(a[0][2]) + std::fabs(a[1][2]);
-        if (off < 1e-15) break;
-        for (int p = 0; p < 2; ++p)
-            for (int q = p + 1; q < 3; ++q) {
-                if (std::fabs(a[p][q]) < 1e-300) continue;
-                const double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-                const double t = (theta >= 0 ? 1 : -1) / (std::fabs(theta) + std::sqrt(theta * theta + 1));
-                const double c = 1 / std::sqrt(t * t + 1), s = t * c;
-                for (int k = 0; k < 3; ++k) {  // A = J^T A J
-                    const double akp = a[k][p], akq = a[k][q];
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for (int k = 0; k < 3; ++k) {
-                    const double apk = a[p][k], aqk = a[q][k];
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                for (int k = 0; k < 3; ++k) {
-                    const double vkp = v[k][p], vkq = v[k][q];
-                    v[k][p] = c * vkp - s * vkq;
-                    v[k][q] = s * vkp + c * vkq;
-                }
-            }
-    }
-    int m = 0;
-    for (int i = 1; i < 3; ++i)
-        if (a[i][i] < a[m][m]) m = i;
-    return {v[0][m], v[1][m], v[2][m]};
-}
-
 std::uint32_t axis_index(std::size_t i, const ProbeGrid& g, int a) {
     const std::size_t nx = g.counts[0], ny = g.counts[1];
     return a == 0 ? std::uint32_t(i % nx) : a == 1 ? std::uint32_t((i / nx) % ny) : std::uint32_t(i / (nx * ny));
@@ -262,6 +227,40 @@ CellFit fit_one_cell(const OccluderBvh& bvh, const ProbeGrid& g, const std::vect
 }
 
 }  // namespace
+
+Vec3 smallest_eigenvector(double a[3][3]) {
+    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int sweep = 0; sweep < 32; ++sweep) {
+        const double off = std::fabs(a[0][1]) + std::fabs(a[0][2]) + std::fabs(a[1][2]);
+        if (off < 1e-15) break;
+        for (int p = 0; p < 2; ++p)
+            for (int q = p + 1; q < 3; ++q) {
+                if (std::fabs(a[p][q]) < 1e-300) continue;
+                const double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+                const double t = (theta >= 0 ? 1 : -1) / (std::fabs(theta) + std::sqrt(theta * theta + 1));
+                const double c = 1 / std::sqrt(t * t + 1), s = t * c;
+                for (int k = 0; k < 3; ++k) {  // A = J^T A J
+                    const double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    const double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    const double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - s * vkq;
+                    v[k][q] = s * vkp + c * vkq;
+                }
+            }
+    }
+    int m = 0;
+    for (int i = 1; i < 3; ++i)
+        if (a[i][i] < a[m][m]) m = i;
+    return {v[0][m], v[1][m], v[2][m]};
+}
 
 Vec3 cell_plane_normal(std::uint8_t ou, std::uint8_t ov) {
     double a = double(ou < 254 ? ou : 254) / 127.0 - 1.0, b = double(ov < 254 ? ov : 254) / 127.0 - 1.0;

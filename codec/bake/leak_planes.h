@@ -61,6 +61,10 @@ double cell_plane_unit(const ProbeGrid& g);
 Vec3 cell_centre(const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z);
 // n . (q - c) - offset unit: >= 0 on the positive side. `cp` must be present().
 double cell_plane_value(const CellPlane& cp, const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z, Vec3 q);
+// The unit eigenvector of the smallest eigenvalue of a symmetric 3x3 matrix (cyclic Jacobi
+// rotations; `a` is overwritten): the normal of the least-squares plane of points whose
+// covariance `a` is.
+Vec3 smallest_eigenvector(double a[3][3]);
 // 5 bytes per entry (ProbeSet::planes), and back.
 std::vector<std::uint8_t> cell_planes_bytes(const std::vector<CellPlane>& planes);
 std::vector<CellPlane> cell_planes_from_bytes(const std::vector<std::uint8_t>& bytes);
