@@ -251,6 +251,66 @@ TEST(RuntimeCVolumeLeak, DemoBakeLeakDataMatchesTheTwinBitForBit) {
     }
 }
 
+// A default `zhc bake` of tests/data/leak_room.json (a closed room with 0.1-thick walls, a lamp
+// outside its west wall): the file carries validity and cell planes (no masks); the runtime equals
+// the twin bit for bit at random points of the box, and inside the room next to the west wall the
+// planes keep the lamp's side out: the mean irradiance there is below half the validity-only blend's.
+TEST(RuntimeCVolumeLeak, BakedRoomPlanesMatchTheTwinAndKeepTheLampOut) {
+    const std::string dir = test::fresh_dir("runtime_c_volume_leak_room");
+    const std::string zhp = dir + "/room.zhp";
+    const auto bake = test::run_zhc({"bake", std::string(ZHC_TEST_DATA_DIR) + "/leak_room.json", "-o", zhp, "-r", "zh3_q16"});
+    ASSERT_EQ(bake.exit_code, 0) << bake.err;
+    const std::vector<std::uint8_t> bytes = test::read_bytes(zhp);
+    auto set = parse_probe_set(bytes, "room.zhp");
+    ASSERT_TRUE(bool(set));
+    ASSERT_EQ(set->validity.size(), set->count);
+    EXPECT_TRUE(set->visibility.empty());
+    ASSERT_EQ(set->planes.size(), 5 * set->count);
+    size_t cells_with_plane = 0;
+    for (size_t i = 0; i < set->count; ++i) cells_with_plane += !(set->planes[5 * i + 2] == 0x00 && set->planes[5 * i + 3] == 0x80);
+    EXPECT_GE(cells_with_plane, 10u);
+    zhc_volume v;
+    ASSERT_EQ(zhc_volume_from_zhp(&v, bytes.data(), bytes.size()), ZHC_OK);
+    ASSERT_NE(v.planes, nullptr);
+    const auto decoded = *decode_probe_set(*set);
+    const ProbeGrid& g = set->layout.grid;
+    std::mt19937 rng(38);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int differ = 0, near = 0;
+    const int samples = int(test::scaled_count(4000, 400));
+    for (int s = 0; s < samples; ++s) {
+        double p[3];
+        for (int c = 0; c < 3; ++c) p[c] = g.origin[c] + u(rng) * (g.counts[size_t(c)] - 1) * g.spacing[c];
+        bool moved = false, near_plane = false;
+        const bool same = matches_twin(v, *set, decoded, p, &moved, &near_plane);
+        if (near_plane) {
+            ++near;
+            continue;
+        }
+        ASSERT_TRUE(same) << "sample " << s;
+        differ += moved;
+    }
+    EXPECT_EQ(near, 0);
+    EXPECT_GT(differ, samples / 20);
+    // Inside the room within 0.5 of the west wall's inner face (x = 2.4), away from the other walls.
+    zhc_volume validity_only = v;
+    validity_only.planes = nullptr;
+    double with_planes = 0, without = 0;
+    for (int s = 0; s < 2000; ++s) {
+        const float p[3] = {float(2.45 + 0.45 * u(rng)), float(0.3 + 4.0 * u(rng)), float(0.2 + 2.7 * u(rng))};
+        const float n[3] = {float(u(rng) - 0.5), float(u(rng) - 0.5), float(u(rng) - 0.5)};
+        float a[3], b[3];
+        zhc_volume_irradiance(&v, p, n, a);
+        zhc_volume_irradiance(&validity_only, p, n, b);
+        with_planes += a[0] + a[1] + a[2];
+        without += b[0] + b[1] + b[2];
+    }
+    std::printf("leak_room bake: %zu cells with a plane; %d of %d samples differ from the plain blend; next to the west wall "
+                "inside: mean irradiance %.4g with planes, %.4g without\n",
+                cells_with_plane, differ, samples, with_planes / 2000, without / 2000);
+    EXPECT_LT(with_planes, 0.5 * without);  // measured: 0.059 of it
+}
+
 // A 2x1x1 grid, probe 0 constant a, probe 1 constant b; probe 1 hidden from the cell between them
 // (its bit 7 - 1 = 6, the cell on its -x side): anywhere in the cell, except exactly at probe 1
 // (where probe 0's weight is 0 and the fallback applies), the sample is exactly probe 0.
