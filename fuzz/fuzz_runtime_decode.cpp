@@ -3,7 +3,11 @@
 // luminance weights), the rest (zero-padded) is the stored probe; the runtime's decode and
 // irradiance must give the codec's bits (any NaN equals any NaN). The whole input is also parsed as
 // a .zhp file by the runtime and by formats/probe_file: same accept/reject and error class, and as a
-// probe volume (zhc_volume_from_zhp, sampled when accepted).
+// probe volume (zhc_volume_from_zhp, sampled when accepted); then once more with both CRC-32s
+// recomputed, so that mutated bodies (validity, visibility masks, cell planes: byte 21 bits 0-2)
+// reach the section checks and the volume sampling instead of stopping at a checksum. An accepted
+// volume has its sections' pointers exactly when byte 21 says so, and is sampled at grid points,
+// cell interiors (where a cell plane's side test runs), outside, infinite and NaN positions.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -40,33 +44,64 @@ int code_of(zhc::ErrorCode c) {
     }
 }
 
+// One .zhp input: the runtime and zhc's reader agree, and an accepted grid samples without a crash.
+void check_zhp(const std::uint8_t* data, std::size_t size) {
+    using namespace zhc;
+    zhc_probe_format f;
+    zhc_zhp_info info{};
+    const int rt = zhc_zhp_open(&f, &info, data, size);
+    const auto ref = parse_probe_set({data, size}, "fuzz");
+    if (rt == ZHC_ERR_COMPRESSED) {
+        if (!ref && ref.error().code != ErrorCode::kBadFormat) std::abort();
+    } else if (ref ? rt != ZHC_OK : rt != code_of(ref.error().code)) {
+        std::abort();
+    }
+    if (rt == ZHC_OK && info.payload_offset + ref->payload.size() != size - (ref->validity.size() + ref->visibility.size() + ref->planes.size()))
+        std::abort();
+    // Probe volumes: zhc_zhp_open's code, then NOT_GRID for a valid non-grid file; an accepted
+    // grid samples anywhere (inside, outside, infinite and NaN positions) without crashing.
+    zhc_volume v;
+    const int vr = zhc_volume_from_zhp(&v, data, size);
+    if (rt != ZHC_OK ? vr != rt : (ref->layout.kind != ProbeLayoutKind::kGrid) != (vr == ZHC_ERR_NOT_GRID)) std::abort();
+    if (vr != ZHC_OK) return;
+    const int sections = data[8] == 2 ? data[21] : 0;
+    if ((v.validity != nullptr) != bool(sections & 1) || (v.visibility != nullptr) != bool(sections & 2) ||
+        (v.planes != nullptr) != bool(sections & 4))
+        std::abort();
+    if (v.planes && std::memcmp(v.planes, ref->planes.data(), ref->planes.size()) != 0) std::abort();
+    const double n[3] = {0.6, -0.48, 0.64};
+    double e[3];
+    const double points[4][3] = {{0, 0, 0}, {1e30, -1e30, 3}, {INFINITY, -INFINITY, 0}, {NAN, 1, NAN}};
+    for (const auto& pt : points) zhc_volume_irradiance_d(&v, pt, n, e);
+    // Inside the grid's box: fractions of it, and the centre of every cell of the first few.
+    for (const double t : {0.13, 0.5, 0.87}) {
+        double p[3];
+        for (int c = 0; c < 3; ++c) p[c] = v.origin[c] + t * double(v.counts[c] - 1) * v.spacing[c];
+        zhc_volume_irradiance_d(&v, p, n, e);
+    }
+    for (std::uint32_t i = 0; i < 8 && i < v.counts[0]; ++i) {
+        const double p[3] = {v.origin[0] + (i + 0.25) * v.spacing[0], v.origin[1] + 0.6 * v.spacing[1], v.origin[2] + 0.3 * v.spacing[2]};
+        zhc_volume_irradiance_d(&v, p, n, e);
+        const float pf[3] = {float(p[0]), float(p[1]), float(p[2])}, nf[3] = {0.0f, 0.0f, 1.0f};
+        float ef[3];
+        zhc_volume_irradiance(&v, pf, nf, ef);
+    }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace zhc;
-    // .zhp parsing: must never crash and must agree with zhc's reader.
-    {
-        zhc_probe_format f;
-        zhc_zhp_info info{};
-        const int rt = zhc_zhp_open(&f, &info, data, size);
-        const auto ref = parse_probe_set({data, size}, "fuzz");
-        if (rt == ZHC_ERR_COMPRESSED) {
-            if (!ref && ref.error().code != ErrorCode::kBadFormat) std::abort();
-        } else if (ref ? rt != ZHC_OK : rt != code_of(ref.error().code)) {
-            std::abort();
-        }
-        if (rt == ZHC_OK && info.payload_offset + ref->payload.size() != size) std::abort();
-        // Probe volumes: zhc_zhp_open's code, then NOT_GRID for a valid non-grid file; an accepted
-        // grid samples anywhere (inside, outside, infinite and NaN positions) without crashing.
-        zhc_volume v;
-        const int vr = zhc_volume_from_zhp(&v, data, size);
-        if (rt != ZHC_OK ? vr != rt : (ref->layout.kind != ProbeLayoutKind::kGrid) != (vr == ZHC_ERR_NOT_GRID)) std::abort();
-        if (vr == ZHC_OK) {
-            const double points[4][3] = {{0, 0, 0}, {1e30, -1e30, 3}, {INFINITY, -INFINITY, 0}, {NAN, 1, NAN}};
-            const double n[3] = {0.6, -0.48, 0.64};
-            double e[3];
-            for (const auto& pt : points) zhc_volume_irradiance_d(&v, pt, n, e);
-        }
+    // .zhp parsing: must never crash and must agree with zhc's reader; then the same input with
+    // its header and body CRC-32s made right.
+    check_zhp(data, size);
+    if (size >= ZHC_ZHP_HEADER_BYTES) {
+        std::vector<std::uint8_t> sealed(data, data + size);
+        const std::uint32_t body = zhc_crc32(0, sealed.data() + ZHC_ZHP_HEADER_BYTES, size - ZHC_ZHP_HEADER_BYTES);
+        for (int b = 0; b < 4; ++b) sealed[176 + std::size_t(b)] = std::uint8_t(body >> (8 * b));
+        const std::uint32_t head = zhc_crc32(0, sealed.data(), 180);
+        for (int b = 0; b < 4; ++b) sealed[180 + std::size_t(b)] = std::uint8_t(head >> (8 * b));
+        check_zhp(sealed.data(), sealed.size());
     }
     const auto table = codecs();
     if (size < 4 || table.empty()) return 0;
