@@ -23,8 +23,9 @@
 //    over every shading point) and masks / plain, planes / plain in the same run.
 // Benchmarks never decide pass/fail (tests/test_leak_suite.cpp asserts the measured facts).
 //
-// Usage: bench_leak [--points N] [--threads N] [--json FILE]
+// Usage: bench_leak [--points N] [--threads N] [--json FILE] [--density K]
 //   --points: shading points per surface of a region (free points: twice that; default 96)
+//   --density: only the L corridor and the closed box, their probe cells split K times per axis
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -98,18 +99,25 @@ void json_metrics(std::ostream& o, const char* key, const Metrics& x) {
 
 int main(int argc, char** argv) {
     int per_face = 96, threads = 1;
+    std::uint32_t density = 1;
     std::string json;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--points" && i + 1 < argc) per_face = std::max(1, std::atoi(argv[++i]));
         else if (a == "--threads" && i + 1 < argc) threads = std::max(1, std::atoi(argv[++i]));
         else if (a == "--json" && i + 1 < argc) json = argv[++i];
+        else if (a == "--density" && i + 1 < argc) density = std::uint32_t(std::max(1, std::atoi(argv[++i])));
         else {
-            std::fprintf(stderr, "usage: %s [--points N] [--threads N] [--json FILE]\n", argv[0]);
+            std::fprintf(stderr, "usage: %s [--points N] [--threads N] [--json FILE] [--density K]\n", argv[0]);
             return 2;
         }
     }
     std::vector<LeakScene> scenes = suite_scenes(per_face);
+    if (density > 1) {
+        // The corridor and the box alone, their probe cells split `density` times per axis.
+        scenes = {l_corridor(per_face, 2, density), closed_box(per_face, 4, density)};
+        std::printf("--density %u: the L corridor and the closed box with their cells split %u times per axis\n", density, density);
+    }
 
     std::printf("Leak suite (tests/leak_scenes.h): direct light only (transport.max_bounces = 0), sh3 probes,\n"
                 "zhc_volume_irradiance on volumes from zhc_volume_from_zhp; %d points per surface, %d free per region.\n\n",

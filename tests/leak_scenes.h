@@ -221,7 +221,8 @@ inline LeakScene two_rooms(double offset, double thickness, int per_face = 24, s
     return ls;
 }
 
-inline LeakScene l_corridor(int per_face = 24, std::uint64_t seed = 2) {
+// density: the probe grid's cells split density times per axis (1: the suite's 1.5 m).
+inline LeakScene l_corridor(int per_face = 24, std::uint64_t seed = 2, std::uint32_t density = 1) {
     LeakScene ls;
     ls.name = "L corridor";
     ls.cell = kCell;
@@ -236,7 +237,7 @@ inline LeakScene l_corridor(int per_face = 24, std::uint64_t seed = 2) {
     box({8, 0, -0.2}, {8.2, 3, 10.2});        // east, both legs
     box({5.8, 0, 10}, {8.2, 3, 10.2});        // z leg, north end
     s.lights.push_back(point_light({1, 2, 1}, 8));
-    set_grid(s, {0.25, 0.25, 0.25}, {7.75, 2.75, 9.25}, {6, 3, 7});
+    set_grid(s, {0.25, 0.25, 0.25}, {7.75, 2.75, 9.25}, {5 * density + 1, 2 * density + 1, 6 * density + 1});
     ls.scene = std::move(s);
     const OccluderBvh bvh(ls.scene.occluders);
     std::mt19937_64 rng(seed);
@@ -278,7 +279,8 @@ inline LeakScene window_room(int per_face = 24, std::uint64_t seed = 3) {
 // [2.4, 0.9, 2.4]..[3.6, 2.1, 3.6]; the probe (3, 1.5, 3) lies inside it.
 constexpr double kBoxLo = 2.3, kBoxHi = 3.7, kBoxYLo = 0.8, kBoxYHi = 2.2, kBoxWall = 0.1;
 
-inline LeakScene closed_box(int per_face = 24, std::uint64_t seed = 4) {
+// density: the probe grid's cells split density times per axis (1: the suite's 1.375 m).
+inline LeakScene closed_box(int per_face = 24, std::uint64_t seed = 4, std::uint32_t density = 1) {
     LeakScene ls;
     ls.name = "closed box in a lit room";
     ls.cell = 1.375;
@@ -298,7 +300,7 @@ inline LeakScene closed_box(int per_face = 24, std::uint64_t seed = 4) {
     box({a + d, y0 + d, a}, {b - d, y1 - d, a + d});  // -z
     box({a + d, y0 + d, b - d}, {b - d, y1 - d, b});  // +z
     s.lights.push_back(point_light({1, 2.5, 1}, 8));
-    set_grid(s, {0.25, 0.25, 0.25}, {5.75, 2.75, 5.75}, {5, 3, 5});
+    set_grid(s, {0.25, 0.25, 0.25}, {5.75, 2.75, 5.75}, {4 * density + 1, 2 * density + 1, 4 * density + 1});
     ls.scene = std::move(s);
     const OccluderBvh bvh(ls.scene.occluders);
     std::mt19937_64 rng(seed);
