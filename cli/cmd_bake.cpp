@@ -13,6 +13,7 @@
 #include "formats/io/file_io.h"
 #include "formats/probes/gltf_probes.h"
 #include "formats/probes/probe_file.h"
+#include "formats/probes/tetra.h"
 #include "formats/scene/scene_gltf.h"
 #include "formats/scene/scene_json.h"
 
@@ -178,6 +179,9 @@ int run(const Options& o) {
     set->validity = std::move(leak.validity);
     set->visibility = std::move(leak.visibility);
     set->planes = std::move(leak.planes);
+    // Probes at explicit positions carry their Delaunay tetrahedra (the runtimes interpolate in them).
+    for (const std::string& line : add_tetrahedra(*set))
+        std::fprintf(stderr, "zhc: warning: %s: %s\n", o.output.c_str(), line.c_str());
     if (gltf_out) {
         // Into a copy of the input asset (everything of it kept, docs/gltf-extension.md), or into
         // a minimal asset for a JSON scene.

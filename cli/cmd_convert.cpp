@@ -13,6 +13,7 @@
 #include "formats/envmap/envmap.h"
 #include "formats/io/file_io.h"
 #include "formats/probes/probe_file.h"
+#include "formats/probes/tetra.h"
 #include "formats/report/audit_inputs.h"
 
 namespace zhc::cli {
@@ -166,8 +167,14 @@ int run(const Options& o) {
                 out.validity = in->set->validity;
                 out.visibility = in->set->visibility;
                 out.planes = in->set->planes;
+                out.tetrahedra = in->set->tetrahedra;
+                out.tetra_neighbours = in->set->tetra_neighbours;
             }
         }
+        // A points layout carries its Delaunay tetrahedra (the input's, else computed here).
+        if (out.layout.kind == ProbeLayoutKind::kPositions && out.tetrahedra.empty())
+            for (const std::string& line : add_tetrahedra(out))
+                std::fprintf(stderr, "zhc: warning: %s: %s\n", o.output.c_str(), line.c_str());
         ProbeFileWriteOptions wo;
         wo.zstd_level = o.zstd;
         auto bytes = serialize_probe_set(out, wo);

@@ -281,6 +281,8 @@ int run(const Options& o) {
             leak["bytes_per_probe"] = (set->validity.empty() ? 0 : 1) + (set->visibility.empty() ? 0 : 1) + (set->planes.empty() ? 0 : 5);
             j["leak_data"] = leak;
         }
+        // Scattered probes: the Delaunay tetrahedra the runtimes interpolate in (docs/runtime.md "Scattered probes").
+        if (!set->tetrahedra.empty()) j["tetrahedra"] = set->tetrahedra.size();
         auto hub = decode_probe_set(*set);
         if (!hub) return report(hub.error());
         probe_stats(*hub, j);

@@ -20,7 +20,9 @@
  *     hemi-octahedral direction decode, HLSH evaluation and the HLSH hemisphere / cone multiply of a
  *     probe (probe occlusion).
  *   - Probe volumes (zhc_volume): the irradiance at any point of a probe grid, trilinear blend of
- *     the 8 surrounding probes' decoded SH3 (docs/runtime.md, "Probe volumes").
+ *     the 8 surrounding probes' decoded SH3 (docs/runtime.md, "Probe volumes"), or of scattered
+ *     probes, barycentric blend of the 4 probes of the Delaunay tetrahedron around the point
+ *     ("Scattered probes (`points` layout)").
  *
  * Safety: every function here is total and safe for untrusted input unless its comment says
  * otherwise: any bytes decode to finite-or-NaN numbers, never undefined behaviour, never a read
@@ -228,7 +230,7 @@ enum zhc_error {
     ZHC_ERR_INVALID_VALUE = 7,  /* non-finite luminance weights, grid values or positions */
     ZHC_ERR_TRAILING_BYTES = 8, /* bytes after the declared body */
     ZHC_ERR_COMPRESSED = 9,     /* valid .zhp whose body is zstd-compressed: out of this header's scope */
-    ZHC_ERR_NOT_GRID = 10       /* zhc_volume_from_zhp: a valid .zhp whose layout is not a grid (none, points) */
+    ZHC_ERR_NOT_GRID = 10       /* zhc_volume_from_zhp: a valid .zhp that is no volume (layout none, points without tetrahedra) */
 };
 
 /* ---- the probe format ---------------------------------------------------------------------- */
@@ -806,6 +808,10 @@ typedef struct zhc_zhp_info {
     uint64_t validity_offset;     /* version 2: count bytes (0/1) after the payload; 0 = absent */
     uint64_t visibility_offset;   /* version 2, grid only: count 8-bit cell masks; 0 = absent */
     uint64_t planes_offset;       /* version 2, grid only: count 5-byte cell planes; 0 = absent */
+    /* version 2, positions only: the tetrahedra section (u32 count, count x 4 u32 probe indices,
+     * count x 4 i32 neighbours); 0 = absent. tetra_count: the count its size gives. */
+    uint64_t tetrahedra_offset;
+    uint32_t tetra_count;
 } zhc_zhp_info;
 
 /* CRC-32, IEEE 802.3 (reflected 0xEDB88320, init and final XOR 0xFFFFFFFF); continue a running
@@ -826,15 +832,16 @@ static inline uint32_t zhc_crc32(uint32_t crc, const void* data, size_t size) {
  * 184). Checks, in zhc's reader order (formats/probes/probe_file.cpp): magic (a short prefix of it:
  * TRUNCATED, else BAD_FORMAT), version 1 or 2 (UNSUPPORTED), 184 bytes present (TRUNCATED), header
  * CRC-32 (CHECKSUM), header size 184, reserved bytes zero (BAD_FORMAT; version 2: byte 21 holds the
- * per-probe sections, bit 0 validity, bit 1 visibility, bit 2 cell planes: other bits UNSUPPORTED,
- * none, or visibility or planes without a grid BAD_FORMAT), enum ranges of kind, DC format, L2
+ * per-probe sections, bit 0 validity, bit 1 visibility, bit 2 cell planes, bit 3 tetrahedra: other
+ * bits UNSUPPORTED, none, visibility or planes without a grid, or tetrahedra without a positions
+ * layout BAD_FORMAT), enum ranges of kind, DC format, L2
  * bound, zonal mapping, axis mode, compression, layout (UNSUPPORTED), sqrt 0/1 and bits 2..8
  * (BAD_FORMAT), representation name printable ASCII, zero padded (BAD_FORMAT) and known
  * (UNSUPPORTED), bytes per probe = the encoding's (BAD_FORMAT), luminance weights finite
  * (INVALID_VALUE), half DC only on sh2_q / hall_curve_q (BAD_FORMAT), probe count <= 2^26
  * (TOO_LARGE), grid values finite (INVALID_VALUE), grid counts multiply to the count or grid fields
  * all +0 without a grid (BAD_FORMAT), body bytes = count (12 [positions] + probe size + 1 per
- * validity / visibility section + 5 for planes) (BAD_FORMAT)
+ * validity / visibility section + 5 for planes), plus 4 + 32 T (T >= 1) with tetrahedra (BAD_FORMAT)
  * and <= 2 GiB (TOO_LARGE), stored body = body when uncompressed, <= ZSTD_compressBound when
  * compressed (BAD_FORMAT). Does not look at the body (see zhc_zhp_open).
  * On ZHC_OK fills f (format, a/b the codec's 0.6/0.08) and info (either may be NULL).
@@ -863,8 +870,8 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
     if ((version == 1 && h[21]) || (h[22] | h[23]) || zhc__u32(h + 68) || zhc__u32(h + 156)) return ZHC_ERR_BAD_FORMAT;
     if (version == 2) {
         leak = h[21];
-        if (leak > 7) return ZHC_ERR_UNSUPPORTED;
-        if (leak == 0 || ((leak & 6) && h[20] != 1)) return ZHC_ERR_BAD_FORMAT;
+        if (leak > 15) return ZHC_ERR_UNSUPPORTED;
+        if (leak == 0 || ((leak & 6) && h[20] != 1) || ((leak & 8) && h[20] != 2)) return ZHC_ERR_BAD_FORMAT;
     }
     if (h[12] > 1 || h[14] > 2 || h[15] > 1 || h[17] > 2 || h[18] > 1 || h[19] > 1 || h[20] > 2)
         return ZHC_ERR_UNSUPPORTED;
@@ -926,7 +933,12 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
     raw_expected = pos_bytes + count * inf.probe_size +
                    count * (uint64_t)((leak & 1) + ((leak >> 1) & 1) + 5 * ((leak >> 2) & 1));
     raw = zhc__u64(h + 160);
-    if (raw != raw_expected) return ZHC_ERR_BAD_FORMAT;
+    if (leak & 8) {
+        /* The tetrahedra section follows: 4 bytes of count, 32 bytes per tetrahedron, at least one. */
+        if (raw < raw_expected + 36 || (raw - raw_expected - 4) % 32 != 0) return ZHC_ERR_BAD_FORMAT;
+    } else if (raw != raw_expected) {
+        return ZHC_ERR_BAD_FORMAT;
+    }
     if (raw > ((uint64_t)1 << 31)) return ZHC_ERR_TOO_LARGE;
     stored = zhc__u64(h + 168);
     if (!inf.compressed && stored != raw) return ZHC_ERR_BAD_FORMAT;
@@ -942,8 +954,54 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
     if (leak & 2) inf.visibility_offset = inf.payload_offset + count * inf.probe_size + ((leak & 1) ? count : 0);
     if (leak & 4)
         inf.planes_offset = inf.payload_offset + count * inf.probe_size + ((leak & 1) ? count : 0) + ((leak & 2) ? count : 0);
+    if (leak & 8) {
+        inf.tetrahedra_offset = ZHC_ZHP_HEADER_BYTES + raw_expected;
+        inf.tetra_count = (uint32_t)((raw - raw_expected - 4) / 32);
+    }
     if (f) *f = fmt;
     if (info) *info = inf;
+    return ZHC_OK;
+}
+
+/* The tetrahedra of a `points` volume (docs/zhp-container.md "tetrahedra"): `tets` holds
+ * tetra_count x 4 u32 probe indices, `nbrs` tetra_count x 4 i32 neighbours (little-endian, any
+ * alignment). ZHC_OK when every index is < count and the 4 of a tetrahedron are distinct, every
+ * neighbour is -1 or another tetrahedron that names this one exactly once and shares the face's 3
+ * probes (face j = the tetrahedron without its vertex j), and tetra_count >= 1; else
+ * ZHC_ERR_INVALID_VALUE. O(tetra_count). Safe for untrusted input. */
+static inline int zhc_tetrahedra_check(const uint8_t* tets, const uint8_t* nbrs, uint32_t tetra_count, uint64_t count) {
+    uint32_t t, n;
+    int j, k, m, backs, back, found;
+    if (!tets || !nbrs || tetra_count == 0 || tetra_count > 0x7FFFFFFFu) return ZHC_ERR_INVALID_VALUE;
+    for (t = 0; t < tetra_count; ++t)
+        for (k = 0; k < 4; ++k) {
+            const uint32_t a = zhc__u32(tets + 16 * (size_t)t + 4 * k);
+            if (a >= count) return ZHC_ERR_INVALID_VALUE;
+            for (m = 0; m < k; ++m)
+                if (zhc__u32(tets + 16 * (size_t)t + 4 * m) == a) return ZHC_ERR_INVALID_VALUE;
+        }
+    for (t = 0; t < tetra_count; ++t)
+        for (j = 0; j < 4; ++j) {
+            const uint32_t raw = zhc__u32(nbrs + 16 * (size_t)t + 4 * j);
+            if (raw == 0xFFFFFFFFu) continue; /* -1: a hull face */
+            if (raw >= tetra_count || raw == t) return ZHC_ERR_INVALID_VALUE;
+            n = raw;
+            backs = 0;
+            back = 0;
+            for (k = 0; k < 4; ++k)
+                if (zhc__u32(nbrs + 16 * (size_t)n + 4 * k) == t) {
+                    back = k;
+                    ++backs;
+                }
+            if (backs != 1) return ZHC_ERR_INVALID_VALUE;
+            for (k = 0; k < 4; ++k) {
+                if (k == j) continue;
+                found = 0;
+                for (m = 0; m < 4; ++m)
+                    if (m != back && zhc__u32(tets + 16 * (size_t)n + 4 * m) == zhc__u32(tets + 16 * (size_t)t + 4 * k)) found = 1;
+                if (!found) return ZHC_ERR_INVALID_VALUE;
+            }
+        }
     return ZHC_OK;
 }
 
@@ -952,7 +1010,9 @@ static inline int zhc_zhp_parse_header(zhc_probe_format* f, zhc_zhp_info* info, 
  * body (ZHC_ERR_COMPRESSED: f and info are still filled, the payload offset is meaningless), finite
  * positions, validity bytes 0/1 and "no plane" (offset -32768) in the plane entry of every grid
  * probe that is the last along some axis of count >= 2 (no cell has it as corner 0; along an axis of
- * count 1 the one probe starts the flat cell) (INVALID_VALUE). On ZHC_OK probe i's bytes are at file + info->payload_offset +
+ * count 1 the one probe starts the flat cell) (INVALID_VALUE), and a tetrahedra section whose count
+ * disagrees with its size (BAD_FORMAT) or whose indices or neighbours are inconsistent
+ * (zhc_tetrahedra_check: INVALID_VALUE). On ZHC_OK probe i's bytes are at file + info->payload_offset +
  * i * info->probe_size. Safe for untrusted input; accepts exactly the uncompressed files zhc's
  * reader accepts, with the same error class. */
 static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const void* file, size_t size) {
@@ -983,6 +1043,12 @@ static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const vo
             if (((nx > 1 && x + 1 == nx) || (ny > 1 && y + 1 == ny) || (nz > 1 && z + 1 == nz)) && !(e[2] == 0x00 && e[3] == 0x80))
                 return ZHC_ERR_INVALID_VALUE;
         }
+    }
+    if (inf.tetrahedra_offset) {
+        const uint8_t* sec = p + inf.tetrahedra_offset;
+        if (zhc__u32(sec) != inf.tetra_count) return ZHC_ERR_BAD_FORMAT;
+        if (zhc_tetrahedra_check(sec + 4, sec + 4 + 16 * (size_t)inf.tetra_count, inf.tetra_count, inf.probe_count) != ZHC_OK)
+            return ZHC_ERR_INVALID_VALUE;
     }
     return ZHC_OK;
 }
@@ -1019,6 +1085,17 @@ typedef struct zhc_volume {
      * little-endian, units of |spacing| / 65534 from the cell's centre along the normal; -32768 = no
      * plane), sides (bit k: corner k lies on the positive side). */
     const uint8_t* planes;
+    /* Scattered probes (a `points` volume, docs/runtime.md "Scattered probes (`points` layout)"),
+     * NULL / 0 for a grid (whose fields above are then unused but format, probes, probe_size and
+     * validity): probe i at the 3 little-endian f32 (x, y, z) at positions + 12 i; tetrahedron t
+     * made of the probes at the 4 little-endian u32 at tetrahedra + 16 t (positive orientation),
+     * its neighbour across face j (the face opposite vertex j) the i32 at neighbours + 16 t + 4 j,
+     * -1 on the convex hull. Fill with zhc_volume_init_points or zhc_volume_from_zhp. */
+    const uint8_t* positions;
+    const uint8_t* tetrahedra;
+    const uint8_t* neighbours;
+    uint32_t tetra_count;
+    uint64_t probe_count;
 } zhc_volume;
 
 /* A volume from its parts: format (validated: ZHC_ERR_ARGUMENT), the stored probes (`size` bytes,
@@ -1056,13 +1133,47 @@ static inline int zhc_volume_init(zhc_volume* v, const zhc_probe_format* format,
     return ZHC_OK;
 }
 
+/* A `points` volume from its parts: format (validated: ZHC_ERR_ARGUMENT), the stored probes (`size`
+ * bytes, at least count zhc_probe_size(format): else ZHC_ERR_TRUNCATED), `count` positions (3 f32
+ * little-endian each, finite: else ZHC_ERR_INVALID_VALUE; 1 <= count <= 2^26: ZHC_ERR_INVALID_VALUE
+ * / ZHC_ERR_TOO_LARGE) and `tetra_count` tetrahedra with their neighbours (zhc_tetrahedra_check:
+ * ZHC_ERR_INVALID_VALUE), as docs/zhp-container.md stores them (the writer's are Delaunay, each
+ * positively oriented). Null pointers: ZHC_ERR_ARGUMENT. On any error v is zeroed. The volume refers
+ * to the caller's bytes. Safe for untrusted input. */
+static inline int zhc_volume_init_points(zhc_volume* v, const zhc_probe_format* format, const void* probes, size_t size,
+                                         const void* positions, uint64_t count, const void* tetrahedra,
+                                         const void* neighbours, uint32_t tetra_count) {
+    uint64_t i;
+    if (!v) return ZHC_ERR_ARGUMENT;
+    memset(v, 0, sizeof *v);
+    if (!format || !probes || !positions || !tetrahedra || !neighbours) return ZHC_ERR_ARGUMENT;
+    if (zhc_probe_format_validate(format) != ZHC_OK) return ZHC_ERR_ARGUMENT;
+    if (count < 1) return ZHC_ERR_INVALID_VALUE;
+    if (count > ((uint64_t)1 << 26)) return ZHC_ERR_TOO_LARGE;
+    if ((uint64_t)size / zhc_probe_size(format) < count) return ZHC_ERR_TRUNCATED;
+    for (i = 0; i < 3 * count; ++i)
+        if (!isfinite(zhc__f32((const uint8_t*)positions + 4 * i))) return ZHC_ERR_INVALID_VALUE;
+    if (zhc_tetrahedra_check((const uint8_t*)tetrahedra, (const uint8_t*)neighbours, tetra_count, count) != ZHC_OK)
+        return ZHC_ERR_INVALID_VALUE;
+    v->format = *format;
+    v->probes = (const uint8_t*)probes;
+    v->probe_size = zhc_probe_size(format);
+    v->positions = (const uint8_t*)positions;
+    v->tetrahedra = (const uint8_t*)tetrahedra;
+    v->neighbours = (const uint8_t*)neighbours;
+    v->tetra_count = tetra_count;
+    v->probe_count = count;
+    return ZHC_OK;
+}
+
 /* A volume from a whole .zhp file in memory (`file`, `size` bytes; the volume points into them):
  * zhc_zhp_open's checks and error codes (ZHC_ERR_COMPRESSED for a zstd body), then
- * ZHC_ERR_NOT_GRID for a valid file without a grid layout (none, or scattered `points`: see
- * docs/runtime.md for what to do with those), then the grid checks of zhc_volume_init (an empty
- * grid, spacing <= 0 or a far corner that overflows: ZHC_ERR_INVALID_VALUE). On error v is zeroed.
- * A version 2 file's validity, visibility and plane sections fill v->validity / v->visibility /
- * v->planes (pointing into `file`); without them they are NULL. Safe for untrusted input (any bytes, any size). */
+ * ZHC_ERR_NOT_GRID for a valid file that is neither a grid nor scattered `points` with a tetrahedra
+ * section (layout none, or points written without tetrahedra: too few or coplanar positions), then
+ * the grid checks of zhc_volume_init (an empty grid, spacing <= 0 or a far corner that overflows:
+ * ZHC_ERR_INVALID_VALUE) or those of zhc_volume_init_points. On error v is zeroed. A version 2
+ * file's validity, visibility and plane sections fill v->validity / v->visibility / v->planes
+ * (pointing into `file`); without them they are NULL. Safe for untrusted input (any bytes, any size). */
 static inline int zhc_volume_from_zhp(zhc_volume* v, const void* file, size_t size) {
     zhc_probe_format f;
     zhc_zhp_info info;
@@ -1071,6 +1182,15 @@ static inline int zhc_volume_from_zhp(zhc_volume* v, const void* file, size_t si
     memset(v, 0, sizeof *v);
     r = zhc_zhp_open(&f, &info, file, size);
     if (r != ZHC_OK) return r;
+    if (info.layout == 2 && info.tetrahedra_offset) {
+        const uint8_t* sec = (const uint8_t*)file + info.tetrahedra_offset;
+        r = zhc_volume_init_points(v, &f, (const uint8_t*)file + info.payload_offset, (size_t)(size - info.payload_offset),
+                                   (const uint8_t*)file + info.positions_offset, info.probe_count, sec + 4,
+                                   sec + 4 + 16 * (size_t)info.tetra_count, info.tetra_count);
+        if (r != ZHC_OK) return r;
+        if (info.validity_offset) v->validity = (const uint8_t*)file + info.validity_offset;
+        return ZHC_OK;
+    }
     if (info.layout != 1) return ZHC_ERR_NOT_GRID;
     r = zhc_volume_init(v, &f, (const uint8_t*)file + info.payload_offset, (size_t)(size - info.payload_offset),
                         info.grid_origin, info.grid_spacing, info.grid_counts);
@@ -1134,6 +1254,267 @@ static inline int zhc__volume_plane_side(const zhc_volume* v, size_t cell, const
     return 1;
 }
 
+/* ---- scattered probes: tetrahedral interpolation (docs/runtime.md "Scattered probes") ------- */
+
+/* det[x, y, z] = x . (y x z), in this order of operations. */
+static inline double zhc__det3(const double x[3], const double y[3], const double z[3]) {
+    return x[0] * (y[1] * z[2] - y[2] * z[1]) + x[1] * (y[2] * z[0] - y[0] * z[2]) + x[2] * (y[0] * z[1] - y[1] * z[0]);
+}
+
+/* Tetrahedron t of a points volume seen from p: q its 4 probes, r their positions minus p, and
+ * vol[j] the signed volume (x 6) of the tetrahedron with vertex j replaced by p: +det[r1, r2, r3],
+ * -det[r0, r2, r3], +det[r0, r1, r3], -det[r0, r1, r2] (vertex order), each determinant taken over
+ * the face's 3 probes sorted by probe index (the permutation's sign applied), so that a face shared
+ * by two tetrahedra gives exactly opposite values in both. vol[j] < 0: p lies beyond face j. */
+static inline void zhc__tetra_volumes(const zhc_volume* v, uint32_t t, const double p[3], uint32_t q[4], double r[4][3],
+                                      double vol[4]) {
+    int j, k, c, f[3], n, tmp, sign;
+    double d;
+    for (k = 0; k < 4; ++k) {
+        q[k] = zhc__u32(v->tetrahedra + 16 * (size_t)t + 4 * k);
+        for (c = 0; c < 3; ++c) r[k][c] = (double)zhc__f32(v->positions + 12 * (size_t)q[k] + 4 * c) - p[c];
+    }
+    for (j = 0; j < 4; ++j) {
+        n = 0;
+        for (k = 0; k < 4; ++k)
+            if (k != j) f[n++] = k;
+        sign = (j & 1) ? -1 : 1;
+        if (q[f[0]] > q[f[1]]) { tmp = f[0]; f[0] = f[1]; f[1] = tmp; sign = -sign; }
+        if (q[f[1]] > q[f[2]]) { tmp = f[1]; f[1] = f[2]; f[2] = tmp; sign = -sign; }
+        if (q[f[0]] > q[f[1]]) { tmp = f[0]; f[0] = f[1]; f[1] = tmp; sign = -sign; }
+        d = zhc__det3(r[f[0]], r[f[1]], r[f[2]]);
+        vol[j] = sign > 0 ? d : -d;
+    }
+}
+
+/* Whether the tetrahedron of the relative positions r, whose volumes from p are vol (zhc__tetra_volumes),
+ * is solid: s = vol[0] + vol[1] + vol[2] + vol[3] (6 x its volume) > 0 and s^2 > 1e-24 L^6, L its
+ * longest edge. Flat tetrahedra (cospherical sites in qhull's triangulated output) are not. */
+static inline int zhc__tetra_solid(double r[4][3], const double vol[4], double* s) {
+    double l2 = 0.0, e, d;
+    int a, b, c;
+    *s = vol[0] + vol[1] + vol[2] + vol[3];
+    for (a = 0; a < 4; ++a)
+        for (b = a + 1; b < 4; ++b) {
+            e = 0.0;
+            for (c = 0; c < 3; ++c) {
+                d = r[b][c] - r[a][c];
+                e += d * d;
+            }
+            if (e > l2) l2 = e;
+        }
+    return *s > 0.0 && *s * *s > 1e-24 * (l2 * l2 * l2);
+}
+
+/* The point of triangle (x, y, z) (positions relative to the query point, which is the origin)
+ * nearest to the origin: returns its squared distance, w its barycentric weights. Inside the
+ * triangle's projection: the projection; else the nearest point of the edges xy, yz, zx (first
+ * wins a tie). A degenerate triangle uses its edges only. */
+static inline double zhc__triangle_nearest(const double x[3], const double y[3], const double z[3], double w[3]) {
+    const double* ends[3][2];
+    double e1[3], e2[3], d00 = 0.0, d01 = 0.0, d11 = 0.0, d20 = 0.0, d21 = 0.0, den, a, b, u, q, dist, best = HUGE_VAL, t, ee, pe;
+    int c, k;
+    for (c = 0; c < 3; ++c) {
+        e1[c] = y[c] - x[c];
+        e2[c] = z[c] - x[c];
+    }
+    for (c = 0; c < 3; ++c) {
+        d00 += e1[c] * e1[c];
+        d01 += e1[c] * e2[c];
+        d11 += e2[c] * e2[c];
+        d20 -= x[c] * e1[c];
+        d21 -= x[c] * e2[c];
+    }
+    den = d00 * d11 - d01 * d01;
+    if (den > 0.0) {
+        a = (d11 * d20 - d01 * d21) / den;
+        b = (d00 * d21 - d01 * d20) / den;
+        u = 1.0 - a - b;
+        if (a >= 0.0 && b >= 0.0 && u >= 0.0) {
+            dist = 0.0;
+            for (c = 0; c < 3; ++c) {
+                q = x[c] + a * e1[c] + b * e2[c];
+                dist += q * q;
+            }
+            w[0] = u;
+            w[1] = a;
+            w[2] = b;
+            return dist;
+        }
+    }
+    ends[0][0] = x; ends[0][1] = y;
+    ends[1][0] = y; ends[1][1] = z;
+    ends[2][0] = z; ends[2][1] = x;
+    w[0] = 1.0;
+    w[1] = w[2] = 0.0;
+    for (k = 0; k < 3; ++k) {
+        ee = 0.0;
+        pe = 0.0;
+        for (c = 0; c < 3; ++c) {
+            const double e = ends[k][1][c] - ends[k][0][c];
+            ee += e * e;
+            pe -= ends[k][0][c] * e;
+        }
+        t = ee > 0.0 ? pe / ee : 0.0;
+        if (!(t > 0.0)) t = 0.0;
+        if (t > 1.0) t = 1.0;
+        dist = 0.0;
+        for (c = 0; c < 3; ++c) {
+            q = ends[k][0][c] + t * (ends[k][1][c] - ends[k][0][c]);
+            dist += q * q;
+        }
+        if (dist < best) {
+            best = dist;
+            w[k] = 1.0 - t;
+            w[(k + 1) % 3] = t;
+            w[(k + 2) % 3] = 0.0;
+        }
+    }
+    return best;
+}
+
+/* Where `position` falls in a points volume and with which weights its 4 probes blend
+ * (docs/runtime.md "Scattered probes (`points` layout)"): probes[k] the probes, weights[k] >= 0,
+ * summing to 1 (k = vertex order of the tetrahedron *tetra).
+ *  1. Walk from tetrahedron *tetra (0 when NULL or out of range): across the face j of the most
+ *     negative volume (zhc__tetra_volumes; the first of equal ones), at most tetra_count steps;
+ *     when no volume is negative and the tetrahedron is solid (zhc__tetra_solid): inside, the
+ *     barycentric weights vol[j] / s. That face a hull face (-1): outside (step 3) when the
+ *     tetrahedron is solid; a flat one crosses its most negative face that has a neighbour instead
+ *     (step 2 when there is none).
+ *  2. Otherwise (a flat tetrahedron, the step limit): every solid tetrahedron in order, the one
+ *     whose smallest weight vol[j] / s is largest (the first of equal ones); inside when that weight
+ *     is >= -1e-9, its weights then clamped at 0 and divided by their sum; else outside.
+ *  3. Outside the convex hull: the nearest point of the hull faces (every face with neighbour -1, in
+ *     order of tetrahedron and face, the first of equally near ones; zhc__triangle_nearest) and its
+ *     barycentric weights on that face's 3 probes (weight 0 on the tetrahedron's fourth): the value
+ *     is clamped to the hull, continuous across it.
+ * Then validity (v->validity, as for grids): probe k is kept when its weight is > 0 and its
+ * validity byte non-zero; kept weights are divided by their sum (k = 0..3 in order); none kept:
+ * the plain weights. A position with a coordinate that is not finite gets weight 1 on vertex 0 of
+ * tetrahedron 0. *tetra receives the tetrahedron used (the start for a nearby next position:
+ * O(1) steps for a moving object). Returns 0 inside the hull, 1 outside, -1 (weights all 0) for a
+ * volume that is not a points volume. Deterministic: the result depends only on the volume, the
+ * position and the start. */
+static inline int zhc_volume_tetra_weights(const zhc_volume* v, const double position[3], uint32_t* tetra,
+                                           uint32_t probes[4], double weights[4]) {
+    uint32_t t, steps, q[4], n, best_t = 0;
+    double r[4][3], vol[4], s, m, best = -HUGE_VAL, sum;
+    int j, k, found = 0, outside = 0;
+    for (k = 0; k < 4; ++k) {
+        probes[k] = 0;
+        weights[k] = 0.0;
+    }
+    if (!v || !v->tetrahedra || !v->positions || v->tetra_count == 0) return -1;
+    t = (tetra && *tetra < v->tetra_count) ? *tetra : 0;
+    if (!isfinite(position[0]) || !isfinite(position[1]) || !isfinite(position[2])) {
+        for (k = 0; k < 4; ++k) probes[k] = zhc__u32(v->tetrahedra + 4 * k);
+        weights[0] = 1.0;
+        if (tetra) *tetra = 0;
+        return 1;
+    }
+    /* 1. The walk. */
+    for (steps = 0; steps < v->tetra_count && !found && !outside; ++steps) {
+        zhc__tetra_volumes(v, t, position, q, r, vol);
+        j = 0;
+        for (k = 1; k < 4; ++k)
+            if (vol[k] < vol[j]) j = k;
+        if (vol[j] >= 0.0) {
+            if (!zhc__tetra_solid(r, vol, &s)) break;
+            for (k = 0; k < 4; ++k) weights[k] = vol[k] / s;
+            found = 1;
+            break;
+        }
+        n = zhc__u32(v->neighbours + 16 * (size_t)t + 4 * j);
+        if (n == 0xFFFFFFFFu) {
+            /* Beyond a hull face of a solid tetrahedron: outside. A flat one orients its faces
+             * arbitrarily: cross its most negative face that has a neighbour, if any. */
+            if (zhc__tetra_solid(r, vol, &s)) {
+                outside = 1;
+                break;
+            }
+            j = -1;
+            for (k = 0; k < 4; ++k)
+                if (vol[k] < 0.0 && zhc__u32(v->neighbours + 16 * (size_t)t + 4 * k) != 0xFFFFFFFFu && (j < 0 || vol[k] < vol[j]))
+                    j = k;
+            if (j < 0) break;
+            n = zhc__u32(v->neighbours + 16 * (size_t)t + 4 * j);
+        }
+        t = n;
+    }
+    /* 2. Every solid tetrahedron. */
+    if (!found && !outside) {
+        for (n = 0; n < v->tetra_count; ++n) {
+            zhc__tetra_volumes(v, n, position, q, r, vol);
+            if (!zhc__tetra_solid(r, vol, &s)) continue;
+            m = vol[0];
+            for (k = 1; k < 4; ++k)
+                if (vol[k] < m) m = vol[k];
+            m /= s;
+            if (m > best) {
+                best = m;
+                best_t = n;
+            }
+        }
+        if (best >= -1e-9) {
+            t = best_t;
+            zhc__tetra_volumes(v, t, position, q, r, vol);
+            sum = 0.0;
+            for (k = 0; k < 4; ++k) {
+                weights[k] = vol[k] > 0.0 ? vol[k] : 0.0;
+                sum += weights[k];
+            }
+            for (k = 0; k < 4; ++k) weights[k] /= sum;
+            found = 1;
+        } else {
+            outside = 1;
+        }
+    }
+    /* 3. The nearest hull face. */
+    if (!found) {
+        double dist, w[3], best_w[3] = {1.0, 0.0, 0.0};
+        int f[3], best_j = 0, c;
+        best = HUGE_VAL;
+        best_t = 0;
+        for (n = 0; n < v->tetra_count; ++n)
+            for (j = 0; j < 4; ++j) {
+                if (zhc__u32(v->neighbours + 16 * (size_t)n + 4 * j) != 0xFFFFFFFFu) continue;
+                for (k = 0; k < 4; ++k) {
+                    q[k] = zhc__u32(v->tetrahedra + 16 * (size_t)n + 4 * k);
+                    for (c = 0; c < 3; ++c) r[k][c] = (double)zhc__f32(v->positions + 12 * (size_t)q[k] + 4 * c) - position[c];
+                }
+                c = 0;
+                for (k = 0; k < 4; ++k)
+                    if (k != j) f[c++] = k;
+                dist = zhc__triangle_nearest(r[f[0]], r[f[1]], r[f[2]], w);
+                if (dist < best) {
+                    best = dist;
+                    best_t = n;
+                    best_j = j;
+                    best_w[0] = w[0];
+                    best_w[1] = w[1];
+                    best_w[2] = w[2];
+                }
+            }
+        t = best_t;
+        c = 0;
+        for (k = 0; k < 4; ++k) weights[k] = k == best_j ? 0.0 : best_w[c++];
+    }
+    for (k = 0; k < 4; ++k) probes[k] = zhc__u32(v->tetrahedra + 16 * (size_t)t + 4 * k);
+    if (tetra) *tetra = t;
+    if (v->validity) {
+        double kept[4];
+        sum = 0.0;
+        for (k = 0; k < 4; ++k) {
+            kept[k] = weights[k] > 0.0 && v->validity[probes[k]] ? weights[k] : 0.0;
+            sum += kept[k];
+        }
+        if (sum > 0.0)
+            for (k = 0; k < 4; ++k) weights[k] = kept[k] / sum;
+    }
+    return found ? 0 : 1;
+}
+
 /* SH3 radiance at `position` (the probe set's frame): the trilinear blend of the decoded SH3 of the
  * 8 probes of the grid cell containing the position (clamped to the grid's box first, so outside
  * the box the value is that of the nearest point of the box), weights
@@ -1145,7 +1526,10 @@ static inline int zhc__volume_plane_side(const zhc_volume* v, size_t cell, const
  * (the cell has no plane, or bit k of the plane's `sides` equals the position's side of it,
  * zhc__volume_plane_side); the kept weights are divided by their sum (summed over corners 0..7 in
  * order); when none is kept the plain trilinear weights are used (the documented fallback). Without
- * any of the three pointers the result is the plain blend, bit for bit. */
+ * any of the three pointers the result is the plain blend, bit for bit.
+ * A points volume (v->tetrahedra set): the blend of the 4 probes of zhc_volume_tetra_weights (walk
+ * started at tetrahedron 0, validity applied), accumulated over k = 0..3 in order, probes of
+ * weight 0 not read. */
 static inline void zhc_volume_sh3(const zhc_volume* v, const double position[3], double sh3[27]) {
     uint32_t i0[3];
     double f[3], w[8], sum = 0.0;
@@ -1153,6 +1537,17 @@ static inline void zhc_volume_sh3(const zhc_volume* v, const double position[3],
     int c, corner, j;
     memset(sh3, 0, 27 * sizeof(double));
     if (!v || !v->probes || v->probe_size == 0) return;
+    if (v->tetrahedra) { /* a points volume: the 4 probes of zhc_volume_tetra_weights from tetrahedron 0 */
+        uint32_t t = 0, q[4];
+        if (zhc_volume_tetra_weights(v, position, &t, q, w) < 0) return;
+        for (corner = 0; corner < 4; ++corner) {
+            float probe[27];
+            if (w[corner] == 0.0) continue;
+            zhc_decode_probe(&v->format, v->probes + (size_t)q[corner] * v->probe_size, probe);
+            for (j = 0; j < 27; ++j) sh3[j] += w[corner] * (double)probe[j];
+        }
+        return;
+    }
     for (c = 0; c < 3; ++c) zhc__volume_axis(position[c], v->origin[c], v->spacing[c], v->counts[c], &i0[c], &f[c]);
     for (corner = 0; corner < 8; ++corner) {
         const int bx = corner & 1, by = (corner >> 1) & 1, bz = (corner >> 2) & 1;
@@ -1190,7 +1585,7 @@ static inline void zhc_volume_sh3(const zhc_volume* v, const double position[3],
  * normal `normal` (both in the probe set's frame; the normal is normalised here, zero or not
  * finite: +Z): E(n) = sum_i s_l c_i Y_i(n), s_l = 1, 2/3, 1/4, of the blended SH3 c of
  * zhc_volume_sh3. By linearity this equals the trilinear blend of the 8 probes' own irradiance at
- * n. Decodes at most 8 probes, evaluates once. Double precision throughout. */
+ * n (the barycentric blend of 4 for a points volume). Decodes at most 8 probes, evaluates once. Double precision throughout. */
 static inline void zhc_volume_irradiance_d(const zhc_volume* v, const double position[3], const double normal[3],
                                            double rgb[3]) {
     double sh[27], n[3], y[9];

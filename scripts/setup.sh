@@ -9,6 +9,7 @@ PACKAGES=(
   cmake ninja-build g++ pkg-config
   libopenexr-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev libzstd-dev libcli11-dev nlohmann-json3-dev libstb-dev
   libastcenc-dev libdeflate-dev
+  libqhull-dev
   libgtest-dev libbenchmark-dev
   fonts-dejavu-core libpng-dev
   clang libclang-rt-14-dev

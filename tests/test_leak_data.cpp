@@ -187,7 +187,7 @@ TEST(LeakData, HostileVersion2FilesGetDistinctErrors) {
     EXPECT_EQ(code_of(longer), ErrorCode::kTrailingBytes);
     // Section flags: unknown bits (a newer writer) unsupported; none in version 2, or any in version
     // 1, malformed; visibility and planes only with a grid layout.
-    EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 21, {8})), ErrorCode::kUnsupported);
+    EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 21, {16})), ErrorCode::kUnsupported);
     // Bit 2 (cell planes) is known: declared without its 5 bytes per probe, the body size is wrong.
     EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 21, {7})), ErrorCode::kBadFormat);
     EXPECT_EQ(code_of(test::zhp_with_header_edit(good, 21, {0x83})), ErrorCode::kUnsupported);
@@ -257,7 +257,7 @@ TEST(LeakData, CliConvertKeepsTheSectionsAndReportsBadFilesWithExitCodes) {
     auto r = test::run_zhc({"info", dir + "/bad.zhp"});
     EXPECT_EQ(r.exit_code, 4) << r.err;
     EXPECT_NE(r.err.find("bad.zhp: validity of probe 0 is 7"), std::string::npos) << r.err;
-    test::write_bytes(dir + "/newer.zhp", test::zhp_with_header_edit(*serialize_probe_set(leak_set()), 21, {8}));
+    test::write_bytes(dir + "/newer.zhp", test::zhp_with_header_edit(*serialize_probe_set(leak_set()), 21, {16}));
     r = test::run_zhc({"convert", dir + "/newer.zhp", "-o", dir + "/x.zhp"});
     EXPECT_EQ(r.exit_code, 5) << r.err;
     EXPECT_FALSE(fs::exists(dir + "/x.zhp"));

@@ -92,6 +92,57 @@ Status validate_leak_data(const ProbeSet& set) {
                                                                    " is set, but no cell has that probe as its first corner");
         }
     }
+    if (!set.tetrahedra.empty() || !set.tetra_neighbours.empty()) {
+        if (set.layout.kind != ProbeLayoutKind::kPositions)
+            return make_error(ErrorCode::kInvalidArgument, "tetrahedra need a positions layout");
+        if (Status st = validate_tetrahedra(set.count, set.tetrahedra, set.tetra_neighbours); !st) return st;
+    }
+    return Ok{};
+}
+
+Status validate_tetrahedra(std::uint64_t count, std::span<const std::array<std::uint32_t, 4>> tetrahedra,
+                           std::span<const std::array<std::int32_t, 4>> neighbours) {
+    auto fail = [](std::size_t t, const std::string& what) {
+        return make_error(ErrorCode::kInvalidArgument, "tetrahedron " + std::to_string(t) + " " + what);
+    };
+    if (neighbours.size() != tetrahedra.size())
+        return make_error(ErrorCode::kInvalidArgument, std::to_string(neighbours.size()) + " neighbour entries for " +
+                                                           std::to_string(tetrahedra.size()) + " tetrahedra");
+    if (tetrahedra.empty()) return make_error(ErrorCode::kInvalidArgument, "a tetrahedra section without a tetrahedron");
+    if (tetrahedra.size() > 0x7FFFFFFFu) return make_error(ErrorCode::kInvalidArgument, "more than 2^31 - 1 tetrahedra");
+    for (std::size_t t = 0; t < tetrahedra.size(); ++t) {
+        const auto& v = tetrahedra[t];
+        for (int k = 0; k < 4; ++k) {
+            if (v[static_cast<std::size_t>(k)] >= count)
+                return fail(t, "vertex " + std::to_string(k) + " is probe " + std::to_string(v[static_cast<std::size_t>(k)]) +
+                                   ", beyond the " + std::to_string(count) + " probes");
+            for (int m = 0; m < k; ++m)
+                if (v[static_cast<std::size_t>(m)] == v[static_cast<std::size_t>(k)])
+                    return fail(t, "names probe " + std::to_string(v[static_cast<std::size_t>(k)]) + " twice");
+        }
+    }
+    for (std::size_t t = 0; t < tetrahedra.size(); ++t)
+        for (std::size_t j = 0; j < 4; ++j) {
+            const std::int32_t n = neighbours[t][j];
+            if (n == -1) continue;
+            if (n < -1 || static_cast<std::size_t>(n) >= tetrahedra.size() || static_cast<std::size_t>(n) == t)
+                return fail(t, "face " + std::to_string(j) + ": neighbour " + std::to_string(n) + " is not another tetrahedron");
+            // The neighbour names t back, across the face made of the same 3 probes.
+            std::size_t back = 4, backs = 0;
+            for (std::size_t k = 0; k < 4; ++k)
+                if (neighbours[static_cast<std::size_t>(n)][k] == static_cast<std::int32_t>(t)) back = k, ++backs;
+            bool same = backs == 1;
+            for (std::size_t k = 0; k < 4 && same; ++k) {
+                if (k == j) continue;
+                bool found = false;
+                for (std::size_t m = 0; m < 4; ++m)
+                    if (m != back && tetrahedra[static_cast<std::size_t>(n)][m] == tetrahedra[t][k]) found = true;
+                same = found;
+            }
+            if (!same)
+                return fail(t, "face " + std::to_string(j) + ": neighbour " + std::to_string(n) +
+                                   " does not share that face with it");
+        }
     return Ok{};
 }
 
@@ -166,6 +217,8 @@ Result<ProbeSet> convert_probe_set(const ProbeSet& set, std::string_view represe
     out->validity = set.validity;  // per-probe leak data does not depend on the representation
     out->visibility = set.visibility;
     out->planes = set.planes;
+    out->tetrahedra = set.tetrahedra;
+    out->tetra_neighbours = set.tetra_neighbours;
     return out;
 }
 

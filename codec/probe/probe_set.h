@@ -12,7 +12,7 @@
 //  * layout kGrid: counts multiply to `count`, origin and spacing finite;
 //    layout kPositions: positions.size() == count, all finite; layout kNone: nothing.
 //  * validity: empty or `count` bytes, each 0 or 1; visibility: empty, or `count` bytes with a
-//    grid layout.
+//    grid layout; tetrahedra: empty, or with a positions layout and consistent neighbours.
 //
 // Thread safety (docs/api.md): every function here is reentrant and keeps no state between
 // calls; calls may run concurrently on different arguments and on the same const ones.
@@ -75,6 +75,13 @@ struct ProbeSet {
     // cell lies on the positive side). Probes that are the last along some axis of count >= 2 start
     // no cell: their entries are "no plane".
     std::vector<std::uint8_t> planes;
+    // tetrahedra (positions layouts only): empty, or a tetrahedralisation of the positions
+    // (formats/probes/tetra.h: Delaunay, canonical order, positive orientation), 4 probe indices per
+    // tetrahedron; tetra_neighbours (as many entries): [t][j] = the tetrahedron across face j of t
+    // (the face opposite vertex j), -1 on the convex hull. The runtimes walk them
+    // (docs/runtime.md "Scattered probes (`points` layout)").
+    std::vector<std::array<std::uint32_t, 4>> tetrahedra;
+    std::vector<std::array<std::int32_t, 4>> tetra_neighbours;
 
     // nullptr when `representation` is not in the table.
     const Codec* codec() const { return find_codec(representation); }
@@ -84,8 +91,15 @@ struct ProbeSet {
 Status validate_probe_set(const ProbeSet& set);
 // The leak-data part of it: validity and visibility each empty or `count` bytes, validity values
 // 0/1, visibility only with a grid layout; planes empty or 5 count bytes with a grid layout, "no
-// plane" on the entries of the last probe along each axis.
+// plane" on the entries of the last probe along each axis; tetrahedra only with a positions layout
+// and consistent (validate_tetrahedra).
 Status validate_leak_data(const ProbeSet& set);
+// The tetrahedra of `count` probes: as many neighbour entries as tetrahedra; each tetrahedron's 4
+// probe indices < count and distinct; each neighbour -1 or another tetrahedron (< the number of
+// tetrahedra) that names this one as its neighbour across the same 3 probes. kInvalidArgument
+// naming the first tetrahedron that breaks a rule. O(tetrahedra).
+Status validate_tetrahedra(std::uint64_t count, std::span<const std::array<std::uint32_t, 4>> tetrahedra,
+                           std::span<const std::array<std::int32_t, 4>> neighbours);
 
 // Probe i's stored bytes -> hub, and hub -> stored bytes. With params.kind == kIrradiance the
 // payload holds irradiance SH: the quantised layouts then use the irradiance-scaled ratio bounds

@@ -57,7 +57,7 @@ enum : std::size_t {
     kOffAxisMode = 18,      // u8
     kOffCompression = 19,   // u8 0 none 1 zstd
     kOffLayoutKind = 20,    // u8
-    kOffLeakFlags = 21,     // u8 version 2: bit 0 validity, bit 1 visibility, bit 2 planes (version 1: zero)
+    kOffLeakFlags = 21,     // u8 version 2: bit 0 validity, bit 1 visibility, bit 2 planes, bit 3 tetrahedra (version 1: zero)
     kOffReserved0 = 22,     // 2 bytes zero
     kOffName = 24,          // 32 bytes ASCII, zero padded
     kNameBytes = 32,
@@ -84,12 +84,18 @@ std::uint64_t positions_bytes(const ProbeSet& set) {
     return set.layout.kind == ProbeLayoutKind::kPositions ? set.count * 12 : 0;
 }
 
-constexpr std::uint8_t kLeakValidity = 1, kLeakVisibility = 2, kLeakPlanes = 4;
+constexpr std::uint8_t kLeakValidity = 1, kLeakVisibility = 2, kLeakPlanes = 4, kLeakTetrahedra = 8;
 
 std::uint8_t leak_flags(const ProbeSet& set) {
     return static_cast<std::uint8_t>((set.validity.empty() ? 0 : kLeakValidity) |
                                      (set.visibility.empty() ? 0 : kLeakVisibility) |
-                                     (set.planes.empty() ? 0 : kLeakPlanes));
+                                     (set.planes.empty() ? 0 : kLeakPlanes) |
+                                     (set.tetrahedra.empty() ? 0 : kLeakTetrahedra));
+}
+
+// The tetrahedra section: u32 count T, T x 4 u32 probe indices, T x 4 i32 neighbours.
+std::uint64_t tetrahedra_bytes(const ProbeSet& set) {
+    return set.tetrahedra.empty() ? 0 : 4 + 32 * static_cast<std::uint64_t>(set.tetrahedra.size());
 }
 
 }  // namespace
@@ -110,7 +116,7 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
                           "zstd level must be 0 (none) .. " + std::to_string(ZSTD_maxCLevel()));
     const std::uint8_t leak = leak_flags(set);
     std::vector<std::uint8_t> body(positions_bytes(set) + set.payload.size() + set.validity.size() +
-                                   set.visibility.size() + set.planes.size());
+                                   set.visibility.size() + set.planes.size() + tetrahedra_bytes(set));
     if (set.layout.kind == ProbeLayoutKind::kPositions)
         for (size_t i = 0; i < set.count; ++i)
             for (size_t c = 0; c < 3; ++c) le::store_f32(body.data() + 12 * i + 4 * c, set.layout.positions[i][c]);
@@ -121,6 +127,17 @@ Result<std::vector<std::uint8_t>> serialize_probe_set(const ProbeSet& set, const
     for (const std::vector<std::uint8_t>* v : {&set.validity, &set.visibility, &set.planes}) {
         if (!v->empty()) std::memcpy(body.data() + at, v->data(), v->size());
         at += v->size();
+    }
+    // Then the tetrahedra (positions layouts): their count, the probe indices, the neighbours.
+    if (!set.tetrahedra.empty()) {
+        const std::size_t t_count = set.tetrahedra.size();
+        le::store(body.data() + at, t_count, 4);
+        for (std::size_t t = 0; t < t_count; ++t)
+            for (std::size_t k = 0; k < 4; ++k) {
+                le::store(body.data() + at + 4 + 16 * t + 4 * k, set.tetrahedra[t][k], 4);
+                le::store(body.data() + at + 4 + 16 * (t_count + t) + 4 * k,
+                          static_cast<std::uint32_t>(set.tetra_neighbours[t][k]), 4);
+            }
     }
     const std::uint64_t raw_bytes = body.size();
     if (options.zstd_level > 0) {
@@ -204,7 +221,7 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
         return err(ErrorCode::kBadFormat, name, "reserved header bytes are not zero (bytes 21-23, 68-71, 156-159)");
     const std::uint8_t leak = h[kOffLeakFlags];
     if (version == kProbeFileVersionLeak) {
-        if (leak > (kLeakValidity | kLeakVisibility | kLeakPlanes))
+        if (leak > (kLeakValidity | kLeakVisibility | kLeakPlanes | kLeakTetrahedra))
             return err(ErrorCode::kUnsupported, name, "unknown per-probe sections " + std::to_string(leak) + " (byte 21)");
         if (leak == 0)
             return err(ErrorCode::kBadFormat, name, "version 2 without per-probe sections (byte 21 is 0; such a file is version 1)");
@@ -212,6 +229,8 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
             return err(ErrorCode::kBadFormat, name, "visibility masks without a grid layout (bytes 20-21)");
         if ((leak & kLeakPlanes) && h[kOffLayoutKind] != static_cast<std::uint8_t>(ProbeLayoutKind::kGrid))
             return err(ErrorCode::kBadFormat, name, "cell planes without a grid layout (bytes 20-21)");
+        if ((leak & kLeakTetrahedra) && h[kOffLayoutKind] != static_cast<std::uint8_t>(ProbeLayoutKind::kPositions))
+            return err(ErrorCode::kBadFormat, name, "tetrahedra without a positions layout (bytes 20-21)");
     }
     auto enum_field = [&](std::size_t off, int max, const char* what) -> Status {
         if (h[off] > max)
@@ -299,10 +318,18 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
         ((leak & kLeakValidity) ? 1u : 0u) + ((leak & kLeakVisibility) ? 1u : 0u) + ((leak & kLeakPlanes) ? 5u : 0u);
     const std::uint64_t raw_expected = pos_bytes + count * probe_bytes + count * leak_sections;
     const std::uint64_t raw_bytes = le::load(h + kOffRawBody, 8);
-    if (raw_bytes != raw_expected)
+    if (leak & kLeakTetrahedra) {
+        // The per-probe part, then the tetrahedra section: 4 bytes of count and 32 per tetrahedron (at least one).
+        if (raw_bytes < raw_expected + 36 || (raw_bytes - raw_expected - 4) % 32 != 0)
+            return err(ErrorCode::kBadFormat, name, "body size " + std::to_string(raw_bytes) + " does not match " +
+                                                        std::to_string(count) + " probes (expected " +
+                                                        std::to_string(raw_expected) +
+                                                        " + 4 + 32 per tetrahedron, at least one, byte 160)");
+    } else if (raw_bytes != raw_expected) {
         return err(ErrorCode::kBadFormat, name, "body size " + std::to_string(raw_bytes) + " does not match " +
                                                     std::to_string(count) + " probes (expected " +
                                                     std::to_string(raw_expected) + ", byte 160)");
+    }
     if (raw_bytes > limits.max_body_bytes)
         return err(ErrorCode::kTooLarge, name, "body of " + std::to_string(raw_bytes) + " bytes exceeds the limit of " +
                                                    std::to_string(limits.max_body_bytes));
@@ -379,6 +406,25 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
                 return err(ErrorCode::kInvalidValue, name, "plane of probe " + std::to_string(i) +
                                                                " is set, but no cell has that probe as its first corner");
         }
+        at += 5 * count;
+    }
+    if (leak & kLeakTetrahedra) {
+        const std::uint64_t t_count = le::load(body.data() + at, 4);
+        const std::uint64_t fits = (raw_bytes - at - 4) / 32;
+        if (t_count != fits)
+            return err(ErrorCode::kBadFormat, name, "tetrahedra section declares " + std::to_string(t_count) +
+                                                        " tetrahedra, its " + std::to_string(raw_bytes - at - 4) +
+                                                        " bytes hold " + std::to_string(fits));
+        set.tetrahedra.resize(t_count);
+        set.tetra_neighbours.resize(t_count);
+        for (std::size_t t = 0; t < t_count; ++t)
+            for (std::size_t k = 0; k < 4; ++k) {
+                set.tetrahedra[t][k] = static_cast<std::uint32_t>(le::load(body.data() + at + 4 + 16 * t + 4 * k, 4));
+                set.tetra_neighbours[t][k] = static_cast<std::int32_t>(
+                    static_cast<std::uint32_t>(le::load(body.data() + at + 4 + 16 * (t_count + t) + 4 * k, 4)));
+            }
+        if (Status st = validate_tetrahedra(count, set.tetrahedra, set.tetra_neighbours); !st)
+            return err(ErrorCode::kInvalidValue, name, st.error().message);
     }
     if (info) {
         info->version = version;

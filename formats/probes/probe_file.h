@@ -3,8 +3,9 @@
 // .zhp (spec: docs/zhp-container.md): a fixed 184-byte little-endian header (magic, version,
 // storage parameters, representation name, probe count, layout, body sizes, CRC-32 of the body
 // and of the header) followed by the body: explicit positions (if any) then the payload, then
-// (version 2 only) a validity and/or visibility byte per probe, the whole body optionally
-// zstd-compressed. A set without validity/visibility is written as version 1. The reader is strict and safe for untrusted input: it
+// (version 2 only) the sections: validity and/or visibility bytes and cell planes per probe, the
+// tetrahedra of a positions layout; the whole body optionally zstd-compressed. A set without any
+// section is written as version 1. The reader is strict and safe for untrusted input: it
 // checks limits before allocating and reports each problem with its own error code:
 //   kTruncated      the bytes end before the header or the declared body ends
 //   kTrailingBytes  bytes after the declared body
@@ -35,7 +36,7 @@
 namespace zhc {
 
 inline constexpr std::uint16_t kProbeFileVersion = 1;      // no per-probe sections
-inline constexpr std::uint16_t kProbeFileVersionLeak = 2;  // validity and/or visibility sections
+inline constexpr std::uint16_t kProbeFileVersionLeak = 2;  // sections: validity, visibility, planes, tetrahedra
 inline constexpr std::size_t kProbeFileHeaderBytes = 184;
 
 struct ProbeFileLimits {
