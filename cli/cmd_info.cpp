@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <optional>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -103,6 +104,26 @@ nlohmann::ordered_json layout_json(const ProbeLayout& l) {
         j["counts"] = {l.grid.counts[0], l.grid.counts[1], l.grid.counts[2]};
     }
     return j;
+}
+
+// The per-probe leak data of a set (docs/zhp-container.md; docs/runtime.md "Cell planes"), or
+// nothing when it has none.
+std::optional<nlohmann::ordered_json> leak_json(const ProbeSet& set) {
+    if (set.validity.empty() && set.visibility.empty() && set.planes.empty()) return std::nullopt;
+    nlohmann::ordered_json leak;
+    if (!set.validity.empty()) {
+        std::uint64_t invalid = 0;
+        for (std::uint8_t v : set.validity) invalid += v == 0;
+        leak["invalid_probes"] = invalid;
+    }
+    if (!set.visibility.empty()) leak["visibility_masks"] = true;
+    if (!set.planes.empty()) {
+        std::uint64_t planes = 0;
+        for (size_t i = 0; i < set.count; ++i) planes += !(set.planes[5 * i + 2] == 0x00 && set.planes[5 * i + 3] == 0x80);
+        leak["cells_with_a_plane"] = planes;
+    }
+    leak["bytes_per_probe"] = (set.validity.empty() ? 0 : 1) + (set.visibility.empty() ? 0 : 1) + (set.planes.empty() ? 0 : 5);
+    return leak;
 }
 
 // Mean radiance (DC / (2 sqrt(pi))) range over probes, and probes that decode to non-finite values.
@@ -264,23 +285,7 @@ int run(const Options& o) {
             j["axis"] = axis_name(*codec, p);
         }
         j["luminance_weights"] = {p.luminance.r, p.luminance.g, p.luminance.b};
-        if (!set->validity.empty() || !set->visibility.empty() || !set->planes.empty()) {
-            // Per-probe leak data (docs/zhp-container.md; docs/runtime.md "Cell planes").
-            nlohmann::ordered_json leak;
-            if (!set->validity.empty()) {
-                std::uint64_t invalid = 0;
-                for (std::uint8_t v : set->validity) invalid += v == 0;
-                leak["invalid_probes"] = invalid;
-            }
-            if (!set->visibility.empty()) leak["visibility_masks"] = true;
-            if (!set->planes.empty()) {
-                std::uint64_t planes = 0;
-                for (size_t i = 0; i < set->count; ++i) planes += !(set->planes[5 * i + 2] == 0x00 && set->planes[5 * i + 3] == 0x80);
-                leak["cells_with_a_plane"] = planes;
-            }
-            leak["bytes_per_probe"] = (set->validity.empty() ? 0 : 1) + (set->visibility.empty() ? 0 : 1) + (set->planes.empty() ? 0 : 5);
-            j["leak_data"] = leak;
-        }
+        if (auto leak = leak_json(*set)) j["leak_data"] = *leak;
         // Scattered probes: the Delaunay tetrahedra the runtimes interpolate in (docs/runtime.md "Scattered probes").
         if (!set->tetrahedra.empty()) j["tetrahedra"] = set->tetrahedra.size();
         auto hub = decode_probe_set(*set);
@@ -364,6 +369,7 @@ int run(const Options& o) {
             vj["sh_axes"] = v.sh_axes == GltfShAxes::kZhc ? "zhc" : "gltf";
             vj["payload"] = v.draco ? "draco point cloud" : "accessors";
             vj["stored_bytes"] = v.stored_bytes;
+            if (auto leak = leak_json(v.set)) vj["leak_data"] = *leak;
             vj["nodes"] = v.nodes;
             auto hub = decode_probe_set(v.set);
             if (!hub) return report(hub.error());

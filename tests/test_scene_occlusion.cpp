@@ -627,6 +627,19 @@ TEST(SkyOcclusionCli, KeysFlagsReportAndErrors) {
     EXPECT_NE(run.out.find("leak estimate: "), std::string::npos) << run.out;
     EXPECT_EQ(run.out.find("visibility masks:"), std::string::npos) << run.out;
     {
+        // zhc info states the leak data of the .zhp and of the same bake as a .glb volume.
+        const auto info = test::run_zhc({"info", dir + "/a.zhp", "--json"});
+        ASSERT_EQ(info.exit_code, 0) << info.err;
+        for (const char* want : {"\"leak_data\": {", "\"invalid_probes\": 0,", "\"cells_with_a_plane\": 21,", "\"bytes_per_probe\": 6"})
+            EXPECT_NE(info.out.find(want), std::string::npos) << want << "\n" << info.out;
+        auto glb = test::run_zhc({"bake", data, "-o", dir + "/a.glb", "--sky-samples", "128"});
+        ASSERT_EQ(glb.exit_code, 0) << glb.err;
+        const auto ginfo = test::run_zhc({"info", dir + "/a.glb", "--json"});
+        ASSERT_EQ(ginfo.exit_code, 0) << ginfo.err;
+        for (const char* want : {"\"leak_data\": {", "\"invalid_probes\": 0,", "\"cells_with_a_plane\": 21,", "\"bytes_per_probe\": 6"})
+            EXPECT_NE(ginfo.out.find(want), std::string::npos) << want << "\n" << ginfo.out;
+    }
+    {
         // occlusion.move_probes false: the row stays inside the wall, invalid and dilated.
         const auto raw = test::read_bytes(data);
         std::string text(raw.begin(), raw.end());

@@ -111,6 +111,11 @@ with open(W("scene.json"), "w") as f:  # info --inputs: a scene and the environm
     json.dump({"format": "zhc-scene", "version": 1, "probes": {"positions": [[0, 0, 0]]},
                "environment": {"map": os.path.abspath(ENVMAP)}}, f)
 check("info", "info", ["info", "--inputs", W("scene.json"), "--json"])
+# A baked grid with leak data (validity + cell planes), as a .zhp and as a glTF volume.
+LEAK_ROOM = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "leak_room.json")
+for name in ("leak.zhp", "leak.glb"):
+    run("bake", LEAK_ROOM, "-o", W(name), "--sky-samples", "64", "--quiet")
+    check("info", "info", ["info", W(name), "--json"])
 # Lightmap files: the SH EXR, its KTX2 / DDS planes, the IrradZ EXR, and a 2-D KTX2 in a format
 # zhc does not read (the BC6H plane relabelled BC7_UNORM_BLOCK, vkFormat 145: same block size).
 run("lightmap", "encode", W("lm.exr"), "-o", W("lm"), "--quality", "fast", "--quiet")
