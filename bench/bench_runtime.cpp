@@ -257,7 +257,7 @@ int main(int argc, char** argv) {
     Row sk;
     sk.name = "skeleton";
     add(sk, kSkeleton, 0, {}, skeleton.instructions);
-    for (const Codec& codec : codecs()) {
+    for (const Codec& codec : runtime_codecs()) {  // the engine layouts have no HLSL decoder (codec.h)
         Row row;
         row.name = std::string(codec.name);
         row.bytes = static_cast<double>(codec.size_bytes);

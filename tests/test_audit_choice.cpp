@@ -275,6 +275,12 @@ TwinChoice twin(const std::vector<InputAudit>& inputs, std::size_t budget, const
     std::vector<bool> ok(n, true);
     TwinChoice t;
     for (std::size_t k = 0; k < n; ++k) {
+        // The engine layouts are audited but never chosen (choice.h): they neither fit nor qualify.
+        // They form the table's tail, so the others' indices are the choice's candidate indices.
+        if (!inputs[0].results[k].codec->traits.engine.empty()) {
+            ok[k] = false;
+            continue;
+        }
         for (const InputAudit& in : inputs) {
             error[k] += in.results[k].metrics.relative_rmse / double(inputs.size());
             if (c.nonnegative && in.results[k].metrics.negative_fraction > 0) ok[k] = false;

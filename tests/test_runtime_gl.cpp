@@ -3,7 +3,7 @@
 // runtime/zhc.glsl at run time, put after "#version 450" and followed by a small compute main that
 // decodes probe words from an SSBO and writes SH3 radiance and irradiance at a normal; the same
 // source after "#version 310 es" runs again on llvmpipe's OpenGL ES 3.1 (smaller sample). Every entry
-// of the codec table (zhc::codecs()) must have a GLSL decoder; each is compared with the C++ codec
+// of the codec table zhc's runtimes read (zhc::runtime_codecs(): all but the engine layouts) must have a GLSL decoder; each is compared with the C++ codec
 // (decode_probe / Codec::irradiance) on >= 100,000 probes (coloured lights + ambient, random SH, the
 // eight sample maps under random rotations) spread over header parameter sets, plus 20,000 probes of
 // random bytes. DC unpacking (R11G11B10F, RGB9E5, half) must be bit-exact; the IrradZ lightmap
@@ -320,7 +320,7 @@ void compare_every_codec(int kBatches, int kGarbageBatches, long min_valid) {
     // luminance L1 whose channels do not vanish); the bounds (irradiance / decode).
     std::printf("%-22s %7s %8s %8s %7s %8s %8s %9s %8s %s\n", "encoding", "probes", "irr uS", "dec uS", "garbage",
                 "irr uS", "dec uS", "nonfinite", "illcond", "bounds");
-    for (const Codec& codec : codecs()) {
+    for (const Codec& codec : runtime_codecs()) {
         const auto it = glsl_entries().find(codec.name);
         if (it == glsl_entries().end()) {
             ADD_FAILURE() << "codec table entry '" << codec.name << "' has no GLSL decoder in runtime/zhc.glsl";
@@ -438,7 +438,8 @@ TEST_F(RuntimeGles, EveryCodecDecodesAndEvaluatesLikeTheCodec) {
 // table's runtime description: every id, and two ids past the end (bytes 0, family 0).
 template <class Fixture>
 void check_generated_table() {
-    const auto table = codecs();
+    // runtime_codecs(): the table without the engine layouts, which no zhc runtime reads (codec.h).
+    const auto table = runtime_codecs();
     const std::size_t n = table.size() + 2;
     typename Fixture::Uniforms un;
     un.mode = 6;
@@ -662,7 +663,7 @@ void compare_volumes(int samples_per_grid) {
     const std::vector<Sh3Radiance> maps = envmap_probes();
     ASSERT_EQ(maps.size(), 8u);
     std::printf("%-22s %8s %10s %8s\n", "volume", "samples", "max u S", "skipped");
-    for (const Codec& codec : codecs()) {
+    for (const Codec& codec : runtime_codecs()) {
         const auto it = glsl_entries().find(codec.name);
         ASSERT_NE(it, glsl_entries().end()) << codec.name;
         const GlslEntry& e = it->second;

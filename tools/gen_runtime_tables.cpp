@@ -391,7 +391,8 @@ int main(int argc, char** argv) {
     const bool write = std::string(argv[1]) == "--write";
     const std::string root = argv[2];
     Model model;
-    for (const zhc::Codec& c : zhc::codecs()) {
+    // runtime_codecs(): the table without the engine layouts, which no zhc runtime reads (codec.h).
+    for (const zhc::Codec& c : zhc::runtime_codecs()) {
         auto e = zhc::runtime_entry(c);
         if (!e) {
             std::fprintf(stderr, "zhc_gen_tables: %s\n", e.error().message.c_str());

@@ -48,6 +48,9 @@ ChoiceResult choose_representations(const std::vector<InputAudit>& inputs,
     out.constraints = constraints;
     out.inputs = inputs.size();
     for (std::size_t c = 0; c < aggregate.size(); ++c) {
+        // The engine layouts are measured beside zhc's representations but are no choice: zhc's
+        // runtimes and containers' readers serve zhc's own (CodecTraits::engine, codec.h).
+        if (!aggregate[c].codec->traits.engine.empty()) continue;
         ChoiceCandidate k;
         k.codec = aggregate[c].codec;
         k.error = aggregate[c].metrics.relative_rmse;
@@ -181,6 +184,69 @@ std::string choice_intro(const ChoiceResult& r) {
            fmt(100.0 * kCheaperWithin, "%.0f%%") + ": the smallest representation with fewer bytes whose relative rmse is at most " +
            fmt(100.0 * kCheaperWithin, "%.0f%%") + " above the choice's, its bytes and how much above. qualifying: "
            "representations meeting the constraints of those that fit.";
+}
+
+std::vector<EngineComparison> compare_engine_layouts(const std::vector<InputAudit>& inputs,
+                                                     const std::vector<RepresentationResult>& aggregate) {
+    auto negative = [&](std::size_t c) {
+        double worst = 0;
+        for (const InputAudit& in : inputs)
+            if (c < in.results.size()) worst = std::max(worst, in.results[c].metrics.negative_fraction);
+        return worst;
+    };
+    std::vector<EngineComparison> out;
+    for (std::size_t e = 0; e < aggregate.size(); ++e) {
+        const Codec* engine = aggregate[e].codec;
+        if (engine->traits.engine.empty()) continue;
+        EngineComparison k;
+        k.engine = engine;
+        k.error = aggregate[e].metrics.relative_rmse;
+        k.max_negative_fraction = negative(e);
+        for (std::size_t c = 0; c < aggregate.size(); ++c) {
+            const Codec* z = aggregate[c].codec;
+            const double err = aggregate[c].metrics.relative_rmse;
+            if (!z->traits.engine.empty() || z->size_bytes > engine->size_bytes || !std::isfinite(err)) continue;
+            if (k.zhc && (err > k.zhc_error || (err == k.zhc_error && z->size_bytes >= k.zhc->size_bytes))) continue;
+            k.zhc = z;
+            k.zhc_error = err;
+            k.zhc_max_negative_fraction = negative(c);
+        }
+        out.push_back(k);
+    }
+    return out;
+}
+
+namespace {
+constexpr double kEqualWithin = 1.005;
+}  // namespace
+
+std::vector<std::vector<std::string>> engine_table(const std::vector<EngineComparison>& rows) {
+    std::vector<std::vector<std::string>> t{{"engine_layout", "engine", "bytes", "rel_rmse", "neg_frac", "zhc_best", "bytes",
+                                             "rel_rmse", "neg_frac", "lower_error"}};
+    for (const EngineComparison& k : rows) {
+        std::vector<std::string> row{std::string(k.engine->name), std::string(k.engine->traits.engine),
+                                     std::to_string(k.engine->size_bytes), fmt(k.error, "%.4f"),
+                                     fmt(k.max_negative_fraction, "%.4f")};
+        if (k.zhc) {
+            // Within 0.5 % of each other: equal (float rounding and a clamp at 0 move errors that little).
+            std::string lead = "equal";
+            if (k.zhc_error * kEqualWithin < k.error) lead = k.zhc_error > 0 ? "zhc " + fmt(k.error / k.zhc_error, "%.2fx") : "zhc";
+            else if (k.error * kEqualWithin < k.zhc_error) lead = k.error > 0 ? "engine " + fmt(k.zhc_error / k.error, "%.2fx") : "engine";
+            row.insert(row.end(), {std::string(k.zhc->name), std::to_string(k.zhc->size_bytes), fmt(k.zhc_error, "%.4f"),
+                                   fmt(k.zhc_max_negative_fraction, "%.4f"), lead});
+        } else {
+            row.insert(row.end(), {"none", "-", "-", "-", "-"});
+        }
+        t.push_back(std::move(row));
+    }
+    return t;
+}
+
+std::string engine_intro() {
+    return "The engines' own probe layouts (docs/engine-layouts.md: each stores a probe as its engine does and evaluates "
+           "irradiance as the engine's shader does) beside zhc's best representation at the same size: the lowest relative "
+           "rmse among zhc's representations storing at most as many bytes per probe. lower_error: which is lower and by "
+           "what factor (equal: within 0.5 %). neg_frac: the largest fraction of directions reconstructing below 0 on an input.";
 }
 
 std::vector<std::string> choice_notes(const ChoiceResult& r) {

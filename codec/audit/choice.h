@@ -11,7 +11,8 @@
 //                     `--runtime-cost`) is at most N; a representation the cost table does not
 //                     list does not qualify;
 //   max_encode_us     its mean encode time per probe (the audit's timing) is at most N us.
-// Among the qualifying representations the lowest error wins; ties go to fewer bytes, then to
+// The engine layouts (CodecTraits::engine) are never candidates: the choice is among the
+// representations zhc's runtimes read. Among the qualifying representations the lowest error wins; ties go to fewer bytes, then to
 // the audit's order (the codec table's unless --representations lists another), so the choice is
 // deterministic. The runner-up is the next one in that
 // order; the margin is the runner-up's error minus the choice's.
@@ -90,7 +91,7 @@ struct BudgetChoice {
 struct ChoiceResult {
     ChoiceConstraints constraints;
     std::size_t inputs = 0;                   // inputs pooled
-    std::vector<ChoiceCandidate> candidates;  // in the audit's (aggregate) order
+    std::vector<ChoiceCandidate> candidates;  // in the audit's (aggregate) order, engine layouts left out
     std::vector<BudgetChoice> budgets;        // ascending
     const ChoiceCandidate* chosen(const BudgetChoice& b) const { return b.choice < 0 ? nullptr : &candidates[b.choice]; }
     const ChoiceCandidate* second(const BudgetChoice& b) const {
@@ -119,5 +120,29 @@ std::vector<std::vector<std::string>> choice_table(const ChoiceResult& result);
 std::string choice_intro(const ChoiceResult& result);
 // The reasons of the budgets with no choice, one line each ("8 bytes: none: ...").
 std::vector<std::string> choice_notes(const ChoiceResult& result);
+
+// ---- the engine layouts beside zhc's representations -------------------------------------------
+
+// One audited engine layout (CodecTraits::engine, codec/probe/engine_layouts.h) against zhc's best
+// representation at its size: zhc's representation with the lowest error among the audited ones
+// storing at most as many bytes per probe (the error and pooling of the choice above; ties: fewer
+// bytes, then the audit's order; a non-finite error never wins).
+struct EngineComparison {
+    const Codec* engine = nullptr;
+    double error = 0;                  // aggregate relative rmse
+    double max_negative_fraction = 0;  // the largest negative_fraction over the inputs
+    const Codec* zhc = nullptr;        // nullptr: no audited zhc representation is that small
+    double zhc_error = 0;
+    double zhc_max_negative_fraction = 0;
+};
+// The audited engine layouts, in the audit's order (empty when none was audited).
+std::vector<EngineComparison> compare_engine_layouts(const std::vector<InputAudit>& inputs,
+                                                     const std::vector<RepresentationResult>& aggregate);
+// As a table (row 0 the header): engine_layout, engine, bytes, rel_rmse, neg_frac, zhc_best, bytes,
+// rel_rmse, neg_frac, lower_error ("zhc 3.1x": the lower error's side and the other's error over
+// it; "equal" when within 0.5 % of each other; "-" without a zhc representation).
+std::vector<std::vector<std::string>> engine_table(const std::vector<EngineComparison>& rows);
+// One paragraph: what the table compares.
+std::string engine_intro();
 
 }  // namespace zhc

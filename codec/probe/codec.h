@@ -11,8 +11,9 @@
 //    crash or trap, never undefined behaviour. Garbage in gives numbers out: any float, +-Inf and
 //    NaN included where the bytes hold a float, half or shared-exponent field that encodes them
 //    (readers of files refuse those with check_finite_probes, formats/probes/probe_file.h). decode
-//    is a pure function of the bytes; irradiance agrees with the irradiance of decode's SH3 and
-//    is finite whenever that SH3 is (tests/test_codec_table.cpp, DecodeAcceptsArbitraryBytes).
+//    is a pure function of the bytes; irradiance is what the entry's irradiance_model says of
+//    decode's SH3 (for zhc's own entries: its irradiance) and is finite whenever that SH3 is
+//    (tests/test_codec_table.cpp, DecodeAcceptsArbitraryBytes).
 //  * the stored bytes are little-endian and the same on every machine; encode is deterministic.
 //  * L0 (DC) round-trips exactly for the float representations.
 //
@@ -132,6 +133,16 @@ enum class ZonalHallucination : std::uint8_t {
     kCurveAdaptive = 4,       // Eq. 21 with a, b times s = 0.5 min(byte 15, 7) (sh2_q layout only)
 };
 
+// How an entry's irradiance relates to the SH3 its decode returns. zhc's own entries are kSh3; the
+// engine layouts (engine_layouts.h) evaluate irradiance as their engine's shader does, which is not
+// always an SH3 function.
+enum class IrradianceModel : std::uint8_t {
+    kSh3 = 0,         // irradiance = the irradiance of decode's SH3
+    kSh3Clamped = 1,  // = max(0, the irradiance of decode's SH3) per channel: the shader clamps
+    kOwn = 2,         // the entry's own reconstruction (ambient cubes, not SH3 functions); decode
+                      // returns its least-squares SH3 projection over the sphere
+};
+
 // What code outside an entry may ask about it instead of testing its name. Each field is a fact
 // about the entry's bytes or decoder; tests check every one of them against the entry's functions
 // (tests/test_codec_table.cpp; zonal_axis and hallucination through the runtimes' decoders:
@@ -149,6 +160,12 @@ struct CodecTraits {
     int float_bands = 0;
     ZonalAxis zonal_axis = ZonalAxis::kNone;
     ZonalHallucination hallucination = ZonalHallucination::kNone;
+    IrradianceModel irradiance_model = IrradianceModel::kSh3;
+    // The engine whose stored layout this entry is ("Unity APV"; engine_layouts.h), empty for zhc's
+    // own representations. The audit, the benchmark and the reports measure engine layouts beside
+    // zhc's; zhc's runtimes, containers' runtime readers and the choice of a representation skip
+    // them (runtime_codecs() below; codec/audit/choice.h).
+    std::string_view engine = {};
 };
 
 struct Codec {
@@ -168,6 +185,11 @@ struct Codec {
 
 // The whole table, in a stable order (audit and benchmark rows follow it).
 std::span<const Codec> codecs();
+// The entries zhc's runtimes decode (runtime/, docs/runtime.md): the table without the engine
+// layouts (CodecTraits::engine), which are the engines' own formats. They sit at the end of the
+// table, so this is a prefix of codecs() and an entry's runtime encoding id (its place in the
+// table) is the same in both. Code that pairs the table with the runtimes walks this.
+std::span<const Codec> runtime_codecs();
 // The entry named `name`, or the entry an alias (codec_aliases below) stands for; nullptr when
 // neither names one. Code that stores or prints a name takes the entry's own (Codec::name), so an
 // alias is read and never written.

@@ -9,9 +9,12 @@
 // The parts of the table: one line per codec module, X(the module's part function), in table order.
 // The table's order is the runtime encoding ids (the runtimes' generated tables, written by
 // `cmake --build build --target update_runtime_tables`, docs/runtime.md "Generated tables"), so a
-// new module's line goes last and no line ever moves or goes (the runtime tests fail otherwise; a
-// module split in two keeps its entries' order with two adjacent lines, as zh3,
-// zh3_hallucinated and zh3_clamp do). This list is the only edit outside a new module's own files
+// new module's line goes after the last of zhc's own modules and no such line ever moves or goes
+// (the runtime tests fail otherwise; a module split in two keeps its entries' order with two
+// adjacent lines, as zh3, zh3_hallucinated and zh3_clamp do). The engine layouts
+// (engine_layouts.h) come after every zhc module: the runtimes do not read them, so they have no
+// runtime id, and runtime_codecs() is the prefix before them (tests/test_engine_layouts.cpp checks
+// that they form the table's tail). This list is the only edit outside a new module's own files
 // (plus its source line in codec/CMakeLists.txt) and the regenerated runtime tables. Static
 // self-registration would need no list, but objects of a static library that nothing references
 // are dropped by the linker, and the order would follow the link order.
@@ -25,7 +28,8 @@
     X(zh3_dering_codecs)       \
     X(zh3_channel_q16_codecs)  \
     X(hall_solve_codecs)       \
-    /* a new module's line goes here, last */
+    /* a new zhc module's line goes here, before the engine layouts */ \
+    X(engine_codecs)
 
 namespace zhc {
 
@@ -43,6 +47,16 @@ std::span<const Codec> codecs() {
         return all;
     }();
     return table;
+}
+
+std::span<const Codec> runtime_codecs() {
+    static const std::span<const Codec> prefix = [] {
+        const std::span<const Codec> all = codecs();
+        std::size_t n = 0;
+        while (n < all.size() && all[n].traits.engine.empty()) ++n;
+        return all.first(n);
+    }();
+    return prefix;
 }
 
 std::span<const CodecAlias> codec_aliases() {

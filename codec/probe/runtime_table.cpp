@@ -59,6 +59,9 @@ Result<RuntimeEntry> runtime_entry(const Codec& c) {
         return make_error(ErrorCode::kUnsupported, "codec table entry '" + std::string(c.name) + "': " + what);
     };
     const bool hall = e.hallucination != ZonalHallucination::kNone;
+    // An engine layout's bytes are that engine's format (engine_layouts.h); zhc's runtimes read none
+    // of them, whatever its size (realitykit_l1 has sh2_f32's 48 bytes, in other axes).
+    if (!c.traits.engine.empty()) return refuse("an engine layout (" + std::string(c.traits.engine) + "): no zhc runtime reads it");
     if (c.packed) {
         switch (c.packed->layout) {
             case PackedLayout::kZh3Q16: e.layout = RuntimeLayout::kZh3Q16; break;

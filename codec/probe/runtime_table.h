@@ -53,7 +53,8 @@ struct RuntimeEntry {
 // the entry says so; 60 bytes with a zonal axis and no hallucination: zh3_f32). kUnsupported naming
 // the entry when no runtime layout holds its bytes or the traits contradict the layout (a
 // hallucination outside sh2_f32 / sh2_q, sh2_q with a model other than the two curves, the
-// adaptive curve outside sh2_q, an axis "format" on a float layout).
+// adaptive curve outside sh2_q, an axis "format" on a float layout), and for every engine layout
+// (CodecTraits::engine: the runtimes read zhc's representations only, codec.h runtime_codecs()).
 Result<RuntimeEntry> runtime_entry(const Codec& c);
 
 }  // namespace zhc
