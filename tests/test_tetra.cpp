@@ -165,15 +165,31 @@ TEST(Tetra, RandomSetsAreDelaunayTilingsOfTheHull) {
     }
 }
 
-TEST(Tetra, CosphericalLatticeKeepsItsFlatTetrahedraConsistent) {
+TEST(Tetra, CosphericalLatticeIsTriangulatedWithoutFlatTetrahedra) {
     const auto p = lattice(4, 3, 3, 0.5f);
     auto tz = tetrahedralize(p);
     ASSERT_TRUE(tz.ok()) << tz.error().message;
-    EXPECT_GT(tz->flat, 0u) << "qhull's Qt output of a lattice holds flat tetrahedra";
-    expect_delaunay_tiling(p, *tz, true);
+    // Every cube is one Delaunay region; its pulling triangulation from its lowest corner cones the
+    // 3 squares without that corner, 2 triangles each: 6 tetrahedra per cube, none flat.
+    EXPECT_EQ(tz->flat, 0u);
+    EXPECT_EQ(tz->tetrahedra.size(), 12u * 6u);
+    expect_delaunay_tiling(p, *tz, false);
     long double total = 0;
     for (const Tet& t : tz->tetrahedra) total += orient(p, t) / 6;
     EXPECT_DOUBLE_EQ(double(total), 1.5 * 1.0 * 1.0);  // the box 1.5 x 1 x 1
+    // A larger lattice with a probe at the centre of the square between two cubes.
+    auto q = lattice(5, 4, 3, 1.0f);
+    q.push_back({2.5f, 1.5f, 1.0f});
+    auto tq = tetrahedralize(q);
+    ASSERT_TRUE(tq.ok()) << tq.error().message;
+    EXPECT_EQ(tq->flat, 0u);
+    expect_delaunay_tiling(q, *tq, false);
+    // qhull's own Qt triangulation of the same lattice: flat tetrahedra between cubes, still a
+    // consistently oriented tiling (what the runtimes are tested with for flat tetrahedra).
+    auto qt = tetrahedralize(p, true);
+    ASSERT_TRUE(qt.ok()) << qt.error().message;
+    EXPECT_GT(qt->flat, 0u);
+    expect_delaunay_tiling(p, *qt, true);
 }
 
 TEST(Tetra, SameResultOnEveryCallAndFromConcurrentThreads) {

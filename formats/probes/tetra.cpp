@@ -69,8 +69,17 @@ int face_sign(const std::array<std::uint32_t, 4>& t, int j) {
     return sign;
 }
 
-// qhull's Delaunay tetrahedra of `pts` as indices into pts (unsorted, qhull's order), or an error.
-Result<std::vector<std::array<std::uint32_t, 4>>> run_qhull(std::vector<P> pts) {
+// One Delaunay region of qhull's output (a lower facet of the lifted hull): its sites, and when it
+// is not a tetrahedron (cospherical sites merged into one region: every cell of a lattice) its
+// ridges: triangles of its boundary, each with the region across it (-1: the convex hull).
+struct Region {
+    std::vector<std::uint32_t> sites;
+    std::vector<std::pair<std::int64_t, std::array<std::uint32_t, 3>>> ridges;
+};
+
+// qhull's Delaunay regions of `pts` (indices into pts), or an error. triangulated: option 'Qt'
+// (every region a tetrahedron, flat ones where sites are cospherical).
+Result<std::vector<Region>> run_qhull(const std::vector<P>& pts, bool triangulated) {
     std::vector<coordT> coords(3 * pts.size());
     for (std::size_t i = 0; i < pts.size(); ++i)
         for (int c = 0; c < 3; ++c) coords[3 * i + static_cast<std::size_t>(c)] = pts[i][static_cast<std::size_t>(c)];
@@ -82,25 +91,47 @@ Result<std::vector<std::array<std::uint32_t, 4>>> run_qhull(std::vector<P> pts) 
     qhT qh_storage;
     qhT* qh = &qh_storage;
     qh_zero(qh, err);
-    char options[] = "qhull d Qt Qbb Qz";
-    const int exitcode = qh_new_qhull(qh, 3, static_cast<int>(pts.size()), coords.data(), False, options, nullptr, err);
-    std::vector<std::array<std::uint32_t, 4>> tets;
-    bool bad_facet = false;
+    // Without 'Qt' cospherical sites stay one region, triangulated below so that neighbouring
+    // regions agree on their common faces.
+    char merged[] = "qhull d Qbb Qz", split[] = "qhull d Qt Qbb Qz";
+    const int exitcode = qh_new_qhull(qh, 3, static_cast<int>(pts.size()), coords.data(), False, triangulated ? split : merged, nullptr, err);
+    std::vector<Region> regions;
+    bool bad = false;
+    auto site = [&](vertexT* vertex, std::uint32_t* out) {
+        const int id = qh_pointid(qh, vertex->point);
+        if (id < 0 || static_cast<std::size_t>(id) >= pts.size()) return false;
+        *out = static_cast<std::uint32_t>(id);
+        return true;
+    };
     if (exitcode == 0) {
         facetT* facet;
         vertexT *vertex, **vertexp;
+        ridgeT *ridge, **ridgep;
         FORALLfacets {
             if (facet->upperdelaunay) continue;
-            std::array<std::uint32_t, 4> t{};
-            int k = 0;
+            Region r;
             FOREACHvertex_(facet->vertices) {
-                const int id = qh_pointid(qh, vertex->point);
-                if (k < 4 && id >= 0 && static_cast<std::size_t>(id) < pts.size()) t[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(id);
-                else bad_facet = true;
-                ++k;
+                std::uint32_t id = 0;
+                if (site(vertex, &id)) r.sites.push_back(id);
+                else bad = true;
             }
-            if (k != 4) bad_facet = true;
-            tets.push_back(t);
+            if (r.sites.size() < 4) bad = true;
+            if (!triangulated && (r.sites.size() > 4 || !facet->simplicial)) {
+                if (!facet->ridges) bad = true;
+                else
+                    FOREACHridge_(facet->ridges) {
+                        facetT* other = otherfacet_(ridge, facet);
+                        std::array<std::uint32_t, 3> tri{};
+                        int k = 0;
+                        FOREACHvertex_(ridge->vertices) {
+                            if (k < 3 && site(vertex, &tri[static_cast<std::size_t>(k)])) ++k;
+                            else bad = true;
+                        }
+                        if (k != 3) bad = true;
+                        r.ridges.emplace_back(other && !other->upperdelaunay ? std::int64_t(other->id) : -1, tri);
+                    }
+            }
+            regions.push_back(std::move(r));
         }
     }
     qh_freeqhull(qh, !qh_ALL);
@@ -117,9 +148,75 @@ Result<std::vector<std::array<std::uint32_t, 4>>> run_qhull(std::vector<P> pts) 
         }
         return make_error(ErrorCode::kInternal, "tetrahedralisation: qhull failed (exit " + std::to_string(exitcode) + "): " + line);
     }
-    if (bad_facet) return make_error(ErrorCode::kInternal, "tetrahedralisation: qhull returned a Delaunay region that is not a tetrahedron");
-    if (tets.empty()) return make_error(ErrorCode::kInternal, "tetrahedralisation: qhull returned no tetrahedron");
-    return tets;
+    if (bad) return make_error(ErrorCode::kInternal, "tetrahedralisation: qhull returned a Delaunay region zhc cannot read");
+    if (regions.empty()) return make_error(ErrorCode::kInternal, "tetrahedralisation: qhull returned no Delaunay region");
+    return regions;
+}
+
+// The tetrahedra of one region (sites as indices into pts). A tetrahedron as it is; a merged region
+// (a convex polytope of cospherical sites) by its pulling triangulation in site order: every face
+// that does not hold the region's lowest site v, triangulated by the fan from its own lowest site,
+// coned from v. A face between two regions is then triangulated the same from both sides (its fan
+// depends on its sites only; when it holds v, v is also its lowest site and the cones from v induce
+// that same fan), so no flat tetrahedra fill mismatched faces. Faces are the ridges grouped by the
+// region across them (their boundary chained into the polygon); on the convex hull, where no other
+// region needs to agree, qhull's own ridge triangles are coned, those in v's plane left out.
+// false when the ridges do not form such faces (the caller then falls back).
+bool triangulate_region(const Region& r, const std::vector<P>& pts, std::vector<std::array<std::uint32_t, 4>>& out) {
+    if (r.ridges.empty()) {
+        if (r.sites.size() != 4) return false;
+        out.push_back({r.sites[0], r.sites[1], r.sites[2], r.sites[3]});
+        return true;
+    }
+    const std::uint32_t v = *std::min_element(r.sites.begin(), r.sites.end());
+    std::map<std::int64_t, std::vector<std::array<std::uint32_t, 3>>> faces;
+    double extent2 = 0;
+    for (std::uint32_t a : r.sites) extent2 = std::max(extent2, dot3(sub(pts[a], pts[v]), sub(pts[a], pts[v])));
+    for (const auto& [other, tri] : r.ridges) {
+        if (other >= 0) {
+            faces[other].push_back(tri);
+            continue;
+        }
+        // A hull ridge: coned from v unless v lies in its plane.
+        if (tri[0] == v || tri[1] == v || tri[2] == v) continue;
+        const double o = orient(pts[v], pts[tri[0]], pts[tri[1]], pts[tri[2]]);
+        if (std::fabs(o) <= 1e-12 * extent2 * std::sqrt(extent2)) continue;
+        out.push_back({v, tri[0], tri[1], tri[2]});
+    }
+    for (const auto& [other, tris] : faces) {
+        // The polygon: boundary edges (used by one triangle of the face) chained into a cycle.
+        std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+        bool holds_v = false;
+        for (const auto& t : tris)
+            for (int e = 0; e < 3; ++e) {
+                std::uint32_t a = t[static_cast<std::size_t>(e)], b = t[static_cast<std::size_t>((e + 1) % 3)];
+                holds_v = holds_v || a == v;
+                if (a > b) std::swap(a, b);
+                ++uses[{a, b}];
+            }
+        if (holds_v) continue;
+        std::map<std::uint32_t, std::vector<std::uint32_t>> next;
+        for (const auto& [edge, n] : uses)
+            if (n == 1) {
+                next[edge.first].push_back(edge.second);
+                next[edge.second].push_back(edge.first);
+            }
+        if (next.size() < 3) return false;
+        std::vector<std::uint32_t> cycle = {next.begin()->first};  // starts at the face's lowest site
+        std::uint32_t prev = cycle[0];
+        if (next[cycle[0]].size() != 2) return false;
+        std::uint32_t cur = std::min(next[cycle[0]][0], next[cycle[0]][1]);
+        while (cur != cycle[0]) {
+            if (next[cur].size() != 2 || cycle.size() > next.size()) return false;
+            cycle.push_back(cur);
+            const std::uint32_t step = next[cur][0] == prev ? next[cur][1] : next[cur][0];
+            prev = cur;
+            cur = step;
+        }
+        if (cycle.size() != next.size()) return false;
+        for (std::size_t i = 1; i + 1 < cycle.size(); ++i) out.push_back({v, cycle[0], cycle[i], cycle[i + 1]});
+    }
+    return true;
 }
 
 }  // namespace
@@ -162,7 +259,7 @@ Result<std::vector<std::array<std::int32_t, 4>>> tetra_neighbours_of(std::span<c
     return nb;
 }
 
-Result<Tetrahedralization> tetrahedralize(std::span<const std::array<float, 3>> positions) {
+Result<Tetrahedralization> tetrahedralize(std::span<const std::array<float, 3>> positions, bool qhull_triangulated) {
     if (positions.size() > (std::size_t(1) << 26))
         return make_error(ErrorCode::kInvalidArgument, "tetrahedralisation: more than 2^26 probes");
     Tetrahedralization out;
@@ -188,8 +285,20 @@ Result<Tetrahedralization> tetrahedralize(std::span<const std::array<float, 3>> 
         for (std::size_t c = 0; c < 3; ++c) pts[i][c] = positions[unique_ids[i]][c];
     if (std::string why = degenerate_reason(pts); !why.empty())
         return make_error(ErrorCode::kInvalidArgument, "tetrahedralisation: " + why);
-    auto raw = run_qhull(pts);
-    if (!raw) return raw.error();
+    // qhull's Delaunay regions, merged regions triangulated consistently; when their ridges do not
+    // form polygon faces (not seen), qhull's own triangulation ('Qt') instead.
+    auto regions = run_qhull(pts, qhull_triangulated);
+    if (!regions) return regions.error();
+    std::vector<std::array<std::uint32_t, 4>> local;
+    bool consistent = true;
+    for (const Region& r : *regions) consistent = consistent && triangulate_region(r, pts, local);
+    if (!consistent) {
+        regions = run_qhull(pts, true);
+        if (!regions) return regions.error();
+        local.clear();
+        for (const Region& r : *regions) triangulate_region(r, pts, local);
+    }
+    const auto* raw = &local;
     // Canonical form: sorted by their probe indices (ascending), each ascending, then oriented.
     std::vector<std::array<std::uint32_t, 4>> tets;
     tets.reserve(raw->size());

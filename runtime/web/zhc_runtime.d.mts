@@ -90,6 +90,10 @@ export interface ZhpFile {
   visibility: Uint8Array | null;
   /** Cell planes (byte 21 bit 2): 5 bytes per probe, the plane of the cell whose corner 0 is the probe. */
   planes: Uint8Array | null;
+  /** Tetrahedra of a positions layout (byte 21 bit 3): 4 probe indices each. */
+  tetrahedra: Uint32Array | null;
+  /** Their neighbours: 4 each, the tetrahedron across face j (the face without vertex j), -1 on the convex hull. */
+  neighbours: Int32Array | null;
 }
 
 /** makeVolume's input: the stored bytes (encoding, params, bytes) or the decoded SH3 (sh), and the grid. */
@@ -110,7 +114,8 @@ export interface ZhcVolumeInput {
   planesAxes?: 'zhc' | 'gltf';
 }
 /** A decoded probe grid (frozen): makeVolume / volumeFromZhp. */
-export interface ZhcVolume {
+export interface ZhcGridVolume {
+  readonly kind: 'grid';
   readonly origin: Vec3;
   readonly spacing: Vec3;
   readonly counts: Vec3;
@@ -120,6 +125,42 @@ export interface ZhcVolume {
   readonly visibility: ArrayLike<number> | null;
   readonly planes: ArrayLike<number> | null;
   readonly planesAxes: 'zhc' | 'gltf';
+}
+/** makePointsVolume's input: the stored bytes (encoding, params, bytes) or the decoded SH3 (sh), positions and tetrahedra. */
+export interface ZhcPointsVolumeInput {
+  encoding?: ZhcEncodingInput;
+  params?: ZhcParams;
+  bytes?: Uint8Array;
+  sh?: ArrayLike<number>;
+  /** 3 floats per probe (float32 values). */
+  positions: ArrayLike<number>;
+  /** 4 probe indices per tetrahedron, consistently oriented (as zhc writes them). */
+  tetrahedra: ArrayLike<number>;
+  /** 4 per tetrahedron: the tetrahedron across face j, -1 on the convex hull. */
+  neighbours: ArrayLike<number>;
+  validity?: ArrayLike<number> | null;
+}
+/** Scattered probes decoded once with their tetrahedra (frozen): makePointsVolume / volumeFromZhp. */
+export interface ZhcPointsVolume {
+  readonly kind: 'points';
+  readonly count: number;
+  readonly sh: ArrayLike<number>;
+  readonly positions: Float32Array;
+  readonly tetrahedra: Uint32Array;
+  readonly neighbours: Int32Array;
+  readonly tetraCount: number;
+  readonly validity: ArrayLike<number> | null;
+}
+/** Either kind of volume: what volumeFromZhp returns and the samplers take. */
+export type ZhcVolume = ZhcGridVolume | ZhcPointsVolume;
+/** volumeTetraWeights's result: the 4 probes blended at a point and their weights (validity applied). */
+export interface ZhcTetraWeights {
+  /** false: outside the convex hull, clamped to its nearest face. */
+  inside: boolean;
+  /** The tetrahedron used (start the next nearby point's walk there). */
+  tetra: number;
+  probes: number[];
+  weights: number[];
 }
 
 export declare const PI: number;
@@ -225,9 +266,15 @@ export declare function parseZhp(bytes: Uint8Array): ZhpFile;
 export declare function decodeAll(encoding: ZhcEncodingInput, payload: Uint8Array, count: number, params?: ZhcParams): Float32Array;
 
 /** A probe grid decoded once (throws Error naming a bad grid). */
-export declare function makeVolume(input: ZhcVolumeInput): ZhcVolume;
-/** A probe grid from a whole .zhp file (throws for a file that is not a grid). */
+export declare function makeVolume(input: ZhcVolumeInput): ZhcGridVolume;
+/** Throws Error naming the first tetrahedron whose indices or neighbours are inconsistent. */
+export declare function checkTetrahedra(tetrahedra: ArrayLike<number>, neighbours: ArrayLike<number>, count: number): void;
+/** Scattered probes decoded once, with their tetrahedra (throws Error naming a problem). */
+export declare function makePointsVolume(input: ZhcPointsVolumeInput): ZhcPointsVolume;
+/** A volume from a whole .zhp file: a grid, or scattered probes with tetrahedra (throws "not a grid" otherwise). */
 export declare function volumeFromZhp(bytes: Uint8Array): ZhcVolume;
+/** Where a point falls in scattered probes: the tetrahedron (walk from `start`, default 0), its 4 probes and weights. */
+export declare function volumeTetraWeights(vol: ZhcPointsVolume, position: Vec3Like, start?: number): ZhcTetraWeights;
 /** Blended SH3 radiance at a point of the volume's frame, Float64Array(27). */
 export declare function volumeSH3(vol: ZhcVolume, position: Vec3Like): Float64Array;
 /** Irradiance at a point for a surface normal (volume frame), in double. */

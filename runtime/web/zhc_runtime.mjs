@@ -527,8 +527,10 @@ export function crc32(bytes, start = 0, end = bytes.length) {
 
 // Parses a .zhp file (Uint8Array). Returns {encoding, params, count, bytesPerProbe, layout,
 // payload (Uint8Array view), positions (Float32Array or null), grid, validity, visibility, planes
-// (Uint8Array views of the per-probe sections, or null)}. Throws on anything the C++ reader rejects
-// that matters here; zstd-compressed bodies are not supported (throws).
+// (Uint8Array views of the per-probe sections, or null), tetrahedra (Uint32Array, 4 probe indices
+// each) and neighbours (Int32Array, 4 each: across face j, -1 on the hull) of a positions layout,
+// or null}. Throws on anything the C++ reader rejects that matters here; zstd-compressed bodies are
+// not supported (throws).
 export function parseZhp(bytes) {
   const magic = [0x89, 0x5a, 0x48, 0x50, 0x0d, 0x0a, 0x1a, 0x0a];
   if (bytes.length < 184 || magic.some((m, i) => bytes[i] !== m)) throw new Error('zhp: not a .zhp file');
@@ -537,11 +539,11 @@ export function parseZhp(bytes) {
   const version = dv.getUint16(8, true);
   if (version !== 1 && version !== 2) throw new Error('zhp: unsupported version');
   if (dv.getUint16(10, true) !== 184) throw new Error('zhp: bad header size');
-  // Version 2: byte 21 lists the per-probe sections after the payload, in this order (bit 0
-  // validity, bit 1 visibility: 1 byte per probe each; bit 2 cell planes: 5 bytes per probe);
-  // version 1: zero.
+  // Version 2: byte 21 lists the sections after the payload, in this order (bit 0 validity, bit 1
+  // visibility: 1 byte per probe each; bit 2 cell planes: 5 bytes per probe; bit 3 tetrahedra:
+  // a u32 count T, then 16 T bytes of indices and 16 T of neighbours); version 1: zero.
   const sections = bytes[21];
-  if (version === 1 ? sections !== 0 : sections === 0 || sections > 7) throw new Error('zhp: bad per-probe sections (byte 21)');
+  if (version === 1 ? sections !== 0 : sections === 0 || sections > 15) throw new Error('zhp: bad per-probe sections (byte 21)');
   const enumOf = (off, names) => {
     const v = bytes[off];
     if (v >= names.length) throw new Error(`zhp: unknown enum value ${v} at byte ${off}`);
@@ -568,8 +570,11 @@ export function parseZhp(bytes) {
   const posBytes = layout === 'positions' ? count * 12 : 0;
   if ((sections & 2) && layout !== 'grid') throw new Error('zhp: visibility masks without a grid layout');
   if ((sections & 4) && layout !== 'grid') throw new Error('zhp: cell planes without a grid layout');
+  if ((sections & 8) && layout !== 'positions') throw new Error('zhp: tetrahedra without a positions layout');
   const sectionBytes = count * ((sections & 1) + ((sections >> 1) & 1) + 5 * ((sections >> 2) & 1));
-  if (body !== posBytes + count * bpp + sectionBytes || 184 + body > bytes.length) throw new Error('zhp: body size mismatch');
+  const fixed = posBytes + count * bpp + sectionBytes;
+  const sizeOk = (sections & 8) ? body >= fixed + 36 && (body - fixed - 4) % 32 === 0 : body === fixed;
+  if (!sizeOk || 184 + body > bytes.length) throw new Error('zhp: body size mismatch');
   if (crc32(bytes, 184, 184 + body) !== dv.getUint32(176, true)) throw new Error('zhp: body CRC mismatch');
   const grid = layout === 'grid' ? {
     origin: [0, 1, 2].map((j) => dv.getFloat64(96 + 8 * j, true)),
@@ -601,7 +606,51 @@ export function parseZhp(bytes) {
         throw new Error(`zhp: probe ${i} is the last along an axis (it starts no cell) but its cell plane entry is not "no plane"`);
     }
   }
-  return { encoding: name, params, count, bytesPerProbe: bpp, layout, grid, positions, payload, validity, visibility, planes };
+  let tetrahedra = null, neighbours = null;
+  if (sections & 8) {
+    const at = 184 + fixed, tCount = (body - fixed - 4) / 32;
+    if (dv.getUint32(at, true) !== tCount) throw new Error(`zhp: the tetrahedra section declares ${dv.getUint32(at, true)} tetrahedra, its bytes hold ${tCount}`);
+    tetrahedra = new Uint32Array(4 * tCount);
+    neighbours = new Int32Array(4 * tCount);
+    for (let j = 0; j < 4 * tCount; j++) {
+      tetrahedra[j] = dv.getUint32(at + 4 + 4 * j, true);
+      neighbours[j] = dv.getInt32(at + 4 + 16 * tCount + 4 * j, true);
+    }
+    checkTetrahedra(tetrahedra, neighbours, count);
+  }
+  return { encoding: name, params, count, bytesPerProbe: bpp, layout, grid, positions, payload, validity, visibility, planes,
+           tetrahedra, neighbours };
+}
+
+// The tetrahedra of `count` scattered probes (zhc_tetrahedra_check): at least one; every index
+// < count and the 4 of a tetrahedron distinct; every neighbour -1 or another tetrahedron that names
+// this one exactly once, across the same 3 probes (face j = the tetrahedron without vertex j).
+// Throws naming the tetrahedron.
+export function checkTetrahedra(tetrahedra, neighbours, count) {
+  const n = tetrahedra.length / 4;
+  if (!Number.isInteger(n) || n < 1 || neighbours.length !== tetrahedra.length) throw new Error('zhc tetrahedra: none, or neighbours not 4 per tetrahedron');
+  for (let t = 0; t < n; t++)
+    for (let k = 0; k < 4; k++) {
+      const a = tetrahedra[4 * t + k];
+      if (!(a < count)) throw new Error(`zhc tetrahedra: tetrahedron ${t} vertex ${k} is probe ${a}, beyond the ${count} probes`);
+      for (let m = 0; m < k; m++) if (tetrahedra[4 * t + m] === a) throw new Error(`zhc tetrahedra: tetrahedron ${t} names probe ${a} twice`);
+    }
+  for (let t = 0; t < n; t++)
+    for (let j = 0; j < 4; j++) {
+      const u = neighbours[4 * t + j];
+      if (u === -1) continue;
+      if (!(u >= 0 && u < n) || u === t) throw new Error(`zhc tetrahedra: tetrahedron ${t} face ${j}: neighbour ${u} is not another tetrahedron`);
+      let back = -1, backs = 0;
+      for (let k = 0; k < 4; k++) if (neighbours[4 * u + k] === t) { back = k; backs++; }
+      let same = backs === 1;
+      for (let k = 0; k < 4 && same; k++) {
+        if (k === j) continue;
+        let found = false;
+        for (let m = 0; m < 4; m++) if (m !== back && tetrahedra[4 * u + m] === tetrahedra[4 * t + k]) found = true;
+        same = found;
+      }
+      if (!same) throw new Error(`zhc tetrahedra: tetrahedron ${t} face ${j}: neighbour ${u} does not share that face with it`);
+    }
 }
 
 // Decodes every probe of a payload: Float32Array(count * 27), probe p at p * 27.
@@ -660,14 +709,45 @@ export function makeVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, origi
     if (a && a.length < count) throw new Error(`zhc volume: ${what} has ${a.length} bytes for ${count} probes`);
   if (planes && planes.length < 5 * count) throw new Error(`zhc volume: planes has ${planes.length} bytes for ${count} probes (5 per probe)`);
   if (planesAxes !== 'zhc' && planesAxes !== 'gltf') throw new Error(`zhc volume: planesAxes must be 'zhc' or 'gltf', got ${planesAxes}`);
-  return Object.freeze({ origin: o, spacing: s, counts: n, count, sh: decoded, validity, visibility, planes, planesAxes });
+  return Object.freeze({ kind: 'grid', origin: o, spacing: s, counts: n, count, sh: decoded, validity, visibility, planes, planesAxes });
 }
 
-// A volume from a whole .zhp file (Uint8Array): parseZhp's checks, then a grid layout (throws
-// "not a grid" for none / positions: see docs/runtime.md for scattered probes) and makeVolume's.
+// A volume of scattered probes (docs/runtime.md "Scattered probes (`points` layout)";
+// zhc_volume_init_points): { encoding, params, bytes } or { sh } as makeVolume, positions
+// (Float32Array, 3 per probe: the float32 values the .zhp holds), tetrahedra (Uint32Array, 4 probe
+// indices each, consistently oriented as zhc writes them) and neighbours (Int32Array, 4 each: the
+// tetrahedron across face j, -1 on the hull), optional validity. Throws Error naming the problem
+// (positions not finite, checkTetrahedra's rules, short arrays).
+export function makePointsVolume({ encoding, params = DEFAULT_PARAMS, bytes, sh, positions, tetrahedra, neighbours, validity = null }) {
+  if (!positions || positions.length % 3 !== 0 || positions.length < 3) throw new Error('zhc points volume: positions must hold 3 floats per probe');
+  const count = positions.length / 3;
+  if (count > 2 ** 26) throw new Error('zhc points volume: more than 2^26 probes');
+  const pos = Float32Array.from(positions);
+  for (let j = 0; j < pos.length; j++) if (!Number.isFinite(pos[j])) throw new Error(`zhc points volume: position of probe ${Math.floor(j / 3)} is not finite`);
+  if (!tetrahedra || !neighbours) throw new Error('zhc points volume: tetrahedra and neighbours are required');
+  const tets = Uint32Array.from(tetrahedra), nbrs = Int32Array.from(neighbours);
+  checkTetrahedra(tets, nbrs, count);
+  let decoded = sh;
+  if (!decoded) {
+    const e = encodingInfo(encoding);
+    if (!bytes || bytes.length < count * e.bytes) throw new Error(`zhc points volume: ${count} probes need ${count * e.bytes} bytes`);
+    decoded = decodeAll(encoding, bytes, count, params);
+  } else if (decoded.length < count * 27) {
+    throw new Error(`zhc points volume: ${count} probes need ${count * 27} SH3 floats`);
+  }
+  if (validity && validity.length < count) throw new Error(`zhc points volume: validity has ${validity.length} bytes for ${count} probes`);
+  return Object.freeze({ kind: 'points', count, sh: decoded, positions: pos, tetrahedra: tets, neighbours: nbrs, tetraCount: tets.length / 4, validity });
+}
+
+// A volume from a whole .zhp file (Uint8Array): parseZhp's checks, then a grid layout (makeVolume)
+// or a positions layout with tetrahedra (makePointsVolume); anything else throws "not a grid" (layout
+// none, or points written without tetrahedra: fewer than 4 probes, or all in one plane).
 export function volumeFromZhp(bytes) {
   const z = parseZhp(bytes);
-  if (z.layout !== 'grid') throw new Error(`zhc volume: the .zhp layout is ${z.layout}, not a grid`);
+  if (z.layout === 'positions' && z.tetrahedra)
+    return makePointsVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, positions: z.positions,
+                              tetrahedra: z.tetrahedra, neighbours: z.neighbours, validity: z.validity });
+  if (z.layout !== 'grid') throw new Error(`zhc volume: the .zhp layout is ${z.layout}${z.layout === 'positions' ? ' without tetrahedra' : ''}, not a grid`);
   return makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid,
                       validity: z.validity, visibility: z.visibility, planes: z.planes });
 }
@@ -723,14 +803,229 @@ function planeSide(vol, cell, i0, position) {
   return s >= 0.0 ? 1 : 0;
 }
 
+// ---- scattered probes: tetrahedral interpolation (zhc_volume_tetra_weights of the C header, the same
+// doubles in the same order) ----
+
+// det[x, y, z] = x . (y x z) (zhc__det3).
+function det3(x, y, z) {
+  return x[0] * (y[1] * z[2] - y[2] * z[1]) + x[1] * (y[2] * z[0] - y[0] * z[2]) + x[2] * (y[0] * z[1] - y[1] * z[0]);
+}
+
+// Tetrahedron t seen from p (zhc__tetra_volumes): fills q (its probes), r (their positions minus p)
+// and vol (the signed volumes x 6 with vertex j replaced by p, each over the face's probes sorted by
+// index with the permutation's sign).
+function tetraVolumes(vol, t, p, q, r, v) {
+  for (let k = 0; k < 4; k++) {
+    q[k] = vol.tetrahedra[4 * t + k];
+    for (let c = 0; c < 3; c++) r[k][c] = vol.positions[3 * q[k] + c] - p[c];
+  }
+  const f = [0, 0, 0];
+  for (let j = 0; j < 4; j++) {
+    let n = 0;
+    for (let k = 0; k < 4; k++) if (k !== j) f[n++] = k;
+    let sign = (j & 1) ? -1 : 1, tmp;
+    if (q[f[0]] > q[f[1]]) { tmp = f[0]; f[0] = f[1]; f[1] = tmp; sign = -sign; }
+    if (q[f[1]] > q[f[2]]) { tmp = f[1]; f[1] = f[2]; f[2] = tmp; sign = -sign; }
+    if (q[f[0]] > q[f[1]]) { tmp = f[0]; f[0] = f[1]; f[1] = tmp; sign = -sign; }
+    const d = det3(r[f[0]], r[f[1]], r[f[2]]);
+    v[j] = sign > 0 ? d : -d;
+  }
+}
+
+// [solid, s] (zhc__tetra_solid): s = the sum of the volumes, solid when s > 0 and s^2 > 1e-24 L^6.
+function tetraSolid(r, v) {
+  let l2 = 0.0;
+  const s = v[0] + v[1] + v[2] + v[3];
+  for (let a = 0; a < 4; a++)
+    for (let b = a + 1; b < 4; b++) {
+      let e = 0.0;
+      for (let c = 0; c < 3; c++) {
+        const d = r[b][c] - r[a][c];
+        e += d * d;
+      }
+      if (e > l2) l2 = e;
+    }
+  return [s > 0.0 && s * s > 1e-24 * (l2 * l2 * l2), s];
+}
+
+// The nearest point of triangle (x, y, z) (relative to the query point) to the origin
+// (zhc__triangle_nearest): [squared distance, barycentric weights].
+function triangleNearest(x, y, z) {
+  const e1 = [0, 0, 0], e2 = [0, 0, 0];
+  let d00 = 0.0, d01 = 0.0, d11 = 0.0, d20 = 0.0, d21 = 0.0;
+  for (let c = 0; c < 3; c++) {
+    e1[c] = y[c] - x[c];
+    e2[c] = z[c] - x[c];
+  }
+  for (let c = 0; c < 3; c++) {
+    d00 += e1[c] * e1[c];
+    d01 += e1[c] * e2[c];
+    d11 += e2[c] * e2[c];
+    d20 -= x[c] * e1[c];
+    d21 -= x[c] * e2[c];
+  }
+  const den = d00 * d11 - d01 * d01;
+  if (den > 0.0) {
+    const a = (d11 * d20 - d01 * d21) / den, b = (d00 * d21 - d01 * d20) / den, u = 1.0 - a - b;
+    if (a >= 0.0 && b >= 0.0 && u >= 0.0) {
+      let dist = 0.0;
+      for (let c = 0; c < 3; c++) {
+        const q = x[c] + a * e1[c] + b * e2[c];
+        dist += q * q;
+      }
+      return [dist, [u, a, b]];
+    }
+  }
+  const ends = [[x, y], [y, z], [z, x]];
+  const w = [1.0, 0.0, 0.0];
+  let best = Infinity;
+  for (let k = 0; k < 3; k++) {
+    let ee = 0.0, pe = 0.0;
+    for (let c = 0; c < 3; c++) {
+      const e = ends[k][1][c] - ends[k][0][c];
+      ee += e * e;
+      pe -= ends[k][0][c] * e;
+    }
+    let t = ee > 0.0 ? pe / ee : 0.0;
+    if (!(t > 0.0)) t = 0.0;
+    if (t > 1.0) t = 1.0;
+    let dist = 0.0;
+    for (let c = 0; c < 3; c++) {
+      const q = ends[k][0][c] + t * (ends[k][1][c] - ends[k][0][c]);
+      dist += q * q;
+    }
+    if (dist < best) {
+      best = dist;
+      w[k] = 1.0 - t;
+      w[(k + 1) % 3] = t;
+      w[(k + 2) % 3] = 0.0;
+    }
+  }
+  return [best, w];
+}
+
+// Where `position` falls in a points volume (zhc_volume_tetra_weights): { inside (false: clamped to
+// the nearest hull face), tetra (the tetrahedron used: the start for a nearby next position),
+// probes [4], weights [4] (validity applied) }. The walk starts at tetrahedron `start` (0 when out of
+// range); the result depends only on the volume, the position and the start.
+export function volumeTetraWeights(vol, position, start = 0) {
+  const T = vol.tetraCount, nb = vol.neighbours;
+  const q = [0, 0, 0, 0], r = [[0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0]], v = [0, 0, 0, 0];
+  const weights = [0.0, 0.0, 0.0, 0.0];
+  let t = Number.isInteger(start) && start >= 0 && start < T ? start : 0;
+  if (!Number.isFinite(position[0]) || !Number.isFinite(position[1]) || !Number.isFinite(position[2])) {
+    weights[0] = 1.0;
+    return { inside: false, tetra: 0, probes: Array.from(vol.tetrahedra.subarray(0, 4)), weights };
+  }
+  let found = false, outside = false;
+  // 1. The walk.
+  for (let steps = 0; steps < T && !found && !outside; ++steps) {
+    tetraVolumes(vol, t, position, q, r, v);
+    let j = 0;
+    for (let k = 1; k < 4; k++) if (v[k] < v[j]) j = k;
+    if (v[j] >= 0.0) {
+      const [solid, s] = tetraSolid(r, v);
+      if (!solid) break;
+      for (let k = 0; k < 4; k++) weights[k] = v[k] / s;
+      found = true;
+      break;
+    }
+    let n = nb[4 * t + j];
+    if (n === -1) {
+      if (tetraSolid(r, v)[0]) {
+        outside = true;
+        break;
+      }
+      j = -1;
+      for (let k = 0; k < 4; k++) if (v[k] < 0.0 && nb[4 * t + k] !== -1 && (j < 0 || v[k] < v[j])) j = k;
+      if (j < 0) break;
+      n = nb[4 * t + j];
+    }
+    t = n;
+  }
+  // 2. Every solid tetrahedron.
+  if (!found && !outside) {
+    let best = -Infinity, bestT = 0;
+    for (let n = 0; n < T; n++) {
+      tetraVolumes(vol, n, position, q, r, v);
+      const [solid, s] = tetraSolid(r, v);
+      if (!solid) continue;
+      let m = v[0];
+      for (let k = 1; k < 4; k++) if (v[k] < m) m = v[k];
+      m /= s;
+      if (m > best) {
+        best = m;
+        bestT = n;
+      }
+    }
+    if (best >= -1e-9) {
+      t = bestT;
+      tetraVolumes(vol, t, position, q, r, v);
+      let sum = 0.0;
+      for (let k = 0; k < 4; k++) {
+        weights[k] = v[k] > 0.0 ? v[k] : 0.0;
+        sum += weights[k];
+      }
+      for (let k = 0; k < 4; k++) weights[k] /= sum;
+      found = true;
+    }
+  }
+  // 3. The nearest hull face.
+  if (!found) {
+    let best = Infinity, bestT = 0, bestJ = 0, bestW = [1.0, 0.0, 0.0];
+    const f = [0, 0, 0];
+    for (let n = 0; n < T; n++)
+      for (let j = 0; j < 4; j++) {
+        if (nb[4 * n + j] !== -1) continue;
+        for (let k = 0; k < 4; k++) {
+          q[k] = vol.tetrahedra[4 * n + k];
+          for (let c = 0; c < 3; c++) r[k][c] = vol.positions[3 * q[k] + c] - position[c];
+        }
+        let c = 0;
+        for (let k = 0; k < 4; k++) if (k !== j) f[c++] = k;
+        const [dist, w] = triangleNearest(r[f[0]], r[f[1]], r[f[2]]);
+        if (dist < best) {
+          best = dist;
+          bestT = n;
+          bestJ = j;
+          bestW = w;
+        }
+      }
+    t = bestT;
+    let c = 0;
+    for (let k = 0; k < 4; k++) weights[k] = k === bestJ ? 0.0 : bestW[c++];
+  }
+  const probes = Array.from(vol.tetrahedra.subarray(4 * t, 4 * t + 4));
+  if (vol.validity) {
+    const kept = [0.0, 0.0, 0.0, 0.0];
+    let sum = 0.0;
+    for (let k = 0; k < 4; k++) {
+      kept[k] = weights[k] > 0.0 && vol.validity[probes[k]] ? weights[k] : 0.0;
+      sum += kept[k];
+    }
+    if (sum > 0.0) for (let k = 0; k < 4; k++) weights[k] = kept[k] / sum;
+  }
+  return { inside: found, tetra: t, probes, weights };
+}
+
 // Blended SH3 radiance at `position` (the volume's frame): Float64Array(27), index i*3+k
 // (zhc_volume_sh3). Probes of weight 0 are skipped. With validity / visibility / planes: corner
 // k = dx + 2 dy + 4 dz keeps its weight w when w > 0, the probe is valid, bit 7 - k of its mask is
 // set, and (the cell has no plane, or bit k of the plane's sides equals the position's side of
 // it); kept weights divided by their sum (corner order), none kept: the plain trilinear weights
-// (zhc_volume_sh3, the same doubles).
+// (zhc_volume_sh3, the same doubles). A points volume (makePointsVolume): the blend of the 4 probes
+// of volumeTetraWeights from tetrahedron 0.
 export function volumeSH3(vol, position) {
   const out = new Float64Array(27);
+  if (vol.kind === 'points') {
+    const { probes, weights } = volumeTetraWeights(vol, position, 0);
+    for (let k = 0; k < 4; k++) {
+      if (weights[k] === 0.0) continue;
+      const base = probes[k] * 27;
+      for (let j = 0; j < 27; j++) out[j] += weights[k] * vol.sh[base + j];
+    }
+    return out;
+  }
   const [ix, fx] = volumeAxis(position[0], vol.origin[0], vol.spacing[0], vol.counts[0]);
   const [iy, fy] = volumeAxis(position[1], vol.origin[1], vol.spacing[1], vol.counts[1]);
   const [iz, fz] = volumeAxis(position[2], vol.origin[2], vol.spacing[2], vol.counts[2]);

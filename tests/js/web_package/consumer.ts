@@ -19,8 +19,9 @@ import {
   kY22, makeParams, makeVolume, normalizeOr, parseIzLog2Range, parseZhp, probeIrradiance, ratioInterval, rotateGltfToZhc,
   rotateZhcToGltf, shBasis, toIrradiance, toRadiance, toThreeConvention, unpackHalf, unpackR11G11B10F, unpackRgb9e5,
   unpackUfloat, volumeFromZhp, volumeIrradiance, volumeIrradianceD, volumeSH3, zh3Axes, zh3Q16IrradianceFast, zhcToGltfDir,
+  checkTetrahedra, makePointsVolume, volumeTetraWeights,
 } from '@zhc/runtime';
-import type { Vec3, ZhcEncodingName, ZhcParams, ZhcVolume, ZhpFile } from '@zhc/runtime';
+import type { Vec3, ZhcEncodingName, ZhcParams, ZhcPointsVolume, ZhcTetraWeights, ZhcVolume, ZhpFile } from '@zhc/runtime';
 import { EXTENSION, ZhcLightProbesPlugin, ZhcProbeVolume, buildVolume, lightProbeGridAtlas } from '@zhc/runtime/three';
 import type { ZhcGltfUserData } from '@zhc/runtime/three';
 import { ZHC_IRRADIANCE_GLSL, packedWords, zh3Q16Words, zhcIrradianceGlsl } from '@zhc/runtime/glsl';
@@ -112,6 +113,12 @@ export async function run(glb: ArrayBuffer, zhp: Uint8Array): Promise<ConsumerRe
   const eD: Vec3 = volumeIrradianceD(vol, [0, 0, 1], [0, 0, 1]);
   const made: ZhcVolume = makeVolume({ sh: all, ...file.grid! });
   const sameVolume = makeVolume({ encoding: file.encoding, params: file.params, bytes: file.payload, ...file.grid! });
+  // Scattered probes: one tetrahedron of four probes.
+  checkTetrahedra([0, 1, 2, 3], [-1, -1, -1, -1], 4);
+  const points: ZhcPointsVolume = makePointsVolume({ sh: all.subarray(0, 4 * 27), positions: [0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1],
+    tetrahedra: [0, 1, 2, 3], neighbours: [-1, -1, -1, -1] });
+  const tetra: ZhcTetraWeights = volumeTetraWeights(points, [0.25, 0.25, 0.25], 0);
+  const pointsSH: Float64Array = volumeSH3(points, [0.25, 0.25, 0.25]);
   const fromZhp: ZhcCompactVolume = compactVolumeFromZhp(zhp, { THREE, masks: false });
   const fromFile = compactVolume(file, { matrixWorld: new THREE.Matrix4() });
   const words: Uint32Array = compactVolumeWords(file.payload, file.bytesPerProbe, file.grid!.counts, COMPACT_TEXELS.zh3_q16);
@@ -190,7 +197,7 @@ export async function run(glb: ArrayBuffer, zhp: Uint8Array): Promise<ConsumerRe
   };
   void misuses;
   const keep = [aliasTarget, sh, basis, ev, irr, three, ratio, axes, zonal, dc, dc2, h, crc, iz, izT, izA, ldr, info, layout, kinds, packed,
-    blended, eD, made, sameVolume, fromZhp, fromFile, words, glsl, texWords, zh3Words, rebuilt, desc, e0, fast, EXTENSION];
+    blended, eD, made, sameVolume, points, tetra, pointsSH, fromZhp, fromFile, words, glsl, texWords, zh3Words, rebuilt, desc, e0, fast, EXTENSION];
   return {
     volumes: volumes.length,
     encoding: volume.encoding,
