@@ -143,6 +143,53 @@ std::string gate_summary(const AuditGates& gates, const AuditRun& run) {
     return s;
 }
 
+// The "engine_layouts" array of the audit JSON (docs/schema/audit.schema.json): each audited engine
+// layout beside zhc's best representation at its size (codec/audit/choice.h).
+nlohmann::ordered_json engine_json(const std::vector<EngineComparison>& rows) {
+    using J = nlohmann::ordered_json;
+    J out = J::array();
+    for (const EngineComparison& k : rows) {
+        J j{{"representation", std::string(k.engine->name)},
+            {"engine", std::string(k.engine->traits.engine)},
+            {"bytes_per_probe", k.engine->size_bytes},
+            {"relative_rmse", k.error},
+            {"max_negative_fraction", k.max_negative_fraction}};
+        j["zhc_best"] = k.zhc ? J{{"representation", std::string(k.zhc->name)},
+                                  {"bytes_per_probe", k.zhc->size_bytes},
+                                  {"relative_rmse", k.zhc_error},
+                                  {"max_negative_fraction", k.zhc_max_negative_fraction}}
+                              : J(nullptr);
+        out.push_back(j);
+    }
+    return out;
+}
+
+// The same as a section of the HTML report.
+HtmlTable engine_html(const std::vector<EngineComparison>& rows) {
+    HtmlTable t;
+    t.id = "engine-layouts";
+    t.title = "Engine layouts";
+    t.intro = engine_intro();
+    const std::vector<std::vector<std::string>> cells = engine_table(rows);
+    t.columns = cells[0];
+    for (std::size_t i = 1; i < cells.size(); ++i) {
+        const EngineComparison& k = rows[i - 1];
+        std::vector<HtmlCell> row;
+        for (const std::string& c : cells[i]) row.push_back({c, 0});
+        row[2].sort = double(k.engine->size_bytes);
+        row[3].sort = k.error;
+        row[4].sort = k.max_negative_fraction;
+        row[6].sort = k.zhc ? double(k.zhc->size_bytes) : -1;
+        row[7].sort = k.zhc ? k.zhc_error : -1;
+        row[8].sort = k.zhc ? k.zhc_max_negative_fraction : -1;
+        row[9].sort = k.zhc && k.zhc_error > 0 ? k.error / k.zhc_error : 0;
+        t.rows.push_back(std::move(row));
+    }
+    t.notes = {"The plot \"Error vs bytes per probe\" below draws the engine layouts as orange squares against zhc's "
+               "Pareto frontier."};
+    return t;
+}
+
 // The failures' detail for the text report: the first 10 lines, then how many more.
 constexpr std::size_t kGateDetailLines = 10;
 
@@ -158,7 +205,8 @@ HtmlRow html_row(const RepresentationResult& r, bool timed) {
 
 HtmlReport html_of(const Options& o, const AuditGates& gates, const AuditedFiles& audited,
                    const std::vector<SpherePictures>& pictures, const RuntimeCostTable* gpu,
-                   const std::vector<double>& eval_ns, const ChoiceResult& choice) {
+                   const std::vector<double>& eval_ns, const ChoiceResult& choice,
+                   const std::vector<EngineComparison>& engines) {
     const std::vector<AuditInput>& inputs = audited.inputs;
     const std::vector<RepresentationResult>& aggregate = audited.run.aggregate;
     HtmlReport h;
@@ -189,15 +237,12 @@ HtmlReport html_of(const Options& o, const AuditGates& gates, const AuditedFiles
     h.gates_configured = gates.configured();
     h.gates = gates.descriptions();
     h.gate_failures = audited.run.gates.messages();
-    // Error against bytes per probe (the summary's relative rmse).
+    // Error against bytes per probe (the summary's relative rmse): zhc's Pareto frontier, the engine
+    // layouts drawn apart.
     ScatterPlot plot{"Error vs bytes per probe", "bytes per probe (log scale)", "relative irradiance rmse (log scale)", {}, {}};
-    std::vector<double> b, e;
-    for (const RepresentationResult& r : aggregate) {
-        plot.points.push_back({std::string(r.codec->name), double(r.codec->size_bytes), r.metrics.relative_rmse});
-        b.push_back(double(r.codec->size_bytes));
-        e.push_back(r.metrics.relative_rmse);
-    }
-    plot.frontier = pareto_frontier(b, e);
+    for (const RepresentationResult& r : aggregate)
+        plot.points.push_back(codec_point(*r.codec, double(r.codec->size_bytes), r.metrics.relative_rmse));
+    plot.frontier = zhc_frontier(plot);
     h.plots.push_back(plot);
     for (size_t i = 0; i < inputs.size(); ++i) {
         HtmlInputSection s;
@@ -211,6 +256,7 @@ HtmlReport html_of(const Options& o, const AuditGates& gates, const AuditedFiles
     // The choice right after the summary and gates (an HTML report is read from the top; its input
     // sections with pictures are long); text, Markdown and JSON end with it.
     h.tables.push_back(choice_html(choice));
+    if (!engines.empty()) h.tables.push_back(engine_html(engines));
     return h;
 }
 
@@ -290,6 +336,7 @@ int run(const Options& o) {
     constraints.max_encode_us = o.max_encode_us;
     const ChoiceResult choice = choose_representations(result.inputs, result.aggregate, choice_instructions(result.aggregate, gpu),
                                                        timed, constraints, choice_budgets(o.budgets));
+    const std::vector<EngineComparison> engines = compare_engine_layouts(result.inputs, result.aggregate);
 
     if (o.json) {
         nlohmann::ordered_json j;
@@ -314,6 +361,7 @@ int run(const Options& o) {
         j["gates"] = {{"passed", failures.empty()}, {"failures", failures}};
         if (!failures.empty()) j["gates"]["summary"] = gate_summary(aopt.gates, result);
         j["choice"] = choice_json(choice);
+        j["engine_layouts"] = engine_json(engines);
         print_json("audit", j);
     } else {
         for (size_t i = 0; i < inputs.size(); ++i) {
@@ -335,6 +383,10 @@ int run(const Options& o) {
         std::cout << "\nchoice: " << choice_intro(choice) << "\n";
         print_table(std::cout, choice_table(choice), false);
         for (const std::string& n : choice_notes(choice)) std::cout << "  " << n << "\n";
+        if (!engines.empty()) {
+            std::cout << "\nengine layouts: " << engine_intro() << "\n";
+            print_table(std::cout, engine_table(engines), false);
+        }
     }
     if (!o.markdown.empty()) {
         std::ostringstream md;
@@ -358,6 +410,10 @@ int run(const Options& o) {
         const std::vector<std::string> notes = choice_notes(choice);
         if (!notes.empty()) md << "\n";
         for (const std::string& n : notes) md << "- " << n << "\n";
+        if (!engines.empty()) {
+            md << "\n## Engine layouts\n\n" << engine_intro() << "\n\n";
+            print_table(md, engine_table(engines), true);
+        }
         const std::string text = md.str();
         if (Status s = write_file_atomic(o.markdown, std::vector<std::uint8_t>(text.begin(), text.end())); !s)
             return report_output(s.error());
@@ -366,7 +422,7 @@ int run(const Options& o) {
         std::vector<double> eval_ns;  // CPU evaluation cost: cheap, measured only when timing is on
         if (!o.no_timing && !inputs[0].probes.empty())
             for (const Codec* c : selected) eval_ns.push_back(eval_ns_per_sample(*c, inputs[0].probes[0], dirs, aopt.codec_options));
-        if (Status s = write_html_report(o.html, html_of(o, aopt.gates, *audited, pictures, gpu, eval_ns, choice)); !s)
+        if (Status s = write_html_report(o.html, html_of(o, aopt.gates, *audited, pictures, gpu, eval_ns, choice, engines)); !s)
             return report_output(s.error());
         std::fprintf(stderr, "report: %s\n", o.html.c_str());
     }
@@ -394,7 +450,7 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
                     "with a note)")
         ->required();
     add_representations_option(sub, o->representations, RepresentationCount::kList, "default: all");
-    add_json_flag(sub, o->json, "files, aggregate, gates, choice");
+    add_json_flag(sub, o->json, "files, aggregate, gates, choice, engine_layouts");
     sub->add_option("--markdown", o->markdown, "also write the tables as Markdown to this file");
     sub->add_option("--html", o->html, "also write one self-contained HTML report (tables, gates, lit spheres, plots) to this file");
     sub->add_option("--runtime-cost", o->runtime_cost,

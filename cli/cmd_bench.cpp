@@ -229,7 +229,7 @@ int run(const Options& o) {
             h.tables.push_back(std::move(t));
         }
         h.summary_caption = "Means over " + std::to_string(probes.size()) + " probes; times are medians";
-        std::vector<double> b, t, e, cost, cost_err;
+        std::vector<double> cost, cost_err;
         ScatterPlot by_bytes{"Error vs bytes per probe", "bytes per probe (log scale)", "mean relative irradiance rmse (log scale)", {}, {}};
         ScatterPlot by_time{"Error vs encode time", "encode time per probe, ns (log scale)", "mean relative irradiance rmse (log scale)", {}, {}};
         ScatterPlot by_runtime{"Error vs runtime cost", "SPIR-V instructions per irradiance evaluation (log scale)",
@@ -249,19 +249,16 @@ int run(const Options& o) {
                 row.gpu_ns = c->ns_per_eval;
             }
             h.summary.push_back(row);
-            by_bytes.points.push_back({row.name, double(row.bytes), r.mean_relative_rmse});
-            by_time.points.push_back({row.name, r.encode_ns.median, r.mean_relative_rmse});
-            b.push_back(double(row.bytes));
-            t.push_back(r.encode_ns.median);
-            e.push_back(r.mean_relative_rmse);
+            by_bytes.points.push_back(codec_point(*r.codec, double(row.bytes), r.mean_relative_rmse));
+            by_time.points.push_back(codec_point(*r.codec, r.encode_ns.median, r.mean_relative_rmse));
             if (const RuntimeCost* c = gpu_cost(r)) {
                 by_runtime.points.push_back({row.name, double(c->spirv_instructions), r.mean_relative_rmse});
                 cost.push_back(c->spirv_instructions);
                 cost_err.push_back(r.mean_relative_rmse);
             }
         }
-        by_bytes.frontier = pareto_frontier(b, e);
-        by_time.frontier = pareto_frontier(t, e);
+        by_bytes.frontier = zhc_frontier(by_bytes);  // the engine layouts drawn apart (formats/report/plot.h)
+        by_time.frontier = zhc_frontier(by_time);
         h.plots = {by_bytes, by_time};
         if (!by_runtime.points.empty()) {
             by_runtime.frontier = pareto_frontier(cost, cost_err);
@@ -275,16 +272,12 @@ int run(const Options& o) {
         fs::create_directories(o.plots, ec);
         ScatterPlot by_time{"Error vs encode time", "encode time per probe, ns (log scale)", "mean relative irradiance rmse (log scale)", {}, {}};
         ScatterPlot by_bytes{"Error vs bytes per probe", "bytes per probe (log scale)", "mean relative irradiance rmse (log scale)", {}, {}};
-        std::vector<double> t, b, e;
         for (const BenchRow& r : rows) {
-            by_time.points.push_back({std::string(r.codec->name), std::max(r.encode_ns.median, 0.1), r.mean_relative_rmse});
-            by_bytes.points.push_back({std::string(r.codec->name), double(r.codec->size_bytes), r.mean_relative_rmse});
-            t.push_back(r.encode_ns.median);
-            b.push_back(double(r.codec->size_bytes));
-            e.push_back(r.mean_relative_rmse);
+            by_time.points.push_back(codec_point(*r.codec, std::max(r.encode_ns.median, 0.1), r.mean_relative_rmse));
+            by_bytes.points.push_back(codec_point(*r.codec, double(r.codec->size_bytes), r.mean_relative_rmse));
         }
-        by_time.frontier = pareto_frontier(t, e);
-        by_bytes.frontier = pareto_frontier(b, e);
+        by_time.frontier = zhc_frontier(by_time);
+        by_bytes.frontier = zhc_frontier(by_bytes);
         const std::string p1 = (fs::path(o.plots) / "error_vs_encode_time.png").string();
         const std::string p2 = (fs::path(o.plots) / "error_vs_bytes.png").string();
         if (Status s = write_scatter_png(p1, by_time); !s) return report_output(s.error());

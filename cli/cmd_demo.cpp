@@ -296,13 +296,9 @@ int run(const Options& o) {
         h.summary_caption = "All " + std::to_string(probes.size()) + " probes pooled";
         h.summary = html_rows;
         ScatterPlot plot{"Error vs bytes per probe", "bytes per probe (log scale)", "relative irradiance rmse (log scale)", {}, {}};
-        std::vector<double> b, e;
-        for (const HtmlRow& r : html_rows) {
-            plot.points.push_back({r.name, double(r.bytes), r.metrics.relative_rmse});
-            b.push_back(double(r.bytes));
-            e.push_back(r.metrics.relative_rmse);
-        }
-        plot.frontier = pareto_frontier(b, e);
+        for (size_t k = 0; k < html_rows.size() && k < all.size(); ++k)  // html_rows follow `all`
+            plot.points.push_back(codec_point(*all[k], double(html_rows[k].bytes), html_rows[k].metrics.relative_rmse));
+        plot.frontier = zhc_frontier(plot);  // the engine layouts drawn apart (formats/report/plot.h)
         h.plots.push_back(plot);
         h.inputs.resize(pick.size());
         {

@@ -16,10 +16,15 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "codec/audit/benchmark.h"
 #include "codec/probe/codec.h"
 #include "codec/probe/engine_layouts.h"
 #include "codec/probe/quantize.h"
 #include "codec/probe/runtime_table.h"
+#include "formats/report/html_report.h"
+#include "formats/report/plot.h"
 #include "support.h"
 
 namespace zhc {
@@ -661,6 +666,95 @@ TEST(EngineLayouts, ClampingShadersClampAndDecodeKeepsTheStoredSh) {
         }
         EXPECT_GT(negative, 0) << name << ": the directional light's L2 rings below 0 somewhere";
     }
+}
+
+// ---- the reports ----------------------------------------------------------------------------
+
+// The plots draw zhc's Pareto frontier without the engine layouts and mark those apart.
+TEST(EngineReport, PlotsDrawZhcsFrontierAndTheEngineLayoutsApart) {
+    ScatterPlot plot{"Error vs bytes per probe", "bytes", "error", {}, {}};
+    test::Rng rng(3);
+    for (const Codec& c : codecs()) plot.points.push_back(codec_point(c, double(c.size_bytes), 0.01 + rng.u()));
+    // An engine layout better than everything: still not on zhc's frontier.
+    for (PlotPoint& p : plot.points)
+        if (p.label == "unity_apv_l1") p.y = 1e-4;
+    const std::vector<std::size_t> front = zhc_frontier(plot);
+    std::vector<double> x, y;
+    std::vector<std::size_t> own;
+    int engines = 0;
+    for (std::size_t i = 0; i < plot.points.size(); ++i) {
+        EXPECT_EQ(plot.points[i].engine, !find_codec(plot.points[i].label)->traits.engine.empty());
+        if (plot.points[i].engine) {
+            ++engines;
+            continue;
+        }
+        own.push_back(i), x.push_back(plot.points[i].x), y.push_back(plot.points[i].y);
+    }
+    std::vector<std::size_t> want;
+    for (std::size_t k : pareto_frontier(x, y)) want.push_back(own[k]);
+    EXPECT_EQ(front, want);
+    ASSERT_FALSE(front.empty());
+    plot.frontier = front;
+    const std::string svg = scatter_svg(plot);
+    std::size_t squares = 0;
+    for (std::size_t at = svg.find("<rect class=\"engine\""); at != std::string::npos; at = svg.find("<rect class=\"engine\"", at + 1))
+        ++squares;
+    EXPECT_EQ(squares, std::size_t(engines));
+    EXPECT_NE(svg.find("orange squares: engine layouts"), std::string::npos);
+    // Without engine layouts, no legend line for them.
+    ScatterPlot own_only = plot;
+    own_only.points.erase(std::remove_if(own_only.points.begin(), own_only.points.end(), [](const PlotPoint& p) { return p.engine; }),
+                          own_only.points.end());
+    own_only.frontier = zhc_frontier(own_only);
+    EXPECT_EQ(scatter_svg(own_only).find("engine layouts"), std::string::npos);
+}
+
+// zhc audit reports every engine layout beside zhc's best at its size: the JSON's engine_layouts
+// against a twin over its own aggregate, the Markdown and HTML sections, the text table.
+TEST(EngineReport, AuditComparesEachEngineLayoutWithZhcsBestAtItsSize) {
+    const std::string dir = test::fresh_dir("engine_audit");
+    const std::string map = test::envmap_paths().at(0);
+    const auto r = test::run_zhc({"audit", map, "--no-timing", "--directions", "256", "--json", "--markdown", dir + "/a.md",
+                                  "--html", dir + "/a.html"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json doc = nlohmann::json::parse(r.out);
+    const nlohmann::json& agg = doc.at("aggregate").at("representations");
+    const nlohmann::json& rows = doc.at("engine_layouts");
+    ASSERT_EQ(rows.size(), engine_layouts().size());
+    for (const nlohmann::json& row : rows) {
+        const std::string name = row.at("representation");
+        const Codec* e = find_codec(name);
+        ASSERT_NE(e, nullptr);
+        EXPECT_EQ(row.at("engine"), std::string(e->traits.engine));
+        EXPECT_EQ(row.at("relative_rmse").get<double>(), agg.at(name).at("relative_rmse").get<double>());
+        // The twin: the lowest relative rmse among zhc's entries of at most as many bytes.
+        std::string best;
+        double best_err = 1e300;
+        for (const Codec& c : runtime_codecs()) {
+            const double err = agg.at(std::string(c.name)).at("relative_rmse").get<double>();
+            if (c.size_bytes <= e->size_bytes && err < best_err) best = std::string(c.name), best_err = err;
+        }
+        ASSERT_FALSE(row.at("zhc_best").is_null()) << name;  // 16 bytes is zhc's smallest, and no engine layout is smaller
+        EXPECT_EQ(row.at("zhc_best").at("representation"), best) << name;
+        EXPECT_EQ(row.at("zhc_best").at("relative_rmse").get<double>(), best_err);
+        EXPECT_LE(row.at("zhc_best").at("bytes_per_probe").get<std::size_t>(), e->size_bytes);
+    }
+    const std::vector<std::uint8_t> md = test::read_bytes(dir + "/a.md"), html = test::read_bytes(dir + "/a.html");
+    const std::string m(md.begin(), md.end()), h(html.begin(), html.end());
+    EXPECT_NE(m.find("\n## Engine layouts\n"), std::string::npos);
+    EXPECT_NE(m.find("| unity_apv_l1 "), std::string::npos);
+    EXPECT_NE(h.find("id=\"engine-layouts\""), std::string::npos);
+    EXPECT_NE(h.find("<rect class=\"engine\""), std::string::npos);
+    // Only zhc's representations: no engine section at all.
+    const auto plain = test::run_zhc({"audit", map, "--no-timing", "--directions", "64", "-r", "sh3,zh3_q16", "--markdown", dir + "/b.md"});
+    ASSERT_EQ(plain.exit_code, 0) << plain.err;
+    EXPECT_EQ(plain.out.find("engine layouts"), std::string::npos);
+    const std::vector<std::uint8_t> b = test::read_bytes(dir + "/b.md");
+    EXPECT_EQ(std::string(b.begin(), b.end()).find("Engine layouts"), std::string::npos);
+    const auto text = test::run_zhc({"audit", map, "--no-timing", "--directions", "64", "-r", "sh3,unity_apv_l2"});
+    ASSERT_EQ(text.exit_code, 0) << text.err;
+    EXPECT_NE(text.out.find("engine layouts:"), std::string::npos);
+    EXPECT_NE(text.out.find("unity_apv_l2"), std::string::npos);
 }
 
 }  // namespace

@@ -450,12 +450,21 @@ std::string scatter_svg(const ScatterPlot& plot) {
         const double x = px(p.x), y = py(p.y);
         o << "<line x1=\"" << html_number(x) << "\" y1=\"" << html_number(y) << "\" x2=\"" << lx - 4 << "\" y2=\"" << html_number(ly[k])
           << "\" stroke=\"" << (f ? "#e99" : "#bbb") << "\" stroke-width=\"0.8\"/>\n";
-        o << "<circle cx=\"" << html_number(x) << "\" cy=\"" << html_number(y) << "\" r=\"4\" fill=\"" << (f ? "#d33" : "#2a5bc8")
-          << "\"><title>" << html_escape(p.label) << ": " << html_number(p.x) << ", " << html_number(p.y) << "</title></circle>\n";
-        o << "<text x=\"" << lx << "\" y=\"" << html_number(ly[k] + 4) << "\" font-size=\"12\" fill=\"" << (f ? "#c22" : "#222")
-          << "\">" << html_escape(p.label) << (off_axis(p) ? " (0: drawn on the axis)" : "") << "</text>\n";
+        const std::string title = "<title>" + html_escape(p.label) + ": " + html_number(p.x) + ", " + html_number(p.y) + "</title>";
+        if (p.engine)  // an engine's layout: an orange square
+            o << "<rect class=\"engine\" x=\"" << html_number(x - 5) << "\" y=\"" << html_number(y - 5)
+              << "\" width=\"10\" height=\"10\" fill=\"#e68a00\">" << title << "</rect>\n";
+        else
+            o << "<circle cx=\"" << html_number(x) << "\" cy=\"" << html_number(y) << "\" r=\"4\" fill=\"" << (f ? "#d33" : "#2a5bc8")
+              << "\">" << title << "</circle>\n";
+        o << "<text x=\"" << lx << "\" y=\"" << html_number(ly[k] + 4) << "\" font-size=\"12\" fill=\""
+          << (p.engine ? "#b36b00" : (f ? "#c22" : "#222")) << "\">" << html_escape(p.label)
+          << (off_axis(p) ? " (0: drawn on the axis)" : "") << "</text>\n";
     }
     o << "<text x=\"" << left + 8 << "\" y=\"" << top + 16 << "\" font-size=\"12\" fill=\"#c22\">red: Pareto frontier</text>\n";
+    if (std::any_of(plot.points.begin(), plot.points.end(), [](const PlotPoint& p) { return p.engine; }))
+        o << "<text x=\"" << left + 8 << "\" y=\"" << top + 31
+          << "\" font-size=\"12\" fill=\"#b36b00\">orange squares: engine layouts (zhc's frontier drawn without them)</text>\n";
     o << "</svg>\n";
     return o.str();
 }

@@ -136,8 +136,9 @@ struct DecodedImage {
 };
 Result<DecodedImage> decode_image_rgb8(const std::vector<std::uint8_t>& bytes);
 // An SVG scatter plot: log axes with decade ticks and units from the plot's labels, the Pareto
-// frontier joined and marked, every point's label in a column beside the plot with a leader
-// line (labels are spaced so they never overprint).
+// frontier joined and marked, engine layouts (PlotPoint::engine) as orange squares with a legend
+// line, every point's label in a column beside the plot with a leader line (labels are spaced so
+// they never overprint).
 std::string scatter_svg(const ScatterPlot& plot);
 
 }  // namespace zhc

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "codec/audit/benchmark.h"
 #include "formats/report/raster.h"
 
 namespace zhc {
@@ -18,10 +19,28 @@ std::string tick_label(double v) {
 }
 }  // namespace
 
+PlotPoint codec_point(const Codec& codec, double x, double y) {
+    return {std::string(codec.name), x, y, !codec.traits.engine.empty()};
+}
+
+std::vector<std::size_t> zhc_frontier(const ScatterPlot& plot) {
+    std::vector<std::size_t> own;
+    std::vector<double> x, y;
+    for (std::size_t i = 0; i < plot.points.size(); ++i)
+        if (!plot.points[i].engine) {
+            own.push_back(i);
+            x.push_back(plot.points[i].x);
+            y.push_back(plot.points[i].y);
+        }
+    std::vector<std::size_t> front;
+    for (std::size_t k : pareto_frontier(x, y)) front.push_back(own[k]);
+    return front;
+}
+
 Status write_scatter_png(const std::string& path, const ScatterPlot& plot) {
     const int W = 1200, H = 720, left = 110, right = 290, top = 60, bottom = 80, row = 21;
     Canvas c(W, H, {255, 255, 255});
-    const Rgb8 ink{30, 30, 30}, grid{225, 225, 225}, dot{40, 90, 200}, front{220, 60, 40};
+    const Rgb8 ink{30, 30, 30}, grid{225, 225, 225}, dot{40, 90, 200}, front{220, 60, 40}, engine{230, 140, 20};
     auto tx = [&](double v) { return plot.log_x ? std::log10(std::max(v, 1e-30)) : v; };
     auto ty = [&](double v) { return plot.log_y ? std::log10(std::max(v, 1e-30)) : v; };
     double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
@@ -94,11 +113,16 @@ Status write_scatter_png(const std::string& path, const ScatterPlot& plot) {
         const PlotPoint& p = plot.points[order[k]];
         const bool f = on_front[order[k]];
         const int x = static_cast<int>(std::lround(px(p.x))), y = static_cast<int>(std::lround(py(p.y)));
-        c.fill_rect(x - 4, y - 4, 9, 9, f ? front : dot);
-        c.text(lx, static_cast<int>(std::lround(ly[k])) - kSmall / 2, p.label, kSmall, f ? front : ink);
+        if (p.engine) c.fill_rect(x - 5, y - 5, 11, 11, engine);  // a bigger orange square
+        else c.fill_rect(x - 4, y - 4, 9, 9, f ? front : dot);
+        c.text(lx, static_cast<int>(std::lround(ly[k])) - kSmall / 2, p.label, kSmall, p.engine ? engine : (f ? front : ink));
     }
     const std::string legend = "red: Pareto frontier";
     c.text(left + pw - 12 - Canvas::text_width(legend, kSmall), top + 8, legend, kSmall, front);
+    if (std::any_of(plot.points.begin(), plot.points.end(), [](const PlotPoint& p) { return p.engine; })) {
+        const std::string more = "orange: engine layouts";
+        c.text(left + pw - 12 - Canvas::text_width(more, kSmall), top + 8 + row, more, kSmall, engine);
+    }
     return write_png(path, c);
 }
 
