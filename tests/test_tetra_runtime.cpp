@@ -50,7 +50,25 @@ struct Twin {
     std::vector<std::array<std::uint32_t, 4>> tets;
     std::vector<std::uint8_t> validity;
     std::vector<std::array<double, 27>> sh;  // decoded probes
+    std::vector<std::array<std::uint32_t, 3>> hull;  // faces of exactly one tetrahedron (hull_faces)
 };
+
+// The faces that belong to one tetrahedron only: the convex hull's.
+void hull_faces(Twin& tw) {
+    std::map<std::array<std::uint32_t, 3>, int> faces;
+    for (const auto& t : tw.tets)
+        for (int j = 0; j < 4; ++j) {
+            std::array<std::uint32_t, 3> f;
+            int n = 0;
+            for (int k = 0; k < 4; ++k)
+                if (k != j) f[size_t(n++)] = t[size_t(k)];
+            std::sort(f.begin(), f.end());
+            ++faces[f];
+        }
+    tw.hull.clear();
+    for (const auto& [f, uses] : faces)
+        if (uses == 1) tw.hull.push_back(f);
+}
 
 // Barycentric coordinates of p in tetrahedron (a, b, c, d): solve [b-a c-a d-a] x = p - a by
 // Gaussian elimination with partial pivoting; false for a (near) flat tetrahedron.
@@ -148,19 +166,8 @@ TwinResult twin_weights(const Twin& tw, const V3& p) {
         break;
     }
     if (!r.inside) {
-        std::map<std::array<std::uint32_t, 3>, int> faces;
-        for (const auto& t : tw.tets)
-            for (int j = 0; j < 4; ++j) {
-                std::array<std::uint32_t, 3> f;
-                int n = 0;
-                for (int k = 0; k < 4; ++k)
-                    if (k != j) f[size_t(n++)] = t[size_t(k)];
-                std::sort(f.begin(), f.end());
-                ++faces[f];
-            }
         double best = INFINITY;
-        for (const auto& [f, uses] : faces) {
-            if (uses != 1) continue;
+        for (const auto& f : tw.hull) {
             double w[3];
             const double d = closest_on_triangle(p, tw.pos[f[0]], tw.pos[f[1]], tw.pos[f[2]], w);
             if (d < best) {
@@ -226,6 +233,7 @@ Volume make_volume(const std::vector<Pos>& p, const std::vector<Sh3Radiance>& hu
             for (int k = 0; k < 3; ++k) s[size_t(3 * i + k)] = h[i][k];
         out.twin.sh.push_back(s);
     }
+    hull_faces(out.twin);
     return out;
 }
 
@@ -614,6 +622,7 @@ TEST(TetraRuntime, ScatteredProbesBakedInALeakRoom) {
             for (int k = 0; k < 3; ++k) s[size_t(3 * i + k)] = h[i][k];
         vol.twin.sh.push_back(s);
     }
+    hull_faces(vol.twin);
     const int inside = compare_with_twin(vol, 24, 2000, {2.4, 0.05, -0.5}, {6.5, 4.5, 3.5}, "leak room, 48 probes");
     EXPECT_GT(inside, 600);
     EXPECT_LT(inside, 1900);
