@@ -193,6 +193,54 @@ def gen_audit_zh3_q16(ctx):
                       ""] + rows)
 
 
+def engine_rows(d):
+    """The engine_layouts of a `zhc audit --json` object as a Markdown table."""
+    rows = ["| engine layout | engine | bytes | rel. rmse | neg. frac | zhc's best at <= its bytes | bytes | rel. rmse | neg. frac "
+            "| lower error |",
+            "|---|---|---:|---:|---:|---|---:|---:|---:|---|"]
+    for e in d["engine_layouts"]:
+        z = e["zhc_best"]
+        if z is None:
+            rows.append("| `%s` | %s | %d | %.4f | %.3f | none | - | - | - | - |" % (
+                e["representation"], e["engine"], e["bytes_per_probe"], e["relative_rmse"], e["max_negative_fraction"]))
+            continue
+        a, b = e["relative_rmse"], z["relative_rmse"]
+        # Within 0.5 % of each other, or both below 1e-5: equal (as zhc audit's lower_error column,
+        # codec/audit/choice.cpp).
+        if max(a, b) < 1e-5 or max(a, b) <= 1.005 * min(a, b):
+            lead = "equal"
+        elif b < a:
+            lead = "zhc %.2fx" % (a / b) if b > 0 else "zhc"
+        else:
+            lead = "engine %.2fx" % (b / a) if a > 0 else "engine"
+        rows.append("| `%s` | %s | %d | %.4f | %.3f | `%s` | %d | %.4f | %.3f | %s |" % (
+            e["representation"], e["engine"], e["bytes_per_probe"], a, e["max_negative_fraction"], z["representation"],
+            z["bytes_per_probe"], b, z["max_negative_fraction"], lead))
+    return rows
+
+
+def gen_engine_maps(ctx):
+    args = ["--no-timing", "--json", "--threads", "2"]
+    out = subprocess.run([ctx["zhc"], "audit", ctx["maps"]] + args, check=True, stdout=subprocess.PIPE, cwd=ctx["tmp"]).stdout
+    d = json.loads(out)
+    return "\n".join([header("zhc audit ../shared/data/envmaps " + " ".join(args)),
+                      "Relative irradiance rmse against each map's true irradiance (%d directions), the mean over the %d sample "
+                      "maps; neg. frac: the largest fraction of directions below 0 on a map." % (d["directions"], len(d["files"])),
+                      ""] + engine_rows(d))
+
+
+def gen_engine_demo(ctx):
+    subprocess.run([ctx["zhc"], "demo", "-o", "engine-demo"], cwd=ctx["tmp"], check=True, stdout=subprocess.DEVNULL)
+    args = ["--no-timing", "--json", "--threads", "2"]
+    out = subprocess.run([ctx["zhc"], "audit", os.path.join("engine-demo", "probes_sh3.zhp")] + args, check=True,
+                         stdout=subprocess.PIPE, cwd=ctx["tmp"]).stdout
+    d = json.loads(out)
+    return "\n".join([header("zhc audit zhc-demo/probes_sh3.zhp " + " ".join(args)),
+                      "The demo scene's %d baked probes (`zhc demo`); the reference is each probe's SH3, so the float L2 "
+                      "layouts are exact up to float rounding (and three.js's and Unreal's clamp at 0)." % d["files"][0]["probes"],
+                      ""] + engine_rows(d))
+
+
 # command (as written in the marker) -> generator
 GENERATORS = {
     "bench_bake --json": gen_bench_bake,
@@ -201,6 +249,8 @@ GENERATORS = {
     "zhc lightmap audit (2048 x 2048)": gen_lightmap_audit,
     "zhc demo (size of report.html)": gen_demo_report,
     "zhc audit --json (16-byte ZH3 entries)": gen_audit_zh3_q16,
+    "zhc audit --json (engine layouts, sample maps)": gen_engine_maps,
+    "zhc audit --json (engine layouts, demo volume)": gen_engine_demo,
 }
 
 

@@ -217,7 +217,7 @@ std::vector<EngineComparison> compare_engine_layouts(const std::vector<InputAudi
 }
 
 namespace {
-constexpr double kEqualWithin = 1.005;
+constexpr double kEqualWithin = 1.005, kEqualBelow = 1e-5;
 }  // namespace
 
 std::vector<std::vector<std::string>> engine_table(const std::vector<EngineComparison>& rows) {
@@ -228,10 +228,13 @@ std::vector<std::vector<std::string>> engine_table(const std::vector<EngineCompa
                                      std::to_string(k.engine->size_bytes), fmt(k.error, "%.4f"),
                                      fmt(k.max_negative_fraction, "%.4f")};
         if (k.zhc) {
-            // Within 0.5 % of each other: equal (float rounding and a clamp at 0 move errors that little).
+            // Within 0.5 % of each other, or both below 1e-5: equal (float rounding, the shaders' rounded
+            // constants and a clamp at 0 move errors that little; against an exact reference the float
+            // layouts have errors of that size).
             std::string lead = "equal";
-            if (k.zhc_error * kEqualWithin < k.error) lead = k.zhc_error > 0 ? "zhc " + fmt(k.error / k.zhc_error, "%.2fx") : "zhc";
-            else if (k.error * kEqualWithin < k.zhc_error) lead = k.error > 0 ? "engine " + fmt(k.zhc_error / k.error, "%.2fx") : "engine";
+            const bool tiny = std::max(k.error, k.zhc_error) < kEqualBelow;
+            if (!tiny && k.zhc_error * kEqualWithin < k.error) lead = k.zhc_error > 0 ? "zhc " + fmt(k.error / k.zhc_error, "%.2fx") : "zhc";
+            else if (!tiny && k.error * kEqualWithin < k.zhc_error) lead = k.error > 0 ? "engine " + fmt(k.zhc_error / k.error, "%.2fx") : "engine";
             row.insert(row.end(), {std::string(k.zhc->name), std::to_string(k.zhc->size_bytes), fmt(k.zhc_error, "%.4f"),
                                    fmt(k.zhc_max_negative_fraction, "%.4f"), lead});
         } else {
@@ -246,7 +249,7 @@ std::string engine_intro() {
     return "The engines' own probe layouts (docs/engine-layouts.md: each stores a probe as its engine does and evaluates "
            "irradiance as the engine's shader does) beside zhc's best representation at the same size: the lowest relative "
            "rmse among zhc's representations storing at most as many bytes per probe. lower_error: which is lower and by "
-           "what factor (equal: within 0.5 %). neg_frac: the largest fraction of directions reconstructing below 0 on an input.";
+           "what factor (equal: within 0.5 %, or both below 1e-5). neg_frac: the largest fraction of directions reconstructing below 0 on an input.";
 }
 
 std::vector<std::string> choice_notes(const ChoiceResult& r) {

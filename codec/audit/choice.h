@@ -140,7 +140,7 @@ std::vector<EngineComparison> compare_engine_layouts(const std::vector<InputAudi
                                                      const std::vector<RepresentationResult>& aggregate);
 // As a table (row 0 the header): engine_layout, engine, bytes, rel_rmse, neg_frac, zhc_best, bytes,
 // rel_rmse, neg_frac, lower_error ("zhc 3.1x": the lower error's side and the other's error over
-// it; "equal" when within 0.5 % of each other; "-" without a zhc representation).
+// it; "equal" when within 0.5 % of each other or both below 1e-5; "-" without a zhc representation).
 std::vector<std::vector<std::string>> engine_table(const std::vector<EngineComparison>& rows);
 // One paragraph: what the table compares.
 std::string engine_intro();
