@@ -135,11 +135,13 @@ void check_file(const std::string& path, const std::string& what, const std::str
     ASSERT_EQ(c99.size(), samples.size()) << what;
     zhc_volume v;
     ASSERT_EQ(zhc_volume_from_zhp(&v, bytes.data(), bytes.size()), ZHC_OK) << what;
-    // The double twin here is the plain trilinear blend: a baked file's validity and visibility
-    // masks (the demo's) are dropped, in-process and in the C99 program. The masked blend has its
-    // own twin (test_runtime_c_volume_leak.cpp, on the demo's masks too).
+    // The double twin here is the plain trilinear blend: a baked file's validity, visibility masks
+    // and cell planes (the demo's) are dropped, in-process and in the C99 program (--plain). The
+    // blend with them has its own twin (test_runtime_c_volume_leak.cpp, on baked files too).
     ASSERT_EQ(v.validity != nullptr, !set->validity.empty()) << what;
+    ASSERT_EQ(v.planes != nullptr, !set->planes.empty()) << what;
     v.validity = v.visibility = nullptr;
+    v.planes = nullptr;
     std::vector<D3> ref;
     double mean = 0;
     for (const Sample& s : samples) {

@@ -1,5 +1,5 @@
-/* zhc_volume_sample FILE.zhp POINTS.txt [--plain]: builds a probe volume from a grid .zhp with
- * runtime/zhc_runtime.h alone (zhc_volume_from_zhp) and prints, for every line
+/* zhc_volume_sample FILE.zhp POINTS.txt [--plain]: builds a probe volume from a grid .zhp, or a
+ * points .zhp with tetrahedra, with runtime/zhc_runtime.h alone (zhc_volume_from_zhp) and prints, for every line
  * "px py pz nx ny nz" of POINTS.txt (floats), the irradiance zhc_volume_irradiance gives at that
  * position and normal: "%.9g %.9g %.9g" (enough digits to read back the same float). --plain drops
  * the file's validity and visibility masks and cell planes (plain trilinear blending: what a sampler
