@@ -1,17 +1,24 @@
-// bench_rays: zhc's BVH (codec/bake/occluders.h) against Embree 3 (Debian libembree-dev, where the
-// build finds it) on the same rays, to choose the bake's ray tracer by measurement
-// (docs/scene.md "The ray tracer").
+// bench_rays: the bake's ray tracer (OccluderBvh, codec/bake/occluders.h: Embree 3 finds the
+// candidates, double-precision tests decide) against zhc's own double-precision BVH (its reference
+// twin, tests/reference_bvh.h) and against Embree alone (float, default scene flags, no filter: the
+// lower bound of what Embree costs) on its SSE4.2 kernels, as the bake runs it, and on the best
+// kernels this CPU has, on the same rays (docs/scene.md "The ray tracer").
 //
 // Scenes: a closed room (a box of 12 triangles) holding a grid of UV-sphere meshes, about 20k and
-// 600k triangles. Rays, the same for both tracers:
+// 600k triangles. Rays, the same for every tracer:
 //  * shadow: coherent any-hit rays from a grid of points on the floor to a point light;
 //  * bounce: incoherent nearest-hit rays from random points in the room in random directions
 //    (what the reflected-light pass casts).
-// Each is timed on 1 and 2 threads (the rays split in contiguous halves), median of 5 runs; the
-// agreement column is the fraction of rays where both say the same (hit or not; for nearest hits,
-// the same distance within 1e-4 relative). Embree traces in single precision, zhc in double.
+// Each is timed on 1 and 2 threads (the rays split in contiguous halves), median of N runs, in CPU
+// time (the slowest thread's, so other work on a shared machine does not count). The agreement
+// column compares the bake's tracer with the reference twin: the fraction of rays where both say
+// the same (hit or not; for nearest hits, the same distance within 1e-5 relative). Build times are
+// wall clock (Embree's build runs on one thread: the bake's device is "threads=1").
 //
 //   bench_rays [--small-only] [--repeats N]
+#include <embree3/rtcore.h>
+
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -22,12 +29,11 @@
 #include <thread>
 #include <vector>
 
+#include <time.h>
+
 #include "bench/timing.h"
 #include "codec/bake/occluders.h"
-
-#ifdef ZHC_EMBREE
-#include <embree3/rtcore.h>
-#endif
+#include "tests/reference_bvh.h"
 
 namespace {
 
@@ -84,15 +90,38 @@ std::vector<Ray> bounce_rays(int n) {
     return rays;
 }
 
+double thread_cpu_s() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// Runs fn(lo, hi) over [0, n) on `threads` threads (contiguous parts); returns the largest CPU time
+// any thread spent.
 template <class Fn>
-void split(size_t n, int threads, Fn&& fn) {
+double split(size_t n, int threads, Fn&& fn) {
+    std::vector<double> cpu(static_cast<size_t>(threads));
+    auto part = [&](int t) {
+        const double a = thread_cpu_s();
+        fn(n * t / threads, n * (t + 1) / threads);
+        cpu[static_cast<size_t>(t)] = thread_cpu_s() - a;
+    };
     if (threads == 1) {
-        fn(0, n);
-        return;
+        part(0);
+    } else {
+        std::vector<std::thread> pool;
+        for (int t = 0; t < threads; ++t) pool.emplace_back(part, t);
+        for (auto& th : pool) th.join();
     }
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back([&, t] { fn(n * t / threads, n * (t + 1) / threads); });
-    for (auto& th : pool) th.join();
+    return *std::max_element(cpu.begin(), cpu.end());
+}
+
+template <class Fn>
+double median_cpu(int repeats, Fn&& run) {
+    std::vector<double> t;
+    for (int i = 0; i < repeats; ++i) t.push_back(run());
+    std::sort(t.begin(), t.end());
+    return t[t.size() / 2];
 }
 
 struct Result {
@@ -100,12 +129,13 @@ struct Result {
     std::vector<double> t;
 };
 
-#ifdef ZHC_EMBREE
-struct Embree {
+// Embree alone: the triangles as one float mesh, default scene flags, no filter (what a float-only
+// tracer would cost).
+struct PlainEmbree {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
-    explicit Embree(const std::vector<Occluder>& tris) {
-        device = rtcNewDevice(nullptr);
+    PlainEmbree(const std::vector<Occluder>& tris, const char* config) {
+        device = rtcNewDevice(config);
         scene = rtcNewScene(device);
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
         float* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * tris.size()));
@@ -122,15 +152,16 @@ struct Embree {
         rtcCommitGeometry(g);
         rtcAttachGeometry(scene, g);
         rtcReleaseGeometry(g);
-        rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
         rtcCommitScene(scene);
     }
-    ~Embree() {
+    PlainEmbree(const PlainEmbree&) = delete;
+    PlainEmbree& operator=(const PlainEmbree&) = delete;
+    ~PlainEmbree() {
         rtcReleaseScene(scene);
         rtcReleaseDevice(device);
     }
-    void trace(const std::vector<Ray>& rays, bool nearest, int threads, Result& out) const {
-        split(rays.size(), threads, [&](size_t lo, size_t hi) {
+    double trace(const std::vector<Ray>& rays, bool nearest, int threads, Result& out) const {
+        return split(rays.size(), threads, [&](size_t lo, size_t hi) {
             RTCIntersectContext ctx;
             rtcInitIntersectContext(&ctx);
             for (size_t i = lo; i < hi; ++i) {
@@ -160,10 +191,10 @@ struct Embree {
         });
     }
 };
-#endif
 
-void zhc_trace(const OccluderBvh& bvh, const std::vector<Ray>& rays, bool nearest, int threads, Result& out) {
-    split(rays.size(), threads, [&](size_t lo, size_t hi) {
+template <class Bvh>
+double trace(const Bvh& bvh, const std::vector<Ray>& rays, bool nearest, int threads, Result& out) {
+    return split(rays.size(), threads, [&](size_t lo, size_t hi) {
         for (size_t i = lo; i < hi; ++i) {
             const Ray& r = rays[i];
             if (nearest) {
@@ -180,20 +211,16 @@ void zhc_trace(const OccluderBvh& bvh, const std::vector<Ray>& rays, bool neares
 }  // namespace
 
 int main(int argc, char** argv) {
-    using namespace zhc::bench;
     bool small_only = false;
     int repeats = 5;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--small-only")) small_only = true;
-        else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
         else {
             std::fprintf(stderr, "usage: bench_rays [--small-only] [--repeats N]\n");
             return 2;
         }
     }
-#ifndef ZHC_EMBREE
-    std::printf("bench_rays: built without Embree (libembree-dev not found): zhc's BVH only\n");
-#endif
     struct Size {
         const char* name;
         int spheres, lat, lon;
@@ -202,37 +229,37 @@ int main(int argc, char** argv) {
     if (!small_only) sizes.push_back({"600k", 16, 34, 36});
     const int n_rays = 1 << 18;
     const auto shadow = shadow_rays(n_rays), bounce = bounce_rays(n_rays);
-    std::printf("%-6s %-8s %-7s %12s %12s %8s %10s\n", "scene", "rays", "threads", "zhc Mray/s", "Embree Mray/s", "ratio", "agreement");
+    std::printf("rays per second in millions (CPU time, median of %d); ratio: bake / reference; agreement: the bake's tracer against the\n"
+                "reference twin; Embree SSE4.2 / best: Embree alone on its SSE4.2 kernels (as the bake) and on this CPU's best\n",
+                repeats);
+    std::printf("%-6s %-8s %-7s %10s %14s %12s %12s %8s %10s\n", "scene", "rays", "threads", "reference", "bake (Embree)", "Embree SSE4.2",
+                "Embree best", "ratio", "agreement");
     for (const Size& sz : sizes) {
         const auto tris = room_scene(sz.spheres, sz.lat, sz.lon);
-        Timing build_zhc = time_repeats(1, [&] { OccluderBvh b(tris); });
-        const OccluderBvh bvh(tris);
-#ifdef ZHC_EMBREE
-        Timing build_embree = time_repeats(1, [&] { Embree e(tris); });
-        const Embree embree(tris);
-        std::printf("%s: %zu triangles; build zhc %.3f s, Embree %.3f s\n", sz.name, tris.size(), build_zhc.median_s, build_embree.median_s);
-#else
-        std::printf("%s: %zu triangles; build zhc %.3f s\n", sz.name, tris.size(), build_zhc.median_s);
-#endif
+        const Timing build_ref = time_repeats(3, [&] { ReferenceBvh b(tris); });
+        const Timing build_bake = time_repeats(3, [&] { OccluderBvh b(tris); });
+        const ReferenceBvh ref(tris);
+        const OccluderBvh bake(tris);
+        const PlainEmbree plain(tris, "max_isa=sse4.2,threads=1"), native(tris, "threads=1");
+        std::printf("%s: %zu triangles; build (wall, median of 3): reference %.3f s, bake %.3f s; memory: reference %.1f, bake %.1f bytes per triangle\n",
+                    sz.name, tris.size(), build_ref.median_s, build_bake.median_s, double(ref.memory_bytes()) / tris.size(),
+                    double(bake.memory_bytes()) / tris.size());
         for (int kind = 0; kind < 2; ++kind) {
             const auto& rays = kind == 0 ? shadow : bounce;
             const bool nearest = kind == 1;
             for (int threads : {1, 2}) {
-                Result rz{std::vector<std::uint8_t>(rays.size()), std::vector<double>(rays.size())};
-                const Timing tz = time_repeats(repeats, [&] { zhc_trace(bvh, rays, nearest, threads, rz); });
-                double embree_rate = 0, agree = 1;
-#ifdef ZHC_EMBREE
-                Result re{std::vector<std::uint8_t>(rays.size()), std::vector<double>(rays.size())};
-                const Timing te = time_repeats(repeats, [&] { embree.trace(rays, nearest, threads, re); });
-                embree_rate = rays.size() / te.median_s * 1e-6;
+                Result rr{std::vector<std::uint8_t>(rays.size()), std::vector<double>(rays.size())};
+                Result rb = rr, rp = rr;
+                const double t_ref = median_cpu(repeats, [&] { return trace(ref, rays, nearest, threads, rr); });
+                const double t_bake = median_cpu(repeats, [&] { return trace(bake, rays, nearest, threads, rb); });
+                const double t_plain = median_cpu(repeats, [&] { return plain.trace(rays, nearest, threads, rp); });
+                const double t_native = median_cpu(repeats, [&] { return native.trace(rays, nearest, threads, rp); });
                 size_t same = 0;
                 for (size_t i = 0; i < rays.size(); ++i)
-                    same += rz.hit[i] == re.hit[i] && (!nearest || !rz.hit[i] || std::fabs(rz.t[i] - re.t[i]) <= 1e-4 * std::max(1.0, rz.t[i]));
-                agree = double(same) / rays.size();
-#endif
-                const double zhc_rate = rays.size() / tz.median_s * 1e-6;
-                std::printf("%-6s %-8s %-7d %12.2f %12.2f %8.2f %9.4f%%\n", sz.name, nearest ? "bounce" : "shadow", threads, zhc_rate, embree_rate,
-                            embree_rate > 0 ? embree_rate / zhc_rate : 0.0, 100 * agree);
+                    same += rr.hit[i] == rb.hit[i] && (!nearest || !rr.hit[i] || std::fabs(rr.t[i] - rb.t[i]) <= 1e-5 * std::max(1.0, rr.t[i]));
+                const double n = double(rays.size()) * 1e-6;
+                std::printf("%-6s %-8s %-7d %10.2f %14.2f %12.2f %12.2f %8.2f %9.4f%%\n", sz.name, nearest ? "bounce" : "shadow", threads,
+                            n / t_ref, n / t_bake, n / t_plain, n / t_native, t_ref / t_bake, 100.0 * double(same) / double(rays.size()));
             }
         }
     }

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
   cmake ninja-build g++ pkg-config
   libopenexr-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev libzstd-dev libcli11-dev nlohmann-json3-dev libstb-dev
-  libastcenc-dev libdeflate-dev
+  libastcenc-dev libdeflate-dev libembree-dev
   libqhull-dev
   libgtest-dev libbenchmark-dev
   fonts-dejavu-core libpng-dev

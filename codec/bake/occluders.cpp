@@ -8,21 +8,6 @@ namespace zhc {
 static_assert(sizeof(Occluder) == 80, "Occluder: the material index lives in the padding after kind");
 namespace {
 
-void bounds_of(const Occluder& o, double lo[3], double hi[3]) {
-    for (int a = 0; a < 3; ++a) {
-        if (o.kind == OccluderKind::kSphere) {
-            lo[a] = o.center()[a] - o.radius();
-            hi[a] = o.center()[a] + o.radius();
-        } else if (o.kind == OccluderKind::kTriangle) {
-            lo[a] = std::min({o.v0[a], o.v1[a], o.v2[a]});
-            hi[a] = std::max({o.v0[a], o.v1[a], o.v2[a]});
-        } else {
-            lo[a] = o.min()[a];
-            hi[a] = o.max()[a];
-        }
-    }
-}
-
 // Slab test: the parameter interval where the ray is inside [lo, hi], clipped to (t0, t1).
 // Division by a zero direction component gives +-inf, which the min/max handle; a NaN (0 * inf
 // when the origin lies on a slab plane) is avoided by testing the origin against the slab.
@@ -136,6 +121,34 @@ Vec3 surface_normal(const Occluder& occ, Vec3 x, Vec3 d) {
     return dot(n, d) > 0 ? -1.0 * n : n;
 }
 
+bool ray_triangle_plane(const Occluder& tri, Vec3 o, Vec3 d, double* t, bool* back) {
+    // The expressions of ray_triangle_face, in the same order: the same t to the last bit.
+    const Vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+    const Vec3 p = cross(d, e2);
+    const double det = dot(e1, p);
+    if (det == 0.0 || !std::isfinite(det)) return false;
+    const double inv = 1.0 / det;
+    const Vec3 s = o - tri.v0;
+    const Vec3 q = cross(s, e1);
+    *t = dot(e2, q) * inv;
+    *back = det < 0;
+    return true;
+}
+
+void occluder_bounds(const Occluder& o, Vec3* lo, Vec3* hi) {
+    if (o.kind == OccluderKind::kSphere) {
+        const Vec3 r{o.radius(), o.radius(), o.radius()};
+        *lo = o.center() - r;
+        *hi = o.center() + r;
+    } else if (o.kind == OccluderKind::kTriangle) {
+        *lo = {std::min({o.v0.x, o.v1.x, o.v2.x}), std::min({o.v0.y, o.v1.y, o.v2.y}), std::min({o.v0.z, o.v1.z, o.v2.z})};
+        *hi = {std::max({o.v0.x, o.v1.x, o.v2.x}), std::max({o.v0.y, o.v1.y, o.v2.y}), std::max({o.v0.z, o.v1.z, o.v2.z})};
+    } else {
+        *lo = o.min();
+        *hi = o.max();
+    }
+}
+
 Occluder triangle_occluder(Vec3 a, Vec3 b, Vec3 c) {
     Occluder o;
     o.kind = OccluderKind::kTriangle;
@@ -198,262 +211,6 @@ bool ray_hits(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max) {
     // Open interval: the box must be entered strictly after t_min and before t_max.
     if (!slab(lo, hi, o, d, t_min, t_max, &enter)) return false;
     return enter < t_max;
-}
-
-OccluderBvh::OccluderBvh(const std::vector<Occluder>& occluders) : prims_(occluders) { build_tree(); }
-
-OccluderBvh::OccluderBvh(std::vector<Occluder>&& occluders) : prims_(std::move(occluders)) {
-    occluders.clear();
-    occluders.shrink_to_fit();
-    build_tree();
-}
-
-void OccluderBvh::build_tree() {
-    if (prims_.empty()) return;
-    prims_.shrink_to_fit();
-    // Boxes once (a centroid is computed from its box where needed: the same doubles as storing it,
-    // 24 bytes per primitive less at the build's peak); the build permutes indices, then the
-    // primitives are put in leaf order (each leaf a contiguous range) in place, following the
-    // permutation's cycles.
-    std::vector<Bounds> bounds(prims_.size());
-    for (size_t i = 0; i < prims_.size(); ++i) {
-        bounds_of(prims_[i], bounds[i].lo, bounds[i].hi);
-    }
-    std::vector<std::uint32_t> order(prims_.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
-    nodes_.reserve(prims_.size() + 1);  // leaves of 2..4 primitives: < n nodes
-    build(order, bounds, 0, static_cast<std::uint32_t>(order.size()), 0);
-    std::vector<Bounds>().swap(bounds);
-    nodes_.shrink_to_fit();  // the reservation was the bound n + 1; leaves hold 2..4 primitives
-    // prims_[i] becomes what prims_[order[i]] held: each cycle of the permutation rotated once.
-    for (size_t start = 0; start < order.size(); ++start) {
-        if (order[start] == start) continue;
-        const Occluder first = prims_[start];
-        size_t i = start;
-        while (order[i] != start) {
-            const size_t next = order[i];
-            prims_[i] = prims_[next];
-            order[i] = static_cast<std::uint32_t>(i);
-            i = next;
-        }
-        prims_[i] = first;
-        order[i] = static_cast<std::uint32_t>(i);
-    }
-}
-
-std::uint32_t OccluderBvh::build(std::vector<std::uint32_t>& order, const std::vector<Bounds>& bounds,
-                                 std::uint32_t first, std::uint32_t count, int depth) {
-    const std::uint32_t index = static_cast<std::uint32_t>(nodes_.size());
-    nodes_.push_back({});
-    Node n;
-    double clo[3], chi[3];  // centroid bounds
-    for (int a = 0; a < 3; ++a) {
-        n.lo[a] = clo[a] = std::numeric_limits<double>::infinity();
-        n.hi[a] = chi[a] = -std::numeric_limits<double>::infinity();
-    }
-    for (std::uint32_t i = first; i < first + count; ++i) {
-        const Bounds& b = bounds[order[i]];
-        for (int a = 0; a < 3; ++a) {
-            n.lo[a] = std::min(n.lo[a], b.lo[a]);
-            n.hi[a] = std::max(n.hi[a], b.hi[a]);
-            clo[a] = std::min(clo[a], b.centroid(a));
-            chi[a] = std::max(chi[a], b.centroid(a));
-        }
-    }
-    // Conservative node boxes: widened by a relative 1e-9 so rounding in the slab test never
-    // rejects a ray that grazes a box face where a primitive's own (widened) test would hit, e.g.
-    // a ray through the rim of a flat mesh whose box has zero thickness.
-    for (int a = 0; a < 3; ++a) {
-        const double pad = 1e-9 * std::max({n.hi[a] - n.lo[a], std::abs(n.lo[a]), std::abs(n.hi[a]), 1e-300});
-        n.lo[a] -= pad;
-        n.hi[a] += pad;
-    }
-    // Depth cap: median splits halve the count, so depth <= log2(n) + 1 < 40 for any n < 2^32;
-    // the cap only guards the traversal stack.
-    if (count <= 4 || depth > 40) {
-        n.first = first;
-        n.count = count;
-        nodes_[index] = n;
-        return index;
-    }
-    int axis = 0;
-    for (int a = 1; a < 3; ++a)
-        if (chi[a] - clo[a] > chi[axis] - clo[axis]) axis = a;
-    const std::uint32_t mid = first + count / 2;
-    // Median split by centroid, ties broken by the primitive's index: a strict total order, so the
-    // partition (and the whole tree) is the same for the same input on every run.
-    std::nth_element(order.begin() + first, order.begin() + mid, order.begin() + first + count,
-                     [&bounds, axis](std::uint32_t a, std::uint32_t b) {
-                         const double ca = bounds[a].centroid(axis), cb = bounds[b].centroid(axis);
-                         return ca < cb || (ca == cb && a < b);
-                     });
-    n.count = 0;
-    n.axis = static_cast<std::uint8_t>(axis);
-    n.left = build(order, bounds, first, mid - first, depth + 1);
-    n.right = build(order, bounds, mid, first + count - mid, depth + 1);
-    nodes_[index] = n;
-    return index;
-}
-
-bool OccluderBvh::occluded(Vec3 o, Vec3 d, double t_min, double t_max) const {
-    if (nodes_.empty()) return false;
-    // Per-ray constants of the slab test (ZERO direction components handled by the origin test).
-    const double org[3] = {o.x, o.y, o.z}, dir[3] = {d.x, d.y, d.z};
-    double inv[3];
-    for (int a = 0; a < 3; ++a) inv[a] = dir[a] != 0.0 ? 1.0 / dir[a] : 0.0;
-    auto node_hit = [&](const Node& n) {
-        double t0 = t_min, t1 = t_max;
-        for (int a = 0; a < 3; ++a) {
-            if (dir[a] == 0.0) {
-                if (org[a] < n.lo[a] || org[a] > n.hi[a]) return false;
-                continue;
-            }
-            double ta = (n.lo[a] - org[a]) * inv[a], tb = (n.hi[a] - org[a]) * inv[a];
-            if (ta > tb) std::swap(ta, tb);
-            t0 = ta > t0 ? ta : t0;
-            t1 = tb < t1 ? tb : t1;
-            if (t0 > t1) return false;
-        }
-        return true;
-    };
-    std::uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const Node& n = nodes_[stack[--top]];
-        // A node is entered when the clipped ray overlaps its box (this includes an origin inside
-        // it: then t0 <= t_min <= t1).
-        if (!node_hit(n)) {
-            bool inside = true;
-            for (int a = 0; a < 3; ++a) inside = inside && org[a] >= n.lo[a] && org[a] <= n.hi[a];
-            if (!inside) continue;
-        }
-        if (n.count > 0) {
-            for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
-                const Occluder& p = prims_[i];
-                const bool hit = p.kind == OccluderKind::kTriangle
-                                     ? ray_hits_triangle(p.v0, p.v1, p.v2, o, d, t_min, t_max)
-                                     : ray_hits(p, o, d, t_min, t_max);
-                if (hit) return true;
-            }
-        } else if (top + 2 <= 128) {
-            // Nearer child (along the ray on the split axis) popped first: an any-hit query stops
-            // sooner when the closer half blocks.
-            if (dir[n.axis] < 0) {
-                stack[top++] = n.left;
-                stack[top++] = n.right;
-            } else {
-                stack[top++] = n.right;
-                stack[top++] = n.left;
-            }
-        }
-    }
-    return false;
-}
-
-RayHit OccluderBvh::nearest(Vec3 o, Vec3 d, double t_min, double t_max) const {
-    RayHit best;
-    if (nodes_.empty()) return best;
-    const double org[3] = {o.x, o.y, o.z}, dir[3] = {d.x, d.y, d.z};
-    double inv[3];
-    for (int a = 0; a < 3; ++a) inv[a] = dir[a] != 0.0 ? 1.0 / dir[a] : 0.0;
-    // The node's clipped interval against (t_min, far); false when the ray misses it.
-    auto node_hit = [&](const Node& n, double far) {
-        double t0 = t_min, t1 = far;
-        for (int a = 0; a < 3; ++a) {
-            if (dir[a] == 0.0) {
-                if (org[a] < n.lo[a] || org[a] > n.hi[a]) return false;
-                continue;
-            }
-            double ta = (n.lo[a] - org[a]) * inv[a], tb = (n.hi[a] - org[a]) * inv[a];
-            if (ta > tb) std::swap(ta, tb);
-            t0 = ta > t0 ? ta : t0;
-            t1 = tb < t1 ? tb : t1;
-            if (t0 > t1) return false;
-        }
-        return true;
-    };
-    std::uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    double far = t_max;
-    while (top > 0) {
-        const Node& n = nodes_[stack[--top]];
-        if (!node_hit(n, far)) {
-            bool inside = true;
-            for (int a = 0; a < 3; ++a) inside = inside && org[a] >= n.lo[a] && org[a] <= n.hi[a];
-            if (!inside) continue;
-        }
-        if (n.count > 0) {
-            for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
-                // Strictly nearer hits only (t < far, the best so far): the first primitive visited wins a tie.
-                const RayHit h = ray_nearest(prims_[i], o, d, t_min, far);
-                if (h.hit && (!best.hit || h.t < best.t)) {
-                    best = h;
-                    best.prim = i;
-                    far = h.t;
-                }
-            }
-        } else if (top + 2 <= 128) {
-            if (dir[n.axis] < 0) {
-                stack[top++] = n.left;
-                stack[top++] = n.right;
-            } else {
-                stack[top++] = n.right;
-                stack[top++] = n.left;
-            }
-        }
-    }
-    return best;
-}
-
-bool OccluderBvh::inside_any_solid(Vec3 p) const {
-    if (nodes_.empty()) return false;
-    const double q[3] = {p.x, p.y, p.z};
-    std::uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const Node& n = nodes_[stack[--top]];
-        bool in = true;
-        for (int a = 0; a < 3; ++a) in = in && q[a] >= n.lo[a] && q[a] <= n.hi[a];
-        if (!in) continue;
-        if (n.count > 0) {
-            for (std::uint32_t i = n.first; i < n.first + n.count; ++i)
-                if (inside_solid(prims_[i], p)) return true;
-        } else if (top + 2 <= 128) {
-            stack[top++] = n.left;
-            stack[top++] = n.right;
-        }
-    }
-    return false;
-}
-
-bool OccluderBvh::overlaps_box(Vec3 lo, Vec3 hi) const {
-    if (nodes_.empty()) return false;
-    const double blo[3] = {lo.x, lo.y, lo.z}, bhi[3] = {hi.x, hi.y, hi.z};
-    auto overlap = [&](const double* a_lo, const double* a_hi) {
-        for (int a = 0; a < 3; ++a)
-            if (a_hi[a] < blo[a] || a_lo[a] > bhi[a]) return false;
-        return true;
-    };
-    std::vector<std::uint32_t> stack{0};
-    while (!stack.empty()) {
-        const Node& n = nodes_[stack.back()];
-        stack.pop_back();
-        if (!overlap(n.lo, n.hi)) continue;
-        if (n.count > 0) {
-            for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
-                double plo[3], phi[3];
-                bounds_of(prims_[i], plo, phi);
-                if (overlap(plo, phi)) return true;
-            }
-        } else {
-            stack.push_back(n.left);
-            stack.push_back(n.right);
-        }
-    }
-    return false;
 }
 
 }  // namespace zhc

@@ -1,18 +1,27 @@
-// zhc/codec/bake/occluders.h — shadow rays against sphere, box and triangle occluders through a BVH.
+// zhc/codec/bake/occluders.h — occluders (spheres, boxes, triangles), their double-precision ray tests, and
+// OccluderBvh: the bake's ray tracer on Embree 3 (docs/scene.md "The ray tracer").
 //
-// std-only (codec/ may not use Embree). The BVH is a binary tree over the occluders' bounding
-// boxes, split at the median centroid along the longest centroid axis (leaves of <= 4
-// primitives), built deterministically from precomputed boxes in O(n log n); `occluded` is an
-// any-hit query with an explicit stack that visits the nearer child first. Triangle meshes of
-// 10^5..10^6 triangles are one triangle primitive each in the same tree; bench/bench_bake reports
-// rays per second against brute force and bytes per triangle. The tree keeps the occluders
-// themselves (80 bytes each) in leaf order plus about 0.7 nodes of 72 bytes: 127 to 135 bytes per
-// triangle (memory_bytes(); test_scene_mesh prints it). Built from a const vector it copies the
-// occluders; from an rvalue it takes them over and reorders them in place, so a baked scene's mesh
-// is held once (bake_scene(Scene&&)).
+// The primitive tests below are exact double arithmetic: analytic spheres, slab boxes and
+// Moller-Trumbore triangles (barycentrics widened by a relative 1e-10, both faces). OccluderBvh
+// (codec/bake/occluder_bvh.cpp) builds an Embree scene over the occluders: triangles as one Embree
+// triangle mesh in float, spheres and boxes as Embree user geometry running the tests below. For a
+// triangle Embree decides whether the ray meets it (its watertight float test, on triangles grown by
+// 2^-18 of the scene's half size so no ray slips between neighbours); the distance, the face and
+// the interval (t_min, t_max) are decided in double (ray_triangle_plane: the same bits as
+// ray_nearest). So hits differ from a double-precision tracer only for rays within about 1e-5 of
+// the scene's size of a triangle's edge (test_scene_mesh compares it with its reference twin,
+// tests/reference_bvh.h, zhc's own double BVH). nearest() keeps the smallest (distance, index) over
+// every candidate, whatever order Embree visits them in; Embree builds on one thread and runs its
+// SSE4.2 kernels (no fused multiply-add), so a bake gives the same bytes for any thread count, on
+// every run and on every x86-64 CPU with SSE4.2. Memory: the occluders (80 bytes each, kept in the order given),
+// Embree's float vertices and indices (48 bytes per triangle) and its BVH, about 192 bytes per
+// triangle in all (memory_bytes(); test_scene_mesh prints it). Built from a const vector it copies
+// the occluders; from an rvalue it takes them over, so a baked scene's mesh is held once
+// (bake_scene(Scene&&)).
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -67,6 +76,13 @@ struct RayHit {
     std::uint32_t prim = 0;  // OccluderBvh::nearest: the primitive hit (OccluderBvh::primitive)
 };
 RayHit ray_nearest(const Occluder& occ, Vec3 o, Vec3 d, double t_min, double t_max);
+// Where o + t d meets the plane of triangle `tri`: ray_nearest's arithmetic (Moller-Trumbore's t, and
+// `back` from its determinant's sign) without the test that the point lies inside the triangle.
+// False when the ray runs parallel to the plane or the triangle is degenerate (determinant 0 or
+// not finite). OccluderBvh takes the inside decision from Embree and the distance from here.
+bool ray_triangle_plane(const Occluder& tri, Vec3 o, Vec3 d, double* t, bool* back);
+// The axis-aligned box of an occluder: a triangle's vertices, a sphere's centre +- radius, a box.
+void occluder_bounds(const Occluder& occ, Vec3* lo, Vec3* hi);
 // Is p inside (or on) a sphere or box occluder? (Triangles bound no volume.)
 bool inside_solid(const Occluder& occ, Vec3 p);
 // The unit surface normal of `occ` at a point x on its surface, turned to face against the ray
@@ -78,14 +94,12 @@ class OccluderBvh {
 public:
     OccluderBvh() = default;
     explicit OccluderBvh(const std::vector<Occluder>& occluders);
-    // Takes the occluders over (no copy: they are reordered in place into the tree's leaf order and
-    // their vector is left empty), so a scene's mesh is held once.
+    // Takes the occluders over (no copy; their vector is left empty), so a scene's mesh is held once.
     explicit OccluderBvh(std::vector<Occluder>&& occluders);
-    bool empty() const { return prims_.empty(); }
+    bool empty() const { return count_ == 0; }
     // Any hit with t in (t_min, t_max)?
     bool occluded(Vec3 o, Vec3 d, double t_min, double t_max) const;
-    // The nearest hit with t in (t_min, t_max) (ties between primitives at the same t: the first
-    // visited, the nearer child on the split axis first, so the answer is the same on every run).
+    // The nearest hit with t in (t_min, t_max); of primitives hit at the same t, the lowest index.
     RayHit nearest(Vec3 o, Vec3 d, double t_min, double t_max) const;
     // Is p inside (or on) any sphere or box occluder?
     bool inside_any_solid(Vec3 p) const;
@@ -93,34 +107,27 @@ public:
     // answer does not mean a surface lies inside the box); the plane fit skips cells it says false
     // for (codec/bake/leak_planes.h).
     bool overlaps_box(Vec3 lo, Vec3 hi) const;
-    // The primitive a nearest() hit names (leaf order; RayHit::prim).
+    // The primitive a nearest() hit names (RayHit::prim): the occluders in the order given.
     const Occluder& primitive(std::uint32_t i) const { return prims_[i]; }
-    std::size_t node_count() const { return nodes_.size(); }
-    // The box around every occluder (the root node's); not called on an empty tree.
+    // The box around every occluder, each side moved out by a relative 1e-9 of the box (a
+    // conservative bound for callers that scale offsets by the scene's extent); not called on an
+    // empty tree.
     void root_bounds(Vec3* lo, Vec3* hi) const {
-        *lo = {nodes_[0].lo[0], nodes_[0].lo[1], nodes_[0].lo[2]};
-        *hi = {nodes_[0].hi[0], nodes_[0].hi[1], nodes_[0].hi[2]};
+        *lo = lo_;
+        *hi = hi_;
     }
-    // Bytes the tree holds (primitives and nodes), printed per primitive by test_scene_mesh.
-    std::size_t memory_bytes() const { return prims_.capacity() * sizeof(Occluder) + nodes_.capacity() * sizeof(Node); }
+    // Bytes held: the occluders (80 each) and everything Embree allocated for the scene (vertex and
+    // index buffers, the BVH), counted by Embree's memory monitor once the build has finished.
+    std::size_t memory_bytes() const;
+
+    struct Impl;  // codec/bake/occluder_bvh.cpp
 
 private:
-    struct Node {
-        double lo[3], hi[3];
-        std::uint32_t first = 0, count = 0;  // leaf: primitive range [first, first + count)
-        std::uint32_t left = 0, right = 0;   // inner node (count == 0): children
-        std::uint8_t axis = 0;               // inner node: split axis (nearer child first)
-    };
-    struct Bounds {
-        double lo[3], hi[3];
-        double centroid(int a) const { return 0.5 * (lo[a] + hi[a]); }
-    };
-    std::vector<Occluder> prims_;  // in leaf order
-    std::vector<Node> nodes_;
-    std::uint32_t build(std::vector<std::uint32_t>& order, const std::vector<Bounds>& bounds, std::uint32_t first,
-                        std::uint32_t count, int depth);
-    // The tree over prims_ (in input order), which it then reorders into leaf order.
-    void build_tree();
+    std::shared_ptr<const Impl> impl_;  // shared by copies: the scene is immutable once built
+    const Occluder* prims_ = nullptr;   // impl_'s occluders
+    std::size_t count_ = 0;
+    Vec3 lo_, hi_;
+    void build(std::vector<Occluder>&& occluders);
 };
 
 }  // namespace zhc

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # An engine adds zhc's source tree with add_subdirectory and gets the codec alone: configures
-# tests/install/subdir_consumer with every third-party package zhc can look for disabled (as on a
-# machine with only a C++ compiler and CMake), builds it with the same generator as zhc (Ninja),
+# tests/install/subdir_consumer with every third-party package zhc can look for disabled but Embree
+# (the codec's one dependency: the bake's ray tracer), as on a machine with a C++ compiler, CMake and
+# Debian's libembree-dev, builds it with the same generator as zhc (Ninja),
 # checks that nothing of zhc::formats or the command was compiled, and runs it.
 #   subdir.sh ZHC_SOURCE_DIR
 set -euo pipefail
