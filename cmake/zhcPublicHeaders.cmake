@@ -10,7 +10,7 @@ set(ZHC_PUBLIC_HEADERS_codec
   probe/codec.h probe/probe_set.h probe/quantize.h probe/dering.h probe/zh3.h
   lightmap/irradz.h lightmap/lightmap.h lightmap/bc6h.h lightmap/bc45.h
   # experimental
-  bake/scene.h bake/sky.h bake/occluders.h bake/transport.h audit/audit.h audit/audit_run.h audit/benchmark.h audit/choice.h)
+  bake/scene.h bake/sky.h bake/occluders.h bake/transport.h bake/leak_planes.h audit/audit.h audit/audit_run.h audit/benchmark.h audit/choice.h)
 set(ZHC_PUBLIC_HEADERS_formats
   io/file_io.h envmap/envmap.h envmap/envmap_cube.h probes/probe_file.h probes/gltf_probes.h
   lightmap/ktx2.h lightmap/dds.h lightmap/lightmap_exr.h

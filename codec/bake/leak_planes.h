@@ -25,8 +25,8 @@
 // side); the best is kept when it predicts fewer pairs wrongly than no plane. Cells whose box (and
 // their corners' baked positions) meets no occluder's bounds trace nothing and get no plane.
 //
-// std-only; deterministic: every probe and every cell is computed alone, so any thread count gives
-// the same bytes.
+// Deterministic: every probe and every cell is computed alone, so any thread count gives the same
+// bytes. Experimental: this API may change between minor versions (docs/api.md "Public headers").
 #pragma once
 
 #include <cstdint>
