@@ -171,15 +171,17 @@ int run(const Options& o) {
                 out.tetra_neighbours = in->set->tetra_neighbours;
             }
         }
-        // A points layout carries its Delaunay tetrahedra (the input's, else computed here).
-        if (out.layout.kind == ProbeLayoutKind::kPositions && out.tetrahedra.empty())
-            for (const std::string& line : add_tetrahedra(out))
-                std::fprintf(stderr, "zhc: warning: %s: %s\n", o.output.c_str(), line.c_str());
+        // A points layout carries its Delaunay tetrahedra (the input's, else computed here). What
+        // the tetrahedralisation notices is printed once the file is written (a failed write
+        // prints its error alone).
+        std::vector<std::string> tetra_notes;
+        if (out.layout.kind == ProbeLayoutKind::kPositions && out.tetrahedra.empty()) tetra_notes = add_tetrahedra(out);
         ProbeFileWriteOptions wo;
         wo.zstd_level = o.zstd;
         auto bytes = serialize_probe_set(out, wo);
         if (!bytes) return report(bytes.error());
         if (Status st = write_file_atomic(o.output, *bytes); !st) return report_output(st.error());
+        for (const std::string& line : tetra_notes) std::fprintf(stderr, "zhc: warning: %s: %s\n", o.output.c_str(), line.c_str());
         const size_t per = out.codec()->size_bytes;
         std::printf("%s: %llu probes as %s (%zu bytes/probe), %zu bytes (%llu payload + %zu header%s), "
                     "clamped ratios: %d\n",
