@@ -10,7 +10,8 @@
 //    force over every triangle on a subset of the same rays;
 //  * occlusion passes on the ~200k-triangle sphere (docs/scene.md "Probes near geometry"): rays per
 //    probe and probes per second of the sky/environment occlusion pass (whose rays also decide
-//    probe validity), the dilation, and the visibility-mask pass, each as a ratio of its rays/s to
+//    probe validity), the dilation, the visibility-mask pass, the relocation of probes out of and
+//    towards walls and the cell-plane fit, each as a ratio of its rays/s to
 //    the shadow-ray throughput of the same mesh measured in the same run.
 // Medians over 5 runs in the thread's CPU time (one thread throughout, so a loaded machine slows
 // the run, not the numbers); the spread (min..max) is printed. The occlusion passes: medians of 3
@@ -346,31 +347,45 @@ int main(int argc, char** argv) {
         std::printf("%-34s %10s %12s %12s %10s\n", "pass", "rays/probe", "probes/s", "rays/s", "vs shadow");
         std::printf("%-34s %10.1f %12.3g %12.3g %9.2fx  (BVH build %.0f ms, not in any pass)\n", "sun shadow rays (reference)",
                     rs.effects[1].rays / probes, probes / sun_s, shadow_rate, 1.0, rs.occluder_build_ms);
-        std::vector<double> occ_ms, dil_ms, mask_ms;
+        std::vector<double> occ_ms, dil_ms, mask_ms, reloc_ms, plane_ms;
         BakeReport r;
+        BakeOptions with_masks;
+        with_masks.visibility_masks = true;  // the masks' pass too (zhc bake writes planes only)
         for (int i = 0; i < 3; ++i) {
             ProbeLeakData leak;
-            bench::keep(bake_scene(s, {}, &r, &leak));
+            bench::keep(bake_scene(s, with_masks, &r, &leak));
             occ_ms.push_back(r.occlusion_ms);
             dil_ms.push_back(r.dilation_ms);
             mask_ms.push_back(r.mask_ms);
+            reloc_ms.push_back(r.relocation_ms);
+            plane_ms.push_back(r.plane_ms);
         }
         auto median = [](std::vector<double> v) {
             std::sort(v.begin(), v.end());
             return v[v.size() / 2];
         };
         const double o_s = median(occ_ms) / 1e3, d_s = median(dil_ms) / 1e3, m_s = median(mask_ms) / 1e3;
+        const double r_s = median(reloc_ms) / 1e3, p_s = median(plane_ms) / 1e3;
         std::printf("%-34s %10.1f %12.3g %12.3g %9.2fx\n", "sky occlusion + validity (nearest)", r.occlusion_rays / probes,
                     probes / o_s, r.occlusion_rays / o_s, r.occlusion_rays / o_s / shadow_rate);
         std::printf("%-34s %10s %12.3g %12s %10s  (%llu invalid, %llu dilated)\n", "dilation", "0", probes / d_s, "-", "-",
                     static_cast<unsigned long long>(r.invalid_probes), static_cast<unsigned long long>(r.dilated_probes));
         std::printf("%-34s %10.1f %12.3g %12.3g %9.2fx\n", "visibility masks (any hit)", r.mask_rays / probes, probes / m_s,
                     r.mask_rays / m_s, r.mask_rays / m_s / shadow_rate);
+        std::printf("%-34s %10.1f %12.3g %12.3g %9.2fx  (%llu moved out, %llu towards walls)\n", "probes kept out of walls",
+                    r.relocation_rays / probes, probes / r_s, r.relocation_rays / r_s, r.relocation_rays / r_s / shadow_rate,
+                    static_cast<unsigned long long>(r.moved_out), static_cast<unsigned long long>(r.moved_towards));
+        std::printf("%-34s %10.1f %12.3g %12.3g %9.2fx  (%llu of %llu cells crossed, %llu planes)\n", "cell planes",
+                    r.planes.rays / probes, probes / p_s, r.planes.rays / p_s, r.planes.rays / p_s / shadow_rate,
+                    static_cast<unsigned long long>(r.planes.crossed_cells), static_cast<unsigned long long>(r.planes.cells),
+                    static_cast<unsigned long long>(r.planes.planes));
         occlusion_json = format("{\"triangles\": %zu, \"probes\": %.0f, \"shadow_rays_per_s\": %.6g, "
                                 "\"occlusion_rays_per_probe\": %.4g, \"occlusion_rays_per_s\": %.6g, \"dilation_probes_per_s\": %.6g, "
-                                "\"mask_rays_per_probe\": %.4g, \"mask_rays_per_s\": %.6g}",
+                                "\"mask_rays_per_probe\": %.4g, \"mask_rays_per_s\": %.6g, \"relocation_rays_per_probe\": %.4g, "
+                                "\"relocation_rays_per_s\": %.6g, \"plane_rays_per_probe\": %.4g, \"plane_rays_per_s\": %.6g}",
                                 s.occluders.size(), probes, shadow_rate, r.occlusion_rays / probes, r.occlusion_rays / o_s,
-                                probes / d_s, r.mask_rays / probes, r.mask_rays / m_s);
+                                probes / d_s, r.mask_rays / probes, r.mask_rays / m_s, r.relocation_rays / probes,
+                                r.relocation_rays / r_s, r.planes.rays / probes, r.planes.rays / p_s);
     }
     // Reflected light (codec/bake/transport.h) over the 596k-triangle sphere mesh and a floor,
     // both grey 0.5, 4 x 4 x 4 probes, 256 paths each: time per probe and per million rays, the
