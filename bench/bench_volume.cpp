@@ -37,8 +37,21 @@
 // the timed samples where the data drops a corner of non-zero weight. The GPU's results are
 // compared with zhc_volume_irradiance_d of the same volume.
 //
+// Engine layouts (a third table, "engine_rows" in the JSON; codec/probe/engine_layouts.h,
+// docs/engine-layouts.md): each engine's stored bytes of every probe, the texel values its shader
+// reads, blended trilinearly at the sample (what a hardware filter does to the textures, before the
+// shader decodes: Unity's ratios then multiply the blended L0, Source 2's RGBM the blended
+// multiplier; Godot and RealityKit blend on the CPU, tetrahedrally in the engine, trilinearly here),
+// then the engine's shader; error against the same reference, on both grids. Beside it: the
+// entry's bytes, the engine's GPU and file bytes per probe, its fetches per sample, its
+// interpolation, whether it can carry zhc's leak data (a hardware-filtered layout blends the
+// corners before the shader: no corner can be dropped), and the CPU model's ns per sample (one
+// thread, double: the blend of the texels and the shader; the engines' GPU shaders are not
+// compiled here).
+//
 // Usage: bench_volume [--samples N] [--gltf FILE] [--json FILE] [--keep DIR]
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -52,6 +65,7 @@
 
 #include "codec/bake/scene.h"
 #include "codec/probe/codec.h"
+#include "codec/probe/engine_layouts.h"
 #include "codec/probe/probe_set.h"
 #include "formats/io/file_io.h"
 #include "formats/scene/scene_gltf.h"
@@ -100,7 +114,52 @@ struct Row {
     // the timed volume use; leak_row false for the layout rows above.
     bool leak_row = false, unrolled = false, masks = false, planes = false, every_cell = false;
     double cut = NAN;  // share of the timed samples where the leak data drops a corner
+    // Engine rows (codec/probe/engine_layouts.h): the layout, and the CPU model's ns per sample.
+    const EngineLayoutInfo* engine = nullptr;
+    double cpu_ns = NAN;
 };
+
+// An engine layout's volume: every probe's texels (engine_layouts.h), blended trilinearly at the
+// sample as the engine's filter or CPU does, then its shader. Corners as zhc__volume_axis gives
+// them (an axis of one probe: that probe).
+struct EngineVolume {
+    const EngineLayoutInfo* info = nullptr;
+    std::vector<double> texels;  // count x texel_count
+    void sample(const zhc_volume& grid, const double p[3], const double n[3], double out[3]) const {
+        std::uint32_t i0[3], i1[3];
+        double f[3];
+        for (int c = 0; c < 3; ++c) {
+            zhc__volume_axis(p[c], grid.origin[c], grid.spacing[c], grid.counts[c], &i0[c], &f[c]);
+            i1[c] = std::min(i0[c] + 1, grid.counts[c] - 1);
+        }
+        const int nt = info->texel_count;
+        double blend[kMaxEngineTexels] = {};
+        for (int k = 0; k < 8; ++k) {
+            const double w = ((k & 1) ? f[0] : 1 - f[0]) * ((k >> 1 & 1) ? f[1] : 1 - f[1]) * ((k >> 2) ? f[2] : 1 - f[2]);
+            if (w == 0) continue;
+            const std::size_t q = ((k & 1) ? i1[0] : i0[0]) +
+                                  std::size_t(grid.counts[0]) * (((k >> 1) & 1 ? i1[1] : i0[1]) + std::size_t(grid.counts[1]) * ((k >> 2) ? i1[2] : i0[2]));
+            for (int t = 0; t < nt; ++t) blend[t] += w * texels[q * std::size_t(nt) + std::size_t(t)];
+        }
+        const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        const Vec3 unit = len > 0 ? Vec3{n[0] / len, n[1] / len, n[2] / len} : Vec3{0, 0, 1};
+        const Rgb e = info->shade(blend, unit);
+        for (int c = 0; c < 3; ++c) out[c] = e[c];
+    }
+};
+
+EngineVolume engine_volume(const std::vector<Sh3Radiance>& probes, const EngineLayoutInfo& info) {
+    EngineVolume v;
+    v.info = &info;
+    const Codec& codec = *find_codec(info.codec);
+    std::vector<std::uint8_t> bytes(codec.size_bytes);
+    v.texels.resize(probes.size() * std::size_t(info.texel_count));
+    for (std::size_t i = 0; i < probes.size(); ++i) {
+        codec.encode(probes[i], CodecOptions{}, bytes.data(), nullptr);
+        info.texels(bytes.data(), v.texels.data() + i * std::size_t(info.texel_count));
+    }
+    return v;
+}
 
 bool encode(const Grid& g, const char* rep, std::vector<std::uint8_t>* payload, zhc_volume* vol, zhc_probe_format* fmt) {
     auto set = encode_probe_set(g.probes, rep, CodecOptions{}, g.layout);
@@ -344,6 +403,16 @@ int main(int argc, char** argv) {
         r.layout = l;
         rows.push_back(r);
     }
+    for (const EngineLayoutInfo& info : engine_layouts()) {
+        Row r;
+        r.name = std::string(info.codec);
+        r.kind = std::string(info.interpolation);
+        r.textures = std::string(info.engine);
+        r.bytes = double(find_codec(info.codec)->size_bytes);
+        r.fetches = info.fetches;
+        r.engine = &info;
+        rows.push_back(r);
+    }
     {
         // Leak rows on the demo grid: masks after the zh3_q16 words, plane entries after the masks.
         const std::uint64_t count = std::uint64_t(grids[0].layout.grid.counts[0]) * grids[0].layout.grid.counts[1] *
@@ -423,6 +492,20 @@ int main(int argc, char** argv) {
             }
             rows[ri++].err[gi] = stats(e);
         }
+        for (const EngineLayoutInfo& info : engine_layouts()) {
+            const EngineVolume ev = engine_volume(g.probes, info);
+            std::vector<double> e(pts.size());
+            const auto t0 = std::chrono::steady_clock::now();
+            for (std::size_t s = 0; s < pts.size(); ++s) {
+                double rgb[3];
+                ev.sample(ref, pts[s].data(), pts[s].data() + 3, rgb);
+                const double d[3] = {rgb[0] - eref[s][0], rgb[1] - eref[s][1], rgb[2] - eref[s][2]};
+                e[s] = norm3(d) / mean_ref;
+            }
+            const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() / double(pts.size());
+            if (gi == 0) rows[ri].cpu_ns = ns;
+            rows[ri++].err[gi] = stats(e);
+        }
         std::printf("grid %s: %u x %u x %u probes, %d samples, mean |E_ref| %.4g\n", g.name.c_str(), ref.counts[0], ref.counts[1],
                     ref.counts[2], samples, mean_ref);
     }
@@ -434,6 +517,7 @@ int main(int argc, char** argv) {
         fs::create_directories(dir);
         const int skeleton = spirv_instructions(dir.string(), "skeleton", skeleton_kernel());
         for (Row& r : rows) {
+            if (r.engine) continue;  // the engines' shaders are not compiled here
             const int c = spirv_instructions(dir.string(), r.name, r.source, &r.spv);
             r.spirv = c >= 0 && skeleton >= 0 ? c - skeleton : -1;
         }
@@ -603,7 +687,7 @@ int main(int argc, char** argv) {
     std::printf("%-22s %6s  %-26s %7s %6s %10s %10s %10s | %10s %10s %10s %8s %6s %9s\n", "layout", "B/probe", "textures", "fetches",
                 "SPIR-V", "mean", "p95", "max", "mean", "p95", "max", "ns", "vs sh3", "GPU-model");
     for (const Row& r : rows)
-        if (!r.leak_row)
+        if (!r.leak_row && !r.engine)
         std::printf("%-22s %6.0f  %-26s %7d %6d %10.3g %10.3g %10.3g | %10.3g %10.3g %10.3g %8.1f %6.2f %9.2g\n", r.name.c_str(), r.bytes,
                     r.textures.c_str(), r.fetches, r.spirv, r.err[0].mean, r.err[0].p95, r.err[0].max, r.err[1].mean, r.err[1].p95,
                     r.err[1].max, r.ns, r.ns / base_ns, r.vs_model);
@@ -622,12 +706,24 @@ int main(int argc, char** argv) {
         if (r.leak_row)
             std::printf("%-32s %7.0f %6d %8.1f %8.3f %6.3f %9.2g\n", r.name.c_str(), r.bytes, r.spirv, r.ns, r.ns / plain_ns(r), r.cut,
                         r.vs_model);
+    std::printf("\nengine layouts (codec/probe/engine_layouts.h): the engine's texels blended trilinearly, then its shader;\n"
+                "error as above (demo | gltf); B/probe: the entry's stored bytes, GPU and file bytes per probe in the engine\n"
+                "(0: none: the CPU blends per object, or no file format); leak data: whether zhc's validity, masks and\n"
+                "planes could apply (no: the hardware filter blends the corners first); CPU ns: the model, one thread\n\n");
+    std::printf("%-22s %7s %5s %5s %7s %-5s %10s %10s %10s | %10s %10s %10s %7s  %s\n", "layout", "B/probe", "GPU", "file",
+                "fetches", "leak", "mean", "p95", "max", "mean", "p95", "max", "CPU ns", "interpolation");
+    for (const Row& r : rows)
+        if (r.engine)
+            std::printf("%-22s %7.0f %5zu %5zu %7d %-5s %10.3g %10.3g %10.3g | %10.3g %10.3g %10.3g %7.0f  %s\n", r.name.c_str(), r.bytes,
+                        r.engine->gpu_bytes, r.engine->disk_bytes, r.fetches, r.engine->hardware_filtered ? "no" : "yes",
+                        r.err[0].mean, r.err[0].p95, r.err[0].max, r.err[1].mean, r.err[1].p95, r.err[1].max, r.cpu_ns,
+                        r.kind.c_str());
     if (!json.empty()) {
         std::ofstream out(json);
         out << "{\n  \"benchmark\": \"volume\",\n  \"device\": \"" << device << "\",\n  \"samples\": " << samples << ",\n  \"grids\": [\"demo\", \"" << gltf
             << "\"],\n  \"rows\": [\n";
-        std::vector<const Row*> layout_rows, leak_rows;
-        for (const Row& r : rows) (r.leak_row ? leak_rows : layout_rows).push_back(&r);
+        std::vector<const Row*> layout_rows, leak_rows, engine_rows;
+        for (const Row& r : rows) (r.engine ? engine_rows : r.leak_row ? leak_rows : layout_rows).push_back(&r);
         for (std::size_t i = 0; i < layout_rows.size(); ++i) {
             const Row& r = *layout_rows[i];
             char buf[1024];
@@ -654,6 +750,22 @@ int main(int argc, char** argv) {
                           r.every_cell ? "true" : "false", r.bytes, r.spirv, std::isfinite(r.ns) ? r.ns : -1.0,
                           std::isfinite(r.ns / plain_ns(r)) ? r.ns / plain_ns(r) : -1.0,
                           std::isfinite(r.cut) ? r.cut : -1.0, std::isfinite(r.vs_model) ? r.vs_model : -1.0, i + 1 < leak_rows.size() ? "," : "");
+            out << buf;
+        }
+        out << "  ],\n  \"engine_rows\": [\n";
+        for (std::size_t i = 0; i < engine_rows.size(); ++i) {
+            const Row& r = *engine_rows[i];
+            char buf[1024];
+            std::snprintf(buf, sizeof buf,
+                          "    {\"layout\": \"%s\", \"engine\": \"%s\", \"interpolation\": \"%s\", \"bytes_per_probe\": %g, "
+                          "\"gpu_bytes_per_probe\": %zu, \"file_bytes_per_probe\": %zu, \"fetches\": %d, \"hardware_filtered\": %s, "
+                          "\"carries_leak_data\": %s, \"cpu_model_ns_per_sample\": %.4g, "
+                          "\"demo\": {\"mean\": %.6g, \"p95\": %.6g, \"max\": %.6g}, "
+                          "\"gltf\": {\"mean\": %.6g, \"p95\": %.6g, \"max\": %.6g}}%s\n",
+                          r.name.c_str(), std::string(r.engine->engine).c_str(), r.kind.c_str(), r.bytes, r.engine->gpu_bytes,
+                          r.engine->disk_bytes, r.fetches, r.engine->hardware_filtered ? "true" : "false",
+                          r.engine->hardware_filtered ? "false" : "true", r.cpu_ns, r.err[0].mean, r.err[0].p95, r.err[0].max,
+                          r.err[1].mean, r.err[1].p95, r.err[1].max, i + 1 < engine_rows.size() ? "," : "");
             out << buf;
         }
         if (!bench::finish_json(out, json)) return 1;

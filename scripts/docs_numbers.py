@@ -241,6 +241,24 @@ def gen_engine_demo(ctx):
                       ""] + engine_rows(d))
 
 
+def gen_bench_volume_engines(ctx):
+    d = run_json(os.path.join(ctx["build"], "bench", "bench_volume"), [], ctx["tmp"])
+    rows = ["| engine layout | bytes (entry) | GPU bytes | file bytes | fetches | leak data | demo mean | demo p95 | glTF mean "
+            "| glTF p95 | CPU model ns |",
+            "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|"]
+    for r in d["engine_rows"]:
+        rows.append("| `%s` | %d | %s | %s | %d | %s | %s | %s | %s | %s | %.0f |" % (
+            r["layout"], r["bytes_per_probe"], r["gpu_bytes_per_probe"] or "-", r["file_bytes_per_probe"] or "-", r["fetches"],
+            "yes" if r["carries_leak_data"] else "no", sig(r["demo"]["mean"]), sig(r["demo"]["p95"]), sig(r["gltf"]["mean"]),
+            sig(r["gltf"]["p95"]), r["cpu_model_ns_per_sample"]))
+    return "\n".join([header("bench_volume --json"),
+                      "Error of one sample against the exact trilinear SH3 volume of the baked probes, |dE| / mean |E|, over %d "
+                      "random points and normals per grid (the demo's 8x8x4 and the glTF scene's 8x8x8). GPU / file bytes: - "
+                      "where the engine keeps none per probe (Godot and RealityKit blend per object on the CPU; three.js bakes at "
+                      "load and writes no file)." %
+                      d["samples"], ""] + rows)
+
+
 # command (as written in the marker) -> generator
 GENERATORS = {
     "bench_bake --json": gen_bench_bake,
@@ -251,6 +269,7 @@ GENERATORS = {
     "zhc audit --json (16-byte ZH3 entries)": gen_audit_zh3_q16,
     "zhc audit --json (engine layouts, sample maps)": gen_engine_maps,
     "zhc audit --json (engine layouts, demo volume)": gen_engine_demo,
+    "bench_volume --json (engine layouts)": gen_bench_volume_engines,
 }
 
 

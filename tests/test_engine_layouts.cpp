@@ -668,6 +668,44 @@ TEST(EngineLayouts, ClampingShadersClampAndDecodeKeepsTheStoredSh) {
     }
 }
 
+// The texels are what the shader reads (irradiance is the shader on them, bit for bit); the float
+// SH layouts' shaders are linear in their texels, so a hardware filter's blend of the corners is the
+// blend of their irradiance, while Unity's ratio decode multiplies by the blended L0 and is not.
+TEST(EngineLayouts, TexelsAreWhatTheShaderReads) {
+    const std::vector<Sh3Radiance> h = hubs();
+    const auto dirs = test::fibonacci_directions(50);
+    for (const EngineLayoutInfo& info : engine_layouts()) {
+        ASSERT_GT(info.texel_count, 0);
+        ASSERT_LE(info.texel_count, kMaxEngineTexels);
+        const Codec& c = *find_codec(info.codec);
+        std::vector<std::uint8_t> a(c.size_bytes), b(c.size_bytes);
+        double ta[kMaxEngineTexels], tb[kMaxEngineTexels], mid[kMaxEngineTexels];
+        double worst_linear = 0;
+        for (size_t i = 0; i + 1 < h.size(); ++i) {
+            c.encode(h[i], CodecOptions{}, a.data(), nullptr);
+            c.encode(h[i + 1], CodecOptions{}, b.data(), nullptr);
+            info.texels(a.data(), ta);
+            info.texels(b.data(), tb);
+            for (int k = 0; k < info.texel_count; ++k) mid[k] = 0.5 * (ta[k] + tb[k]);
+            for (const Vec3 n : dirs) {
+                const Rgb direct = c.irradiance(a.data(), CodecOptions{}, n), shaded = info.shade(ta, n);
+                for (int k = 0; k < 3; ++k) ASSERT_EQ(direct[k], shaded[k]) << info.codec;
+                const Rgb m = info.shade(mid, n), ea = info.shade(ta, n), eb = info.shade(tb, n);
+                for (int k = 0; k < 3; ++k)
+                    worst_linear = std::max(worst_linear, std::fabs(m[k] - 0.5 * (double(ea[k]) + eb[k])) /
+                                                              std::max(scale_of(h[i]), scale_of(h[i + 1])));
+            }
+        }
+        const std::string name(info.codec);
+        if (name == "godot_l2" || name == "realitykit_l1" || name == "vrchat_lv_l1" || name == "bevy_ambient_cube") {
+            EXPECT_LT(worst_linear, 1e-6) << name << ": linear in its texels";
+        }
+        if (name == "unity_apv_l1" || name == "unity_apv_l2" || name == "unreal_vlm_l2" || name == "source2_ambient_cube") {
+            EXPECT_GT(worst_linear, 1e-3) << name << ": its decode multiplies blended texels";
+        }
+    }
+}
+
 // ---- the reports ----------------------------------------------------------------------------
 
 // The plots draw zhc's Pareto frontier without the engine layouts and mark those apart.

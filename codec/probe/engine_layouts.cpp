@@ -196,27 +196,25 @@ void threejs_encode(const Sh3Radiance& hub, const CodecOptions&, std::uint8_t* o
     }
 }
 
+// Texels: the 28 values of the 7 RGBA texels.
 template <bool Half>
-double threejs_value(const std::uint8_t* in, int i, int c) {
-    const int k = 3 * i + c;
-    return Half ? half_at(in + 2 * k) : double(get_f32(in + 4 * k));
+void threejs_texels(const std::uint8_t* in, double* t) {
+    for (int k = 0; k < 28; ++k) t[k] = Half ? half_at(in + 2 * k) : double(get_f32(in + 4 * k));
 }
 
-template <bool Half>
-Sh3Radiance threejs_decode(const std::uint8_t* in, const CodecOptions&) {
+Sh3Radiance threejs_hub(const double* tex) {
     EngineSh t{};
     for (int i = 0; i < 9; ++i)
-        for (int c = 0; c < 3; ++c) t[i][c] = threejs_value<Half>(in, i, c) * kIrradianceBandScale[band(i)];
+        for (int c = 0; c < 3; ++c) t[i][c] = tex[3 * i + c] * kIrradianceBandScale[band(i)];
     return hub_from_engine_irradiance_sh(t, kAxesYUpRight);
 }
 
-template <bool Half>
-Rgb threejs_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
+Rgb threejs_shade(const double* tex, Vec3 n) {
     const Vec3 e = to_engine(kAxesYUpRight, n);
     const double x = e.x, y = e.y, z = e.z;
     Rgb out;
     for (int c = 0; c < 3; ++c) {
-        auto s = [&](int i) { return threejs_value<Half>(in, i, c); };
+        auto s = [&](int i) { return tex[3 * i + c]; };
         double r = s(0) * 0.886227;
         r += s(1) * 2.0 * 0.511664 * y;
         r += s(2) * 2.0 * 0.511664 * z;
@@ -303,19 +301,27 @@ void apv_encode(const Sh3Radiance& hub, const CodecOptions&, std::uint8_t* out, 
 struct ApvDecoded {
     double l0[3], l1[3][3], l2[3][4], c[3];
 };
+// Texels, as the textures return them: L0_L1Rx (4 halves), L1G_L1Ry and L1B_L1Rz (unorm: byte /
+// 255), with L2 L2_0, L2_1, L2_2, L2_3: 12 or 28 values. The shader decodes after the filter.
 template <bool L2>
-ApvDecoded apv_decode_sample(const std::uint8_t* in) {
+void apv_texels(const std::uint8_t* in, double* t) {
+    for (int k = 0; k < 4; ++k) t[k] = half_at(in + 2 * k);
+    for (int k = 8; k < (L2 ? 32 : 16); ++k) t[k - 4] = in[k] / 255.0;
+}
+
+template <bool L2>
+ApvDecoded apv_decode_sample(const double* t) {
     ApvDecoded d{};
-    double enc[3][3];  // [channel][axis], as the shader reads them (unorm bytes / 255)
-    for (int c = 0; c < 3; ++c) d.l0[c] = half_at(in + 2 * c);
-    enc[0][0] = half_at(in + 6), enc[0][1] = in[11] / 255.0, enc[0][2] = in[15] / 255.0;
-    for (int k = 0; k < 3; ++k) enc[1][k] = in[8 + k] / 255.0, enc[2][k] = in[12 + k] / 255.0;
+    double enc[3][3];  // [channel][axis]
+    for (int c = 0; c < 3; ++c) d.l0[c] = t[c];
+    enc[0][0] = t[3], enc[0][1] = t[7], enc[0][2] = t[11];
+    for (int k = 0; k < 3; ++k) enc[1][k] = t[4 + k], enc[2][k] = t[8 + k];
     for (int c = 0; c < 3; ++c)
         for (int k = 0; k < 3; ++k) d.l1[c][k] = (enc[c][k] - 0.5) * (2.0 * kApvL1Scale * d.l0[c]);
     if (L2) {
         for (int c = 0; c < 3; ++c) {
-            for (int k = 0; k < 4; ++k) d.l2[c][k] = (in[16 + 4 * c + k] / 255.0 - 0.5) * (kApvL2Scale * d.l0[c]);
-            d.c[c] = (in[28 + c] / 255.0 - 0.5) * kApvL2Scale * d.l0[c];
+            for (int k = 0; k < 4; ++k) d.l2[c][k] = (t[12 + 4 * c + k] - 0.5) * (kApvL2Scale * d.l0[c]);
+            d.c[c] = (t[24 + c] - 0.5) * kApvL2Scale * d.l0[c];
             d.l0[c] -= d.l2[c][2];
             d.l2[c][2] *= 3.0;
         }
@@ -324,8 +330,8 @@ ApvDecoded apv_decode_sample(const std::uint8_t* in) {
 }
 
 template <bool L2>
-Rgb apv_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
-    const ApvDecoded d = apv_decode_sample<L2>(in);
+Rgb apv_shade(const double* t, Vec3 n) {
+    const ApvDecoded d = apv_decode_sample<L2>(t);
     const Vec3 e = to_engine(kAxesUnity, n);
     const double vb[4] = {e.x * e.y, e.y * e.z, e.z * e.z, e.z * e.x}, vc = e.x * e.x - e.y * e.y;
     Rgb out;
@@ -338,8 +344,8 @@ Rgb apv_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
 }
 
 template <bool L2>
-Sh3Radiance apv_decode(const std::uint8_t* in, const CodecOptions&) {
-    const ApvDecoded d = apv_decode_sample<L2>(in);
+Sh3Radiance apv_hub(const double* tex) {
+    const ApvDecoded d = apv_decode_sample<L2>(tex);
     EngineSh t{};
     for (int c = 0; c < 3; ++c) {
         // Decoded L0 + d2 z^2 (d2 = 3 d) is L0 + d (3 z^2 - 1) with L0 the stored one.
@@ -398,34 +404,41 @@ void unreal_encode(const Sh3Radiance& hub, const CodecOptions&, std::uint8_t* ou
         }
 }
 
-// The nine radiance coefficients (Unreal's basis and axes) the shader reconstructs.
-void unreal_coefficients(const std::uint8_t* in, double u[9][3]) {
+// Texels: the ambient's R, G, B, then each SHCoefficients texel's R, G, B, A (unorm; the bytes are
+// B, G, R, A in memory): 27 values.
+void unreal_texels(const std::uint8_t* in, double* t) {
     const Rgb ambient = unpack_r11g11b10f(get_u32(in));
-    for (int c = 0; c < 3; ++c) {
-        u[0][c] = ambient[c];
-        for (int half = 0; half < 2; ++half) {
-            const std::uint8_t* p = in + 4 + 4 * (2 * c + half);
-            const double rgba[4] = {p[2] / 255.0, p[1] / 255.0, p[0] / 255.0, p[3] / 255.0};
-            for (int k = 0; k < 4; ++k) {
-                const int i = 1 + 4 * half + k;
-                u[i][c] = (rgba[k] * 2.0 - 1.0) * double(ambient[c]) * kUeScale[i - 1];
-            }
-        }
+    for (int c = 0; c < 3; ++c) t[c] = ambient[c];
+    for (int j = 0; j < 6; ++j) {
+        const std::uint8_t* p = in + 4 + 4 * j;
+        t[3 + 4 * j] = p[2] / 255.0, t[4 + 4 * j] = p[1] / 255.0, t[5 + 4 * j] = p[0] / 255.0, t[6 + 4 * j] = p[3] / 255.0;
     }
 }
 
-Sh3Radiance unreal_decode(const std::uint8_t* in, const CodecOptions&) {
+// The nine radiance coefficients (Unreal's basis and axes) the shader reconstructs.
+void unreal_coefficients(const double* t, double u[9][3]) {
+    for (int c = 0; c < 3; ++c) {
+        u[0][c] = t[c];
+        for (int half = 0; half < 2; ++half)
+            for (int k = 0; k < 4; ++k) {
+                const int i = 1 + 4 * half + k;
+                u[i][c] = (t[3 + 4 * (2 * c + half) + k] * 2.0 - 1.0) * t[c] * kUeScale[i - 1];
+            }
+    }
+}
+
+Sh3Radiance unreal_hub(const double* tex) {
     double u[9][3];
-    unreal_coefficients(in, u);
+    unreal_coefficients(tex, u);
     EngineSh t{};
     for (int i = 0; i < 9; ++i)
         for (int c = 0; c < 3; ++c) t[i][c] = kUeSign[i] * u[i][c] * kIrradianceBandScale[band(i)];
     return hub_from_engine_irradiance_sh(t, kAxesUnreal);
 }
 
-Rgb unreal_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
+Rgb unreal_shade(const double* tex, Vec3 n) {
     double u[9][3];
-    unreal_coefficients(in, u);
+    unreal_coefficients(tex, u);
     const Vec3 e = to_engine(kAxesUnreal, n);
     const double x = e.x, y = e.y, z = e.z;
     // SHBasisFunction3 (Condon-Shortley sign) times CalcDiffuseTransferSH3's band factors pi, 2pi/3, pi/4.
@@ -463,20 +476,25 @@ void godot_encode(const Sh3Radiance& hub, const CodecOptions&, std::uint8_t* out
     }
 }
 
-Sh3Radiance godot_decode(const std::uint8_t* in, const CodecOptions&) {
+// Texels: the nine colours' R, G, B, A (the engine blends them on the CPU per object): 36 values.
+void godot_texels(const std::uint8_t* in, double* t) {
+    for (int k = 0; k < 36; ++k) t[k] = get_f32(in + 4 * k);
+}
+
+Sh3Radiance godot_hub(const double* tex) {
     EngineSh t{};
     for (int i = 0; i < 9; ++i)
-        for (int c = 0; c < 3; ++c) t[i][c] = double(get_f32(in + 16 * i + 4 * c)) * kPi * kIrradianceBandScale[band(i)];
+        for (int c = 0; c < 3; ++c) t[i][c] = tex[4 * i + c] * kPi * kIrradianceBandScale[band(i)];
     return hub_from_engine_irradiance_sh(t, kAxesYUpRight);
 }
 
-Rgb godot_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
+Rgb godot_shade(const double* tex, Vec3 n) {
     const Vec3 e = to_engine(kAxesYUpRight, n);
     const double x = e.x, y = e.y, z = e.z;
     constexpr double c1 = 0.429043, c2 = 0.511664, c3 = 0.743125, c4 = 0.886227, c5 = 0.247708;
     Rgb out;
     for (int c = 0; c < 3; ++c) {
-        auto s = [&](int i) { return double(get_f32(in + 16 * i + 4 * c)); };
+        auto s = [&](int i) { return tex[4 * i + c]; };
         out[c] = static_cast<float>(c1 * s(8) * (x * x - y * y) + c3 * s(6) * z * z + c4 * s(0) - c5 * s(6) +
                                     2.0 * c1 * s(4) * x * y + 2.0 * c1 * s(7) * x * z + 2.0 * c1 * s(5) * y * z +
                                     2.0 * c2 * s(3) * x + 2.0 * c2 * s(1) * y + 2.0 * c2 * s(2) * z);
@@ -539,30 +557,33 @@ void vrchat_encode(const Sh3Radiance& hub, const CodecOptions&, std::uint8_t* ou
     for (int k = 0; k < 12; ++k) put_u16(out + 2 * k, pack_half(texel[k / 4][k % 4]));
 }
 
+// Texels: the three texels' R, G, B, A (halves): 12 values.
+void vrchat_texels(const std::uint8_t* in, double* t) {
+    for (int k = 0; k < 12; ++k) t[k] = half_at(in + 2 * k);
+}
+
 // L0 and L1 (x, y, z) of channel c as LV_SampleLightVolumeTex packs them.
-void vrchat_sample(const std::uint8_t* in, double l0[3], double l1[3][3]) {
-    double tex[3][4];
-    for (int k = 0; k < 12; ++k) tex[k / 4][k % 4] = half_at(in + 2 * k);
+void vrchat_sample(const double* t, double l0[3], double l1[3][3]) {
     for (int c = 0; c < 3; ++c) {
-        l0[c] = tex[0][c];
-        l1[c][0] = tex[1][c];
-        l1[c][1] = tex[2][c];
-        l1[c][2] = tex[c][3];  // z: tex0.a (red), tex1.a (green), tex2.a (blue)
+        l0[c] = t[c];
+        l1[c][0] = t[4 + c];
+        l1[c][1] = t[8 + c];
+        l1[c][2] = t[4 * c + 3];  // z: tex0.a (red), tex1.a (green), tex2.a (blue)
     }
 }
 
-Rgb vrchat_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
+Rgb vrchat_shade(const double* tex, Vec3 n) {
     double l0[3], l1[3][3];
-    vrchat_sample(in, l0, l1);
+    vrchat_sample(tex, l0, l1);
     const Vec3 e = to_engine(kAxesUnity, n);
     Rgb out;
     for (int c = 0; c < 3; ++c) out[c] = static_cast<float>(l0[c] + l1[c][0] * e.x + l1[c][1] * e.y + l1[c][2] * e.z);
     return out;
 }
 
-Sh3Radiance vrchat_decode(const std::uint8_t* in, const CodecOptions&) {
+Sh3Radiance vrchat_hub(const double* tex) {
     double l0[3], l1[3][3];
-    vrchat_sample(in, l0, l1);
+    vrchat_sample(tex, l0, l1);
     EngineSh t{};
     for (int c = 0; c < 3; ++c) {
         t[0][c] = l0[c] / kY00;
@@ -583,18 +604,23 @@ void realitykit_encode(const Sh3Radiance& hub, const CodecOptions&, std::uint8_t
         for (int c = 0; c < 3; ++c) put_f32(out + 12 * i + 4 * c, static_cast<float>(t[i][c] / kIrradianceBandScale[band(i)]));
 }
 
-Sh3Radiance realitykit_decode(const std::uint8_t* in, const CodecOptions&) {
+// Texels: the 12 floats.
+void realitykit_texels(const std::uint8_t* in, double* t) {
+    for (int k = 0; k < 12; ++k) t[k] = get_f32(in + 4 * k);
+}
+
+Sh3Radiance realitykit_hub(const double* tex) {
     EngineSh t{};
     for (int i = 0; i < 4; ++i)
-        for (int c = 0; c < 3; ++c) t[i][c] = double(get_f32(in + 12 * i + 4 * c)) * kIrradianceBandScale[band(i)];
+        for (int c = 0; c < 3; ++c) t[i][c] = tex[3 * i + c] * kIrradianceBandScale[band(i)];
     return hub_from_engine_irradiance_sh(t, kAxesYUpRight);
 }
 
-Rgb realitykit_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
+Rgb realitykit_shade(const double* tex, Vec3 n) {
     const Vec3 e = to_engine(kAxesYUpRight, n);
     Rgb out;
     for (int c = 0; c < 3; ++c) {
-        auto s = [&](int i) { return double(get_f32(in + 12 * i + 4 * c)); };
+        auto s = [&](int i) { return tex[3 * i + c]; };
         out[c] = static_cast<float>((kPi * kY00 * s(0) + (2.0 * kPi / 3.0) * kY1 * (s(1) * e.y + s(2) * e.z + s(3) * e.x)) / kPi);
     }
     return out;
@@ -625,7 +651,7 @@ Rgb cube_evaluate(const double faces[6][3], Vec3 e) {
     Rgb out;
     for (int c = 0; c < 3; ++c) {
         double r = 0;
-        for (int a = 0; a < 3; ++a) r += n[a] * n[a] * faces[2 * a + (n[a] < 0 ? 1 : 0)][c];
+        for (int a = 0; a < 3; ++a) r += n[a] * n[a] * faces[2 * a + (n[a] < 0 ? 1 : 0)][c];  // the face on n_a's side
         out[c] = static_cast<float>(r);
     }
     return out;
@@ -658,20 +684,21 @@ void bevy_encode(const Sh3Radiance& hub, const CodecOptions&, std::uint8_t* out,
     cube_faces(hub, kAxesYUpRight, faces);
     for (int f = 0; f < 6; ++f) put_u32(out + 4 * f, pack_rgb9e5(faces[f].r, faces[f].g, faces[f].b));
 }
-void bevy_faces(const std::uint8_t* in, double faces[6][3]) {
+// Texels: each face's R, G, B (one filtered tap per face the normal's signs select): 18 values.
+void bevy_texels(const std::uint8_t* in, double* t) {
     for (int f = 0; f < 6; ++f) {
         const Rgb v = unpack_rgb9e5(get_u32(in + 4 * f));
-        for (int c = 0; c < 3; ++c) faces[f][c] = v[c];
+        for (int c = 0; c < 3; ++c) t[3 * f + c] = v[c];
     }
 }
-Rgb bevy_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
+Rgb bevy_shade(const double* tex, Vec3 n) {
     double faces[6][3];
-    bevy_faces(in, faces);
+    for (int k = 0; k < 18; ++k) faces[k / 3][k % 3] = tex[k];
     return cube_evaluate(faces, to_engine(kAxesYUpRight, n));
 }
-Sh3Radiance bevy_decode(const std::uint8_t* in, const CodecOptions&) {
+Sh3Radiance bevy_hub(const double* tex) {
     double faces[6][3];
-    bevy_faces(in, faces);
+    for (int k = 0; k < 18; ++k) faces[k / 3][k % 3] = tex[k];
     return cube_projection(faces, kAxesYUpRight);
 }
 
@@ -692,24 +719,41 @@ void source2_encode(const Sh3Radiance& hub, const CodecOptions&, std::uint8_t* o
         for (int c = 0; c < 3; ++c) p[c] = m > 0 ? unorm8_round(v[c] / (m / 255.0 * kRgbmRange)) : 0;
     }
 }
-void source2_faces(const std::uint8_t* in, double faces[6][3]) {
-    for (int f = 0; f < 6; ++f) {
-        const std::uint8_t* p = in + 4 * f;
-        for (int c = 0; c < 3; ++c) faces[f][c] = p[c] / 255.0 * (p[3] / 255.0) * kRgbmRange;
-    }
+// Texels: each face's R, G, B, M (unorm), filtered before the multiply: 24 values.
+void source2_texels(const std::uint8_t* in, double* t) {
+    for (int k = 0; k < 24; ++k) t[k] = in[k] / 255.0;
 }
-Rgb source2_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
+void source2_faces(const double* t, double faces[6][3]) {
+    for (int f = 0; f < 6; ++f)
+        for (int c = 0; c < 3; ++c) faces[f][c] = t[4 * f + c] * t[4 * f + 3] * kRgbmRange;
+}
+Rgb source2_shade(const double* tex, Vec3 n) {
     double faces[6][3];
-    source2_faces(in, faces);
+    source2_faces(tex, faces);
     return cube_evaluate(faces, to_engine(kAxesZUpRight, n));
 }
-Sh3Radiance source2_decode(const std::uint8_t* in, const CodecOptions&) {
+Sh3Radiance source2_hub(const double* tex) {
     double faces[6][3];
-    source2_faces(in, faces);
+    source2_faces(tex, faces);
     return cube_projection(faces, kAxesZUpRight);
 }
 
 // ---- the table part -------------------------------------------------------------------------
+
+// Every entry's decode and irradiance go through its texels, as the engine's shader reads them.
+template <int N, void (*Texels)(const std::uint8_t*, double*), Sh3Radiance (*Hub)(const double*)>
+Sh3Radiance via_texels_decode(const std::uint8_t* in, const CodecOptions&) {
+    double t[N];
+    Texels(in, t);
+    return Hub(t);
+}
+template <int N, void (*Texels)(const std::uint8_t*, double*), Rgb (*Shade)(const double*, Vec3)>
+Rgb via_texels_irradiance(const std::uint8_t* in, const CodecOptions&, Vec3 n) {
+    double t[N];
+    Texels(in, t);
+    return Shade(t, n);
+}
+#define ZHC_ENGINE_FUNCTIONS(N, texels, hub, shade) via_texels_decode<N, texels, hub>, via_texels_irradiance<N, texels, shade>
 
 constexpr CodecTraits engine_traits(std::string_view engine, IrradianceModel model) {
     CodecTraits t;
@@ -720,68 +764,77 @@ constexpr CodecTraits engine_traits(std::string_view engine, IrradianceModel mod
 
 const Codec kEngineCodecs[] = {
     {"threejs_grid_float", "three.js LightProbeGrid (WebGL): L2 radiance SH, 7 RGBA32F texels, clamped at 0", 112,
-     threejs_encode<false>, threejs_decode<false>, threejs_irradiance<false>,
+     threejs_encode<false>, ZHC_ENGINE_FUNCTIONS(28, threejs_texels<false>, threejs_hub, threejs_shade),
      engine_traits("three.js", IrradianceModel::kSh3Clamped)},
     {"threejs_grid_half", "three.js LightProbeGrid (WebGPU): L2 radiance SH, 7 RGBA16F texels, clamped at 0", 56,
-     threejs_encode<true>, threejs_decode<true>, threejs_irradiance<true>,
+     threejs_encode<true>, ZHC_ENGINE_FUNCTIONS(28, threejs_texels<true>, threejs_hub, threejs_shade),
      engine_traits("three.js", IrradianceModel::kSh3Clamped)},
     {"unity_apv_l1", "Unity APV L1: L0 + L1 red x in RGBA16F, L1 as ratios to L0 in 2 RGBA8", 16, apv_encode<false>,
-     apv_decode<false>, apv_irradiance<false>, engine_traits("Unity APV", IrradianceModel::kSh3)},
+     ZHC_ENGINE_FUNCTIONS(12, apv_texels<false>, apv_hub<false>, apv_shade<false>),
+     engine_traits("Unity APV", IrradianceModel::kSh3)},
     {"unity_apv_l2", "Unity APV L2: the L1 texels + L2 as ratios to L0 in 4 RGBA8", 32, apv_encode<true>,
-     apv_decode<true>, apv_irradiance<true>, engine_traits("Unity APV", IrradianceModel::kSh3)},
+     ZHC_ENGINE_FUNCTIONS(28, apv_texels<true>, apv_hub<true>, apv_shade<true>),
+     engine_traits("Unity APV", IrradianceModel::kSh3)},
     {"unreal_vlm_l2", "Unreal volumetric lightmap: L2 radiance SH, R11G11B10F ambient + 6 BGRA8 ratios, clamped at 0",
-     28, unreal_encode, unreal_decode, unreal_irradiance, engine_traits("Unreal", IrradianceModel::kSh3Clamped)},
-    {"bevy_ambient_cube", "Bevy irradiance volume: ambient cube, 6 faces in RGB9E5", 24, bevy_encode, bevy_decode,
-     bevy_irradiance, engine_traits("Bevy", IrradianceModel::kOwn)},
-    {"vrchat_lv_l1", "VRChat Light Volumes: L0 + deringed L1 in 3 RGBA16F texels", 24, vrchat_encode, vrchat_decode,
-     vrchat_irradiance, engine_traits("VRChat Light Volumes", IrradianceModel::kSh3)},
-    {"godot_l2", "Godot 4 LightmapGI probes: L2 radiance SH / pi, 9 RGBA32F colours", 144, godot_encode, godot_decode,
-     godot_irradiance, engine_traits("Godot", IrradianceModel::kSh3)},
+     28, unreal_encode, ZHC_ENGINE_FUNCTIONS(27, unreal_texels, unreal_hub, unreal_shade),
+     engine_traits("Unreal", IrradianceModel::kSh3Clamped)},
+    {"bevy_ambient_cube", "Bevy irradiance volume: ambient cube, 6 faces in RGB9E5", 24, bevy_encode,
+     ZHC_ENGINE_FUNCTIONS(18, bevy_texels, bevy_hub, bevy_shade), engine_traits("Bevy", IrradianceModel::kOwn)},
+    {"vrchat_lv_l1", "VRChat Light Volumes: L0 + deringed L1 in 3 RGBA16F texels", 24, vrchat_encode,
+     ZHC_ENGINE_FUNCTIONS(12, vrchat_texels, vrchat_hub, vrchat_shade),
+     engine_traits("VRChat Light Volumes", IrradianceModel::kSh3)},
+    {"godot_l2", "Godot 4 LightmapGI probes: L2 radiance SH / pi, 9 RGBA32F colours", 144, godot_encode,
+     ZHC_ENGINE_FUNCTIONS(36, godot_texels, godot_hub, godot_shade), engine_traits("Godot", IrradianceModel::kSh3)},
     {"realitykit_l1", "RealityKit probes (inferred): L1 radiance SH, 12 float32", 48, realitykit_encode,
-     realitykit_decode, realitykit_irradiance, engine_traits("RealityKit", IrradianceModel::kSh3)},
-    {"source2_ambient_cube", "Source 2 (inferred): ambient cube, 6 faces in RGBM8", 24, source2_encode, source2_decode,
-     source2_irradiance, engine_traits("Source 2", IrradianceModel::kOwn)},
+     ZHC_ENGINE_FUNCTIONS(12, realitykit_texels, realitykit_hub, realitykit_shade),
+     engine_traits("RealityKit", IrradianceModel::kSh3)},
+    {"source2_ambient_cube", "Source 2 (inferred): ambient cube, 6 faces in RGBM8", 24, source2_encode,
+     ZHC_ENGINE_FUNCTIONS(24, source2_texels, source2_hub, source2_shade), engine_traits("Source 2", IrradianceModel::kOwn)},
 };
+#undef ZHC_ENGINE_FUNCTIONS
 
 const EngineLayoutInfo kLayouts[] = {
     {"threejs_grid_float", "three.js LightProbeGrid, WebGL (r184+)",
      "three r187 examples/jsm/lighting/LightProbeGridWebGL.js _ensureTextures, repack; "
      "src/renderers/shaders/ShaderChunk/lightprobes_pars_fragment.glsl.js getLightProbeGridIrradiance",
-     kAxesYUpRight, 112, 0, 7, "hardware trilinear, 7 taps of one RGBA atlas", true},
+     kAxesYUpRight, 112, 0, 7, "hardware trilinear, 7 taps of one RGBA atlas", true, 28, threejs_texels<false>, threejs_shade},
     {"threejs_grid_half", "three.js LightProbeGrid, WebGPU (r184+)",
      "three r187 examples/jsm/lighting/LightProbeGrid.js _ensureTextures, repackNode; "
      "examples/jsm/tsl/lighting/LightProbeGridNode.js evaluateGridIrradiance",
-     kAxesYUpRight, 56, 0, 7, "hardware trilinear, 7 taps of one RGBA atlas", true},
+     kAxesYUpRight, 56, 0, 7, "hardware trilinear, 7 taps of one RGBA atlas", true, 28, threejs_texels<true>, threejs_shade},
     {"unity_apv_l1", "Unity Adaptive Probe Volumes, L1",
      "Unity-Technologies/Graphics core Runtime/Lighting/ProbeVolume: ProbeBrickPool.cs CreateDataLocation, "
      "DecodeSH.hlsl, ProbeVolume.hlsl SampleAPV / EvaluateAdaptiveProbeVolume; "
      "Editor ProbeGIBaking.Serialization.cs WriteToShaderCoeffsL0L1",
-     kAxesUnity, 16, 16, 3, "hardware trilinear in 4x4x4 bricks", true},
+     kAxesUnity, 16, 16, 3, "hardware trilinear in 4x4x4 bricks", true, 12, apv_texels<false>, apv_shade<false>},
     {"unity_apv_l2", "Unity Adaptive Probe Volumes, L2",
      "as unity_apv_l1, plus DecodeSH.hlsl DecodeSH_L2 and WriteToShaderCoeffsL2", kAxesUnity, 32, 32, 7,
-     "hardware trilinear in 4x4x4 bricks", true},
+     "hardware trilinear in 4x4x4 bricks", true, 28, apv_texels<true>, apv_shade<true>},
     {"unreal_vlm_l2", "Unreal volumetric lightmap",
      "Unreal's public API reference (PrecomputedVolumetricLightmap.h FVolumetricLightmapBasicBrickDataLayers) and "
      "the decode of VolumetricLightmapShared.ush as quoted publicly; Epic's source is not public",
-     kAxesUnreal, 33, 33, 7, "hardware trilinear in bricks (indirection texture)", true},
+     kAxesUnreal, 33, 33, 7, "hardware trilinear in bricks (indirection texture)", true, 27, unreal_texels,
+     unreal_shade},
     {"bevy_ambient_cube", "Bevy irradiance volume",
      "bevyengine/bevy crates/bevy_pbr/src/light_probe/irradiance_volume.rs (layout), irradiance_volume.wgsl "
-     "irradiance_volume_light", kAxesYUpRight, 24, 24, 3, "hardware trilinear, 3 taps (one per axis)", true},
+     "irradiance_volume_light", kAxesYUpRight, 24, 24, 3, "hardware trilinear, 3 taps (one per axis)", true, 18,
+     bevy_texels, bevy_shade},
     {"vrchat_lv_l1", "VRChat Light Volumes",
      "REDSIM/VRCLightVolumes Scripts/LightVolume.cs Save3DTexturesProgressive, Scripts/Texture3DAtlasGenerator.cs "
      "PostProcessSphericalHarmonics, Scripts/LVUtils.cs LinearizeSingleSH, Shaders/LightVolumes.cginc "
      "LV_SampleLightVolumeTex / LightVolumeEvaluate",
-     kAxesUnity, 24, 24, 3, "hardware trilinear, 3 taps of one RGBA16F atlas", true},
+     kAxesUnity, 24, 24, 3, "hardware trilinear, 3 taps of one RGBA16F atlas", true, 12, vrchat_texels, vrchat_shade},
     {"godot_l2", "Godot 4 LightmapGI probes",
      "godotengine/godot scene/3d/lightmap_gi.cpp LightmapGI::bake, LightmapGIData::_get_probe_data; "
      "modules/lightmapper_rd/lm_compute.glsl MODE_LIGHT_PROBES; scene_forward_clustered.glsl lightmap capture",
-     kAxesYUpRight, 144, 144, 9, "tetrahedral on the CPU, once per object (9 RGBA of the blended probe)", false},
+     kAxesYUpRight, 0, 144, 9, "tetrahedral on the CPU, once per object (9 RGBA of the blended probe)", false, 36,
+     godot_texels, godot_shade},
     {"realitykit_l1", "RealityKit probe lighting (inferred)",
-     "no public source: issue 40's survey (L1 float, 48 bytes, tetrahedra)", kAxesYUpRight, 48, 48, 3,
-     "tetrahedral, per object (inferred)", false},
+     "no public source: issue 40's survey (L1 float, 48 bytes, tetrahedra)", kAxesYUpRight, 0, 48, 3,
+     "tetrahedral, per object (inferred)", false, 12, realitykit_texels, realitykit_shade},
     {"source2_ambient_cube", "Source 2 light probes (inferred)",
      "no public source: issue 40's survey (ambient cube, RGBM, 24 bytes) and Mitchell 2006 (Valve's ambient cube)",
-     kAxesZUpRight, 24, 24, 3, "volume texture, hardware trilinear (inferred)", true},
+     kAxesZUpRight, 24, 24, 3, "volume texture, hardware trilinear (inferred)", true, 24, source2_texels, source2_shade},
 };
 static_assert(sizeof kLayouts / sizeof kLayouts[0] == sizeof kEngineCodecs / sizeof kEngineCodecs[0]);
 

@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <string_view>
 
@@ -34,15 +35,27 @@ struct EngineLayoutInfo {
     // Engine axes from zhc's: v_engine = axes * v_zhc (a signed permutation; det -1 for left-handed
     // engines). Stated per entry; a converter writing the engine's files uses the same matrix.
     Mat3 axes;
-    std::size_t gpu_bytes = 0;       // bytes per probe in GPU memory (texture padding included)
-    std::size_t disk_bytes = 0;      // bytes per probe in the engine's baked files
+    std::size_t gpu_bytes = 0;       // bytes per probe in GPU memory (0: none; the CPU blends per object)
+    std::size_t disk_bytes = 0;      // bytes per probe in the engine's baked files (0: no file format)
     int fetches = 0;                 // texture fetches (or buffer reads) per shading sample
     std::string_view interpolation;  // how the engine blends probes ("hardware trilinear", ...)
     // true: the GPU's filtering blends the stored probes before the shader decodes them, so a
     // shader cannot drop single corners (zhc's validity, visibility masks and cell planes need the
     // eight corners apart: 8 loads and a blend in the shader, as zhc's runtimes do).
     bool hardware_filtered = false;
+    // What the engine's shader reads of a stored probe: its texel values (the numbers the texture
+    // fetches, or the CPU's reads, return: unorm as byte / 255, halves, floats, shared exponents
+    // decoded), texel_count of them in the engine's texel order, and the shader from texel values
+    // (zhc's normal in, zhc's units out). The entry's irradiance is shade(texels(bytes)); a
+    // hardware-filtered volume blends the texels of the corner probes and then shades (its
+    // decode runs on the blend: Unity's ratios multiply the blended L0, Source 2's RGBM the blended
+    // multiplier), which bench/bench_volume.cpp models.
+    int texel_count = 0;
+    void (*texels)(const std::uint8_t* stored, double* out) = nullptr;
+    Rgb (*shade)(const double* texels, Vec3 n) = nullptr;
 };
+// The most texels any layout has (texel_count <= kMaxEngineTexels).
+inline constexpr int kMaxEngineTexels = 36;
 
 // Every engine layout, in the order of their codec-table entries.
 std::span<const EngineLayoutInfo> engine_layouts();
