@@ -70,10 +70,16 @@ function compareWithJson(what, sh, jsonFile, quiet = false) {
 }
 
 // The codec table as zhc reports it (`zhc audit --json` keys every entry by name, with its size):
-// runtime/web must decode every entry, with the same size, and know no other name.
+// runtime/web must decode every entry zhc's runtimes read, with the same size, and know no other
+// name. The engine layouts (`engine_layouts`: the engines' own formats, docs/engine-layouts.md)
+// are not runtime encodings, and runtime/web must not know them.
 fs.writeFileSync(W('two.json'), JSON.stringify({ format: 'zhc-probes', version: 1, kind: 'radiance', layout: { type: 'positions' },
   probes: probes.slice(0, 2).map((sh, i) => ({ position: [i, 0, 0], sh3: sh })) }));
-const table = JSON.parse(run('audit', W('two.json'), '--json', '--no-timing')).aggregate.representations;
+const audited = JSON.parse(run('audit', W('two.json'), '--json', '--no-timing'));
+const engineNames = new Set(audited.engine_layouts.map((e) => e.representation));
+check(engineNames.size > 0, 'zhc audit lists the engine layouts');
+for (const name of engineNames) check(!(name in runtime.ENCODINGS), `runtime/web ENCODINGS.${name} is an engine layout`);
+const table = Object.fromEntries(Object.entries(audited.aggregate.representations).filter(([name]) => !engineNames.has(name)));
 const tableNames = Object.keys(table);
 check(tableNames.length > 0, 'zhc audit lists the codec table');
 for (const name of tableNames)
