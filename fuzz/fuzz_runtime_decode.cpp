@@ -52,17 +52,27 @@ void check_zhp(const std::uint8_t* data, std::size_t size) {
     const int rt = zhc_zhp_open(&f, &info, data, size);
     const auto ref = parse_probe_set({data, size}, "fuzz");
     if (rt == ZHC_ERR_COMPRESSED) {
-        if (!ref && ref.error().code != ErrorCode::kBadFormat) std::abort();
+        // The header can't see inside a zstd body; zhc's reader can: a bad frame (kBadFormat) or
+        // values the body holds (kInvalidValue: a non-finite position, a validity byte, a plane or
+        // tetrahedron out of place).
+        if (!ref && ref.error().code != ErrorCode::kBadFormat && ref.error().code != ErrorCode::kInvalidValue) std::abort();
     } else if (ref ? rt != ZHC_OK : rt != code_of(ref.error().code)) {
         std::abort();
     }
-    if (rt == ZHC_OK && info.payload_offset + ref->payload.size() != size - (ref->validity.size() + ref->visibility.size() + ref->planes.size()))
+    // The payload ends where the per-probe sections and the tetrahedra section (count, then 4
+    // indices and 4 neighbours per tetrahedron) begin.
+    const std::size_t tetra_bytes = ref && !ref->tetrahedra.empty() ? 4 + 32 * ref->tetrahedra.size() : 0;
+    if (rt == ZHC_OK && info.payload_offset + ref->payload.size() !=
+                            size - (ref->validity.size() + ref->visibility.size() + ref->planes.size() + tetra_bytes))
         std::abort();
-    // Probe volumes: zhc_zhp_open's code, then NOT_GRID for a valid non-grid file; an accepted
-    // grid samples anywhere (inside, outside, infinite and NaN positions) without crashing.
+    // Probe volumes: zhc_zhp_open's code, then NOT_GRID for a valid file that is not a volume; an
+    // accepted volume samples anywhere (inside, outside, infinite and NaN positions) without crashing.
     zhc_volume v;
     const int vr = zhc_volume_from_zhp(&v, data, size);
-    if (rt != ZHC_OK ? vr != rt : (ref->layout.kind != ProbeLayoutKind::kGrid) != (vr == ZHC_ERR_NOT_GRID)) std::abort();
+    // A grid, or scattered probes with their tetrahedra, is a volume; other valid files are not.
+    const bool volume = rt == ZHC_OK && (ref->layout.kind == ProbeLayoutKind::kGrid ||
+                                         (ref->layout.kind == ProbeLayoutKind::kPositions && !ref->tetrahedra.empty()));
+    if (rt != ZHC_OK ? vr != rt : (volume ? vr != ZHC_OK : vr != ZHC_ERR_NOT_GRID)) std::abort();
     if (vr != ZHC_OK) return;
     const int sections = data[8] == 2 ? data[21] : 0;
     if ((v.validity != nullptr) != bool(sections & 1) || (v.visibility != nullptr) != bool(sections & 2) ||
