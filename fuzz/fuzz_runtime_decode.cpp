@@ -69,10 +69,12 @@ void check_zhp(const std::uint8_t* data, std::size_t size) {
     // accepted volume samples anywhere (inside, outside, infinite and NaN positions) without crashing.
     zhc_volume v;
     const int vr = zhc_volume_from_zhp(&v, data, size);
-    // A grid, or scattered probes with their tetrahedra, is a volume; other valid files are not.
+    // A grid, or scattered probes with their tetrahedra, is a volume (or refused by
+    // zhc_volume_init's own checks, e.g. a spacing <= 0 the container allows); other valid files
+    // are NOT_GRID.
     const bool volume = rt == ZHC_OK && (ref->layout.kind == ProbeLayoutKind::kGrid ||
                                          (ref->layout.kind == ProbeLayoutKind::kPositions && !ref->tetrahedra.empty()));
-    if (rt != ZHC_OK ? vr != rt : (volume ? vr != ZHC_OK : vr != ZHC_ERR_NOT_GRID)) std::abort();
+    if (rt != ZHC_OK ? vr != rt : (!volume) != (vr == ZHC_ERR_NOT_GRID)) std::abort();
     if (vr != ZHC_OK) return;
     const int sections = data[8] == 2 ? data[21] : 0;
     if ((v.validity != nullptr) != bool(sections & 1) || (v.visibility != nullptr) != bool(sections & 2) ||
