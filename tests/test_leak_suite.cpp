@@ -234,7 +234,7 @@ TEST(LeakSuite, BytesPerProbeAndTheSh3Floor) {
 }
 
 // The default bake (probes kept out of walls, one plane per cell; what `zhc bake` writes and every
-// runtime applies): issue 38's acceptance on the suite.
+// runtime applies): the suite's targets (docs/leaks.md "Metrics").
 TEST(LeakSuite, TheDefaultBakesPlanesStopTheLeakInEveryTwoRoomConfiguration) {
     for (const Case& c : suite()) {
         SCOPED_TRACE(c.scene.name);

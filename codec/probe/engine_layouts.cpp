@@ -593,7 +593,7 @@ Sh3Radiance vrchat_hub(const double* tex) {
 }
 
 // ---- RealityKit -----------------------------------------------------------------------------
-// No source is public. Inferred from issue 40's survey of Apple's RealityKit (2026) probe lighting:
+// No source is public. Inferred from public descriptions of Apple's RealityKit (2026) probe lighting:
 // L1 radiance SH as float32, 48 bytes a probe, tetrahedral interpolation. The entry stores the four
 // coefficients (DC, then y, z, x, the basis without the Condon-Shortley sign) x R, G, B in glTF's
 // axes (RealityKit is Y up, right-handed) and evaluates sum c_i A_l Y_i(n) / pi, no clamp: zhc's sh2
@@ -702,7 +702,7 @@ Sh3Radiance bevy_hub(const double* tex) {
     return cube_projection(faces, kAxesYUpRight);
 }
 
-// Source 2. No source is public. Inferred from issue 40's survey (ambient cube, RGBM, 24 bytes a
+// Source 2. No source is public. Inferred from public descriptions (ambient cube, RGBM, 24 bytes a
 // probe) and Valve's ambient cube above; Source's axes (Z up, right-handed) are zhc's. RGBM with an
 // 8-bit multiplier over the range kRgbmRange (engine_layouts.h): m = ceil(max(r, g, b) / range * 255)
 // / 255, each colour round(c / (m range) * 255), decoded as byte / 255 * m * range.
@@ -830,10 +830,10 @@ const EngineLayoutInfo kLayouts[] = {
      kAxesYUpRight, 0, 144, 9, "tetrahedral on the CPU, once per object (9 RGBA of the blended probe)", false, 36,
      godot_texels, godot_shade},
     {"realitykit_l1", "RealityKit probe lighting (inferred)",
-     "no public source: issue 40's survey (L1 float, 48 bytes, tetrahedra)", kAxesYUpRight, 0, 48, 3,
+     "no public source: public descriptions (L1 float, 48 bytes, tetrahedra)", kAxesYUpRight, 0, 48, 3,
      "tetrahedral, per object (inferred)", false, 12, realitykit_texels, realitykit_shade},
     {"source2_ambient_cube", "Source 2 light probes (inferred)",
-     "no public source: issue 40's survey (ambient cube, RGBM, 24 bytes) and Mitchell 2006 (Valve's ambient cube)",
+     "no public source: public descriptions (ambient cube, RGBM, 24 bytes) and Mitchell 2006 (Valve's ambient cube)",
      kAxesZUpRight, 24, 24, 3, "volume texture, hardware trilinear (inferred)", true, 24, source2_texels, source2_shade},
 };
 static_assert(sizeof kLayouts / sizeof kLayouts[0] == sizeof kEngineCodecs / sizeof kEngineCodecs[0]);
