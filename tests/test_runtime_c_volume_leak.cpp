@@ -155,6 +155,20 @@ bool matches_twin(const zhc_volume& v, const ProbeSet& set, const std::vector<Sh
     return std::memcmp(got.data(), want.data(), sizeof got) == 0;
 }
 
+// A grid of random probes (random_probe(rng, i * stride) for probe i) over a fixed box, encoded
+// as `enc`: the random-volume tests' common start.
+Result<ProbeSet> random_grid_set(std::mt19937_64& rng, std::array<std::uint32_t, 3> counts, const char* enc, std::size_t stride) {
+    const size_t n = size_t(counts[0]) * counts[1] * counts[2];
+    std::vector<Sh3Radiance> hub;
+    for (size_t i = 0; i < n; ++i) hub.push_back(random_probe(rng, i * stride));
+    ProbeLayout layout;
+    layout.kind = ProbeLayoutKind::kGrid;
+    layout.grid.counts = counts;
+    layout.grid.origin = {-0.5, 1, 2};
+    layout.grid.spacing = {0.75, 0.5, 1.25};
+    return encode_probe_set(hub, enc, {}, layout);
+}
+
 TEST(RuntimeCVolumeLeak, RandomMasksMatchTheTwinBitForBit) {
     std::mt19937_64 rng(27);
     int samples = 0, renormalised = 0;
@@ -163,15 +177,9 @@ TEST(RuntimeCVolumeLeak, RandomMasksMatchTheTwinBitForBit) {
         for (const char* enc : {"sh3", "zh3_q16", "sh3_q28"})
             for (int sections = 1; sections <= 3; ++sections) {
                 const size_t n = size_t(counts[0]) * counts[1] * counts[2];
-                std::vector<Sh3Radiance> hub;
-                for (size_t i = 0; i < n; ++i) hub.push_back(random_probe(rng, i * 3));
-                ProbeLayout layout;
-                layout.kind = ProbeLayoutKind::kGrid;
-                layout.grid.counts = counts;
-                layout.grid.origin = {-0.5, 1, 2};
-                layout.grid.spacing = {0.75, 0.5, 1.25};
-                auto set = encode_probe_set(hub, enc, {}, layout);
+                auto set = random_grid_set(rng, counts, enc, 3);
                 ASSERT_TRUE(bool(set));
+                const ProbeLayout& layout = set->layout;
                 if (sections & 1)
                     for (size_t i = 0; i < n; ++i) set->validity.push_back(rng() % 4 == 0 ? 0 : 1);
                 if (sections & 2)
@@ -515,15 +523,9 @@ TEST(RuntimeCVolumeLeak, RandomPlanesMatchTheTwinBitForBit) {
         for (const char* enc : {"sh3", "zh3_q16", "sh3_q28"})
             for (int sections = 4; sections <= 7; ++sections) {
                 const size_t n = size_t(counts[0]) * counts[1] * counts[2];
-                std::vector<Sh3Radiance> hub;
-                for (size_t i = 0; i < n; ++i) hub.push_back(random_probe(rng, i * 5));
-                ProbeLayout layout;
-                layout.kind = ProbeLayoutKind::kGrid;
-                layout.grid.counts = counts;
-                layout.grid.origin = {-0.5, 1, 2};
-                layout.grid.spacing = {0.75, 0.5, 1.25};
-                auto set = encode_probe_set(hub, enc, {}, layout);
+                auto set = random_grid_set(rng, counts, enc, 5);
                 ASSERT_TRUE(bool(set));
+                const ProbeLayout& layout = set->layout;
                 if (sections & 1)
                     for (size_t i = 0; i < n; ++i) set->validity.push_back(rng() % 4 == 0 ? 0 : 1);
                 if (sections & 2)
