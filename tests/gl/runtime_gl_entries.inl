@@ -73,6 +73,26 @@ std::uint32_t axis_mode(const GlslEntry& e, const CodecOptions& p) {
     return static_cast<std::uint32_t>(p.axis_mode);
 }
 
+// The kernel's format uniforms (ZhcFormat) of entry e stored with parameters p, and its job `mode`.
+template <class Uniforms>
+void set_format_uniforms(Uniforms& un, std::uint32_t mode, const GlslEntry& e, const CodecOptions& p) {
+    un.mode = mode;
+    un.a[0] = e.family;
+    un.a[1] = e.hallucination;
+    un.a[2] = static_cast<std::uint32_t>(p.bits);
+    un.a[3] = p.sqrt_encoding ? 1u : 0u;
+    un.b[0] = static_cast<std::uint32_t>(p.l2_bound);
+    un.b[1] = static_cast<std::uint32_t>(p.dc_format);
+    un.b[2] = static_cast<std::uint32_t>(p.zonal_mapping);
+    un.b[3] = axis_mode(e, p);
+    un.kind = static_cast<std::uint32_t>(p.kind);
+    un.lum[0] = static_cast<float>(p.luminance.r);
+    un.lum[1] = static_cast<float>(p.luminance.g);
+    un.lum[2] = static_cast<float>(p.luminance.b);
+    un.curve[0] = static_cast<float>(p.hallucinate_a);
+    un.curve[1] = static_cast<float>(p.hallucinate_b);
+}
+
 bool is_quantised(std::uint32_t family) { return family >= kZh3Q16; }
 bool is_zonal(const GlslEntry& e) { return e.family == kZh3F32 || e.family == kZh3Q16 || e.hallucination != kHallNone; }
 bool has_l2(const GlslEntry& e) { return e.family == kSh3F32 || e.family == kSh3Q28 || is_zonal(e); }
