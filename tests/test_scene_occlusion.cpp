@@ -666,6 +666,10 @@ TEST(SkyOcclusionCli, KeysFlagsReportAndErrors) {
     auto parsed = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(bad.data()), bad.size()), "bad.json", "");
     ASSERT_FALSE(parsed.ok());
     EXPECT_EQ(parsed.error().message, "bad.json: occlusion.sky_samples: must be >= 0 (got -3)");
+    const std::string notbool = R"({"version": 1, "probes": {"positions": [[0, 0, 0]]}, "occlusion": {"move_probes": 1}})";
+    auto nb = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(notbool.data()), notbool.size()), "nb.json", "");
+    ASSERT_FALSE(nb.ok());
+    EXPECT_NE(nb.error().message.find("occlusion.move_probes"), std::string::npos) << nb.error().message;
     const std::string typo = R"({"version": 1, "probes": {"positions": [[0, 0, 0]]}, "occlusion": {"sky_sample": 3}})";
     EXPECT_FALSE(parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(typo.data()), typo.size()), "t.json", "").ok());
     // Round trip of the keys.
