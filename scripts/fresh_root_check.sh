@@ -29,6 +29,7 @@ command -v debootstrap >/dev/null || { echo "fresh_root_check: debootstrap missi
 repo=$(cd "$(dirname "$0")/.." && pwd)
 [ -n "$root" ] || root=$(mktemp -d /var/tmp/zhc-fresh-root.XXXXXX)
 mkdir -p "$root"
+chmod 755 "$root"  # the root's "/": mktemp makes it 0700, which no machine's / is (tests run zhc as nobody)
 logs=$(mktemp -d /var/tmp/zhc-fresh-logs.XXXXXX)
 echo "fresh_root_check: logs in $logs"
 
