@@ -1,13 +1,14 @@
-// zhc bake SCENE.json|SCENE.gltf|SCENE.glb -o PROBES.zhp|.json|.glb|.gltf [--threads N]
+// zhc bake SCENE.json|SCENE.gltf|SCENE.glb -o PROBES.zhp|.json|.glb|.gltf [--engine NAME] [--threads N]
 //          [--to REPRESENTATION] [--zstd LEVEL] [--sky-samples N] [--invalid-fraction F]:
 // bakes the scene's probes (only the effects it lists; docs/scene.md) and writes them: a probe
 // container, a JSON probe list, or a glTF with the probes embedded (ZHC_light_probes,
 // docs/gltf-extension.md) — into a copy of the input asset when the scene is glTF, else into a
-// minimal asset.
+// minimal asset; with --engine NAME, an engine's probe file (formats/engines/engine_files.h).
 #include <cstdio>
 #include <thread>
 
 #include "cli.h"
+#include "engine_output.h"
 #include "progress.h"
 #include "codec/bake/scene.h"
 #include "formats/io/file_io.h"
@@ -25,6 +26,8 @@ struct Options {
     std::string scene;
     std::string output;
     std::string to = "sh3";
+    std::string engine;
+    CLI::Option* to_option = nullptr;  // --to given: refused with --engine
     int threads = 0;
     int zstd = 0;
     int sky_samples = -1;        // -1: the scene's occlusion.sky_samples
@@ -83,7 +86,16 @@ void print_report(const BakeReport& r) {
 int run(const Options& o) {
     const std::string ext = file_extension(o.output);
     const bool gltf_out = ext == ".glb" || ext == ".gltf";
-    if (ext != ".zhp" && ext != ".json" && !gltf_out) {
+    const EngineFile* engine = nullptr;
+    if (!o.engine.empty()) {
+        engine = engine_for_output(o.engine, o.output);
+        if (!engine) return kExitUsage;
+        if (o.zstd != 0 || (o.to_option && o.to_option->count() > 0)) {
+            std::fprintf(stderr, "zhc: error: --engine %s: the file holds the engine's own layout (%s): --to and --zstd do not apply\n",
+                         o.engine.c_str(), std::string(engine->layout_codec).c_str());
+            return kExitUsage;
+        }
+    } else if (ext != ".zhp" && ext != ".json" && !gltf_out) {
         std::fprintf(stderr, "zhc: error: -o %s: the output must end in .zhp (container), .json (probe list) or .glb/.gltf (glTF with embedded probes)\n",
                      o.output.c_str());
         return kExitUsage;
@@ -159,6 +171,13 @@ int run(const Options& o) {
     }
 
     const ProbeLayout layout = probe_layout(scene->probes);
+    if (engine) {
+        EngineFileInput ei;
+        ei.hub = *probes;
+        ei.layout = layout;
+        ei.validity = leak.validity;
+        return write_engine_output(*engine, ei, o.output);
+    }
     if (ext == ".json") {
         ProbeList list;
         list.probes = *probes;
@@ -221,9 +240,11 @@ const VerbRegistration registration(15, [](CLI::App& app) -> std::function<int()
     auto o = std::make_shared<Options>();
     CLI::App* sub = app.add_subcommand("bake", "Bake a scene (JSON, or glTF lights and meshes) into SH3 radiance probes");
     sub->add_option("SCENE", o->scene, "scene: JSON (docs/scene.md) or glTF .gltf/.glb (KHR_lights_punctual lights, meshes as occluders)")->required();
-    sub->add_option("-o,--output", o->output, "output: .zhp (probe container), .json (float SH3 probe list), .glb/.gltf (probes embedded in glTF)")->required();
+    sub->add_option("-o,--output", o->output, "output: .zhp (probe container), .json (float SH3 probe list), .glb/.gltf (probes embedded in glTF), or with --engine the engine's file")->required();
+    add_engine_option(sub, o->engine);
     add_threads_option(sub, o->threads, "output identical for any count");
-    add_representations_option(sub, o->to, RepresentationCount::kOne, "stored in the .zhp/glTF (default sh3)", "--to")->capture_default_str();
+    o->to_option = add_representations_option(sub, o->to, RepresentationCount::kOne, "stored in the .zhp/glTF (default sh3)", "--to");
+    o->to_option->capture_default_str();
     sub->add_option("--sky-samples", o->sky_samples, "occlusion rays per probe for the sky/environment, probe validity (default: the scene's occlusion.sky_samples, 256; 0 = no occlusion)")->check(CLI::Range(0, 65536));
     sub->add_option("--invalid-fraction", o->invalid_fraction, "a probe is invalid (dilated) when more than this fraction of its rays start inside geometry (default: the scene's occlusion.invalid_fraction, 0.25)")->check(CLI::Range(0.0, 1.0));
     sub->add_option("--bounces", o->bounces, "reflected light: at most this many surface bounces per path (default: the scene's transport.bounces, 64; 0 = no reflected or emitted light)")->check(CLI::Range(0, 1024));

@@ -1,15 +1,19 @@
 // zhc convert IN -o OUT [--to REPRESENTATION] [quantiser options] [--zstd LEVEL]
 //
-// IN: an environment map (one probe, projected to SH3), a .zhp probe container or a JSON probe
-// list (detected by content). OUT's extension picks the output: .zhp (container) or .json
-// (float SH3 probe list). Outputs are written atomically.
+// IN: an environment map (one probe, projected to SH3), a .zhp probe container, a JSON probe list or
+// an engine's probe file (formats/engines/engine_files.h; detected by content). OUT's extension
+// picks the output: .zhp (container) or .json (float SH3 probe list); with --engine NAME, the
+// engine's file (its extension), read back once written to print its irradiance error against the
+// input. Outputs are written atomically.
 #include <cstdio>
 #include <map>
 #include <optional>
 #include <vector>
 
 #include "cli.h"
+#include "engine_output.h"
 #include "codec/probe/probe_set.h"
+#include "formats/engines/engine_files.h"
 #include "formats/envmap/envmap.h"
 #include "formats/io/file_io.h"
 #include "formats/probes/probe_file.h"
@@ -24,6 +28,7 @@ struct Options {
     std::string input;
     std::string output;
     std::string to;
+    std::string engine;
     int bits = 8;
     bool sqrt = false;
     std::string bound = "tight";
@@ -70,7 +75,8 @@ int refuse_unused_storage_options(const Options& o, const std::string& rep) {
 struct Loaded {
     ProbeList list;
     std::optional<ProbeSet> set;
-    std::string kind;  // "envmap", "zhp", "json"
+    std::string kind;  // "envmap", "zhp", "json", or an engine file's name
+    std::vector<std::uint8_t> validity;  // an engine file's, when it has one
 };
 
 Result<Loaded> load_input(const Options& o) {
@@ -94,6 +100,14 @@ Result<Loaded> load_input(const Options& o) {
         if (!img) return img.error();
         in.list.probes.push_back(project_envmap(*img, resolve_threads(o.threads)));
         in.kind = "envmap";
+    } else if (const EngineFile* engine = sniff_engine_file(*bytes)) {
+        auto probes = engine->read(*bytes, o.input);
+        if (!probes) return probes.error();
+        for (const std::string& line : probes->notes) std::fprintf(stderr, "zhc: note: %s: %s\n", o.input.c_str(), line.c_str());
+        in.list.probes = std::move(probes->hub);
+        in.list.layout = std::move(probes->layout);
+        in.validity = std::move(probes->validity);
+        in.kind = std::string(engine->name);
     } else if (looks_like_json(*bytes)) {
         auto list = parse_probe_json(*bytes, o.input);
         if (!list) return list.error();
@@ -118,10 +132,32 @@ Result<CodecOptions> params_from(const Options& o) {
     return p;
 }
 
+// --engine NAME: the engine's file (read back before it is written, to print its error).
+int run_engine(const Options& o, const EngineFile& engine) {
+    if (!o.to.empty() || o.any_storage_flag() || o.zstd != 0) {
+        std::fprintf(stderr, "zhc: error: --engine %s: the file holds the engine's own layout (%s): -r/--to, the quantiser options and --zstd do not apply\n",
+                     o.engine.c_str(), std::string(engine.layout_codec).c_str());
+        return kExitUsage;
+    }
+    if (int rc = refuse_output_over_input("-o", o.output, {o.input}); rc != kExitOk) return rc;
+    auto in = load_input(o);
+    if (!in) return report(in.error());
+    EngineFileInput ei;
+    ei.hub = in->list.probes;
+    ei.layout = in->list.layout;
+    ei.validity = in->set ? std::span<const std::uint8_t>(in->set->validity) : std::span<const std::uint8_t>(in->validity);
+    if (in->set) ei.tetrahedra = in->set->tetrahedra;
+    return write_engine_output(engine, ei, o.output);
+}
+
 int run(const Options& o) {
     const std::string ext = file_extension(o.output);
+    if (!o.engine.empty()) {
+        const EngineFile* engine = engine_for_output(o.engine, o.output);
+        return engine ? run_engine(o, *engine) : kExitUsage;
+    }
     if (ext != ".zhp" && ext != ".json") {
-        std::fprintf(stderr, "zhc: error: %s: output extension must be .zhp or .json\n", o.output.c_str());
+        std::fprintf(stderr, "zhc: error: %s: output extension must be .zhp or .json (an engine's file: --engine NAME)\n", o.output.c_str());
         return kExitUsage;
     }
     if (ext == ".json" && o.zstd != 0) {
@@ -163,6 +199,7 @@ int run(const Options& o) {
             auto set = encode_probe_set(in->list.probes, rep, *params, in->list.layout, &stats);
             if (!set) return report(set.error());
             out = std::move(set).value();
+            out.validity = in->validity;  // an engine file's validity (empty otherwise)
             if (in->set) {  // validity, visibility masks and cell planes do not depend on the representation
                 out.validity = in->set->validity;
                 out.visibility = in->set->visibility;
@@ -209,8 +246,9 @@ const VerbRegistration registration(40, [](CLI::App& app) -> std::function<int()
         "convert", "Convert probes between environment maps, .zhp containers and JSON probe lists");
     sub->add_option("IN", o->input, "environment map (EXR/.hdr or KTX2/KTX 1/DDS cube map: one probe), .zhp container or JSON probe list")
         ->required();
-    sub->add_option("-o,--output", o->output, "output file: .zhp (container) or .json (float SH3 probe list)")
+    sub->add_option("-o,--output", o->output, "output file: .zhp (container), .json (float SH3 probe list) or, with --engine, the engine's file")
         ->required();
+    add_engine_option(sub, o->engine);
     add_representations_option(sub, o->to, RepresentationCount::kOne, "default: the input container's; JSON output: none (float SH3)", "--to");
     auto& f = o->storage_flags;
     f.emplace_back(sub->add_option("--bits", o->bits, "bits per quantised ratio (2..8, default 8)")->check(CLI::Range(2, 8)),

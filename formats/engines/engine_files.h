@@ -63,6 +63,16 @@ struct EngineFile {
     Result<EngineFileProbes> (*read)(std::span<const std::uint8_t> bytes, const std::string& name) = nullptr;
 };
 
+// How far a converted bake is from its source: irradiance of `back` (what the file gives back)
+// against `source` at 64 spherical-Fibonacci normals per probe (codec/sh/sh.h irradiance), over
+// every probe and channel. rms: RMS of the differences / RMS of the source's values; max: the
+// largest |difference| / the largest |source value|. Both 0 for identical probes; sizes must match.
+struct EngineFileError {
+    double rms = 0;
+    double max = 0;
+};
+EngineFileError engine_file_error(std::span<const Sh3Radiance> source, std::span<const Sh3Radiance> back);
+
 // Every engine file format, in a fixed order.
 std::span<const EngineFile> engine_files();
 // The entry named `name`; nullptr when none.
