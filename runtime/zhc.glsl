@@ -834,4 +834,34 @@ ZhcSh3 zhcVolumeSh3(ZhcVolume v, ZhcFormat f, vec3 p) {
 vec3 zhcVolumeIrradiance(ZhcVolume v, ZhcFormat f, vec3 p, vec3 normal) {
     return zhcIrradianceSh3(zhcVolumeSh3(v, f, p), zhcNormalizeOrZ(normal));
 }
+
+// Scattered probes (a `points` volume; docs/runtime.md "Scattered probes (`points` layout)"). The
+// tetrahedron around a point is found on the CPU, once per object (zhc_volume_tetra_weights of
+// zhc_runtime.h, or volumeTetraWeights of runtime/web/zhc_runtime.mjs: its 4 probe indices and
+// weights, validity already applied), as Unity's light probe groups do; the shader blends those 4
+// probes, read through the same ZHC_VOLUME_WORD binding as the grid functions, e.g.
+//
+//   uniform uvec4 uTetraProbes;   // probes[] of zhc_volume_tetra_weights
+//   uniform vec4 uTetraWeights;   // weights[] as float
+//   vec3 e = zhcVolumeTetraIrradiance(uTetraProbes, uTetraWeights, uFormat, worldNormal);
+//
+// The blend is zhc_volume_sh3's points branch in float: probes k = 0..3 in order, each decoded to
+// SH3 and added with its weight, probes of weight 0 not read (a weight below float's range counts
+// as 0). The probe indices must lie below the probe count: they index the buffer unchecked.
+ZhcSh3 zhcVolumeTetraSh3(uvec4 probes, vec4 weights, ZhcFormat f) {
+    ZhcSh3 acc = zhcZeroSh3();
+    for (int k = 0; k < 4; ++k) {
+        float w = weights[k];
+        if (w == 0.0) continue;
+        ZhcSh3 s = zhcVolumeProbe(probes[k], f);
+        for (int i = 0; i < 9; ++i) acc.c[i] += w * s.c[i];
+    }
+    return acc;
+}
+
+// Irradiance (zhc's normalised kernel) of zhcVolumeTetraSh3's blend for the surface normal `normal`
+// (normalised here; zero or not finite: +Z), evaluated once as zhcVolumeIrradiance does.
+vec3 zhcVolumeTetraIrradiance(uvec4 probes, vec4 weights, ZhcFormat f, vec3 normal) {
+    return zhcIrradianceSh3(zhcVolumeTetraSh3(probes, weights, f), zhcNormalizeOrZ(normal));
+}
 #endif

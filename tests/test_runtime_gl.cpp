@@ -36,6 +36,7 @@
 #include "codec/probe/runtime_table.h"
 #include "codec/probe/zh3.h"
 #include "support.h"
+#include "tetra_gpu_cases.h"
 #include "volume_planes_cases.h"
 #include "zhc_runtime.h"
 #include "zhc_runtime_params.hpp"
@@ -53,7 +54,8 @@ constexpr double kCFloat = 16, kCQuant = 32, kCDecode = 16, kCLightmap = 16;
 constexpr int kOutFloats = 30;  // per item: 27 SH3 radiance + 3 irradiance
 
 // The test main appended after zhc.glsl. Modes: 0 probe decode + irradiance, 1 IrradZ texel,
-// 2 DC unpacking, 3 HLSH, 4 probe volume, 5 the ASTC LDR fallback's I_z decode, 6 the generated table.
+// 2 DC unpacking, 3 HLSH, 4 probe volume, 5 the ASTC LDR fallback's I_z decode, 6 the generated table,
+// 7 scattered probes (zhcVolumeTetraSh3 / zhcVolumeTetraIrradiance).
 // Before zhc.glsl: the probe words, bound for the volume functions (ZHC_VOLUME_WORD).
 const char* kTestPrelude = R"(
 layout(std430, binding = 0) readonly buffer Words { uint words[]; };
@@ -135,6 +137,17 @@ void main() {
             outv[o + 3u] = float(zhcVolumePlaneKeep(ZHC_VOLUME_PLANE(i0.x + cn.x * (i0.y + cn.y * i0.z)), vv, i0, p));
         }
 #endif
+    } else if (uMode == 7u) {  // scattered probes: normals[] holds 4 weights, 4 probe indices, normal per item
+        ZhcFormat f = ZhcFormat(uA.x, uA.y, uA.z, uA.w, uB.x, uB.y, uB.z, uB.w, uKind, uLum, uCurve);
+        uint b = 11u * i;
+        vec4 wt = vec4(normals[b], normals[b + 1u], normals[b + 2u], normals[b + 3u]);
+        uvec4 q = uvec4(vec4(normals[b + 4u], normals[b + 5u], normals[b + 6u], normals[b + 7u]));
+        vec3 nn = vec3(normals[b + 8u], normals[b + 9u], normals[b + 10u]);
+        ZhcSh3 s = zhcVolumeTetraSh3(q, wt, f);
+        for (int c = 0; c < 9; ++c)
+            for (int k = 0; k < 3; ++k) outv[o + uint(3 * c + k)] = s.c[c][k];
+        vec3 e = zhcVolumeTetraIrradiance(q, wt, f, nn);
+        outv[o + 27u] = e.x; outv[o + 28u] = e.y; outv[o + 29u] = e.z;
     } else if (uMode == 6u) {  // the generated table: item i is encoding id i (ids past the end included)
         outv[o] = float(zhcEncodingBytes(i));
         outv[o + 1u] = float(zhcEncodingFamily(i));
@@ -981,6 +994,168 @@ void compare_plane_volumes(int samples, bool gltf) {
     }
 }
 
+// Scattered probes (zhcVolumeTetraSh3 / zhcVolumeTetraIrradiance, docs/runtime.md "Scattered
+// probes (`points` layout)"): 150 random positions tetrahedralised by formats/probes/tetra.h (qhull),
+// probes encoded as sh3, zh3_q16, sh3_q28 and hall_adaptive_q16, with and without validity (1 in 4
+// invalid), against the C header's zhc_volume_sh3 / zhc_volume_irradiance_d at points inside and
+// outside the hull and at every probe, the shader given the 4 probes and weights (as float) of
+// zhc_volume_tetra_weights. Every weight-0 probe index is replaced by that of a probe of 0xFF bytes,
+// which decodes to NaN / Inf: the result stays finite only if the blend does not read it. Bound:
+// compare_volumes' decode, evaluation and blend terms, 48 u S with S = sum_k w_k S_k (the weights
+// are a partition of unity; rounding each to float moves it by u w_k, inside the 48); decoded SH3
+// within kCDecode + 8 u of sum_k w_k M_k.
+template <class Fixture>
+void compare_tetra_volumes(int samples) {
+    const std::vector<Sh3Radiance> maps = envmap_probes();
+    ASSERT_EQ(maps.size(), 8u);
+    std::printf("%-22s %8s %8s %10s %10s %8s\n", "scattered probes", "samples", "outside", "max u S", "dec. u M", "skipped");
+    for (const char* name : {"sh3", "zh3_q16", "sh3_q28", "hall_adaptive_q16"})
+        for (int with_validity = 0; with_validity < 2; ++with_validity) {
+            const Codec* codec = find_codec(name);
+            ASSERT_NE(codec, nullptr);
+            const GlslEntry& e = glsl_entries().at(name);
+            std::mt19937_64 rng(0x7e7u + codec->size_bytes + unsigned(with_validity));
+            const std::vector<std::array<float, 3>> positions = tetra_test::random_positions(rng, 150);
+            std::vector<Sh3Radiance> hubs;
+            std::vector<std::uint8_t> validity;
+            for (std::uint32_t i = 0; i < positions.size(); ++i) {
+                hubs.push_back(random_probe(rng, maps, int(i % 3)));
+                if (with_validity) validity.push_back(rng() % 4 == 0 ? 0 : 1);
+            }
+            const CodecOptions p{};
+            tetra_test::PointsVolume v;
+            tetra_test::make_points_volume(v, *codec, p, positions, hubs, validity);
+            ASSERT_TRUE(v.error.empty()) << v.error;
+            ASSERT_TRUE(tetra_test::nan_probe_poisons(v)) << name;
+            const std::vector<tetra_test::Sample> ss = tetra_test::samples(rng, v, samples, true, test::uniform_direction);
+            std::vector<float> items;
+            for (const tetra_test::Sample& sm : ss) {
+                for (int k = 0; k < 4; ++k) items.push_back(float(sm.weights[k]));
+                for (int k = 0; k < 4; ++k) items.push_back(float(sm.probes[k]));
+                for (int c = 0; c < 3; ++c) items.push_back(sm.normal[c]);
+            }
+            std::vector<std::uint32_t> w(v.bytes.size() / 4);
+            std::memcpy(w.data(), v.bytes.data(), v.bytes.size());
+            typename Fixture::Uniforms un;
+            set_format_uniforms(un, 7, e, p);
+            const std::vector<float> gpu = Fixture::run(un, w, items, ss.size());
+            Tally t;
+            long compared = 0, outside = 0, skipped = 0, dropped = 0;
+            for (std::size_t i = 0; i < ss.size(); ++i) {
+                const tetra_test::Sample& sm = ss[i];
+                const double pos[3] = {sm.pos[0], sm.pos[1], sm.pos[2]};
+                const double nrm[3] = {sm.normal[0], sm.normal[1], sm.normal[2]};
+                double ref[3], ref_sh[27];
+                zhc_volume_irradiance_d(&v.vol, pos, nrm, ref);
+                zhc_volume_sh3(&v.vol, pos, ref_sh);
+                ASSERT_GE(sm.outside, 0);
+                outside += sm.outside;
+                double scale[3] = {0, 0, 0}, coeff[9][3] = {};
+                bool defined = true;
+                for (int k = 0; k < 4; ++k) {
+                    if (sm.weights[k] == 0.0) {
+                        dropped += with_validity && sm.outside == 0;
+                        continue;
+                    }
+                    const Scale sc = probe_scale(e, p, v.decoded[sm.probes[k]]);
+                    defined = defined && sc.defined;
+                    for (int c = 0; c < 3; ++c) {
+                        scale[c] += sm.weights[k] * sc.irradiance[c];
+                        for (int j = 0; j < 9; ++j) coeff[j][c] += sm.weights[k] * sc.coeff[j][c];
+                    }
+                }
+                if (!defined) {
+                    ++skipped;
+                    continue;
+                }
+                ++compared;
+                const std::string what = std::string(name) + (with_validity ? " (validity)" : "") + " sample " + std::to_string(i);
+                for (int c = 0; c < 3; ++c)
+                    check_value(t, &t.max_irr, ref[c], gpu[i * kOutFloats + 27 + std::size_t(c)], scale[c], 48, what + " channel " + std::to_string(c));
+                for (int j = 0; j < 9; ++j)
+                    for (int c = 0; c < 3; ++c)
+                        check_value(t, &t.max_dec, ref_sh[3 * j + c], gpu[i * kOutFloats + std::size_t(3 * j + c)], coeff[j][c], kCDecode + 8,
+                                    what + " coefficient " + std::to_string(3 * j + c));
+            }
+            std::printf("%-22s %8ld %8ld %10.3f %10.3f %8ld%s\n", name, compared, outside, t.max_irr, t.max_dec, skipped,
+                        with_validity ? " (validity)" : "");
+            EXPECT_EQ(t.failures, 0) << name << ": " << t.first_failure;
+            EXPECT_EQ(t.compared, 30 * compared) << name << ": every value finite";
+            EXPECT_EQ(skipped, 0) << name;
+            EXPECT_GT(outside, long(ss.size()) / 3) << name << ": points outside the hull";
+            EXPECT_LT(outside, long(ss.size()) * 9 / 10) << name << ": points inside the hull";
+            if (with_validity) {
+                EXPECT_GT(dropped, long(ss.size()) / 10) << name << ": validity drops probes inside the hull";
+            }
+        }
+}
+
+// Analytic fields through zhcVolumeTetraIrradiance, against the double twin of the field itself
+// (not the C header): every probe equal (sh3 and zh3_q16) gives that probe's irradiance everywhere,
+// inside and outside the hull, within 48 u S of the probe; an SH3 field affine in position stored as
+// sh3 is reproduced inside the hull within 48 u S of sum_k w_k S_k (the stored float rounding of the
+// probes, u each, is inside it).
+template <class Fixture>
+void check_tetra_fields(int samples) {
+    const std::vector<Sh3Radiance> maps = envmap_probes();
+    ASSERT_EQ(maps.size(), 8u);
+    for (const char* name : {"sh3", "zh3_q16", "affine"}) {
+        const bool affine = std::string(name) == "affine";
+        const Codec* codec = find_codec(affine ? "sh3" : name);
+        ASSERT_NE(codec, nullptr);
+        const GlslEntry& e = glsl_entries().at(std::string(codec->name));
+        std::mt19937_64 rng(0xf1e1du + codec->size_bytes + (affine ? 1u : 0u));
+        const std::vector<std::array<float, 3>> positions = tetra_test::random_positions(rng, 120);
+        const Sh3Radiance constant = random_probe(rng, maps, 0);
+        const tetra_test::AffineField field = tetra_test::random_affine(rng);
+        std::vector<Sh3Radiance> hubs;
+        for (const auto& q : positions) hubs.push_back(affine ? field.hub_at(q) : constant);
+        const CodecOptions p{};
+        tetra_test::PointsVolume v;
+        tetra_test::make_points_volume(v, *codec, p, positions, hubs, {});
+        ASSERT_TRUE(v.error.empty()) << v.error;
+        const std::vector<tetra_test::Sample> ss = tetra_test::samples(rng, v, samples, false, test::uniform_direction);
+        std::vector<float> items;
+        for (const tetra_test::Sample& sm : ss) {
+            for (int k = 0; k < 4; ++k) items.push_back(float(sm.weights[k]));
+            for (int k = 0; k < 4; ++k) items.push_back(float(sm.probes[k]));
+            for (int c = 0; c < 3; ++c) items.push_back(sm.normal[c]);
+        }
+        std::vector<std::uint32_t> w(v.bytes.size() / 4);
+        std::memcpy(w.data(), v.bytes.data(), v.bytes.size());
+        typename Fixture::Uniforms un;
+        set_format_uniforms(un, 7, e, p);
+        const std::vector<float> gpu = Fixture::run(un, w, items, ss.size());
+        Tally t;
+        long compared = 0;
+        for (std::size_t i = 0; i < ss.size(); ++i) {
+            const tetra_test::Sample& sm = ss[i];
+            if (affine && sm.outside) continue;
+            double sh[27], want[3], scale[3] = {0, 0, 0};
+            if (affine) {
+                const double x[3] = {sm.pos[0], sm.pos[1], sm.pos[2]};
+                field.at(x, sh);
+            } else {
+                for (int j = 0; j < 27; ++j) sh[j] = v.decoded[0][j / 3][j % 3];
+            }
+            tetra_test::irradiance_twin(sh, sm.normal, want);
+            for (int k = 0; k < 4; ++k) {  // constant: the probe's own S (weights sum to 1)
+                const Scale sc = probe_scale(e, p, v.decoded[affine ? sm.probes[k] : 0]);
+                for (int c = 0; c < 3; ++c) scale[c] += sm.weights[k] * sc.irradiance[c];
+            }
+            ++compared;
+            for (int c = 0; c < 3; ++c)
+                check_value(t, &t.max_irr, want[c], gpu[i * kOutFloats + 27 + std::size_t(c)], scale[c], 48,
+                            std::string(name) + " sample " + std::to_string(i) + " channel " + std::to_string(c));
+        }
+        std::printf("%-22s %8ld samples, max %.3f u S\n", affine ? "affine field (sh3)" : (std::string("constant ") + name).c_str(),
+                    compared, t.max_irr);
+        EXPECT_EQ(t.failures, 0) << name << ": " << t.first_failure;
+        EXPECT_EQ(t.compared, 3 * compared) << name;
+        EXPECT_GT(compared, affine ? long(samples) / 4 : long(ss.size()) - 1) << name;
+    }
+}
+
 TEST_F(RuntimeGl, ProbeVolumesMatchTheCHeader) { compare_volumes<RuntimeGl>(int(test::sample_count(10000))); }
 TEST_F(RuntimeGl, MaskedProbeVolumesMatchTheCHeader) { compare_masked_volumes<RuntimeGl>(int(test::sample_count(10000))); }
 TEST_F(RuntimeGles, MaskedProbeVolumesMatchTheCHeader) { compare_masked_volumes<RuntimeGles>(int(test::sample_count(2000))); }
@@ -989,6 +1164,9 @@ TEST_F(RuntimeGl, PlaneProbeVolumesMatchTheCHeader) { compare_plane_volumes<Runt
 TEST_F(RuntimeGl, PlaneProbeVolumesInGltfAxesMatchTheCHeader) { compare_plane_volumes<RuntimeGl>(int(test::sample_count(10000)), true); }
 TEST_F(RuntimeGles, PlaneProbeVolumesMatchTheCHeader) { compare_plane_volumes<RuntimeGles>(int(test::sample_count(2000)), false); }
 TEST_F(RuntimeGles, PlaneProbeVolumesInGltfAxesMatchTheCHeader) { compare_plane_volumes<RuntimeGles>(int(test::sample_count(2000)), true); }
+TEST_F(RuntimeGl, ScatteredProbesMatchTheCHeader) { compare_tetra_volumes<RuntimeGl>(int(test::sample_count(10000))); }
+TEST_F(RuntimeGles, ScatteredProbesMatchTheCHeader) { compare_tetra_volumes<RuntimeGles>(int(test::sample_count(2000))); }
+TEST_F(RuntimeGl, ScatteredProbesKeepConstantAndAffineFields) { check_tetra_fields<RuntimeGl>(int(test::sample_count(4000))); }
 
 }  // namespace
 }  // namespace zhc

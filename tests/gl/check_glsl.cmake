@@ -24,6 +24,8 @@ void main() {
     e += zhcHlshIrradiance(s.c[0], s.c[1], s.c[2], s.c[3], n);
     e += zhcUnpackR11G11B10F(w[0]) + zhcUnpackRGB9E5(w[1]) + vec3(zhcUnpackHalf(w[2]));
     e += zhcVolumeIrradiance(uVolume, uFormat, vec3(float(i), 0.5, 2.0), n) + zhcVolumeSh3(uVolume, uFormat, n).c[4];
+    e += zhcVolumeTetraIrradiance(uvec4(i, 1u, 2u, 3u), vec4(0.5, 0.25, 0.25, 0.0), uFormat, n) +
+         zhcVolumeTetraSh3(uvec4(0u, i, 2u, 3u), vec4(0.25), uFormat).c[4];
     outv[i] = vec4(e, 1.0);
 }
 ")

@@ -3,7 +3,7 @@
 # test_mesa_bc; it is built only when EGL/GL were found (tests/CMakeLists.txt filters it out
 # otherwise, and ZHC_REQUIRE_MESA_TEST makes that an error).
 if(TARGET test_runtime_gl)
-  target_link_libraries(test_runtime_gl PRIVATE OpenGL::OpenGL OpenGL::EGL zhc_runtime)  # zhc_volume_*: the reference
+  target_link_libraries(test_runtime_gl PRIVATE OpenGL::OpenGL OpenGL::EGL zhc_runtime zhc_tetra)  # zhc_volume_*: the reference; zhc_tetra: scattered probes' tetrahedra
   target_compile_definitions(test_runtime_gl PRIVATE ZHC_RUNTIME_GLSL_PATH="${PROJECT_SOURCE_DIR}/runtime/zhc.glsl")
   # Mesa/LLVM allocations live until exit (see gl/CMakeLists.txt): no leak checking here only.
   gtest_discover_tests(test_runtime_gl DISCOVERY_TIMEOUT 60
