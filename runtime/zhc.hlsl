@@ -964,6 +964,39 @@ float3 zhc_volume_irradiance(ZhcVolume v, ZhcFormat f, float3 p, float3 normal)
 {
     return zhc_sh3_irradiance(zhc_volume_sh3(v, f, p), zhc_normalize_or_z(normal));
 }
+
+// Scattered probes (a `points` volume; docs/runtime.md "Scattered probes (`points` layout)"). The
+// tetrahedron around a point is found on the CPU, once per object (zhc_volume_tetra_weights of
+// zhc_runtime.h: its 4 probe indices and weights, validity already applied), as Unity's light probe
+// groups do; the shader blends those 4 probes, read through the same ZHC_VOLUME_WORD binding as the
+// grid functions, e.g.
+//
+//   cbuffer Object { uint4 gTetraProbes; float4 gTetraWeights; };   // probes[], weights[] as float
+//   float3 e = zhc_volume_tetra_irradiance(gTetraProbes, gTetraWeights, gFormat, worldNormal);
+//
+// The blend is zhc_volume_sh3's points branch in float: probes k = 0..3 in order, each decoded to
+// SH3 and added with its weight, probes of weight 0 not read (a weight below float's range counts
+// as 0). The probe indices must lie below the probe count: they index the buffer unchecked.
+ZhcSH3 zhc_volume_tetra_sh3(uint4 probes, float4 weights, ZhcFormat f)
+{
+    ZhcSH3 acc;
+    [unroll] for (int i = 0; i < 9; ++i) acc.c[i] = float3(0.0f, 0.0f, 0.0f);
+    [loop] for (uint k = 0u; k < 4u; ++k)
+    {
+        float w = weights[k];
+        if (w == 0.0f) continue;
+        ZhcSH3 s = zhc_volume_probe(probes[k], f);
+        [unroll] for (int j = 0; j < 9; ++j) acc.c[j] += w * s.c[j];
+    }
+    return acc;
+}
+
+// Irradiance (zhc's normalised kernel) of zhc_volume_tetra_sh3's blend for the surface normal
+// `normal` (normalised here; zero or not finite: +Z), evaluated once as zhc_volume_irradiance does.
+float3 zhc_volume_tetra_irradiance(uint4 probes, float4 weights, ZhcFormat f, float3 normal)
+{
+    return zhc_sh3_irradiance(zhc_volume_tetra_sh3(probes, weights, f), zhc_normalize_or_z(normal));
+}
 #endif
 
 #endif  // ZHC_HLSL_INCLUDED

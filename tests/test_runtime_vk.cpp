@@ -45,6 +45,7 @@
 #include "codec/probe/zh3.h"
 #include "support.h"
 #include "vk_compute.h"
+#include "tetra_gpu_cases.h"
 #include "volume_planes_cases.h"
 #include "zhc_runtime.h"
 #include "zhc_runtime_params.hpp"
@@ -1061,6 +1062,170 @@ TEST_F(RuntimeVk, PlaneProbeVolumesMatchTheCHeader) {
             EXPECT_LE(near, samples / 100) << name;
             EXPECT_GT(by_plane, samples / 4) << name << ": the planes act";
         }
+    }
+}
+
+// Scattered probes (zhc_volume_tetra_sh3 / zhc_volume_tetra_irradiance, mode 5; docs/runtime.md
+// "Scattered probes (`points` layout)") against the C header's zhc_volume_sh3 /
+// zhc_volume_irradiance_d: 150 random positions tetrahedralised by formats/probes/tetra.h (qhull),
+// probes (lights, random SH, sample maps) stored as sh3, zh3_q16, sh3_q28 and hall_adaptive_q16,
+// with and without validity (1 in 4 invalid), 10,000 points inside and outside the hull plus every
+// probe, the kernel given the 4 probes and weights (as float) of zhc_volume_tetra_weights. Every
+// weight-0 probe index is replaced by that of a probe of 0xFF bytes (decodes to NaN / Inf): the
+// results stay finite only if the blend does not read it. Bound, for the blended SH3 and the
+// irradiance: ProbeVolumesMatchTheCHeader's decode, evaluation and blend terms, 40 eps T with
+// T = sum_k w_k T_k (the weights are a partition of unity; rounding them to float moves each by
+// u w_k, inside the 40). Then analytic fields against their own double twin: every probe equal
+// (sh3, zh3_q16) gives that probe's irradiance inside and outside the hull, and an SH3 field affine
+// in position stored as sh3 is reproduced inside the hull, both within 40 eps T.
+TEST_F(RuntimeVk, ScatteredProbesMatchTheCHeader) {
+    const int samples = int(test::sample_count(10000));
+    std::printf("%-22s %8s %8s %12s\n", "scattered probes", "samples", "outside", "max err/eps T");
+    auto params_of = [](const char* name, const CodecOptions& p, std::size_t count, std::uint32_t stride, std::uint32_t out[16]) {
+        const std::uint32_t v[16] = {static_cast<std::uint32_t>(hlsl_encoding(name)),
+                                     static_cast<std::uint32_t>(p.bits),
+                                     p.sqrt_encoding ? 1u : 0u,
+                                     static_cast<std::uint32_t>(p.l2_bound),
+                                     static_cast<std::uint32_t>(p.dc_format),
+                                     static_cast<std::uint32_t>(p.zonal_mapping),
+                                     static_cast<std::uint32_t>(p.axis_mode),
+                                     static_cast<std::uint32_t>(p.kind),
+                                     float_bits(static_cast<float>(p.luminance.r)),
+                                     float_bits(static_cast<float>(p.luminance.g)),
+                                     float_bits(static_cast<float>(p.luminance.b)),
+                                     float_bits(static_cast<float>(p.hallucinate_a)),
+                                     float_bits(static_cast<float>(p.hallucinate_b)),
+                                     static_cast<std::uint32_t>(count),
+                                     stride,
+                                     5u};
+        std::memcpy(out, v, sizeof v);
+    };
+    auto items_of = [](const std::vector<tetra_test::Sample>& ss) {
+        std::vector<float> items;  // weights, probe indices (as floats), normal, 0
+        for (const tetra_test::Sample& sm : ss) {
+            for (int k = 0; k < 4; ++k) items.push_back(float(sm.weights[k]));
+            for (int k = 0; k < 4; ++k) items.push_back(float(sm.probes[k]));
+            items.insert(items.end(), {sm.normal[0], sm.normal[1], sm.normal[2], 0.0f});
+        }
+        return items;
+    };
+    auto direction = [](double u1, double u2) { return test::uniform_direction(u1, u2); };
+    for (const char* name : {"sh3", "zh3_q16", "sh3_q28", "hall_adaptive_q16"})
+        for (int with_validity = 0; with_validity < 2; ++with_validity) {
+            const Codec* codec = find_codec(name);
+            ASSERT_NE(codec, nullptr);
+            ASSERT_GE(hlsl_encoding(name), 0) << name;
+            std::mt19937_64 rng(0x7e7Au + codec->size_bytes + unsigned(with_validity));
+            const std::vector<std::array<float, 3>> positions = tetra_test::random_positions(rng, 150);
+            std::vector<Sh3Radiance> hubs;
+            std::vector<std::uint8_t> validity;
+            for (std::uint32_t i = 0; i < positions.size(); ++i) {
+                hubs.push_back(i % 3 == 0 ? random_lights(rng) : (i % 3 == 1 ? random_sh(rng) : random_envmap(rng)));
+                if (with_validity) validity.push_back(rng() % 4 == 0 ? 0 : 1);
+            }
+            const CodecOptions p{};
+            tetra_test::PointsVolume v;
+            tetra_test::make_points_volume(v, *codec, p, positions, hubs, validity);
+            ASSERT_TRUE(v.error.empty()) << v.error;
+            ASSERT_TRUE(tetra_test::nan_probe_poisons(v)) << name;
+            const std::vector<tetra_test::Sample> ss = tetra_test::samples(rng, v, samples, true, direction);
+            std::uint32_t params[16];
+            params_of(name, p, ss.size(), std::uint32_t(codec->size_bytes / 4), params);
+            std::vector<std::uint32_t> words(v.bytes.size() / 4);
+            std::memcpy(words.data(), v.bytes.data(), v.bytes.size());
+            const std::vector<float> out = Gpu::get().run(params, words, items_of(ss), ss.size());
+            ASSERT_EQ(out.size(), ss.size() * kOutFloats);
+            double max_rel = 0;
+            long failures = 0, outside = 0;
+            std::string first;
+            for (std::size_t i = 0; i < ss.size(); ++i) {
+                const tetra_test::Sample& sm = ss[i];
+                const double pos[3] = {sm.pos[0], sm.pos[1], sm.pos[2]};
+                const double nrm[3] = {sm.normal[0], sm.normal[1], sm.normal[2]};
+                double ref[3], ref_sh[27], t[3] = {0, 0, 0};
+                zhc_volume_irradiance_d(&v.vol, pos, nrm, ref);
+                zhc_volume_sh3(&v.vol, pos, ref_sh);
+                ASSERT_GE(sm.outside, 0);
+                outside += sm.outside;
+                for (int k = 0; k < 4; ++k) {
+                    if (sm.weights[k] == 0.0) continue;
+                    double tb[3], kappa;
+                    probe_scales(*codec, p, v.decoded[sm.probes[k]], tb, &kappa);
+                    for (int c = 0; c < 3; ++c) t[c] += sm.weights[k] * tb[c];
+                }
+                for (int j = 0; j < 30; ++j) {
+                    const int c = j % 3;
+                    const double want = j < 27 ? ref_sh[j] : ref[c];
+                    ASSERT_TRUE(std::isfinite(t[c]) && std::isfinite(want)) << name << " item " << i;
+                    const double got = out[i * kOutFloats + std::size_t(j)];
+                    const double err = std::fabs(got - want);
+                    if (!(err <= 40 * FLT_EPSILON * t[c] + kFlushFloor) && failures++ == 0)
+                        first = std::string(name) + (with_validity ? " (validity)" : "") + " item " + std::to_string(i) + " output " +
+                                std::to_string(j) + ": shader " + std::to_string(got) + " C " + std::to_string(want);
+                    max_rel = std::max(max_rel, err / (FLT_EPSILON * t[c] + kFlushFloor));
+                }
+            }
+            std::printf("%-22s %8zu %8ld %12.3f%s\n", name, ss.size(), outside, max_rel, with_validity ? " (validity)" : "");
+            EXPECT_EQ(failures, 0) << first;
+            EXPECT_GT(outside, long(ss.size()) / 3) << name << ": points outside the hull";
+            EXPECT_LT(outside, long(ss.size()) * 9 / 10) << name << ": points inside the hull";
+        }
+    // Analytic fields.
+    for (const char* name : {"sh3", "zh3_q16", "affine"}) {
+        const bool affine = std::string(name) == "affine";
+        const char* enc = affine ? "sh3" : name;
+        const Codec* codec = find_codec(enc);
+        ASSERT_NE(codec, nullptr);
+        std::mt19937_64 rng(0xf1e1dAu + codec->size_bytes + (affine ? 1u : 0u));
+        const std::vector<std::array<float, 3>> positions = tetra_test::random_positions(rng, 120);
+        const Sh3Radiance constant = random_lights(rng);
+        const tetra_test::AffineField field = tetra_test::random_affine(rng);
+        std::vector<Sh3Radiance> hubs;
+        for (const auto& q : positions) hubs.push_back(affine ? field.hub_at(q) : constant);
+        const CodecOptions p{};
+        tetra_test::PointsVolume v;
+        tetra_test::make_points_volume(v, *codec, p, positions, hubs, {});
+        ASSERT_TRUE(v.error.empty()) << v.error;
+        const std::vector<tetra_test::Sample> ss = tetra_test::samples(rng, v, 4000, false, direction);
+        std::uint32_t params[16];
+        params_of(enc, p, ss.size(), std::uint32_t(codec->size_bytes / 4), params);
+        std::vector<std::uint32_t> words(v.bytes.size() / 4);
+        std::memcpy(words.data(), v.bytes.data(), v.bytes.size());
+        const std::vector<float> out = Gpu::get().run(params, words, items_of(ss), ss.size());
+        ASSERT_EQ(out.size(), ss.size() * kOutFloats);
+        double max_rel = 0;
+        long failures = 0, compared = 0;
+        std::string first;
+        for (std::size_t i = 0; i < ss.size(); ++i) {
+            const tetra_test::Sample& sm = ss[i];
+            if (affine && sm.outside) continue;
+            double sh[27], want[3], t[3] = {0, 0, 0};
+            if (affine) {
+                const double x[3] = {sm.pos[0], sm.pos[1], sm.pos[2]};
+                field.at(x, sh);
+            } else {
+                for (int j = 0; j < 27; ++j) sh[j] = v.decoded[0][j / 3][j % 3];
+            }
+            tetra_test::irradiance_twin(sh, sm.normal, want);
+            for (int k = 0; k < 4; ++k) {  // constant: the probe's own T (weights sum to 1)
+                double tb[3], kappa;
+                probe_scales(*codec, p, v.decoded[affine ? sm.probes[k] : 0], tb, &kappa);
+                for (int c = 0; c < 3; ++c) t[c] += sm.weights[k] * tb[c];
+            }
+            ++compared;
+            for (int c = 0; c < 3; ++c) {
+                const double got = out[i * kOutFloats + 27 + std::size_t(c)];
+                const double err = std::fabs(got - want[c]);
+                if (!(err <= 40 * FLT_EPSILON * t[c] + kFlushFloor) && failures++ == 0)
+                    first = std::string(name) + " item " + std::to_string(i) + " channel " + std::to_string(c) + ": shader " +
+                            std::to_string(got) + " twin " + std::to_string(want[c]);
+                max_rel = std::max(max_rel, err / (FLT_EPSILON * t[c] + kFlushFloor));
+            }
+        }
+        std::printf("%-22s %8ld samples, max err/eps T %.3f\n", affine ? "affine field (sh3)" : (std::string("constant ") + name).c_str(),
+                    compared, max_rel);
+        EXPECT_EQ(failures, 0) << first;
+        EXPECT_GT(compared, affine ? 1000L : long(ss.size()) - 1) << name;
     }
 }
 

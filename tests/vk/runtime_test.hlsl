@@ -7,7 +7,10 @@
 // mode 0: probes; 1: IrradZ HHD; 2: IrradZ AHD (irradiance in floats 27..29); 3: probe volume
 // (params 16..24: grid origin, spacing (float bits), counts; binding 2 holds position, normal as two
 // float4 per item; irradiance in floats 27..29); 4: the ASTC LDR fallback's I_z decode
-// (zhc_irradz_iz_from_ldr; per item 5 floats t rgb, lo, hi; result in floats 27..29).
+// (zhc_irradz_iz_from_ldr; per item 5 floats t rgb, lo, hi; result in floats 27..29); 5: scattered
+// probes (zhc_volume_tetra_sh3 / zhc_volume_tetra_irradiance; binding 2 holds the 4 weights, the 4
+// probe indices as floats and the normal as three float4 per item; blended SH3 in floats 0..26,
+// irradiance in 27..29).
 // Compiled four times: plain; with -DZHC_TEST_MASKED (ZHC_VOLUME_MASK: validity and visibility masks
 // at word params[25] of binding 1); with -DZHC_TEST_MASKED -DZHC_TEST_PLANES (and ZHC_VOLUME_PLANE:
 // cell-plane entries, 2 words per probe, at word params[26]; mode 3 also writes the corners the
@@ -72,6 +75,36 @@ void main(uint3 id : SV_DispatchThreadID)
             results[o] = float(zhc_volume_plane_keep(ZHC_VOLUME_PLANE(i0.x + cn.x * (i0.y + cn.y * i0.z)), v, i0, p));
         }
 #endif
+        return;
+    }
+    if (mode == 5u)
+    {
+        ZhcFormat f = zhc_default_format(params[0]);
+        f.bits = params[1];
+        f.sqrtEncoding = params[2];
+        f.l2Bound = params[3];
+        f.dcFormat = params[4];
+        f.zonalMapping = params[5];
+        f.axisMode = params[6];
+        f.kind = params[7];
+        f.lumR = asfloat(params[8]);
+        f.lumG = asfloat(params[9]);
+        f.lumB = asfloat(params[10]);
+        f.hallA = asfloat(params[11]);
+        f.hallB = asfloat(params[12]);
+        float4 wt = normals[3u * i];
+        uint4 q = uint4(normals[3u * i + 1u]);
+        ZhcSH3 sh = zhc_volume_tetra_sh3(q, wt, f);
+        [unroll] for (uint c = 0u; c < 9u; ++c)
+        {
+            results[o + 3u * c] = sh.c[c].x;
+            results[o + 3u * c + 1u] = sh.c[c].y;
+            results[o + 3u * c + 2u] = sh.c[c].z;
+        }
+        float3 e = zhc_volume_tetra_irradiance(q, wt, f, normals[3u * i + 2u].xyz);
+        results[o + 27u] = e.x;
+        results[o + 28u] = e.y;
+        results[o + 29u] = e.z;
         return;
     }
     if (mode == 4u)
