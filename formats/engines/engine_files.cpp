@@ -11,12 +11,14 @@
 namespace zhc {
 
 // Each format's file in this folder defines its entry (declared here, listed in engine_files()).
+extern const EngineFile kGodotLightmapGiFile;
 
 std::span<const EngineFile> engine_files() {
     // A function-local table: the command's verbs read it while they are registered, during static
     // initialisation (the entries themselves are constant-initialised).
     static const std::vector<EngineFile> files = [] {
         const std::vector<const EngineFile*> list = {
+            &kGodotLightmapGiFile,
         };
         std::vector<EngineFile> v;
         for (const EngineFile* f : list) v.push_back(*f);
