@@ -67,3 +67,33 @@ fn zhcVolumeSh3(v: ZhcVolume, f: ZhcFormat, p: vec3<f32>) -> ZhcSh3 {
 fn zhcVolumeIrradiance(v: ZhcVolume, f: ZhcFormat, p: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
     return zhcIrradianceSh3(zhcVolumeSh3(v, f, p), zhcNormalizeOrZ(normal));
 }
+
+// Scattered probes (a `points` volume; docs/runtime.md "Scattered probes (`points` layout)"). The
+// tetrahedron around a point is found on the CPU, once per object (volumeTetraWeights of
+// runtime/web/zhc_runtime.mjs, or zhc_volume_tetra_weights of zhc_runtime.h: its 4 probe indices
+// and weights, validity already applied), as Unity's light probe groups do; the shader blends those
+// 4 probes, read through the same zhcVolumeWord as the grid functions, e.g.
+//
+//   struct Tetra { probes: vec4<u32>, weights: vec4<f32> }   // probes, weights (as f32) of the search
+//   @group(1) @binding(0) var<uniform> uTetra: Tetra;
+//   let e = zhcVolumeTetraIrradiance(uTetra.probes, uTetra.weights, uFormat, worldNormal);
+//
+// The blend is zhc_volume_sh3's points branch in f32: probes k = 0..3 in order, each decoded to SH3
+// and added with its weight, probes of weight 0 not read (a weight below f32's range counts as 0).
+// The probe indices must lie below the probe count (zhcVolumeWord is asked for their words as given).
+fn zhcVolumeTetraSh3(probes: vec4<u32>, weights: vec4<f32>, f: ZhcFormat) -> ZhcSh3 {
+    var acc = zhcZeroSh3();
+    for (var k = 0u; k < 4u; k++) {
+        let w = weights[k];
+        if (w == 0.0) { continue; }
+        let s = zhcVolumeProbe(probes[k], f);
+        for (var i = 0; i < 9; i++) { acc.c[i] = acc.c[i] + w * s.c[i]; }
+    }
+    return acc;
+}
+
+// Irradiance (zhc's normalised kernel) of zhcVolumeTetraSh3's blend for the surface normal `normal`
+// (normalised here; zero or not finite: +Z), evaluated once as zhcVolumeIrradiance does.
+fn zhcVolumeTetraIrradiance(probes: vec4<u32>, weights: vec4<f32>, f: ZhcFormat, normal: vec3<f32>) -> vec3<f32> {
+    return zhcIrradianceSh3(zhcVolumeTetraSh3(probes, weights, f), zhcNormalizeOrZ(normal));
+}

@@ -31,6 +31,14 @@
 //     (tests/js/planes_fixtures.mjs) with validity and masks in zhc axes, and planes alone on the
 //     same grid in glTF axes (the override ZHC_VOLUME_PLANE_AXES_GLTF), against the runtime's
 //     volumeIrradianceD on the zhc-axes volume; the corners each plane keeps must equal the JS side's;
+//     Scattered probes (zhc_volume.wgsl's zhcVolumeTetraSh3 / zhcVolumeTetraIrradiance): `points`
+//     .zhp files written by `zhc convert` (its qhull tetrahedra) of 150 random positions, as sh3,
+//     zh3_q16, sh3_q28 and hall_adaptive_q16, with and without validity, the kernel given the 4
+//     probes and weights of the runtime's volumeTetraWeights (the C header's zhc_volume_tetra_weights,
+//     bit-identical per js.runtime_tetra), against volumeSH3 / volumeIrradianceD at points inside and
+//     outside the hull and at every probe; weight-0 probes point at a probe of 0xFF bytes (NaN / Inf),
+//     which the blend must not read; every probe equal (sh3, zh3_q16) and an affine field (sh3)
+//     against their own double twin;
 //  5. asserts: no console error or WebGPU validation error, no compilation message, every probe and
 //     sample of every encoding compared, every value within its bound; prints the per-encoding maxima.
 // Time bounded: the browser part times out after 420 s (Chromium killed).
@@ -122,7 +130,8 @@ runtime.ENCODING_TABLE.forEach((row, id) => {
     for (const f of ['zhcDecode', 'zhcIrradiance', 'zhcIrradianceSh3', 'zhcEvalSh3', 'zhcDecodeSh3F32', 'zhcDecodeSh2F32', 'zhcDecodeZh3F32',
       'zhcDecodeZh3Q16', 'zhcDecodeSh3Q28', 'zhcDecodeSh2Q', 'zhcIrradianceSh3F32', 'zhcIrradianceSh2F32', 'zhcIrradianceZh3F32',
       'zhcIrradianceZh3Q16', 'zhcIrradianceSh3Q28', 'zhcIrradianceSh2Q', 'zhcVolumeSh3', 'zhcVolumeIrradiance', 'zhcVolumeSh3Masked',
-      'zhcVolumeIrradianceMasked', 'zhcPlaneNormal', 'zhcVolumePlaneKeep', 'zhcVolumeSh3Planes', 'zhcVolumeIrradiancePlanes'])
+      'zhcVolumeIrradianceMasked', 'zhcPlaneNormal', 'zhcVolumePlaneKeep', 'zhcVolumeSh3Planes', 'zhcVolumeIrradiancePlanes',
+      'zhcVolumeTetraSh3', 'zhcVolumeTetraIrradiance'])
       check(fns.has(f), `WGSL function ${f} exists`);
     check(!alone.error && alone.entry.compute.length === 0 && alone.storage.length === 0 && alone.uniforms.length === 0,
       'runtime/zhc.wgsl declares no bindings and no entry points');
@@ -705,6 +714,134 @@ for (const e of encodings)
   for (const planes of ['zhc', 'gltf'])
     cases.push({ e, volume: true, planes, grid: volumeGrids[0], zhp: W(`${e.name}_${volumeGrids[0].batch}.zhp`) });
 
+// Scattered probes (zhc_volume.wgsl's zhcVolumeTetraSh3 / zhcVolumeTetraIrradiance). Sets written by
+// `zhc convert` from JSON probe lists with positions (its tetrahedra: formats/probes/tetra.h, qhull):
+// 150 random positions in a box with batch 0's first probes, stored as each encoding of tetraNames
+// (cases 'random', and 'validity' with a quarter of the probes invalid, given to makePointsVolume);
+// the same positions with every probe equal to one lit probe (sh3, zh3_q16: 'constant'); an SH3 field
+// affine in position stored as sh3 ('affine'). Samples: 10,000 points, a third in the box, the rest
+// in the box grown by half its size on every side, plus every probe; the kernel gets the 4 probes and
+// weights (as f32) of volumeTetraWeights walking from tetrahedron 0 (volumeSH3's call). Reference:
+// the runtime's volumeSH3 / volumeIrradianceD (the C header's doubles, js.runtime_tetra) for 'random'
+// and 'validity', where every weight-0 probe index is replaced by that of a probe of 0xFF bytes
+// appended to the words (it decodes to NaN / Inf: the results stay finite only if the blend skips
+// it); the double twin of the field itself for 'constant' (everywhere) and 'affine' (inside the
+// hull). Bound (test_runtime_gl compare_tetra_volumes): 48 u S, S = sum_k w_k S_k; decoded SH3
+// kCDecode + 8 u of sum_k w_k M_k.
+const kTetraSamples = 10000, kTetraProbes = 150;
+const tetraNames = ['sh3', 'zh3_q16', 'sh3_q28', 'hall_adaptive_q16'];
+const tetraTallies = new Map();
+{
+  const rand = makeRand(7607);
+  const lo = [-1.5, 2.0, 0.25], size = [4.0, 2.5, 3.0];
+  const positions = Array.from({ length: kTetraProbes }, () => [0, 1, 2].map((a) => Math.fround(lo[a] + size[a] * rand())));
+  const lit = batchProbes(1000);
+  const list = (sh) => JSON.stringify({ format: 'zhc-probes', version: 1, kind: 'radiance', layout: { type: 'positions' },
+    probes: positions.map((q, i) => ({ position: q, sh3: sh(q, i) })) });
+  const affine = { a: Array.from({ length: 27 }, (_, j) => (j < 3 ? 1.5 + 0.5 * (2 * rand() - 1) : 0.5 * (2 * rand() - 1))),
+    b: Array.from({ length: 27 }, () => [0, 1, 2].map(() => 0.3 * (2 * rand() - 1))) };
+  const affineAt = (x) => affine.a.map((a, j) => a + affine.b[j][0] * x[0] + affine.b[j][1] * x[1] + affine.b[j][2] * x[2]);
+  fs.writeFileSync(W('tetra_random.json'), list((q, i) => lit[i]));
+  fs.writeFileSync(W('tetra_constant.json'), list(() => lit[0]));
+  fs.writeFileSync(W('tetra_affine.json'), list((q) => {
+    const c = affineAt(q);
+    return Array.from({ length: 9 }, (_, i) => [c[3 * i], c[3 * i + 1], c[3 * i + 2]]);
+  }));
+  const jobs = [], push = (e, tetra, set) => {
+    const zhp = W(`tetra_${set}_${e.name}.zhp`);
+    jobs.push(() => execFileP(zhc, ['convert', W(`tetra_${set}.json`), '-o', zhp, '--to', e.name]));
+    return zhp;
+  };
+  for (const e of encodings) {
+    if (!tetraNames.includes(e.name)) continue;
+    const zhp = push(e, 'random', 'random');
+    for (const tetra of ['random', 'validity']) cases.push({ e, tetra, zhp });
+    if (e.name === 'sh3' || e.name === 'zh3_q16') cases.push({ e, tetra: 'constant', zhp: push(e, 'constant', 'constant') });
+    if (e.name === 'sh3') cases.push({ e, tetra: 'affine', zhp: push(e, 'affine', 'affine'), affineAt });
+  }
+  await pool(jobs, 2);
+  for (const c of cases) if (c.tetra) tetraTallies.set(`${c.e.name} ${c.tetra}`, { ...tally(), samples: 0, outside: 0, dropped: 0, nanProbe: false });
+}
+function tetraJob(c) {
+  const z = runtime.parseZhp(new Uint8Array(fs.readFileSync(c.zhp)));
+  check(z.layout === 'positions' && z.tetrahedra !== null && z.count === kTetraProbes, `${c.zhp}: ${kTetraProbes} probes with tetrahedra`);
+  const count = z.count, bpp = c.e.bytes;
+  c.p = z.params;
+  c.validity = c.tetra === 'validity' ? Uint8Array.from({ length: count }, () => (caseRand() < 0.25 ? 0 : 1)) : null;
+  c.vol = runtime.makePointsVolume({ encoding: c.e.name, params: c.p, bytes: z.payload, positions: z.positions, tetrahedra: z.tetrahedra,
+    neighbours: z.neighbours, validity: c.validity });
+  c.decoded = Array.from({ length: count }, (_, q) => runtime.decodeProbe(c.e.name, z.payload, q * bpp, c.p));
+  const bytes = new Uint8Array((count + 1) * bpp).fill(0xFF);  // the probes, then one of 0xFF bytes
+  bytes.set(z.payload.subarray(0, count * bpp));
+  const poison = c.tetra === 'random' || c.tetra === 'validity';
+  tetraTallies.get(`${c.e.name} ${c.tetra}`).nanProbe = !runtime.decodeProbe(c.e.name, bytes, count * bpp, c.p).every(Number.isFinite);
+  const lo = [0, 1, 2].map((a) => Math.min(...Array.from({ length: count }, (_, q) => z.positions[3 * q + a])));
+  const hi = [0, 1, 2].map((a) => Math.max(...Array.from({ length: count }, (_, q) => z.positions[3 * q + a])));
+  const n = kTetraSamples + count;
+  c.samples = n;
+  c.items = new Float32Array(11 * n);
+  c.ref = [];
+  for (let i = 0; i < n; i++) {
+    const pos = [0, 1, 2].map((a) => Math.fround(i >= kTetraSamples ? z.positions[3 * (i - kTetraSamples) + a]
+      : i % 3 === 0 ? lo[a] + (hi[a] - lo[a]) * caseRand() : lo[a] - 0.5 * (hi[a] - lo[a]) + 2 * (hi[a] - lo[a]) * caseRand()));
+    const zz = 2 * caseRand() - 1, phi = 2 * Math.PI * caseRand(), r = Math.sqrt(Math.max(0, 1 - zz * zz));
+    const nrm = [r * Math.cos(phi), r * Math.sin(phi), zz].map(Math.fround);
+    const tw = runtime.volumeTetraWeights(c.vol, pos, 0);
+    const probes = tw.probes.map((q, k) => (poison && tw.weights[k] === 0 ? count : q));
+    c.items.set([...tw.weights, ...probes, ...nrm], 11 * i);
+    c.ref.push({ pos, nrm, inside: tw.inside, probes: tw.probes, weights: tw.weights });
+  }
+  c.outFloats = 30 * n;
+  return jobBytes(5, n, 30, 11, bpp / 4, null, formatBytes(c.e, c.p), wordsOf(bytes), c.items);
+}
+// The double twin of an SH3 radiance's irradiance (band scales 1, 2/3, 1/4; normal normalised).
+function irradianceTwin(sh, nrm) {
+  const len = Math.hypot(nrm[0], nrm[1], nrm[2]);
+  const y = runtime.shBasis(nrm[0] / len, nrm[1] / len, nrm[2] / len);
+  const rgb = [0, 0, 0];
+  for (let i = 0; i < 9; i++) for (let k = 0; k < 3; k++) rgb[k] += (i === 0 ? 1 : i < 4 ? 2 / 3 : 0.25) * sh[3 * i + k] * y[i];
+  return rgb;
+}
+function compareTetra(c, gpu) {
+  const t = tetraTallies.get(`${c.e.name} ${c.tetra}`);
+  for (let i = 0; i < c.samples; i++) {
+    const { pos, nrm, inside, probes, weights } = c.ref[i];
+    t.outside += inside ? 0 : 1;
+    if (c.tetra === 'affine' && !inside) continue;
+    const scale = [0, 0, 0], coeff = Array.from({ length: 9 }, () => [0, 0, 0]);
+    let defined = true;
+    for (let k = 0; k < 4; k++) {
+      if (weights[k] === 0) {
+        if (c.tetra === 'validity' && inside) t.dropped++;
+        continue;
+      }
+      const sc = probeScale(c.e, c.p, c.decoded[c.tetra === 'constant' ? 0 : probes[k]]);
+      defined = defined && sc.defined;
+      for (let a = 0; a < 3; a++) {
+        scale[a] += weights[k] * sc.irradiance[a];
+        for (let j = 0; j < 9; j++) coeff[j][a] += weights[k] * sc.coeff[j][a];
+      }
+    }
+    if (!defined) {
+      t.skippedIllcond++;
+      continue;
+    }
+    t.samples++;
+    const what = (v) => () => `${c.e.name} ${c.tetra} sample ${i} (position ${pos.join(',')}, normal ${nrm.join(',')}) ${v}`;
+    let rgb, sh = null;
+    if (c.tetra === 'constant') rgb = irradianceTwin(c.decoded[0], nrm);
+    else if (c.tetra === 'affine') rgb = irradianceTwin(c.affineAt(pos), nrm);
+    else {
+      rgb = runtime.volumeIrradianceD(c.vol, pos, nrm);
+      sh = runtime.volumeSH3(c.vol, pos);
+    }
+    for (let k = 0; k < 3; k++) checkValue(t, 'maxIrr', rgb[k], gpu[30 * i + 27 + k], scale[k], 48, what(`channel ${k}`));
+    if (sh)
+      for (let j = 0; j < 27; j++)
+        checkValue(t, 'maxDec', sh[j], gpu[30 * i + j], coeff[Math.floor(j / 3)][j % 3], kCDecode + 8, what(`coefficient ${j}`));
+  }
+}
+
 // --- 3. server + Chromium ---------------------------------------------------------------------
 const roots = { '/runtime/': path.join(repo, 'runtime'), '/test/': path.join(here, 'browser') };
 const caseRand = makeRand(99991);
@@ -719,7 +856,7 @@ const routes = {
     }
     current = cases[nextCase++];
     res.writeHead(200, { 'Content-Type': 'application/octet-stream' });
-    res.end(current.volume ? volumeJob(current) : decodeJob(current));
+    res.end(current.tetra ? tetraJob(current) : current.volume ? volumeJob(current) : decodeJob(current));
   },
   'POST /job/result': async (req, res) => {
     const body = await readBody(req);
@@ -728,10 +865,10 @@ const routes = {
     check(current && gpu.length === want, `result of job ${nextCase - 1}: ${want} floats`);
     if (current && gpu.length === want) {
       const tc = Date.now();
-      (current.volume ? compareVolume : compareCase)(current, gpu);
+      (current.tetra ? compareTetra : current.volume ? compareVolume : compareCase)(current, gpu);
       compareMs += Date.now() - tc;
       current.bytes = current.normals = current.items = current.decoded = current.vol = current.validity = current.visibility = null;
-      current.planeBytes = null;
+      current.planeBytes = current.ref = null;
       jobsDone++;
     }
     res.end('ok');
@@ -796,6 +933,21 @@ for (const [name, t] of planeTallies) {
     t.compared === 3 * t.samples, `${name} planes volume: every sample compared or counted (${t.samples} + ${t.skipped} + ${t.near})`);
   check(t.byPlane > kVolumeSamples / 4, `${name}: the planes act (${t.byPlane} samples cut)`);
 }
+console.log('scattered probes (zhcVolumeTetraIrradiance / zhcVolumeTetraSh3): max error in u S (S = sum_k w_k S_k) / u M vs volumeIrradianceD / volumeSH3 (random, validity) or the field\'s twin (constant, affine):');
+for (const [name, t] of tetraTallies) {
+  const [enc, kind] = name.split(' ');
+  console.log(`${name.padEnd(34)} ${String(t.samples).padStart(7)} samples (${t.outside} outside the hull) ${t.maxIrr.toFixed(3).padStart(8)} u S ${t.maxDec.toFixed(3).padStart(8)} u M`);
+  check(t.failures === 0, `${name}: ${t.failures} values out of bound; first: ${t.firstFailure}`);
+  const n = kTetraSamples + kTetraProbes;
+  check(t.skippedIllcond === 0 && t.skippedNonfinite === 0 && t.compared === t.samples * (kind === 'random' || kind === 'validity' ? 30 : 3),
+    `${name}: every sample compared (${t.samples}, ${t.compared} values)`);
+  check(t.outside > n / 3 && t.outside < n * 0.9, `${name}: points inside and outside the hull (${t.outside} outside)`);
+  check(kind === 'affine' ? t.samples === n - t.outside : t.samples === n, `${name}: ${t.samples} samples`);
+  if (kind === 'random' || kind === 'validity') check(t.nanProbe, `${enc}: a probe of 0xFF bytes decodes to NaN or Inf`);
+  if (kind === 'validity') check(t.dropped > n / 10, `${name}: validity drops probes inside the hull (${t.dropped})`);
+  if (!tetraNames.includes(enc)) check(false, `${name}: unexpected encoding`);
+}
+check(process.env.ZHC_WGSL_ONLY || tetraTallies.size === 2 * tetraNames.length + 3, `scattered probes: ${tetraTallies.size} cases`);
 console.log(`wall time: encoding ${((tEncoded - t0) / 1000).toFixed(1)} s, browser + comparison ${((tBrowser - tEncoded) / 1000).toFixed(1)} s ` +
   `(of which JS reference + comparison ${(compareMs / 1000).toFixed(1)} s), total ${((Date.now() - t0) / 1000).toFixed(1)} s`);
 finish('runtime/zhc.wgsl');

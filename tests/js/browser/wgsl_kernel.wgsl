@@ -10,6 +10,9 @@
 // plane_volume_kernel: the same with zhcVolumeIrradiancePlanes; the masks as above, the plane
 // entries (2 words per probe) from word job.pad1 on; writes 4 floats per item at out[4 i ..]: the
 // irradiance and the corners the cell's plane keeps (zhcVolumePlaneKeep, as a float).
+// tetra_volume_kernel: item i = the 4 weights items[11 i ..], the 4 probe indices (as floats)
+// items[11 i + 4 ..] and the normal items[11 i + 8 ..]; writes zhcVolumeTetraSh3 (27 floats) and
+// zhcVolumeTetraIrradiance (3 floats) at out[30 i ..].
 
 struct Job {
     stride: u32,
@@ -102,4 +105,24 @@ fn plane_volume_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
     outv[4u * i + 1u] = e.y;
     outv[4u * i + 2u] = e.z;
     outv[4u * i + 3u] = f32(keep);
+}
+
+@compute @workgroup_size(64)
+fn tetra_volume_kernel(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= job.count) { return; }
+    let b = 11u * i;
+    let w = vec4<f32>(items[b], items[b + 1u], items[b + 2u], items[b + 3u]);
+    let q = vec4<u32>(vec4<f32>(items[b + 4u], items[b + 5u], items[b + 6u], items[b + 7u]));
+    let n = vec3<f32>(items[b + 8u], items[b + 9u], items[b + 10u]);
+    let sh = zhcVolumeTetraSh3(q, w, fmt);
+    for (var c = 0u; c < 9u; c++) {
+        outv[30u * i + 3u * c] = sh.c[c].x;
+        outv[30u * i + 3u * c + 1u] = sh.c[c].y;
+        outv[30u * i + 3u * c + 2u] = sh.c[c].z;
+    }
+    let e = zhcVolumeTetraIrradiance(q, w, fmt, n);
+    outv[30u * i + 27u] = e.x;
+    outv[30u * i + 28u] = e.y;
+    outv[30u * i + 29u] = e.z;
 }

@@ -6,7 +6,7 @@
 // uniform (80 bytes), `wordCount` u32 probe words and `count * itemFloats` f32 item inputs (kernel 0:
 // decode_kernel, kernel 1: volume_kernel, kernel 2: masked_volume_kernel, kernel 3:
 // plane_volume_kernel of wgsl_kernel.wgsl, kernel 4: plane_volume_kernel with the override
-// ZHC_VOLUME_PLANE_AXES_GLTF = true). POST /job/result: the `count * outFloats` output floats.
+// ZHC_VOLUME_PLANE_AXES_GLTF = true, kernel 5: tetra_volume_kernel). POST /job/result: the `count * outFloats` output floats.
 // POST /result: a JSON summary.
 
 const errors = window.zhcErrors;
@@ -34,7 +34,7 @@ async function main() {
   const ci = await module.getCompilationInfo();
   for (const m of ci.messages) summary.compilation.push(`${m.type} ${m.lineNum}:${m.linePos} ${m.message}`);
   const pipelines = {};
-  for (const entry of ['decode_kernel', 'volume_kernel', 'masked_volume_kernel', 'plane_volume_kernel'])
+  for (const entry of ['decode_kernel', 'volume_kernel', 'masked_volume_kernel', 'plane_volume_kernel', 'tetra_volume_kernel'])
     if (code.includes(`fn ${entry}(`)) pipelines[entry] = device.createComputePipeline({ layout: 'auto', compute: { module, entryPoint: entry } });
   if (code.includes('fn plane_volume_kernel(')) {
     pipelines.plane_volume_kernel_gltf = device.createComputePipeline({ layout: 'auto',
@@ -66,7 +66,8 @@ async function main() {
     const outSize = 4 * count * outFloats;
     const out = device.createBuffer({ size: outSize, usage: GPUBufferUsage.STORAGE | GPUBufferUsage.COPY_SRC });
     const read = device.createBuffer({ size: outSize, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST });
-    const pipeline = pipelines[['decode_kernel', 'volume_kernel', 'masked_volume_kernel', 'plane_volume_kernel', 'plane_volume_kernel_gltf'][kernel]];
+    const pipeline = pipelines[['decode_kernel', 'volume_kernel', 'masked_volume_kernel', 'plane_volume_kernel', 'plane_volume_kernel_gltf',
+      'tetra_volume_kernel'][kernel]];
     if (!pipeline) throw new Error(`kernel ${kernel} is not in the shader`);
     device.pushErrorScope('validation');
     const bind = device.createBindGroup({ layout: pipeline.getBindGroupLayout(0), entries: [
