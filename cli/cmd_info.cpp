@@ -370,6 +370,7 @@ int run(const Options& o) {
             vj["payload"] = v.draco ? "draco point cloud" : "accessors";
             vj["stored_bytes"] = v.stored_bytes;
             if (auto leak = leak_json(v.set)) vj["leak_data"] = *leak;
+            if (!v.set.tetrahedra.empty()) vj["tetrahedra"] = v.set.tetrahedra.size();
             vj["nodes"] = v.nodes;
             auto hub = decode_probe_set(v.set);
             if (!hub) return report(hub.error());

@@ -409,6 +409,8 @@ Result<ProbeSet> rotate_set(const ProbeSet& set, const Mat3& r) {
     out->validity = set.validity;  // per-probe data, independent of the SH axes
     out->visibility = set.visibility;
     out->planes = set.planes;
+    out->tetrahedra = set.tetrahedra;  // probe indices: the positions do not move
+    out->tetra_neighbours = set.tetra_neighbours;
     return out;
 }
 

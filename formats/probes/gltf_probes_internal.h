@@ -32,6 +32,7 @@ inline constexpr auto le32 = le::load32;
 
 inline constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
 inline constexpr int kUbyte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+inline constexpr int kUint = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
 
 inline constexpr std::uint32_t kGlbMagic = 0x46546C67;   // "glTF"
 inline constexpr std::uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
@@ -102,7 +103,7 @@ Vec3 from_gltf(Vec3 v);
 bool is_float_vec3_encoding(const std::string& name);
 
 // Re-encodes every probe after rotating it by r (decode -> rotate -> encode); validity,
-// visibility and cell planes are kept.
+// visibility, cell planes and tetrahedra are kept.
 Result<ProbeSet> rotate_set(const ProbeSet& set, const Mat3& r);
 
 // A visibility mask or a cell plane's sides byte (bit cx + 2 cy + 4 cz, c per grid axis) from

@@ -122,6 +122,55 @@ struct VolumeReader {
         return Ok{};
     }
 
+    // Optional tetrahedra (docs/gltf-extension.md "Tetrahedra"): `tetrahedra` and `tetraNeighbours`,
+    // both or neither, VEC4 UNSIGNED_INT accessors of the same count (one element per tetrahedron),
+    // points layouts only. Indices are into the volume's probe order (the set's own for points) and
+    // keep their orientation (the glTF axes are a rotation of zhc's); a neighbour 4294967295 is -1
+    // (the hull). Into set.tetrahedra / set.tetra_neighbours; validate_probe_set then checks them
+    // (indices below count, neighbours sharing their faces) as the .zhp reader does.
+    Status read_tetrahedra(const json& v, ProbeSet& set, std::uint64_t& stored_bytes) const {
+        const bool has_tets = v.contains("tetrahedra"), has_nbrs = v.contains("tetraNeighbours");
+        if (!has_tets && !has_nbrs) return Ok{};
+        if (has_tets != has_nbrs)
+            return bad(ErrorCode::kBadFormat, has_tets ? "tetrahedra without tetraNeighbours (the tetrahedra need both accessors)"
+                                                       : "tetraNeighbours without tetrahedra (the tetrahedra need both accessors)");
+        if (set.layout.kind != ProbeLayoutKind::kPositions) return bad(ErrorCode::kBadFormat, "tetrahedra need layout points");
+        const tinygltf::Model& m = in.model;
+        auto ta = index(v, "tetrahedra", m.accessors.size());
+        if (!ta) return ta.error();
+        const std::uint64_t t_count = m.accessors[static_cast<size_t>(*ta)].count;
+        if (t_count == 0 || t_count > 0x7FFFFFFFu)
+            return bad(ErrorCode::kBadFormat, "tetrahedra accessor " + std::to_string(*ta) + " has " + std::to_string(t_count) +
+                                                  " elements, expected 1 to 2^31 - 1 tetrahedra");
+        auto tb = accessor_bytes(*ta, kUint, TINYGLTF_TYPE_VEC4, t_count, "tetrahedra");
+        if (!tb) return tb.error();
+        auto na = index(v, "tetraNeighbours", m.accessors.size());
+        if (!na) return na.error();
+        auto nb = accessor_bytes(*na, kUint, TINYGLTF_TYPE_VEC4, t_count, "tetraNeighbours");
+        if (!nb) return nb.error();
+        set.tetrahedra.resize(static_cast<size_t>(t_count));
+        set.tetra_neighbours.resize(static_cast<size_t>(t_count));
+        for (std::uint64_t t = 0; t < t_count; ++t)
+            for (std::size_t k = 0; k < 4; ++k) {
+                const std::uint32_t vertex = le32(tb->data() + 16 * t + 4 * k), n = le32(nb->data() + 16 * t + 4 * k);
+                if (vertex >= set.count)
+                    return bad(ErrorCode::kInvalidValue, "tetrahedra accessor " + std::to_string(*ta) + ": tetrahedron " + std::to_string(t) +
+                                                             " names probe " + std::to_string(vertex) + ", beyond the " +
+                                                             std::to_string(set.count) + " probes");
+                if (n != 0xFFFFFFFFu && n >= t_count)
+                    return bad(ErrorCode::kInvalidValue, "tetraNeighbours accessor " + std::to_string(*na) + ": tetrahedron " +
+                                                             std::to_string(t) + " face " + std::to_string(k) + " names tetrahedron " +
+                                                             std::to_string(n) + ", beyond the " + std::to_string(t_count) +
+                                                             " tetrahedra (4294967295: none)");
+                set.tetrahedra[static_cast<size_t>(t)][k] = vertex;
+                set.tetra_neighbours[static_cast<size_t>(t)][k] = n == 0xFFFFFFFFu ? -1 : static_cast<std::int32_t>(n);
+            }
+        if (Status st = validate_tetrahedra(set.count, set.tetrahedra, set.tetra_neighbours); !st)
+            return bad(ErrorCode::kInvalidValue, st.error().message);
+        stored_bytes += tb->size() + nb->size();
+        return Ok{};
+    }
+
     Result<GltfProbeVolume> read(const json& v) const {
         if (!v.is_object()) return bad(ErrorCode::kBadFormat, "not an object");
         GltfProbeVolume out;
@@ -297,6 +346,7 @@ struct VolumeReader {
             (is_validity ? set.validity : set.visibility) = std::move(data);
         }
         if (auto planes = read_planes(v, set, out.stored_bytes); !planes) return planes.error();
+        if (auto tets = read_tetrahedra(v, set, out.stored_bytes); !tets) return tets.error();
         auto valid = validate_probe_set(set);
         if (!valid) return bad(ErrorCode::kBadFormat, valid.error().message);
         if (out.sh_axes == GltfShAxes::kGltf) {

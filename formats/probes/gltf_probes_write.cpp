@@ -333,6 +333,22 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
         vol["planeSides"] = add_accessor(append_view(sides, options.name + " planeSides"), kUbyte, "SCALAR", set.count,
                                          options.name + " planeSides");
     }
+    if (!set.tetrahedra.empty()) {  // positions only (validate_probe_set): docs/gltf-extension.md "Tetrahedra"
+        // Probe indices into the volume's probe order, which for points is the set's own order; the
+        // axis change (x, y, z)_glTF = (y, z, x)_zhc is a rotation, so every tetrahedron keeps its
+        // orientation and the canonical form (formats/probes/tetra.h) holds in glTF axes too. A
+        // neighbour of -1 (the hull) is stored as its 32-bit pattern, 4294967295.
+        const std::size_t t_count = set.tetrahedra.size();
+        std::vector<std::uint8_t> tets(16 * t_count), nbrs(16 * t_count);
+        for (std::size_t t = 0; t < t_count; ++t)
+            for (std::size_t k = 0; k < 4; ++k) {
+                le::store(tets.data() + 16 * t + 4 * k, set.tetrahedra[t][k], 4);
+                le::store(nbrs.data() + 16 * t + 4 * k, static_cast<std::uint32_t>(set.tetra_neighbours[t][k]), 4);
+            }
+        vol["tetrahedra"] = add_accessor(append_view(tets, options.name + " tetrahedra"), kUint, "VEC4", t_count, options.name + " tetrahedra");
+        vol["tetraNeighbours"] = add_accessor(append_view(nbrs, options.name + " tetraNeighbours"), kUint, "VEC4", t_count,
+                                              options.name + " tetraNeighbours");
+    }
     if (!options.output_path.empty()) {
         auto st = relocate_images(doc, scene_path, options, limits, append_view);
         if (!st) return st.error();

@@ -2,7 +2,7 @@
 // plugin for ZHC_light_probes and the decoded volumes it attaches (three.js types: @types/three).
 import type { HalfFloatType, FloatType, LightProbe, Matrix4, Object3D, SphericalHarmonics3 } from 'three';
 import type { GLTF, GLTFLoaderPlugin, GLTFParser } from 'three/addons/loaders/GLTFLoader.js';
-import type { Vec3, Vec3Like, ZhcEncodingName, ZhcGrid, ZhcKind, ZhcParams } from './zhc_runtime.mjs';
+import type { Vec3, Vec3Like, ZhcEncodingName, ZhcGrid, ZhcKind, ZhcParams, ZhcTetraWeights } from './zhc_runtime.mjs';
 import type { ZhcCompactOptions, ZhcCompactVolume } from './zhc_volume.glsl.mjs';
 
 export declare const EXTENSION: 'ZHC_light_probes';
@@ -32,6 +32,10 @@ export interface ZhcProbeVolumeFields {
   /** Cell planes (accessors planes + planeSides), 5 bytes per probe in glTF probe order: ou, ov (normal
    * code, zhc axes), offset lo, offset hi, sides (glTF corner bits); null when absent. */
   planes?: Uint8Array | null;
+  /** Tetrahedra of a points volume (accessor tetrahedra): 4 probe indices each; null when absent. */
+  tetrahedra?: Uint32Array | null;
+  /** Their neighbours (accessor tetraNeighbours): 4 each, the tetrahedron across face j, -1 on the hull; null when absent. */
+  neighbours?: Int32Array | null;
   /** The Object3Ds that place the volume (one per referencing node), set by the plugin. */
   nodes?: Object3D[];
 }
@@ -47,8 +51,15 @@ export declare class ZhcProbeVolume {
   probeSHGltf(p: number): Float32Array;
   /** Irradiance of probe p at a direction in glTF / three.js axes (node-local). */
   irradiance(p: number, dir: Vec3Like): Vec3;
-  /** Irradiance at any point of a grid volume (node-local glTF axes), 8 probes blended (masks and cell planes applied). */
+  /** Irradiance at any point (node-local glTF axes): a grid's 8 probes blended (masks and cell planes applied), or the 4
+   * probes of a points volume's tetrahedron (validity applied). Throws for layout none and points without tetrahedra. */
   irradianceAt(position: Vec3Like, normal: Vec3Like): Vec3;
+  /** The blended SH3 radiance at a point (node-local glTF axes), in glTF axes and zhc's basis. */
+  shAt(position: Vec3Like): Float32Array;
+  /** shAt as a three.js SphericalHarmonics3 (three.js's signs, glTF axes, radiance): a LightProbe's sh for an object there. */
+  threeSHAt(position: Vec3Like, target?: SphericalHarmonics3): SphericalHarmonics3;
+  /** Points volumes with tetrahedra: the tetrahedron holding a point and its 4 probes' weights (walk from `start`). */
+  tetraWeights(position: Vec3Like, start?: number): ZhcTetraWeights;
   /** The compact path: stored bytes in an RGBA32UI Data3DTexture, uniforms and GLSL (three.js passed in). */
   compactVolume(options?: Omit<ZhcCompactOptions, 'THREE'>): ZhcCompactVolume;
   /** three.js's own probe grid (r187+ LightProbeGridWebGL or LightProbeGrid) filled from the decoded probes. */
@@ -103,6 +114,8 @@ export declare function buildVolume(
   visibilityArray?: ArrayLike<number> | null,
   planesArray?: ArrayLike<number> | null,
   planeSidesArray?: ArrayLike<number> | null,
+  tetrahedraArray?: ArrayLike<number> | null,
+  tetraNeighboursArray?: ArrayLike<number> | null,
 ): ZhcProbeVolume;
 
 /** What the plugin puts in gltf.userData. */

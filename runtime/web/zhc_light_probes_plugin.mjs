@@ -18,8 +18,8 @@
 // world directions by the inverse of the anchor's world rotation before a lookup.
 import * as THREE from 'three';
 import {
-  PACKED_LAYOUTS, decodeAll, encodingInfo, encodingName, gltfToZhcDir, irradiance as shIrradiance, makeParams, normalizeOr,
-  makeVolume, rotateZhcToGltf, toThreeConvention, volumeIrradiance,
+  PACKED_LAYOUTS, checkTetrahedra, decodeAll, encodingInfo, encodingName, gltfToZhcDir, irradiance as shIrradiance, makeParams, normalizeOr,
+  makePointsVolume, makeVolume, rotateZhcToGltf, toThreeConvention, volumeIrradiance, volumeSH3, volumeTetraWeights,
 } from './zhc_runtime.mjs';
 import { compactVolume } from './zhc_volume.glsl.mjs';
 
@@ -54,22 +54,51 @@ export class ZhcProbeVolume {
     return shIrradiance(this.probeSH(p), this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
   }
 
-  // Irradiance at any point of a GRID volume: the trilinear blend of the 8 surrounding probes'
-  // decoded SH3 (the point clamped to the grid's box), evaluated at `normal`; position and normal in
-  // glTF / three.js axes, node-local (docs/runtime.md "Probe volumes"). The normal is normalised
-  // (zero: +Y). With validity / visibility accessors the weights are masked and renormalised
-  // (docs/runtime.md "Validity and visibility"); with cell planes (`planes`) a corner on the other
-  // side of its cell's plane from the position is dropped too (docs/gltf-extension.md "Cell
-  // planes"). Throws for points / none layouts (scattered probes: see the docs) and for a grid
-  // whose spacing is not > 0.
+  // Irradiance at any point of the volume, evaluated at `normal`; position and normal in glTF /
+  // three.js axes, node-local. The normal is normalised (zero: +Y).
+  //  * GRID: the trilinear blend of the 8 surrounding probes' decoded SH3 (the point clamped to the
+  //    grid's box; docs/runtime.md "Probe volumes"). With validity / visibility accessors the weights
+  //    are masked and renormalised (docs/runtime.md "Validity and visibility"); with cell planes
+  //    (`planes`) a corner on the other side of its cell's plane from the position is dropped too
+  //    (docs/gltf-extension.md "Cell planes").
+  //  * POINTS with tetrahedra (docs/gltf-extension.md "Tetrahedra"): the barycentric blend of the 4
+  //    probes of the tetrahedron holding the point (outside the hull: the nearest hull face), valid
+  //    probes only (zhc_runtime.mjs volumeTetraWeights, walked from tetrahedron 0). The walk runs
+  //    in zhc's axes (positions permuted back, exact), so the weights are the C header's
+  //    (zhc_volume_irradiance on the .zhp) to the bit.
+  // Throws for layout none, points without tetrahedra, and a grid whose spacing is not > 0.
   irradianceAt(position, normal) {
-    if (this.layout !== 'grid') throw new Error(`zhc: volume '${this.name}' has layout ${this.layout}: irradianceAt needs a grid`);
-    if (!this.sh) this.#check(0);
-    if (!this.#volume)
-      this.#volume = makeVolume({ sh: this.sh, ...this.grid, validity: this.validity ?? null, visibility: this.visibility ?? null,
-        planes: this.planes ?? null, planesAxes: 'gltf' });
+    const vol = this.#sampler('irradianceAt');
     const d = normalizeOr([normal[0], normal[1], normal[2]], [0, 1, 0]);
-    return volumeIrradiance(this.#volume, position, this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
+    return volumeIrradiance(vol, this.#samplePoint(position), this.shAxes === 'zhc' ? gltfToZhcDir(d) : d);
+  }
+
+  // The blended SH3 radiance at `position` (glTF axes, node-local) in glTF axes and zhc's basis
+  // (Float32Array(27), index i*3+k): the weights of irradianceAt applied to the decoded probes
+  // (in doubles), then rotated from the stored axes (exact except Y20/Y22, as probeSHGltf).
+  shAt(position) {
+    const sh = volumeSH3(this.#sampler('shAt'), this.#samplePoint(position));
+    return this.shAxes === 'zhc' ? rotateZhcToGltf(sh) : Float32Array.from(sh);
+  }
+
+  // shAt(position) as a THREE.SphericalHarmonics3 in three.js's convention (as threeSH): what a
+  // THREE.LightProbe lighting an object at `position` holds, e.g. per object each frame
+  //   volume.threeSHAt(mesh.getWorldPosition(v), probe.sh)   (position in the volume's node space)
+  // then three.js's shading gives albedo * E, E = irradianceAt(position, n) up to its 6-digit
+  // basis constants (getIrradianceAt(n) = pi * E).
+  threeSHAt(position, target = new THREE.SphericalHarmonics3()) {
+    const c = toThreeConvention(this.shAt(position));
+    for (let i = 0; i < 9; i++) target.coefficients[i].set(c[i * 3], c[i * 3 + 1], c[i * 3 + 2]);
+    return target;
+  }
+
+  // Where `position` (glTF axes, node-local) falls in a POINTS volume with tetrahedra:
+  // { inside, tetra, probes [4], weights [4] } of zhc_runtime.mjs volumeTetraWeights, the walk
+  // starting at tetrahedron `start` (a moving object passes the last `tetra` for a short walk; the
+  // blend does not depend on the start).
+  tetraWeights(position, start = 0) {
+    if (this.layout !== 'points') throw new Error(`zhc: volume '${this.name}' has layout ${this.layout}: tetraWeights needs points`);
+    return volumeTetraWeights(this.#sampler('tetraWeights'), this.#samplePoint(position), start);
   }
 
   // The compact path (zhc_volume.glsl.mjs): the stored probe bytes as an RGBA32UI Data3DTexture,
@@ -180,6 +209,37 @@ export class ZhcProbeVolume {
 
   #volume = null;
 
+  // The zhc_runtime.mjs volume irradianceAt / shAt sample: a grid in glTF axes (makeVolume), or the
+  // points with their tetrahedra in zhc axes (makePointsVolume: positions (x, y, z)_zhc =
+  // (z, x, y)_glTF, a permutation of floats, so the walk's arithmetic is the C header's on the .zhp).
+  #sampler(what) {
+    if (this.#volume) return this.#volume;
+    if (this.layout === 'grid') {
+      if (!this.sh) this.#check(0);
+      this.#volume = makeVolume({ sh: this.sh, ...this.grid, validity: this.validity ?? null, visibility: this.visibility ?? null,
+        planes: this.planes ?? null, planesAxes: 'gltf' });
+    } else if (this.layout === 'points' && this.tetrahedra) {
+      if (!this.sh) this.#check(0);
+      const zhc = new Float32Array(3 * this.count);
+      for (let p = 0; p < this.count; p++) {
+        zhc[3 * p] = this.positions[3 * p + 2];
+        zhc[3 * p + 1] = this.positions[3 * p];
+        zhc[3 * p + 2] = this.positions[3 * p + 1];
+      }
+      this.#volume = makePointsVolume({ sh: this.sh, positions: zhc, tetrahedra: this.tetrahedra, neighbours: this.neighbours,
+        validity: this.validity ?? null });
+    } else {
+      throw new Error(`zhc: volume '${this.name}' has layout ${this.layout}${this.layout === 'points' ? ' without tetrahedra' : ''}: ` +
+        `${what} needs a grid or points with tetrahedra`);
+    }
+    return this.#volume;
+  }
+
+  // A glTF-axes position in the sampler's frame (the points sampler's is zhc's).
+  #samplePoint(position) {
+    return this.layout === 'points' ? gltfToZhcDir(position) : position;
+  }
+
   #check(p) {
     if (!this.sh) throw new Error(`zhc: volume '${this.name}' is not decoded (Draco point clouds need the Draco decoder)`);
     if (!Number.isInteger(p) || p < 0 || p >= this.count) throw new RangeError(`zhc: probe ${p} out of range (${this.count} probes)`);
@@ -215,9 +275,12 @@ export function lightProbeGridAtlas(volume, half = false) {
 // validityArray / visibilityArray: the optional `validity` / `visibility` accessors (count bytes,
 // glTF probe order, masks in glTF grid axes: docs/gltf-extension.md), or null. planesArray /
 // planeSidesArray: the optional `planes` (4 count bytes) / `planeSides` (count bytes) accessors,
-// both or neither (docs/gltf-extension.md "Cell planes"), or null.
+// both or neither (docs/gltf-extension.md "Cell planes"), or null. tetrahedraArray /
+// neighboursArray: the optional `tetrahedra` / `tetraNeighbours` accessors (4 per tetrahedron,
+// UNSIGNED_INT; a neighbour 4294967295 = none), both or neither (docs/gltf-extension.md
+// "Tetrahedra"), or null.
 export function buildVolume(v, coefficientsArray, positionsArray, validityArray = null, visibilityArray = null,
-  planesArray = null, planeSidesArray = null) {
+  planesArray = null, planeSidesArray = null, tetrahedraArray = null, neighboursArray = null) {
   if (typeof v.encoding !== 'string') throw new Error('ZHC_light_probes: missing encoding');
   const enc = encodingInfo(v.encoding);
   const count = v.count;
@@ -267,11 +330,40 @@ export function buildVolume(v, coefficientsArray, positionsArray, validityArray 
   const validity = perProbe(validityArray, 'validity'), visibility = perProbe(visibilityArray, 'visibility');
   if (visibility && v.layout !== 'grid') throw new Error('ZHC_light_probes: visibility needs layout grid');
   const planes = cellPlanes(v, count, planesArray, planeSidesArray);
+  const { tetrahedra, neighbours } = tetrahedraOf(v, count, tetrahedraArray, neighboursArray);
   return new ZhcProbeVolume({
     name: v.name, encoding: encodingName(v.encoding), kind: params.kind, count, shAxes, layout: v.layout, grid: v.grid,
     params, bytesPerProbe: enc.bytes, bytes, positions, sh: decodeAll(v.encoding, bytes, count, params),
-    validity, visibility, planes,
+    validity, visibility, planes, tetrahedra, neighbours,
   });
+}
+
+// The `tetrahedra` / `tetraNeighbours` accessors as a Uint32Array of probe indices and an
+// Int32Array of neighbours (4294967295 read as -1), 4 per tetrahedron; both null when absent.
+// Throws for one without the other, a layout other than points, sizes that are not 4 per
+// tetrahedron or differ, and what checkTetrahedra refuses (an index out of range, a neighbour that
+// does not share its face: zhc_runtime.mjs checkTetrahedra).
+function tetrahedraOf(v, count, tetsArray, nbrsArray) {
+  if (!tetsArray && !nbrsArray) return { tetrahedra: null, neighbours: null };
+  if (!tetsArray || !nbrsArray)
+    throw new Error(`ZHC_light_probes: ${tetsArray ? 'tetrahedra without tetraNeighbours' : 'tetraNeighbours without tetrahedra'} (the tetrahedra need both accessors)`);
+  if (v.layout !== 'points') throw new Error('ZHC_light_probes: tetrahedra need layout points');
+  if (tetsArray.length === 0 || tetsArray.length % 4 !== 0 || nbrsArray.length !== tetsArray.length)
+    throw new Error(`ZHC_light_probes: tetrahedra / tetraNeighbours accessor sizes (${tetsArray.length}, ${nbrsArray.length}): ` +
+      'VEC4, one element per tetrahedron, the same count');
+  const tetrahedra = Uint32Array.from(tetsArray);
+  const neighbours = new Int32Array(nbrsArray.length);
+  for (let j = 0; j < nbrsArray.length; j++) {
+    const n = nbrsArray[j];
+    if (!Number.isInteger(n) || n < 0 || n > 0xFFFFFFFF) throw new Error(`ZHC_light_probes: tetraNeighbours element ${j} is ${n}`);
+    neighbours[j] = n === 0xFFFFFFFF ? -1 : n > 0x7FFFFFFF ? -2 : n;  // -2: refused by checkTetrahedra
+  }
+  try {
+    checkTetrahedra(tetrahedra, neighbours, count);
+  } catch (e) {
+    throw new Error(`ZHC_light_probes: tetrahedra: ${e.message}`);
+  }
+  return { tetrahedra, neighbours };
 }
 
 // The `planes` / `planeSides` accessors as one Uint8Array of 5 bytes per probe in glTF probe
@@ -330,7 +422,8 @@ export class ZhcLightProbesPlugin {
       const coeffs = (await this.parser.getDependency('accessor', v.coefficients)).array;
       const pos = v.positions !== undefined ? (await this.parser.getDependency('accessor', v.positions)).array : null;
       const acc = async (key) => (v[key] !== undefined ? (await this.parser.getDependency('accessor', v[key])).array : null);
-      volumes.push(buildVolume(v, coeffs, pos, await acc('validity'), await acc('visibility'), await acc('planes'), await acc('planeSides')));
+      volumes.push(buildVolume(v, coeffs, pos, await acc('validity'), await acc('visibility'), await acc('planes'), await acc('planeSides'),
+        await acc('tetrahedra'), await acc('tetraNeighbours')));
     }
     for (const v of volumes) v.nodes = [];
     for (const anchor of this.anchors) {
