@@ -838,8 +838,10 @@ vec3 zhcVolumeIrradiance(ZhcVolume v, ZhcFormat f, vec3 p, vec3 normal) {
 // Scattered probes (a `points` volume; docs/runtime.md "Scattered probes (`points` layout)"). The
 // tetrahedron around a point is found on the CPU, once per object (zhc_volume_tetra_weights of
 // zhc_runtime.h, or volumeTetraWeights of runtime/web/zhc_runtime.mjs: its 4 probe indices and
-// weights, validity already applied), as Unity's light probe groups do; the shader blends those 4
-// probes, read through the same ZHC_VOLUME_WORD binding as the grid functions, e.g.
+// weights, validity already applied), as Godot does per instance at its AABB centre
+// (RendererSceneCull::_update_instance_lightmap_captures, servers/rendering/renderer_scene_cull.cpp,
+// which also blends there); the shader blends those 4 stored probes, read through the same
+// ZHC_VOLUME_WORD binding as the grid functions, e.g.
 //
 //   uniform uvec4 uTetraProbes;   // probes[] of zhc_volume_tetra_weights
 //   uniform vec4 uTetraWeights;   // weights[] as float

@@ -967,9 +967,10 @@ float3 zhc_volume_irradiance(ZhcVolume v, ZhcFormat f, float3 p, float3 normal)
 
 // Scattered probes (a `points` volume; docs/runtime.md "Scattered probes (`points` layout)"). The
 // tetrahedron around a point is found on the CPU, once per object (zhc_volume_tetra_weights of
-// zhc_runtime.h: its 4 probe indices and weights, validity already applied), as Unity's light probe
-// groups do; the shader blends those 4 probes, read through the same ZHC_VOLUME_WORD binding as the
-// grid functions, e.g.
+// zhc_runtime.h: its 4 probe indices and weights, validity already applied), as Godot does per
+// instance at its AABB centre (RendererSceneCull::_update_instance_lightmap_captures,
+// servers/rendering/renderer_scene_cull.cpp, which also blends there); the shader blends those 4
+// stored probes, read through the same ZHC_VOLUME_WORD binding as the grid functions, e.g.
 //
 //   cbuffer Object { uint4 gTetraProbes; float4 gTetraWeights; };   // probes[], weights[] as float
 //   float3 e = zhc_volume_tetra_irradiance(gTetraProbes, gTetraWeights, gFormat, worldNormal);

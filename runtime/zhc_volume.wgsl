@@ -71,8 +71,10 @@ fn zhcVolumeIrradiance(v: ZhcVolume, f: ZhcFormat, p: vec3<f32>, normal: vec3<f3
 // Scattered probes (a `points` volume; docs/runtime.md "Scattered probes (`points` layout)"). The
 // tetrahedron around a point is found on the CPU, once per object (volumeTetraWeights of
 // runtime/web/zhc_runtime.mjs, or zhc_volume_tetra_weights of zhc_runtime.h: its 4 probe indices
-// and weights, validity already applied), as Unity's light probe groups do; the shader blends those
-// 4 probes, read through the same zhcVolumeWord as the grid functions, e.g.
+// and weights, validity already applied), as Godot does per instance at its AABB centre
+// (RendererSceneCull::_update_instance_lightmap_captures, servers/rendering/renderer_scene_cull.cpp,
+// which also blends there); the shader blends those 4 stored probes, read through the same
+// zhcVolumeWord as the grid functions, e.g.
 //
 //   struct Tetra { probes: vec4<u32>, weights: vec4<f32> }   // probes, weights (as f32) of the search
 //   @group(1) @binding(0) var<uniform> uTetra: Tetra;
