@@ -11,6 +11,7 @@
 namespace zhc {
 
 // Each format's file in this folder defines its entry (declared here, listed in engine_files()).
+extern const EngineFile kBevyIrradianceVolumeFile;
 extern const EngineFile kGodotLightmapGiFile;
 
 std::span<const EngineFile> engine_files() {
@@ -18,6 +19,7 @@ std::span<const EngineFile> engine_files() {
     // initialisation (the entries themselves are constant-initialised).
     static const std::vector<EngineFile> files = [] {
         const std::vector<const EngineFile*> list = {
+            &kBevyIrradianceVolumeFile,
             &kGodotLightmapGiFile,
         };
         std::vector<EngineFile> v;
