@@ -172,7 +172,8 @@ std::array<float, 4> barycentric(F3 a, F3 b, F3 c, F3 d, F3 p) {
 }
 
 // Godot's capture at p (Godot's axes) and its shader at the normal n (Godot's axes): the blended
-// nine colours, then scene_forward_clustered.glsl's lightmap capture formula.
+// nine colours, then scene_forward_clustered.glsl's lightmap capture formula (the scene shader's
+// `INSTANCE_FLAGS_USE_LIGHTMAP_CAPTURE` branch).
 bool godot_capture(const GodotData& d, F3 p, F3 n, double out[3], int* tet_out = nullptr) {
     const int t = walk(d, p);
     if (tet_out) *tet_out = t;
@@ -185,12 +186,15 @@ bool godot_capture(const GodotData& d, F3 p, F3 n, double out[3], int* tet_out =
         for (int j = 0; j < 9; ++j)
             for (int k = 0; k < 4; ++k) sh[j][k] += d.sh[static_cast<std::size_t>(tet[i]) * 9 + j][k] * c;
     }
-    const double c1 = 0.429043, c2 = 0.511664, c3 = 0.743125, c4 = 0.886227, c5 = 0.247708;
+    // Godot 4.6's form of the polynomial (c[0..4]; earlier 4.x write the same with c1..c5 = 0.429043,
+    // 0.511664, 0.743125, 0.886227, 0.247708), times IBL_exposure_normalization (1 without camera
+    // attributes).
+    const double c[5] = {0.886227, 1.023327, 0.858086, 0.247708, 0.429043};
     const double x = n.x, y = n.y, z = n.z;
     for (int k = 0; k < 3; ++k)
-        out[k] = c1 * sh[8][k] * (x * x - y * y) + c3 * sh[6][k] * z * z + c4 * sh[0][k] - c5 * sh[6][k] +
-                 2.0 * c1 * sh[4][k] * x * y + 2.0 * c1 * sh[7][k] * x * z + 2.0 * c1 * sh[5][k] * y * z +
-                 2.0 * c2 * sh[3][k] * x + 2.0 * c2 * sh[1][k] * y + 2.0 * c2 * sh[2][k] * z;
+        out[k] = c[0] * sh[0][k] + c[1] * sh[1][k] * y + c[1] * sh[2][k] * z + c[1] * sh[3][k] * x +
+                 c[2] * sh[4][k] * x * y + c[2] * sh[5][k] * y * z + c[3] * sh[6][k] * (3.0 * z * z - 1.0) +
+                 c[2] * sh[7][k] * x * z + c[4] * sh[8][k] * (x * x - y * y);
     return true;
 }
 
@@ -645,6 +649,31 @@ TEST(EngineFileGodot, HostileFilesGiveErrors) {
     binary.insert(binary.find("\"points\""), std::string("\x01\xff\x00\x7f", 4));
     expect_error(binary, "binary bytes", ErrorCode::kBadFormat);
     EXPECT_FALSE(godot().read({}, "empty.tres"));
+}
+
+TEST(EngineFileGodot, RandomByteChangesNeverCrash) {
+    // Random bytes replaced (printable and not): the reader answers every file, with probes that
+    // agree with their layout or with a one-line error.
+    const std::string base = small_file();
+    test::Rng rng(99);
+    int errors = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        std::string t = base;
+        const int edits = 1 + static_cast<int>(rng.u() * 4);
+        for (int e = 0; e < edits; ++e) {
+            const std::size_t at = static_cast<std::size_t>(rng.u() * t.size()) % t.size();
+            const char* pool = "0123456789-.,()[]{}:=\"e \nnainf\x01\xff";
+            t[at] = pool[static_cast<std::size_t>(rng.u() * 32) % 32];
+        }
+        auto r = godot().read(bytes_of(t), "flip.tres");
+        if (r) {
+            EXPECT_EQ(r->hub.size(), r->layout.positions.size());
+        } else {
+            ++errors;
+            EXPECT_EQ(r.error().message.find('\n'), std::string::npos) << r.error().message;
+        }
+    }
+    EXPECT_GT(errors, 1000);
 }
 
 }  // namespace
