@@ -6,7 +6,7 @@ import type * as GltfTransformCore from '@gltf-transform/core';
 
 export declare const ZHC_LIGHT_PROBES: 'ZHC_light_probes';
 
-/** The stored data of a volume's accessor property ('coefficients', 'positions', 'validity', 'visibility', 'planes', 'planeSides'). */
+/** The stored data of a volume's accessor property ('coefficients', 'positions', 'validity', 'visibility', 'planes', 'planeSides', 'tetrahedra', 'tetraNeighbours'). */
 export interface ZhcAccessorData {
   bytes: Uint8Array;
   componentType: number;
@@ -47,8 +47,8 @@ declare class ZhcLightProbeVolumeProperty extends ExtensionProperty<IZhcLightPro
   getCount(): number | undefined;
   getLayout(): string | undefined;
   getGrid(): { origin: number[]; spacing: number[]; counts: number[] } | null;
-  getAccessorData(key: 'coefficients' | 'positions' | 'validity' | 'visibility' | 'planes' | 'planeSides'): ZhcAccessorData | null;
-  setAccessorData(key: 'coefficients' | 'positions' | 'validity' | 'visibility' | 'planes' | 'planeSides', data: ZhcAccessorData | null): this;
+  getAccessorData(key: 'coefficients' | 'positions' | 'validity' | 'visibility' | 'planes' | 'planeSides' | 'tetrahedra' | 'tetraNeighbours'): ZhcAccessorData | null;
+  setAccessorData(key: 'coefficients' | 'positions' | 'validity' | 'visibility' | 'planes' | 'planeSides' | 'tetrahedra' | 'tetraNeighbours', data: ZhcAccessorData | null): this;
   getDracoPayload(): Uint8Array | null;
   setDracoPayload(bytes: Uint8Array | null): this;
 }

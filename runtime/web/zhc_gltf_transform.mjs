@@ -15,8 +15,9 @@
 //
 // How the probe data is held. Each volume is a ZhcLightProbeVolume (an ExtensionProperty, parent
 // type Node) holding its JSON definition (everything but buffer indices) and the stored bytes of
-// its accessors (ACCESSOR_KEYS: `coefficients`, `positions` and the per-probe `validity`,
-// `visibility`, `planes`, `planeSides`) and of its Draco payload bufferView, exactly as read.
+// its accessors (ACCESSOR_KEYS: `coefficients`, `positions`, the per-probe `validity`,
+// `visibility`, `planes`, `planeSides` and the points' `tetrahedra`, `tetraNeighbours`) and of its
+// Draco payload bufferView, exactly as read.
 // The bytes are NOT kept as glTF-Transform Accessors: glTF-Transform's meshopt() and the writer's
 // EXT_meshopt_compression compress every Accessor of the document (into a uri-less fallback
 // buffer that zhc's reader and most loaders cannot read as plain bytes), sparse() turns mostly-zero
@@ -35,8 +36,8 @@ export const ZHC_LIGHT_PROBES = 'ZHC_light_probes';
 // only carried when its value is a string or a boolean (a number or an object could be an index
 // of something this module cannot renumber, so such a file is refused rather than written wrong).
 const KNOWN_KEYS = new Set(['name', 'encoding', 'kind', 'count', 'shAxes', 'layout', 'grid', 'positions', 'coefficients', 'validity', 'visibility',
-  'planes', 'planeSides', 'quantization', 'luminanceWeights', 'draco', 'extras']);
-const ACCESSOR_KEYS = ['positions', 'coefficients', 'validity', 'visibility', 'planes', 'planeSides'];
+  'planes', 'planeSides', 'tetrahedra', 'tetraNeighbours', 'quantization', 'luminanceWeights', 'draco', 'extras']);
+const ACCESSOR_KEYS = ['positions', 'coefficients', 'validity', 'visibility', 'planes', 'planeSides', 'tetrahedra', 'tetraNeighbours'];
 
 const COMPONENT_BYTES = { 5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4 };
 const TYPE_SIZE = { SCALAR: 1, VEC2: 2, VEC3: 3, VEC4: 4, MAT2: 4, MAT3: 9, MAT4: 16 };
@@ -81,7 +82,7 @@ export function defineZhcLightProbes(core) {
 
     /**
      * The stored data of accessor property `key` ('coefficients', 'positions', 'validity', 'visibility',
-     * 'planes' or 'planeSides'):
+     * 'planes', 'planeSides', 'tetrahedra' or 'tetraNeighbours'):
      * { bytes: Uint8Array, componentType, type, count, name?, min?, max? }, or null.
      */
     getAccessorData(key) {

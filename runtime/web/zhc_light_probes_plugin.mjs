@@ -8,6 +8,8 @@
 //   const volume = gltf.userData.zhcLightProbes[0];        // a ZhcProbeVolume
 //   volume.irradiance(7, [0, 1, 0]);                        // RGB, glTF / three.js axes
 //   scene.add(volume.lightProbe(7));                        // THREE.LightProbe for probe 7
+//   volume.irradianceAt([1, 2, 3], [0, 1, 0]);              // anywhere: a grid, or points with tetrahedra
+//   volume.threeSHAt(objectPosition, objectProbe.sh);       // per object: a LightProbe's SH at its position
 //
 // Every volume is decoded at load by zhc_runtime.mjs into SH3 radiance (bit exact with zhc's own
 // decoder). Nodes that reference a volume get a child Object3D named "ZHC_light_probes" with

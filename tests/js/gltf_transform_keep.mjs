@@ -5,7 +5,7 @@
 //     bake's validity and cell planes accessors), and `zhc gltf embed` outputs with a second volume
 //     (Draco point cloud, float points with positions, --sh-axes gltf), one with the probe nodes
 //     under a transformed parent, one .gltf, a grid with validity, visibility and random cell
-//     planes (grid_leak.glb);
+//     planes (grid_leak.glb), scattered probes with their tetrahedra accessors (points_tetra.glb);
 //  2. the real CLI (node_modules/.bin/gltf-transform, @gltf-transform/cli 4.x) runs
 //     copy, optimize, meshopt, draco, dedup, prune, quantize, flatten, sparse, weld on each
 //     with --config runtime/web/gltf-transform.config.mjs;
@@ -106,6 +106,8 @@ function definition(vol) {
   delete d.visibility;
   delete d.planes;
   delete d.planeSides;
+  delete d.tetrahedra;
+  delete d.tetraNeighbours;
   if (d.draco) delete d.draco.bufferView;
   return JSON.stringify(d);
 }
@@ -179,6 +181,14 @@ inputs.push({ name: 'grid_sh2_q.gltf', file: W('grid_sh2_q.gltf') });
     'grid_leak.glb: validity, visibility, planes and planeSides accessors');
   inputs.push({ name: 'grid_leak.glb', file: W('grid_leak.glb'), leak: true });
 }
+// Scattered probes with their tetrahedra (`zhc convert` of the positions list writes them) and validity.
+{
+  run(['convert', W('points.json'), '-o', W('points_tetra.zhp'), '--to', 'zh3_q16']);
+  run(['gltf', 'embed', W('tri.glb'), W('points_tetra.zhp'), '-o', W('points_tetra.glb')]);
+  const vol = readJson(W('points_tetra.glb')).json.extensions.ZHC_light_probes.volumes[0];
+  check(Number.isInteger(vol.tetrahedra) && Number.isInteger(vol.tetraNeighbours), 'points_tetra.glb: tetrahedra and tetraNeighbours accessors');
+  inputs.push({ name: 'points_tetra.glb', file: W('points_tetra.glb'), tetra: true });
+}
 // The default bake of a scene with walls writes cell planes into the glTF output too.
 for (const name of ['baked_zh3_q16.glb', 'baked_sh3.glb']) {
   const vol = readJson(W(name)).json.extensions.ZHC_light_probes.volumes[0];
@@ -215,13 +225,17 @@ for (const inp of inputs) {
     check(z[8] === 2 && z[21] === 7 && z.equals(src),
       'grid_leak.glb: zhc gltf extract gives the .zhp it was embedded from (validity, visibility, planes)');
   }
+  if (inp.tetra) {  // the extraction is the embedded version 2 .zhp with its tetrahedra section
+    const z = inp.extracted[0].zhp, src = fs.readFileSync(W('points_tetra.zhp'));
+    check(z[8] === 2 && z[21] === 8 && z.equals(src), 'points_tetra.glb: zhc gltf extract gives the .zhp it was embedded from (tetrahedra)');
+  }
 }
 
 // --- 2./3. the CLI with the config ----------------------------------------------------------------
 // Every command on the inputs that cover the encodings' storage kinds (quantised grid, float
 // grid with a Draco-compressed mesh... see `full`), copy and optimize on all of them.
 const commands = ['copy', 'optimize', 'meshopt', 'draco', 'dedup', 'prune', 'quantize', 'flatten', 'sparse', 'weld'];
-const full = new Set(['demo_probes.glb', 'baked_zh3_q16.glb', 'placed.glb', 'points_sh3_gltf_axes.glb', 'grid_leak.glb']);
+const full = new Set(['demo_probes.glb', 'baked_zh3_q16.glb', 'placed.glb', 'points_sh3_gltf_axes.glb', 'grid_leak.glb', 'points_tetra.glb']);
 function gltfTransform(args) {
   return spawnSync(cli, args, { encoding: 'utf8', cwd: work });
 }
