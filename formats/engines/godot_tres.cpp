@@ -1,6 +1,6 @@
 // Godot 4 LightmapGIData probe data as a text resource (.tres): the probes Godot's LightmapGI
 // captures dynamic objects with, written and read by zhc (docs/engine-files.md "Godot 4:
-// godot_lightmap_gi"). Written from godotengine/godot 4.6-stable (the snapshot's version.py):
+// godot_lightmap_gi"). Written from godotengine/godot 4.6.2-stable (version.py):
 //  * scene/3d/lightmap_gi.cpp LightmapGIData::_set_probe_data / _get_probe_data (the keys of the
 //    `probe_data` Dictionary: bounds, points, tetrahedra, bsp, sh, interior, baked_exposure, and the
 //    optional lightprobe_hash), set_capture_data (9 Colors per point, 6 int32 per BSP node);
@@ -366,6 +366,9 @@ Result<EngineFileOutput> godot_write(const EngineFileInput& in) {
         if (!t->duplicates.empty())
             out.notes.push_back(std::to_string(t->duplicates.size()) +
                                 " probes share a position with another: written, never blended");
+        if (!t->unused.empty())
+            out.notes.push_back(std::to_string(t->unused.size()) +
+                                " probes are in no tetrahedron (within qhull's precision of another): written, never blended");
     }
     if (tets.empty()) return fail("no tetrahedra for Godot's probes");
 
@@ -910,7 +913,8 @@ Result<EngineFileProbes> godot_read(std::span<const std::uint8_t> bytes, const s
     if (exposure->number != 1.0)
         out.notes.push_back("baked with exposure normalization " + std::to_string(exposure->number) +
                             ": the SH are read as stored");
-    if (interior->text == "true") out.notes.push_back("an interior lightmap (Godot ignores the environment beyond it)");
+    if (interior->text == "true")
+        out.notes.push_back("an interior lightmap: where it overlaps exterior ones, Godot captures from it alone");
     return out;
 }
 
