@@ -588,6 +588,15 @@ TEST(EngineFileGodot, OtherPropertiesAndSectionsAreSkipped) {
     ASSERT_TRUE(r) << r.error().message;
     ASSERT_EQ(r->hub.size(), plain->hub.size());
     for (std::size_t i = 0; i < r->hub.size(); ++i) EXPECT_EQ(r->hub[i], plain->hub[i]);
+    // A large property beside probe_data (parsed, not stored), and keys probe_data does not need.
+    std::string big = base;
+    std::string zeros = "metadata/big = [";
+    for (int i = 0; i < 200000; ++i) zeros += i ? ", 0" : "0";
+    big.insert(big.find("probe_data = "), zeros + "]\n");
+    big.insert(big.find("\"points\""), "\"extra\": {\"a\": [1, 2], 3: PackedInt32Array(1)},\n");
+    auto r3 = godot().read(bytes_of(big), "big.tres");
+    ASSERT_TRUE(r3) << r3.error().message;
+    EXPECT_EQ(r3->hub.size(), plain->hub.size());
     // Keys in another order, a lightprobe_hash (4.4+), an exposure other than 1 (noted).
     std::string u = base;
     u = replace_value(u, "baked_exposure", "0.5");

@@ -459,19 +459,29 @@ Result<EngineFileOutput> godot_write(const EngineFileInput& in) {
 // ---- text input ----------------------------------------------------------------------------------
 
 // A value of Godot's text resource grammar (VariantParser::parse_value), as much as the reader
-// keeps: numbers (a constructor's numbers in `numbers`), strings, identifiers, and the nesting.
+// keeps. Every value is parsed (the grammar checked), but only a kept one stores its contents: a
+// constructor's numbers, and a dictionary's entries under the keys `wanted` names; array items and
+// other constructor arguments are never stored. So memory grows with what probe_data needs (8
+// bytes a number, at most 4 times the text), never with what other properties hold.
 struct Value {
     enum Kind { kNumber, kString, kIdent, kConstruct, kArray, kDict } kind = kNumber;
     double number = 0;
     bool integer = false;
     std::int64_t integer_value = 0;
-    std::string text;                // string, identifier, constructor name
-    std::vector<double> numbers;     // constructor arguments when all are numbers
-    std::vector<std::int64_t> ints;  // the same, as integers (when all are integer literals)
-    bool all_ints = true;
-    std::vector<Value> items;        // array items, dict key/value pairs, other constructor arguments
+    std::string text;             // string, identifier, constructor name
+    std::vector<double> numbers;  // a kept constructor's numeric arguments
+    bool all_ints = true;         // every numeric argument an integer literal
+    bool other_args = false;      // arguments that are not numbers
+    std::vector<Value> items;     // a kept dictionary's wanted entries: key, value, key, value ...
     int line = 0;
 };
+// The probe_data keys the reader keeps (LightmapGIData::_set_probe_data's).
+bool wanted(const Value& key) {
+    if (key.kind != Value::kString) return false;
+    for (const char* k : {"bounds", "points", "tetrahedra", "bsp", "sh", "interior", "baked_exposure"})
+        if (key.text == k) return true;
+    return false;
+}
 
 class Parser {
 public:
@@ -515,9 +525,10 @@ public:
             const int line = line_;
             auto key = parse_key();
             if (!key) return key.error();
-            auto v = parse_value(0);
+            const bool keep = section == "resource" && *key == "probe_data";
+            auto v = parse_value(0, keep);
             if (!v) return v.error();
-            if (section == "resource" && *key == "probe_data") {
+            if (keep) {
                 if (have) return error(ErrorCode::kBadFormat, "probe_data is assigned twice", line);
                 data = std::move(*v);
                 data.line = line;
@@ -570,7 +581,7 @@ private:
             if (key.empty() || pos_ >= s_.size() || s_[pos_] != '=')
                 return error(ErrorCode::kBadFormat, "malformed attribute in the tag [" + name, line_);
             ++pos_;
-            auto v = parse_value(0);
+            auto v = parse_value(0, false);
             if (!v) return v.error();
             attrs[key] = std::move(*v);
         }
@@ -676,14 +687,14 @@ private:
         return v;
     }
 
-    Result<Value> parse_value(int depth) {
+    Result<Value> parse_value(int depth, bool keep) {
         if (depth > kMaxDepth) return error(ErrorCode::kTooLarge, "values nested deeper than " + std::to_string(kMaxDepth), line_);
         auto tok = next();
         if (!tok) return tok.error();
-        return value_from(*tok, depth);
+        return value_from(*tok, depth, keep);
     }
 
-    Result<Value> value_from(const Token& t, int depth) {
+    Result<Value> value_from(const Token& t, int depth, bool keep) {
         switch (t.type) {
             case Token::kEof:
                 return error(ErrorCode::kTruncated, "the file ends where a value was expected", t.line);
@@ -697,7 +708,7 @@ private:
                 return v;
             }
             case Token::kPunct:
-                if (t.punct == '[' || t.punct == '{') return list(t.punct, depth, t.line);
+                if (t.punct == '[' || t.punct == '{') return list(t.punct, depth, t.line, keep);
                 return error(ErrorCode::kBadFormat, std::string("unexpected '") + t.punct + "'", t.line);
             case Token::kIdent:
                 break;
@@ -709,7 +720,7 @@ private:
         skip_space();
         if (pos_ < s_.size() && s_[pos_] == '[') {  // Array[Type](...), Dictionary[K, V](...)
             ++pos_;
-            auto types = list('[', depth + 1, line_);
+            auto types = list('[', depth + 1, line_, false);
             if (!types) return types.error();
             skip_space();
         }
@@ -731,16 +742,15 @@ private:
                 if (a->type == Token::kNumber) {
                     auto n = number(*a);
                     if (!n) return n.error();
-                    v.numbers.push_back(n->number);
-                    if (n->integer) v.ints.push_back(n->integer_value);
-                    else v.all_ints = false;
+                    if (keep) v.numbers.push_back(n->number);
+                    if (!n->integer) v.all_ints = false;
                 } else if (a->type == Token::kIdent && (a->text == "nan" || a->text == "inf" || a->text == "inf_neg")) {
-                    v.numbers.push_back(a->text == "nan" ? NAN : (a->text == "inf" ? INFINITY : -INFINITY));
+                    if (keep) v.numbers.push_back(a->text == "nan" ? NAN : (a->text == "inf" ? INFINITY : -INFINITY));
                     v.all_ints = false;
                 } else {
-                    auto item = value_from(*a, depth + 1);
+                    auto item = value_from(*a, depth + 1, false);
                     if (!item) return item.error();
-                    v.items.push_back(std::move(*item));
+                    v.other_args = true;
                 }
             }
         }
@@ -748,7 +758,7 @@ private:
     }
 
     // [a, b, ...] or {k: v, ...}; the opening bracket is consumed.
-    Result<Value> list(char open, int depth, int line) {
+    Result<Value> list(char open, int depth, int line, bool keep) {
         if (depth > kMaxDepth) return error(ErrorCode::kTooLarge, "values nested deeper than " + std::to_string(kMaxDepth), line);
         Value v;
         v.kind = open == '[' ? Value::kArray : Value::kDict;
@@ -767,17 +777,20 @@ private:
                 if (!a) return a.error();
             }
             first = false;
-            auto item = value_from(*a, depth + 1);
+            auto item = value_from(*a, depth + 1, false);
             if (!item) return item.error();
-            v.items.push_back(std::move(*item));
             if (open == '{') {
                 auto colon = next();
                 if (!colon) return colon.error();
                 if (colon->type != Token::kPunct || colon->punct != ':')
                     return error(ErrorCode::kBadFormat, "expected ':' in a dictionary", colon->line);
-                auto val = parse_value(depth + 1);
+                const bool store = keep && wanted(*item);
+                auto val = parse_value(depth + 1, store);
                 if (!val) return val.error();
-                v.items.push_back(std::move(*val));
+                if (store) {
+                    v.items.push_back(std::move(*item));
+                    v.items.push_back(std::move(*val));
+                }
             }
         }
         return v;
@@ -801,7 +814,6 @@ Result<EngineFileProbes> godot_read(std::span<const std::uint8_t> bytes, const s
     std::map<std::string, const Value*> keys;
     for (std::size_t i = 0; i + 1 < data->items.size(); i += 2) {
         const Value& k = data->items[i];
-        if (k.kind != Value::kString) return bad(ErrorCode::kBadFormat, "has a key that is not a string", k.line);
         if (!keys.emplace(k.text, &data->items[i + 1]).second)
             return bad(ErrorCode::kBadFormat, "has the key \"" + k.text + "\" twice", k.line);
     }
@@ -810,7 +822,7 @@ Result<EngineFileProbes> godot_read(std::span<const std::uint8_t> bytes, const s
         if (!keys.count(k)) return bad(ErrorCode::kBadFormat, std::string("has no \"") + k + "\"", data->line);
     const auto construct = [&](const char* key, const char* type) -> Result<const Value*> {
         const Value* v = keys[key];
-        if (v->kind != Value::kConstruct || v->text != type || !v->items.empty())
+        if (v->kind != Value::kConstruct || v->text != type || v->other_args)
             return bad(ErrorCode::kBadFormat, std::string("\"") + key + "\" is not a " + type + " of numbers", v->line);
         return v;
     };
@@ -853,22 +865,25 @@ Result<EngineFileProbes> godot_read(std::span<const std::uint8_t> bytes, const s
 
     // Tetrahedra and BSP: checked as Godot's walk relies on them (indices in range; each child after
     // its node, so the walk ends).
-    const auto& tv = (*tetra)->ints;
+    // Integer literals (all_ints) held as doubles: exact within int32, checked before any cast.
+    const auto& tv = (*tetra)->numbers;
     if (!(*tetra)->all_ints || tv.size() % 4)
         return bad(ErrorCode::kBadFormat, "\"tetrahedra\" is not 4 integers per tetrahedron", (*tetra)->line);
-    for (std::int64_t v : tv)
-        if (v < 0 || static_cast<std::uint64_t>(v) >= n)
-            return bad(ErrorCode::kBadFormat, "\"tetrahedra\" names point " + std::to_string(v) + " of " + std::to_string(n),
+    for (double v : tv)
+        if (v < 0 || v >= static_cast<double>(n))
+            return bad(ErrorCode::kBadFormat, "\"tetrahedra\" names point " + std::to_string(static_cast<long long>(v)) +
+                                                  " of " + std::to_string(n),
                        (*tetra)->line);
     const std::size_t tet_count = tv.size() / 4;
-    const auto& bv = (*bsp)->ints;
+    const auto& bv = (*bsp)->numbers;
     if (!(*bsp)->all_ints || bv.size() % 6)
         return bad(ErrorCode::kBadFormat, "\"bsp\" is not 6 integers per node", (*bsp)->line);
     const std::size_t nodes = bv.size() / 6;
     for (std::size_t i = 0; i < bv.size(); ++i) {
-        const std::int64_t v = bv[i];
-        if (v < std::numeric_limits<std::int32_t>::min() || v > std::numeric_limits<std::int32_t>::max())
-            return bad(ErrorCode::kBadFormat, "\"bsp\" holds " + std::to_string(v) + ", not an int32", (*bsp)->line);
+        if (bv[i] < std::numeric_limits<std::int32_t>::min() || bv[i] > std::numeric_limits<std::int32_t>::max())
+            return bad(ErrorCode::kBadFormat, "\"bsp\" holds " + std::to_string(static_cast<long long>(bv[i])) + ", not an int32",
+                       (*bsp)->line);
+        const auto v = static_cast<std::int64_t>(bv[i]);
         if (i % 6 < 4) {
             float f;
             const auto bits = static_cast<std::int32_t>(v);
