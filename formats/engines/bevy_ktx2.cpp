@@ -345,7 +345,7 @@ Result<BevyGrid> grid_from_keys(const Ktx2Texture& t, const std::array<std::uint
             g.spacing[r] = 1.0 / res[r];
             g.origin[r] = -0.5 + 0.5 * g.spacing[r];
         }
-        notes.push_back("the file holds no bounds (no zhc.volume key): the volume is taken as the unit cube centred at the origin, "
+        notes.push_back("the file holds no bounds (no zhc.volume or bevy.IrradianceVolume key): the volume is taken as the unit cube centred at the origin, "
                         "as Bevy places it under an identity Transform (give the entity's Transform to place it)");
     }
     return g;
