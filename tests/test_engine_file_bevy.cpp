@@ -494,6 +494,25 @@ TEST(EngineFileBevy, HostileFilesRefused) {
     EXPECT_EQ(sniff_engine_file(shaped(2, 4, 6)), find_engine_file("bevy_irradiance_volume"));
 }
 
+// Exactly one entry of the table claims a Bevy volume (zhc's and the exporter's), so `zhc convert`
+// reads it whatever the table's order.
+TEST(EngineFileBevy, OnlyTheBevyEntrySniffsBevyVolumes) {
+    EngineFileInput in;
+    const auto hub = random_hub(8, 6);
+    in.hub = hub;
+    in.layout = grid_layout({2, 2, 2}, {0, 0, 0}, {1, 1, 1});
+    auto out = bevy_file().write(in);
+    ASSERT_TRUE(out.ok());
+    const auto example = read_all(std::string(ZHC_TEST_DATA_DIR) + "/engines/bevy_example.vxgi.ktx2");
+    const std::vector<const std::vector<std::uint8_t>*> files = {&out->bytes, &example};
+    for (const auto* bytes : files) {
+        std::vector<std::string> claimed;
+        for (const EngineFile& f : engine_files())
+            if (f.sniff && f.sniff(*bytes)) claimed.emplace_back(f.name);
+        EXPECT_EQ(claimed, std::vector<std::string>{"bevy_irradiance_volume"});
+    }
+}
+
 TEST(EngineFileBevy, WriterRefusesWhatBevyCannotHold) {
     const auto hub = random_hub(8, 1);
     EngineFileInput in;
