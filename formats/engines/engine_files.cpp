@@ -12,6 +12,8 @@ namespace zhc {
 
 // Each format's file in this folder defines its entry (declared here, listed in engine_files()).
 extern const EngineFile kBevyIrradianceVolumeFile;
+extern const EngineFile kThreejsGridExrFile;
+extern const EngineFile kThreejsGridKtx2File;
 extern const EngineFile kGodotLightmapGiFile;
 
 std::span<const EngineFile> engine_files() {
@@ -20,6 +22,8 @@ std::span<const EngineFile> engine_files() {
     static const std::vector<EngineFile> files = [] {
         const std::vector<const EngineFile*> list = {
             &kBevyIrradianceVolumeFile,
+            &kThreejsGridExrFile,
+            &kThreejsGridKtx2File,
             &kGodotLightmapGiFile,
         };
         std::vector<EngineFile> v;

@@ -32,6 +32,7 @@ import type { ZhcCompactVolume } from '@zhc/runtime/volume';
 import { ZHC_LIGHT_PROBES, defineZhcLightProbes } from '@zhc/runtime/gltf-transform';
 import type { ZhcLightProbes as ZhcLightProbesInstance } from '@zhc/runtime/gltf-transform';
 import config, { ZhcLightProbes } from '@zhc/runtime/gltf-transform.config.mjs';
+import { THREEJS_GRID_KEY, ZHC_VOLUME_KEY, gridBoundsFromExrHeader, gridBoundsFromKtx2, lightProbeGridFromTexture } from '@zhc/runtime/threejs-grid';
 
 export interface ConsumerReport {
   volumes: number;
@@ -226,4 +227,11 @@ export async function run(glb: ArrayBuffer, zhp: Uint8Array): Promise<ConsumerRe
     threeSignsLength: THREE_SIGNS.length,
     tableLength: ENCODING_TABLE.length + Object.keys(ENCODINGS).length,
   };
+}
+
+// @zhc/runtime/threejs-grid (type-checked, not run here: js.threejs_grid_files runs it in Chromium):
+// a LightProbeGridWebGL from EXRLoader's texture and header, and the bounds of a KTX2 file.
+export function threejsGridFromFiles(exr: THREE.DataTexture, header: Record<string, unknown>, ktx2: ArrayBuffer): [LightProbeGridWebGL, number[], string] {
+  const grid: LightProbeGridWebGL = lightProbeGridFromTexture(LightProbeGridWebGL, exr, gridBoundsFromExrHeader(header), { name: 'grid' });
+  return [grid, gridBoundsFromKtx2(ktx2).grid.resolution, `${ZHC_VOLUME_KEY} ${THREEJS_GRID_KEY}`];
 }
