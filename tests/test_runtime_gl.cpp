@@ -1054,7 +1054,7 @@ void compare_tetra_volumes(int samples) {
                 bool defined = true;
                 for (int k = 0; k < 4; ++k) {
                     if (sm.weights[k] == 0.0) {
-                        dropped += with_validity && sm.outside == 0;
+                        dropped += with_validity && sm.outside == 0 && i < std::size_t(samples);  // not at a probe
                         continue;
                     }
                     const Scale sc = probe_scale(e, p, v.decoded[sm.probes[k]]);
