@@ -236,7 +236,7 @@ std::array<double, 3> shader_twin(const Atlas3d& atlas, const double pmin[3], co
 // The entry's irradiance at zhc point p, normal n: the texels of the eight corner probes of zhc's
 // grid blended trilinearly at p + n spacing / 2 (clamped to the probes), then the entry's shade.
 Rgb entry_blend(const std::vector<Sh3Radiance>& hub, const ProbeGrid& g, std::string_view codec_name, Vec3 p, Vec3 n,
-                double* blended = nullptr) {
+                double* abs_blended = nullptr) {
     const Codec& codec = *find_codec(codec_name);
     const EngineLayoutInfo& info = *find_engine_layout(codec_name);
     const double pp[3] = {p.x + n.x * g.spacing.x * 0.5, p.y + n.y * g.spacing.y * 0.5, p.z + n.z * g.spacing.z * 0.5};
@@ -249,7 +249,7 @@ Rgb entry_blend(const std::vector<Sh3Radiance>& hub, const ProbeGrid& g, std::st
         i0[k] = std::min(int(std::floor(q)), std::max(cnt - 2, 0));
         f[k] = q - i0[k];
     }
-    double blend[kMaxEngineTexels] = {};
+    double blend[kMaxEngineTexels] = {}, abs_blend[kMaxEngineTexels] = {};
     std::vector<std::uint8_t> bytes(codec.size_bytes);
     for (int corner = 0; corner < 8; ++corner) {
         int idx[3];
@@ -263,9 +263,12 @@ Rgb entry_blend(const std::vector<Sh3Radiance>& hub, const ProbeGrid& g, std::st
         encode_probe(codec, CodecOptions{}, hub[i], bytes.data(), nullptr);
         double t[kMaxEngineTexels];
         info.texels(bytes.data(), t);
-        for (int k = 0; k < info.texel_count; ++k) blend[k] += wt * t[k];
+        for (int k = 0; k < info.texel_count; ++k) {
+            blend[k] += wt * t[k];
+            abs_blend[k] += wt * std::fabs(t[k]);
+        }
     }
-    if (blended) std::copy(blend, blend + info.texel_count, blended);
+    if (abs_blended) std::copy(abs_blend, abs_blend + info.texel_count, abs_blended);
     return info.shade(blend, n);
 }
 
@@ -769,8 +772,8 @@ TEST(ThreejsGridKtx2, HostileFilesRefusalsDeterminismSniffing) {
 
 // ---- fixtures for tests/js/threejs_grid_files.mjs ---------------------------------------------------
 
-// Writes DIR/grid.exr (and DIR/grid.ktx2 when that entry exists) and DIR/expected.json: sample
-// points and normals in three.js's world axes and the entry's irradiance there (zhc units).
+// Writes DIR/grid.exr, DIR/grid.ktx2 and DIR/expected.json: the bounds, sample points and normals
+// in three.js's world axes, the entry's irradiance there (zhc units) and the term scale S.
 TEST(ThreejsGridFixtures, WriteForThreejs) {
     const char* dir = std::getenv("ZHC_THREEJS_GRID_FIXTURES");
     if (!dir) GTEST_SKIP() << "ZHC_THREEJS_GRID_FIXTURES not set";
@@ -795,16 +798,18 @@ TEST(ThreejsGridFixtures, WriteForThreejs) {
                    float(g.origin.z + (0.05 + 0.9 * u(gen)) * (g.counts[2] - 1) * g.spacing.z)};
             const double z = 2 * u(gen) - 1, phi = 2 * kPiD * u(gen), r = std::sqrt(1 - z * z);
             Vec3 n{float(r * std::cos(phi)), float(r * std::sin(phi)), float(z)};
-            double blend[kMaxEngineTexels];
-            const Rgb e = entry_blend(hub, g, f->layout_codec, p, n, blend);
+            double abs_blend[kMaxEngineTexels];
+            const Rgb e = entry_blend(hub, g, f->layout_codec, p, n, abs_blend);
             const Vec3 tp = to_three(p), tn = to_three(n);
-            // Term scale: the magnitudes of the shader's nine terms (three.js's axes) / pi.
+            // Term scale S: the magnitudes of the shader's nine terms (three.js's axes) / pi, summed
+            // over the corner probes with their weights (>= |E|; a relative error e of every stored
+            // value moves E by at most e S).
             const double x = tn.x, y = tn.y, zz = tn.z;
             const double basis[9] = {0.886227, 2 * 0.511664 * y, 2 * 0.511664 * zz, 2 * 0.511664 * x, 2 * 0.429043 * x * y,
                                      2 * 0.429043 * y * zz, 0.743125 * zz * zz - 0.247708, 2 * 0.429043 * x * zz, 0.429043 * (x * x - y * y)};
             std::array<double, 3> scale{};
             for (int ch = 0; ch < 3; ++ch)
-                for (int i = 0; i < 9; ++i) scale[size_t(ch)] += std::fabs(blend[3 * i + ch] * basis[i]) / kPiD;
+                for (int i = 0; i < 9; ++i) scale[size_t(ch)] += abs_blend[3 * i + ch] * std::fabs(basis[i]) / kPiD;
             samples.push_back({{"position", {tp.x, tp.y, tp.z}}, {"normal", {tn.x, tn.y, tn.z}}, {"irradiance", {e.r, e.g, e.b}}, {"termScale", scale}});
         }
         auto back = f->read(out->bytes, file);
