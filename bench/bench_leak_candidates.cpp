@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
     std::vector<double> bytes;
     bool header = false;
     for (const LeakScene& ls : scenes) {
-        const Baked b = bake_volumes(ls, 1);
+        const Baked b = bake_volumes(ls, 1, false);
         if (!b.error.empty()) {
             std::fprintf(stderr, "%s\n", b.error.c_str());
             return 1;

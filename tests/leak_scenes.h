@@ -379,7 +379,8 @@ inline std::vector<double> truth_of(const LeakScene& ls) {
 // Two bakes of one scene: every probe at its grid point (occlusion.move_probes false, visibility
 // masks traced), written without leak data (plain) and with validity + masks; and the default bake
 // (probes kept out of walls, codec/bake/leak_planes.h) with validity + planes, as `zhc bake`
-// writes it.
+// writes it. shadow_planes false: the planes follow geometry only (occlusion.shadow_planes; the
+// candidate study's scheme, tests/leak_candidates.h).
 struct Baked {
     std::vector<Sh3Radiance> probes;  // at the grid points
     ProbeLeakData leak;
@@ -392,7 +393,7 @@ struct Baked {
     std::string error;                                 // non-empty: the bake or a write failed
 };
 
-inline Baked bake_volumes(const LeakScene& ls, int threads = 1) {
+inline Baked bake_volumes(const LeakScene& ls, int threads = 1, bool shadow_planes = true) {
     Baked b;
     BakeOptions opt;
     opt.threads = threads;
@@ -422,7 +423,9 @@ inline Baked bake_volumes(const LeakScene& ls, int threads = 1) {
     b.masked_zhp = std::move(*masked);
     BakeOptions def;
     def.threads = threads;
-    auto moved = bake_scene(ls.scene, def, &b.planes_report, &b.planes_leak);
+    Scene defaults = ls.scene;
+    defaults.occlusion.shadow_planes = shadow_planes;
+    auto moved = bake_scene(defaults, def, &b.planes_report, &b.planes_leak);
     if (!moved) {
         b.error = ls.name + ": " + moved.error().message;
         return b;

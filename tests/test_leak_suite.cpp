@@ -7,16 +7,20 @@
 //    is exactly 0;
 //  * the shading points: every surface kind on both sides, 1e-4 off real geometry, none inside a
 //    solid; the corridor's dark points are all in shadow;
-//  * the volumes, facts that hold today: plain trilinear leaks in every two-room configuration, less
-//    as the wall moves towards the dark probe plane; the masks cut the leak at least 10x where the
-//    wall lies on the lit side of the cell's middle (a probe column inside the wall included, whose
-//    probes are exactly the invalid ones); the masks take 2 bytes per probe; a probe at the shading
-//    point itself (the SH3 limit) is within 10 % of the truth on the lit side and every volume is
-//    further off;
+//  * the volumes: plain trilinear leaks in every two-room configuration, less as the wall moves
+//    towards the dark probe plane; the masks cut the leak at least 10x where the wall lies on the
+//    lit side of the cell's middle (a probe column inside the wall included, whose probes are
+//    exactly the invalid ones); the masks take 2 bytes per probe; a probe at the shading point
+//    itself (the SH3 limit) is within 10 % of the truth on the lit side and every volume is further
+//    off;
+//  * the default bake (probes kept out of walls, a plane per cell, 6 bytes per probe): never above
+//    plain's leak; the dark side below 1 % of the lit side in every two-room configuration and in
+//    the L corridor (its shadow planes), the window room within the truth's own ratio; the lit side
+//    closer to the truth than plain or within 10 % of plain's mean, but for the closed box, which
+//    misses both targets (docs/leaks.md says why);
 //  * determinism: the same files and numbers with 1 and 2 bake threads; the metrics on known values.
 // The table of every configuration is printed (docs/leaks.md has it; bench/bench_leak prints it
-// with per-sample cost). The target of a scheme that stops leaks (dark side under 1 % of the lit
-// side everywhere) is not asserted: today's samplings do not meet it.
+// with per-sample cost).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -267,6 +271,13 @@ TEST(LeakSuite, TheDefaultBakesPlanesStopTheLeakInEveryTwoRoomConfiguration) {
         EXPECT_GE(c.baked.planes_report.moved_out, 15u) << th;
         EXPECT_LT(c.m.planes.lit_error, c.m.plain.lit_error) << th;
     }
+    // The L corridor: the point light's shadow edge past the inner corner crosses cells of open air;
+    // their shadow planes keep the dark leg's points on the shadowed probes (measured 0.00 %), and
+    // the lit side closer to the truth than plain.
+    const Case& corridor = named_case("L corridor");
+    EXPECT_GT(corridor.baked.planes_report.planes.shadow_planes, 0u);
+    EXPECT_LT(corridor.m.planes.leak, 0.01);
+    EXPECT_LT(corridor.m.planes.lit_error, corridor.m.plain.lit_error);
     // The window room: the outside's light inside within the truth's own ratio + 1 point.
     const Case& w = named_case("window room (sky)");
     EXPECT_LT(w.m.planes.leak, w.m.truth.leak + 0.01);

@@ -623,7 +623,7 @@ TEST(SkyOcclusionCli, KeysFlagsReportAndErrors) {
     EXPECT_NE(run.out.find("probes kept out of walls: 16 in or near geometry at their grid points: 16 baked at a clear point nearby, "
                            "0 left inside geometry (invalid, dilated), 0 left near it;"),
               std::string::npos) << run.out;
-    EXPECT_NE(run.out.find("cell planes: 21 of 24 cells crossed by geometry have a plane (108 cells;"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("cell planes: 21 of 24 cells crossed by geometry or a shadow edge have a plane, 0 along a light's shadow edge (108 cells;"), std::string::npos) << run.out;
     EXPECT_NE(run.out.find("leak estimate: "), std::string::npos) << run.out;
     EXPECT_EQ(run.out.find("visibility masks:"), std::string::npos) << run.out;
     {
@@ -670,6 +670,20 @@ TEST(SkyOcclusionCli, KeysFlagsReportAndErrors) {
     auto nb = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(notbool.data()), notbool.size()), "nb.json", "");
     ASSERT_FALSE(nb.ok());
     EXPECT_NE(nb.error().message.find("occlusion.move_probes"), std::string::npos) << nb.error().message;
+    const std::string notbool2 = R"({"version": 1, "probes": {"positions": [[0, 0, 0]]}, "occlusion": {"shadow_planes": "no"}})";
+    auto nb2 = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(notbool2.data()), notbool2.size()), "nb.json", "");
+    ASSERT_FALSE(nb2.ok());
+    EXPECT_NE(nb2.error().message.find("occlusion.shadow_planes"), std::string::npos) << nb2.error().message;
+    {
+        // occlusion.shadow_planes false is read and written back (only when not the default).
+        const std::string off = R"({"version": 1, "probes": {"positions": [[0, 0, 0]]}, "occlusion": {"shadow_planes": false}})";
+        auto p = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(off.data()), off.size()), "off.json", "");
+        ASSERT_TRUE(p.ok()) << p.error().message;
+        EXPECT_FALSE(p->occlusion.shadow_planes);
+        EXPECT_NE(scene_json(*p).find("\"shadow_planes\": false"), std::string::npos) << scene_json(*p);
+        p->occlusion.shadow_planes = true;
+        EXPECT_EQ(scene_json(*p).find("shadow_planes"), std::string::npos);
+    }
     const std::string typo = R"({"version": 1, "probes": {"positions": [[0, 0, 0]]}, "occlusion": {"sky_sample": 3}})";
     EXPECT_FALSE(parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(typo.data()), typo.size()), "t.json", "").ok());
     // Round trip of the keys.

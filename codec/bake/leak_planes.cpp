@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <utility>
 
 #include "codec/bake/bake_internal.h"
@@ -90,101 +91,49 @@ struct CellFit {
     PlaneFitStats stats;
 };
 
-CellFit fit_one_cell(const OccluderBvh& bvh, const ProbeGrid& g, const std::vector<Vec3>& baked,
-                     const std::vector<std::uint8_t>& valid, int lattice, std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-    CellFit out;
-    const std::uint32_t base[3] = {x, y, z};
+// The plane predicting the fewest (point, valid corner) pairs' visibility `vis` wrongly among the
+// candidates (for the hit points, then the shadow edge's points: the least-squares plane of the
+// points, and per axis the axis-aligned planes at their minimum, maximum, middle and median),
+// quantised as stored; "no plane" when none beats predicting
+// every pair visible. blocked: the pairs `vis` calls blocked; wrong / leaking: the chosen plane's.
+CellPlane best_plane(const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z, const std::vector<Vec3>& hits,
+                     const std::vector<Vec3>& edge, const std::vector<Vec3>& pts,
+                     const std::vector<std::array<std::uint8_t, 8>>& vis, const Vec3 corner[8], const bool cvalid[8],
+                     std::uint64_t* blocked_out, std::uint64_t* wrong_out, std::uint64_t* leaking_out) {
+    CellPlane chosen;
     const Vec3 c = cell_centre(g, x, y, z);
     const double unit = cell_plane_unit(g);
-    Vec3 corner[8];
-    bool cvalid[8];
-    for (int k = 0; k < 8; ++k) {
-        std::uint32_t idx[3];
-        for (int a = 0; a < 3; ++a) idx[a] = std::min(base[a] + std::uint32_t((k >> a) & 1), g.counts[static_cast<size_t>(a)] - 1);
-        const std::size_t i = grid_index(g, idx[0], idx[1], idx[2]);
-        corner[k] = baked[i];
-        cvalid[k] = valid[i] != 0;
-    }
-    // The cell's sample points: lattice^3 (1 along an axis of count 1: the probes' own plane).
-    int L[3];
-    for (int a = 0; a < 3; ++a) L[a] = g.counts[static_cast<size_t>(a)] > 1 ? lattice : 1;
-    Vec3 lo{}, hi{};
-    for (int a = 0; a < 3; ++a) {
-        const double o = g.origin[a] + base[a] * g.spacing[a];
-        set_axis(lo, a, o);
-        set_axis(hi, a, g.counts[static_cast<size_t>(a)] > 1 ? o + g.spacing[a] : o);
-    }
-    for (const Vec3& q : corner)
-        for (int a = 0; a < 3; ++a) {
-            set_axis(lo, a, std::min(lo[a], q[a]));
-            set_axis(hi, a, std::max(hi[a], q[a]));
-        }
-    // Every segment lies in the box around the cell and its corners: nothing there, nothing to fit.
-    if (!bvh.overlaps_box(lo, hi)) return out;
-    std::vector<Vec3> pts;
-    for (int kz = 0; kz < L[2]; ++kz)
-        for (int ky = 0; ky < L[1]; ++ky)
-            for (int kx = 0; kx < L[0]; ++kx) {
-                const int kk[3] = {kx, ky, kz};
-                Vec3 q{};
-                for (int a = 0; a < 3; ++a)
-                    set_axis(q, a, g.counts[static_cast<size_t>(a)] > 1 ? g.origin[a] + (base[a] + (kk[a] + 0.5) / L[a]) * g.spacing[a]
-                                                                        : g.origin[a] + base[a] * g.spacing[a]);
-                if (!bvh.inside_any_solid(q)) pts.push_back(q);
-            }
-    std::vector<std::array<std::uint8_t, 8>> vis(pts.size());
-    std::vector<Vec3> hits;
-    for (size_t j = 0; j < pts.size(); ++j)
-        for (int k = 0; k < 8; ++k) {
-            vis[j][static_cast<size_t>(k)] = 1;
-            if (!cvalid[k]) continue;
-            const Vec3 v = corner[k] - pts[j];
-            const double len = length(v);
-            if (!(len > 2 * kRayEpsilon)) continue;
-            const Vec3 d = (1.0 / len) * v;
-            ++out.stats.rays;
-            const RayHit h = bvh.nearest(pts[j], d, kRayEpsilon, len - kRayEpsilon);
-            if (!h.hit) continue;
-            vis[j][static_cast<size_t>(k)] = 0;
-            hits.push_back(pts[j] + h.t * d);
-            ++out.stats.rays;
-            const RayHit h2 = bvh.nearest(corner[k], -1.0 * d, kRayEpsilon, len - kRayEpsilon);
-            if (h2.hit) hits.push_back(corner[k] - h2.t * d);
-        }
-    if (hits.empty()) return out;
-    ++out.stats.crossed_cells;
-    // Candidate planes (normal, a point on it).
+    // Candidate planes (normal, a point on it): those of the hit points, then those of the edge's.
     std::vector<std::pair<Vec3, Vec3>> cand;
-    Vec3 mean{};
-    for (const Vec3& h : hits) mean = mean + h;
-    mean = (1.0 / double(hits.size())) * mean;
-    double cov[3][3] = {};
-    for (const Vec3& h : hits) {
-        const Vec3 d = h - mean;
-        for (int r = 0; r < 3; ++r)
-            for (int s = 0; s < 3; ++s) cov[r][s] += d[r] * d[s];
-    }
-    cand.push_back({smallest_eigenvector(cov), mean});
-    for (int a = 0; a < 3; ++a) {
-        std::vector<double> coord;
-        coord.reserve(hits.size());
-        for (const Vec3& h : hits) coord.push_back(h[a]);
-        std::sort(coord.begin(), coord.end());
-        Vec3 n{};
-        set_axis(n, a, 1);
-        for (double v : {coord.front(), coord.back(), 0.5 * (coord.front() + coord.back()), coord[coord.size() / 2]}) {
-            Vec3 p = c;
-            set_axis(p, a, v);
-            cand.push_back({n, p});
+    for (const std::vector<Vec3>* set : {&hits, &edge}) {
+        if (set->empty()) continue;
+        Vec3 mean{};
+        for (const Vec3& h : *set) mean = mean + h;
+        mean = (1.0 / double(set->size())) * mean;
+        double cov[3][3] = {};
+        for (const Vec3& h : *set) {
+            const Vec3 d = h - mean;
+            for (int r = 0; r < 3; ++r)
+                for (int s = 0; s < 3; ++s) cov[r][s] += d[r] * d[s];
+        }
+        cand.push_back({smallest_eigenvector(cov), mean});
+        for (int a = 0; a < 3; ++a) {
+            std::vector<double> coord;
+            coord.reserve(set->size());
+            for (const Vec3& h : *set) coord.push_back(h[a]);
+            std::sort(coord.begin(), coord.end());
+            Vec3 n{};
+            set_axis(n, a, 1);
+            for (double v : {coord.front(), coord.back(), 0.5 * (coord.front() + coord.back()), coord[coord.size() / 2]}) {
+                Vec3 p = c;
+                set_axis(p, a, v);
+                cand.push_back({n, p});
+            }
         }
     }
-    std::uint64_t blocked = 0, scored = 0;
+    std::uint64_t blocked = 0;
     for (size_t j = 0; j < pts.size(); ++j)
-        for (int k = 0; k < 8; ++k)
-            if (cvalid[k]) {
-                ++scored;
-                blocked += vis[j][static_cast<size_t>(k)] == 0;
-            }
+        for (int k = 0; k < 8; ++k) blocked += cvalid[k] && vis[j][static_cast<size_t>(k)] == 0;
     // Quantise each candidate, then count the pairs it predicts wrongly.
     std::uint64_t best_wrong = blocked, best_leaking = blocked;  // no plane: every blocked pair is predicted visible
     for (const auto& [n, p] : cand) {
@@ -209,13 +158,152 @@ CellFit fit_one_cell(const OccluderBvh& bvh, const ProbeGrid& g, const std::vect
         if (wrong < best_wrong) {
             best_wrong = wrong;
             best_leaking = leaking;
-            out.plane = cp;
+            chosen = cp;
         }
     }
+    *blocked_out = blocked;
+    *wrong_out = best_wrong;
+    *leaking_out = best_leaking;
+    return chosen;
+}
+
+// Does `q` receive the light's direct light (inside a spot's outer cone, its shadow ray unblocked)?
+bool receives(const OccluderBvh& bvh, const ShadowLight& l, Vec3 q, std::uint64_t* rays) {
+    ++*rays;
+    if (l.directional) return !bvh.occluded(q, l.direction, kRayEpsilon, std::numeric_limits<double>::infinity());
+    const Vec3 v = l.position - q;
+    const double d = length(v);
+    if (!(d > 2 * kRayEpsilon)) return true;
+    if (l.cos_outer > -1 && dot(l.spot_axis, (-1.0 / d) * v) < l.cos_outer) return false;
+    return !bvh.occluded(q, (1.0 / d) * v, kRayEpsilon, d - kRayEpsilon);
+}
+
+// The hard shadow edge in a cell (leak_planes.h "Shadow planes"): of the lights that reach some of
+// its valid corners and not others, the one whose direct light at a receiving corner is strongest.
+// Each (point, valid corner) pair `vis` calls visible that disagrees on receiving it becomes
+// blocked, and where the edge crosses the pair (6 bisection steps) goes to `edge`. False (nothing
+// changed) when no light has an edge between the corners.
+bool split_at_shadow_edge(const OccluderBvh& bvh, std::span<const ShadowLight> lights, const Vec3 corner[8], const bool cvalid[8],
+                          const std::vector<Vec3>& pts, std::vector<std::array<std::uint8_t, 8>>& vis, std::vector<Vec3>& edge,
+                          std::uint64_t* rays) {
+    if (lights.empty() || pts.empty()) return false;
+    int chosen = -1;
+    double chosen_strength = 0;
+    std::array<std::uint8_t, 8> chosen_lit{};
+    for (size_t li = 0; li < lights.size(); ++li) {
+        const ShadowLight& l = lights[li];
+        std::array<std::uint8_t, 8> lit{};
+        int n_lit = 0, n_valid = 0;
+        double strength = 0;
+        for (int k = 0; k < 8; ++k) {
+            if (!cvalid[k]) continue;
+            ++n_valid;
+            lit[static_cast<size_t>(k)] = receives(bvh, l, corner[k], rays) ? 1 : 0;
+            if (!lit[static_cast<size_t>(k)]) continue;
+            ++n_lit;
+            const double d2 = l.directional ? 1.0 : dot(l.position - corner[k], l.position - corner[k]);
+            strength = std::max(strength, l.intensity / std::max(d2, 1e-12));
+        }
+        if (n_lit == 0 || n_lit == n_valid) continue;  // no shadow edge between the corners
+        if (chosen < 0 || strength > chosen_strength) {
+            chosen = static_cast<int>(li);
+            chosen_strength = strength;
+            chosen_lit = lit;
+        }
+    }
+    if (chosen < 0) return false;
+    const ShadowLight& l = lights[static_cast<size_t>(chosen)];
+    for (size_t j = 0; j < pts.size(); ++j) {
+        const std::uint8_t pt_lit = receives(bvh, l, pts[j], rays) ? 1 : 0;
+        for (int k = 0; k < 8; ++k) {
+            if (!cvalid[k] || !vis[j][static_cast<size_t>(k)] || pt_lit == chosen_lit[static_cast<size_t>(k)]) continue;
+            vis[j][static_cast<size_t>(k)] = 0;
+            Vec3 a = pts[j], b = corner[k];
+            for (int step = 0; step < 6; ++step) {
+                const Vec3 m = 0.5 * (a + b);
+                ((receives(bvh, l, m, rays) ? 1 : 0) == pt_lit ? a : b) = m;
+            }
+            edge.push_back(0.5 * (a + b));
+        }
+    }
+    return true;
+}
+
+CellFit fit_one_cell(const OccluderBvh& bvh, const ProbeGrid& g, const std::vector<Vec3>& baked,
+                     const std::vector<std::uint8_t>& valid, int lattice, std::span<const ShadowLight> lights, std::uint32_t x,
+                     std::uint32_t y, std::uint32_t z) {
+    CellFit out;
+    const std::uint32_t base[3] = {x, y, z};
+    Vec3 corner[8];
+    bool cvalid[8];
+    for (int k = 0; k < 8; ++k) {
+        std::uint32_t idx[3];
+        for (int a = 0; a < 3; ++a) idx[a] = std::min(base[a] + std::uint32_t((k >> a) & 1), g.counts[static_cast<size_t>(a)] - 1);
+        const std::size_t i = grid_index(g, idx[0], idx[1], idx[2]);
+        corner[k] = baked[i];
+        cvalid[k] = valid[i] != 0;
+    }
+    // The cell's sample points: lattice^3 (1 along an axis of count 1: the probes' own plane).
+    int L[3];
+    for (int a = 0; a < 3; ++a) L[a] = g.counts[static_cast<size_t>(a)] > 1 ? lattice : 1;
+    Vec3 lo{}, hi{};
+    for (int a = 0; a < 3; ++a) {
+        const double o = g.origin[a] + base[a] * g.spacing[a];
+        set_axis(lo, a, o);
+        set_axis(hi, a, g.counts[static_cast<size_t>(a)] > 1 ? o + g.spacing[a] : o);
+    }
+    for (const Vec3& q : corner)
+        for (int a = 0; a < 3; ++a) {
+            set_axis(lo, a, std::min(lo[a], q[a]));
+            set_axis(hi, a, std::max(hi[a], q[a]));
+        }
+    // Every segment lies in the box around the cell and its corners: nothing there to block them
+    // (the shadow of a light may still cross the cell).
+    const bool near_occluder = bvh.overlaps_box(lo, hi);
+    if (!near_occluder && lights.empty()) return out;
+    std::vector<Vec3> pts;
+    for (int kz = 0; kz < L[2]; ++kz)
+        for (int ky = 0; ky < L[1]; ++ky)
+            for (int kx = 0; kx < L[0]; ++kx) {
+                const int kk[3] = {kx, ky, kz};
+                Vec3 q{};
+                for (int a = 0; a < 3; ++a)
+                    set_axis(q, a, g.counts[static_cast<size_t>(a)] > 1 ? g.origin[a] + (base[a] + (kk[a] + 0.5) / L[a]) * g.spacing[a]
+                                                                        : g.origin[a] + base[a] * g.spacing[a]);
+                if (!bvh.inside_any_solid(q)) pts.push_back(q);
+            }
+    std::vector<std::array<std::uint8_t, 8>> vis(pts.size());
+    std::vector<Vec3> hits;
+    for (size_t j = 0; j < pts.size(); ++j)
+        for (int k = 0; k < 8; ++k) {
+            vis[j][static_cast<size_t>(k)] = 1;
+            if (!cvalid[k] || !near_occluder) continue;
+            const Vec3 v = corner[k] - pts[j];
+            const double len = length(v);
+            if (!(len > 2 * kRayEpsilon)) continue;
+            const Vec3 d = (1.0 / len) * v;
+            ++out.stats.rays;
+            const RayHit h = bvh.nearest(pts[j], d, kRayEpsilon, len - kRayEpsilon);
+            if (!h.hit) continue;
+            vis[j][static_cast<size_t>(k)] = 0;
+            hits.push_back(pts[j] + h.t * d);
+            ++out.stats.rays;
+            const RayHit h2 = bvh.nearest(corner[k], -1.0 * d, kRayEpsilon, len - kRayEpsilon);
+            if (h2.hit) hits.push_back(corner[k] - h2.t * d);
+        }
+    std::vector<Vec3> edge;
+    const bool shadowed = split_at_shadow_edge(bvh, lights, corner, cvalid, pts, vis, edge, &out.stats.rays) && !edge.empty();
+    if (hits.empty() && !shadowed) return out;
+    ++out.stats.crossed_cells;
+    std::uint64_t blocked = 0, best_wrong = 0, best_leaking = 0;
+    out.plane = best_plane(g, x, y, z, hits, edge, pts, vis, corner, cvalid, &blocked, &best_wrong, &best_leaking);
+    if (shadowed && out.plane.present()) ++out.stats.shadow_planes;
     if (!out.plane.present()) {
         out.stats.unresolved_pairs += blocked;
         return out;
     }
+    std::uint64_t scored = 0;
+    for (int k = 0; k < 8; ++k) scored += cvalid[k] ? pts.size() : 0;
     ++out.stats.planes;
     out.stats.pairs += scored;
     out.stats.blocked_pairs += blocked;
@@ -340,7 +428,8 @@ std::vector<CellPlane> cell_planes_from_bytes(const std::vector<std::uint8_t>& b
 
 std::vector<CellPlane> fit_cell_planes(const OccluderBvh& bvh, const ProbeGrid& g, const std::vector<Vec3>& baked,
                                        const std::vector<std::uint8_t>& valid, int lattice, int threads,
-                                       PlaneFitStats* stats, std::vector<double>* wrong_fraction) {
+                                       PlaneFitStats* stats, std::vector<double>* wrong_fraction,
+                                       std::span<const ShadowLight> shadow_lights) {
     const std::size_t count = std::size_t(g.counts[0]) * g.counts[1] * g.counts[2];
     std::vector<CellPlane> out(count);
     std::vector<double> wrong(count, 0.0);
@@ -350,7 +439,7 @@ std::vector<CellPlane> fit_cell_planes(const OccluderBvh& bvh, const ProbeGrid& 
             for (size_t i = lo; i < hi; ++i) {
                 const std::uint32_t x = axis_index(i, g, 0), y = axis_index(i, g, 1), z = axis_index(i, g, 2);
                 if (!starts_cell(g, x, y, z)) continue;
-                const CellFit f = fit_one_cell(bvh, g, baked, valid, std::max(1, lattice), x, y, z);
+                const CellFit f = fit_one_cell(bvh, g, baked, valid, std::max(1, lattice), shadow_lights, x, y, z);
                 out[i] = f.plane;
                 wrong[i] = f.wrong_fraction;
                 per[i] = f.stats;
@@ -368,6 +457,7 @@ std::vector<CellPlane> fit_cell_planes(const OccluderBvh& bvh, const ProbeGrid& 
             stats->leaking_pairs += per[i].leaking_pairs;
             stats->dropped_pairs += per[i].dropped_pairs;
             stats->unresolved_pairs += per[i].unresolved_pairs;
+            stats->shadow_planes += per[i].shadow_planes;
             stats->rays += per[i].rays;
         }
     }

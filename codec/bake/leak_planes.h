@@ -25,12 +25,22 @@
 // side); the best is kept when it predicts fewer pairs wrongly than no plane. Cells whose box (and
 // their corners' baked positions) meets no occluder's bounds trace nothing and get no plane.
 //
+// Shadow planes: a cell where no (point, corner) segment is blocked, but the light of one of
+// `shadow_lights` reaches some of its valid corners and not others, gets the plane along that
+// light's shadow edge: the same candidates and scoring, with "visible" read as "the point and the
+// corner agree on receiving the light" and the candidates fitted to where the edge crosses the
+// disagreeing segments (6 bisection steps each). Of several such lights, the one whose direct light
+// at a receiving corner is strongest. A hard shadow edge in open air is then kept within the cell:
+// the points in the shadow blend the probes in the shadow (the probes hold the same light, less
+// that light), the lit points the lit probes. Soft shadows (the sky, cone lights) get none.
+//
 // Deterministic: every probe and every cell is computed alone, so any thread count gives the same
 // bytes. Experimental: this API may change between minor versions (docs/api.md "Public headers").
 #pragma once
 
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "codec/bake/occluders.h"
@@ -85,7 +95,21 @@ struct PlaneFitStats {
     // (visible, yet on the other side: light lost).
     std::uint64_t leaking_pairs = 0, dropped_pairs = 0;
     std::uint64_t unresolved_pairs = 0;  // blocked pairs of crossed cells left without a plane (all blended)
+    // Of `planes`, those fitted with a light's shadow edge in the cell (pairs across it count as
+    // blocked: in the counts above).
+    std::uint64_t shadow_planes = 0;
     std::uint64_t rays = 0;
+};
+
+// A light whose shadow has a hard edge (point and spot lights, directional lights of zero angular
+// radius, each casting shadows): what a shadow plane follows.
+struct ShadowLight {
+    bool directional = false;
+    Vec3 position;             // point, spot
+    Vec3 direction{0, 0, 1};   // directional: towards the light
+    Vec3 spot_axis{0, 0, 1};   // spot: where it points
+    double cos_outer = -2;     // spot: cos of its outer half-angle (points outside receive nothing); -2: no cone
+    double intensity = 0;      // luminance of its intensity (point, spot) or irradiance (directional)
 };
 
 // The fit described above. `baked`: each probe's baked position; `valid`: its validity (invalid
@@ -94,7 +118,8 @@ struct PlaneFitStats {
 // of the cell's blocked pairs its plane predicts wrongly (0 without a plane).
 std::vector<CellPlane> fit_cell_planes(const OccluderBvh& bvh, const ProbeGrid& g, const std::vector<Vec3>& baked,
                                        const std::vector<std::uint8_t>& valid, int lattice, int threads,
-                                       PlaneFitStats* stats, std::vector<double>* wrong_fraction = nullptr);
+                                       PlaneFitStats* stats, std::vector<double>* wrong_fraction = nullptr,
+                                       std::span<const ShadowLight> shadow_lights = {});
 
 // Where each grid probe is baked (steps 1-3 above) and what the steps found.
 struct ProbeRelocation {

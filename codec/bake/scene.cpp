@@ -502,8 +502,29 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
         const auto t_plane = Clock::now();
         leak->validity = valid;
         leak->baked_positions = positions;
+        // The hard shadow edges the planes follow in open air (leak_planes.h "Shadow planes").
+        std::vector<ShadowLight> shadow_lights;
+        for (const SceneLight& l : scene.lights) {
+            if (!l.shadows || !scene.occlusion.shadow_planes) continue;
+            ShadowLight sl;
+            sl.intensity = 0.2126 * l.color.r + 0.7152 * l.color.g + 0.0722 * l.color.b;
+            if (l.kind == LightKind::kDirectional && l.angular_radius_rad <= 0) {
+                sl.directional = true;
+                sl.direction = l.direction;
+            } else if (l.kind == LightKind::kPoint || l.kind == LightKind::kSpot) {
+                sl.position = l.position;
+                if (l.kind == LightKind::kSpot) {
+                    sl.spot_axis = l.direction;
+                    sl.cos_outer = std::cos(l.outer_angle_rad);
+                }
+            } else {
+                continue;  // cone lights: soft shadows
+            }
+            if (sl.intensity > 0) shadow_lights.push_back(sl);
+        }
         leak->planes = cell_planes_bytes(fit_cell_planes(bvh, layout.grid, positions, valid, placement.lattice,
-                                                         std::max(1, options.threads), &plane_stats));
+                                                         std::max(1, options.threads), &plane_stats, nullptr,
+                                                         shadow_lights));
         plane_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_plane).count();
     }
 

@@ -129,6 +129,9 @@ struct SceneOcclusion {
     // a wall that crosses one of their cells nearer to it (codec/bake/leak_planes.h); false: every
     // probe is baked at its grid point.
     bool move_probes = true;
+    // Grids: cells where a light's hard shadow edge passes between the corner probes get the plane
+    // along that edge (codec/bake/leak_planes.h "Shadow planes"); false: planes follow geometry only.
+    bool shadow_planes = true;
 };
 // Visibility-mask rays per (probe, cell): the cell's centre and the 8 points centre +- spacing/4.
 constexpr int kMaskPoints = 9;

@@ -229,9 +229,12 @@ std::vector<std::string> BakeReport::leak_lines() const {
     if (planes.cells > 0) {
         const PlaneFitStats& p = planes;
         const std::uint64_t blocked = p.blocked_pairs + p.unresolved_pairs, leaking = p.leaking_pairs + p.unresolved_pairs;
-        std::snprintf(buf, sizeof buf, "cell planes: %llu of %llu cells crossed by geometry have a plane (%llu cells; %llu rays, %.3f ms)",
+        std::snprintf(buf, sizeof buf,
+                      "cell planes: %llu of %llu cells crossed by geometry or a shadow edge have a plane, %llu along a light's shadow "
+                      "edge (%llu cells; %llu rays, %.3f ms)",
                       static_cast<unsigned long long>(p.planes), static_cast<unsigned long long>(p.crossed_cells),
-                      static_cast<unsigned long long>(p.cells), static_cast<unsigned long long>(p.rays), plane_ms);
+                      static_cast<unsigned long long>(p.shadow_planes), static_cast<unsigned long long>(p.cells),
+                      static_cast<unsigned long long>(p.rays), plane_ms);
         out.push_back(buf);
         if (blocked > 0)
             std::snprintf(buf, sizeof buf,
@@ -241,7 +244,7 @@ std::vector<std::string> BakeReport::leak_lines() const {
                           100.0 * double(leaking) / double(blocked), static_cast<unsigned long long>(p.dropped_pairs),
                           p.pairs ? 100.0 * double(p.dropped_pairs) / double(p.pairs) : 0.0);
         else
-            std::snprintf(buf, sizeof buf, "leak estimate: no geometry crosses a cell: nothing to separate");
+            std::snprintf(buf, sizeof buf, "leak estimate: no geometry or shadow edge crosses a cell: nothing to separate");
         out.push_back(buf);
     }
     return out;

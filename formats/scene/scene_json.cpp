@@ -193,7 +193,7 @@ SceneSky read_sky(const Reader& r, const json& j) {
 
 SceneOcclusion read_occlusion(const Reader& r, const json& j) {
     const std::string p = "occlusion";
-    r.object(j, p, {"sky_samples", "invalid_fraction", "move_probes"});
+    r.object(j, p, {"sky_samples", "invalid_fraction", "move_probes", "shadow_planes"});
     SceneOcclusion o;
     if (j.contains("sky_samples")) {
         const json& s = j["sky_samples"];
@@ -210,6 +210,7 @@ SceneOcclusion read_occlusion(const Reader& r, const json& j) {
         o.invalid_fraction = f;
     }
     if (j.contains("move_probes")) o.move_probes = r.boolean(j["move_probes"], p + ".move_probes");
+    if (j.contains("shadow_planes")) o.shadow_planes = r.boolean(j["shadow_planes"], p + ".shadow_planes");
     return o;
 }
 
@@ -587,9 +588,10 @@ std::string scene_json(const Scene& s) {
     }
     const SceneOcclusion defaults;
     if (s.occlusion.sky_samples != defaults.sky_samples || s.occlusion.invalid_fraction != defaults.invalid_fraction ||
-        s.occlusion.move_probes != defaults.move_probes) {
+        s.occlusion.move_probes != defaults.move_probes || s.occlusion.shadow_planes != defaults.shadow_planes) {
         doc["occlusion"] = {{"sky_samples", s.occlusion.sky_samples}, {"invalid_fraction", s.occlusion.invalid_fraction}};
         if (s.occlusion.move_probes != defaults.move_probes) doc["occlusion"]["move_probes"] = s.occlusion.move_probes;
+        if (s.occlusion.shadow_planes != defaults.shadow_planes) doc["occlusion"]["shadow_planes"] = s.occlusion.shadow_planes;
     }
     json lights = json::array();
     for (const SceneLight& l : s.lights) {
