@@ -13,7 +13,8 @@
 //   });
 //
 //   const bytes = await (await fetch('grid.ktx2')).arrayBuffer();
-//   const texture = await ktx2Loader.parseAsync?.(bytes) ...  // or loadAsync(url) and fetch the bytes for the bounds
+//   const ktx2 = new KTX2Loader().detectSupport(renderer);
+//   const texture = await new Promise((resolve, reject) => ktx2.parse(bytes, resolve, reject));  // a Data3DTexture
 //   scene.add(lightProbeGridFromTexture(LightProbeGridWebGL, texture, gridBoundsFromKtx2(bytes)));
 //
 // The grid is placed as ZhcProbeVolume.lightProbeGrid (zhc_light_probes_plugin.mjs) places it:
