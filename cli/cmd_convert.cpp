@@ -83,6 +83,8 @@ Result<Loaded> load_input(const Options& o) {
     auto bytes = read_file_bytes(o.input, std::uint64_t(2) << 30);
     if (!bytes) return bytes.error();
     Loaded in;
+    // An engine's file before environment maps: three.js's atlas is an OpenEXR, Bevy's volume a
+    // KTX2, both of which an environment-map reader would take for an image.
     if (looks_like_probe_file(*bytes)) {
         auto file = parse_and_decode_probe_set(*bytes, o.input);
         if (!file) return file.error();
@@ -90,6 +92,14 @@ Result<Loaded> load_input(const Options& o) {
         in.list.layout = file->set.layout;
         in.set = std::move(file->set);
         in.kind = "zhp";
+    } else if (const EngineFile* engine = sniff_engine_file(*bytes)) {
+        auto probes = engine->read(*bytes, o.input);
+        if (!probes) return probes.error();
+        for (const std::string& line : probes->notes) std::fprintf(stderr, "zhc: note: %s: %s\n", o.input.c_str(), line.c_str());
+        in.list.probes = std::move(probes->hub);
+        in.list.layout = std::move(probes->layout);
+        in.validity = std::move(probes->validity);
+        in.kind = std::string(engine->name);
     } else if (looks_like_envmap(*bytes)) {
         EnvmapReadOptions ro;
         if (o.replace_non_finite) ro.non_finite = NonFinitePolicy::kReplaceZero;
@@ -100,14 +110,6 @@ Result<Loaded> load_input(const Options& o) {
         if (!img) return img.error();
         in.list.probes.push_back(project_envmap(*img, resolve_threads(o.threads)));
         in.kind = "envmap";
-    } else if (const EngineFile* engine = sniff_engine_file(*bytes)) {
-        auto probes = engine->read(*bytes, o.input);
-        if (!probes) return probes.error();
-        for (const std::string& line : probes->notes) std::fprintf(stderr, "zhc: note: %s: %s\n", o.input.c_str(), line.c_str());
-        in.list.probes = std::move(probes->hub);
-        in.list.layout = std::move(probes->layout);
-        in.validity = std::move(probes->validity);
-        in.kind = std::string(engine->name);
     } else if (looks_like_json(*bytes)) {
         auto list = parse_probe_json(*bytes, o.input);
         if (!list) return list.error();
