@@ -812,7 +812,7 @@ function compareTetra(c, gpu) {
     let defined = true;
     for (let k = 0; k < 4; k++) {
       if (weights[k] === 0) {
-        if (c.tetra === 'validity' && inside) t.dropped++;
+        if (c.tetra === 'validity' && inside && i < kTetraSamples) t.dropped++;  // not at a probe
         continue;
       }
       const sc = probeScale(c.e, c.p, c.decoded[c.tetra === 'constant' ? 0 : probes[k]]);
