@@ -736,10 +736,15 @@ vec3 zhcHlshIrradiance(vec3 iz, vec3 ca, vec3 cx, vec3 cy, vec3 m) {
 //
 // When the entry's offset is not -32768 the point's side of the plane, dot(n, p - c) - offset
 // |spacing| / 65534 >= 0 (n the octahedral code's normal, c the cell's centre; float), drops the
-// corners whose sides bit k = dx + 2 dy + 4 dz differs, before the renormalisation above. With
+// corners whose sides bit k = dx + 2 dy + 4 dz differs, before the renormalisation above. An entry
+// with offset -32768 and bit 7 of byte 4 set is a corner region (docs/runtime.md "Corner regions"):
+// q_a = (bytes 0-1 >> 5a) & 31, d_a = bit a of byte 4; the point is inside when along every axis
+// with q_a != 0, s_a = (p_a - (origin_a + i0_a spacing_a)) * 31 is >= q_a spacing_a (d_a = 1) or
+// < q_a spacing_a (d_a = 0), and the corners inside are those whose bit a equals d_a along those
+// axes; a point inside keeps the corners inside, a point outside the others. With
 // ZHC_VOLUME_PLANE_AXES_GLTF defined the grid is in glTF axes while the code's normal is in zhc
-// axes: the normal used is (n.y, n.z, n.x). Without ZHC_VOLUME_MASK and ZHC_VOLUME_PLANE the blend
-// is the plain trilinear one.
+// axes: the normal used is (n.y, n.z, n.x) (a region's fields are stored in the grid's axes: used
+// as they stand). Without ZHC_VOLUME_MASK and ZHC_VOLUME_PLANE the blend is the plain trilinear one.
 
 struct ZhcVolume {
     vec3 origin;   // position of probe (0, 0, 0)
@@ -766,11 +771,30 @@ vec3 zhcPlaneNormal(uint ou, uint ov) {
     return normalize(vec3(ab, z));
 }
 
-// The corners kept by the plane entry e (ZHC_VOLUME_PLANE's uvec2) of the cell with first probe i0
-// at p: bit k set when corner k's sides bit equals p's side; 0xFF when the entry has no plane.
+// The corners a corner region entry e keeps at p (zhc__volume_plane_side of zhc_runtime.h, in
+// float, the same operations): inside the region, the corners inside it; outside, the others.
+uint zhcVolumeRegionKeep(uvec2 e, ZhcVolume v, uvec3 i0, vec3 p) {
+    uvec3 q = uvec3(e.x, e.x >> 5, e.x >> 10) & 31u;
+    uvec3 d = uvec3(e.y, e.y >> 1, e.y >> 2) & 1u;
+    vec3 s = (p - (v.origin + vec3(i0) * v.spacing)) * 31.0;
+    vec3 t = vec3(q) * v.spacing;
+    const uvec3 axisCorners = uvec3(0xAAu, 0xCCu, 0xF0u);  // the corners k whose bit a is 1
+    bool inside = true;
+    uint corners = 0xFFu;
+    for (int a = 0; a < 3; ++a) {
+        if (q[a] == 0u) continue;  // the axis does not bound the region
+        inside = inside && (d[a] != 0u ? s[a] >= t[a] : s[a] < t[a]);
+        corners &= d[a] != 0u ? axisCorners[a] : ~axisCorners[a];
+    }
+    return (inside ? corners : ~corners) & 0xFFu;
+}
+
+// The corners kept by the entry e (ZHC_VOLUME_PLANE's uvec2) of the cell with first probe i0 at p:
+// a plane, bit k set when corner k's sides bit equals p's side; a corner region,
+// zhcVolumeRegionKeep; 0xFF when the entry has neither.
 uint zhcVolumePlaneKeep(uvec2 e, ZhcVolume v, uvec3 i0, vec3 p) {
     int offset = int(e.x) >> 16;  // bytes 2-3, sign-extended
-    if (offset == -32768) return 0xFFu;
+    if (offset == -32768) return (e.y & 0x80u) != 0u ? zhcVolumeRegionKeep(e, v, i0, p) : 0xFFu;
     vec3 nrm = zhcPlaneNormal(e.x & 0xFFu, (e.x >> 8) & 0xFFu);
 #ifdef ZHC_VOLUME_PLANE_AXES_GLTF
     nrm = nrm.yzx;  // glTF (x, y, z) = zhc (y, z, x)

@@ -850,10 +850,15 @@ float3 zhc_irradz_irradiance_astc(float3 iz, float3 dwa, uint model, float3 n)
 //
 // When the entry's offset is not -32768 the point's side of the plane, dot(n, p - c) - offset
 // |spacing| / 65534 >= 0 (n the octahedral code's normal, c the cell's centre; float), drops the
-// corners whose sides bit k = dx + 2 dy + 4 dz differs, before the renormalisation above. With
+// corners whose sides bit k = dx + 2 dy + 4 dz differs, before the renormalisation above. An entry
+// with offset -32768 and bit 7 of byte 4 set is a corner region (docs/runtime.md "Corner regions"):
+// q_a = (bytes 0-1 >> 5a) & 31, d_a = bit a of byte 4; the point is inside when along every axis
+// with q_a != 0, s_a = (p_a - (origin_a + i0_a spacing_a)) * 31 is >= q_a spacing_a (d_a = 1) or
+// < q_a spacing_a (d_a = 0), and the corners inside are those whose bit a equals d_a along those
+// axes; a point inside keeps the corners inside, a point outside the others. With
 // ZHC_VOLUME_PLANE_AXES_GLTF defined the grid is in glTF axes while the code's normal is in zhc
-// axes: the normal used is (n.y, n.z, n.x). Without ZHC_VOLUME_MASK and ZHC_VOLUME_PLANE the blend
-// is the plain trilinear one.
+// axes: the normal used is (n.y, n.z, n.x) (a region's fields are stored in the grid's axes: used
+// as they stand). Without ZHC_VOLUME_MASK and ZHC_VOLUME_PLANE the blend is the plain trilinear one.
 struct ZhcVolume
 {
     float3 origin;   // position of probe (0, 0, 0)
@@ -887,12 +892,33 @@ float3 zhc_plane_normal(uint ou, uint ov)
     return normalize(float3(a, b, z));
 }
 
-// The corners kept by the plane entry e (ZHC_VOLUME_PLANE's uint2) of the cell with first probe i0
-// at p: bit k set when corner k's sides bit equals p's side; 0xFF when the entry has no plane.
+// The corners a corner region entry e keeps at p (zhc__volume_plane_side of zhc_runtime.h, in
+// float, the same operations): inside the region, the corners inside it; outside, the others.
+uint zhc_volume_region_keep(uint2 e, ZhcVolume v, uint3 i0, float3 p)
+{
+    uint3 q = uint3(e.x, e.x >> 5, e.x >> 10) & 31u;
+    uint3 d = uint3(e.y, e.y >> 1, e.y >> 2) & 1u;
+    float3 s = (p - (v.origin + float3(i0) * v.spacing)) * 31.0f;
+    float3 t = float3(q) * v.spacing;
+    const uint3 axisCorners = uint3(0xAAu, 0xCCu, 0xF0u);  // the corners k whose bit a is 1
+    bool inside = true;
+    uint corners = 0xFFu;
+    [unroll] for (uint a = 0u; a < 3u; ++a)
+    {
+        if (q[a] == 0u) continue;  // the axis does not bound the region
+        inside = inside && (d[a] != 0u ? s[a] >= t[a] : s[a] < t[a]);
+        corners &= d[a] != 0u ? axisCorners[a] : ~axisCorners[a];
+    }
+    return (inside ? corners : ~corners) & 0xFFu;
+}
+
+// The corners kept by the entry e (ZHC_VOLUME_PLANE's uint2) of the cell with first probe i0 at p:
+// a plane, bit k set when corner k's sides bit equals p's side; a corner region,
+// zhc_volume_region_keep; 0xFF when the entry has neither.
 uint zhc_volume_plane_keep(uint2 e, ZhcVolume v, uint3 i0, float3 p)
 {
     int offset = asint(e.x) >> 16;  // bytes 2-3, sign-extended
-    if (offset == -32768) return 0xFFu;
+    if (offset == -32768) return (e.y & 0x80u) != 0u ? zhc_volume_region_keep(e, v, i0, p) : 0xFFu;
     float3 nrm = zhc_plane_normal(e.x & 0xFFu, (e.x >> 8) & 0xFFu);
 #ifdef ZHC_VOLUME_PLANE_AXES_GLTF
     nrm = nrm.yzx;  // glTF (x, y, z) = zhc (y, z, x)

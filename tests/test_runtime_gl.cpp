@@ -856,24 +856,27 @@ void compare_masked_volumes(int samples) {
         }
 }
 
-// Cell planes (ZHC_VOLUME_PLANE, docs/runtime.md "Cell planes") against the C header with
-// zhc_volume::planes set: a 6x5x4 grid per entry, a plane in 3 of 4 cells (random normal code, through
-// a random point of the cell, the corners' sides as the bake writes them), uploaded as 2 words per
-// probe. `gltf` false: the kPlanes program (masks and planes) with random validity (1 in 4 invalid)
+// Cell planes and corner regions (ZHC_VOLUME_PLANE, docs/runtime.md "Cell planes", "Corner
+// regions") against the C header with zhc_volume::planes set: a 6x5x4 grid per entry, an entry in 3
+// of 4 cells, a third of them corner regions (random thresholds, some axes unbounded, random
+// directions), the others planes (random normal code, through a random point of the cell, the
+// corners' sides as the bake writes them), uploaded as 2 words per probe. `gltf` false: the kPlanes program (masks and planes) with random validity (1 in 4 invalid)
 // and visibility (each bit set with p = 3/4); true: the kPlanesGltf program (planes alone,
 // ZHC_VOLUME_PLANE_AXES_GLTF) on the same volume in glTF axes (grid, probe order and sides bits
-// permuted, normal codes kept), sampled at the permuted points, against the header on the zhc-axes
-// volume. Per sample: the corners the plane keeps (the shader's zhcVolumePlaneKeep) equal the
-// header's, and the irradiance lies within compare_masked_volumes' bound, the weight part divided by
-// the kept weight sum M (samples with 0 < M < 1e-3 counted, not compared). Points within 1e-4
-// |spacing| of their cell's plane (or 1e-5 cell widths of a face between cells), where float and
-// double may pick different sides, are counted, not compared.
+// permuted, normal codes kept, regions' per-axis fields permuted), sampled at the permuted points,
+// against the header on the zhc-axes volume. Per sample: the corners the entry keeps (the shader's
+// zhcVolumePlaneKeep) equal the header's, and the irradiance lies within compare_masked_volumes'
+// bound, the weight part divided by the kept weight sum M (samples with 0 < M < 1e-3 counted, not
+// compared). Points within 1e-4 |spacing| of their cell's plane or of a bounding plane of its region
+// (or 1e-5 cell widths of a face between cells), where float and double may pick different sides,
+// are counted, not compared. The header's region keeps equal planes_test::region_keep (the spec's
+// twin), and samples fall both inside and outside regions.
 template <class Fixture>
 void compare_plane_volumes(int samples, bool gltf) {
     const std::vector<Sh3Radiance> maps = envmap_probes();
     ASSERT_EQ(maps.size(), 8u);
-    std::printf("%-22s %8s %10s %8s %6s %8s %s\n", gltf ? "planes (glTF axes)" : "masks + planes", "samples", "max u S", "skipped", "near",
-                "by plane", "corner sets");
+    std::printf("%-22s %8s %10s %8s %6s %8s %9s %10s %s\n", gltf ? "planes (glTF axes)" : "masks + planes", "samples", "max u S", "skipped", "near",
+                "by plane", "in region", "out region", "corner sets");
     for (const char* name : {"sh3", "zh3_q16", "sh3_q28", "hall_adaptive_q16"}) {
         const Codec* codec = find_codec(name);
         ASSERT_NE(codec, nullptr);
@@ -896,7 +899,7 @@ void compare_plane_volumes(int samples, bool gltf) {
             visibility[i] = std::uint8_t(rng() | rng());
             masks[i / 4] |= std::uint32_t(validity[i] ? visibility[i] : 0u) << (8 * (i % 4));
         }
-        const std::vector<std::uint8_t> planes = planes_test::random_cell_planes(rng, origin, spacing, counts, 0.75);
+        const std::vector<std::uint8_t> planes = planes_test::random_cell_planes(rng, origin, spacing, counts, 0.75, 1.0 / 3);
         zhc_probe_format fmt;
         ASSERT_TRUE(runtime_format(name, p, &fmt));
         zhc_volume vol;
@@ -942,7 +945,7 @@ void compare_plane_volumes(int samples, bool gltf) {
         const std::vector<float> gpu = Fixture::run(un, w, items, std::size_t(samples), gltf ? nullptr : &masks, &plane_words,
                                                     gltf ? Fixture::kPlanesGltf : Fixture::kPlanes);
         Tally t;
-        long compared = 0, skipped = 0, near = 0, by_plane = 0, keep_compared = 0, keep_wrong = 0;
+        long compared = 0, skipped = 0, near = 0, by_plane = 0, region_in = 0, region_out = 0, twin_wrong = 0, keep_compared = 0, keep_wrong = 0;
         std::string first_keep;
         for (int i = 0; i < samples; ++i) {
             const double* pos = positions.data() + 3 * size_t(i);
@@ -959,6 +962,8 @@ void compare_plane_volumes(int samples, bool gltf) {
                 first_keep = std::string(name) + " sample " + std::to_string(i) + ": shader keeps " + std::to_string(got_keep) +
                              ", C " + std::to_string(want_keep);
             by_plane += sm.plane_keep != 0xFF;
+            if (sm.region) ++(sm.inside ? region_in : region_out);
+            twin_wrong += sm.region_twin_differs;
             double ref[3];
             zhc_volume_irradiance_d(&vol, pos, nrm, ref);
             double scale[3] = {0, 0, 0}, extra = 0;
@@ -983,7 +988,8 @@ void compare_plane_volumes(int samples, bool gltf) {
                 check_value(t, &t.max_irr, ref[k], gpu[size_t(i) * kOutFloats + std::size_t(k)], scale[k], bound,
                             std::string(name) + " sample " + std::to_string(i) + " channel " + std::to_string(k));
         }
-        std::printf("%-22s %8ld %10.3f %8ld %6ld %8ld %ld of %ld equal\n", name, compared, t.max_irr, skipped, near, by_plane,
+        std::printf("%-22s %8ld %10.3f %8ld %6ld %8ld %9ld %10ld %ld of %ld equal\n", name, compared, t.max_irr, skipped, near, by_plane,
+                    region_in, region_out,
                     keep_compared - keep_wrong, keep_compared);
         EXPECT_EQ(t.failures, 0) << name << ": " << t.first_failure;
         EXPECT_EQ(t.compared, 3 * compared) << name;
@@ -991,6 +997,9 @@ void compare_plane_volumes(int samples, bool gltf) {
         EXPECT_LE(skipped, samples / 100) << name;
         EXPECT_LE(near, samples / 100) << name;
         EXPECT_GT(by_plane, samples / 4) << name << ": the planes act";
+        EXPECT_EQ(twin_wrong, 0) << name << ": the header's corner region keeps differ from the spec's twin";
+        EXPECT_GT(region_in, samples / 100) << name << ": samples inside corner regions";
+        EXPECT_GT(region_out, samples / 100) << name << ": samples outside corner regions, in their cells";
     }
 }
 

@@ -903,22 +903,25 @@ TEST_F(RuntimeVk, MaskedProbeVolumesMatchTheCHeader) {
         }
 }
 
-// Cell planes (ZHC_VOLUME_PLANE, docs/runtime.md "Cell planes") against the C header with
-// zhc_volume::planes: a 6x5x4 grid per entry, a plane in 3 of 4 cells (random normal code through a
-// random point of the cell, the corners' sides as the bake writes them), 2 words per probe after the
-// masks. runtime_test_planes.spv: with random validity (1 in 4 invalid) and visibility (each bit set
+// Cell planes and corner regions (ZHC_VOLUME_PLANE, docs/runtime.md "Cell planes", "Corner
+// regions") against the C header with zhc_volume::planes: a 6x5x4 grid per entry, an entry in 3 of 4
+// cells, a third of them corner regions (random thresholds, some axes unbounded, random
+// directions), the others planes (random normal code through a random point of the cell, the
+// corners' sides as the bake writes them), 2 words per probe after the masks. runtime_test_planes.spv: with random validity (1 in 4 invalid) and visibility (each bit set
 // with p = 3/4); runtime_test_planes_gltf.spv: planes alone with ZHC_VOLUME_PLANE_AXES_GLTF on the
-// same volume in glTF axes (grid, probe order and sides bits permuted, normal codes kept) at the
-// permuted points, against the header on the zhc-axes volume. Per sample the corners the plane keeps
-// (zhc_volume_plane_keep) equal the header's, and the irradiance lies within
-// MaskedProbeVolumesMatchTheCHeader's bound with M the kept weight sum (0 < M < 1e-3: counted, not
-// compared). Points within 1e-4 |spacing| of their cell's plane (or 1e-5 cell widths of a face
-// between cells) are counted, not compared.
+// same volume in glTF axes (grid, probe order and sides bits permuted, normal codes kept, regions'
+// per-axis fields permuted) at the permuted points, against the header on the zhc-axes volume. Per
+// sample the corners the entry keeps (zhc_volume_plane_keep) equal the header's, and the irradiance
+// lies within MaskedProbeVolumesMatchTheCHeader's bound with M the kept weight sum (0 < M < 1e-3:
+// counted, not compared). Points within 1e-4 |spacing| of their cell's plane or of a bounding plane
+// of its region (or 1e-5 cell widths of a face between cells) are counted, not compared. The
+// header's region keeps equal planes_test::region_keep (the spec's twin), and samples fall both
+// inside and outside regions.
 TEST_F(RuntimeVk, PlaneProbeVolumesMatchTheCHeader) {
     const int samples = int(test::sample_count(10000));
     for (const bool gltf : {false, true}) {
-        std::printf("%-22s %8s %12s %8s %6s %8s %s\n", gltf ? "planes (glTF axes)" : "masks + planes", "samples", "max err/eps T", "skipped",
-                    "near", "by plane", "corner sets");
+        std::printf("%-22s %8s %12s %8s %6s %8s %9s %10s %s\n", gltf ? "planes (glTF axes)" : "masks + planes", "samples", "max err/eps T", "skipped",
+                    "near", "by plane", "in region", "out region", "corner sets");
         for (const char* name : {"sh3", "zh3_q16", "sh3_q28", "hall_adaptive_q16"}) {
             const Codec* codec = find_codec(name);
             ASSERT_NE(codec, nullptr);
@@ -941,7 +944,7 @@ TEST_F(RuntimeVk, PlaneProbeVolumesMatchTheCHeader) {
                 validity[i] = rng() % 4 == 0 ? 0 : 1;
                 visibility[i] = std::uint8_t(rng() | rng());
             }
-            const std::vector<std::uint8_t> planes = planes_test::random_cell_planes(rng, origin, spacing, counts, 0.75);
+            const std::vector<std::uint8_t> planes = planes_test::random_cell_planes(rng, origin, spacing, counts, 0.75, 1.0 / 3);
             zhc_probe_format fmt;
             ASSERT_TRUE(runtime_format(name, p, &fmt));
             zhc_volume vol;
@@ -1004,7 +1007,7 @@ TEST_F(RuntimeVk, PlaneProbeVolumesMatchTheCHeader) {
                 Gpu::get().run(params, words, items, std::size_t(samples), gltf ? Gpu::kPlanesGltf : Gpu::kPlanes);
             ASSERT_EQ(out.size(), std::size_t(samples) * kOutFloats);
             double max_rel = 0;
-            long compared = 0, failures = 0, skipped = 0, near = 0, by_plane = 0, keep_compared = 0, keep_wrong = 0;
+            long compared = 0, failures = 0, skipped = 0, near = 0, by_plane = 0, region_in = 0, region_out = 0, twin_wrong = 0, keep_compared = 0, keep_wrong = 0;
             std::string first, first_keep;
             for (int i = 0; i < samples; ++i) {
                 const double* pos = positions.data() + 3 * std::size_t(i);
@@ -1022,6 +1025,8 @@ TEST_F(RuntimeVk, PlaneProbeVolumesMatchTheCHeader) {
                     first_keep = std::string(name) + " item " + std::to_string(i) + ": shader keeps " + std::to_string(got_keep) + ", C " +
                                  std::to_string(want_keep);
                 by_plane += sm.plane_keep != 0xFF;
+                if (sm.region) ++(sm.inside ? region_in : region_out);
+                twin_wrong += sm.region_twin_differs;
                 double ref[3];
                 zhc_volume_irradiance_d(&vol, pos, nrm, ref);
                 double t[3] = {0, 0, 0}, extra = 0;
@@ -1054,13 +1059,17 @@ TEST_F(RuntimeVk, PlaneProbeVolumesMatchTheCHeader) {
                 }
                 ++compared;
             }
-            std::printf("%-22s %8ld %12.3f %8ld %6ld %8ld %ld of %ld equal\n", name, compared, max_rel, skipped, near, by_plane,
+            std::printf("%-22s %8ld %12.3f %8ld %6ld %8ld %9ld %10ld %ld of %ld equal\n", name, compared, max_rel, skipped, near, by_plane,
+                        region_in, region_out,
                         keep_compared - keep_wrong, keep_compared);
             EXPECT_EQ(failures, 0) << first;
             EXPECT_EQ(keep_wrong, 0) << first_keep;
             EXPECT_LE(skipped, samples / 100) << name;
             EXPECT_LE(near, samples / 100) << name;
             EXPECT_GT(by_plane, samples / 4) << name << ": the planes act";
+            EXPECT_EQ(twin_wrong, 0) << name << ": the header's corner region keeps differ from the spec's twin";
+            EXPECT_GT(region_in, samples / 100) << name << ": samples inside corner regions";
+            EXPECT_GT(region_out, samples / 100) << name << ": samples outside corner regions, in their cells";
         }
     }
 }
