@@ -88,7 +88,7 @@ export interface ZhpFile {
   payload: Uint8Array;
   validity: Uint8Array | null;
   visibility: Uint8Array | null;
-  /** Cell planes (byte 21 bit 2): 5 bytes per probe, the plane of the cell whose corner 0 is the probe. */
+  /** Cell planes (byte 21 bit 2): 5 bytes per probe, the plane or corner region of the cell whose corner 0 is the probe. */
   planes: Uint8Array | null;
   /** Tetrahedra of a positions layout (byte 21 bit 3): 4 probe indices each. */
   tetrahedra: Uint32Array | null;
@@ -108,9 +108,9 @@ export interface ZhcVolumeInput {
   counts: Vec3Like;
   validity?: ArrayLike<number> | null;
   visibility?: ArrayLike<number> | null;
-  /** Cell planes, 5 bytes per probe (ou, ov, offset lo, offset hi, sides), probe order. */
+  /** Cell planes, 5 bytes per probe (ou, ov, offset lo, offset hi, sides; or a corner region: thresholds r lo, r hi, 0x00, 0x80, 0x80 | directions), probe order. */
   planes?: ArrayLike<number> | null;
-  /** 'zhc' (default): the grid is in the axes of the normals' code; 'gltf': the grid in glTF axes, the codes in zhc axes. */
+  /** 'zhc' (default): the grid is in the axes of the normals' code; 'gltf': the grid in glTF axes, the codes in zhc axes (corner regions: in the grid's axes either way). */
   planesAxes?: 'zhc' | 'gltf';
 }
 /** A decoded probe grid (frozen): makeVolume / volumeFromZhp. */

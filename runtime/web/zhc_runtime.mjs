@@ -597,13 +597,17 @@ export function parseZhp(bytes) {
   if (validity && validity.some((v) => v > 1)) throw new Error('zhp: validity byte other than 0 or 1');
   if (planes) {
     // The last probe along an axis of count >= 2 starts no cell: its entry must be "no plane"
-    // (zhc_zhp_open; along an axis of count 1 the one probe starts the flat cell).
+    // (offset -32768, bit 7 of byte 4 clear: neither a plane nor a corner region; zhc_zhp_open;
+    // along an axis of count 1 the one probe starts the flat cell). A corner region's reserved bits
+    // (bit 15 of its thresholds, bits 3..6 of byte 4) are 0.
     const [nx, ny, nz] = grid.counts;
     for (let i = 0; i < count; i++) {
       const x = i % nx, y = Math.floor(i / nx) % ny, z = Math.floor(i / (nx * ny));
       if (((nx > 1 && x + 1 === nx) || (ny > 1 && y + 1 === ny) || (nz > 1 && z + 1 === nz)) &&
-          !(planes[5 * i + 2] === 0x00 && planes[5 * i + 3] === 0x80))
+          !(planes[5 * i + 2] === 0x00 && planes[5 * i + 3] === 0x80 && !(planes[5 * i + 4] & 0x80)))
         throw new Error(`zhp: probe ${i} is the last along an axis (it starts no cell) but its cell plane entry is not "no plane"`);
+      if (isCellRegion(planes, 5 * i) && ((planes[5 * i + 1] & 0x80) || (planes[5 * i + 4] & 0x78)))
+        throw new Error(`zhp: probe ${i}'s corner region sets reserved bits (bit 15 of its thresholds or bits 3-6 of byte 4)`);
     }
   }
   let tetrahedra = null, neighbours = null;
@@ -674,10 +678,11 @@ export function decodeAll(encoding, payload, count, params = DEFAULT_PARAMS) {
 // x + nx (y + ny z) at origin + (x sx, y sy, z sz)), or { sh (Float32Array(count x 27), decoded
 // radiance), origin, spacing, counts }; optional validity / visibility (Uint8Array, one byte per
 // probe, docs/runtime.md "Validity and visibility"; null = absent) and planes (Uint8Array, 5 bytes
-// per probe: the separating plane of the cell whose corner 0 is the probe, docs/runtime.md "Cell
-// planes"; null = absent). planesAxes: 'zhc' (default) when the grid's frame is the one the plane
-// normals' code is in (a .zhp), 'gltf' when the grid is in glTF axes and the codes in zhc axes
-// (ZHC_light_probes volumes: the decoded n is used as (n.y, n.z, n.x)). Throws Error naming the
+// per probe: the separating plane or corner region of the cell whose corner 0 is the probe,
+// docs/runtime.md "Cell planes" and "Corner regions"; null = absent). planesAxes: 'zhc' (default)
+// when the grid's frame is the one the plane normals' code is in (a .zhp), 'gltf' when the grid is
+// in glTF axes and the codes in zhc axes (ZHC_light_probes volumes: the decoded n is used as (n.y,
+// n.z, n.x); corner regions' fields are in the grid's axes either way). Throws Error naming the
 // problem: counts integers >= 1, origin and spacing finite, spacing > 0, far corner finite
 // (zhc_volume_init's rules), validity / visibility shorter than the probe count, planes shorter
 // than 5 x the probe count, planesAxes not 'zhc' or 'gltf'.
@@ -781,13 +786,38 @@ function planeNormal(ou, ov) {
 // zhc axis c of a glTF-axes grid: glTF (x, y, z) = zhc (y, z, x), so zhc x, y, z are glTF z, x, y.
 const GLTF_AXIS_OF_ZHC = [2, 0, 1];
 
-// The side of the plane of the cell whose corner 0 is probe `cell` (first probe i0) that `position`
-// lies on: null when the cell has no plane, else n . (x - c) - offset |spacing| / 65534 >= 0,
-// c = origin + (i0 + 0.5) spacing (zhc__volume_plane_side: the same doubles in the same order).
-// planesAxes 'gltf': n is in zhc axes and the grid in glTF axes; the sums run over zhc's axes
-// (glTF components z, x, y), so the side is the one the C header computes on the .zhp.
+// Whether the cell entry at planes[at..at + 4] is a corner region (docs/runtime.md "Corner regions";
+// zhc_cell_entry_is_region): offset -32768 and bit 7 of byte 4 set.
+function isCellRegion(planes, at) {
+  return planes[at + 2] === 0x00 && planes[at + 3] === 0x80 && (planes[at + 4] & 0x80) !== 0;
+}
+
+// The separating entry of the cell whose corner 0 is probe `cell` (first probe i0) at `position`
+// (zhc__volume_plane_side: the same doubles in the same order): null when the cell has none, else
+// [side, sides] (sides bit k: the side of corner k). A plane: side = n . (x - c) - offset |spacing|
+// / 65534 >= 0, c = origin + (i0 + 0.5) spacing, sides = byte 4. planesAxes 'gltf': n is in zhc
+// axes and the grid in glTF axes; the sums run over zhc's axes (glTF components z, x, y), so the
+// side is the one the C header computes on the .zhp. A corner region: r = bytes 0, 1 little-endian,
+// q_a = (r >> 5a) & 31, d_a = bit a of byte 4; side = the point is inside (along every axis a with
+// q_a > 0: d_a ? s_a >= t_a : s_a < t_a, s_a = (x_a - (origin_a + i0_a spacing_a)) 31, t_a = q_a
+// spacing_a), sides = the corners inside (bit a of k equals d_a along every such axis). Its fields
+// are in the grid's axes whatever planesAxes says (a glTF writer permutes them with the grid).
 function planeSide(vol, cell, i0, position) {
   const e = vol.planes, at = 5 * cell;
+  if (isCellRegion(e, at)) {
+    const r = e[at] | (e[at + 1] << 8);
+    const sp = vol.spacing, o = vol.origin;
+    let inside = 1, corners = 0xff;
+    for (let c = 0; c < 3; c++) {
+      const q = (r >> (5 * c)) & 31, d = (e[at + 4] >> c) & 1;
+      if (q === 0) continue;
+      const sa = (position[c] - (o[c] + i0[c] * sp[c])) * 31.0;
+      const ta = q * sp[c];
+      if (!(d ? sa >= ta : sa < ta)) inside = 0;
+      for (let k = 0; k < 8; k++) if (((k >> c) & 1) !== d) corners &= ~(1 << k);
+    }
+    return [inside, corners];
+  }
   const raw = e[at + 2] | (e[at + 3] << 8);
   const offset = raw >= 0x8000 ? raw - 0x10000 : raw;
   if (offset === -32768) return null;
@@ -800,7 +830,7 @@ function planeSide(vol, cell, i0, position) {
     const g = ax[c];
     s += n[c] * (position[g] - (o[g] + (i0[g] + 0.5) * sp[g]));
   }
-  return s >= 0.0 ? 1 : 0;
+  return [s >= 0.0 ? 1 : 0, e[at + 4]];
 }
 
 // ---- scattered probes: tetrahedral interpolation (zhc_volume_tetra_weights of the C header, the same
@@ -1012,7 +1042,8 @@ export function volumeTetraWeights(vol, position, start = 0) {
 // (zhc_volume_sh3). Probes of weight 0 are skipped. With validity / visibility / planes: corner
 // k = dx + 2 dy + 4 dz keeps its weight w when w > 0, the probe is valid, bit 7 - k of its mask is
 // set, and (the cell has no plane, or bit k of the plane's sides equals the position's side of
-// it); kept weights divided by their sum (corner order), none kept: the plain trilinear weights
+// it; a corner region: corner k is inside it exactly when the position is); kept weights divided
+// by their sum (corner order), none kept: the plain trilinear weights
 // (zhc_volume_sh3, the same doubles). A points volume (makePointsVolume): the blend of the 4 probes
 // of volumeTetraWeights from tetrahedron 0.
 export function volumeSH3(vol, position) {
@@ -1039,13 +1070,12 @@ export function volumeSH3(vol, position) {
   if (vol.validity || vol.visibility || vol.planes) {
     const m = new Float64Array(8);
     let sum = 0.0;
-    const side = vol.planes ? planeSide(vol, index[0], [ix, iy, iz], position) : null;
-    const sides = side === null ? 0 : vol.planes[5 * index[0] + 4];
+    const entry = vol.planes ? planeSide(vol, index[0], [ix, iy, iz], position) : null;
     for (let corner = 0; corner < 8; corner++) {
       if (w[corner] === 0.0) continue;
       if (vol.validity && !vol.validity[index[corner]]) continue;
       if (vol.visibility && !((vol.visibility[index[corner]] >> (7 - corner)) & 1)) continue;
-      if (side !== null && ((sides >> corner) & 1) !== side) continue;
+      if (entry !== null && ((entry[1] >> corner) & 1) !== entry[0]) continue;
       m[corner] = w[corner];
       sum += m[corner];
     }

@@ -13,21 +13,28 @@
 //     mean irradiance (the plugin blends in glTF probe order: a different order of the same sums);
 //  3b. the same with validity and visibility sections (version 2 files), fallback included;
 //  3c. cell planes (byte 21 bit 2): random planes (random codes, offsets, geometric or random sides,
-//      "no plane" cells) alone and with validity and visibility, bit for bit against the C header;
+//      "no plane" cells) and corner regions (random thresholds, some axes unbounded, random
+//      directions) alone and with validity and visibility, bit for bit against the C header, with
+//      samples inside and outside regions in every file, and the regions changing the result;
 //      all "no plane": the masks-only result bit for bit; a hand-made 3x2x2 grid of constant probes
 //      with two axis planes: each side shows its own probe's value, a plane whose corners all lie
-//      on the other side falls back to the plain blend; constant probes stay constant under any
-//      planes; the same volumes in glTF axes (planesAxes 'gltf': the grid, probe order and sides
-//      bits permuted, the normal code kept) against the C header on the .zhp;
+//      on the other side falls back to the plain blend; a hand-made 2x2x2 grid with one corner
+//      region (d = 0 on two axes, d = 1 on three): inside it only the colour of the corners inside,
+//      outside none of it; constant probes stay constant under any planes and regions; the same
+//      volumes in glTF axes (planesAxes 'gltf': the grid, probe order and sides bits permuted, the
+//      normal code kept, the regions' fields permuted) against the C header on the .zhp, and
+//      regions left unpermuted would be wrong;
 //  4. volumeFromZhp refuses a points file and a spacing <= 0 grid; irradianceAt refuses non-grids;
-//     parseZhp refuses a plane on a probe that starts no cell and planes without a grid, makeVolume
-//     short planes and a bad planesAxes.
+//     parseZhp refuses a plane, a corner region or bit 7 of byte 4 on a probe that starts no cell,
+//     a corner region's reserved bits and planes without a grid, makeVolume short planes and a bad
+//     planesAxes.
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { register } from 'node:module';
 import { makeRand, checker, triangleScene } from './fixtures.mjs';
-import { zhpWithPlanes, encodeNormal, planeEntry, planesSection, randomPlanes, gltfProbeOrder, gltfBits, gltfPlanes, NO_PLANE } from './planes_fixtures.mjs';
+import { zhpWithPlanes, encodeNormal, planeEntry, planesSection, randomPlanes, gltfProbeOrder, gltfBits, gltfPlanes, NO_PLANE,
+  regionEntry, isRegion, planeSideAt } from './planes_fixtures.mjs';
 
 register('./three_resolver.mjs', import.meta.url);
 const runtime = await import('../../runtime/web/zhc_runtime.mjs');
@@ -217,7 +224,10 @@ const withSections = (bytes, validity, visibility) => zhpWithPlanes(bytes, { val
     const count = z1.count;
     const validity = withValidity ? Uint8Array.from({ length: count }, () => (rand() < 0.2 ? 0 : 1)) : null;
     const visibility = withVisibility ? Uint8Array.from({ length: count }, () => Math.floor(rand() * 256)) : null;
-    const planes = randomPlanes(z1.grid, rand);
+    const planes = randomPlanes(z1.grid, rand, { pRegion: 0.3 });
+    // The same entries with every corner region replaced by "no plane" (a reader without regions).
+    const planesOnly = planes.slice();
+    for (let i = 0; i < count; i++) if (isRegion(planes, 5 * i)) planesOnly.set(NO_PLANE, 5 * i);
     const file = W(`planes_${validity ? 'v' : ''}${visibility ? 'm' : ''}_${name}`);
     fs.writeFileSync(file, zhpWithPlanes(v1, { validity, visibility, planes }, runtime.crc32));
     const z = runtime.parseZhp(new Uint8Array(fs.readFileSync(file)));
@@ -227,21 +237,39 @@ const withSections = (bytes, validity, visibility) => zhpWithPlanes(bytes, { val
     const masksOnly = runtime.makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, validity, visibility });
     const noPlanes = runtime.makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, validity, visibility,
       planes: planesSection(z.grid, () => null) });
+    const withoutRegions = runtime.makeVolume({ encoding: z.encoding, params: z.params, bytes: z.payload, ...z.grid, validity, visibility,
+      planes: planesOnly });
+    let regionCells = 0;
+    for (let i = 0; i < count; i++) if (isRegion(planes, 5 * i)) regionCells++;
     const pts = randomPoints(vol, 5000, 400 + planeSamples);
     const want = sampleC(file, pts);
-    let identical = 0, differ = 0, noneSame = 0;
+    let identical = 0, differ = 0, noneSame = 0, inRegion = 0, outRegion = 0, regionDiffer = 0, regionSame = 0;
     pts.forEach(({ p, n }, i) => {
       const got = runtime.volumeIrradiance(vol, p, n);
-      if (want[i] && same(got, want[i])) identical++;
+      const ok = want[i] && same(got, want[i]);
+      if (ok) identical++;
       const base = runtime.volumeIrradiance(masksOnly, p, n);
       if (!same(got, base)) differ++;
       if (same(runtime.volumeIrradiance(noPlanes, p, n), base)) noneSame++;
+      // Samples in a corner region's cell, on either side of it (the fixtures' twin of the rule).
+      const ps = planeSideAt(z.grid, planes, p);
+      if (ps && ps.region) {
+        if (ps.side) inRegion++;
+        else outRegion++;
+        if (ok) regionSame++;
+        if (!same(got, runtime.volumeIrradiance(withoutRegions, p, n))) regionDiffer++;
+      }
     });
-    console.log(`volume with planes${validity ? ' + validity' : ''}${visibility ? ' + visibility' : ''} (${name}): ` +
-      `${identical}/${pts.length} bit-identical to the C header, ${differ} differ from the volume without planes`);
+    console.log(`volume with planes and corner regions${validity ? ' + validity' : ''}${visibility ? ' + visibility' : ''} (${name}): ` +
+      `${identical}/${pts.length} bit-identical to the C header, ${differ} differ from the volume without planes; ` +
+      `${regionCells} region cells, samples in them ${inRegion} inside / ${outRegion} outside (${regionSame} bit-identical), ` +
+      `${regionDiffer} differ from the regions read as "no plane"`);
     check(identical === pts.length, `${name} planes${validity ? ' validity' : ''}${visibility ? ' visibility' : ''}: volumeIrradiance equals the C header bit for bit`);
     check(differ > pts.length / 4, `${name} planes: the planes change the result (${differ} of ${pts.length})`);
     check(noneSame === pts.length, `${name}: every entry "no plane" gives the result without planes bit for bit`);
+    check(inRegion >= 50 && outRegion >= 50 && regionSame === inRegion + outRegion,
+      `${name}: corner regions sampled on both sides (${inRegion} inside, ${outRegion} outside), bit-identical to the C header`);
+    check(regionDiffer > (inRegion + outRegion) / 4, `${name}: the corner regions change the result (${regionDiffer} of ${inRegion + outRegion})`);
     planeSamples += identical;
 
     // glTF axes: grid and probe order permuted, sides and mask bits permuted, the normal codes kept;
@@ -257,23 +285,25 @@ const withSections = (bytes, validity, visibility) => zhpWithPlanes(bytes, { val
       visibility: visibility && Uint8Array.from(order, (q) => gltfBits(visibility[q])),
       planes: gltfPlanes(z.grid.counts, planes), planesAxes });
     const gvol = gltfVol('gltf'), wrong = gltfVol('zhc');
-    let mean = 0, worst = 0, wrongFar = 0;
+    // Corner regions left in zhc axes (not permuted with the grid): must be wrong somewhere.
+    const unpermuted = gltfPlanes(z.grid.counts, planes);
+    order.forEach((q, g) => { if (isRegion(planes, 5 * q)) unpermuted.set(planes.subarray(5 * q, 5 * q + 5), 5 * g); });
+    const rawRegions = runtime.makeVolume({ ...gvol, planes: unpermuted });
+    let mean = 0, worst = 0, wrongFar = 0, rawFar = 0;
     for (const e of want) mean += (Math.abs(e[0]) + Math.abs(e[1]) + Math.abs(e[2])) / 3;
     mean /= want.length;
+    const off = (a, i) => a.some((x, k) => Math.abs(x - want[i][k]) > 1e-6 * mean);
     pts.forEach(({ p, n }, i) => {
       const got = runtime.volumeIrradiance(gvol, runtime.zhcToGltfDir(p), n);
-      const bad = runtime.volumeIrradiance(wrong, runtime.zhcToGltfDir(p), n);
-      let far = false;
-      for (let k = 0; k < 3; k++) {
-        worst = Math.max(worst, Math.abs(got[k] - want[i][k]) / mean);
-        if (Math.abs(bad[k] - want[i][k]) > 1e-6 * mean) far = true;
-      }
-      if (far) wrongFar++;
+      for (let k = 0; k < 3; k++) worst = Math.max(worst, Math.abs(got[k] - want[i][k]) / mean);
+      if (off(runtime.volumeIrradiance(wrong, runtime.zhcToGltfDir(p), n), i)) wrongFar++;
+      if (off(runtime.volumeIrradiance(rawRegions, runtime.zhcToGltfDir(p), n), i)) rawFar++;
     });
     console.log(`  the same in glTF axes (planesAxes 'gltf'): max error / mean ${worst.toExponential(2)} against the C header; ` +
-      `the normal code read in the grid's axes ('zhc') is off at ${wrongFar} of ${pts.length}`);
+      `the normal code read in the grid's axes ('zhc') is off at ${wrongFar} of ${pts.length}, regions not permuted to glTF axes at ${rawFar}`);
     check(mean > 0 && worst <= 1e-6, `${name} planes in glTF axes: volumeIrradiance agrees with the C header within 1e-6 of the mean`);
     check(wrongFar > pts.length / 20, `${name} planes in glTF axes: planesAxes 'zhc' (no swizzle) would be wrong (${wrongFar})`);
+    check(rawFar > (inRegion + outRegion) / 10, `${name} corner regions in glTF axes: their fields left in zhc axes would be wrong (${rawFar})`);
   }
   console.log(`volumes with planes: ${planeSamples} samples bit-identical between JS and C`);
 
@@ -334,18 +364,72 @@ const withSections = (bytes, validity, visibility) => zhpWithPlanes(bytes, { val
   check(handSame === handPts.length && ffSame === handPts.length, 'hand-made planes: bit-identical to the C header');
   check(sideOk === handPts.length, 'hand-made planes: every point shows the probe column on its side of the plane (within 1e-6)');
   check(ffNeg >= 50 && ffPlain === ffNeg, 'a plane with every corner on the positive side: points on the negative side take the plain blend');
+  // Hand-made corner regions: a 2x2x2 grid (spacing 2, 1, 1.5) of DC-only probes whose irradiance is
+  // red (1, 0, 0) at corners 0 and 2 (x = 0, z = 0), blue (0, 0, 1) at corner 7, green elsewhere.
+  // Region A: q = (10, 0, 20), d = (0, 0, 0): x < 20/31, z < 30/31, any y; inside it corners 0 and 2
+  // only, so red exactly, outside no red at all. Region B: q = (21, 9, 3), d = (1, 1, 1): inside it
+  // corner 7 only (blue exactly), outside no blue.
+  {
+    const g2 = { origin: [0, 0, 0], spacing: [2, 1, 1.5], counts: [2, 2, 2] };
+    const colourOf = (k) => (k === 0 || k === 2 ? [1, 0, 0] : k === 7 ? [0, 0, 1] : [0, 1, 0]);
+    const probes2 = Array.from({ length: 8 }, (_, k) => ({
+      sh3: Array.from({ length: 9 }, (_, j) => (j === 0 ? colourOf(k).map((c) => c * 2 * Math.sqrt(Math.PI)) : [0, 0, 0])) }));
+    fs.writeFileSync(W('region.json'), JSON.stringify({ format: 'zhc-probes', version: 1, layout: { type: 'grid', ...g2 }, probes: probes2 }));
+    run('convert', W('region.json'), '-o', W('region_v1.zhp'), '--to', 'sh3');
+    const rv1 = new Uint8Array(fs.readFileSync(W('region_v1.zhp')));
+    const regionCases = [
+      { tag: 'A', entry: regionEntry([10, 0, 20], [0, 0, 0]), d: 0, channel: 0, bounds: [[0, 10], [2, 20]] },
+      { tag: 'B', entry: regionEntry([21, 9, 3], [1, 1, 1]), d: 1, channel: 2, bounds: [[0, 21], [1, 9], [2, 3]] },
+    ];
+    const rr = makeRand(6);
+    for (const rc of regionCases) {
+      const planesR = planesSection(g2, () => rc.entry);
+      const file = W(`region_${rc.tag}.zhp`);
+      fs.writeFileSync(file, zhpWithPlanes(rv1, { planes: planesR }, runtime.crc32));
+      const vol = runtime.volumeFromZhp(new Uint8Array(fs.readFileSync(file)));
+      const pts = [];
+      while (pts.length < 600) {
+        const p = [0, 1, 2].map((a) => f32(g2.spacing[a] * rr()));
+        // 1e-3 away from the region's faces (x_a = q_a spacing_a / 31).
+        if (rc.bounds.some(([a, q]) => Math.abs(p[a] - q * g2.spacing[a] / 31) < 1e-3)) continue;
+        const zz = 2 * rr() - 1, phi = 2 * Math.PI * rr(), r = Math.sqrt(1 - zz * zz);
+        pts.push({ p, n: [f32(r * Math.cos(phi)), f32(r * Math.sin(phi)), f32(zz)] });
+      }
+      const want = sampleC(file, pts);
+      let bit = 0, inside = 0, insideExact = 0, outside = 0, outsideNone = 0;
+      pts.forEach(({ p, n }, i) => {
+        const got = runtime.volumeIrradiance(vol, p, n);
+        if (same(got, want[i])) bit++;
+        // The region by its definition: x_a < q_a s_a / 31 (d_a = 0) or >= (d_a = 1) on its axes.
+        const inR = rc.bounds.every(([a, q]) => (rc.d ? p[a] >= q * g2.spacing[a] / 31 : p[a] < q * g2.spacing[a] / 31));
+        if (inR) {
+          inside++;
+          if (got.every((x, k) => Math.abs(x - (k === rc.channel ? 1 : 0)) <= 1e-6)) insideExact++;
+        } else {
+          outside++;
+          if (got[rc.channel] === 0) outsideNone++;
+        }
+      });
+      console.log(`hand-made corner region ${rc.tag}: ${bit}/${pts.length} bit-identical to the C header; inside ${insideExact}/${inside} ` +
+        `show only its corners' colour, outside ${outsideNone}/${outside} none of it`);
+      check(bit === pts.length, `hand-made corner region ${rc.tag}: bit-identical to the C header`);
+      check(inside >= 30 && insideExact === inside, `hand-made corner region ${rc.tag}: every point inside shows only the corners inside (1e-6)`);
+      check(outside >= 30 && outsideNone === outside, `hand-made corner region ${rc.tag}: no point outside gets any weight from the corners inside`);
+    }
+  }
+
   // Constant probes stay constant under any planes (the kept weights are renormalised).
   const one = new Float32Array(27 * 12);
   for (let p = 0; p < 12; p++) one.set([0.7, 0.4, 0.2, 0.1, -0.05, 0.02, 0.3, 0.1, 0, 0.01, 0.02, 0.03].concat(Array(15).fill(0.01)), 27 * p);
-  const constVol = runtime.makeVolume({ sh: one, ...grid, planes: randomPlanes(grid, makeRand(9), { pNone: 0, pRandomSides: 0.5 }) });
+  const constVol = runtime.makeVolume({ sh: one, ...grid, planes: randomPlanes(grid, makeRand(9), { pNone: 0, pRandomSides: 0.5, pRegion: 0.4 }) });
   let constWorst = 0;
   const ref = (n) => runtime.irradiance(one.subarray(0, 27), runtime.normalizeOr(n));
   handPts.forEach(({ p, n }) => {
     const got = runtime.volumeIrradiance(constVol, p, n), e = ref(n);
     for (let k = 0; k < 3; k++) constWorst = Math.max(constWorst, Math.abs(got[k] - e[k]) / (Math.abs(e[k]) + 1e-3));
   });
-  console.log(`constant probes under random planes: max relative difference ${constWorst.toExponential(2)}`);
-  check(constWorst <= 1e-6, 'constant probes stay constant under random planes (1e-6)');
+  console.log(`constant probes under random planes and corner regions: max relative difference ${constWorst.toExponential(2)}`);
+  check(constWorst <= 1e-6, 'constant probes stay constant under random planes and corner regions (1e-6)');
 }
 
 // --- 4: refusals ----------------------------------------------------------------------------------------
@@ -382,8 +466,23 @@ check(throwsWith(() => runtime.makeVolume({ sh: new Float32Array(27), origin: [0
   planes.set([127, 127, 0, 0, 0x0F], 5 * last);
   check(throwsWith(() => runtime.parseZhp(zhpWithPlanes(v1, { planes }, runtime.crc32)), new RegExp(`probe ${last} is the last along an axis`)),
     'parseZhp refuses a plane on a probe that starts no cell');
+  planes.set(regionEntry([5, 0, 7], [1, 0, 0]), 5 * last);
+  check(throwsWith(() => runtime.parseZhp(zhpWithPlanes(v1, { planes }, runtime.crc32)), new RegExp(`probe ${last} is the last along an axis`)),
+    'parseZhp refuses a corner region on a probe that starts no cell');
+  planes.set([0, 0, 0x00, 0x80, 0x80], 5 * last);  // bit 7 alone: a region with every axis unbounded
+  check(throwsWith(() => runtime.parseZhp(zhpWithPlanes(v1, { planes }, runtime.crc32)), new RegExp(`probe ${last} is the last along an axis`)),
+    'parseZhp refuses bit 7 of byte 4 on a probe that starts no cell');
   planes.set(NO_PLANE, 5 * last);
   check(runtime.parseZhp(zhpWithPlanes(v1, { planes }, runtime.crc32)).planes !== null, 'the same file with "no plane" there is read');
+  // Corner regions' reserved bits (bit 15 of r, bits 3..6 of byte 4) on probe 0, which starts a cell.
+  planes.set(regionEntry([5, 0, 7], [1, 0, 0]), 0);
+  check(runtime.parseZhp(zhpWithPlanes(v1, { planes }, runtime.crc32)).planes[4] === 0x81, 'a corner region on probe 0 is read');
+  for (const [b, bit] of [[1, 0x80], [4, 0x08], [4, 0x40]]) {
+    const bad = planes.slice();
+    bad[b] |= bit;
+    check(throwsWith(() => runtime.parseZhp(zhpWithPlanes(v1, { planes: bad }, runtime.crc32)), /probe 0's corner region sets reserved bits/),
+      `parseZhp refuses a corner region with bit ${bit.toString(16)} of byte ${b} set`);
+  }
   const pts = new Uint8Array(fs.readFileSync(W('points.zhp')));
   check(throwsWith(() => runtime.parseZhp(zhpWithPlanes(pts, { planes: new Uint8Array(5).fill(0) }, runtime.crc32)), /cell planes without a grid layout/),
     'parseZhp refuses planes without a grid layout');
