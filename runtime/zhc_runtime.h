@@ -1005,12 +1005,20 @@ static inline int zhc_tetrahedra_check(const uint8_t* tets, const uint8_t* nbrs,
     return ZHC_OK;
 }
 
+/* A corner region entry (docs/runtime.md "Corner regions"): offset -32768 and bit 7 of byte 4 set;
+ * r = bytes 0, 1 little-endian: q_a = (r >> 5a) & 31 per axis a, byte 4 bits 0..2: d_a. Inside the
+ * region along axis a: q_a == 0, or d_a ? s_a >= t_a : s_a < t_a with s_a = (x_a - (origin_a + i0_a
+ * spacing_a)) * 31 and t_a = q_a spacing_a; corner k = dx + 2 dy + 4 dz along a: q_a == 0 or d_a ==
+ * its bit. */
+static inline int zhc_cell_entry_is_region(const uint8_t e[5]) { return e[2] == 0x00 && e[3] == 0x80 && (e[4] & 0x80u); }
+
 /* A whole .zhp file in memory (`file`, `size` bytes): the header as zhc_zhp_parse_header, then
  * file size = 184 + stored body (TRUNCATED / TRAILING_BYTES), body CRC-32 (CHECKSUM), a compressed
  * body (ZHC_ERR_COMPRESSED: f and info are still filled, the payload offset is meaningless), finite
- * positions, validity bytes 0/1 and "no plane" (offset -32768) in the plane entry of every grid
- * probe that is the last along some axis of count >= 2 (no cell has it as corner 0; along an axis of
- * count 1 the one probe starts the flat cell) (INVALID_VALUE), and a tetrahedra section whose count
+ * positions, validity bytes 0/1, "no plane" (offset -32768, bit 7 of byte 4 clear) in the cell
+ * entry of every grid probe that is the last along some axis of count >= 2 (no cell has it as corner
+ * 0; along an axis of count 1 the one probe starts the flat cell), reserved bits 0 in corner regions
+ * (INVALID_VALUE), and a tetrahedra section whose count
  * disagrees with its size (BAD_FORMAT) or whose indices or neighbours are inconsistent
  * (zhc_tetrahedra_check: INVALID_VALUE). On ZHC_OK probe i's bytes are at file + info->payload_offset +
  * i * info->probe_size. Safe for untrusted input; accepts exactly the uncompressed files zhc's
@@ -1040,8 +1048,11 @@ static inline int zhc_zhp_open(zhc_probe_format* f, zhc_zhp_info* info, const vo
         for (i = 0; i < inf.probe_count; ++i) {
             const uint64_t x = i % nx, y = (i / nx) % ny, z = i / (nx * ny);
             const uint8_t* e = p + inf.planes_offset + 5 * i;
-            if (((nx > 1 && x + 1 == nx) || (ny > 1 && y + 1 == ny) || (nz > 1 && z + 1 == nz)) && !(e[2] == 0x00 && e[3] == 0x80))
+            if (((nx > 1 && x + 1 == nx) || (ny > 1 && y + 1 == ny) || (nz > 1 && z + 1 == nz)) &&
+                !(e[2] == 0x00 && e[3] == 0x80 && !(e[4] & 0x80u)))
                 return ZHC_ERR_INVALID_VALUE;
+            /* A corner region's reserved bits (bit 15 of its thresholds, bits 3..6 of byte 4) are 0. */
+            if (zhc_cell_entry_is_region(e) && ((e[1] & 0x80u) || (e[4] & 0x78u))) return ZHC_ERR_INVALID_VALUE;
         }
     }
     if (inf.tetrahedra_offset) {
@@ -1234,16 +1245,36 @@ static inline void zhc_plane_normal(uint8_t ou, uint8_t ov, double n[3]) {
     n[2] = z / l;
 }
 
-/* Which side of the plane of the cell whose corner 0 is probe `cell` (first probe i0) the point
- * `position` lies on: returns 0 when the cell has no plane, else 1 with *side = (n . (x - c) -
- * offset |spacing| / 65534 >= 0), c = origin + (i0 + 0.5) spacing (the cell's centre), and *sides the
- * entry's side bits. */
+/* Which side of the separating entry of the cell whose corner 0 is probe `cell` (first probe i0) the
+ * point `position` lies on: returns 0 when the cell has none, else 1 with *side and *sides (bit k:
+ * the side of corner k). A plane: *side = (n . (x - c) - offset |spacing| / 65534 >= 0), c = origin +
+ * (i0 + 0.5) spacing (the cell's centre), *sides the entry's side bits. A corner region: *side = the
+ * point is inside, *sides = the corners inside (zhc_cell_entry_is_region). */
 static inline int zhc__volume_plane_side(const zhc_volume* v, size_t cell, const uint32_t i0[3], const double position[3],
                                          int* side, unsigned* sides) {
     const uint8_t* e = v->planes + 5 * cell;
     const int offset = (int)(int16_t)(uint16_t)(e[2] | (e[3] << 8));
     double n[3], s, diag;
     int c;
+    if (zhc_cell_entry_is_region(e)) {
+        const unsigned r = (unsigned)e[0] | ((unsigned)e[1] << 8);
+        unsigned k, inside_corners = 0xFFu;
+        int inside = 1;
+        for (c = 0; c < 3; ++c) {
+            const unsigned q = (r >> (5 * c)) & 31u, d = (e[4] >> c) & 1u;
+            if (q == 0) continue;
+            {
+                const double sa = (position[c] - (v->origin[c] + (double)i0[c] * v->spacing[c])) * 31.0;
+                const double ta = (double)q * v->spacing[c];
+                if (!(d ? sa >= ta : sa < ta)) inside = 0;
+            }
+            for (k = 0; k < 8; ++k)
+                if (((k >> c) & 1u) != d) inside_corners &= ~(1u << k);
+        }
+        *side = inside;
+        *sides = inside_corners;
+        return 1;
+    }
     if (offset == -32768) return 0;
     zhc_plane_normal(e[0], e[1], n);
     diag = sqrt(v->spacing[0] * v->spacing[0] + v->spacing[1] * v->spacing[1] + v->spacing[2] * v->spacing[2]);

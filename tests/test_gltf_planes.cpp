@@ -84,9 +84,18 @@ ProbeSet planes_set(const std::string& rep = "zh3_q16", unsigned seed = 3, std::
         std::uint8_t* e = set->planes.data() + 5 * i;
         const std::array<std::uint64_t, 3> i0{i % nx, (i / nx) % ny, i / (nx * ny)};
         for (int b = 0; b < 5; ++b) e[b] = static_cast<std::uint8_t>(byte(rng));
-        if ((nx > 1 && i0[0] + 1 == nx) || (ny > 1 && i0[1] + 1 == ny) || (nz > 1 && i0[2] + 1 == nz) || i % 7 == 3) {
+        const bool last = (nx > 1 && i0[0] + 1 == nx) || (ny > 1 && i0[1] + 1 == ny) || (nz > 1 && i0[2] + 1 == nz);
+        if (last || i % 7 == 3) {
             e[2] = 0x00;
             e[3] = 0x80;
+            e[4] &= 0x7F;  // "no plane" (bit 7 would make it a corner region)
+            continue;
+        }
+        if (i % 7 == 5) {  // a corner region: random thresholds and directions (docs/runtime.md "Corner regions")
+            e[1] &= 0x7F;
+            e[2] = 0x00;
+            e[3] = 0x80;
+            e[4] = static_cast<std::uint8_t>(0x80 | (e[4] & 7));
             continue;
         }
         const std::uint16_t off = static_cast<std::uint16_t>(offset(rng) / 4);  // within the cell's reach mostly
@@ -191,13 +200,40 @@ TEST(GltfPlanes, StoredPlanesAreTheSamePlanesInGltfAxes) {
     ASSERT_EQ(gn[1], kNz);
     ASSERT_EQ(gn[2], kNx);
     const Vec3 origin{g["origin"][0], g["origin"][1], g["origin"][2]}, spacing{g["spacing"][0], g["spacing"][1], g["spacing"][2]};
-    int planes_seen = 0, corners_checked = 0, corners_positive = 0;
+    int planes_seen = 0, regions_seen = 0, corners_checked = 0, corners_positive = 0;
     for (std::uint64_t p = 0; p < set.count; ++p) {
         const std::array<std::uint64_t, 3> gi{p % gn[0], (p / gn[0]) % gn[1], p / (gn[0] * gn[1])};
         // The same probe in zhc's grid: (x, y, z)_zhc = (gz, gx, gy); its entry's first four bytes as stored.
         const std::uint64_t z = gi[2] + kNx * (gi[0] + kNy * gi[1]);
         const std::uint8_t* e = planes.data() + 4 * p;
-        for (int b = 0; b < 4; ++b) EXPECT_EQ(e[b], set.planes[5 * z + static_cast<size_t>(b)]) << "probe " << p << " byte " << b;
+        const std::uint8_t* ez = set.planes.data() + 5 * z;
+        if (offset_of(e) == -32768 && (sides[p] & 0x80)) {
+            // A corner region: its per-axis fields in glTF axes (glTF axis a = zhc axis (a + 1) % 3),
+            // so the corners inside it are zhc's corners inside it, permuted like the masks.
+            ++regions_seen;
+            const unsigned rg = unsigned(e[0]) | unsigned(e[1]) << 8, rz = unsigned(ez[0]) | unsigned(ez[1]) << 8;
+            std::uint8_t inside_g = 0, inside_z = 0;
+            for (int a = 0; a < 3; ++a) {
+                EXPECT_EQ((rg >> (5 * a)) & 31u, (rz >> (5 * ((a + 1) % 3))) & 31u) << "probe " << p << " axis " << a;
+                EXPECT_EQ((sides[p] >> a) & 1u, (ez[4] >> ((a + 1) % 3)) & 1u) << "probe " << p << " axis " << a;
+            }
+            for (int k = 0; k < 8; ++k) {
+                bool in_g = true, in_z = true;
+                for (int a = 0; a < 3; ++a) {
+                    in_g = in_g && (((rg >> (5 * a)) & 31u) == 0 || ((sides[p] >> a) & 1u) == unsigned((k >> a) & 1));
+                    in_z = in_z && (((rz >> (5 * a)) & 31u) == 0 || ((ez[4] >> a) & 1u) == unsigned((k >> a) & 1));
+                }
+                inside_g = static_cast<std::uint8_t>(inside_g | (in_g ? 1u << k : 0u));
+                inside_z = static_cast<std::uint8_t>(inside_z | (in_z ? 1u << k : 0u));
+            }
+            std::uint8_t inside_z_in_gltf = 0;  // zhc corner (dx, dy, dz) is glTF corner (dy, dz, dx)
+            for (int k = 0; k < 8; ++k)
+                if ((inside_z >> k) & 1)
+                    inside_z_in_gltf = static_cast<std::uint8_t>(inside_z_in_gltf | 1u << (((k >> 1) & 1) + 2 * ((k >> 2) & 1) + 4 * (k & 1)));
+            EXPECT_EQ(inside_g, inside_z_in_gltf) << "probe " << p;
+            continue;
+        }
+        for (int b = 0; b < 4; ++b) EXPECT_EQ(e[b], ez[b]) << "probe " << p << " byte " << b;
         if (offset_of(e) == -32768) continue;
         ++planes_seen;
         const Vec3 nz = plane_normal(e[0], e[1]);
@@ -212,7 +248,9 @@ TEST(GltfPlanes, StoredPlanesAreTheSamePlanesInGltfAxes) {
             EXPECT_EQ((sides[p] >> k) & 1, d >= 0 ? 1 : 0) << "glTF probe " << p << " corner " << k << " distance " << d;
         }
     }
-    EXPECT_GE(planes_seen, 6);
+    EXPECT_GE(planes_seen + regions_seen, 6);
+    EXPECT_GE(planes_seen, 4);
+    EXPECT_GE(regions_seen, 1);
     EXPECT_GT(corners_checked, 8 * planes_seen - 4);
     EXPECT_GT(corners_positive, 0);
     EXPECT_LT(corners_positive, corners_checked);  // both sides occur

@@ -65,6 +65,36 @@ double spec_plane_value(const std::uint8_t* e, const double origin[3], const dou
     return dot - double(offset) * diag / 65534.0;
 }
 
+// A corner region entry (docs/runtime.md "Corner regions"): offset -32768 and bit 7 of byte 4.
+bool spec_is_region(const std::uint8_t* e) { return e[2] == 0x00 && e[3] == 0x80 && (e[4] & 0x80) != 0; }
+
+// Whether x lies inside the corner region `e` of the cell with first probe i0, and (*corners) which
+// corners do; *margin: the smallest |s_a - t_a| / (31 spacing_a) over the bounding axes (how near x
+// is to a face of the region, in cells).
+bool spec_region_inside(const std::uint8_t* e, const double origin[3], const double spacing[3], const std::uint32_t i0[3],
+                        const double x[3], std::uint8_t* corners, double* margin) {
+    const unsigned r = unsigned(e[0]) | unsigned(e[1]) << 8;
+    bool inside = true;
+    *corners = 0;
+    *margin = INFINITY;
+    for (int k = 0; k < 8; ++k) {
+        bool in = true;
+        for (int a = 0; a < 3; ++a) {
+            const unsigned q = (r >> (5 * a)) & 31u, d = (e[4] >> a) & 1u;
+            in = in && (q == 0 || d == unsigned((k >> a) & 1));
+        }
+        if (in) *corners = std::uint8_t(*corners | (1u << k));
+    }
+    for (int a = 0; a < 3; ++a) {
+        const unsigned q = (r >> (5 * a)) & 31u, d = (e[4] >> a) & 1u;
+        if (q == 0) continue;
+        const double s_a = (x[a] - (origin[a] + double(i0[a]) * spacing[a])) * 31.0, t_a = double(q) * spacing[a];
+        inside = inside && (d ? s_a >= t_a : s_a < t_a);
+        *margin = std::min(*margin, std::fabs(s_a - t_a) / (31.0 * spacing[a]));
+    }
+    return inside;
+}
+
 // The twin: the cell of p (clamped grid coordinate, lower corner <= n - 2), the 8 corner weights,
 // masked per the contract, renormalised, blended over the decoded hub in corner order. *near_plane
 // (when given) is set when p lies within 1e-12 |spacing| of its cell's plane, where the twin's
@@ -91,11 +121,19 @@ Sh27 twin_sh3(const ProbeSet& set, const std::vector<Sh3Radiance>& hub, const do
     if (!set.planes.empty()) {
         const std::uint8_t* e = set.planes.data() + 5 * (i0[0] + size_t(g.counts[0]) * (i0[1] + size_t(g.counts[1]) * i0[2]));
         const double origin[3] = {g.origin.x, g.origin.y, g.origin.z}, spacing[3] = {g.spacing.x, g.spacing.y, g.spacing.z};
-        const double value = spec_plane_value(e, origin, spacing, i0, p, &has_plane);
-        side = value >= 0 ? 1 : 0;
-        sides = e[4];
-        const double diag = std::sqrt(spacing[0] * spacing[0] + spacing[1] * spacing[1] + spacing[2] * spacing[2]);
-        if (near_plane && has_plane) *near_plane = std::fabs(value) < 1e-12 * diag;
+        if (spec_is_region(e)) {
+            double margin = 0;
+            has_plane = true;
+            side = spec_region_inside(e, origin, spacing, i0, p, &sides, &margin) ? 1 : 0;
+            // The header's operations exactly (one subtraction, one product, one comparison per
+            // axis): no rounding difference to allow for.
+        } else {
+            const double value = spec_plane_value(e, origin, spacing, i0, p, &has_plane);
+            side = value >= 0 ? 1 : 0;
+            sides = e[4];
+            const double diag = std::sqrt(spacing[0] * spacing[0] + spacing[1] * spacing[1] + spacing[2] * spacing[2]);
+            if (near_plane && has_plane) *near_plane = std::fabs(value) < 1e-12 * diag;
+        }
     }
     double w[8], m[8], sum = 0;
     size_t idx[8];
@@ -501,11 +539,16 @@ std::vector<std::uint8_t> random_planes(std::mt19937_64& rng, const ProbeGrid& g
                 std::array<std::uint8_t, 5> e = kNoPlane;
                 e[0] = std::uint8_t(rng());
                 e[1] = std::uint8_t(rng());
-                e[4] = std::uint8_t(rng());
+                e[4] = std::uint8_t(rng() & 0x7F);  // "no plane": any bytes but bit 7 of byte 4
                 // The last probe along an axis of count >= 2 starts no cell (along a count-1 axis the
                 // one probe starts the flat cell).
                 const bool last = (n[0] > 1 && x + 1 == n[0]) || (n[1] > 1 && y + 1 == n[1]) || (n[2] > 1 && z + 1 == n[2]);
-                if (!last && rng() % 4 != 0) {
+                const unsigned kind = unsigned(rng() % 8);
+                if (!last && kind >= 5) {
+                    // A corner region: random thresholds (0 = the axis does not bound it) and directions.
+                    const unsigned r = unsigned(rng() % 32) | unsigned(rng() % 32) << 5 | unsigned(rng() % 32) << 10;
+                    e = {std::uint8_t(r & 0xFF), std::uint8_t(r >> 8), 0x00, 0x80, std::uint8_t(0x80 | (rng() & 7))};
+                } else if (!last && kind >= 2) {
                     const std::uint32_t i0[3] = {x, y, z};
                     e = plane_entry(e[0], e[1], int(rng() % 65535) - 32767, e[4]);
                     if (rng() % 2) e[4] = geometric_sides(e, origin, spacing, i0);
@@ -517,7 +560,7 @@ std::vector<std::uint8_t> random_planes(std::mt19937_64& rng, const ProbeGrid& g
 
 TEST(RuntimeCVolumeLeak, RandomPlanesMatchTheTwinBitForBit) {
     std::mt19937_64 rng(38);
-    int samples = 0, by_planes = 0, near = 0;
+    int samples = 0, by_planes = 0, near = 0, in_region = 0, out_region = 0;
     for (const std::array<std::uint32_t, 3>& counts :
          {std::array<std::uint32_t, 3>{4, 3, 2}, {2, 2, 2}, {3, 3, 3}, {5, 1, 3}, {1, 1, 1}})
         for (const char* enc : {"sh3", "zh3_q16", "sh3_q28"})
@@ -568,11 +611,30 @@ TEST(RuntimeCVolumeLeak, RandomPlanesMatchTheTwinBitForBit) {
                     const Sh27 base = runtime_sh3(masks_only, p);
                     by_planes += std::memcmp(got.data(), base.data(), sizeof got) != 0;
                     ++samples;
+                    {  // which kind of entry the sample's cell has, and (a region) which side
+                        std::uint32_t i0[3];
+                        for (int c = 0; c < 3; ++c) {
+                            const std::uint32_t nc = counts[size_t(c)];
+                            double t = std::clamp((p[c] - layout.grid.origin[c]) / layout.grid.spacing[c], 0.0, double(nc - 1));
+                            i0[c] = std::min(std::uint32_t(t), nc >= 2 ? nc - 2 : 0u);
+                        }
+                        const std::uint8_t* e = set->planes.data() + 5 * (i0[0] + size_t(counts[0]) * (i0[1] + size_t(counts[1]) * i0[2]));
+                        if (spec_is_region(e)) {
+                            std::uint8_t corners = 0;
+                            double margin = 0;
+                            const double origin[3] = {layout.grid.origin.x, layout.grid.origin.y, layout.grid.origin.z};
+                            const double spacing[3] = {layout.grid.spacing.x, layout.grid.spacing.y, layout.grid.spacing.z};
+                            ++(spec_region_inside(e, origin, spacing, i0, p, &corners, &margin) ? in_region : out_region);
+                        }
+                    }
                 }
             }
-    std::printf("volume with planes: %d samples bit for bit, %d differ from the masks-only blend, %d within 1e-12 |spacing| of a plane\n",
-                samples, by_planes, near);
+    std::printf("volume with planes: %d samples bit for bit, %d differ from the masks-only blend, %d within 1e-12 |spacing| of a plane; "
+                "%d inside and %d outside a corner region\n",
+                samples, by_planes, near, in_region, out_region);
     EXPECT_GT(by_planes, samples / 8);  // the planes do change the result
+    EXPECT_GT(in_region, samples / 50);  // both sides of corner regions are sampled
+    EXPECT_GT(out_region, samples / 50);
     EXPECT_EQ(near, 0);
 }
 
@@ -754,8 +816,9 @@ TEST(RuntimeCVolumeLeak, PlanesKeepAConstantFieldConstant) {
 }
 
 TEST(RuntimeCVolumeLeak, NoPlaneEntriesGiveTheMasksOnlyBlendBitForBit) {
-    // Every entry "no plane" (random normal codes and sides bytes: ignored): the result equals the
-    // same volume without planes, bit for bit, with and without validity and masks.
+    // Every entry "no plane" (random normal codes and sides bytes but bit 7, which marks a corner
+    // region: ignored): the result equals the same volume without planes, bit for bit, with and
+    // without validity and masks.
     std::mt19937_64 rng(23);
     std::vector<Sh3Radiance> hub;
     for (size_t i = 0; i < 24; ++i) hub.push_back(random_probe(rng, i));
@@ -768,7 +831,7 @@ TEST(RuntimeCVolumeLeak, NoPlaneEntriesGiveTheMasksOnlyBlendBitForBit) {
     for (size_t i = 0; i < 24; ++i) {
         set->validity.push_back(rng() % 4 == 0 ? 0 : 1);
         set->visibility.push_back(std::uint8_t(rng()));
-        const std::array<std::uint8_t, 5> e = {std::uint8_t(rng()), std::uint8_t(rng()), 0x00, 0x80, std::uint8_t(rng())};
+        const std::array<std::uint8_t, 5> e = {std::uint8_t(rng()), std::uint8_t(rng()), 0x00, 0x80, std::uint8_t(rng() & 0x7F)};
         set->planes.insert(set->planes.end(), e.begin(), e.end());
     }
     const auto bytes = *serialize_probe_set(*set);
@@ -944,6 +1007,24 @@ TEST(RuntimeCVolumeLeak, FilesWithPlanesAndAPlaneOnALastProbe) {
     ok[ok.size() - 60 + 3] = 0x00;
     reseal(ok);
     EXPECT_EQ(zhc_volume_from_zhp(&v, ok.data(), ok.size()), ZHC_OK);
+    // Corner regions (docs/runtime.md "Corner regions"): accepted on a probe that owns a cell,
+    // refused on a last probe (probe 2: x = 2) and with a reserved bit set, by the header and the
+    // C++ reader alike.
+    const auto with_entry = [&](size_t probe, std::array<std::uint8_t, 5> e) {
+        auto b = bytes;
+        std::copy(e.begin(), e.end(), b.begin() + std::ptrdiff_t(b.size() - 60 + 5 * probe));
+        reseal(b);
+        return b;
+    };
+    const std::array<std::uint8_t, 5> region = {0x2F, 0x21, 0x00, 0x80, 0x85};  // q = 15, 9, 8; d = 1, 0, 1
+    for (const auto& [b, code] : {std::pair{with_entry(0, region), ZHC_OK},
+                                  std::pair{with_entry(2, region), ZHC_ERR_INVALID_VALUE},
+                                  std::pair{with_entry(2, {0, 0, 0x00, 0x80, 0x80}), ZHC_ERR_INVALID_VALUE},
+                                  std::pair{with_entry(0, {0x2F, 0xA1, 0x00, 0x80, 0x85}), ZHC_ERR_INVALID_VALUE},
+                                  std::pair{with_entry(0, {0x2F, 0x21, 0x00, 0x80, 0x8D}), ZHC_ERR_INVALID_VALUE}}) {
+        EXPECT_EQ(zhc_volume_from_zhp(&v, b.data(), b.size()), code);
+        EXPECT_EQ(parse_probe_set(b, "x").ok(), code == ZHC_OK);
+    }
     // A flat 3x1x2 grid: the y = 0 probes start the flat cells (x < 2, z = 0: probes 0 and 1 hold a
     // plane), the others are the last along x or z.
     layout.grid.counts = {3, 1, 2};

@@ -72,8 +72,10 @@ struct ProbeSet {
     // plane of the grid cell whose corner 0 is probe i (docs/runtime.md "Cell planes"): ou, ov (the
     // normal's octahedral code, zhc axes), offset (int16 little-endian from the cell's centre along
     // the normal in units of |spacing| / 65534; -32768 = no plane), sides (bit k: corner k of the
-    // cell lies on the positive side). Probes that are the last along some axis of count >= 2 start
-    // no cell: their entries are "no plane".
+    // cell lies on the positive side); or, with offset -32768 and bit 7 of byte 4 set, a corner
+    // region (docs/runtime.md "Corner regions": a 5-bit threshold per axis in bytes 0-1, a
+    // direction bit per axis in byte 4). Probes that are the last along some axis of count >= 2
+    // start no cell: their entries are "no plane" (byte 4 bit 7 clear).
     std::vector<std::uint8_t> planes;
     // tetrahedra (positions layouts only): empty, or a tetrahedralisation of the positions
     // (formats/probes/tetra.h: Delaunay, canonical order, positive orientation), 4 probe indices per

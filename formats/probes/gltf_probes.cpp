@@ -424,6 +424,24 @@ std::uint8_t visibility_to_gltf(std::uint8_t mask) {
     return out;
 }
 
+// A corner region's per-axis fields (5-bit thresholds in bytes 0-1, direction bits 0-2 of byte 4;
+// docs/runtime.md "Corner regions") in the other axis order: to glTF, field a of glTF axis a =
+// zhc's field of axis (a + 1) % 3; back, zhc axis a = glTF axis (a + 2) % 3. Reserved bits kept.
+void region_entry_axes(std::uint8_t e[5], bool to_gltf) {
+    const unsigned r = unsigned(e[0]) | unsigned(e[1]) << 8;
+    unsigned q = r & 0x8000u, d = e[4] & ~7u;
+    for (unsigned a = 0; a < 3; ++a) {
+        const unsigned from = to_gltf ? (a + 1) % 3 : (a + 2) % 3;
+        q |= ((r >> (5 * from)) & 31u) << (5 * a);
+        d |= ((unsigned(e[4]) >> from) & 1u) << a;
+    }
+    e[0] = static_cast<std::uint8_t>(q & 0xFFu);
+    e[1] = static_cast<std::uint8_t>(q >> 8);
+    e[4] = static_cast<std::uint8_t>(d);
+}
+
+bool is_region_entry(const std::uint8_t e[5]) { return e[2] == 0x00 && e[3] == 0x80 && (e[4] & 0x80u); }
+
 std::uint8_t visibility_from_gltf(std::uint8_t mask) {
     std::uint8_t out = 0;
     for (int b = 0; b < 8; ++b) {

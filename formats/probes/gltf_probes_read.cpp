@@ -109,13 +109,19 @@ struct VolumeReader {
             // The last probe along an axis of two or more starts no cell (along an axis of one, the
             // probe starts a flat cell: validate_leak_data).
             const bool last = (gx_n > 1 && gx + 1 == gx_n) || (gy_n > 1 && gy + 1 == gy_n) || (gz_n > 1 && gz + 1 == gz_n);
-            if (last && !(e[2] == 0x00 && e[3] == 0x80))
+            if (last && !(e[2] == 0x00 && e[3] == 0x80 && !((*sb)[g] & 0x80u)))
                 return bad(ErrorCode::kInvalidValue, "planes accessor " + std::to_string(*pa) + ": probe " + std::to_string(g) +
                                                          " (glTF order) is the last along an axis and starts no cell, but its plane is set "
                                                          "(offset " + std::to_string(static_cast<std::int16_t>(e[2] | e[3] << 8)) +
                                                          ", expected -32768 = no plane)");
-            std::memcpy(entries.data() + 5 * g, e, 4);
-            entries[5 * g + 4] = visibility_from_gltf((*sb)[g]);
+            std::uint8_t* out = entries.data() + 5 * g;
+            std::memcpy(out, e, 4);
+            out[4] = (*sb)[g];
+            if (is_region_entry(out)) {
+                region_entry_axes(out, /*to_gltf=*/false);  // a corner region: its per-axis fields back in zhc axes
+            } else {
+                out[4] = visibility_from_gltf(out[4]);
+            }
         }
         set.planes = reorder_grid(entries, 5, zc, /*to_gltf_order=*/false);
         stored_bytes += pb->size() + sb->size();

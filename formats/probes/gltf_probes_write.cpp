@@ -326,8 +326,15 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
         const std::vector<std::uint8_t> entries = reorder_grid(set.planes, 5, set.layout.grid.counts, /*to_gltf_order=*/true);
         std::vector<std::uint8_t> planes(4 * set.count), sides(set.count);
         for (std::size_t i = 0; i < set.count; ++i) {
-            std::memcpy(planes.data() + 4 * i, entries.data() + 5 * i, 4);  // ou, ov, offset lo, offset hi: as stored
-            sides[i] = visibility_to_gltf(entries[5 * i + 4]);              // corner bits permuted like the masks
+            std::uint8_t e[5];
+            std::memcpy(e, entries.data() + 5 * i, 5);
+            if (is_region_entry(e)) {
+                region_entry_axes(e, /*to_gltf=*/true);  // a corner region: its per-axis fields in glTF axes
+            } else {
+                e[4] = visibility_to_gltf(e[4]);  // a plane's corner bits, permuted like the masks
+            }
+            std::memcpy(planes.data() + 4 * i, e, 4);  // ou, ov, offset lo, offset hi (a region: its thresholds)
+            sides[i] = e[4];
         }
         vol["planes"] = add_accessor(append_view(planes, options.name + " planes"), kUbyte, "VEC4", set.count, options.name + " planes");
         vol["planeSides"] = add_accessor(append_view(sides, options.name + " planeSides"), kUbyte, "SCALAR", set.count,
