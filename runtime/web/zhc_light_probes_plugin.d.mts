@@ -30,7 +30,8 @@ export interface ZhcProbeVolumeFields {
   validity?: Uint8Array | null;
   visibility?: Uint8Array | null;
   /** Cell planes (accessors planes + planeSides), 5 bytes per probe in glTF probe order: ou, ov (normal
-   * code, zhc axes), offset lo, offset hi, sides (glTF corner bits); null when absent. */
+   * code, zhc axes), offset lo, offset hi, sides (glTF corner bits), or a corner region (thresholds and
+   * directions in glTF axes; docs/runtime.md "Corner regions"); null when absent. */
   planes?: Uint8Array | null;
   /** Tetrahedra of a points volume (accessor tetrahedra): 4 probe indices each; null when absent. */
   tetrahedra?: Uint32Array | null;

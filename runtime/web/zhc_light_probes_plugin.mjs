@@ -61,8 +61,8 @@ export class ZhcProbeVolume {
   //  * GRID: the trilinear blend of the 8 surrounding probes' decoded SH3 (the point clamped to the
   //    grid's box; docs/runtime.md "Probe volumes"). With validity / visibility accessors the weights
   //    are masked and renormalised (docs/runtime.md "Validity and visibility"); with cell planes
-  //    (`planes`) a corner on the other side of its cell's plane from the position is dropped too
-  //    (docs/gltf-extension.md "Cell planes").
+  //    (`planes`) a corner on the other side of its cell's plane (or corner region) from the
+  //    position is dropped too (docs/gltf-extension.md "Cell planes").
   //  * POINTS with tetrahedra (docs/gltf-extension.md "Tetrahedra"): the barycentric blend of the 4
   //    probes of the tetrahedron holding the point (outside the hull: the nearest hull face), valid
   //    probes only (zhc_runtime.mjs volumeTetraWeights, walked from tetrahedron 0). The walk runs
@@ -369,9 +369,12 @@ function tetrahedraOf(v, count, tetsArray, nbrsArray) {
 }
 
 // The `planes` / `planeSides` accessors as one Uint8Array of 5 bytes per probe in glTF probe
-// order (ou, ov, offset lo, offset hi as stored, then the sides byte in glTF corner bits), or null
+// order (ou, ov, offset lo, offset hi as stored, then the sides byte in glTF corner bits; a corner
+// region, docs/runtime.md "Corner regions": its thresholds and directions in glTF axes), or null
 // when both are absent. Throws for one without the other, a layout other than grid, a wrong size,
-// or a plane on a probe that starts no cell (the last along a glTF grid axis of two or more probes).
+// a plane or corner region on a probe that starts no cell (the last along a glTF grid axis of two
+// or more probes), or a corner region with reserved bits set (bit 15 of its thresholds, bits 3..6
+// of its planeSides byte).
 function cellPlanes(v, count, planesArray, sidesArray) {
   if (!planesArray && !sidesArray) return null;
   if (!planesArray || !sidesArray)
@@ -386,8 +389,11 @@ function cellPlanes(v, count, planesArray, sidesArray) {
     out[5 * p + 4] = sidesArray[p];
     const x = p % nx, y = Math.floor(p / nx) % ny, z = Math.floor(p / (nx * ny));
     const last = (nx > 1 && x + 1 === nx) || (ny > 1 && y + 1 === ny) || (nz > 1 && z + 1 === nz);
-    if (last && !(out[5 * p + 2] === 0x00 && out[5 * p + 3] === 0x80))
-      throw new Error(`ZHC_light_probes: planes accessor: probe ${p} is the last along an axis and starts no cell, but its plane is set`);
+    const noneOrRegion = out[5 * p + 2] === 0x00 && out[5 * p + 3] === 0x80, region = noneOrRegion && (out[5 * p + 4] & 0x80) !== 0;
+    if (last && !(noneOrRegion && !region))
+      throw new Error(`ZHC_light_probes: planes accessor: probe ${p} is the last along an axis and starts no cell, but its ${region ? 'corner region' : 'plane'} is set`);
+    if (region && ((out[5 * p + 1] & 0x80) || (out[5 * p + 4] & 0x78)))
+      throw new Error(`ZHC_light_probes: planes accessor: probe ${p}'s corner region sets reserved bits (bit 15 of its thresholds or bits 3-6 of planeSides)`);
   }
   return out;
 }

@@ -1,26 +1,30 @@
 // Cell planes through glTF and the three.js GLTFLoader plugin (CTest: js.plugin_planes).
 // Usage: node plugin_planes.mjs ZHC_BINARY ZHC_VOLUME_SAMPLE WORK_DIR
 //
-//  1. `zhc demo`'s zh3_q16 grid with random cell planes (tests/js/planes_fixtures.mjs), alone and
-//     with random validity and visibility, written as version 2 .zhp files and embedded by
+//  1. `zhc demo`'s zh3_q16 grid with random cell planes and corner regions (tests/js/planes_fixtures.mjs),
+//     alone and with random validity and visibility, written as version 2 .zhp files and embedded by
 //     `zhc gltf embed`: the plugin's volume.planes holds the entries in glTF probe order with the
-//     sides bits in glTF corner bits (planes_fixtures' gltfPlanes, computed here from the .zhp), and
-//     ZhcProbeVolume.irradianceAt at 5000 random points (glTF axes) agrees with the C header's
-//     zhc_volume_irradiance on the .zhp at the same points in zhc axes within 1e-6 of the mean
-//     irradiance (the tolerance of the mask tests: the plugin blends in glTF probe order); the
-//     planes change the result at more than a quarter of the points;
+//     sides bits in glTF corner bits and the regions' fields in glTF axes (planes_fixtures'
+//     gltfPlanes, computed here from the .zhp), and ZhcProbeVolume.irradianceAt at 5000 random
+//     points (glTF axes) agrees with the C header's zhc_volume_irradiance on the .zhp at the same
+//     points in zhc axes within 1e-6 of the mean irradiance (the tolerance of the mask tests: the
+//     plugin blends in glTF probe order); the planes change the result at more than a quarter of
+//     the points; points inside and outside corner regions (>= 50 each), where the regions change
+//     the result at more than a tenth;
 //  2. a hand-made 3x2x2 grid of three constant probe columns with the planes x = 0.6 and x = 3 (zhc
 //     axes): irradianceAt gives exactly the colour of the point's side of the wall; a default
 //     `zhc bake` of examples/hall.gltf (validity + planes) to .glb against the C header on the same
 //     bake's .zhp, as in 1;
-//  3. refusals: one accessor of the two, planes on a volume without a grid, a wrong size, a plane on
-//     a probe that starts no cell (buildVolume and the loader).
+//  3. refusals: one accessor of the two, planes on a volume without a grid, a wrong size, a plane, a
+//     corner region or bit 7 of planeSides on a probe that starts no cell, a corner region's reserved
+//     bits (buildVolume and the loader).
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { register } from 'node:module';
 import { makeRand, checker, triangleScene, freshWork, repoRoot } from './fixtures.mjs';
-import { zhpWithPlanes, encodeNormal, planeEntry, planesSection, randomPlanes, gltfPlanes, NO_PLANE } from './planes_fixtures.mjs';
+import { zhpWithPlanes, encodeNormal, planeEntry, planesSection, randomPlanes, gltfPlanes, NO_PLANE, regionEntry, gltfRegion, isRegion,
+  planeSideAt } from './planes_fixtures.mjs';
 
 register('./three_resolver.mjs', import.meta.url);
 const runtime = await import('../../runtime/web/zhc_runtime.mjs');
@@ -84,7 +88,7 @@ run('demo', '-o', W('demo'), '--directions', '16');
   const rand = makeRand(38);
   let total = 0;
   for (const withMasks of [false, true]) {
-    const planes = randomPlanes(z.grid, rand);
+    const planes = randomPlanes(z.grid, rand, { pRegion: 0.3 });
     const validity = withMasks ? Uint8Array.from({ length: count }, () => (rand() < 0.25 ? 0 : 1)) : null;
     const visibility = withMasks ? Uint8Array.from({ length: count }, () => Math.floor(rand() * 256)) : null;
     const tag = withMasks ? 'planes_masks' : 'planes';
@@ -101,24 +105,40 @@ run('demo', '-o', W('demo'), '--directions', '16');
     const want = sampleC(zhpFile, pts);
     check(want.length === pts.length, `${tag}: the C sampler printed ${want.length} of ${pts.length} results`);
     const plain = withoutPlanes(v);
-    let mean = 0, worst = 0, differ = 0;
+    // The plugin's volume with its corner regions read as "no plane" (a reader without them).
+    const noRegions = v.planes.slice();
+    for (let g = 0; g < count; g++) if (isRegion(noRegions, 5 * g)) noRegions.set(NO_PLANE, 5 * g);
+    const planesOnly = new ZhcProbeVolume({ ...v, planes: noRegions });
+    let mean = 0, worst = 0, differ = 0, inRegion = 0, outRegion = 0, regionWorst = 0, regionDiffer = 0;
     for (const e of want) mean += (Math.abs(e[0]) + Math.abs(e[1]) + Math.abs(e[2])) / 3;
     mean /= want.length;
     pts.forEach(({ p, n }, i) => {
       const pg = runtime.zhcToGltfDir(p), ng = runtime.zhcToGltfDir(n);  // zhc (x, y, z) -> glTF (y, z, x)
       const got = v.irradianceAt(pg, ng);
       const base = plain.irradianceAt(pg, ng);
-      let d = false;
+      let d = false, e = 0;
       for (let k = 0; k < 3; k++) {
-        worst = Math.max(worst, Math.abs(got[k] - want[i][k]) / mean);
+        e = Math.max(e, Math.abs(got[k] - want[i][k]) / mean);
         if (Math.abs(got[k] - base[k]) > 1e-6 * mean) d = true;
       }
+      worst = Math.max(worst, e);
       if (d) differ++;
+      const ps = planeSideAt(z.grid, planes, p);  // the sample's cell entry on the .zhp (zhc axes)
+      if (ps && ps.region) {
+        if (ps.side) inRegion++;
+        else outRegion++;
+        regionWorst = Math.max(regionWorst, e);
+        const r = planesOnly.irradianceAt(pg, ng);
+        if (r.some((x, k) => Math.abs(x - got[k]) > 1e-6 * mean)) regionDiffer++;
+      }
     });
-    console.log(`plugin irradianceAt with planes${withMasks ? ' + validity + visibility' : ''} (${tag}.glb) vs C on the .zhp: ` +
-      `${pts.length} samples, mean ${mean.toPrecision(6)}, max error / mean ${worst.toExponential(2)}, ${differ} differ from the volume without planes`);
+    console.log(`plugin irradianceAt with planes and corner regions${withMasks ? ' + validity + visibility' : ''} (${tag}.glb) vs C on the .zhp: ` +
+      `${pts.length} samples, mean ${mean.toPrecision(6)}, max error / mean ${worst.toExponential(2)}, ${differ} differ from the volume without planes; ` +
+      `in region cells ${inRegion} inside / ${outRegion} outside (max error / mean ${regionWorst.toExponential(2)}), ${regionDiffer} differ from the regions read as "no plane"`);
     check(mean > 0 && worst <= 1e-6, `${tag}: plugin irradianceAt agrees with the C header within 1e-6 of the mean`);
     check(differ > pts.length / 4, `${tag}: the planes change the plugin's result (${differ} of ${pts.length})`);
+    check(inRegion >= 50 && outRegion >= 50, `${tag}: corner regions sampled on both sides (${inRegion} inside, ${outRegion} outside)`);
+    check(regionDiffer > (inRegion + outRegion) / 10, `${tag}: the corner regions change the plugin's result (${regionDiffer})`);
     total += pts.length;
   }
 }
@@ -219,6 +239,30 @@ run('demo', '-o', W('demo'), '--directions', '16');
     bad.set([254, 127, 0, 0], 4 * p);
     check(throwsWith(() => buildVolume(def, coeffs, null, null, null, bad, sides), new RegExp(`probe ${p} is the last along an axis`)),
       `refused: a plane on glTF probe ${p}, which starts no cell`);
+    // A corner region there (offset -32768 with bit 7 of planeSides), or bit 7 alone.
+    for (const [entry, what] of [[regionEntry([4, 9, 0], [0, 1, 0]), 'a corner region'], [[0, 0, 0x00, 0x80, 0x80], 'bit 7 of planeSides']]) {
+      const bq = quad.slice(), bs = sides.slice();
+      bq.set(entry.slice(0, 4), 4 * p);
+      bs[p] = entry[4];
+      check(throwsWith(() => buildVolume(def, coeffs, null, null, null, bq, bs), new RegExp(`probe ${p} is the last along an axis and starts no cell, but its corner region is set`)),
+        `refused: ${what} on glTF probe ${p}, which starts no cell`);
+    }
+  }
+  // A corner region on probe 0 (which starts a cell) is read as it stands; its reserved bits are refused.
+  {
+    const rq = quad.slice(), rs = sides.slice();
+    const entry = regionEntry([4, 9, 31], [0, 1, 1]);
+    rq.set(entry.slice(0, 4), 0);
+    rs[0] = entry[4];
+    const rv = buildVolume(def, coeffs, null, null, null, rq, rs);
+    check(sameBytes(rv.planes.subarray(0, 5), entry), 'buildVolume: a corner region on probe 0 is kept as it stands (glTF axes)');
+    for (const [b, bit] of [[1, 0x80], [4, 0x08], [4, 0x40]]) {
+      const bq = rq.slice(), bs = rs.slice();
+      if (b === 4) bs[0] |= bit;
+      else bq[b] |= bit;
+      check(throwsWith(() => buildVolume(def, coeffs, null, null, null, bq, bs), /probe 0's corner region sets reserved bits/),
+        `refused: a corner region with bit ${bit.toString(16)} of ${b === 4 ? 'planeSides' : `planes byte ${b}`} set`);
+    }
   }
   // Through the loader: planeSides removed from the hand-made asset.
   const b = fs.readFileSync(W('hand.glb'));
