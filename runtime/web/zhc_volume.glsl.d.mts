@@ -38,7 +38,7 @@ export interface ZhcCompactSource {
   shAxes?: 'zhc' | 'gltf';
   validity?: ArrayLike<number> | null;
   visibility?: ArrayLike<number> | null;
-  /** Cell planes, 5 bytes per probe in probe order. */
+  /** Cell planes, 5 bytes per probe in probe order (planes or corner regions, docs/runtime.md "Corner regions"). */
   planes?: ArrayLike<number> | null;
   /** The axes of the grid relative to the planes' normal code (default 'gltf'; a ZhpFile: 'zhc'). */
   planesAxes?: 'zhc' | 'gltf';

@@ -13,9 +13,10 @@
 // A grid with validity / visibility masks (a baked one) also gets its combined mask bytes
 // (valid ? visibility : 0) in an R8UI 3D texture, one texel per probe, and the masked, renormalised
 // weights of zhc_volume_sh3 (docs/runtime.md "Validity and visibility"); `masks: false` drops them.
-// A grid with cell planes gets them in an RG32UI 3D texture, one texel per probe (the plane of the
-// cell whose corner 0 is that probe: .x = bytes 0..3 little-endian, .y = byte 4), and the side test
-// of zhc_volume_sh3 (docs/runtime.md "Cell planes"); `planes: false` drops them.
+// A grid with cell planes gets them in an RG32UI 3D texture, one texel per probe (the plane or
+// corner region of the cell whose corner 0 is that probe: .x = bytes 0..3 little-endian, .y = byte
+// 4), and the side test of zhc_volume_sh3 (docs/runtime.md "Cell planes", "Corner regions");
+// `planes: false` drops them.
 //
 //   zhcVolumeGlsl({ encoding, params, normalAxes, masked, planes, planesAxes })   GLSL ES 3.00 chunk (zhc_irradiance's included):
 //     struct ZhcVolume { vec3 origin; vec3 spacing; vec3 counts; };
@@ -90,25 +91,45 @@ export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same', mask
 // : 0 at texel (x, y, z); corner b = (bx, by, bz) keeps its weight w_b when bit 7 - (bx + 2 by +
 // 4 bz) of its m is set, else 0; the kept weights are divided by their sum (summed over corners
 // 0..7 in order); when every corner is dropped the plain weights stay (zhc_volume_sh3's fallback).` : '') + (planes ? `
-// Cell planes (ZHC_VOLUME_PLANES): planeTex holds at texel i0 the plane of the cell whose corner 0
-// is probe i0: .x = ou | ov << 8 | offset << 16 (int16), .y = sides. Offset -32768: no plane.
-// Else side = (dot(n, p - c) - offset |spacing| / 65534 >= 0), n the decoded normal (zhcPlaneNormal;
-// n.yzx for ZHC_VOLUME_PLANE_AXES_GLTF), c = origin + (i0 + 0.5) spacing, and corner b keeps its
-// weight only when bit (bx + 2 by + 4 bz) of sides equals side${masked ? ' (and its mask bit is set)' : ''}; the kept weights
-// are divided by their sum as above, none kept: the plain weights.` : '');
+// Cell planes (ZHC_VOLUME_PLANES): planeTex holds at texel i0 the entry of the cell whose corner 0
+// is probe i0: .x = bytes 0..3 little-endian, .y = byte 4. A plane: .x = ou | ov << 8 | offset << 16
+// (int16), .y = sides; side = (dot(n, p - c) - offset |spacing| / 65534 >= 0), n the decoded normal
+// (zhcPlaneNormal; n.yzx for ZHC_VOLUME_PLANE_AXES_GLTF), c = origin + (i0 + 0.5) spacing. Offset
+// -32768 with bit 7 of .y clear: no plane. Offset -32768 with bit 7 set: a corner region
+// (docs/runtime.md "Corner regions"; its fields in the grid's axes): q_a = (.x >> 5a) & 31, d_a =
+// bit a of .y; side = 1 when along every axis with q_a > 0 (d_a ? s_a >= t_a : s_a < t_a), s_a =
+// (p_a - (origin_a + i0_a spacing_a)) 31, t_a = q_a spacing_a; sides = the corners k whose bit a is
+// d_a along every such axis. Corner b keeps its weight only when bit (bx + 2 by + 4 bz) of sides
+// equals side${masked ? ' (and its mask bit is set)' : ''}; the kept weights are divided by their sum as above, none kept: the
+// plain weights.` : '');
   const planeSide = planes ? `
-  // The cell's plane (1 fetch): which side of it p lies on.
+  // The cell's plane or corner region (1 fetch): which side of it p lies on, and the corners' sides.
   uvec2 pe = texelFetch(planeTex, i0, 0).xy;
   int planeOffset = int(pe.x >> 16u) - (pe.x >= 0x80000000u ? 65536 : 0);
-  bool hasPlane = planeOffset != -32768;
-  uint side = 0u;
-  if (hasPlane) {
+  bool hasPlane = planeOffset != -32768 || (pe.y & 0x80u) != 0u;
+  uint side = 0u, sides = pe.y;
+  if (planeOffset != -32768) {
     vec3 pn = zhcPlaneNormal(pe.x & 255u, (pe.x >> 8u) & 255u);
 #ifdef ZHC_VOLUME_PLANE_AXES_GLTF
     pn = pn.yzx;  // the code is in zhc axes, the grid in glTF axes: glTF (x, y, z) = zhc (y, z, x)
 #endif
     vec3 c = v.origin + (vec3(i0) + 0.5) * v.spacing;
     side = dot(pn, p - c) - float(planeOffset) * (length(v.spacing) / 65534.0) >= 0.0 ? 1u : 0u;
+  } else if (hasPlane) {
+    // A corner region: per axis a threshold q_a (0: unbounded) and a direction d_a.
+    uvec3 rq = (uvec3(pe.x) >> uvec3(0u, 5u, 10u)) & 31u;
+    bvec3 rd = notEqual((uvec3(pe.y) >> uvec3(0u, 1u, 2u)) & 1u, uvec3(0u));
+    vec3 rs = (p - (v.origin + vec3(i0) * v.spacing)) * 31.0;  // the point in 31ths of the cell
+    vec3 rt = vec3(rq) * v.spacing;
+    bvec3 bounded = notEqual(rq, uvec3(0u));
+    bvec3 above = greaterThanEqual(rs, rt), below = lessThan(rs, rt);
+    bvec3 inAxis = bvec3(!bounded.x || (rd.x ? above.x : below.x), !bounded.y || (rd.y ? above.y : below.y),
+                         !bounded.z || (rd.z ? above.z : below.z));
+    side = all(inAxis) ? 1u : 0u;
+    sides = 0xFFu;  // the corners inside: along a bounded axis those whose bit a is d_a (bit a set: 0xAA, 0xCC, 0xF0)
+    if (bounded.x) sides &= rd.x ? 0xAAu : 0x55u;
+    if (bounded.y) sides &= rd.y ? 0xCCu : 0x33u;
+    if (bounded.z) sides &= rd.z ? 0xF0u : 0x0Fu;
   }` : '';
   const maskWeights = kept ? `${planeSide}
   // ${masked ? 'Masked' : 'Kept'} weights first${masked ? ' (8 mask fetches)' : ''}, then the blend below with w_b = m_b / sum.
@@ -120,7 +141,7 @@ export function zhcVolumeGlsl({ encoding, params = {}, normalAxes = 'same', mask
     float w = wv.x * wv.y * wv.z;
     wm[corner] = 0.0;
     if (w == 0.0) continue;  // also every corner beyond a count-1 axis: not fetched${planes ? `
-    if (hasPlane && ((pe.y >> uint(corner)) & 1u) != side) continue;  // the other side of the plane` : ''}${masked ? `
+    if (hasPlane && ((sides >> uint(corner)) & 1u) != side) continue;  // the other side of the plane / region` : ''}${masked ? `
     uint m = texelFetch(maskTex, i0 + b, 0).r;` : ''}
     ${masked ? 'if (((m >> uint(7 - corner)) & 1u) != 0u) ' : ''}wm[corner] = w;
     sum += wm[corner];
@@ -277,7 +298,8 @@ export function compactVolumeMask(validity, visibility, count) {
 
 // The plane texels of a grid (docs/runtime.md "Cell planes": what reaches the GPU):
 // Uint32Array(2 count), probe p's texel (.x, .y) = (bytes 0..3 of its entry little-endian, byte 4);
-// null when planes are absent or every entry is "no plane" (offset -32768: nothing to apply).
+// null when planes are absent or every entry is "no plane" (offset -32768 and bit 7 of byte 4
+// clear: nothing to apply).
 function compactVolumePlanes(planes, count) {
   if (!planes) return null;
   if (planes.length < 5 * count) throw new Error(`zhc compact volume: planes has ${planes.length} bytes for ${count} probes (5 per probe)`);
@@ -287,7 +309,7 @@ function compactVolumePlanes(planes, count) {
     const e = 5 * p;
     out[2 * p] = (planes[e] | (planes[e + 1] << 8) | (planes[e + 2] << 16) | (planes[e + 3] << 24)) >>> 0;
     out[2 * p + 1] = planes[e + 4];
-    if (!(planes[e + 2] === 0x00 && planes[e + 3] === 0x80)) any = true;
+    if (!(planes[e + 2] === 0x00 && planes[e + 3] === 0x80) || (planes[e + 4] & 0x80)) any = true;  // a plane or a corner region
   }
   return any ? out : null;
 }

@@ -13,14 +13,19 @@
 //     plain weights); a hand-made 4x3x2 zh3_q16 grid whose first probe column is black, an axis
 //     plane in the cells of its first cell column (the "wall") and an oblique one in the third
 //     (.zhp; the same with random validity and visibility; and in glTF axes as a compact source:
-//     grid, probe order and sides bits permuted, planesAxes 'gltf');
+//     grid, probe order and sides bits permuted, planesAxes 'gltf'); the same probes with corner
+//     regions (docs/runtime.md "Corner regions"): cell column 0 the region x < -1 + 11/31 holding
+//     the black corners, cell column 1 random regions, cell column 2 the oblique plane and a region
+//     bounded along all three axes (.zhp, with masks, and in glTF axes with the regions' fields
+//     permuted), at least 4 samples inside and 4 outside a region in its cell;
 //  2. 24 samples per volume: 20 points q random inside the grid's box, 4 outside it (clamped),
 //     random unit directions d, in the volume's frame (glb / glTF source: node-local glTF axes;
 //     .zhp: zhc axes); on grids with masks or planes no coordinate within 1e-3 of a cell face (a
 //     masked blend is not continuous across cell faces, so float32 and double could pick different
-//     cells there) and no point within 1e-4 |spacing| of its cell's plane (float32 and double may
-//     put such a point on different sides); the two rooms and the hand-made grid: 10 of the 20 in
-//     the dark region (in the cells the wall crosses, on its dark side);
+//     cells there) and no point within 1e-4 |spacing| of its cell's plane or of a bounding plane of
+//     its cell's corner region (float32 and double may put such a point on different sides); the
+//     two rooms and the hand-made grids: 10 of the 20 in the dark region (in the cells the wall or
+//     the black corners' region crosses, on its dark side);
 //  3. headless Chromium (SwiftShader WebGL2) runs tests/js/browser/three_compact_page.mjs: the stored
 //     bytes in an RGBA32UI Data3DTexture (compactVolume), (A) a ShaderMaterial writing
 //     zhcVolumeIrradiance per sample, (B) white spheres with a MeshLambertMaterial patched by
@@ -32,7 +37,8 @@
 //     header's doubles in the same order, bit for bit: js.runtime_volume), and in the fully masked
 //     cells the plain C header, bit for bit;
 //  5. masks and planes: compactVolume's combined mask texture and RG32UI plane texture against
-//     twins (glTF volumes: the .zhp's bytes with probe order and bits permuted to glTF), the chunk
+//     twins (glTF volumes: the .zhp's bytes with probe order, bits and region fields permuted to
+//     glTF; entries that are all corner regions get the texture too), the chunk
 //     defines ZHC_VOLUME_PLANES (and ZHC_VOLUME_PLANE_AXES_GLTF for glTF volumes) exactly when the
 //     volume has planes, the leak data move the C header's E beyond the tolerance at >= 4 samples
 //     of the baked and hand-made grids (ignoring them would fail); in the dark regions the C header
@@ -61,7 +67,8 @@ import { fileURLToPath } from 'node:url';
 import { makeRand, checker, freshWork, repoRoot } from './fixtures.mjs';
 import { chromiumPages } from './chromium_page.mjs';
 import { parseZhp, decodeAll, makeVolume, volumeIrradiance, crc32, kY00, kY1, kY20 } from '../../runtime/web/zhc_runtime.mjs';
-import { zhpWithPlanes, encodeNormal, decodeNormal, planeEntry, planesSection, planeMargin, planeSideAt, gltfProbeOrder, gltfBits, gltfPlanes } from './planes_fixtures.mjs';
+import { zhpWithPlanes, encodeNormal, decodeNormal, planeEntry, planesSection, planeMargin, planeSideAt, gltfProbeOrder, gltfBits, gltfPlanes,
+  regionEntry, isRegion } from './planes_fixtures.mjs';
 import { zhcVolumeGlsl, compactVolume, compactVolumeMask } from '../../runtime/web/zhc_volume.glsl.mjs';
 
 const [zhc, sampler, workArg, chromiumArg] = process.argv.slice(2);
@@ -151,12 +158,28 @@ const HAND_WALL = -0.65;
   const validity = Uint8Array.from({ length: count }, () => (mr() < 0.15 ? 0 : 1));
   const visibility = Uint8Array.from({ length: count }, () => { let m = 0; for (let j = 0; j < 8; j++) if (mr() >= 0.25) m |= 1 << j; return m; });
   fs.writeFileSync(W('hand_all.zhp'), zhpWithPlanes(v1, { validity, visibility, planes }, crc32));
+  // Corner regions (docs/runtime.md "Corner regions") on the same probes: cell column 0, the region
+  // x < -1 + 11/31 (q = (11, 0, 0), d = 0: the black corners inside it, the "wall" at HAND_REGION_WALL);
+  // cell column 1, random regions (some axes unbounded); cell column 2, the oblique plane at y = 0
+  // and a region bounded on all three axes (d = (1, 0, 1)) at y = 1.
+  const rr = makeRand(78);
+  const regions = planesSection(handGrid, (i0) => {
+    if (i0[0] === 0) return regionEntry([11, 0, 0], [0, 0, 0]);
+    if (i0[0] === 1) return regionEntry([0, 1, 2].map(() => (rr() < 0.25 ? 0 : 1 + Math.floor(rr() * 31))), [0, 1, 2].map(() => (rr() < 0.5 ? 0 : 1)));
+    if (i0[1] === 1) return regionEntry([20, 15, 10], [1, 0, 1]);
+    const n = decodeNormal(...oblique), c = [0, 1, 2].map((a) => handGrid.origin[a] + (i0[a] + 0.5) * handGrid.spacing[a]);
+    return planeEntry(handGrid, i0, oblique, c.map((x, a) => x + 0.1 * n[a]));
+  });
+  fs.writeFileSync(W('hand_regions.zhp'), zhpWithPlanes(v1, { planes: regions }, crc32));
+  fs.writeFileSync(W('hand_regions_all.zhp'), zhpWithPlanes(v1, { validity, visibility, planes: regions }, crc32));
 }
+const HAND_REGION_WALL = handGrid.origin[0] + 11 * handGrid.spacing[0] / 31;
 
 // What the GPU applies, in zhc axes: `leak` = the volume's validity / visibility / planes (null each
 // when absent or dropped); derived from the data, not assumed.
 const hasMasks = (z) => (compactVolumeMask(z.validity, z.visibility, z.count) ?? []).some((m) => m !== 0xFF);
-const hasPlanes = (z) => !!z.planes && Array.from({ length: z.count }, (_, i) => !(z.planes[5 * i + 2] === 0 && z.planes[5 * i + 3] === 0x80)).some((x) => x);
+const hasPlanes = (z) => !!z.planes && Array.from({ length: z.count }, (_, i) => !(z.planes[5 * i + 2] === 0 && z.planes[5 * i + 3] === 0x80) ||
+  isRegion(z.planes, 5 * i)).some((x) => x);
 // The demo's grids carry a few leak data near its occluders (`fewLeakData`: they need not move E
 // at 4 of the samples there). `dark`: [axis, lo, hi] of the dark region in zhc axes; `blackProbes`:
 // some probes are black, so E may be 0 (and then the GPU pixels must be 0 too).
@@ -175,6 +198,9 @@ const volumes = [
   { name: 'hand-made planes (.zhp)', zhp: 'hand_planes.zhp', ref: W('hand_planes.zhp'), gltf: false, requirePlanes: true, blackProbes: true, dark: [0, -1, HAND_WALL], rootTranslation: [0.2, -0.3, 0.6], rootScale: 1.4, seed: 32 },
   { name: 'hand-made planes + masks (.zhp)', zhp: 'hand_all.zhp', ref: W('hand_all.zhp'), gltf: false, requirePlanes: true, blackProbes: true, rootTranslation: [-0.4, 0.1, 0.3], rootScale: 1.1, seed: 33 },
   { name: 'hand-made planes in glTF axes (source)', source: 'hand_planes.zhp', ref: W('hand_planes.zhp'), gltf: true, requirePlanes: true, blackProbes: true, dark: [0, -1, HAND_WALL], rootTranslation: [0.5, 0.2, -0.8], rootScale: 0.9, seed: 34 },
+  { name: 'hand-made corner regions (.zhp)', zhp: 'hand_regions.zhp', ref: W('hand_regions.zhp'), gltf: false, requirePlanes: true, regions: true, blackProbes: true, dark: [0, -1, HAND_REGION_WALL], rootTranslation: [-0.3, 0.4, 0.2], rootScale: 1.2, seed: 35 },
+  { name: 'hand-made corner regions + masks (.zhp)', zhp: 'hand_regions_all.zhp', ref: W('hand_regions_all.zhp'), gltf: false, requirePlanes: true, regions: true, blackProbes: true, rootTranslation: [0.6, -0.2, -0.4], rootScale: 0.8, seed: 36 },
+  { name: 'hand-made corner regions in glTF axes (source)', source: 'hand_regions.zhp', ref: W('hand_regions.zhp'), gltf: true, requirePlanes: true, regions: true, blackProbes: true, dark: [0, -1, HAND_REGION_WALL], rootTranslation: [0.1, -0.6, 0.7], rootScale: 1.3, seed: 37 },
 ];
 const toZhc = (v) => [v[2], v[0], v[1]];  // glTF (x, y, z) = zhc (y, z, x)
 const SAMPLES = 24, OUTSIDE = 4, DARK = 10;
@@ -249,6 +275,16 @@ for (const v of volumes) {
     const d = [r * Math.cos(phi), r * Math.sin(phi), zz];
     const len = Math.hypot(...d);
     v.samples.push({ q, d: d.map((x) => f32(x / len)) });
+  }
+  if (v.regions) {
+    // Samples in corner region cells, inside and outside the region (planes_fixtures' twin of the rule).
+    v.regionSides = [0, 0];
+    for (const { q } of v.samples) {
+      const ps = planeSideAt(g, z.planes, zhcOf(q));
+      if (ps && ps.region) v.regionSides[ps.side]++;
+    }
+    console.log(`${v.name}: ${v.regionSides[1]} samples inside a corner region, ${v.regionSides[0]} outside one in its cell`);
+    check(v.regionSides[1] >= 4 && v.regionSides[0] >= 4, `${v.name}: samples on both sides of corner regions (${v.regionSides[1]} inside, ${v.regionSides[0]} outside; >= 4 each)`);
   }
 }
 fs.writeFileSync(W('three_compact_spec.json'), JSON.stringify({
@@ -348,6 +384,10 @@ const throws = (fn, re) => { try { fn(); return false; } catch (e) { return re.t
   check(!cpOff.planed && cpOff.planeData === null && cpOff.glsl === cpNone.glsl && cpOff.gpuBytes === 16 * h.count && cpOff.gpuBytesPerProbe === 16,
     'planes: false gives the chunk and bytes of a grid without planes');
   check(!cpNoPlane.planed && cpNoPlane.glsl === cpNone.glsl, 'planes whose entries are all "no plane" give the plain chunk');
+  const onlyRegions = planesSection(h.grid, () => regionEntry([3, 0, 0], [1, 0, 0]));
+  const cpRegions = compactVolume({ ...h, planes: onlyRegions });
+  check(cpRegions.planed && cpRegions.glsl === cp.glsl && cpRegions.planeData[1] === 0x81 && cpRegions.planeData[0] === 0x80000003,
+    'entries that are all corner regions (offset -32768, bit 7 set) get the planes chunk and texture');
   const wordsOk = (data, planes) => Array.from({ length: planes.length / 5 }, (_, p) =>
     data[2 * p] === ((planes[5 * p] | (planes[5 * p + 1] << 8) | (planes[5 * p + 2] << 16) | (planes[5 * p + 3] << 24)) >>> 0) &&
     data[2 * p + 1] === planes[5 * p + 4]).every((x) => x);
@@ -468,10 +508,12 @@ for (const r of report.volumes ?? []) {
   const bitsOf = v.gltf ? gltfBits : (m) => m;
   if (v.planed) {
     check(r.planeSize[0] === nx && r.planeSize[1] === ny && r.planeSize[2] === nz, `${r.name}: plane texture ${r.planeSize.join('x')} = nx x ny x nz`);
-    const e = v.leak.planes;
-    const want = order.flatMap((p) => [(e[5 * p] | (e[5 * p + 1] << 8) | (e[5 * p + 2] << 16) | (e[5 * p + 3] << 24)) >>> 0, bitsOf(e[5 * p + 4])]);
+    // glTF volumes: the entries in glTF probe order, sides bits and corner regions' fields in glTF axes.
+    const e = v.gltf ? gltfPlanes(z.grid.counts, v.leak.planes) : v.leak.planes;
+    const want = Array.from({ length: z.count }, (_, g) =>
+      [(e[5 * g] | (e[5 * g + 1] << 8) | (e[5 * g + 2] << 16) | (e[5 * g + 3] << 24)) >>> 0, e[5 * g + 4]]).flat();
     check(r.planeData.length === want.length && r.planeData.every((x, i) => x === want[i]),
-      `${r.name}: the plane texture holds (bytes 0..3, sides) per probe${v.gltf ? ' (glTF probe order and sides bits)' : ''}`);
+      `${r.name}: the plane texture holds (bytes 0..3, byte 4) per probe${v.gltf ? ' (glTF probe order, sides bits and region fields)' : ''}`);
   }
   if (v.masked) {
     check(r.maskSize[0] === nx && r.maskSize[1] === ny && r.maskSize[2] === nz, `${r.name}: mask texture ${r.maskSize.join('x')} = nx x ny x nz`);
