@@ -379,8 +379,9 @@ inline std::vector<double> truth_of(const LeakScene& ls) {
 // Two bakes of one scene: every probe at its grid point (occlusion.move_probes false, visibility
 // masks traced), written without leak data (plain) and with validity + masks; and the default bake
 // (probes kept out of walls, codec/bake/leak_planes.h) with validity + planes, as `zhc bake`
-// writes it. shadow_planes false: the planes follow geometry only (occlusion.shadow_planes; the
-// candidate study's scheme, tests/leak_candidates.h).
+// writes it. shadow_planes false: one plane per cell that follows geometry only
+// (occlusion.shadow_planes and occlusion.corner_regions false: the candidate study's scheme,
+// tests/leak_candidates.h).
 struct Baked {
     std::vector<Sh3Radiance> probes;  // at the grid points
     ProbeLeakData leak;
@@ -424,7 +425,8 @@ inline Baked bake_volumes(const LeakScene& ls, int threads = 1, bool shadow_plan
     BakeOptions def;
     def.threads = threads;
     Scene defaults = ls.scene;
-    defaults.occlusion.shadow_planes = shadow_planes;
+    defaults.occlusion.shadow_planes = shadow_planes && ls.scene.occlusion.shadow_planes;
+    defaults.occlusion.corner_regions = shadow_planes && ls.scene.occlusion.corner_regions;
     auto moved = bake_scene(defaults, def, &b.planes_report, &b.planes_leak);
     if (!moved) {
         b.error = ls.name + ": " + moved.error().message;

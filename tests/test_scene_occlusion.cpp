@@ -623,7 +623,7 @@ TEST(SkyOcclusionCli, KeysFlagsReportAndErrors) {
     EXPECT_NE(run.out.find("probes kept out of walls: 16 in or near geometry at their grid points: 16 baked at a clear point nearby, "
                            "0 left inside geometry (invalid, dilated), 0 left near it;"),
               std::string::npos) << run.out;
-    EXPECT_NE(run.out.find("cell planes: 21 of 24 cells crossed by geometry or a shadow edge have a plane, 0 along a light's shadow edge (108 cells;"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("cell planes: 21 of 24 cells crossed by geometry or a shadow edge have a plane, 0 along a light's shadow edge, 0 of them corner regions (108 cells;"), std::string::npos) << run.out;
     EXPECT_NE(run.out.find("leak estimate: "), std::string::npos) << run.out;
     EXPECT_EQ(run.out.find("visibility masks:"), std::string::npos) << run.out;
     {
@@ -683,6 +683,16 @@ TEST(SkyOcclusionCli, KeysFlagsReportAndErrors) {
         EXPECT_NE(scene_json(*p).find("\"shadow_planes\": false"), std::string::npos) << scene_json(*p);
         p->occlusion.shadow_planes = true;
         EXPECT_EQ(scene_json(*p).find("shadow_planes"), std::string::npos);
+        // occlusion.corner_regions likewise.
+        const std::string off2 = R"({"version": 1, "probes": {"positions": [[0, 0, 0]]}, "occlusion": {"corner_regions": false}})";
+        auto q = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(off2.data()), off2.size()), "off.json", "");
+        ASSERT_TRUE(q.ok()) << q.error().message;
+        EXPECT_FALSE(q->occlusion.corner_regions);
+        EXPECT_NE(scene_json(*q).find("\"corner_regions\": false"), std::string::npos) << scene_json(*q);
+        const std::string bad3 = R"({"version": 1, "probes": {"positions": [[0, 0, 0]]}, "occlusion": {"corner_regions": 0}})";
+        auto nb3 = parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(bad3.data()), bad3.size()), "nb.json", "");
+        ASSERT_FALSE(nb3.ok());
+        EXPECT_NE(nb3.error().message.find("occlusion.corner_regions"), std::string::npos) << nb3.error().message;
     }
     const std::string typo = R"({"version": 1, "probes": {"positions": [[0, 0, 0]]}, "occlusion": {"sky_sample": 3}})";
     EXPECT_FALSE(parse_scene_json(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(typo.data()), typo.size()), "t.json", "").ok());

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <utility>
@@ -167,6 +168,85 @@ CellPlane best_plane(const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::
     return chosen;
 }
 
+// The pairs an entry (plane or corner region) predicts wrongly against `vis`, and of them those it
+// still blends (*leaking).
+std::uint64_t entry_wrong(const CellPlane& cp, const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z,
+                          const std::vector<Vec3>& pts, const std::vector<std::array<std::uint8_t, 8>>& vis, const bool cvalid[8],
+                          std::uint64_t* leaking) {
+    std::uint64_t wrong = 0;
+    *leaking = 0;
+    const std::uint8_t sides = cp.region() ? cell_region_corners(cp) : cp.sides;
+    for (size_t j = 0; j < pts.size(); ++j) {
+        const unsigned side = !cp.any() ? 0u
+                              : cp.region() ? (cell_region_inside(cp, g, x, y, z, pts[j]) ? 1u : 0u)
+                                            : (cell_plane_value(cp, g, x, y, z, pts[j]) >= 0 ? 1u : 0u);
+        for (int k = 0; k < 8; ++k) {
+            if (!cvalid[k]) continue;
+            const bool keep = !cp.any() || ((sides >> k) & 1u) == side, visible = vis[j][static_cast<size_t>(k)] != 0;
+            wrong += keep != visible;
+            *leaking += keep && !visible;
+        }
+    }
+    return wrong;
+}
+
+// The corner region (docs/runtime.md "Corner regions") predicting the fewest pairs of `vis` wrongly
+// among those that bound every axis of the cell (q = 0 only along a flat axis), so each holds one
+// corner (an enclosed pocket seen from its cells: a closed box's inside): per axis the thresholds (in
+// 31ths of the cell, quantised as stored) in the middle of a wall across it and at the hit points'
+// minimum, maximum, middle and median along it, the region grown from each of the 8 corners.
+// *wrong_out: its wrong pairs ("no entry", and its count, when none beats it).
+CellPlane best_region(const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z, const std::vector<Vec3>& hits,
+                      const std::vector<Vec3>& pts, const std::vector<std::array<std::uint8_t, 8>>& vis, const bool cvalid[8],
+                      std::uint64_t* wrong_out) {
+    CellPlane chosen;
+    std::uint64_t leaking = 0, best_wrong = entry_wrong(chosen, g, x, y, z, pts, vis, cvalid, &leaking);
+    std::array<std::vector<int>, 3> qs;
+    for (int a = 0; a < 3; ++a) {
+        std::vector<int>& qa = qs[static_cast<size_t>(a)];
+        qa = {};
+        if (g.counts[static_cast<size_t>(a)] < 2) {  // a flat axis bounds nothing
+            qa = {0};
+            continue;
+        }
+        if (hits.empty()) return chosen;
+        std::vector<int> q;
+        const double lo = g.origin[a] + double(a == 0 ? x : (a == 1 ? y : z)) * g.spacing[a];
+        // The middle of a wall across this axis first (ties keep the first candidate): the hits
+        // on a wall's two faces pile up at two coordinates, the two fullest bins of a histogram in
+        // quarters of a threshold step; the lattice of sample points cannot tell thresholds within
+        // the wall apart, and shading points on the wall's faces need it inside the wall.
+        std::array<int, 125> bins{};
+        for (const Vec3& h : hits) ++bins[static_cast<size_t>(std::clamp(int(std::floor((h[a] - lo) / g.spacing[a] * 124.0)), 0, 124))];
+        int b1 = 0, b2 = -1;
+        for (int b = 1; b < 125; ++b)
+            if (bins[static_cast<size_t>(b)] > bins[static_cast<size_t>(b1)]) b1 = b;
+        for (int b = 0; b < 125; ++b)
+            if (b != b1 && std::abs(b - b1) <= 16 && bins[static_cast<size_t>(b)] > 0 && (b2 < 0 || bins[static_cast<size_t>(b)] > bins[static_cast<size_t>(b2)]))
+                b2 = b;
+        const double mid = b2 < 0 ? (b1 + 0.5) / 124.0 : (0.5 * (b1 + b2) + 0.5) / 124.0;
+        qa.insert(qa.begin(), std::clamp(int(std::lround(mid * 31.0)), 1, 31));
+        for (const Vec3& h : hits) q.push_back(std::clamp(int(std::lround((h[a] - lo) / g.spacing[a] * 31.0)), 1, 31));
+        std::sort(q.begin(), q.end());
+        for (int v : {q.front(), q.back(), (q.front() + q.back()) / 2, q[q.size() / 2]})
+            if (std::find(qa.begin(), qa.end(), v) == qa.end()) qa.push_back(v);
+    }
+    for (int anchor = 0; anchor < 8; ++anchor)
+        for (int qx : qs[0])
+            for (int qy : qs[1])
+                for (int qz : qs[2]) {
+                    if (qx == 0 && qy == 0 && qz == 0) continue;  // a single flat cell: nothing to bound
+                    const CellPlane cp = cell_region(qx, qy, qz, anchor);
+                    const std::uint64_t wrong = entry_wrong(cp, g, x, y, z, pts, vis, cvalid, &leaking);
+                    if (wrong < best_wrong) {
+                        best_wrong = wrong;
+                        chosen = cp;
+                    }
+                }
+    *wrong_out = best_wrong;
+    return chosen;
+}
+
 // Does `q` receive the light's direct light (inside a spot's outer cone, its shadow ray unblocked)?
 bool receives(const OccluderBvh& bvh, const ShadowLight& l, Vec3 q, std::uint64_t* rays) {
     ++*rays;
@@ -230,8 +310,8 @@ bool split_at_shadow_edge(const OccluderBvh& bvh, std::span<const ShadowLight> l
 }
 
 CellFit fit_one_cell(const OccluderBvh& bvh, const ProbeGrid& g, const std::vector<Vec3>& baked,
-                     const std::vector<std::uint8_t>& valid, int lattice, std::span<const ShadowLight> lights, std::uint32_t x,
-                     std::uint32_t y, std::uint32_t z) {
+                     const std::vector<std::uint8_t>& valid, int lattice, std::span<const ShadowLight> lights, bool regions,
+                     std::uint32_t x, std::uint32_t y, std::uint32_t z) {
     CellFit out;
     const std::uint32_t base[3] = {x, y, z};
     Vec3 corner[8];
@@ -291,14 +371,35 @@ CellFit fit_one_cell(const OccluderBvh& bvh, const ProbeGrid& g, const std::vect
             const RayHit h2 = bvh.nearest(corner[k], -1.0 * d, kRayEpsilon, len - kRayEpsilon);
             if (h2.hit) hits.push_back(corner[k] - h2.t * d);
         }
+    const std::vector<std::array<std::uint8_t, 8>> vis_geometry = vis;  // blocked by geometry only
     std::vector<Vec3> edge;
     const bool shadowed = split_at_shadow_edge(bvh, lights, corner, cvalid, pts, vis, edge, &out.stats.rays) && !edge.empty();
     if (hits.empty() && !shadowed) return out;
     ++out.stats.crossed_cells;
     std::uint64_t blocked = 0, best_wrong = 0, best_leaking = 0;
     out.plane = best_plane(g, x, y, z, hits, edge, pts, vis, corner, cvalid, &blocked, &best_wrong, &best_leaking);
-    if (shadowed && out.plane.present()) ++out.stats.shadow_planes;
-    if (!out.plane.present()) {
+    // A corner region replaces the plane where geometry crosses the cell, the plane predicts over
+    // a tenth of the geometry-blocked pairs wrongly, and the region at most half as many (a closed
+    // box's inside: three faces around one corner), also when the cell holds a shadow edge too (light
+    // through walls first). A wall keeps its plane (which also moves probes towards it).
+    if (regions && !hits.empty()) {
+        std::uint64_t region_wrong = 0, unused = 0, blocked_geometry = 0;
+        for (size_t j = 0; j < pts.size(); ++j)
+            for (int k = 0; k < 8; ++k) blocked_geometry += cvalid[k] && vis_geometry[j][static_cast<size_t>(k)] == 0;
+        const std::uint64_t plane_wrong = entry_wrong(out.plane, g, x, y, z, pts, vis_geometry, cvalid, &unused);
+        const CellPlane region = 10 * plane_wrong > blocked_geometry ? best_region(g, x, y, z, hits, pts, vis_geometry, cvalid, &region_wrong)
+                                                                     : CellPlane{};
+        std::uint64_t region_leaking = 0;
+        const std::uint64_t region_all = region.region() ? entry_wrong(region, g, x, y, z, pts, vis, cvalid, &region_leaking) : 0;
+        if (region.region() && 2 * region_wrong <= plane_wrong) {
+            out.plane = region;
+            best_wrong = region_all;
+            best_leaking = region_leaking;
+        }
+    }
+    if (shadowed && out.plane.any()) ++out.stats.shadow_planes;
+    if (out.plane.region()) ++out.stats.regions;
+    if (!out.plane.any()) {
         out.stats.unresolved_pairs += blocked;
         return out;
     }
@@ -402,6 +503,41 @@ double cell_plane_value(const CellPlane& cp, const ProbeGrid& g, std::uint32_t x
     return s;
 }
 
+CellPlane cell_region(int qx, int qy, int qz, int anchor) {
+    CellPlane cp;
+    const unsigned r = unsigned(qx & 31) | unsigned(qy & 31) << 5 | unsigned(qz & 31) << 10;
+    cp.ou = static_cast<std::uint8_t>(r & 0xFFu);
+    cp.ov = static_cast<std::uint8_t>(r >> 8);
+    cp.offset = CellPlane::kNoPlane;
+    cp.sides = static_cast<std::uint8_t>(0x80u | (unsigned(anchor) & 7u));
+    return cp;
+}
+
+int cell_region_threshold(const CellPlane& cp, int a) { return int(((unsigned(cp.ou) | unsigned(cp.ov) << 8) >> (5 * a)) & 31u); }
+
+std::uint8_t cell_region_corners(const CellPlane& cp) {
+    std::uint8_t inside = 0xFF;
+    for (int a = 0; a < 3; ++a) {
+        if (cell_region_threshold(cp, a) == 0) continue;
+        const unsigned d = (cp.sides >> a) & 1u;
+        for (int k = 0; k < 8; ++k)
+            if (unsigned((k >> a) & 1) != d) inside = static_cast<std::uint8_t>(inside & ~(1u << k));
+    }
+    return inside;
+}
+
+bool cell_region_inside(const CellPlane& cp, const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z, Vec3 q) {
+    // The runtime's operations (zhc__volume_plane_side): one subtraction, one product, one comparison per axis.
+    const std::uint32_t i0[3] = {x, y, z};
+    for (int a = 0; a < 3; ++a) {
+        const int qa = cell_region_threshold(cp, a);
+        if (qa == 0) continue;
+        const double s_a = (q[a] - (g.origin[a] + double(i0[a]) * g.spacing[a])) * 31.0, t_a = double(qa) * g.spacing[a];
+        if (!(((cp.sides >> a) & 1u) ? s_a >= t_a : s_a < t_a)) return false;
+    }
+    return true;
+}
+
 std::vector<std::uint8_t> cell_planes_bytes(const std::vector<CellPlane>& planes) {
     std::vector<std::uint8_t> out(5 * planes.size());
     for (size_t i = 0; i < planes.size(); ++i) {
@@ -429,7 +565,7 @@ std::vector<CellPlane> cell_planes_from_bytes(const std::vector<std::uint8_t>& b
 std::vector<CellPlane> fit_cell_planes(const OccluderBvh& bvh, const ProbeGrid& g, const std::vector<Vec3>& baked,
                                        const std::vector<std::uint8_t>& valid, int lattice, int threads,
                                        PlaneFitStats* stats, std::vector<double>* wrong_fraction,
-                                       std::span<const ShadowLight> shadow_lights) {
+                                       std::span<const ShadowLight> shadow_lights, bool regions) {
     const std::size_t count = std::size_t(g.counts[0]) * g.counts[1] * g.counts[2];
     std::vector<CellPlane> out(count);
     std::vector<double> wrong(count, 0.0);
@@ -439,7 +575,7 @@ std::vector<CellPlane> fit_cell_planes(const OccluderBvh& bvh, const ProbeGrid& 
             for (size_t i = lo; i < hi; ++i) {
                 const std::uint32_t x = axis_index(i, g, 0), y = axis_index(i, g, 1), z = axis_index(i, g, 2);
                 if (!starts_cell(g, x, y, z)) continue;
-                const CellFit f = fit_one_cell(bvh, g, baked, valid, std::max(1, lattice), shadow_lights, x, y, z);
+                const CellFit f = fit_one_cell(bvh, g, baked, valid, std::max(1, lattice), shadow_lights, regions, x, y, z);
                 out[i] = f.plane;
                 wrong[i] = f.wrong_fraction;
                 per[i] = f.stats;
@@ -458,6 +594,7 @@ std::vector<CellPlane> fit_cell_planes(const OccluderBvh& bvh, const ProbeGrid& 
             stats->dropped_pairs += per[i].dropped_pairs;
             stats->unresolved_pairs += per[i].unresolved_pairs;
             stats->shadow_planes += per[i].shadow_planes;
+            stats->regions += per[i].regions;
             stats->rays += per[i].rays;
         }
     }
@@ -529,7 +666,9 @@ ProbeRelocation relocate_grid_probes(const OccluderBvh& bvh, const ProbeGrid& g,
 
     // Towards walls: the first fit with the probes where step 1 put them.
     std::vector<double> wrong;
-    const std::vector<CellPlane> first = fit_cell_planes(bvh, g, r.positions, r.valid, options.lattice, threads, &r.first_fit, &wrong);
+    // Planes only: relocation moves probes towards the walls planes describe.
+    const std::vector<CellPlane> first =
+        fit_cell_planes(bvh, g, r.positions, r.valid, options.lattice, threads, &r.first_fit, &wrong, {}, /*regions=*/false);
     r.rays += r.first_fit.rays;
     std::vector<Vec3> moved = r.positions;
     std::vector<std::uint8_t> did(count, 0);

@@ -22,7 +22,10 @@
 // the blocked segments' hit points seen from both ends, and per axis the axis-aligned planes at the
 // hits' minimum, maximum, middle and median) are quantised to the stored 5 bytes and scored by the
 // pairs whose visibility they predict wrongly (visible predicted = point and corner on the same
-// side); the best is kept when it predicts fewer pairs wrongly than no plane. Cells whose box (and
+// side); the best is kept when it predicts fewer pairs wrongly than no plane. Where the best plane
+// still predicts some pair wrongly, corner regions (docs/runtime.md "Corner regions") are scored
+// too (per axis the thresholds at the points' minimum, maximum, middle and median, or none, grown
+// from each of the 8 corners); one replaces the plane when it predicts fewer pairs wrongly. Cells whose box (and
 // their corners' baked positions) meets no occluder's bounds trace nothing and get no plane.
 //
 // Shadow planes: a cell where no (point, corner) segment is blocked, but the light of one of
@@ -56,7 +59,11 @@ struct CellPlane {
     std::uint8_t ou = 0, ov = 0;
     std::int16_t offset = kNoPlane;
     std::uint8_t sides = 0;
-    bool present() const { return offset != kNoPlane; }
+    bool present() const { return offset != kNoPlane; }  // a plane
+    // A corner region (docs/runtime.md "Corner regions"): offset kNoPlane, bit 7 of sides; the
+    // thresholds q_a = ((ou | ov << 8) >> 5a) & 31, the directions in bits 0-2 of sides.
+    bool region() const { return offset == kNoPlane && (sides & 0x80u) != 0; }
+    bool any() const { return present() || region(); }
 };
 
 // The unit normal of code (ou, ov), the same operations as runtime/zhc_runtime.h zhc_plane_normal
@@ -69,6 +76,14 @@ void encode_cell_plane_normal(Vec3 n, std::uint8_t* ou, std::uint8_t* ov);
 double cell_plane_unit(const ProbeGrid& g);
 // Centre of the cell whose corner 0 is probe (x, y, z).
 Vec3 cell_centre(const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z);
+// The corner region with thresholds (qx, qy, qz) (0..31; 0: the axis does not bound it) that holds
+// corner `anchor` (its direction bits are the anchor's coordinates).
+CellPlane cell_region(int qx, int qy, int qz, int anchor);
+// Threshold q_a of a region, the corners inside it (bit k), and whether q lies inside it, with the
+// runtime's operations (bit for bit).
+int cell_region_threshold(const CellPlane& cp, int a);
+std::uint8_t cell_region_corners(const CellPlane& cp);
+bool cell_region_inside(const CellPlane& cp, const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z, Vec3 q);
 // n . (q - c) - offset unit: >= 0 on the positive side. `cp` must be present().
 double cell_plane_value(const CellPlane& cp, const ProbeGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z, Vec3 q);
 // The unit eigenvector of the smallest eigenvalue of a symmetric 3x3 matrix (cyclic Jacobi
@@ -98,6 +113,8 @@ struct PlaneFitStats {
     // Of `planes`, those fitted with a light's shadow edge in the cell (pairs across it count as
     // blocked: in the counts above).
     std::uint64_t shadow_planes = 0;
+    // Of `planes`, the corner regions (a box's corner in the cell: three faces no plane separates).
+    std::uint64_t regions = 0;
     std::uint64_t rays = 0;
 };
 
@@ -112,14 +129,14 @@ struct ShadowLight {
     double intensity = 0;      // luminance of its intensity (point, spot) or irradiance (directional)
 };
 
-// The fit described above. `baked`: each probe's baked position; `valid`: its validity (invalid
+// The fit described above (`regions` false: planes only). `baked`: each probe's baked position; `valid`: its validity (invalid
 // corners are neither scored nor kept). Returns one entry per probe index (the cell whose corner 0
 // it is; the last probe of an axis gets none). `wrong_fraction`, when given: per entry the fraction
 // of the cell's blocked pairs its plane predicts wrongly (0 without a plane).
 std::vector<CellPlane> fit_cell_planes(const OccluderBvh& bvh, const ProbeGrid& g, const std::vector<Vec3>& baked,
                                        const std::vector<std::uint8_t>& valid, int lattice, int threads,
                                        PlaneFitStats* stats, std::vector<double>* wrong_fraction = nullptr,
-                                       std::span<const ShadowLight> shadow_lights = {});
+                                       std::span<const ShadowLight> shadow_lights = {}, bool regions = true);
 
 // Where each grid probe is baked (steps 1-3 above) and what the steps found.
 struct ProbeRelocation {

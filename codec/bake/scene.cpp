@@ -524,7 +524,7 @@ Result<std::vector<Sh3Radiance>> bake_with(const Scene& scene, const OccluderBvh
         }
         leak->planes = cell_planes_bytes(fit_cell_planes(bvh, layout.grid, positions, valid, placement.lattice,
                                                          std::max(1, options.threads), &plane_stats, nullptr,
-                                                         shadow_lights));
+                                                         shadow_lights, scene.occlusion.corner_regions));
         plane_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_plane).count();
     }
 

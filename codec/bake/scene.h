@@ -132,6 +132,9 @@ struct SceneOcclusion {
     // Grids: cells where a light's hard shadow edge passes between the corner probes get the plane
     // along that edge (codec/bake/leak_planes.h "Shadow planes"); false: planes follow geometry only.
     bool shadow_planes = true;
+    // Grids: cells around an enclosed pocket of air (a closed box's inside) get a corner region
+    // instead of a plane where it separates far better (leak_planes.h); false: planes only.
+    bool corner_regions = true;
 };
 // Visibility-mask rays per (probe, cell): the cell's centre and the 8 points centre +- spacing/4.
 constexpr int kMaskPoints = 9;

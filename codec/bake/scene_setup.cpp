@@ -231,9 +231,10 @@ std::vector<std::string> BakeReport::leak_lines() const {
         const std::uint64_t blocked = p.blocked_pairs + p.unresolved_pairs, leaking = p.leaking_pairs + p.unresolved_pairs;
         std::snprintf(buf, sizeof buf,
                       "cell planes: %llu of %llu cells crossed by geometry or a shadow edge have a plane, %llu along a light's shadow "
-                      "edge (%llu cells; %llu rays, %.3f ms)",
+                      "edge, %llu of them corner regions (%llu cells; %llu rays, %.3f ms)",
                       static_cast<unsigned long long>(p.planes), static_cast<unsigned long long>(p.crossed_cells),
-                      static_cast<unsigned long long>(p.shadow_planes), static_cast<unsigned long long>(p.cells),
+                      static_cast<unsigned long long>(p.shadow_planes), static_cast<unsigned long long>(p.regions),
+                      static_cast<unsigned long long>(p.cells),
                       static_cast<unsigned long long>(p.rays), plane_ms);
         out.push_back(buf);
         if (blocked > 0)

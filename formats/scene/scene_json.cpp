@@ -193,7 +193,7 @@ SceneSky read_sky(const Reader& r, const json& j) {
 
 SceneOcclusion read_occlusion(const Reader& r, const json& j) {
     const std::string p = "occlusion";
-    r.object(j, p, {"sky_samples", "invalid_fraction", "move_probes", "shadow_planes"});
+    r.object(j, p, {"sky_samples", "invalid_fraction", "move_probes", "shadow_planes", "corner_regions"});
     SceneOcclusion o;
     if (j.contains("sky_samples")) {
         const json& s = j["sky_samples"];
@@ -211,6 +211,7 @@ SceneOcclusion read_occlusion(const Reader& r, const json& j) {
     }
     if (j.contains("move_probes")) o.move_probes = r.boolean(j["move_probes"], p + ".move_probes");
     if (j.contains("shadow_planes")) o.shadow_planes = r.boolean(j["shadow_planes"], p + ".shadow_planes");
+    if (j.contains("corner_regions")) o.corner_regions = r.boolean(j["corner_regions"], p + ".corner_regions");
     return o;
 }
 
@@ -588,10 +589,12 @@ std::string scene_json(const Scene& s) {
     }
     const SceneOcclusion defaults;
     if (s.occlusion.sky_samples != defaults.sky_samples || s.occlusion.invalid_fraction != defaults.invalid_fraction ||
-        s.occlusion.move_probes != defaults.move_probes || s.occlusion.shadow_planes != defaults.shadow_planes) {
+        s.occlusion.move_probes != defaults.move_probes || s.occlusion.shadow_planes != defaults.shadow_planes ||
+        s.occlusion.corner_regions != defaults.corner_regions) {
         doc["occlusion"] = {{"sky_samples", s.occlusion.sky_samples}, {"invalid_fraction", s.occlusion.invalid_fraction}};
         if (s.occlusion.move_probes != defaults.move_probes) doc["occlusion"]["move_probes"] = s.occlusion.move_probes;
         if (s.occlusion.shadow_planes != defaults.shadow_planes) doc["occlusion"]["shadow_planes"] = s.occlusion.shadow_planes;
+        if (s.occlusion.corner_regions != defaults.corner_regions) doc["occlusion"]["corner_regions"] = s.occlusion.corner_regions;
     }
     json lights = json::array();
     for (const SceneLight& l : s.lights) {
