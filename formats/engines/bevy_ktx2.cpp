@@ -43,6 +43,7 @@
 
 #include "codec/probe/engine_layouts.h"
 #include "codec/probe/quantize.h"
+#include "formats/engines/engine_file_common.h"
 #include "formats/engines/engine_files.h"
 #include "formats/engines/ktx2_volume.h"
 #include "formats/io/json_depth.h"
@@ -53,6 +54,16 @@ namespace zhc {
 extern const EngineFile kBevyIrradianceVolumeFile;
 
 namespace {
+
+using engine_file_detail::AxisMap;
+using engine_file_detail::axis_map;
+using engine_file_detail::bad;
+using engine_file_detail::json_counts;
+using engine_file_detail::json_vec3;
+using engine_file_detail::near;
+using engine_file_detail::num;
+using engine_file_detail::parse_object;
+using engine_file_detail::vec_json;
 
 constexpr const char* kCodecName = "bevy_ambient_cube";
 constexpr const char* kVolumeKey = "zhc.volume";
@@ -72,28 +83,6 @@ struct BevyGrid {
     std::uint64_t voxels() const { return std::uint64_t(counts[0]) * counts[1] * counts[2]; }
 };
 
-// Bevy axis r is zhc axis col[r] times sign[r] (EngineLayoutInfo::axes is a signed permutation).
-struct AxisMap {
-    std::array<int, 3> col{};
-    std::array<int, 3> sign{};
-};
-AxisMap axis_map() {
-    const Mat3& a = find_engine_layout(kCodecName)->axes;
-    AxisMap m;
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-            if (a(r, c) != 0) {
-                m.col[static_cast<size_t>(r)] = c;
-                m.sign[static_cast<size_t>(r)] = a(r, c) > 0 ? 1 : -1;
-            }
-    return m;
-}
-
-std::string num(double v) {
-    char buf[64];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest text that reads back to v
-    return std::string(buf, r.ptr);
-}
 // Three values joined as "<open>a<sep>b<sep>c<close>" (appended piecewise: g++ 12 -O3 warns of a
 // false overlap in "[" + std::string).
 template <class T>
@@ -109,8 +98,6 @@ std::string join3(const std::array<T, 3>& v, const char* open, const char* sep, 
     s += close;
     return s;
 }
-std::string vec_json(const std::array<double, 3>& v) { return join3(v, "[", ",", "]"); }
-std::string counts_json(const std::array<std::uint32_t, 3>& n) { return join3(n, "[", ",", "]"); }
 
 // The entity's Transform: translation = the volume's centre, scale = its size.
 std::array<double, 3> translation_of(const BevyGrid& g) {
@@ -124,7 +111,6 @@ std::array<double, 3> scale_of(const BevyGrid& g) {
     return s;
 }
 
-Error bad(ErrorCode code, const std::string& name, const std::string& what) { return make_error(code, name + ": " + what); }
 
 // Zhc's probe index <-> Bevy's voxel (x, y, z).
 std::array<std::uint64_t, 3> voxel_of(std::uint64_t i, const ProbeGrid& zg, const BevyGrid& g, const AxisMap& m) {
@@ -177,7 +163,7 @@ Result<EngineFileOutput> bevy_write(const EngineFileInput& in) {
     if (!in.validity.empty() && in.validity.size() != count)
         return bad(ErrorCode::kInvalidArgument, name, "validity must be empty or one byte per probe");
 
-    const AxisMap m = axis_map();
+    const AxisMap m = axis_map(kCodecName);
     BevyGrid g;
     for (size_t r = 0; r < 3; ++r) {
         const int c = m.col[r];
@@ -219,8 +205,8 @@ Result<EngineFileOutput> bevy_write(const EngineFileInput& in) {
     }
     const auto t = translation_of(g), s = scale_of(g);
     const std::string volume = "{\"origin\":" + vec_json(g.origin) + ",\"spacing\":" + vec_json(g.spacing) +
-                               ",\"counts\":" + counts_json(g.counts) + "}";
-    const std::string bevy = "{\"translation\":" + vec_json(t) + ",\"scale\":" + vec_json(s) + ",\"resolution\":" + counts_json(g.counts) + "}";
+                               ",\"counts\":" + vec_json(g.counts) + "}";
+    const std::string bevy = "{\"translation\":" + vec_json(t) + ",\"scale\":" + vec_json(s) + ",\"resolution\":" + vec_json(g.counts) + "}";
     tex.key_values = {{kVolumeKey, std::vector<std::uint8_t>(volume.begin(), volume.end())},
                       {kBevyKey, std::vector<std::uint8_t>(bevy.begin(), bevy.end())}};
     auto bytes = encode_ktx2_texture(tex);
@@ -248,39 +234,12 @@ Result<EngineFileOutput> bevy_write(const EngineFileInput& in) {
 
 // ---- reading ---------------------------------------------------------------------------------
 
-Result<std::array<double, 3>> json_vec3(const nlohmann::json& j, const char* key, const std::string& where) {
-    const auto it = j.find(key);
-    const std::string msg = std::string("\"") + key + "\" must be an array of 3 numbers";
-    if (it == j.end() || !it->is_array() || it->size() != 3) return bad(ErrorCode::kBadFormat, where, msg);
-    std::array<double, 3> v{};
-    for (size_t i = 0; i < 3; ++i) {
-        if (!(*it)[i].is_number()) return bad(ErrorCode::kBadFormat, where, msg);
-        v[i] = (*it)[i].get<double>();
-        if (!std::isfinite(v[i])) return bad(ErrorCode::kInvalidValue, where, std::string("\"") + key + "\" is not finite");
-    }
-    return v;
-}
-Result<std::array<std::uint32_t, 3>> json_counts(const nlohmann::json& j, const char* key, const std::string& where) {
-    const auto it = j.find(key);
-    const std::string msg = std::string("\"") + key + "\" must be 3 integers in 1..65535";
-    if (it == j.end() || !it->is_array() || it->size() != 3) return bad(ErrorCode::kBadFormat, where, msg);
-    std::array<std::uint32_t, 3> n{};
-    for (size_t i = 0; i < 3; ++i) {
-        const auto& e = (*it)[i];
-        if (!e.is_number_integer() || e.get<std::int64_t>() < 1 || e.get<std::int64_t>() > 65535) return bad(ErrorCode::kBadFormat, where, msg);
-        n[i] = static_cast<std::uint32_t>(e.get<std::int64_t>());
-    }
-    return n;
-}
-Result<nlohmann::json> parse_object(const std::vector<std::uint8_t>& value, const std::string& where) {
+// A key's value as a JSON object (a NUL-terminated value, which KTX2 3.11 allows, too).
+Result<nlohmann::json> parse_value(const std::vector<std::uint8_t>& value, const std::string& where) {
     std::string text(value.begin(), value.end());
-    if (!text.empty() && text.back() == '\0') text.pop_back();  // a NUL-terminated value (KTX2 3.11 allows it)
-    if (Status s = check_json_depth(std::string_view(text), where); !s) return s.error();
-    nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-    if (j.is_discarded() || !j.is_object()) return bad(ErrorCode::kBadFormat, where, "not a JSON object");
-    return j;
+    if (!text.empty() && text.back() == '\0') text.pop_back();
+    return parse_object(text, where);
 }
-bool near(double a, double b, double scale) { return std::fabs(a - b) <= 1e-6 * scale; }
 
 // The grid of a volume of resolution `res` from the file's keys (either or both; they must agree),
 // or the unit cube centred at the origin.
@@ -296,7 +255,7 @@ Result<BevyGrid> grid_from_keys(const Ktx2Texture& t, const std::array<std::uint
     const std::string dims = join3(res, "(", ", ", ")");
     if (volume) {
         const std::string where = name + ": " + kVolumeKey;
-        auto j = parse_object(volume->value, where);
+        auto j = parse_value(volume->value, where);
         if (!j) return j.error();
         auto origin = json_vec3(*j, "origin", where);
         if (!origin) return origin.error();
@@ -313,7 +272,7 @@ Result<BevyGrid> grid_from_keys(const Ktx2Texture& t, const std::array<std::uint
     }
     if (bevy) {
         const std::string where = name + ": " + kBevyKey;
-        auto j = parse_object(bevy->value, where);
+        auto j = parse_value(bevy->value, where);
         if (!j) return j.error();
         auto translation = json_vec3(*j, "translation", where);
         if (!translation) return translation.error();
@@ -414,7 +373,7 @@ Result<EngineFileProbes> bevy_read(std::span<const std::uint8_t> bytes, const st
                 basis[static_cast<size_t>(f)][static_cast<size_t>(c)] = decode_probe(*codec, CodecOptions{}, unit);
             }
     }
-    const AxisMap m = axis_map();
+    const AxisMap m = axis_map(kCodecName);
     ProbeGrid zg;
     for (size_t r = 0; r < 3; ++r) {
         const size_t c = static_cast<size_t>(m.col[r]);

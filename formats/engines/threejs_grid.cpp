@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "codec/probe/engine_layouts.h"
+#include "formats/engines/engine_file_common.h"
 #include "formats/engines/engine_files.h"
 #include "formats/engines/ktx2_volume.h"
 #include "formats/io/exr_memory.h"
@@ -53,6 +54,16 @@ extern const EngineFile kThreejsGridExrFile;
 extern const EngineFile kThreejsGridKtx2File;
 
 namespace {
+
+using engine_file_detail::AxisMap;
+using engine_file_detail::axis_map;
+using engine_file_detail::bad;
+using engine_file_detail::json_counts;
+using engine_file_detail::json_vec3;
+using engine_file_detail::near;
+using engine_file_detail::num;
+using engine_file_detail::parse_object;
+using engine_file_detail::vec_json;
 
 constexpr const char* kVolumeKey = "zhc.volume";
 constexpr const char* kThreeKey = "threejs.LightProbeGrid";
@@ -69,37 +80,6 @@ struct ThreeGrid {
     std::uint64_t texels() const { return std::uint64_t(counts[0]) * counts[1] * depth(); }
 };
 
-// three.js axis r is zhc axis col[r] times sign[r] (a signed permutation).
-struct AxisMap {
-    std::array<int, 3> col{};
-    std::array<int, 3> sign{};
-};
-AxisMap axis_map(std::string_view codec_name) {
-    const Mat3& a = find_engine_layout(codec_name)->axes;
-    AxisMap m;
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-            if (a(r, c) != 0) {
-                m.col[static_cast<size_t>(r)] = c;
-                m.sign[static_cast<size_t>(r)] = a(r, c) > 0 ? 1 : -1;
-            }
-    return m;
-}
-
-std::string num(double v) {
-    char buf[64];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest text that reads back to v
-    return std::string(buf, r.ptr);
-}
-std::string vec_json(const std::array<double, 3>& v) {
-    std::string out = "[";
-    for (size_t i = 0; i < 3; ++i) {
-        if (i) out += ',';
-        out += num(v[i]);
-    }
-    out += ']';
-    return out;
-}
 
 std::array<double, 3> position_of(const ThreeGrid& g) {
     std::array<double, 3> p{};
@@ -128,43 +108,7 @@ std::string three_json(const ThreeGrid& g) {
            "],\"boundingBox\":{\"min\":" + vec_json(lo) + ",\"max\":" + vec_json(hi) + "}}";
 }
 
-Error bad(ErrorCode code, const std::string& name, const std::string& what) { return make_error(code, name + ": " + what); }
-
-// ---- JSON bounds -----------------------------------------------------------------------------
-
-Result<std::array<double, 3>> json_vec3(const nlohmann::json& j, const char* key, const std::string& where) {
-    const auto it = j.find(key);
-    if (it == j.end() || !it->is_array() || it->size() != 3)
-        return make_error(ErrorCode::kBadFormat, where + ": \"" + key + "\" must be an array of 3 numbers");
-    std::array<double, 3> v{};
-    for (size_t i = 0; i < 3; ++i) {
-        if (!(*it)[i].is_number()) return make_error(ErrorCode::kBadFormat, where + ": \"" + key + "\" must be an array of 3 numbers");
-        v[i] = (*it)[i].get<double>();
-        if (!std::isfinite(v[i])) return make_error(ErrorCode::kInvalidValue, where + ": \"" + key + "\" is not finite");
-    }
-    return v;
-}
-Result<std::array<std::uint32_t, 3>> json_counts(const nlohmann::json& j, const char* key, const std::string& where) {
-    const auto it = j.find(key);
-    std::array<std::uint32_t, 3> n{};
-    const bool shape = it != j.end() && it->is_array() && it->size() == 3;
-    for (size_t i = 0; shape && i < 3; ++i) {
-        const auto& e = (*it)[i];
-        if (!e.is_number_integer() || e.get<std::int64_t>() < 1 || e.get<std::int64_t>() > 65535)
-            return make_error(ErrorCode::kBadFormat, where + ": \"" + key + "\" must be 3 integers in 1..65535");
-        n[i] = static_cast<std::uint32_t>(e.get<std::int64_t>());
-    }
-    if (!shape) return make_error(ErrorCode::kBadFormat, where + ": \"" + key + "\" must be 3 integers in 1..65535");
-    return n;
-}
-Result<nlohmann::json> parse_object(const std::string& text, const std::string& where) {
-    if (Status s = check_json_depth(std::string_view(text), where); !s) return s.error();
-    nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-    if (j.is_discarded() || !j.is_object()) return make_error(ErrorCode::kBadFormat, where + ": not a JSON object");
-    return j;
-}
-
-bool near(double a, double b, double scale) { return std::fabs(a - b) <= 1e-6 * scale; }
+// ---- JSON bounds (engine_file_common.h reads the fields) -------------------------------------
 
 // The grid from the file's two JSON texts, which must agree.
 Result<ThreeGrid> parse_bounds(const std::string& volume, const std::string& three, const std::string& name) {
