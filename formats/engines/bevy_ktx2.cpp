@@ -111,7 +111,6 @@ std::array<double, 3> scale_of(const BevyGrid& g) {
     return s;
 }
 
-
 // Zhc's probe index <-> Bevy's voxel (x, y, z).
 std::array<std::uint64_t, 3> voxel_of(std::uint64_t i, const ProbeGrid& zg, const BevyGrid& g, const AxisMap& m) {
     const std::array<std::uint64_t, 3> zi = {i % zg.counts[0], (i / zg.counts[0]) % zg.counts[1],
