@@ -24,10 +24,16 @@
 // |spacing| / 65534 >= 0 (n the octahedral code's normal, c the cell's centre; float), keeps the
 // corners (dx, dy, dz) whose sides bit dx + 2 dy + 4 dz equals it; each kept corner also needs its
 // mask bit 7 - (dx + 2 dy + 4 dz); the kept weights are divided by their sum; when none is kept
-// the plain trilinear weights are used. For a volume whose grid is in glTF axes (ZHC_light_probes)
+// the plain trilinear weights are used. An entry with offset -32768 and bit 7 of byte 4 set is a
+// corner region (docs/runtime.md "Corner regions"): q_a = (bytes 0-1 >> 5a) & 31, d_a = bit a of
+// byte 4; the point is inside when along every axis with q_a != 0, s_a = (p_a - (origin_a + i0_a
+// spacing_a)) * 31 is >= q_a spacing_a (d_a = 1) or < q_a spacing_a (d_a = 0), and the corners
+// inside are those whose bit a equals d_a along those axes; a point inside keeps the corners
+// inside, a point outside the others. For a volume whose grid is in glTF axes (ZHC_light_probes)
 // while the normal codes are in zhc axes, set the pipeline-overridable constant
 // ZHC_VOLUME_PLANE_AXES_GLTF to true (GPUProgrammableStage.constants): the normal used is
-// (n.y, n.z, n.x). Cost over zhcVolumeSh3: 1 entry load, the normal's decode, a dot product, 8 mask
+// (n.y, n.z, n.x) (a region's fields are stored in the grid's axes: used as they stand). Cost over
+// zhcVolumeSh3: 1 entry load, the normal's decode, a dot product (a region: 3 compares), 8 mask
 // loads, ~8 selects, 8 adds, 8 divisions.
 
 // true: the grid is in glTF axes, the plane normals' codes in zhc axes.
@@ -42,11 +48,33 @@ fn zhcPlaneNormal(ou: u32, ov: u32) -> vec3<f32> {
     return normalize(vec3<f32>(ab, z));
 }
 
-// The corners kept by the plane entry e of the cell with first probe i0 at p: bit k set when
-// corner k's sides bit equals p's side; 0xFF when the entry has no plane.
+// The corners a corner region entry e keeps at p (zhc__volume_plane_side of zhc_runtime.h, in
+// float, the same operations): inside the region, the corners inside it; outside, the others.
+fn zhcVolumeRegionKeep(e: vec2<u32>, v: ZhcVolume, i0: vec3<u32>, p: vec3<f32>) -> u32 {
+    let q = vec3<u32>(e.x, e.x >> 5u, e.x >> 10u) & vec3<u32>(31u);
+    let d = vec3<u32>(e.y, e.y >> 1u, e.y >> 2u) & vec3<u32>(1u);
+    let s = (p - (v.origin + vec3<f32>(i0) * v.spacing)) * 31.0;
+    let t = vec3<f32>(q) * v.spacing;
+    let axisCorners = vec3<u32>(0xAAu, 0xCCu, 0xF0u);  // the corners k whose bit a is 1
+    var inside = true;
+    var corners = 0xFFu;
+    for (var a = 0u; a < 3u; a++) {
+        if (q[a] == 0u) { continue; }  // the axis does not bound the region
+        inside = inside && select(s[a] < t[a], s[a] >= t[a], d[a] != 0u);
+        corners = corners & select(~axisCorners[a], axisCorners[a], d[a] != 0u);
+    }
+    return select(~corners, corners, inside) & 0xFFu;
+}
+
+// The corners kept by the entry e of the cell with first probe i0 at p: a plane, bit k set when
+// corner k's sides bit equals p's side; a corner region, zhcVolumeRegionKeep; 0xFF when the entry
+// has neither.
 fn zhcVolumePlaneKeep(e: vec2<u32>, v: ZhcVolume, i0: vec3<u32>, p: vec3<f32>) -> u32 {
     let offset = bitcast<i32>(e.x) >> 16u;  // bytes 2-3, sign-extended
-    if (offset == -32768) { return 0xFFu; }
+    if (offset == -32768) {
+        if ((e.y & 0x80u) != 0u) { return zhcVolumeRegionKeep(e, v, i0, p); }
+        return 0xFFu;
+    }
     var nrm = zhcPlaneNormal(e.x & 0xFFu, (e.x >> 8u) & 0xFFu);
     if (ZHC_VOLUME_PLANE_AXES_GLTF) { nrm = nrm.yzx; }  // glTF (x, y, z) = zhc (y, z, x)
     let c = v.origin + (vec3<f32>(i0) + 0.5) * v.spacing;

@@ -28,9 +28,11 @@
 //     js.runtime_volume) and the test's own double twin, with the bound of test_runtime_gl's volume test;
 //     Masked volumes (runtime/zhc_volume_mask.wgsl) with random validity and visibility, and volumes
 //     with cell planes (runtime/zhc_volume_plane.wgsl, zhcVolumeIrradiancePlanes): random planes
-//     (tests/js/planes_fixtures.mjs) with validity and masks in zhc axes, and planes alone on the
-//     same grid in glTF axes (the override ZHC_VOLUME_PLANE_AXES_GLTF), against the runtime's
-//     volumeIrradianceD on the zhc-axes volume; the corners each plane keeps must equal the JS side's;
+//     and corner regions (tests/js/planes_fixtures.mjs) with validity and masks in zhc axes, and
+//     planes and regions alone on the same grid in glTF axes (the override
+//     ZHC_VOLUME_PLANE_AXES_GLTF), against the runtime's volumeIrradianceD on the zhc-axes volume;
+//     the corners each plane or region keeps must equal the JS side's, and samples must fall both
+//     inside and outside regions;
 //     Scattered probes (zhc_volume.wgsl's zhcVolumeTetraSh3 / zhcVolumeTetraIrradiance): `points`
 //     .zhp files written by `zhc convert` (its qhull tetrahedra) of 150 random positions, as sh3,
 //     zh3_q16, sh3_q28 and hall_adaptive_q16, with and without validity, the kernel given the 4
@@ -570,17 +572,19 @@ function compareMaskedVolume(c, gpu) {
 for (const e of encodings) maskedTallies.set(e.name + ' all invalid', { ...tally(), samples: 0, skipped: 0, renormalised: 0 });
 
 // Volumes with cell planes (zhc_volume_plane.wgsl). c.planes 'zhc': random validity (1 in 4
-// invalid), visibility (each bit set with p = 3/4) and planes (1 in 4 cells without; 1 in 5 with
-// random sides bits, the rest with the corners' own sides), uploaded in zhc axes; 'gltf': the same
-// planes alone, the probe words, grid and plane entries in glTF axes (masks all 0xFF), the points
-// permuted, the kernel with ZHC_VOLUME_PLANE_AXES_GLTF = true. Reference: the runtime's
+// invalid), visibility (each bit set with p = 3/4) and cell entries (1 in 4 cells without; of the
+// others 1 in 3 a corner region with random thresholds, some axes unbounded, and directions, the
+// rest planes, 1 in 5 with random sides bits, the others with the corners' own sides), uploaded in
+// zhc axes; 'gltf': the same entries alone, the probe words, grid and entries in glTF axes (sides
+// bits and regions' per-axis fields permuted; masks all 0xFF), the points permuted, the kernel with
+// ZHC_VOLUME_PLANE_AXES_GLTF = true. Reference: the runtime's
 // volumeIrradianceD on the zhc-axes volume (bit for bit the C header's, js.runtime_volume).
 function planeVolumeJob(c, counts, count) {
   const grid = { origin: volumeOrigin, spacing: volumeSpacing, counts };
   const gltf = c.planes === 'gltf';
   c.validity = gltf ? null : Uint8Array.from({ length: count }, () => (caseRand() < 0.25 ? 0 : 1));
   c.visibility = gltf ? null : Uint8Array.from({ length: count }, () => Math.floor(caseRand() * 256) | Math.floor(caseRand() * 256));
-  c.planeBytes = randomPlanes(grid, caseRand, { pNone: 0.25, pRandomSides: 0.2 });
+  c.planeBytes = randomPlanes(grid, caseRand, { pNone: 0.25, pRandomSides: 0.2, pRegion: 1 / 3 });
   c.vol = runtime.makeVolume({ encoding: c.e.name, params: c.p, bytes: c.bytes, ...grid, validity: c.validity, visibility: c.visibility,
     planes: c.planeBytes });
   c.items = new Float32Array(6 * kVolumeSamples);  // zhc axes
@@ -619,15 +623,16 @@ function planeVolumeJob(c, counts, count) {
   return jobBytes(gltf ? 4 : 3, kVolumeSamples, 4, 6, bpp / 4, gpuGrid, formatBytes(c.e, c.p), words, gpuItems,
     probeWords.length, probeWords.length + maskWords);
 }
-// Per sample (zhc axes): points within 1e-4 |spacing| of their cell's plane or 1e-5 cell widths of a
-// face between cells (float and double may pick different sides or cells) are counted, not
-// compared; else the corners the plane keeps (the kernel's zhcVolumePlaneKeep, glTF corner bits
-// for 'gltf') equal planeSideAt's, and the irradiance lies within compareMaskedVolume's bound with
+// Per sample (zhc axes): points within 1e-4 |spacing| of their cell's plane, of a bounding plane of
+// its cell's region or 1e-5 cell widths of a face between cells (float and double may pick
+// different sides or cells) are counted, not compared; else the corners the plane or region keeps
+// (the kernel's zhcVolumePlaneKeep, glTF corner bits for 'gltf') equal planeSideAt's, and the irradiance lies within compareMaskedVolume's bound with
 // M the weight kept by validity, masks and plane (0 < M < 1e-3: counted, not compared).
 const planeTallies = new Map();
 for (const e of encodings)
   for (const axes of ['zhc', 'gltf'])
-    planeTallies.set(`${e.name} ${axes}`, { ...tally(), samples: 0, skipped: 0, near: 0, byPlane: 0, keepWrong: 0, firstKeep: '' });
+    planeTallies.set(`${e.name} ${axes}`, { ...tally(), samples: 0, skipped: 0, near: 0, byPlane: 0, regionIn: 0, regionOut: 0, keepWrong: 0,
+      firstKeep: '' });
 function comparePlaneVolume(c, gpu) {
   const t = planeTallies.get(`${c.e.name} ${c.planes}`);
   const counts = c.grid.counts, grid = { origin: volumeOrigin, spacing: volumeSpacing, counts };
@@ -647,6 +652,7 @@ function comparePlaneVolume(c, gpu) {
     if (gpu[4 * i + 3] !== wantKeep && t.keepWrong++ === 0)
       t.firstKeep = `${c.e.name} ${c.planes} sample ${i} (position ${pos.join(',')}): wgsl keeps ${gpu[4 * i + 3]}, JS ${wantKeep}`;
     if (keep !== 0xff) t.byPlane++;
+    if (ps && ps.region) t[ps.side ? 'regionIn' : 'regionOut']++;
     let extra = 0, kept = 0;
     for (let a = 0; a < 3; a++) extra += (Math.abs(pos[a]) + Math.abs(volumeOrigin[a])) / volumeSpacing[a] + ax[a].t + 2;
     for (let corner = 0; corner < 8; corner++) {
@@ -926,12 +932,15 @@ for (const [name, t] of maskedTallies) {
 console.log('probe volumes with cell planes (zhc_volume_plane.wgsl): max error in u S of zhcVolumeIrradiancePlanes vs volumeIrradianceD:');
 for (const [name, t] of planeTallies) {
   console.log(`${name.padEnd(34)} ${String(t.samples).padStart(7)} samples ${t.maxIrr.toFixed(3).padStart(8)} u S, skipped ${t.skipped}, ` +
-    `near a plane or face ${t.near}, cut by a plane ${t.byPlane}, kept corners differ ${t.keepWrong}`);
+    `near a plane or face ${t.near}, cut by a plane ${t.byPlane}, in a region ${t.regionIn}, outside one in its cell ${t.regionOut}, ` +
+    `kept corners differ ${t.keepWrong}`);
   check(t.failures === 0, `${name} planes volume: ${t.failures} values out of bound; first: ${t.failures ? t.firstFailure : ''}`);
   check(t.keepWrong === 0, `${name} planes volume: the kept corners equal the JS side's; first: ${t.firstKeep}`);
   check(t.samples + t.skipped + t.near === kVolumeSamples && t.skipped <= kVolumeSamples / 100 && t.near <= kVolumeSamples / 100 &&
     t.compared === 3 * t.samples, `${name} planes volume: every sample compared or counted (${t.samples} + ${t.skipped} + ${t.near})`);
   check(t.byPlane > kVolumeSamples / 4, `${name}: the planes act (${t.byPlane} samples cut)`);
+  check(t.regionIn > kVolumeSamples / 100 && t.regionOut > kVolumeSamples / 100,
+    `${name}: samples inside corner regions (${t.regionIn}) and outside them in their cells (${t.regionOut})`);
 }
 console.log('scattered probes (zhcVolumeTetraIrradiance / zhcVolumeTetraSh3): max error in u S (S = sum_k w_k S_k) / u M vs volumeIrradianceD / volumeSH3 (random, validity) or the field\'s twin (constant, affine):');
 for (const [name, t] of tetraTallies) {
