@@ -47,6 +47,7 @@
 #include "formats/engines/engine_files.h"
 #include "formats/engines/ktx2_volume.h"
 #include "formats/io/exr_memory.h"
+#include "tests/support.h"
 
 namespace zhc {
 namespace {
@@ -773,10 +774,13 @@ TEST(ThreejsGridKtx2, HostileFilesRefusalsDeterminismSniffing) {
 // ---- fixtures for tests/js/threejs_grid_files.mjs ---------------------------------------------------
 
 // Writes DIR/grid.exr, DIR/grid.ktx2 and DIR/expected.json: the bounds, sample points and normals
-// in three.js's world axes, the entry's irradiance there (zhc units) and the term scale S.
+// in three.js's world axes, the entry's irradiance there (zhc units) and the term scale S. DIR is
+// $ZHC_THREEJS_GRID_FIXTURES (tests/js/threejs_grid_files.mjs), else a test folder: the files are
+// then checked to exist and the expectations to name both files with 16 samples each.
 TEST(ThreejsGridFixtures, WriteForThreejs) {
-    const char* dir = std::getenv("ZHC_THREEJS_GRID_FIXTURES");
-    if (!dir) GTEST_SKIP() << "ZHC_THREEJS_GRID_FIXTURES not set";
+    const char* env = std::getenv("ZHC_THREEJS_GRID_FIXTURES");
+    const std::string dir_name = env ? std::string(env) : test::fresh_dir("threejs_grid_fixtures");
+    const char* dir = dir_name.c_str();
     const ProbeLayout layout = grid_layout({-1, -0.5, 0.25}, {0.5, 0.4, 0.6}, {4, 3, 5});
     const auto hub = random_hub(60, 21);
     nlohmann::json files = nlohmann::json::array();
@@ -820,6 +824,14 @@ TEST(ThreejsGridFixtures, WriteForThreejs) {
         files.push_back({{"file", file}, {"engine", name}, {"codec", std::string(f->layout_codec)}, {"bounds", bounds}, {"samples", samples}});
     }
     std::ofstream(std::filesystem::path(dir) / "expected.json") << nlohmann::json{{"files", files}}.dump(1);
+    ASSERT_EQ(files.size(), 2u);
+    for (const auto& f : files) {
+        EXPECT_TRUE(std::filesystem::is_regular_file(std::filesystem::path(dir) / f["file"].get<std::string>()));
+        EXPECT_EQ(f["samples"].size(), 16u);
+    }
+    std::ifstream back(std::filesystem::path(dir) / "expected.json");
+    const nlohmann::json written = nlohmann::json::parse(back, nullptr, false);
+    EXPECT_EQ(written, (nlohmann::json{{"files", files}}));
 }
 
 }  // namespace
