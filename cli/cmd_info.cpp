@@ -120,10 +120,9 @@ std::optional<nlohmann::ordered_json> leak_json(const ProbeSet& set) {
     if (!set.planes.empty()) {
         std::uint64_t planes = 0, regions = 0;
         for (size_t i = 0; i < set.count; ++i) {
-            const std::uint8_t* e = &set.planes[5 * i];
-            const bool none_or_region = e[2] == 0x00 && e[3] == 0x80;
-            planes += !none_or_region;
-            regions += none_or_region && (e[4] & 0x80u);  // docs/runtime.md "Corner regions"
+            const CellEntryKind kind = cell_entry_kind(&set.planes[5 * i]);
+            planes += kind == CellEntryKind::kPlane;
+            regions += kind == CellEntryKind::kRegion;
         }
         leak["cells_with_a_plane"] = planes;
         if (regions > 0) leak["cells_with_a_corner_region"] = regions;

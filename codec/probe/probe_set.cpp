@@ -61,6 +61,21 @@ Sh3Radiance as_radiance_type(const Sh3Irradiance& e) {
 }
 }  // namespace
 
+CellEntryKind cell_entry_kind(const std::uint8_t* e) {
+    if (!(e[2] == 0x00 && e[3] == 0x80)) return CellEntryKind::kPlane;
+    return (e[4] & 0x80u) ? CellEntryKind::kRegion : CellEntryKind::kNone;
+}
+
+std::string cell_entry_problem(const std::uint8_t* e, bool starts_cell) {
+    const CellEntryKind kind = cell_entry_kind(e);
+    if (!starts_cell && kind != CellEntryKind::kNone)
+        return std::string(kind == CellEntryKind::kPlane ? "a plane" : "a corner region") +
+               " is set, but no cell has that probe as its first corner";
+    if (kind == CellEntryKind::kRegion && ((e[1] & 0x80u) || (e[4] & 0x78u)))
+        return "its corner region sets reserved bits (bit 15 of its thresholds or bits 3-6 of byte 4)";
+    return {};
+}
+
 Status validate_leak_data(const ProbeSet& set) {
     if (!set.validity.empty()) {
         if (set.validity.size() != set.count)
@@ -87,14 +102,9 @@ Status validate_leak_data(const ProbeSet& set) {
         const auto& n = set.layout.grid.counts;
         for (std::uint64_t i = 0; i < set.count; ++i) {
             const std::uint64_t x = i % n[0], y = (i / n[0]) % n[1], z = i / (std::uint64_t(n[0]) * n[1]);
-            const std::uint8_t* e = &set.planes[5 * i];
-            const bool none_or_region = e[2] == 0x00 && e[3] == 0x80, region = none_or_region && (e[4] & 0x80u);
-            if (((n[0] > 1 && x + 1 == n[0]) || (n[1] > 1 && y + 1 == n[1]) || (n[2] > 1 && z + 1 == n[2])) && !(none_or_region && !region))
-                return make_error(ErrorCode::kInvalidArgument, "plane of probe " + std::to_string(i) +
-                                                                   " is set, but no cell has that probe as its first corner");
-            if (region && ((e[1] & 0x80u) || (e[4] & 0x78u)))
-                return make_error(ErrorCode::kInvalidArgument, "corner region of probe " + std::to_string(i) +
-                                                                   " sets reserved bits (bit 15 of its thresholds or bits 3-6 of byte 4)");
+            const bool last = (n[0] > 1 && x + 1 == n[0]) || (n[1] > 1 && y + 1 == n[1]) || (n[2] > 1 && z + 1 == n[2]);
+            if (std::string why = cell_entry_problem(&set.planes[5 * i], !last); !why.empty())
+                return make_error(ErrorCode::kInvalidArgument, "probe " + std::to_string(i) + ": " + why);
         }
     }
     if (!set.tetrahedra.empty() || !set.tetra_neighbours.empty()) {

@@ -96,6 +96,15 @@ Status validate_probe_set(const ProbeSet& set);
 // plane" on the entries of the last probe along each axis; tetrahedra only with a positions layout
 // and consistent (validate_tetrahedra).
 Status validate_leak_data(const ProbeSet& set);
+// The kind of a 5-byte cell entry of ProbeSet::planes: no entry (offset -32768, bit 7 of byte 4
+// clear), a plane, or a corner region (offset -32768, bit 7 of byte 4 set).
+enum class CellEntryKind : std::uint8_t { kNone, kPlane, kRegion };
+CellEntryKind cell_entry_kind(const std::uint8_t* e);
+// What is wrong with entry `e` of a probe that starts a cell (`starts_cell`) or not, empty when
+// nothing: a plane or region on a probe that starts no cell, a region's reserved bits set (bit 15
+// of bytes 0-1, bits 3-6 of byte 4). The one rule the .zhp and glTF readers and
+// validate_leak_data apply.
+std::string cell_entry_problem(const std::uint8_t* e, bool starts_cell);
 // The tetrahedra of `count` probes: as many neighbour entries as tetrahedra; each tetrahedron's 4
 // probe indices < count and distinct; each neighbour -1 or another tetrahedron (< the number of
 // tetrahedra) that names this one as its neighbour across the same 3 probes. kInvalidArgument

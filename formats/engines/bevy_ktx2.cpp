@@ -55,20 +55,10 @@ extern const EngineFile kBevyIrradianceVolumeFile;
 
 namespace {
 
-using engine_file_detail::AxisMap;
-using engine_file_detail::axis_map;
-using engine_file_detail::bad;
-using engine_file_detail::json_counts;
-using engine_file_detail::json_vec3;
-using engine_file_detail::near;
-using engine_file_detail::num;
-using engine_file_detail::parse_object;
-using engine_file_detail::vec_json;
+using namespace engine_file_detail;  // engine_file_common.h
 
 constexpr const char* kCodecName = "bevy_ambient_cube";
-constexpr const char* kVolumeKey = "zhc.volume";
 constexpr const char* kBevyKey = "bevy.IrradianceVolume";
-constexpr const char* kThreeKey = "threejs.LightProbeGrid";  // three.js atlases (threejs_grid.cpp) are not Bevy volumes
 // At most 2^24 voxels: 6 2^24 texels, within decode_ktx2_texture's default limit of 2^28.
 constexpr std::uint64_t kMaxVoxels = std::uint64_t(1) << 24;
 // wgpu's default Limits::max_texture_dimension_3d (Bevy's default WgpuSettings).

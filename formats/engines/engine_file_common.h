@@ -18,6 +18,12 @@
 
 namespace zhc::engine_file_detail {
 
+// The key / attribute holding zhc's grid as JSON {"origin", "spacing", "counts"} in the engine's
+// axes, and the one naming a three.js atlas's grid (whose presence also tells a three.js KTX2 from
+// a Bevy volume).
+inline constexpr const char* kVolumeKey = "zhc.volume";
+inline constexpr const char* kThreeKey = "threejs.LightProbeGrid";
+
 // Engine axis r is zhc axis col[r] times sign[r] (EngineLayoutInfo::axes is a signed permutation).
 struct AxisMap {
     std::array<int, 3> col{};

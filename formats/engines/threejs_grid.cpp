@@ -55,18 +55,8 @@ extern const EngineFile kThreejsGridKtx2File;
 
 namespace {
 
-using engine_file_detail::AxisMap;
-using engine_file_detail::axis_map;
-using engine_file_detail::bad;
-using engine_file_detail::json_counts;
-using engine_file_detail::json_vec3;
-using engine_file_detail::near;
-using engine_file_detail::num;
-using engine_file_detail::parse_object;
-using engine_file_detail::vec_json;
+using namespace engine_file_detail;  // engine_file_common.h
 
-constexpr const char* kVolumeKey = "zhc.volume";
-constexpr const char* kThreeKey = "threejs.LightProbeGrid";
 // The most atlas texels a file may hold (reader and writer): 2^24 RGBA32F texels are 256 MiB.
 constexpr std::uint64_t kMaxAtlasTexels = std::uint64_t(1) << 24;
 // WebGL2's guaranteed MAX_3D_TEXTURE_SIZE: larger atlases load only where the GPU allows them.

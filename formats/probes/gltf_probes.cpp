@@ -440,7 +440,6 @@ void region_entry_axes(std::uint8_t e[5], bool to_gltf) {
     e[4] = static_cast<std::uint8_t>(d);
 }
 
-bool is_region_entry(const std::uint8_t e[5]) { return e[2] == 0x00 && e[3] == 0x80 && (e[4] & 0x80u); }
 
 std::uint8_t visibility_from_gltf(std::uint8_t mask) {
     std::uint8_t out = 0;

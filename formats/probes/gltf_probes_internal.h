@@ -110,9 +110,8 @@ Result<ProbeSet> rotate_set(const ProbeSet& set, const Mat3& r);
 // zhc's grid axes to the glTF grid's (glTF axis 0, 1, 2 = zhc axis 1, 2, 0) and back.
 std::uint8_t visibility_to_gltf(std::uint8_t mask);
 std::uint8_t visibility_from_gltf(std::uint8_t mask);
-// Cell entries that are corner regions (docs/runtime.md "Corner regions") and their per-axis fields
-// permuted to glTF axes (to_gltf) or back.
-bool is_region_entry(const std::uint8_t e[5]);
+// A corner region's (docs/runtime.md "Corner regions") per-axis fields permuted to glTF axes
+// (to_gltf) or back.
 void region_entry_axes(std::uint8_t e[5], bool to_gltf);
 
 // Grid probe order zhc (i fastest, zhc axes) <-> glTF (glTF x = zhc y fastest).

@@ -117,7 +117,7 @@ struct VolumeReader {
             std::uint8_t* out = entries.data() + 5 * g;
             std::memcpy(out, e, 4);
             out[4] = (*sb)[g];
-            if (is_region_entry(out)) {
+            if (cell_entry_kind(out) == CellEntryKind::kRegion) {
                 region_entry_axes(out, /*to_gltf=*/false);  // a corner region: its per-axis fields back in zhc axes
             } else {
                 out[4] = visibility_from_gltf(out[4]);

@@ -328,7 +328,7 @@ Result<std::vector<std::uint8_t>> embed_probes_gltf(std::span<const std::uint8_t
         for (std::size_t i = 0; i < set.count; ++i) {
             std::uint8_t e[5];
             std::memcpy(e, entries.data() + 5 * i, 5);
-            if (is_region_entry(e)) {
+            if (cell_entry_kind(e) == CellEntryKind::kRegion) {
                 region_entry_axes(e, /*to_gltf=*/true);  // a corner region: its per-axis fields in glTF axes
             } else {
                 e[4] = visibility_to_gltf(e[4]);  // a plane's corner bits, permuted like the masks

@@ -402,14 +402,9 @@ Result<ProbeSet> parse_probe_set(std::span<const std::uint8_t> bytes, const std:
         const auto& n = set.layout.grid.counts;
         for (std::uint64_t i = 0; i < count; ++i) {
             const std::uint64_t x = i % n[0], y = (i / n[0]) % n[1], z = i / (std::uint64_t(n[0]) * n[1]);
-            const std::uint8_t* e = &set.planes[5 * i];
-            const bool none_or_region = e[2] == 0x00 && e[3] == 0x80, region = none_or_region && (e[4] & 0x80u);
-            if (((n[0] > 1 && x + 1 == n[0]) || (n[1] > 1 && y + 1 == n[1]) || (n[2] > 1 && z + 1 == n[2])) && !(none_or_region && !region))
-                return err(ErrorCode::kInvalidValue, name, "plane of probe " + std::to_string(i) +
-                                                               " is set, but no cell has that probe as its first corner");
-            if (region && ((e[1] & 0x80u) || (e[4] & 0x78u)))  // docs/runtime.md "Corner regions"
-                return err(ErrorCode::kInvalidValue, name, "corner region of probe " + std::to_string(i) +
-                                                               " sets reserved bits (bit 15 of its thresholds or bits 3-6 of byte 4)");
+            const bool last = (n[0] > 1 && x + 1 == n[0]) || (n[1] > 1 && y + 1 == n[1]) || (n[2] > 1 && z + 1 == n[2]);
+            if (std::string why = cell_entry_problem(&set.planes[5 * i], !last); !why.empty())  // docs/runtime.md "Cell planes"
+                return err(ErrorCode::kInvalidValue, name, "cell entry of probe " + std::to_string(i) + ": " + why);
         }
         at += 5 * count;
     }
