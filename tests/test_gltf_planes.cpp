@@ -333,6 +333,51 @@ TEST(GltfPlanes, APlaneOnAProbeThatStartsNoCellIsRefused) {
     EXPECT_EQ(ok->volumes[0].set.planes[3], 0);
 }
 
+// planes_set()'s .glb with the entry of glTF probe `probe` made a corner region: offset -32768,
+// thresholds `r` (bytes 0-1), planeSides `sides` (bit 7 set).
+Bytes glb_with_region_on(std::uint64_t probe, std::uint16_t r, std::uint8_t sides) {
+    Bytes b = *embed_probes_gltf(empty_gltf(), "in.gltf", planes_set(), {});
+    const json doc = gltf_test::gltf_json(b);
+    const json& vol = doc["extensions"]["ZHC_light_probes"]["volumes"][0];
+    std::uint32_t json_len;
+    std::memcpy(&json_len, b.data() + 12, 4);
+    const auto at = [&](const char* key, std::size_t stride) {
+        const json& acc = doc["accessors"][vol[key].get<size_t>()];
+        return 28 + json_len + doc["bufferViews"][acc["bufferView"].get<size_t>()]["byteOffset"].get<size_t>() + stride * probe;
+    };
+    const std::size_t e = at("planes", 4);
+    b[e] = static_cast<std::uint8_t>(r & 0xFF);
+    b[e + 1] = static_cast<std::uint8_t>(r >> 8);
+    b[e + 2] = 0x00;
+    b[e + 3] = 0x80;
+    b[at("planeSides", 1)] = sides;
+    return b;
+}
+
+// A corner region is read on a probe that starts a cell (its fields back in zhc axes), refused on one
+// that starts none and with a reserved bit set.
+TEST(GltfPlanes, CornerRegionsOnlyWhereACellStarts) {
+    const std::uint16_t r = 3 | 7 << 5 | 11 << 10;  // glTF axes: q = 3, 7, 11
+    auto ok = read_gltf_probes(glb_with_region_on(0, r, 0x80 | 0x5), "x.glb");
+    ASSERT_TRUE(ok.ok()) << ok.error().message;
+    const std::uint8_t* e = ok->volumes[0].set.planes.data();  // glTF probe 0 is zhc probe 0
+    ASSERT_EQ(cell_entry_kind(e), CellEntryKind::kRegion);
+    const unsigned rz = unsigned(e[0]) | unsigned(e[1]) << 8;
+    // zhc axis a is glTF axis (a + 2) % 3: q = 11, 3, 7 and d = (1, 1, 0) from glTF's (1, 0, 1).
+    EXPECT_EQ(rz, 11u | 3u << 5 | 7u << 10);
+    EXPECT_EQ(e[4], 0x80 | 0x3);
+    for (std::uint64_t p : {1u, 6u, 16u, 23u}) {
+        auto bad = read_gltf_probes(glb_with_region_on(p, r, 0x81), "x.glb");
+        ASSERT_FALSE(bad.ok()) << p;
+        expect_refused(bad.error(), ErrorCode::kInvalidValue, "planes accessor");
+    }
+    for (const auto& [rr, sides] : {std::pair<std::uint16_t, std::uint8_t>{std::uint16_t(r | 0x8000), 0x81}, {r, 0x89}}) {
+        auto bad = read_gltf_probes(glb_with_region_on(0, rr, sides), "x.glb");
+        ASSERT_FALSE(bad.ok());
+        EXPECT_NE(bad.error().message.find("reserved bits"), std::string::npos) << bad.error().message;
+    }
+}
+
 TEST(GltfPlanes, CliEmbedExtractConvert) {
     const std::string dir = test::fresh_dir("gltf_planes");
     const ProbeSet set = planes_set();
