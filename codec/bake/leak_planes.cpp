@@ -371,7 +371,8 @@ CellFit fit_one_cell(const OccluderBvh& bvh, const ProbeGrid& g, const std::vect
             const RayHit h2 = bvh.nearest(corner[k], -1.0 * d, kRayEpsilon, len - kRayEpsilon);
             if (h2.hit) hits.push_back(corner[k] - h2.t * d);
         }
-    const std::vector<std::array<std::uint8_t, 8>> vis_geometry = vis;  // blocked by geometry only
+    // Blocked by geometry only: what a corner region is scored on (a copy only where one may be tried).
+    const std::vector<std::array<std::uint8_t, 8>> vis_geometry = regions && !hits.empty() ? vis : decltype(vis){};
     std::vector<Vec3> edge;
     const bool shadowed = split_at_shadow_edge(bvh, lights, corner, cvalid, pts, vis, edge, &out.stats.rays) && !edge.empty();
     if (hits.empty() && !shadowed) return out;
